@@ -1,0 +1,46 @@
+"""Recursive filters (000 §1.2, §3.6): KF, EKF, UKF (augmented and additive), landmark filter.
+
+Functions carry the maths (``kf_predict``, ``ekf_update``, ``ukf_predict``…);
+thin classes keep state (``KalmanFilter``, ``ExtendedKalmanFilter``,
+``UnscentedKalmanFilter``, ``LandmarkFilter``).
+"""
+
+from .consistency import chi2_interval, nees, nis
+from .ekf import ExtendedKalmanFilter, check_jacobian, ekf_predict, ekf_update, numerical_jacobian
+from .kalman import KalmanFilter, Update, kf_predict, kf_update, symmetrize
+from .landmark import LandmarkFilter, landmark_predict, landmark_update
+from .ukf import (
+    CholeskyError,
+    UnscentedKalmanFilter,
+    sigma_points,
+    sigma_weights,
+    ukf_predict,
+    ukf_update,
+    unscented_transform,
+)
+
+__all__ = [
+    "CholeskyError",
+    "ExtendedKalmanFilter",
+    "KalmanFilter",
+    "LandmarkFilter",
+    "UnscentedKalmanFilter",
+    "Update",
+    "check_jacobian",
+    "chi2_interval",
+    "ekf_predict",
+    "ekf_update",
+    "kf_predict",
+    "kf_update",
+    "landmark_predict",
+    "landmark_update",
+    "nees",
+    "nis",
+    "numerical_jacobian",
+    "sigma_points",
+    "sigma_weights",
+    "symmetrize",
+    "ukf_predict",
+    "ukf_update",
+    "unscented_transform",
+]

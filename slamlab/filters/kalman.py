@@ -1,0 +1,199 @@
+"""Linear Kalman filter (000 §1.2.1): predict, update (short and Joseph forms).
+
+Index convention (000 mixes ``B_k u_k`` and ``B_k u_{k-1}``): we write the
+prediction as ``x_{k|k-1} = F x_{k-1|k-1} + B u`` where ``u`` is the control
+applied between the two steps, and ``Q`` the noise of that same interval.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .. import _validate as v
+
+__all__ = ["KalmanFilter", "Update", "kf_predict", "kf_update", "symmetrize"]
+
+
+class Update(NamedTuple):
+    """Result of a measurement update: posterior ``x, P``, innovation ``y``, its covariance ``S``, gain ``K``."""
+
+    x: np.ndarray
+    P: np.ndarray
+    y: np.ndarray
+    S: np.ndarray
+    K: np.ndarray
+
+
+def symmetrize(P: np.ndarray) -> np.ndarray:
+    """``(P + P^T) / 2``: keeps covariances symmetric against rounding."""
+    return 0.5 * (P + P.T)
+
+
+# --- strict core (no validation; callers have checked) ------------------------------------------
+
+
+def _predict(x, P, F, Q, Bu=None):
+    # x_{k|k-1} = F x_{k-1|k-1} + B u
+    x = F @ x if Bu is None else F @ x + Bu
+    # P_{k|k-1} = F P_{k-1|k-1} F^T + Q
+    P = F @ P @ F.T + Q
+    return x, symmetrize(P)
+
+
+def _gain(PHt, S):
+    # K = P H^T S^-1  (solve instead of inverting S; S is symmetric)
+    return np.linalg.solve(S, PHt.T).T
+
+
+def _update(x, P, y, H, R, form="short", K=None):
+    PHt = P @ H.T
+    # S = H P H^T + R
+    S = symmetrize(H @ PHt + R)
+    if K is None:
+        K = _gain(PHt, S)
+    # x_{k|k} = x_{k|k-1} + K y
+    x = x + K @ y
+    I_KH = np.eye(P.shape[0]) - K @ H
+    if form == "short":
+        # P_{k|k} = (I - K H) P_{k|k-1}   (valid for the optimal gain only)
+        P = I_KH @ P
+    else:
+        # Joseph: P_{k|k} = (I - K H) P (I - K H)^T + K R K^T   (valid for any gain)
+        P = I_KH @ P @ I_KH.T + K @ R @ K.T
+    return Update(x, symmetrize(P), y, S, K)
+
+
+# --- friendly layer ------------------------------------------------------------------------------
+
+
+def kf_predict(x, P, F, Q, B=None, u=None):
+    """Predict step (000 §1.2.1).
+
+    Parameters
+    ----------
+    x : (n,) state estimate ``x_{k-1|k-1}``.
+    P : (n, n) its covariance.
+    F : (n, n) state transition matrix.
+    Q : (n, n) process noise covariance.
+    B : (n, m) control matrix, optional (needs ``u``).
+    u : (m,) control vector, optional.
+
+    Returns
+    -------
+    x, P : the prior ``x_{k|k-1}, P_{k|k-1}``.
+
+    Examples
+    --------
+    >>> x, P = kf_predict([0.0, 1.0], np.eye(2), [[1, 1], [0, 1]], 0.1 * np.eye(2))
+    >>> x
+    array([1., 1.])
+    >>> P
+    array([[2.1, 1. ],
+           [1. , 1.1]])
+    """
+    x = v.as_vector(x, "x")
+    n = x.shape[0]
+    P = v.as_covariance(P, "P", n)
+    F = v.as_matrix(F, "F", (n, n))
+    Q = v.as_covariance(Q, "Q", n)
+    Bu = None
+    if (B is None) != (u is None):
+        raise ValueError("`B` and `u` must be given together; got only `" + ("B" if u is None else "u") + "`")
+    if B is not None:
+        B = v.as_matrix(B, "B", (n, None))
+        u = v.as_vector(u, "u", B.shape[1])
+        Bu = B @ u
+    return _predict(x, P, F, Q, Bu)
+
+
+def kf_update(x, P, z, H, R, *, form: str = "short", K=None) -> Update:
+    """Update step (000 §1.2.1), short ``(I-KH)P`` or Joseph covariance form.
+
+    Parameters
+    ----------
+    x : (n,) prior state ``x_{k|k-1}``.
+    P : (n, n) prior covariance.
+    z : (m,) measurement.
+    H : (m, n) measurement matrix.
+    R : (m, m) measurement noise covariance.
+    form : ``"short"`` (000's ``P=(I-KH)P``, valid only for the optimal gain)
+        or ``"joseph"`` (``(I-KH)P(I-KH)^T + KRK^T``, valid for any gain).
+    K : (n, m) gain to use instead of the optimal ``P H^T S^-1`` (for teaching:
+        shows why the short form needs the optimal gain).
+
+    Returns
+    -------
+    Update
+        ``(x, P, y, S, K)``: posterior, innovation, its covariance, the gain.
+
+    Examples
+    --------
+    >>> upd = kf_update([0.0], [[1.0]], [2.0], [[1.0]], [[1.0]])
+    >>> upd.x, upd.P
+    (array([1.]), array([[0.5]]))
+    """
+    x = v.as_vector(x, "x")
+    n = x.shape[0]
+    P = v.as_covariance(P, "P", n)
+    H = v.as_matrix(H, "H", (None, n))
+    m = H.shape[0]
+    z = v.as_vector(z, "z", m)
+    R = v.as_covariance(R, "R", m)
+    v.check_choice(form, "form", ("short", "joseph"))
+    if K is not None:
+        K = v.as_matrix(K, "K", (n, m))
+    return _update(x, P, z - H @ x, H, R, form, K)
+
+
+class KalmanFilter:
+    """Linear Kalman filter (000 §1.2.1): thin state holder over :func:`kf_predict`, :func:`kf_update`.
+
+    Keeps ``x_prior, P_prior`` (after :meth:`predict`) and ``x_post, P_post``,
+    ``y, S, K`` (after :meth:`update`).
+
+    Examples
+    --------
+    >>> kf = KalmanFilter(x=[0.0], P=[[1.0]], F=[[1.0]], Q=[[0.0]], H=[[1.0]], R=[[1.0]])
+    >>> kf.predict(); kf.update([2.0]); kf.x
+    array([1.])
+    """
+
+    def __init__(self, x, P, F, Q, H, R, B=None, *, form: str = "short"):
+        self.x = v.as_vector(x, "x")
+        n = self.x.shape[0]
+        self.P = v.as_covariance(P, "P", n)
+        self.F = v.as_matrix(F, "F", (n, n))
+        self.Q = v.as_covariance(Q, "Q", n)
+        self.H = v.as_matrix(H, "H", (None, n))
+        self.R = v.as_covariance(R, "R", self.H.shape[0])
+        self.B = None if B is None else v.as_matrix(B, "B", (n, None))
+        self.form = v.check_choice(form, "form", ("short", "joseph"))
+        self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
+        self.x_post, self.P_post = self.x.copy(), self.P.copy()
+        m = self.H.shape[0]
+        self.y, self.S, self.K = np.zeros(m), np.zeros((m, m)), np.zeros((n, m))
+
+    @property
+    def dim_x(self) -> int:
+        return self.x.shape[0]
+
+    def predict(self, u=None) -> None:
+        """Predict with the stored ``F, Q`` (and ``B u`` when a control is given)."""
+        Bu = None
+        if u is not None:
+            if self.B is None:
+                raise ValueError("`u` was given but the filter has no control matrix `B`")
+            Bu = self.B @ v.as_vector(u, "u", self.B.shape[1])
+        self.x, self.P = _predict(self.x, self.P, self.F, self.Q, Bu)
+        self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
+
+    def update(self, z) -> None:
+        """Update with measurement ``z`` (validated for shape and finiteness)."""
+        z = v.as_vector(z, "z", self.H.shape[0])
+        self.x, self.P, self.y, self.S, self.K = _update(self.x, self.P, z - self.H @ self.x, self.H, self.R, self.form)
+        self.x_post, self.P_post = self.x.copy(), self.P.copy()
+
+    def __repr__(self) -> str:
+        return f"KalmanFilter(dim_x={self.dim_x}, dim_z={self.H.shape[0]}, form={self.form!r})"

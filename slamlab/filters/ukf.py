@@ -1,0 +1,266 @@
+"""Unscented Kalman filter (000 §1.2.3): augmented form of 000 and the additive-noise form.
+
+*Augmented* (000): the predict step augments the state with the process noise,
+``x^a = [x; E w]``, ``P^a = blkdiag(P, Q)``, and calls ``f(x, u, w)``; the update
+re-draws sigma points from ``(x_{k|k-1}, P_{k|k-1})`` augmented with ``R`` and
+calls ``h(x, v)``. So ``L`` differs between predict (``n + dim w``) and update
+(``n + dim v``), and neither step adds ``Q`` or ``R`` afterwards.
+
+*Additive* (our addition; 000 has none): ``f(x, u)`` and ``h(x)``, ``L = n``,
+``Q`` and ``R`` added to the transformed covariances; sigma points are re-drawn
+from the prior before the update, as filterpy 2.0 does.
+
+Weights (000): ``lambda = alpha^2 (L + kappa) - L``, ``Ws0 = lambda / (L + lambda)``,
+``Wc0 = Ws0 + (1 - alpha^2 + beta)``, ``Wi = 1 / (2 (L + lambda))``; defaults
+``alpha = 1e-3, kappa = 0, beta = 2``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg import block_diag
+
+from .. import _validate as v
+from .kalman import Update, _gain, symmetrize
+
+__all__ = [
+    "CholeskyError",
+    "UnscentedKalmanFilter",
+    "sigma_points",
+    "sigma_weights",
+    "ukf_predict",
+    "ukf_update",
+    "unscented_transform",
+]
+
+FORMS = ("augmented", "additive")
+
+
+class CholeskyError(np.linalg.LinAlgError):
+    """Cholesky factorisation failed: the matrix is not positive definite (a ``ValueError``)."""
+
+
+def cholesky_lower(M: np.ndarray, step: str) -> np.ndarray:
+    """Lower Cholesky factor ``A`` with ``A A^T = M``; a failure names ``step``."""
+    try:
+        return np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        eig = np.linalg.eigvalsh(symmetrize(M)) if np.all(np.isfinite(M)) else np.array([np.nan])
+        raise CholeskyError(
+            f"Cholesky factorisation failed in {step}: the scaled covariance is not positive definite "
+            f"(smallest eigenvalue {eig[0]:.3e}); check P, Q, R and alpha/kappa"
+        ) from None
+
+
+def sigma_weights(L: int, alpha: float = 1e-3, beta: float = 2.0, kappa: float = 0.0):
+    """Weights ``(Ws, Wc)`` of the ``2L+1`` sigma points and ``lambda`` (000 §1.2.3).
+
+    >>> Ws, Wc, lam = sigma_weights(2, alpha=1.0, beta=2.0, kappa=1.0)
+    >>> Ws, Wc, lam
+    (array([0.3333, 0.1667, 0.1667, 0.1667, 0.1667]), array([2.3333, 0.1667, 0.1667, 0.1667, 0.1667]), 1.0)
+    """
+    L = v.check_int(L, "L", minimum=1)
+    alpha = v.check_positive(alpha, "alpha")
+    beta = float(beta)
+    kappa = float(kappa)
+    lam = alpha**2 * (L + kappa) - L
+    if L + lam <= 0:
+        raise ValueError(f"`kappa` must give L + lambda > 0; got L + lambda = {L + lam:.3g} (L={L}, kappa={kappa})")
+    Ws = np.full(2 * L + 1, 0.5 / (L + lam))
+    Wc = Ws.copy()
+    Ws[0] = lam / (L + lam)
+    Wc[0] = lam / (L + lam) + (1.0 - alpha**2 + beta)
+    return Ws, Wc, lam
+
+
+def _sigma_points(x, P, lam, step):
+    L = x.shape[0]
+    A = cholesky_lower((L + lam) * P, step)  # columns of sqrt((L + lambda) P), A A^T = (L+lambda) P
+    return np.vstack([x, x + A.T, x - A.T])
+
+
+def sigma_points(x, P, alpha: float = 1e-3, kappa: float = 0.0) -> np.ndarray:
+    """The ``2L+1`` sigma points as rows: ``x``, ``x + A_i``, ``x - A_i`` (000 §1.2.3).
+
+    ``A_i`` is column ``i`` of the lower Cholesky factor of ``(L + lambda) P``.
+
+    >>> sigma_points([0.0, 0.0], np.eye(2), alpha=1.0, kappa=2.0)
+    array([[ 0.,  0.],
+           [ 2.,  0.],
+           [ 0.,  2.],
+           [-2.,  0.],
+           [ 0., -2.]])
+    """
+    x = v.as_vector(x, "x")
+    P = v.as_covariance(P, "P", x.shape[0])
+    _, _, lam = sigma_weights(x.shape[0], alpha, 2.0, kappa)
+    return _sigma_points(x, P, lam, "sigma_points")
+
+
+def unscented_transform(sigmas, Ws, Wc, noise_cov=None, mean_fn=None, residual_fn=None):
+    """Weighted mean and covariance of transformed sigma points (rows of ``sigmas``).
+
+    ``mean_fn(sigmas, Ws)`` and ``residual_fn(a, b)`` (broadcasting over rows)
+    replace the linear mean and subtraction, e.g. for angles.
+
+    >>> Ws, Wc, _ = sigma_weights(1, alpha=1.0, kappa=2.0)
+    >>> unscented_transform(np.array([[0.0], [3.0], [-3.0]]), Ws, Wc)
+    (array([0.]), array([[3.]]))
+    """
+    sigmas = np.asarray(sigmas, dtype=float)
+    mean = Ws @ sigmas if mean_fn is None else np.asarray(mean_fn(sigmas, Ws), dtype=float)
+    d = sigmas - mean if residual_fn is None else residual_fn(sigmas, mean)
+    cov = (d.T * Wc) @ d
+    if noise_cov is not None:
+        cov = cov + noise_cov
+    return mean, symmetrize(cov)
+
+
+def _ukf_predict(x, P, f, Q, u, form, alpha, beta, kappa, mean_fn, residual_fn, vectorized):
+    n = x.shape[0]
+    if form == "augmented":
+        nq = Q.shape[0]
+        # x^a = [x; E w],  P^a = blkdiag(P, Q)
+        xa = np.concatenate([x, np.zeros(nq)])
+        Pa = block_diag(P, Q)
+        Ws, Wc, lam = sigma_weights(n + nq, alpha, beta, kappa)
+        chi = _sigma_points(xa, Pa, lam, "ukf_predict (augmented sigma points)")
+        # chi_{k|k-1}^i = f(chi_x^i, u, chi_w^i)
+        if vectorized:
+            Y = np.asarray(f(chi[:, :n], u, chi[:, n:]), dtype=float)
+        else:
+            Y = np.array([np.asarray(f(c[:n], u, c[n:]), dtype=float) for c in chi])
+        return unscented_transform(Y, Ws, Wc, None, mean_fn, residual_fn)
+    Ws, Wc, lam = sigma_weights(n, alpha, beta, kappa)
+    chi = _sigma_points(x, P, lam, "ukf_predict (sigma points)")
+    Y = np.asarray(f(chi, u), dtype=float) if vectorized else np.array([np.asarray(f(c, u), float) for c in chi])
+    # additive form: P_{k|k-1} = sum Wc (Y - x)(Y - x)^T + Q
+    return unscented_transform(Y, Ws, Wc, Q, mean_fn, residual_fn)
+
+
+def _ukf_update(x, P, z, h, R, form, alpha, beta, kappa, z_mean_fn, z_residual_fn, x_residual_fn, vectorized):
+    n = x.shape[0]
+    if form == "augmented":
+        nr = R.shape[0]
+        # x^a = [x_{k|k-1}; E v],  P^a = blkdiag(P_{k|k-1}, R)
+        xa = np.concatenate([x, np.zeros(nr)])
+        Pa = block_diag(P, R)
+        Ws, Wc, lam = sigma_weights(n + nr, alpha, beta, kappa)
+        chi = _sigma_points(xa, Pa, lam, "ukf_update (augmented sigma points)")
+        X = chi[:, :n]
+        # gamma^i = h(chi_x^i, chi_v^i)
+        if vectorized:
+            Z = np.asarray(h(X, chi[:, n:]), dtype=float)
+        else:
+            Z = np.array([np.asarray(h(c[:n], c[n:]), dtype=float) for c in chi])
+        z_pred, Pzz = unscented_transform(Z, Ws, Wc, None, z_mean_fn, z_residual_fn)
+    else:
+        Ws, Wc, lam = sigma_weights(n, alpha, beta, kappa)
+        X = _sigma_points(x, P, lam, "ukf_update (sigma points)")
+        Z = np.asarray(h(X), dtype=float) if vectorized else np.array([np.asarray(h(c), float) for c in X])
+        z_pred, Pzz = unscented_transform(Z, Ws, Wc, R, z_mean_fn, z_residual_fn)
+    dX = X - x if x_residual_fn is None else x_residual_fn(X, x)
+    dZ = Z - z_pred if z_residual_fn is None else z_residual_fn(Z, z_pred)
+    # P_xz = sum Wc (chi - x)(gamma - z)^T
+    Pxz = (dX.T * Wc) @ dZ
+    # K = P_xz P_zz^-1
+    K = _gain(Pxz, Pzz)
+    y = z - z_pred if z_residual_fn is None else z_residual_fn(z, z_pred)
+    # x = x + K (z - z_pred);  P = P - K P_zz K^T
+    x_new = x + K @ y
+    P_new = symmetrize(P - K @ Pzz @ K.T)
+    return Update(x_new, P_new, y, Pzz, K)
+
+
+def _check_common(x, P, form, alpha, beta, kappa):
+    x = v.as_vector(x, "x")
+    P = v.as_covariance(P, "P", x.shape[0])
+    v.check_choice(form, "form", FORMS)
+    v.check_positive(alpha, "alpha")
+    if not np.isfinite(beta) or not np.isfinite(kappa):
+        raise ValueError(f"`beta` and `kappa` must be finite; got beta={beta}, kappa={kappa}")
+    return x, P
+
+
+def ukf_predict(x, P, f, Q, u=None, *, form: str = "augmented", alpha: float = 1e-3, beta: float = 2.0,
+                kappa: float = 0.0, mean_fn=None, residual_fn=None, vectorized: bool = False):
+    """UKF predict step (000 §1.2.3).
+
+    Parameters
+    ----------
+    x : (n,) posterior state.  P : (n, n) its covariance.
+    f : ``f(x, u, w)`` for ``form="augmented"`` (``w`` the process-noise
+        component of the sigma point), ``f(x, u)`` for ``"additive"``.
+    Q : covariance of ``w`` (augmented; any size) or of the state noise
+        (additive; (n, n)).
+    u : control, passed to ``f``.
+    alpha, beta, kappa : sigma-point parameters (000's defaults 1e-3, 2, 0).
+    mean_fn, residual_fn : state mean ``mean_fn(sigmas, Ws)`` and difference
+        ``residual_fn(a, b)`` hooks (angles), broadcasting over rows.
+    vectorized : ``f`` accepts all sigma points at once as rows.
+
+    Returns
+    -------
+    x, P : the prior.
+    """
+    x, P = _check_common(x, P, form, alpha, beta, kappa)
+    v.check_callable(f, "f")
+    Q = v.as_covariance(Q, "Q", None if form == "augmented" else x.shape[0])
+    return _ukf_predict(x, P, f, Q, u, form, alpha, beta, kappa, mean_fn, residual_fn, vectorized)
+
+
+def ukf_update(x, P, z, h, R, *, form: str = "augmented", alpha: float = 1e-3, beta: float = 2.0,
+               kappa: float = 0.0, z_mean_fn=None, z_residual_fn=None, x_residual_fn=None,
+               vectorized: bool = False) -> Update:
+    """UKF update step (000 §1.2.3): re-draws sigma points from the prior.
+
+    ``h(x, v)`` for ``form="augmented"``, ``h(x)`` for ``"additive"``. Returns
+    :class:`~slamlab.filters.Update` with ``S = P_zz`` and ``K = P_xz P_zz^-1``.
+    """
+    x, P = _check_common(x, P, form, alpha, beta, kappa)
+    z = v.as_vector(z, "z")
+    R = v.as_covariance(R, "R", None if form == "augmented" else z.shape[0])
+    v.check_callable(h, "h")
+    return _ukf_update(x, P, z, h, R, form, alpha, beta, kappa, z_mean_fn, z_residual_fn, x_residual_fn,
+                       vectorized)
+
+
+class UnscentedKalmanFilter:
+    """UKF (000 §1.2.3) in the augmented (000) or additive (ours) form.
+
+    Keeps ``x_prior, P_prior, x_post, P_post, y, S, K``. ``Q`` and ``R`` may be
+    reassigned between steps. The hooks are as in :func:`ukf_predict`.
+    """
+
+    def __init__(self, x, P, f, Q, h, R, *, form: str = "augmented", alpha: float = 1e-3, beta: float = 2.0,
+                 kappa: float = 0.0, x_mean_fn=None, x_residual_fn=None, z_mean_fn=None, z_residual_fn=None,
+                 vectorized: bool = False):
+        self.x, self.P = _check_common(x, P, form, alpha, beta, kappa)
+        self.f, self.h = v.check_callable(f, "f"), v.check_callable(h, "h")
+        self.form = form
+        n = self.x.shape[0]
+        self.Q = v.as_covariance(Q, "Q", None if form == "augmented" else n)
+        self.R = v.as_covariance(R, "R")
+        self.alpha, self.beta, self.kappa = float(alpha), float(beta), float(kappa)
+        self.x_mean_fn, self.x_residual_fn = x_mean_fn, x_residual_fn
+        self.z_mean_fn, self.z_residual_fn = z_mean_fn, z_residual_fn
+        self.vectorized = vectorized
+        self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
+        self.x_post, self.P_post = self.x.copy(), self.P.copy()
+        self.y = self.S = self.K = None
+
+    def predict(self, u=None) -> None:
+        self.x, self.P = _ukf_predict(self.x, self.P, self.f, self.Q, u, self.form, self.alpha, self.beta,
+                                      self.kappa, self.x_mean_fn, self.x_residual_fn, self.vectorized)
+        self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
+
+    def update(self, z) -> None:
+        z = v.as_vector(z, "z", self.R.shape[0])
+        self.x, self.P, self.y, self.S, self.K = _ukf_update(
+            self.x, self.P, z, self.h, self.R, self.form, self.alpha, self.beta, self.kappa,
+            self.z_mean_fn, self.z_residual_fn, self.x_residual_fn, self.vectorized)
+        self.x_post, self.P_post = self.x.copy(), self.P.copy()
+
+    def __repr__(self) -> str:
+        return (f"UnscentedKalmanFilter(form={self.form!r}, dim_x={self.x.shape[0]}, alpha={self.alpha}, "
+                f"beta={self.beta}, kappa={self.kappa})")

@@ -1,0 +1,160 @@
+"""Unicycle robot with a range-bearing landmark sensor (Ch. 1 nonlinear example).
+
+State ``[x_m, y_m, heading_rad]``; control ``[v_mps, omega_radps]`` held for
+``dt_s``; first-order (Euler) motion. Every function broadcasts over leading
+axes, so sigma points can be pushed through in one call.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as v
+from ..geometry import angle_mean, wrap_angle
+
+__all__ = ["RangeBearingSensor", "UnicycleModel", "simulate_unicycle"]
+
+
+@dataclass(frozen=True)
+class UnicycleModel:
+    """Unicycle motion with control noise ``w ~ N(0, diag(v_std^2, omega_std^2))``."""
+
+    dt_s: float = 0.5
+    v_std_mps: float = 0.1
+    omega_std_radps: float = 0.05
+
+    def __post_init__(self):
+        v.check_positive(self.dt_s, "dt_s")
+        v.check_positive(self.v_std_mps, "v_std_mps", allow_zero=True)
+        v.check_positive(self.omega_std_radps, "omega_std_radps", allow_zero=True)
+
+    @property
+    def M(self) -> np.ndarray:
+        """Control-noise covariance (2, 2)."""
+        return np.diag([self.v_std_mps**2, self.omega_std_radps**2])
+
+    def f(self, x, u, w=None):
+        """``x_k = f(x_{k-1}, u + w)``: Euler step of the unicycle (noise ``w`` on the control)."""
+        x = np.asarray(x, dtype=float)
+        u = np.asarray(u, dtype=float)
+        vel = u[0] if w is None else u[0] + np.asarray(w)[..., 0]
+        om = u[1] if w is None else u[1] + np.asarray(w)[..., 1]
+        th = x[..., 2]
+        return np.stack([x[..., 0] + vel * self.dt_s * np.cos(th),
+                         x[..., 1] + vel * self.dt_s * np.sin(th),
+                         wrap_angle(th + om * self.dt_s)], axis=-1)
+
+    def F_jac(self, x, u):
+        """``df/dx`` (3, 3) at ``(x, u)``."""
+        th, s = x[2], u[0] * self.dt_s
+        return np.array([[1.0, 0.0, -s * np.sin(th)], [0.0, 1.0, s * np.cos(th)], [0.0, 0.0, 1.0]])
+
+    def V_jac(self, x, u):
+        """``df/du`` (3, 2): maps control noise into the state."""
+        th, dt = x[2], self.dt_s
+        return np.array([[dt * np.cos(th), 0.0], [dt * np.sin(th), 0.0], [0.0, dt]])
+
+    def Q(self, x, u):
+        """State-space process noise ``V M V^T`` linearised at ``(x, u)`` (EKF, additive UKF)."""
+        V = self.V_jac(x, u)
+        return V @ self.M @ V.T
+
+    @staticmethod
+    def residual(a, b):
+        """State difference with the heading wrapped."""
+        d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+        d[..., 2] = wrap_angle(d[..., 2])
+        return d
+
+    @staticmethod
+    def mean(sigmas, weights):
+        """Weighted mean of states with a circular mean for the heading."""
+        m = weights @ sigmas
+        m[2] = angle_mean(sigmas[:, 2], weights)
+        return m
+
+
+@dataclass(frozen=True)
+class RangeBearingSensor:
+    """Range and bearing to every landmark: ``z = [r_1, b_1, r_2, b_2, ...]``."""
+
+    landmarks_m: np.ndarray = field(default_factory=lambda: np.array([[5.0, 5.0], [-5.0, 5.0], [0.0, -5.0]]))
+    range_std_m: float = 0.1
+    bearing_std_rad: float = np.deg2rad(2.0)
+
+    def __post_init__(self):
+        lm = v.as_finite_array(self.landmarks_m, "landmarks_m", ndim=2)
+        if lm.shape[1] != 2 or lm.shape[0] < 1:
+            raise ValueError(f"`landmarks_m` must have shape (M, 2) with M >= 1; got {lm.shape}")
+        object.__setattr__(self, "landmarks_m", lm)
+        v.check_positive(self.range_std_m, "range_std_m")
+        v.check_positive(self.bearing_std_rad, "bearing_std_rad")
+
+    @property
+    def dim_z(self) -> int:
+        return 2 * self.landmarks_m.shape[0]
+
+    @property
+    def R(self) -> np.ndarray:
+        return np.diag(np.tile([self.range_std_m**2, self.bearing_std_rad**2], self.landmarks_m.shape[0]))
+
+    def h(self, x, v_noise=None):
+        """Predicted measurement (..., 2M); ``v_noise`` is added (augmented UKF)."""
+        x = np.asarray(x, dtype=float)
+        dx = self.landmarks_m[:, 0] - x[..., 0, None]
+        dy = self.landmarks_m[:, 1] - x[..., 1, None]
+        r = np.hypot(dx, dy)
+        b = np.arctan2(dy, dx) - x[..., 2, None]
+        z = np.stack([r, b], axis=-1).reshape(*x.shape[:-1], -1)
+        if v_noise is not None:
+            z = z + np.asarray(v_noise)
+        z[..., 1::2] = wrap_angle(z[..., 1::2])
+        return z
+
+    def H_jac(self, x):
+        """``dh/dx`` (2M, 3)."""
+        dx = self.landmarks_m[:, 0] - x[0]
+        dy = self.landmarks_m[:, 1] - x[1]
+        q = dx**2 + dy**2
+        r = np.sqrt(q)
+        H = np.zeros((self.dim_z, 3))
+        H[0::2, 0], H[0::2, 1] = -dx / r, -dy / r
+        H[1::2, 0], H[1::2, 1], H[1::2, 2] = dy / q, -dx / q, -1.0
+        return H
+
+    @staticmethod
+    def residual(a, b):
+        """Measurement difference with bearings wrapped."""
+        d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+        d[..., 1::2] = wrap_angle(d[..., 1::2])
+        return d
+
+    @staticmethod
+    def mean(sigmas, weights):
+        """Weighted mean of measurements with circular means for the bearings."""
+        m = weights @ sigmas
+        m[1::2] = angle_mean(sigmas[:, 1::2], weights)
+        return m
+
+
+def simulate_unicycle(model: UnicycleModel, sensor: RangeBearingSensor, x0, controls, rng=None):
+    """True path and measurements: control noise from ``model.M``, sensor noise from ``sensor.R``.
+
+    ``controls`` is ``(K, 2)``; returns ``(X, Z)`` with ``X (K, 3)`` the true
+    states after each step and ``Z (K, 2M)`` the measurements taken there.
+    """
+    rng = v.as_rng(rng)
+    x = v.as_vector(x0, "x0", 3)
+    U = v.as_finite_array(controls, "controls", ndim=2)
+    if U.shape[1] != 2:
+        raise ValueError(f"`controls` must have shape (K, 2); got {U.shape}")
+    K = U.shape[0]
+    W = rng.normal(size=(K, 2)) * np.sqrt(np.diag(model.M))
+    Vn = rng.normal(size=(K, sensor.dim_z)) * np.sqrt(np.diag(sensor.R))
+    X = np.empty((K, 3))
+    for k in range(K):
+        x = model.f(x, U[k], W[k])
+        X[k] = x
+    return X, sensor.h(X, Vn)
