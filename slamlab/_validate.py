@@ -7,6 +7,7 @@ argument, says what was expected and what came.
 
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Callable, Iterable
 from typing import Any
@@ -18,6 +19,7 @@ __all__ = [
     "as_finite_array",
     "as_image",
     "as_matrix",
+    "as_measurement",
     "as_rng",
     "as_vector",
     "check_callable",
@@ -70,6 +72,20 @@ def as_vector(value: Any, name: str, n: int | None = None) -> np.ndarray:
     if n is not None and arr.shape[0] != n:
         raise ValueError(f"`{name}` must have length {n}; got shape {arr.shape}")
     return arr
+
+
+def as_measurement(value: Any, name: str, n: int) -> np.ndarray:
+    """:func:`as_vector` with a fast path for a float64 ``(n,)`` array (per-step filter input).
+
+    >>> as_measurement(np.array([1.0, 2.0]), "z", 2)
+    array([1., 2.])
+    """
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.shape == (n,):
+        # a NaN/inf anywhere makes the dot product non-finite (cheaper than isfinite().all() on tiny arrays)
+        if math.isfinite(value @ value) or np.isfinite(value).all():
+            return value
+        raise ValueError(f"`{name}` must be finite; got {int(n - np.isfinite(value).sum())} NaN/inf value(s)")
+    return as_vector(value, name, n)
 
 
 def as_matrix(value: Any, name: str, shape: tuple[int | None, int | None] | None = None) -> np.ndarray:

@@ -7,10 +7,10 @@ thin classes keep state (``KalmanFilter``, ``ExtendedKalmanFilter``,
 
 from .consistency import chi2_interval, nees, nis
 from .ekf import ExtendedKalmanFilter, check_jacobian, ekf_predict, ekf_update, numerical_jacobian
-from .kalman import KalmanFilter, Update, kf_predict, kf_update, symmetrize
+from ._linalg import CholeskyError, symmetrize
+from .kalman import KalmanFilter, Update, kf_predict, kf_update
 from .landmark import LandmarkFilter, landmark_predict, landmark_update
 from .ukf import (
-    CholeskyError,
     UnscentedKalmanFilter,
     sigma_points,
     sigma_weights,

@@ -10,16 +10,17 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as v
-from .kalman import Update, _gain, symmetrize
+from ._linalg import gain, symmetrize
+from .kalman import Update
 
 __all__ = ["ExtendedKalmanFilter", "check_jacobian", "ekf_predict", "ekf_update", "numerical_jacobian"]
 
 
 def _ekf_predict(x, P, f, F_jac, Q, u):
     # F_{k-1} = df/dx at (x_{k-1|k-1}, u_{k-1})  (evaluated before x moves)
-    F = np.atleast_2d(F_jac(x, u))
+    F = F_jac(x, u)
     # x_{k|k-1} = f(x_{k-1|k-1}, u_{k-1})
-    x = np.asarray(f(x, u), dtype=float)
+    x = f(x, u)
     # P_{k|k-1} = F P F^T + Q
     P = symmetrize(F @ P @ F.T + Q)
     return x, P
@@ -27,16 +28,16 @@ def _ekf_predict(x, P, f, F_jac, Q, u):
 
 def _ekf_update(x, P, z, h, H_jac, R, residual):
     # H_k = dh/dx at x_{k|k-1}
-    H = np.atleast_2d(H_jac(x))
+    H = H_jac(x)
     # y = z - h(x_{k|k-1})
-    y = residual(z, np.asarray(h(x), dtype=float))
+    y = residual(z, h(x))
     PHt = P @ H.T
     # S = H P H^T + R ; K = P H^T S^-1
-    S = symmetrize(H @ PHt + R)
-    K = _gain(PHt, S)
-    # x = x + K y ; P = (I - K H) P
+    S = H @ PHt + R
+    K = gain(PHt, S, "ekf_update")
+    # x = x + K y ; P = (I - K H) P = P - K (H P)
     x = x + K @ y
-    P = symmetrize((np.eye(x.shape[0]) - K @ H) @ P)
+    P = symmetrize(P - K @ PHt.T)
     return Update(x, P, y, S, K)
 
 
@@ -115,7 +116,8 @@ def numerical_jacobian(fun, x, *args, eps: float | None = None) -> np.ndarray:
     for j in range(x.shape[0]):
         dx = np.zeros_like(x)
         dx[j] = h[j]
-        cols.append((np.asarray(fun(x + dx, *args), float) - np.asarray(fun(x - dx, *args), float)) / (2 * h[j]))
+        f_plus, f_minus = np.asarray(fun(x + dx, *args), float), np.asarray(fun(x - dx, *args), float)
+        cols.append((f_plus - f_minus) / (2 * h[j]))
     return np.stack(cols, axis=-1)
 
 
@@ -167,7 +169,7 @@ class ExtendedKalmanFilter:
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
 
     def update(self, z) -> None:
-        z = v.as_vector(z, "z", self.R.shape[0])
+        z = v.as_measurement(z, "z", self.R.shape[0])
         self.x, self.P, self.y, self.S, self.K = _ekf_update(
             self.x, self.P, z, self.h, self.H_jac, self.R, self.residual)
         self.x_post, self.P_post = self.x.copy(), self.P.copy()

@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import _validate as v
+from ._linalg import gain, symmetrize
 
 __all__ = ["KalmanFilter", "Update", "kf_predict", "kf_update", "symmetrize"]
 
@@ -26,11 +27,6 @@ class Update(NamedTuple):
     K: np.ndarray
 
 
-def symmetrize(P: np.ndarray) -> np.ndarray:
-    """``(P + P^T) / 2``: keeps covariances symmetric against rounding."""
-    return 0.5 * (P + P.T)
-
-
 # --- strict core (no validation; callers have checked) ------------------------------------------
 
 
@@ -42,25 +38,20 @@ def _predict(x, P, F, Q, Bu=None):
     return x, symmetrize(P)
 
 
-def _gain(PHt, S):
-    # K = P H^T S^-1  (solve instead of inverting S; S is symmetric)
-    return np.linalg.solve(S, PHt.T).T
-
-
 def _update(x, P, y, H, R, form="short", K=None):
     PHt = P @ H.T
     # S = H P H^T + R
-    S = symmetrize(H @ PHt + R)
+    S = H @ PHt + R
     if K is None:
-        K = _gain(PHt, S)
+        K = gain(PHt, S, "kf_update")
     # x_{k|k} = x_{k|k-1} + K y
     x = x + K @ y
-    I_KH = np.eye(P.shape[0]) - K @ H
     if form == "short":
-        # P_{k|k} = (I - K H) P_{k|k-1}   (valid for the optimal gain only)
-        P = I_KH @ P
+        # P_{k|k} = (I - K H) P_{k|k-1} = P - K (H P)   (valid for the optimal gain only)
+        P = P - K @ PHt.T
     else:
         # Joseph: P_{k|k} = (I - K H) P (I - K H)^T + K R K^T   (valid for any gain)
+        I_KH = np.eye(P.shape[0]) - K @ H
         P = I_KH @ P @ I_KH.T + K @ R @ K.T
     return Update(x, symmetrize(P), y, S, K)
 
@@ -191,7 +182,7 @@ class KalmanFilter:
 
     def update(self, z) -> None:
         """Update with measurement ``z`` (validated for shape and finiteness)."""
-        z = v.as_vector(z, "z", self.H.shape[0])
+        z = v.as_measurement(z, "z", self.H.shape[0])
         self.x, self.P, self.y, self.S, self.K = _update(self.x, self.P, z - self.H @ self.x, self.H, self.R, self.form)
         self.x_post, self.P_post = self.x.copy(), self.P.copy()
 

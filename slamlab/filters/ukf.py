@@ -21,7 +21,8 @@ import numpy as np
 from scipy.linalg import block_diag
 
 from .. import _validate as v
-from .kalman import Update, _gain, symmetrize
+from ._linalg import CholeskyError, cholesky_lower, gain, symmetrize
+from .kalman import Update
 
 __all__ = [
     "CholeskyError",
@@ -34,22 +35,6 @@ __all__ = [
 ]
 
 FORMS = ("augmented", "additive")
-
-
-class CholeskyError(np.linalg.LinAlgError):
-    """Cholesky factorisation failed: the matrix is not positive definite (a ``ValueError``)."""
-
-
-def cholesky_lower(M: np.ndarray, step: str) -> np.ndarray:
-    """Lower Cholesky factor ``A`` with ``A A^T = M``; a failure names ``step``."""
-    try:
-        return np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        eig = np.linalg.eigvalsh(symmetrize(M)) if np.all(np.isfinite(M)) else np.array([np.nan])
-        raise CholeskyError(
-            f"Cholesky factorisation failed in {step}: the scaled covariance is not positive definite "
-            f"(smallest eigenvalue {eig[0]:.3e}); check P, Q, R and alpha/kappa"
-        ) from None
 
 
 def sigma_weights(L: int, alpha: float = 1e-3, beta: float = 2.0, kappa: float = 0.0):
@@ -164,7 +149,7 @@ def _ukf_update(x, P, z, h, R, form, alpha, beta, kappa, z_mean_fn, z_residual_f
     # P_xz = sum Wc (chi - x)(gamma - z)^T
     Pxz = (dX.T * Wc) @ dZ
     # K = P_xz P_zz^-1
-    K = _gain(Pxz, Pzz)
+    K = gain(Pxz, Pzz, "ukf_update")
     y = z - z_pred if z_residual_fn is None else z_residual_fn(z, z_pred)
     # x = x + K (z - z_pred);  P = P - K P_zz K^T
     x_new = x + K @ y
@@ -255,7 +240,7 @@ class UnscentedKalmanFilter:
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
 
     def update(self, z) -> None:
-        z = v.as_vector(z, "z", self.R.shape[0])
+        z = v.as_measurement(z, "z", self.R.shape[0])
         self.x, self.P, self.y, self.S, self.K = _ukf_update(
             self.x, self.P, z, self.h, self.R, self.form, self.alpha, self.beta, self.kappa,
             self.z_mean_fn, self.z_residual_fn, self.x_residual_fn, self.vectorized)

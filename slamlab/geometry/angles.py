@@ -16,16 +16,26 @@ def wrap_angle(angle_rad):
     return np.mod(np.asarray(angle_rad, dtype=float) + np.pi, 2.0 * np.pi) - np.pi
 
 
-def angle_mean(angles_rad, weights=None, axis: int = 0):
-    """Weighted circular mean: ``atan2(sum w sin a, sum w cos a)``.
+def angle_mean(angles_rad, weights=None, axis: int = 0, ref=None):
+    """Weighted mean of angles.
 
-    Weights may be negative (unscented transforms): the result is still the
-    direction of the weighted resultant vector.
+    Without ``ref``: the circular mean ``atan2(sum w sin a, sum w cos a)``.
+    With ``ref``: the mean taken in the chart around ``ref``,
+    ``ref + sum w wrap(a - ref)`` (weights summing to 1). The unscented
+    transform needs the second: with a small ``alpha`` its weights reach
+    ``-10^6`` and the sin/cos sums approximate ``E[cos a] ~ 1 - sigma^2/2``,
+    which turns negative (the mean flips by 180 deg) once ``sigma > sqrt(2)`` rad.
 
     >>> float(angle_mean(np.array([np.pi - 0.1, -np.pi + 0.1])))
     3.141592653589793
+    >>> float(angle_mean(np.array([np.pi - 0.1, -np.pi + 0.3]), np.array([0.5, 0.5]), ref=np.pi))
+    -3.041592653589793
     """
     a = np.asarray(angles_rad, dtype=float)
+    if ref is not None:
+        d = wrap_angle(a - np.expand_dims(ref, axis) if np.ndim(ref) else a - ref)
+        m = d.mean(axis=axis) if weights is None else np.tensordot(np.asarray(weights, float), d, axes=(0, axis))
+        return wrap_angle(np.asarray(ref, dtype=float) + m)
     if weights is None:
         s, c = np.sin(a).sum(axis=axis), np.cos(a).sum(axis=axis)
     else:

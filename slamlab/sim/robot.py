@@ -70,9 +70,9 @@ class UnicycleModel:
 
     @staticmethod
     def mean(sigmas, weights):
-        """Weighted mean of states with a circular mean for the heading."""
+        """Weighted mean of sigma points; heading averaged in the chart around the centre point."""
         m = weights @ sigmas
-        m[2] = angle_mean(sigmas[:, 2], weights)
+        m[2] = angle_mean(sigmas[:, 2], weights, ref=sigmas[0, 2])
         return m
 
 
@@ -133,9 +133,9 @@ class RangeBearingSensor:
 
     @staticmethod
     def mean(sigmas, weights):
-        """Weighted mean of measurements with circular means for the bearings."""
+        """Weighted mean of sigma points; bearings averaged in the chart around the centre point."""
         m = weights @ sigmas
-        m[1::2] = angle_mean(sigmas[:, 1::2], weights)
+        m[1::2] = angle_mean(sigmas[:, 1::2], weights, ref=sigmas[0, 1::2])
         return m
 
 
