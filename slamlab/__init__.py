@@ -11,9 +11,11 @@ The notebooks start with::
 
 from __future__ import annotations
 
+from . import chapters, data, filters, geometry, plotting, sim
+
 __version__ = "0.1.0"
 
-__all__ = ["__version__", "notebook_setup"]
+__all__ = ["__version__", "chapters", "data", "filters", "geometry", "notebook_setup", "plotting", "sim"]
 
 
 def notebook_setup(*, dpi: int = 80, precision: int = 4) -> None:

@@ -18,7 +18,7 @@ def format_table(headers: Sequence[str], rows: Sequence[Sequence], title: str | 
     """
     cells = [[str(c) for c in r] for r in rows]
     widths = [max(len(h), *(len(r[i]) for r in cells)) if cells else len(h) for i, h in enumerate(headers)]
-    fmt = "  ".join("{:>%d}" % w for w in widths)
+    fmt = "  ".join(f"{{:>{w}}}" for w in widths)
     lines = [] if title is None else [title]
     lines += [fmt.format(*headers), "  ".join("-" * w for w in widths)]
     lines += [fmt.format(*r) for r in cells]

@@ -82,8 +82,9 @@ def as_measurement(value: Any, name: str, n: int) -> np.ndarray:
     """
     if type(value) is np.ndarray and value.dtype == np.float64 and value.shape == (n,):
         # a NaN/inf anywhere makes the dot product non-finite (cheaper than isfinite().all() on tiny arrays)
-        if math.isfinite(value @ value) or np.isfinite(value).all():
-            return value
+        with np.errstate(over="ignore"):
+            if math.isfinite(value @ value) or np.isfinite(value).all():
+                return value
         raise ValueError(f"`{name}` must be finite; got {int(n - np.isfinite(value).sum())} NaN/inf value(s)")
     return as_vector(value, name, n)
 
@@ -153,7 +154,7 @@ def as_image(value: Any, name: str = "image", *, allow_color: bool = False) -> n
 def as_rng(rng: Any, name: str = "rng") -> np.random.Generator:
     """Normalise ``rng`` (Generator, int seed, SeedSequence or None) to a Generator.
 
-    >>> as_rng(7).integers(100) == as_rng(7).integers(100)
+    >>> bool(as_rng(7).integers(100) == as_rng(7).integers(100))
     True
     """
     if isinstance(rng, np.random.Generator):

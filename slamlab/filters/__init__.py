@@ -5,11 +5,21 @@ thin classes keep state (``KalmanFilter``, ``ExtendedKalmanFilter``,
 ``UnscentedKalmanFilter``, ``LandmarkFilter``).
 """
 
+from ._linalg import CholeskyError, symmetrize
 from .consistency import chi2_interval, nees, nis
 from .ekf import ExtendedKalmanFilter, check_jacobian, ekf_predict, ekf_update, numerical_jacobian
-from ._linalg import CholeskyError, symmetrize
+from .experiments import (
+    default_landmarks,
+    run_cv_target,
+    run_joseph_vs_short,
+    run_landmark_filter,
+    run_sigma_alpha_study,
+    run_stabilising_noise,
+    run_unicycle_comparison,
+)
 from .kalman import KalmanFilter, Update, kf_predict, kf_update
 from .landmark import LandmarkFilter, landmark_predict, landmark_update
+from .plot import cv_figure, plot_cv_example, plot_joseph, plot_nees, plot_unicycle_paths, unicycle_figure
 from .ukf import (
     UnscentedKalmanFilter,
     sigma_points,
@@ -43,4 +53,24 @@ __all__ = [
     "ukf_predict",
     "ukf_update",
     "unscented_transform",
+]
+
+from .widgets import explore_cv_target, explore_unicycle
+
+__all__ += [
+    "cv_figure",
+    "default_landmarks",
+    "explore_cv_target",
+    "explore_unicycle",
+    "plot_cv_example",
+    "plot_joseph",
+    "plot_nees",
+    "plot_unicycle_paths",
+    "run_cv_target",
+    "run_joseph_vs_short",
+    "run_landmark_filter",
+    "run_sigma_alpha_study",
+    "run_stabilising_noise",
+    "run_unicycle_comparison",
+    "unicycle_figure",
 ]

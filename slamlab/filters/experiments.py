@@ -13,7 +13,13 @@ import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
-from ..sim import RangeBearingSensor, UnicycleModel, constant_velocity_model, simulate_linear, simulate_unicycle
+from ..sim import (
+    RangeBearingSensor,
+    UnicycleModel,
+    constant_velocity_model,
+    simulate_linear,
+    simulate_unicycle,
+)
 from .consistency import chi2_interval, nees
 from .ekf import ExtendedKalmanFilter
 from .kalman import KalmanFilter, _predict, _update, kf_update
@@ -38,6 +44,13 @@ __all__ = [
 
 FILTER_NAMES = ("LKF", "EKF", "UKF-aug", "UKF-add")
 DIVERGED_RMSE_M = 2.0  # a run whose position RMSE exceeds this has lost track
+
+
+def _nanmean(a) -> float:
+    """Mean over the finite entries; NaN (without a warning) when there are none."""
+    a = np.asarray(a, dtype=float)
+    ok = np.isfinite(a)
+    return float(a[ok].mean()) if ok.any() else float("nan")
 
 
 def _spawn(rng, n):
@@ -205,7 +218,8 @@ class UnicycleResult:
     landmarks_m: np.ndarray = field(repr=False)
 
     def __str__(self) -> str:
-        best = self.filters[int(np.nanargmin(self.rmse_pos_m))]
+        finite = np.where(np.isfinite(self.rmse_pos_m), self.rmse_pos_m, np.inf)
+        best = self.filters[int(np.argmin(finite))]
         return (f"Unicycle, {self.n_runs} runs x {self.n_steps} steps: lowest position RMSE {best}; "
                 + ", ".join(f"{f} {r:.3f} m" for f, r in zip(self.filters, self.rmse_pos_m, strict=True)))
 
@@ -222,8 +236,9 @@ class UnicycleResult:
             ok = np.isfinite(self.run_rmse_pos_m[i])
             med = np.median(self.run_rmse_pos_m[i, ok]) if ok.any() else np.nan
             rows.append([name, f"{self.rmse_pos_m[i]:.3f}", f"{med:.3f}",
-                         f"{np.rad2deg(self.rmse_heading_rad[i]):.2f}", f"{np.nanmean(a):.2f}",
-                         f"{np.nanmean((a >= lo) & (a <= hi)):.0%}", f"{int(self.diverged[i])}",
+                         f"{np.rad2deg(self.rmse_heading_rad[i]):.2f}", f"{_nanmean(a):.2f}",
+                         f"{_nanmean(np.where(np.isfinite(a), (a >= lo) & (a <= hi), np.nan)):.0%}",
+                         f"{int(self.diverged[i])}",
                          f"{int(self.failures[i])}"])
         return format_table(["filter", "pos RMSE [m]", "median run [m]", "heading RMSE [deg]", "mean NEES (3)",
                              f"NEES in [{lo:.2f}, {hi:.2f}]", f"diverged (>{DIVERGED_RMSE_M:g} m)", "failed"],
@@ -346,9 +361,9 @@ def run_unicycle_comparison(n_runs: int = 30, n_steps: int = 60, *, filters=FILT
         rmse_pos = np.sqrt(se_pos / counts)
         rmse_head = np.sqrt(se_head / counts)
         anees = nees_sum / nees_cnt
-    params = dict(range_std_m=range_std_m, bearing_std_deg=bearing_std_deg, v_std_mps=v_std_mps,
-                  omega_std_degps=omega_std_degps, init_heading_std_deg=init_heading_std_deg, alpha=alpha,
-                  beta=beta, kappa=kappa, stabilising_noise=stabilising_noise)
+    params = {"range_std_m": range_std_m, "bearing_std_deg": bearing_std_deg, "v_std_mps": v_std_mps,
+                  "omega_std_degps": omega_std_degps, "init_heading_std_deg": init_heading_std_deg, "alpha": alpha,
+                  "beta": beta, "kappa": kappa, "stabilising_noise": stabilising_noise}
     ok_runs = max(1, int(n_runs - failures.max()))
     return UnicycleResult(filters, n_runs, n_steps, params, rmse_pos, rmse_head, anees, failures, run_rmse,
                           chi2_interval(3, ok_runs), ex_truth, ex_est, ex_P, sensor.landmarks_m)
@@ -389,7 +404,7 @@ def run_stabilising_noise(scales=(1.0, 2.0, 4.0, 8.0), n_runs: int = 30, n_steps
         res = run_unicycle_comparison(n_runs, n_steps, filters=("EKF",), stabilising_noise=float(s), rng=rng,
                                       **scenario)
         rm.append(res.rmse_pos_m[0])
-        nn.append(np.nanmean(res.anees[0]))
+        nn.append(_nanmean(res.anees[0]))
         bounds = res.nees_bounds
     return StabilisingNoiseResult(scales, np.array(rm), np.array(nn), bounds, n_runs)
 

@@ -8,7 +8,7 @@ import numpy as np
 from ..geometry import covariance_ellipse
 from ..plotting import STYLE, new_axes
 
-__all__ = ["plot_cv_example", "plot_joseph", "plot_nees", "plot_unicycle_paths"]
+__all__ = ["cv_figure", "plot_cv_example", "plot_joseph", "plot_nees", "plot_unicycle_paths", "unicycle_figure"]
 
 _FILTER_COLORS = {"LKF": "tab:red", "EKF": "tab:orange", "UKF-aug": "tab:blue", "UKF-add": "tab:purple",
                   "KF": "tab:blue"}
@@ -87,5 +87,14 @@ def unicycle_figure(result):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     plot_unicycle_paths(result, ax=axes[0])
     plot_nees(result.anees, result.nees_bounds, labels=list(result.filters), ax=axes[1], dim=3)
+    fig.tight_layout()
+    return fig
+
+
+def cv_figure(result):
+    """One constant-velocity run and the KF's NEES side by side."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    plot_cv_example(result, ax=axes[0])
+    plot_nees(result.anees, result.nees_bounds, labels=["KF"], ax=axes[1], dim=4, title="KF NEES (expect 4)")
     fig.tight_layout()
     return fig

@@ -49,18 +49,22 @@ def sigma_weights(L: int, alpha: float = 1e-3, beta: float = 2.0, kappa: float =
     beta = float(beta)
     kappa = float(kappa)
     lam = alpha**2 * (L + kappa) - L
-    if L + lam <= 0:
-        raise ValueError(f"`kappa` must give L + lambda > 0; got L + lambda = {L + lam:.3g} (L={L}, kappa={kappa})")
-    Ws = np.full(2 * L + 1, 0.5 / (L + lam))
+    # L + lambda = alpha^2 (L + kappa), computed directly: the difference L + lambda cancels
+    # catastrophically for small alpha (1e-10 relative at alpha = 1e-3, as in filterpy's weights)
+    L_lam = alpha**2 * (L + kappa)
+    if L_lam <= 0:
+        raise ValueError(f"`kappa` must give L + lambda > 0; got L + lambda = {L_lam:.3g} (L={L}, kappa={kappa})")
+    Ws = np.full(2 * L + 1, 0.5 / L_lam)
     Wc = Ws.copy()
-    Ws[0] = lam / (L + lam)
-    Wc[0] = lam / (L + lam) + (1.0 - alpha**2 + beta)
+    Ws[0] = lam / L_lam
+    Wc[0] = lam / L_lam + (1.0 - alpha**2 + beta)
     return Ws, Wc, lam
 
 
-def _sigma_points(x, P, lam, step):
+def _sigma_points(x, P, alpha, kappa, step):
     L = x.shape[0]
-    A = cholesky_lower((L + lam) * P, step)  # columns of sqrt((L + lambda) P), A A^T = (L+lambda) P
+    # columns of sqrt((L + lambda) P): A A^T = (L + lambda) P, with L + lambda = alpha^2 (L + kappa)
+    A = cholesky_lower(alpha**2 * (L + kappa) * P, step)
     return np.vstack([x, x + A.T, x - A.T])
 
 
@@ -78,8 +82,8 @@ def sigma_points(x, P, alpha: float = 1e-3, kappa: float = 0.0) -> np.ndarray:
     """
     x = v.as_vector(x, "x")
     P = v.as_covariance(P, "P", x.shape[0])
-    _, _, lam = sigma_weights(x.shape[0], alpha, 2.0, kappa)
-    return _sigma_points(x, P, lam, "sigma_points")
+    sigma_weights(x.shape[0], alpha, 2.0, kappa)  # validates alpha, kappa
+    return _sigma_points(x, P, alpha, kappa, "sigma_points")
 
 
 def unscented_transform(sigmas, Ws, Wc, noise_cov=None, mean_fn=None, residual_fn=None):
@@ -108,16 +112,16 @@ def _ukf_predict(x, P, f, Q, u, form, alpha, beta, kappa, mean_fn, residual_fn, 
         # x^a = [x; E w],  P^a = blkdiag(P, Q)
         xa = np.concatenate([x, np.zeros(nq)])
         Pa = block_diag(P, Q)
-        Ws, Wc, lam = sigma_weights(n + nq, alpha, beta, kappa)
-        chi = _sigma_points(xa, Pa, lam, "ukf_predict (augmented sigma points)")
+        Ws, Wc, _ = sigma_weights(n + nq, alpha, beta, kappa)
+        chi = _sigma_points(xa, Pa, alpha, kappa, "ukf_predict (augmented sigma points)")
         # chi_{k|k-1}^i = f(chi_x^i, u, chi_w^i)
         if vectorized:
             Y = np.asarray(f(chi[:, :n], u, chi[:, n:]), dtype=float)
         else:
             Y = np.array([np.asarray(f(c[:n], u, c[n:]), dtype=float) for c in chi])
         return unscented_transform(Y, Ws, Wc, None, mean_fn, residual_fn)
-    Ws, Wc, lam = sigma_weights(n, alpha, beta, kappa)
-    chi = _sigma_points(x, P, lam, "ukf_predict (sigma points)")
+    Ws, Wc, _ = sigma_weights(n, alpha, beta, kappa)
+    chi = _sigma_points(x, P, alpha, kappa, "ukf_predict (sigma points)")
     Y = np.asarray(f(chi, u), dtype=float) if vectorized else np.array([np.asarray(f(c, u), float) for c in chi])
     # additive form: P_{k|k-1} = sum Wc (Y - x)(Y - x)^T + Q
     return unscented_transform(Y, Ws, Wc, Q, mean_fn, residual_fn)
@@ -130,8 +134,8 @@ def _ukf_update(x, P, z, h, R, form, alpha, beta, kappa, z_mean_fn, z_residual_f
         # x^a = [x_{k|k-1}; E v],  P^a = blkdiag(P_{k|k-1}, R)
         xa = np.concatenate([x, np.zeros(nr)])
         Pa = block_diag(P, R)
-        Ws, Wc, lam = sigma_weights(n + nr, alpha, beta, kappa)
-        chi = _sigma_points(xa, Pa, lam, "ukf_update (augmented sigma points)")
+        Ws, Wc, _ = sigma_weights(n + nr, alpha, beta, kappa)
+        chi = _sigma_points(xa, Pa, alpha, kappa, "ukf_update (augmented sigma points)")
         X = chi[:, :n]
         # gamma^i = h(chi_x^i, chi_v^i)
         if vectorized:
@@ -140,8 +144,8 @@ def _ukf_update(x, P, z, h, R, form, alpha, beta, kappa, z_mean_fn, z_residual_f
             Z = np.array([np.asarray(h(c[:n], c[n:]), dtype=float) for c in chi])
         z_pred, Pzz = unscented_transform(Z, Ws, Wc, None, z_mean_fn, z_residual_fn)
     else:
-        Ws, Wc, lam = sigma_weights(n, alpha, beta, kappa)
-        X = _sigma_points(x, P, lam, "ukf_update (sigma points)")
+        Ws, Wc, _ = sigma_weights(n, alpha, beta, kappa)
+        X = _sigma_points(x, P, alpha, kappa, "ukf_update (sigma points)")
         Z = np.asarray(h(X), dtype=float) if vectorized else np.array([np.asarray(h(c), float) for c in X])
         z_pred, Pzz = unscented_transform(Z, Ws, Wc, R, z_mean_fn, z_residual_fn)
     dX = X - x if x_residual_fn is None else x_residual_fn(X, x)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import ipywidgets as widgets
 
 from .experiments import run_cv_target, run_unicycle_comparison
-from .plot import plot_cv_example, plot_nees, unicycle_figure
+from .plot import cv_figure, unicycle_figure
 
 __all__ = ["explore_cv_target", "explore_unicycle"]
 
@@ -23,8 +23,8 @@ def explore_unicycle(**defaults):
     Calls :func:`run_unicycle_comparison` with the slider values; ``alpha`` is
     set on a log scale. A bad combination prints its message instead of failing.
     """
-    d = dict(n_runs=10, n_steps=60, range_std_m=0.5, bearing_std_deg=10.0, omega_std_degps=10.0,
-             init_heading_std_deg=90.0, alpha=1e-3, beta=2.0, kappa=0.0, stabilising_noise=1.0, rng=2010)
+    d = {"n_runs": 10, "n_steps": 60, "range_std_m": 0.5, "bearing_std_deg": 10.0, "omega_std_degps": 10.0,
+             "init_heading_std_deg": 90.0, "alpha": 1e-3, "beta": 2.0, "kappa": 0.0, "stabilising_noise": 1.0, "rng": 2010}
     d.update(defaults)
 
     def show(n_runs, range_std_m, bearing_std_deg, omega_std_degps, init_heading_std_deg, alpha, beta, kappa,
@@ -59,7 +59,7 @@ def explore_unicycle(**defaults):
 
 def explore_cv_target(**defaults):
     """Constant-velocity target: acceleration noise and measurement noise -> KF table, NEES plot."""
-    d = dict(n_runs=30, n_steps=50, accel_std=0.2, pos_std_m=1.0, rng=2010)
+    d = {"n_runs": 30, "n_steps": 50, "accel_std": 0.2, "pos_std_m": 1.0, "rng": 2010}
     d.update(defaults)
 
     def show(accel_std, pos_std_m):
@@ -69,9 +69,7 @@ def explore_cv_target(**defaults):
             print(f"Cannot run with these settings: {exc}")
             return
         print(res.table())
-        ax = plot_cv_example(res)
-        del ax
-        plot_nees(res.anees, res.nees_bounds, labels=["KF"], dim=4, title="KF NEES (expect 4)")
+        cv_figure(res)
 
     return widgets.interactive(
         show,

@@ -42,7 +42,7 @@ def test_landmark_filter_bad_input():
     with pytest.raises(ValueError, match=r"`Z` must have shape \(M, 3\)"):
         lf.add(np.zeros((2, 2)))
     lf.add(np.zeros((2, 3)))
-    with pytest.raises(ValueError, match="`idx` must index existing landmarks 0..1"):
+    with pytest.raises(ValueError, match=r"`idx` must index existing landmarks 0\.\.1"):
         lf.observe(np.array([5]), np.zeros((1, 3)))
     with pytest.raises(TypeError, match="`idx` must be a 1-D integer index array"):
         lf.observe(np.array([0.5]), np.zeros((1, 3)))

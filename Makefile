@@ -1,0 +1,63 @@
+# slamlab: set-up, tests and notebooks. `make lab` and `make test` are all a fresh machine needs.
+
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+
+PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
+	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
+	-p no:cacheprovider
+
+.PHONY: venv lab test notebooks lint bench lock clean distclean
+
+## venv: create .venv if missing and install slamlab[test] from constraints.txt (again only when those change)
+venv: $(STAMP)
+
+$(STAMP): pyproject.toml constraints.txt
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --upgrade pip
+	$(BIN)/python -m pip install -c constraints.txt -e '.[test]'
+	touch $(STAMP)
+
+## lab: start JupyterLab on notebooks/
+lab: venv
+	$(BIN)/jupyter lab notebooks/
+
+## test: the whole suite in one pytest run: unit tests, doctests, every notebook under nbval
+test: venv
+	MPLBACKEND=Agg $(BIN)/python -m pytest $(PYTEST_ARGS)
+
+## notebooks: re-execute every notebook in place (refreshes nbval's stored reference outputs)
+notebooks: venv
+	MPLBACKEND=Agg $(BIN)/python tools/run_notebooks.py
+
+## lint: ruff
+lint: venv
+	$(BIN)/ruff check .
+
+## bench: run every benchmarks/bench_*.py
+bench: venv
+	@set -e; for f in $(sort $(wildcard benchmarks/bench_*.py)); do \
+		echo "== $$f"; MPLBACKEND=Agg $(BIN)/python $$f; \
+	done
+
+## lock: regenerate constraints.txt from a fresh temporary venv (then run `make test`)
+lock:
+	@set -e; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
+	$(PYTHON) -m venv "$$tmp/venv"; \
+	"$$tmp/venv/bin/python" -m pip install --upgrade pip; \
+	"$$tmp/venv/bin/python" -m pip install -e '.[test]'; \
+	"$$tmp/venv/bin/python" tools/freeze_lock.py > "$$tmp/constraints.txt"; \
+	mv "$$tmp/constraints.txt" constraints.txt; \
+	echo "constraints.txt updated; now run: make test"
+
+## clean: remove caches and build leftovers (keeps .venv)
+clean:
+	rm -rf build dist *.egg-info .pytest_cache .ruff_cache
+	find . -path ./$(VENV) -prune -o -type d \( -name __pycache__ -o -name .ipynb_checkpoints \) -print \
+		| xargs rm -rf
+
+## distclean: clean, and remove .venv too
+distclean: clean
+	rm -rf $(VENV)

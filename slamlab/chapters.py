@@ -1,0 +1,111 @@
+"""The chapter map: which notebook rebuilds which source section, with which subpackage.
+
+Source documents (in ``shared/seeds``): 000 Rodikov 2010 (stereo SLAM, Kalman
+filters, SURF, kd-trees), 002 Kazmin 2017 (plane-based Monte Carlo SLAM),
+003 diploma 2019 (monocular mapping), 004 research summary (correlation
+localisation and Hough SLAM).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["CHAPTERS", "SHARED_TOPICS", "Chapter", "chapter_table", "get_chapter"]
+
+
+@dataclass(frozen=True)
+class Chapter:
+    """One notebook of the lab and what it rebuilds.
+
+    Attributes
+    ----------
+    number : int
+        The notebook number ``NN`` (numbered once, never renumbered).
+    title : str
+        Short English title.
+    notebook : str
+        File name in ``notebooks/``, ``NN_topic.ipynb``.
+    subpackages : tuple of str
+        The slamlab subpackages holding the chapter's code.
+    sources : str
+        Source document and sections, e.g. ``"000 §1.2, §3.6; 003 §2.1.1"``.
+    status : {"available", "planned"}
+        Whether the notebook exists yet.
+    """
+
+    number: int
+    title: str
+    notebook: str
+    subpackages: tuple[str, ...]
+    sources: str
+    status: str
+
+    def __str__(self) -> str:
+        return f"{self.number:02d} {self.title} ({self.notebook}; {self.sources}; {self.status})"
+
+
+#: Every chapter in order.
+CHAPTERS: tuple[Chapter, ...] = (
+    Chapter(0, "Overview: the SLAM problem and the lab", "00_overview.ipynb",
+            ("slamlab.plotting",), "000 §1, §1.1", "available"),
+    Chapter(1, "Kalman filter variants: KF, EKF, UKF", "01_kalman_filters.ipynb",
+            ("slamlab.filters",), "000 §1.2, §3.6; 003 §2.1.1", "available"),
+    Chapter(2, "Feature detectors and descriptors", "02_feature_detectors.ipynb",
+            ("slamlab.features",), "000 §1.4; 003 §3", "planned"),
+    Chapter(3, "Feature matching: kd-tree and BBF", "03_feature_matching.ipynb",
+            ("slamlab.features", "slamlab.kdtree"), "000 §1.4.3; 003 §3", "planned"),
+    Chapter(4, "Landmark stores: kd-tree vs multi kd-tree", "04_landmark_stores.ipynb",
+            ("slamlab.kdtree",), "000 §3.4, §4", "planned"),
+    Chapter(5, "Stereo SLAM", "05_stereo_slam.ipynb",
+            ("slamlab.stereo",), "000 §3", "planned"),
+    Chapter(6, "Correlation localisation on a known map", "06_correlation_localisation.ipynb",
+            ("slamlab.correlation",), "004", "planned"),
+    Chapter(7, "Hough-transform SLAM", "07_hough_slam.ipynb",
+            ("slamlab.hough",), "004", "planned"),
+    Chapter(8, "Probabilistic localisation: Markov, MCL", "08_probabilistic_localisation.ipynb",
+            ("slamlab.localisation",), "003 §2.2; 002", "planned"),
+    Chapter(9, "Monocular mapping", "09_monocular_mapping.ipynb",
+            ("slamlab.mono",), "003 §2.1, §4", "planned"),
+)
+
+#: Library-only topics used by several chapters: (title, where used, subpackage, sources, status).
+SHARED_TOPICS: tuple[tuple[str, str, str, str, str], ...] = (
+    ("Trajectory evaluation: ATE, RPE", "(library; used by 05, 09)", "slamlab.evaluation", "003 §5.2",
+     "planned"),
+)
+
+
+def get_chapter(number: int) -> Chapter:
+    """The chapter with the given notebook number.
+
+    >>> get_chapter(1).notebook
+    '01_kalman_filters.ipynb'
+    """
+    for chapter in CHAPTERS:
+        if chapter.number == number:
+            return chapter
+    raise ValueError(f"`number` must be one of {[c.number for c in CHAPTERS]}; got {number!r}")
+
+
+def chapter_table() -> str:
+    """The chapter map as a fixed-width text table (printed in ``00_overview``).
+
+    Examples
+    --------
+    >>> print(chapter_table().splitlines()[0])
+    NN  chapter                                    notebook                             subpackage                         source                      status
+    """
+    head = ("NN", "chapter", "notebook", "subpackage", "source", "status")
+    rows = [
+        (f"{c.number:02d}", c.title, c.notebook, ", ".join(c.subpackages), c.sources, c.status)
+        for c in CHAPTERS
+    ]
+    rows += [("--", *topic) for topic in SHARED_TOPICS]
+    widths = [max(len(r[i]) for r in [head, *rows]) for i in range(len(head))]
+
+    def fmt(r):
+        return "  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)).rstrip()
+
+    lines = [fmt(head), "  ".join("-" * w for w in widths)]
+    lines += [fmt(r) for r in rows]
+    return "\n".join(lines)
