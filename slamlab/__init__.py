@@ -11,11 +11,26 @@ The notebooks start with::
 
 from __future__ import annotations
 
+import importlib
+from types import ModuleType
+
 from . import chapters, data, filters, geometry, plotting, sim
 
 __version__ = "0.1.0"
 
 __all__ = ["__version__", "chapters", "data", "filters", "geometry", "notebook_setup", "plotting", "sim"]
+
+
+def __getattr__(name: str) -> ModuleType:
+    """Import a chapter subpackage on first use: ``sl.kdtree``, ``sl.hough``, ... (PEP 562)."""
+    if name.startswith("_"):
+        raise AttributeError(name)
+    try:
+        return importlib.import_module(f"{__name__}.{name}")
+    except ModuleNotFoundError as exc:
+        if exc.name == f"{__name__}.{name}":
+            raise AttributeError(f"module 'slamlab' has no attribute or subpackage {name!r}") from None
+        raise
 
 
 def notebook_setup(*, dpi: int = 80, precision: int = 4) -> None:
