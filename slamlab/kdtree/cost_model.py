@@ -1,0 +1,197 @@
+"""Cost model of the multi kd-tree and its optimum (000 §4.1.2 and Appendix).
+
+A multi kd-tree keeps static trees with maximum sizes ``n1, q n1, q^2 n1, ...``;
+``p`` is the number of non-empty trees. 000 bounds ``p`` by (1)-(3)::
+
+    log_q(n/n1 (q-1) + 1) <= p <= log_q(n/n1) + 1
+
+and estimates, with all logarithms base 2 (the Appendix's ``log_2``)::
+
+    T_search(n1, q) = p log n1 + p(p-1)/2 log q                  (one query over p trees)
+    T_modify(n1, q) = m q p log n1 + m q p(p-1)/2 log q          (mean cost of merges per iteration)
+    iterTime        = n1 log n1 + T_modify + C s T_search         (per iteration)
+
+with ``C = C1/C2`` the cost of one search step relative to one build step,
+calibrated by 000 from one tree (``s = 526`` searches in 79 ms, ``m = 678``
+inserts in 750 ms at ``n = 44828``, an insert costing a rebuild of all ``n``
+points): ``C = (79/526)/(750/44828) = 8.98``.
+
+Which reading lands on 000's optimum (``q = 5.5, n1 ≈ 3500`` read off a Maple
+plot for ``n = 50000, s = m = 500, C = 9``) is for :func:`run_cost_model` to
+show: the build term ``n1 log n1`` and ``p`` at its upper bound (real) give
+``n1 ≈ 3430, q ≈ 5.3``; without the build term the optimum runs to the edge.
+The Appendix's own text differs from §4.1.2 in two places that we read as
+slips: its ``searchKd`` multiplies the ``p(p-1)/2 log q`` term by ``C`` and its
+``iterTime = addKd + C searchKd`` lacks the factor ``s``; taken literally they
+give ``n1 ≈ 1200, q ≈ 2.3``, far from 000's plot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as v
+from .._table import format_table
+
+__all__ = [
+    "P_RULES",
+    "CostModelResult",
+    "calibrate_C",
+    "iter_time",
+    "minimise_iter_time",
+    "p_bounds",
+    "run_cost_model",
+    "t_modify",
+    "t_search",
+]
+
+#: How ``p`` is taken from the bounds (3): 000's surface uses a real ``p``.
+P_RULES = ("upper", "lower", "integer")
+
+
+def p_bounds(n, n1, q):
+    """Lower and upper bound of the number of non-empty trees ``p`` (000 §4.1.2, eq. 3).
+
+    >>> lo, hi = p_bounds(50000, 3500, 5.5)
+    >>> round(float(lo), 3), round(float(hi), 3)
+    (2.451, 2.56)
+    """
+    n, n1, q = (np.asarray(a, dtype=float) for a in (n, n1, q))
+    lo = np.log(n / n1 * (q - 1.0) + 1.0) / np.log(q)
+    hi = np.log(n / n1) / np.log(q) + 1.0
+    return lo, hi
+
+
+def _p(n, n1, q, p_rule):
+    lo, hi = p_bounds(n, n1, q)
+    if p_rule == "upper":
+        return hi
+    if p_rule == "lower":
+        return lo
+    # integer: the number of trees actually needed to hold n points
+    return np.ceil(lo - 1e-12)
+
+
+def t_search(n1, q, p):
+    """``T_search = p log2 n1 + p(p-1)/2 log2 q``: one query over ``p`` trees (000 §4.1.2).
+
+    >>> float(t_search(1024, 2.0, 1))
+    10.0
+    """
+    n1, q, p = (np.asarray(a, dtype=float) for a in (n1, q, p))
+    return p * np.log2(n1) + p * (p - 1.0) / 2.0 * np.log2(q)
+
+
+def t_modify(n1, q, p, m):
+    """``T_modify = m q p log2 n1 + m q p(p-1)/2 log2 q``: mean merge cost per iteration (000 §4.1.2).
+
+    >>> float(t_modify(1024, 2.0, 1, 10))
+    200.0
+    """
+    n1, q, p = (np.asarray(a, dtype=float) for a in (n1, q, p))
+    return m * q * t_search(n1, q, p)
+
+
+def iter_time(n1, q, *, n: float = 50000, s: float = 500, m: float = 500, C: float = 9.0,
+              p_rule: str = "upper", build_term: bool = True):
+    """Per-iteration cost ``[n1 log2 n1] + T_modify + C s T_search`` (000 Appendix), element-wise.
+
+    ``p_rule`` picks ``p`` from the bounds (3); ``build_term=False`` drops
+    ``n1 log2 n1`` (§4.1.2's ``f = T_modify + C s T_search``).
+    """
+    v.check_choice(p_rule, "p_rule", P_RULES)
+    n1 = np.asarray(n1, dtype=float)
+    q = np.asarray(q, dtype=float)
+    if np.any(n1 <= 1) or np.any(q <= 1):
+        raise ValueError("`n1` and `q` must be > 1")
+    p = _p(n, n1, q, p_rule)
+    out = t_modify(n1, q, p, m) + C * s * t_search(n1, q, p)
+    return out + n1 * np.log2(n1) if build_term else out
+
+
+def calibrate_C(s: float, t_search_s: float, m: float, t_modify_s: float, n: float) -> float:
+    """``C = C1 / C2`` from one tree: ``C1 s log n = t_s``, ``C2 n log n = t_m`` (000 §4.1.2).
+
+    The insert of ``m`` points is modelled as a rebuild of all ``n`` points, so
+    ``m`` does not enter. 000's numbers give 8.98:
+
+    >>> round(calibrate_C(526, 0.079, 678, 0.750, 44828), 2)
+    8.98
+    """
+    for val, name in ((s, "s"), (t_search_s, "t_search_s"), (t_modify_s, "t_modify_s"), (n, "n")):
+        v.check_positive(val, name)
+    v.check_positive(m, "m")
+    return (t_search_s / s) / (t_modify_s / n)
+
+
+def minimise_iter_time(*, n: float = 50000, s: float = 500, m: float = 500, C: float = 9.0, p_rule: str = "upper",
+                       build_term: bool = True, n1_range=(500.0, 20000.0), q_range=(1.5, 10.0),
+                       grid: tuple[int, int] = (391, 171)):
+    """Grid minimum of :func:`iter_time` over ``n1_range × q_range`` (000's Maple plot ranges).
+
+    Returns ``(n1, q, value, N1, Q, F)`` with the grid for plotting. The grid
+    steps are 50 points in ``n1`` and 0.05 in ``q`` by default.
+    """
+    N1 = np.linspace(*n1_range, grid[0])
+    Q = np.linspace(*q_range, grid[1])
+    F = iter_time(N1[:, None], Q[None, :], n=n, s=s, m=m, C=C, p_rule=p_rule, build_term=build_term)
+    i, j = np.unravel_index(np.argmin(F), F.shape)
+    return float(N1[i]), float(Q[j]), float(F[i, j]), N1, Q, F
+
+
+@dataclass(frozen=True)
+class CostModelResult:
+    """Optimum of the multi kd-tree cost model under each reading of 000's formulas."""
+
+    n: float
+    s: float
+    m: float
+    C: float
+    readings: tuple[tuple[str, float, float, float, bool], ...]  # (name, n1, q, cost, at_edge)
+    flat_n1: tuple[float, float]  # n1 range within 1 % of the minimum (main reading)
+    flat_q: tuple[float, float]
+    N1: np.ndarray = field(repr=False)
+    Q: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)  # main reading's surface
+
+    def __str__(self) -> str:
+        _name, n1, q, _, _ = self.readings[0]
+        return (f"multi kd-tree optimum (first reading): n1 = {n1:.0f}, q = {q:.2f} for n = {self.n:.0f}, "
+                f"s = {self.s:.0f}, m = {self.m:.0f}, C = {self.C:.2f} (000: n1 ≈ 3500, q = 5.5)")
+
+    def table(self) -> str:
+        rows = [[name, f"{n1:.0f}", f"{q:.2f}", "edge of the range" if edge else ""]
+                for name, n1, q, _, edge in self.readings]
+        rows.append(["000 (read off its Maple plot)", "3500", "5.50", ""])
+        t = format_table(["reading of 000's formulas", "n1", "q", "note"], rows)
+        return (t + f"\nwithin 1 % of the minimum (first reading): n1 {self.flat_n1[0]:.0f}-{self.flat_n1[1]:.0f},"
+                f" q {self.flat_q[0]:.2f}-{self.flat_q[1]:.2f}")
+
+
+def run_cost_model(*, n: float = 50000, s: float = 500, m: float = 500, C: float = 9.0) -> CostModelResult:
+    """Minimise the cost under 000's readings and report each optimum (000 §4.1.2, Appendix)."""
+    n = v.check_positive(n, "n")
+    s = v.check_positive(s, "s")
+    m = v.check_positive(m, "m")
+    C = v.check_positive(C, "C")
+    specs = [
+        ("Appendix: n1 log n1 + T_modify + C s T_search, p upper (real)", "upper", True),
+        ("same, p at the lower bound (real)", "lower", True),
+        ("same, p integer (trees actually needed)", "integer", True),
+        ("§4.1.2 f = T_modify + C s T_search (no build term)", "upper", False),
+    ]
+    readings = []
+    main = None
+    for name, rule, build in specs:
+        n1, q, val, N1, Q, F = minimise_iter_time(n=n, s=s, m=m, C=C, p_rule=rule, build_term=build)
+        edge = n1 in (N1[0], N1[-1]) or q in (Q[0], Q[-1])
+        readings.append((name, n1, q, val, bool(edge)))
+        if main is None:
+            main = (N1, Q, F)
+    N1, Q, F = main
+    near = 1.01 * F.min() >= F
+    flat_n1 = (float(N1[near.any(axis=1)].min()), float(N1[near.any(axis=1)].max()))
+    flat_q = (float(Q[near.any(axis=0)].min()), float(Q[near.any(axis=0)].max()))
+    return CostModelResult(n, s, m, C, tuple(readings), flat_n1, flat_q, N1, Q, F)
