@@ -71,7 +71,7 @@ CHAPTERS: tuple[Chapter, ...] = (
 #: Library-only topics used by several chapters: (title, where used, subpackage, sources, status).
 SHARED_TOPICS: tuple[tuple[str, str, str, str, str], ...] = (
     ("Trajectory evaluation: ATE, RPE", "(library; used by 05, 09)", "slamlab.evaluation", "003 §5.2",
-     "planned"),
+     "available"),
 )
 
 
