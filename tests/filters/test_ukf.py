@@ -185,3 +185,24 @@ def test_cholesky_failure_names_the_step():
     with pytest.raises(CholeskyError, match=r"Cholesky factorisation failed in ukf_predict \(sigma points\)"):
         ukf_predict(np.zeros(2), bad_P, lambda x, u: x, np.zeros((2, 2)), form="additive")
     assert issubclass(CholeskyError, ValueError)
+
+
+@pytest.mark.parametrize("form", ["augmented", "additive"])
+def test_class_agrees_with_functions(robot, form):
+    model, sensor, U, _, Z = robot
+    x, P = np.array([0.1, 0.0, 0.05]), 0.2 * np.eye(3)
+    Q = model.M if form == "augmented" else model.Q(x, U[0])
+    hooks = {"z_mean_fn": sensor.mean, "z_residual_fn": sensor.residual}
+    ukf = UnscentedKalmanFilter(x, P, model.f, Q, sensor.h, sensor.R, form=form, alpha=0.5, x_mean_fn=model.mean,
+                                x_residual_fn=model.residual, vectorized=True, **hooks)
+    for u, z in zip(U[:8], Z[:8], strict=True):
+        ukf.predict(u)
+        ukf.update(z)
+        x, P = ukf_predict(x, P, model.f, Q, u, form=form, alpha=0.5, mean_fn=model.mean,
+                           residual_fn=model.residual, vectorized=True)
+        upd = ukf_update(x, P, z, sensor.h, sensor.R, form=form, alpha=0.5, x_residual_fn=model.residual,
+                         vectorized=True, **hooks)
+        x, P = upd.x, upd.P
+        np.testing.assert_allclose(ukf.x, x, rtol=1e-13, atol=1e-15)
+        np.testing.assert_allclose(ukf.P, P, rtol=1e-13, atol=1e-15)
+        np.testing.assert_allclose(ukf.S, upd.S, rtol=1e-13, atol=1e-15)
