@@ -5,3 +5,27 @@ from .ellipse import covariance_ellipse
 from .registration import RigidTransform, apply_transform, umeyama
 
 __all__ = ["RigidTransform", "angle_mean", "apply_transform", "covariance_ellipse", "umeyama", "wrap_angle"]
+
+# --- pinhole camera, stereo rig, midpoint triangulation, RANSAC, SE(3) helpers (000 §3) ---
+from .camera import PinholeCamera, StereoRig, focal_from_hfov, fundamental_matrix, rotation_xyz
+from .ransac import RansacResult, ransac
+from .se3 import planar_from_se3, se3, se3_from_planar, se3_inverse, yaw_from_R
+from .triangulation import Triangulation, triangulate_midpoint, triangulate_stereo
+
+__all__ += [
+    "PinholeCamera",
+    "RansacResult",
+    "StereoRig",
+    "Triangulation",
+    "focal_from_hfov",
+    "fundamental_matrix",
+    "planar_from_se3",
+    "ransac",
+    "rotation_xyz",
+    "se3",
+    "se3_from_planar",
+    "se3_inverse",
+    "triangulate_midpoint",
+    "triangulate_stereo",
+    "yaw_from_R",
+]

@@ -1,0 +1,212 @@
+"""Pinhole camera and stereo rig (000 §3.2-3.3).
+
+Camera frame as in OpenCV: ``x`` right, ``y`` down, ``z`` forward (optical axis).
+Pixel coordinates are ``(u, v) = (column, row)`` with the centre of the top-left
+pixel at ``(0, 0)``. The rig of 000 §3.2: two cameras of 768×576 pixels and a 40°
+horizontal field of view, which gives a focal length of
+``f = (768 / 2) / tan(20°) ≈ 1055 px``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as v
+
+__all__ = [
+    "PinholeCamera",
+    "StereoRig",
+    "focal_from_hfov",
+    "fundamental_matrix",
+    "rotation_xyz",
+]
+
+
+def focal_from_hfov(width_px: int, hfov_rad: float) -> float:
+    """Focal length in pixels for a horizontal field of view (000 §3.2).
+
+    ``f = (W / 2) / tan(hfov / 2)``.
+
+    >>> round(focal_from_hfov(768, np.deg2rad(40.0)), 3)
+    1055.031
+    """
+    width_px = v.check_int(width_px, "width_px", minimum=1)
+    hfov_rad = v.check_positive(hfov_rad, "hfov_rad")
+    if hfov_rad >= np.pi:
+        raise ValueError(f"`hfov_rad` must be < pi; got {hfov_rad}")
+    return float(0.5 * width_px / np.tan(0.5 * hfov_rad))
+
+
+def rotation_xyz(rx_rad: float = 0.0, ry_rad: float = 0.0, rz_rad: float = 0.0) -> np.ndarray:
+    """Rotation ``Rz @ Ry @ Rx`` from three angles (small extrinsic changes, our helper).
+
+    >>> np.allclose(rotation_xyz(0, 0, np.pi / 2) @ [1, 0, 0], [0, 1, 0])
+    True
+    """
+    cx, sx = np.cos(rx_rad), np.sin(rx_rad)
+    cy, sy = np.cos(ry_rad), np.sin(ry_rad)
+    cz, sz = np.cos(rz_rad), np.sin(rz_rad)
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+@dataclass(frozen=True)
+class PinholeCamera:
+    """Pinhole camera ``u = fx x / z + cx``, ``v = fy y / z + cy`` (000 §3.3).
+
+    Build it from the field of view with :meth:`from_hfov`.
+
+    >>> cam = PinholeCamera.from_hfov(768, 576, np.deg2rad(40.0))
+    >>> cam.project([[0.0, 0.0, 2.0]])
+    array([[383.5, 287.5]])
+    """
+
+    width_px: int
+    height_px: int
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+
+    def __post_init__(self):
+        v.check_int(self.width_px, "width_px", minimum=1)
+        v.check_int(self.height_px, "height_px", minimum=1)
+        for name in ("fx", "fy"):
+            v.check_positive(getattr(self, name), name)
+        for name in ("cx", "cy"):
+            val = getattr(self, name)
+            if isinstance(val, bool) or not np.isfinite(float(val)):
+                raise ValueError(f"`{name}` must be a finite number; got {val!r}")
+
+    @classmethod
+    def from_hfov(cls, width_px: int = 768, height_px: int = 576, hfov_rad: float = np.deg2rad(40.0)) -> PinholeCamera:
+        """Square pixels, principal point at the image centre, focal length from ``hfov_rad``."""
+        f = focal_from_hfov(width_px, hfov_rad)
+        height_px = v.check_int(height_px, "height_px", minimum=1)
+        return cls(width_px, height_px, f, f, (width_px - 1) / 2.0, (height_px - 1) / 2.0)
+
+    @property
+    def K(self) -> np.ndarray:
+        """The 3×3 intrinsic matrix."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def project(self, points_cam) -> np.ndarray:
+        """Pixel coordinates ``(N, 2)`` of camera-frame points ``(N, 3)`` (``z`` must be > 0)."""
+        P = v.as_finite_array(points_cam, "points_cam", ndim=2)
+        if P.shape[1] != 3:
+            raise ValueError(f"`points_cam` must have shape (N, 3); got {P.shape}")
+        if np.any(P[:, 2] <= 0):
+            raise ValueError("`points_cam` must lie in front of the camera (z > 0)")
+        z = P[:, 2]
+        return np.column_stack([self.fx * P[:, 0] / z + self.cx, self.fy * P[:, 1] / z + self.cy])
+
+    def backproject(self, uv) -> np.ndarray:
+        """Viewing-ray directions ``(N, 3)`` with ``z = 1`` through pixels ``uv (N, 2)``."""
+        uv = v.as_finite_array(uv, "uv", ndim=2)
+        if uv.shape[1] != 2:
+            raise ValueError(f"`uv` must have shape (N, 2); got {uv.shape}")
+        return np.column_stack([(uv[:, 0] - self.cx) / self.fx, (uv[:, 1] - self.cy) / self.fy, np.ones(len(uv))])
+
+    def pixel_rays(self) -> np.ndarray:
+        """Ray directions ``(H, W, 3)`` (``z = 1``) through every pixel centre, for rendering."""
+        u = (np.arange(self.width_px) - self.cx) / self.fx
+        w = (np.arange(self.height_px) - self.cy) / self.fy
+        rays = np.empty((self.height_px, self.width_px, 3))
+        rays[..., 0] = u[None, :]
+        rays[..., 1] = w[:, None]
+        rays[..., 2] = 1.0
+        return rays
+
+
+def _skew(t):
+    return np.array([[0.0, -t[2], t[1]], [t[2], 0.0, -t[0]], [-t[1], t[0], 0.0]])
+
+
+def fundamental_matrix(K_left, K_right, R, t) -> np.ndarray:
+    """``F`` with ``x_r^T F x_l = 0`` for a right camera at ``x_r = R x_l + t`` (000 §3.3).
+
+    >>> K = np.eye(3); F = fundamental_matrix(K, K, np.eye(3), [-1.0, 0, 0])
+    >>> float(np.array([0.5, 0.2, 1.0]) @ F @ np.array([0.7, 0.2, 1.0]))
+    0.0
+    """
+    K_left = v.as_matrix(K_left, "K_left", (3, 3))
+    K_right = v.as_matrix(K_right, "K_right", (3, 3))
+    R = v.as_matrix(R, "R", (3, 3))
+    t = v.as_vector(t, "t", 3)
+    E = _skew(t) @ R
+    return np.linalg.inv(K_right).T @ E @ np.linalg.inv(K_left)
+
+
+@dataclass(frozen=True)
+class StereoRig:
+    """Two pinhole cameras; the right one at ``x_r = R_rl x_l + t_rl`` (000 §3.2-3.3).
+
+    ``R_rl, t_rl`` is the calibrated "transfer matrix from one camera to the
+    other" of 000 §3.3. :meth:`parallel` builds the usual rig: same camera
+    twice, the right one ``baseline_m`` to the right of the left one.
+
+    >>> rig = StereoRig.parallel(baseline_m=0.2)
+    >>> rig.right_center_m
+    array([0.2, 0. , 0. ])
+    """
+
+    left: PinholeCamera
+    right: PinholeCamera
+    R_rl: np.ndarray = field(repr=False)
+    t_rl: np.ndarray = field(repr=False)
+
+    def __post_init__(self):
+        if not isinstance(self.left, PinholeCamera) or not isinstance(self.right, PinholeCamera):
+            raise TypeError("`left` and `right` must be PinholeCamera instances")
+        R = v.as_matrix(self.R_rl, "R_rl", (3, 3))
+        if not np.allclose(R.T @ R, np.eye(3), atol=1e-9) or np.linalg.det(R) <= 0:
+            raise ValueError("`R_rl` must be a proper rotation matrix")
+        object.__setattr__(self, "R_rl", R)
+        object.__setattr__(self, "t_rl", v.as_vector(self.t_rl, "t_rl", 3))
+
+    @classmethod
+    def parallel(
+        cls,
+        baseline_m: float = 0.2,
+        width_px: int = 768,
+        height_px: int = 576,
+        hfov_rad: float = np.deg2rad(40.0),
+    ) -> StereoRig:
+        """A rectified rig: identical cameras, parallel axes, ``baseline_m`` apart along ``x``."""
+        baseline_m = v.check_positive(baseline_m, "baseline_m")
+        cam = PinholeCamera.from_hfov(width_px, height_px, hfov_rad)
+        return cls(cam, cam, np.eye(3), np.array([-baseline_m, 0.0, 0.0]))
+
+    @property
+    def baseline_m(self) -> float:
+        """Distance between the two optical centres."""
+        return float(np.linalg.norm(self.t_rl))
+
+    @property
+    def right_center_m(self) -> np.ndarray:
+        """Optical centre of the right camera in the left camera's frame: ``-R^T t``."""
+        return -self.R_rl.T @ self.t_rl
+
+    @property
+    def F(self) -> np.ndarray:
+        """Fundamental matrix, ``x_r^T F x_l = 0``."""
+        return fundamental_matrix(self.left.K, self.right.K, self.R_rl, self.t_rl)
+
+    def project(self, points_left) -> tuple[np.ndarray, np.ndarray]:
+        """Pixels in the left and right images of points given in the left camera frame."""
+        P = v.as_finite_array(points_left, "points_left", ndim=2)
+        if P.shape[1] != 3:
+            raise ValueError(f"`points_left` must have shape (N, 3); got {P.shape}")
+        return self.left.project(P), self.right.project(P @ self.R_rl.T + self.t_rl)
+
+    def rays(self, uv_left, uv_right) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Both viewing rays in the left frame: ``(c_left, d_left, c_right, d_right)`` (000 §3.3)."""
+        d_l = self.left.backproject(uv_left)
+        d_r = self.right.backproject(uv_right) @ self.R_rl  # R^T d for each row
+        if d_l.shape != d_r.shape:
+            raise ValueError(f"`uv_left` and `uv_right` must have the same shape; got {d_l.shape[0]} and {d_r.shape[0]} rows")
+        return np.zeros(3), d_l, self.right_center_m, d_r

@@ -1,0 +1,310 @@
+"""The simulated lunar arena of 000 §3.2/§3.7: a textured fence and floor seen by a stereo pair.
+
+World frame: ``x`` along the arena width, ``y`` along its length, ``z`` up; the
+arena is the box ``[0, W] × [0, L]`` closed by a vertical fence ``H`` high
+(000 §3.7: ~0.5 m, covered with photographs of the lunar surface — here the
+procedural textures of :mod:`slamlab.sim.textures`). Above the fence lies a
+featureless dark background.
+
+Robot (body) frame: ``x`` forward, ``y`` left, ``z`` up, origin on the floor
+below the middle of the stereo rig. The left camera sits ``baseline / 2`` to
+the left of it at ``camera_height_m`` and looks forward (000 §3.2: 768×576,
+40° field of view; the baseline is not given in 000 — ours 0.2 m).
+
+Rendering casts the ray of every pixel against the five planes (four fence
+walls and the floor) at once and samples the textures bilinearly.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from .. import _validate as v
+from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
+from ..geometry.se3 import se3, se3_from_planar
+from .textures import lunar_texture
+
+__all__ = ["R_BODY_CAM", "StereoArena", "StereoSim"]
+
+#: camera axes (x right, y down, z forward) expressed in the body frame (x forward, y left, z up)
+R_BODY_CAM = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+
+SKY, FLOOR, WALL = 0, 1, 2
+MIP_LEVELS = 4  # texture pyramid levels: a pixel samples the level matching its footprint
+
+
+def _mip_levels(tex, n):
+    """Gaussian pyramid ``[tex, pyrDown(tex), ...]`` (pixel ``i`` of level ``k`` sits at ``2^k i``)."""
+    levels = [tex]
+    for _ in range(n - 1):
+        if min(levels[-1].shape) < 4:
+            break
+        levels.append(cv2.pyrDown(levels[-1]))
+    return levels
+
+
+def _sample_mip(levels, r, c, footprint_texels, wrap_cols):
+    """Bilinear sample of the pyramid level whose texel matches the pixel footprint (anti-aliasing)."""
+    lvl = np.clip(np.floor(np.log2(np.maximum(footprint_texels, 1.0))), 0, len(levels) - 1).astype(np.intp)
+    out = np.empty(r.shape, dtype=np.float32)
+    for k, tex in enumerate(levels):
+        m = lvl == k
+        if m.any():
+            scale = 0.5**k
+            out[m] = _bilinear(tex, r[m] * scale, c[m] * scale, wrap_cols)
+    return out
+
+
+def _bilinear(tex, r, c, wrap_cols: bool):
+    """Sample ``tex`` at fractional (row, col); rows clamped, columns wrapped or clamped."""
+    rows, cols = tex.shape
+    r = np.clip(r, 0.0, rows - 1.000001)
+    r0 = r.astype(np.intp)
+    fr = r - r0
+    if wrap_cols:
+        c = np.mod(c, cols)
+        c0 = c.astype(np.intp)
+        c1 = c0 + 1
+        c1[c1 == cols] = 0
+    else:
+        c = np.clip(c, 0.0, cols - 1.000001)
+        c0 = c.astype(np.intp)
+        c1 = c0 + 1
+    fc = c - c0
+    top = tex[r0, c0] * (1 - fc) + tex[r0, c1] * fc
+    bot = tex[r0 + 1, c0] * (1 - fc) + tex[r0 + 1, c1] * fc
+    return top * (1 - fr) + bot * fr
+
+
+class StereoArena:
+    """Closed rectangular arena with a textured fence and floor (000 §3.2, §3.7).
+
+    Parameters
+    ----------
+    width_m, length_m : arena size along ``x`` and ``y`` (000 §3.7: a 6×8 m visible area).
+    fence_height_m : fence height (000: ~0.5 m).
+    texel_m, floor_texel_m : texture resolution of the fence and of the floor.
+    floor_contrast : contrast of the floor texture relative to the fence (our choice: 0.6).
+    sky : brightness of the featureless background above the fence, in ``[0, 1]``.
+    seed : everything in the scene is deterministic from this seed.
+
+    Examples
+    --------
+    >>> arena = StereoArena(2.0, 3.0, texel_m=0.01, seed=1)
+    >>> arena.wall_texture.shape, arena.perimeter_m
+    ((50, 1000), 10.0)
+    """
+
+    def __init__(
+        self,
+        width_m: float = 6.0,
+        length_m: float = 8.0,
+        *,
+        fence_height_m: float = 0.5,
+        texel_m: float = 0.004,
+        floor_texel_m: float = 0.01,
+        floor_contrast: float = 0.6,
+        sky: float = 0.12,
+        seed: int = 0,
+    ):
+        self.width_m = v.check_positive(width_m, "width_m")
+        self.length_m = v.check_positive(length_m, "length_m")
+        self.fence_height_m = v.check_positive(fence_height_m, "fence_height_m")
+        self.texel_m = v.check_positive(texel_m, "texel_m")
+        self.floor_texel_m = v.check_positive(floor_texel_m, "floor_texel_m")
+        self.floor_contrast = v.check_positive(floor_contrast, "floor_contrast")
+        self.sky = float(np.clip(v.check_positive(sky, "sky", allow_zero=True), 0.0, 1.0))
+        self.seed = v.check_int(seed, "seed", minimum=0)
+        r_wall, r_floor = np.random.default_rng(self.seed).spawn(2)
+        rows = max(round(self.fence_height_m / self.texel_m), 2)
+        cols = max(round(self.perimeter_m / self.texel_m), 2)
+        # crater sizes in metres (1-12 cm on the fence, 2-30 cm on the floor) -> texels
+        n_wall = int(40 * self.perimeter_m * self.fence_height_m / 0.5)
+        self.wall_texture = lunar_texture(
+            (rows, cols), n_craters=n_wall, radius_px=(0.01 / self.texel_m, 0.12 / self.texel_m), noise_amp_px=1.0 / (self.texel_m / 0.004), rng=r_wall
+        ).astype(np.float32)
+        frows = max(round(self.length_m / self.floor_texel_m), 2)
+        fcols = max(round(self.width_m / self.floor_texel_m), 2)
+        n_floor = int(12 * self.width_m * self.length_m)
+        self.floor_texture = lunar_texture(
+            (frows, fcols),
+            n_craters=n_floor,
+            radius_px=(0.015 / self.floor_texel_m, 0.2 / self.floor_texel_m),
+            noise_amp_px=1.0,
+            contrast=self.floor_contrast,
+            rng=r_floor,
+        ).astype(np.float32)
+        self._wall_mips = _mip_levels(self.wall_texture, MIP_LEVELS)
+        self._floor_mips = _mip_levels(self.floor_texture, MIP_LEVELS)
+        self._ray_cache: dict = {}
+
+    @property
+    def perimeter_m(self) -> float:
+        """Length of the fence; the fence texture's column axis runs along it."""
+        return 2.0 * (self.width_m + self.length_m)
+
+    def contains(self, xy_m) -> np.ndarray:
+        """True where the points ``(N, 2)`` lie strictly inside the arena."""
+        xy = v.as_finite_array(xy_m, "xy_m", ndim=2)
+        return (xy[:, 0] > 0) & (xy[:, 0] < self.width_m) & (xy[:, 1] > 0) & (xy[:, 1] < self.length_m)
+
+    def _rays(self, camera: PinholeCamera) -> np.ndarray:
+        rays = self._ray_cache.get(camera)
+        if rays is None:
+            rays = camera.pixel_rays().reshape(-1, 3).astype(np.float32)
+            self._ray_cache = {camera: rays}
+        return rays
+
+    def cast(self, camera: PinholeCamera, T_world_cam) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Cast every pixel's ray (000 §3.2): ``(surface (H, W), t (H, W), points (H, W, 3))``.
+
+        ``surface`` is 0 (background), 1 (floor) or 2 (fence); ``t`` the ray parameter
+        (depth ``z`` in the camera frame, rays have ``z = 1``); ``points`` world hits (NaN on the background).
+        """
+        surface, t, d, o = self._cast(camera, T_world_cam)
+        pts = o + t[:, None].astype(np.float64) * d
+        pts[surface == SKY] = np.nan
+        shape = (camera.height_px, camera.width_px)
+        return surface.reshape(shape), t.reshape(shape), pts.reshape((*shape, 3))
+
+    def _cast(self, camera, T_world_cam):
+        if not isinstance(camera, PinholeCamera):
+            raise TypeError(f"`camera` must be a PinholeCamera; got {type(camera).__name__}")
+        T = v.as_matrix(T_world_cam, "T_world_cam", (4, 4))
+        o = T[:3, 3]
+        if not (0 < o[0] < self.width_m and 0 < o[1] < self.length_m and o[2] > 0):
+            raise ValueError(f"the camera must be inside the arena above the floor; got position {np.round(o, 3).tolist()}")
+        d = self._rays(camera) @ T[:3, :3].T.astype(np.float32)
+        dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
+        W, L, H = self.width_m, self.length_m, self.fence_height_m
+        # ray parameters of the exits through the x-walls, the y-walls and the floor (camera inside
+        # the box, so every distance is positive; a zero direction component gives +inf)
+        with np.errstate(divide="ignore"):
+            tx = np.where(dx > 0, W - o[0], o[0]) / np.abs(dx)
+            ty = np.where(dy > 0, L - o[1], o[1]) / np.abs(dy)
+            tf = o[2] / np.maximum(-dz, 0.0)
+        tw = np.minimum(tx, ty)
+        floor = tf < tw
+        wall = ~floor & (o[2] + tw * dz <= H)
+        surface = floor.view(np.uint8) + 2 * wall.view(np.uint8)
+        t = np.where(floor, tf, tw)
+        t[surface == SKY] = np.inf
+        return surface, t, d, o
+
+    def wall_coordinate(self, points_m) -> np.ndarray:
+        """Arc length ``s`` along the fence (y=0 wall, then x=W, y=L, x=0) of points on it."""
+        P = v.as_finite_array(points_m, "points_m", ndim=2)
+        x, y = P[:, 0], P[:, 1]
+        W, L = self.width_m, self.length_m
+        dist = np.column_stack([np.abs(y), np.abs(x - W), np.abs(y - L), np.abs(x)])
+        side = np.argmin(dist, axis=1)
+        s = np.choose(side, [x, W + y, W + L + (W - x), 2 * W + L + (L - y)])
+        return s
+
+    def render(self, camera: PinholeCamera, T_world_cam) -> np.ndarray:
+        """Noise-free float32 image ``(H, W)`` in ``[0, 1]`` seen by ``camera`` at pose ``T_world_cam``.
+
+        >>> arena = StereoArena(2.0, 3.0, texel_m=0.01, seed=1)
+        >>> cam = PinholeCamera.from_hfov(64, 48)
+        >>> T = se3(R_BODY_CAM, [1.0, 1.0, 0.3])
+        >>> img = arena.render(cam, T); img.shape, img.dtype
+        ((48, 64), dtype('float32'))
+        """
+        surface, t, d, o = self._cast(camera, T_world_cam)
+        img = np.full(surface.shape, self.sky, dtype=np.float32)
+        f = surface == FLOOR
+        # pixel footprint on the surface (m): t |d|^2 / (f |d . n|) along the steepest direction
+        dn2 = np.einsum("ij,ij->i", d, d)
+        pix = 1.0 / min(camera.fx, camera.fy)
+        if f.any():
+            df = d[f]
+            p = o + t[f, None] * df
+            fp = t[f] * dn2[f] * pix / (np.abs(df[:, 2]) * self.floor_texel_m)
+            img[f] = _sample_mip(self._floor_mips, p[:, 1] / self.floor_texel_m, p[:, 0] / self.floor_texel_m, fp, False)
+        w = surface == WALL
+        if w.any():
+            dw = d[w]
+            p = o + t[w, None] * dw
+            s = self.wall_coordinate(p)
+            hit_x = np.minimum(np.abs(p[:, 0]), np.abs(p[:, 0] - self.width_m)) < np.minimum(np.abs(p[:, 1]), np.abs(p[:, 1] - self.length_m))
+            dnorm = np.where(hit_x, np.abs(dw[:, 0]), np.abs(dw[:, 1]))
+            fp = t[w] * dn2[w] * pix / (np.maximum(dnorm, 1e-6) * self.texel_m)
+            img[w] = _sample_mip(self._wall_mips, (self.fence_height_m - p[:, 2]) / self.texel_m, s / self.texel_m, fp, True)
+        return img.reshape(camera.height_px, camera.width_px)
+
+
+class StereoSim:
+    """A stereo rig on a robot in a :class:`StereoArena`: renders image pairs for body poses (000 §3.2).
+
+    Parameters
+    ----------
+    arena : the scene.
+    rig : the *calibrated* (nominal) rig; default :meth:`StereoRig.parallel` (0.2 m, 768×576, 40°).
+    camera_height_m : height of the optical centres above the floor.
+    noise_std : standard deviation of additive Gaussian image noise, in grey levels (0-255).
+    drift_std_rad : calibration drift (000 §3.2: "the calibration tends to change while
+        filming"): the true right-camera orientation takes a random-walk step of this standard
+        deviation per rendered frame about each axis, while the pipeline keeps the nominal ``rig``.
+    rng : Generator, int or None — the noise and drift streams.
+
+    Examples
+    --------
+    >>> sim = StereoSim(StereoArena(2.0, 3.0, texel_m=0.01), StereoRig.parallel(0.2, 64, 48), rng=0)
+    >>> left, right = sim.render_pair([1.0, 1.5, 0.0])
+    >>> left.shape, left.dtype
+    ((48, 64), dtype('uint8'))
+    """
+
+    def __init__(
+        self,
+        arena: StereoArena,
+        rig: StereoRig | None = None,
+        *,
+        camera_height_m: float = 0.4,
+        noise_std: float = 0.0,
+        drift_std_rad: float = 0.0,
+        rng=None,
+    ):
+        if not isinstance(arena, StereoArena):
+            raise TypeError(f"`arena` must be a StereoArena; got {type(arena).__name__}")
+        self.arena = arena
+        self.rig = StereoRig.parallel() if rig is None else rig
+        if not isinstance(self.rig, StereoRig):
+            raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
+        self.camera_height_m = v.check_positive(camera_height_m, "camera_height_m")
+        if self.camera_height_m >= arena.fence_height_m * 4:
+            raise ValueError(f"`camera_height_m` must be below {4 * arena.fence_height_m} m; got {camera_height_m}")
+        self.noise_std = v.check_positive(noise_std, "noise_std", allow_zero=True)
+        self.drift_std_rad = v.check_positive(drift_std_rad, "drift_std_rad", allow_zero=True)
+        self.rng = v.as_rng(rng)
+        self.drift_rad = np.zeros(3)
+        # left camera: baseline/2 to the left of the body origin; right camera from the rig
+        b = self.rig.baseline_m
+        self.T_body_left = se3(R_BODY_CAM, [0.0, 0.5 * b, self.camera_height_m])
+
+    def T_body_right(self, drift_rad=None) -> np.ndarray:
+        """Pose of the right camera in the body frame (with a drift rotation, if given)."""
+        R_rl = self.rig.R_rl if drift_rad is None else rotation_xyz(*drift_rad) @ self.rig.R_rl
+        T_right_left = se3(R_rl, self.rig.t_rl)
+        # T_body_right = T_body_left @ inv(T_right_left)
+        Rt = T_right_left[:3, :3].T
+        return self.T_body_left @ se3(Rt, -Rt @ T_right_left[:3, 3])
+
+    def render_pair(self, pose) -> tuple[np.ndarray, np.ndarray]:
+        """Left and right uint8 images for the body pose ``(x_m, y_m, yaw_rad)``; advances the drift."""
+        pose = v.as_vector(pose, "pose", 3)
+        T_wb = se3_from_planar(*pose)
+        if self.drift_std_rad > 0:
+            self.drift_rad = self.drift_rad + self.rng.normal(0.0, self.drift_std_rad, 3)
+        out = []
+        for cam, T_bc in ((self.rig.left, self.T_body_left), (self.rig.right, self.T_body_right(self.drift_rad))):
+            img = self.arena.render(cam, T_wb @ T_bc) * 255.0
+            if self.noise_std > 0:
+                img += self.rng.normal(0.0, self.noise_std, img.shape).astype(np.float32)
+            out.append(np.clip(np.rint(img), 0, 255).astype(np.uint8))
+        return out[0], out[1]
+
+    def ground_truth_se3(self, pose) -> np.ndarray:
+        """4×4 world pose of the body for ``(x_m, y_m, yaw_rad)``."""
+        return se3_from_planar(*v.as_vector(pose, "pose", 3))

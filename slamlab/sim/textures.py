@@ -1,0 +1,126 @@
+"""Procedural lunar-surface textures for the stereo arena (000 §3.7; our construction).
+
+000 §3.7 covers the arena fence with photographs of the Moon's surface. We
+cannot ship those photographs, so we synthesise look-alikes: a height field of
+fractal (1/f^beta) noise plus bowl-shaped craters with raised rims, lit from a
+low sun (Lambert shading) and multiplied by a slowly varying albedo. Every
+texture is periodic along both axes and deterministic from the seed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _validate as v
+
+__all__ = ["crater_heightfield", "fractal_noise", "lunar_texture"]
+
+
+def _shape(shape, name="shape"):
+    if not isinstance(shape, tuple | list) or len(shape) != 2:
+        raise ValueError(f"`{name}` must be (rows, cols); got {shape!r}")
+    return tuple(v.check_int(s, name, minimum=2) for s in shape)
+
+
+def fractal_noise(shape, beta: float = 2.0, rng=None) -> np.ndarray:
+    """Periodic fractal noise with power spectrum ``1 / f^beta``, zero mean, unit std (our texture).
+
+    >>> z = fractal_noise((32, 64), rng=0)
+    >>> z.shape, round(float(z.mean()), 12), round(float(z.std()), 12)
+    ((32, 64), 0.0, 1.0)
+    """
+    rows, cols = _shape(shape)
+    beta = v.check_positive(beta, "beta", allow_zero=True)
+    rng = v.as_rng(rng)
+    fy = np.fft.fftfreq(rows)[:, None]
+    fx = np.fft.rfftfreq(cols)[None, :]
+    f = np.hypot(fx, fy)
+    f[0, 0] = 1.0
+    amp = f ** (-beta / 2.0)
+    amp[0, 0] = 0.0
+    spec = amp * (rng.standard_normal(amp.shape) + 1j * rng.standard_normal(amp.shape))
+    z = np.fft.irfft2(spec, s=(rows, cols))
+    z -= z.mean()
+    return z / z.std()
+
+
+def crater_heightfield(shape, n_craters: int = 300, radius_px=(3.0, 40.0), slope: float = 2.2, rng=None) -> np.ndarray:
+    """Sum of craters: a parabolic bowl inside ``r < R`` and a rim decaying outside (our texture).
+
+    Radii follow a power law ``p(R) ~ R^-slope`` between ``radius_px``; depth is
+    ``0.2 R``; the field wraps around both edges.
+
+    >>> h = crater_heightfield((64, 64), n_craters=1, radius_px=(10.0, 10.0), rng=0)
+    >>> bool(h.min() < 0 < h.max())
+    True
+    """
+    rows, cols = _shape(shape)
+    n_craters = v.check_int(n_craters, "n_craters", minimum=0)
+    r_lo, r_hi = (v.check_positive(r, "radius_px") for r in v.as_vector(radius_px, "radius_px", 2))
+    if r_hi < r_lo:
+        raise ValueError(f"`radius_px` must be (min, max) with min <= max; got {tuple(radius_px)}")
+    slope = v.check_positive(slope, "slope")
+    rng = v.as_rng(rng)
+    h = np.zeros((rows, cols))
+    if n_craters == 0:
+        return h
+    # inverse-CDF sampling of the power law R^-slope on [r_lo, r_hi]
+    u = rng.random(n_craters)
+    a = 1.0 - slope
+    R = (r_lo**a + u * (r_hi**a - r_lo**a)) ** (1.0 / a) if r_hi > r_lo else np.full(n_craters, r_lo)
+    cy = rng.uniform(0, rows, n_craters)
+    cx = rng.uniform(0, cols, n_craters)
+    for Ri, yi, xi in zip(R, cy, cx, strict=True):  # a few hundred stamps, once per texture
+        ext = int(np.ceil(2.0 * Ri)) + 1
+        ys = np.arange(int(yi) - ext, int(yi) + ext + 1)
+        xs = np.arange(int(xi) - ext, int(xi) + ext + 1)
+        q = np.hypot((ys[:, None] - yi), (xs[None, :] - xi)) / Ri
+        bowl = (q**2 - 1.0) * 0.2 * Ri  # parabolic floor, zero at the rim
+        rim = 0.06 * Ri * np.exp(-((q - 1.0) ** 2) / 0.04)  # raised rim around r = R
+        prof = np.where(q < 1.0, bowl, 0.0) + rim * (q < 2.0)
+        h[np.ix_(ys % rows, xs % cols)] += prof
+    return h
+
+
+def lunar_texture(
+    shape,
+    *,
+    n_craters: int = 300,
+    radius_px=(3.0, 40.0),
+    noise_beta: float = 2.4,
+    noise_amp_px: float = 4.0,
+    sun_azimuth_rad: float = 0.6,
+    sun_elevation_rad: float = 0.5,
+    contrast: float = 1.0,
+    rng=None,
+) -> np.ndarray:
+    """A shaded lunar-surface-like image in ``[0, 1]``, periodic, deterministic from ``rng`` (000 §3.7).
+
+    Height = ``noise_amp_px`` × fractal noise + craters; brightness = albedo × Lambert
+    shading under a sun at ``sun_azimuth_rad`` / ``sun_elevation_rad``.
+
+    >>> t = lunar_texture((64, 96), rng=3)
+    >>> t.shape, bool(0.0 <= t.min() and t.max() <= 1.0)
+    ((64, 96), True)
+    >>> bool(np.array_equal(t, lunar_texture((64, 96), rng=3)))
+    True
+    """
+    rows, cols = _shape(shape)
+    noise_amp_px = v.check_positive(noise_amp_px, "noise_amp_px", allow_zero=True)
+    contrast = v.check_positive(contrast, "contrast")
+    rng = v.as_rng(rng)
+    r_noise, r_crater, r_albedo = rng.spawn(3)
+    h = noise_amp_px * fractal_noise((rows, cols), noise_beta, r_noise)
+    h += crater_heightfield((rows, cols), n_craters, radius_px, rng=r_crater)
+    # periodic central differences -> surface normal (-hx, -hy, 1)
+    hx = 0.5 * (np.roll(h, -1, axis=1) - np.roll(h, 1, axis=1))
+    hy = 0.5 * (np.roll(h, -1, axis=0) - np.roll(h, 1, axis=0))
+    sun = np.array(
+        [np.cos(sun_elevation_rad) * np.cos(sun_azimuth_rad), np.cos(sun_elevation_rad) * np.sin(sun_azimuth_rad), np.sin(sun_elevation_rad)]
+    )
+    shade = (-hx * sun[0] - hy * sun[1] + sun[2]) / np.sqrt(hx**2 + hy**2 + 1.0)
+    shade = np.clip(shade, 0.0, None)
+    albedo = 0.75 + 0.2 * np.tanh(fractal_noise((rows, cols), 3.0, r_albedo))
+    img = albedo * shade
+    img = 0.5 + contrast * (img - img.mean()) / (4.0 * img.std() + 1e-12)
+    return np.clip(img, 0.0, 1.0)

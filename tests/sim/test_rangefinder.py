@@ -1,0 +1,167 @@
+"""Scanning rangefinder and odometry against brute-force and closed-form references."""
+
+import numpy as np
+import pytest
+
+from slamlab.geometry import wrap_angle
+from slamlab.sim import grid as G
+from slamlab.sim import rangefinder as R
+
+
+def _brute_force_ranges(grid, pose, angles, rmax, step=1e-3):
+    """March each beam in tiny steps and report the first sample inside an obstacle cell."""
+    t = np.arange(0.0, rmax + step, step)
+    th = pose[2] + angles[:, None]
+    x = pose[0] + t * np.cos(th)
+    y = pose[1] + t * np.sin(th)
+    r = np.floor(y + 0.5).astype(int)
+    c = np.floor(x + 0.5).astype(int)
+    inside = (r >= 0) & (r < grid.shape[0]) & (c >= 0) & (c < grid.shape[1])
+    solid = inside & (grid[np.clip(r, 0, grid.shape[0] - 1), np.clip(c, 0, grid.shape[1] - 1)] == G.OBSTACLE)
+    # a beam that has left the grid never hits again
+    left = np.cumsum(~inside, axis=1) > 0
+    solid &= ~left
+    hit = solid.any(axis=1)
+    first = np.argmax(solid, axis=1)
+    return np.where(hit, t[first], rmax), hit
+
+
+def test_cast_rays_matches_brute_force_on_test_room():
+    M = G.measurement_room_200()
+    rng = np.random.default_rng(3)
+    ang = rng.uniform(0, 2 * np.pi, 200)
+    for pose in ([70.3, 30.8, 0.3], [150.0, 110.0, 2.0], [20.5, 180.2, -1.0]):
+        ours, hit = R.cast_rays(M, pose, ang, 120.0)
+        ref, ref_hit = _brute_force_ranges(M, np.array(pose), ang, 120.0)
+        agree = hit == ref_hit
+        assert agree.mean() > 0.99
+        assert np.max(np.abs(ours - ref)[agree & hit]) < 2.5e-3
+
+
+def test_cast_rays_closed_form_in_empty_box():
+    # free box with walls at rows/cols 0 and 40: faces at 0.5 and 39.5
+    g = G.make_grid(41, 41, G.OBSTACLE)
+    g[1:40, 1:40] = G.FREE
+    x0, y0 = 12.3, 25.6
+    ang = np.linspace(0, 2 * np.pi, 361)[:-1]
+    r, hit = R.cast_rays(g, [x0, y0, 0.0], ang, 100.0)
+    c, s = np.cos(ang), np.sin(ang)
+    with np.errstate(divide="ignore"):
+        tx = np.where(c > 0, (39.5 - x0) / c, np.where(c < 0, (0.5 - x0) / c, np.inf))
+        ty = np.where(s > 0, (39.5 - y0) / s, np.where(s < 0, (0.5 - y0) / s, np.inf))
+    assert hit.all()
+    np.testing.assert_allclose(r, np.minimum(tx, ty), atol=1e-9)
+
+
+def test_no_return_beyond_max_range_and_outside_grid():
+    g = G.make_grid(10, 10)
+    r, hit = R.cast_rays(g, [5, 5, 0], [0.0, 1.0], 3.0)
+    assert not hit.any()
+    assert r.tolist() == [3.0, 3.0]
+    g[5, 9] = G.OBSTACLE
+    r, hit = R.cast_rays(g, [5, 5, 0], [0.0], 3.0)  # wall at 3.5 > max range
+    assert not hit[0]
+    r, hit = R.cast_rays(g, [5, 5, 0], [0.0], 3.5)  # exactly at max range counts
+    assert hit[0]
+    assert r[0] == pytest.approx(3.5)
+
+
+def test_beam_angles_layouts():
+    np.testing.assert_allclose(R.beam_angles(360), np.radians(np.arange(360)))
+    a = R.beam_angles(181, np.pi)
+    assert a[0] == pytest.approx(-np.pi / 2)
+    assert a[-1] == pytest.approx(np.pi / 2)
+    np.testing.assert_allclose(np.diff(a), np.radians(1.0))
+
+
+def test_noise_and_quantisation():
+    g = G.make_grid(201, 201, G.OBSTACLE)
+    g[1:200, 1:200] = G.FREE
+    rf = R.Rangefinder(n_beams=4000, max_range_cells=300, range_std_cells=0.5, quantum_cells=0.1)
+    s = rf.scan(g, [100.0, 100.0, 0.0], rng=1)
+    exact, _ = R.cast_rays(g, [100.0, 100.0, 0.0], rf.angles_rad, 300)
+    err = s.ranges_cells - exact
+    assert abs(err.std() - 0.5) < 0.03
+    assert abs(err.mean()) < 0.03
+    assert np.allclose(s.ranges_cells * 10, np.round(s.ranges_cells * 10), atol=1e-9)
+    # seeded: same scan twice
+    assert np.array_equal(s.ranges_cells, rf.scan(g, [100.0, 100.0, 0.0], rng=1).ranges_cells)
+    # noise-free, unquantised = exact
+    s0 = R.Rangefinder(n_beams=4000, max_range_cells=300, quantum_cells=0).scan(g, [100.0, 100.0, 0.0])
+    assert np.array_equal(s0.ranges_cells, exact)
+
+
+def test_scan_points_land_on_obstacles():
+    M = G.measurement_room_200()
+    s = R.Rangefinder(n_beams=720, max_range_cells=150, quantum_cells=0).scan(M, [70.0, 30.0, 0.4])
+    pts = s.points()
+    # step 1e-6 beyond the face: inside the obstacle cell
+    th = 0.4 + s.angles_rad[s.hit]
+    inner = pts + 1e-6 * np.column_stack([np.cos(th), np.sin(th)])
+    rc = G.world_to_cell(inner)
+    assert np.all(M[rc[:, 0], rc[:, 1]] == G.OBSTACLE)
+
+
+def test_relative_compose_round_trip():
+    rng = np.random.default_rng(5)
+    P = np.column_stack([rng.uniform(0, 100, (30, 2)), rng.uniform(-np.pi, np.pi, 30)])
+    U = R.relative_poses(P)
+    Q = R.compose_poses(P[0], U)
+    np.testing.assert_allclose(Q[:, :2], P[:, :2], atol=1e-9)
+    np.testing.assert_allclose(wrap_angle(Q[:, 2] - P[:, 2]), 0, atol=1e-9)
+    # one increment checked by hand: move 1 ahead facing +y
+    assert R.relative_poses([[0, 0, np.pi / 2], [0, 1, np.pi / 2]]).round(12).tolist() == [[1.0, 0.0, 0.0]]
+
+
+def test_odometry_drift_closed_form():
+    # straight line of 50 unit steps: a heading drift of k rad/cell turns the path on an arc
+    P = np.column_stack([np.arange(51.0), np.zeros(51), np.zeros(51)])
+    k = 0.002
+    odo = R.simulate_odometry(P, drift_rad_per_cell=k)
+    assert odo.poses[-1, 2] == pytest.approx(50 * k)
+    # each step is taken along the previous heading: y_n = Σ_{j<n} sin(j k)
+    assert odo.poses[-1, 1] == pytest.approx(np.sin(np.arange(50) * k).sum())
+    # noise-free, drift-free odometry reproduces the path
+    np.testing.assert_allclose(R.simulate_odometry(P).poses, P, atol=1e-12)
+    noisy = R.simulate_odometry(P, trans_std_frac=0.05, rot_std_rad=0.01, rng=4)
+    assert np.std(noisy.increments[:, 0] - 1.0) == pytest.approx(0.05, rel=0.4)
+
+
+def test_simulate_scans_uses_one_stream():
+    M = G.test_room_200()
+    rf = R.Rangefinder(n_beams=90, range_std_cells=0.3)
+    a = R.simulate_scans(M, [[70, 30, 0], [70, 30, 0]], rf, rng=7)
+    assert not np.array_equal(a[0].ranges_cells, a[1].ranges_cells)  # independent noise per scan
+    b = R.simulate_scans(M, [[70, 30, 0], [70, 30, 0]], rf, rng=7)
+    assert np.array_equal(a[1].ranges_cells, b[1].ranges_cells)
+    assert "90 beams" in str(a[0])
+
+
+def test_bad_input():
+    g = G.make_grid(5, 5)
+    with pytest.raises(ValueError, match="`pose` must have length 3"):
+        R.cast_rays(g, [1, 2], [0.0], 5)
+    with pytest.raises(ValueError, match="`pose` must be finite"):
+        R.cast_rays(g, [1, np.nan, 0], [0.0], 5)
+    with pytest.raises(ValueError, match="`max_range_cells` must be > 0"):
+        R.cast_rays(g, [1, 1, 0], [0.0], 0)
+    with pytest.raises(ValueError, match="`fov_rad` must be <= 2π"):
+        R.beam_angles(10, 7.0)
+    with pytest.raises(ValueError, match="`n_beams` must be >= 1"):
+        R.Rangefinder(n_beams=0)
+    with pytest.raises(ValueError, match="`range_std_cells` must be >= 0"):
+        R.Rangefinder(range_std_cells=-1)
+    with pytest.raises(ValueError, match="same length"):
+        R.scan_to_points([0.0, 1.0], [1.0], [0, 0, 0])
+    with pytest.raises(ValueError, match="`hit` must be a bool array"):
+        R.scan_to_points([0.0], [1.0], [0, 0, 0], hit=[1])
+    with pytest.raises(ValueError, match="`poses` must have shape \\(n, 3\\)"):
+        R.relative_poses([[0, 0]])
+    with pytest.raises(ValueError, match="`increments` must have shape"):
+        R.compose_poses([0, 0, 0], [1, 2, 3])
+    with pytest.raises(TypeError, match="`scale_error` must be a finite real"):
+        R.simulate_odometry([[0, 0, 0], [1, 0, 0]], scale_error="x")
+    with pytest.raises(TypeError, match="`rangefinder` must be a Rangefinder"):
+        R.simulate_scans(g, [[1, 1, 0]], rangefinder=3)
+    with pytest.raises(TypeError, match="`rng` must be a numpy Generator"):
+        R.Rangefinder().scan(g, [1, 1, 0], rng="seed")
