@@ -59,7 +59,7 @@ CHAPTERS: tuple[Chapter, ...] = (
     Chapter(5, "Stereo SLAM", "05_stereo_slam.ipynb",
             ("slamlab.stereo",), "000 §3", "planned"),
     Chapter(6, "Correlation localisation on a known map", "06_correlation_localisation.ipynb",
-            ("slamlab.correlation",), "004", "planned"),
+            ("slamlab.correlation",), "004", "available"),
     Chapter(7, "Hough-transform SLAM", "07_hough_slam.ipynb",
             ("slamlab.hough",), "004", "planned"),
     Chapter(8, "Probabilistic localisation: Markov, MCL", "08_probabilistic_localisation.ipynb",

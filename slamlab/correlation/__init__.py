@@ -1,0 +1,73 @@
+"""Correlation localisation on a known map from a scanning rangefinder (004 §7; Ch. 5)."""
+
+from .algorithm import (
+    Localisation,
+    check_constants,
+    heading_candidates,
+    heading_error,
+    localise,
+    rasterise_scan,
+    scan_arrays,
+    score_maps,
+)
+from .experiments import (
+    SOURCE_TABLE1,
+    ConstantsResult,
+    IntelResult,
+    MonteCarloResult,
+    Table1Result,
+    random_clutter,
+    run_constants_study,
+    run_intel_localisation,
+    run_monte_carlo,
+    run_table1,
+)
+from .mapping import GridFrame, occupancy_grid_from_scans
+from .plot import (
+    constants_figure,
+    localisation_figure,
+    plot_error_distribution,
+    plot_grid,
+    plot_heading_profile,
+    plot_intel,
+    plot_localisation,
+    plot_score_map,
+    plot_stamp,
+    plot_table1,
+)
+from .widgets import explore_intel_scan, explore_localisation
+
+__all__ = [
+    "SOURCE_TABLE1",
+    "ConstantsResult",
+    "GridFrame",
+    "IntelResult",
+    "Localisation",
+    "MonteCarloResult",
+    "Table1Result",
+    "check_constants",
+    "constants_figure",
+    "explore_intel_scan",
+    "explore_localisation",
+    "heading_candidates",
+    "heading_error",
+    "localisation_figure",
+    "localise",
+    "occupancy_grid_from_scans",
+    "plot_error_distribution",
+    "plot_grid",
+    "plot_heading_profile",
+    "plot_intel",
+    "plot_localisation",
+    "plot_score_map",
+    "plot_stamp",
+    "plot_table1",
+    "random_clutter",
+    "rasterise_scan",
+    "run_constants_study",
+    "run_intel_localisation",
+    "run_monte_carlo",
+    "run_table1",
+    "scan_arrays",
+    "score_maps",
+]

@@ -1,0 +1,523 @@
+"""Correlation localisation on a known map (004 §7): rasterise the scan per heading, correlate with M by FFT.
+
+API summary
+-----------
+- :func:`heading_candidates` — the headings α0n = n·Δα (full circle) or a window
+  around a previous heading (tracking mode).
+- :func:`rasterise_scan` ``(angles, ranges, hit, headings, ...) -> (T, origin)``: the
+  images T_n of 004 (a_c along each beam, a_p at its end or over ±Δl, a_n
+  elsewhere), vectorised over beams and headings.
+- :func:`score_maps` ``(M_values, T, origin, method) -> (n, H, W)``: the
+  correlation C_n(k, p) = Σ M(x, y)·T_n(x - k, y - p) re-indexed by the robot's
+  cell, by one batched FFT (``"batched"``), per heading with
+  ``scipy.signal.fftconvolve`` (``"fftconvolve"``) or by the definition (``"direct"``).
+- :func:`localise` ``(grid, scan, ...) -> Localisation``: the maximum of the 3-D stack
+  → heading and position, streamed over heading chunks (bounded memory).
+
+Index mapping (0-based; 004's ``x = x0 + Ma - xc + 1`` is 1-based Matlab ``xcorr2``)
+-------------------------------------------------------------------------------------
+T_n is ``S × S`` with ``S = 2(l_max + 2)`` and the robot at ``T[o, o]``,
+``o = l_max + 2``. Cell ``T[i, j]`` stands for map cell ``(row + i - o, col + j - o)``
+when the robot is at map cell ``(row, col)``. The full linear correlation
+``C[a, b] = Σ_{i,j} T[i, j]·M[i + a - (S - 1), j + b - (S - 1)]`` (size
+``(H + S - 1) × (W + S - 1)``, zero padding = a_n = 0) therefore has the robot at
+
+    row = a + o - (S - 1),   col = b + o - (S - 1),
+
+and :func:`score_maps` returns exactly the ``H × W`` block of C whose robot cell
+lies inside the map, indexed by that cell: ``D[n, row, col]``. The estimate is
+the pose ``(x, y) = (col, row)`` (x along columns, see :mod:`slamlab.sim.grid`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.fft as sfft
+from scipy.signal import fftconvolve
+
+from .. import _validate as v
+from ..geometry import wrap_angle
+from ..sim.grid import check_grid, grid_to_values
+from ..sim.rangefinder import Scan
+
+__all__ = [
+    "Localisation",
+    "check_constants",
+    "heading_candidates",
+    "heading_error",
+    "localise",
+    "rasterise_scan",
+    "scan_arrays",
+    "score_maps",
+]
+
+_METHODS = ("batched", "fftconvolve", "direct")
+
+
+def _check_real(value, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value):
+        raise TypeError(f"`{name}` must be a finite real number; got {value!r}")
+    return float(value)
+
+
+def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
+    """Validate 004's constants: real numbers with ``a_c ≠ a_p`` (004 §7, conditions (1)-(3))."""
+    a_c, a_p, a_n = _check_real(a_c, "a_c"), _check_real(a_p, "a_p"), _check_real(a_n, "a_n")
+    if a_c == a_p:
+        raise ValueError(f"`a_c` and `a_p` must differ (free and obstacle must be told apart); got both {a_c}")
+    return a_c, a_p, a_n
+
+
+def heading_candidates(delta_alpha_rad: float, *, center_rad: float | None = None,
+                       window_rad: float | None = None) -> np.ndarray:
+    """Candidate headings α0n (004 §7).
+
+    Full search (``center_rad`` None): ``α0n = n·Δα`` for ``0 ≤ α0n < 2π``
+    (004 prints "n·360/Δα", a slip for ``n·Δα``). Tracking mode: ``center + k·Δα``
+    for every integer ``k`` with ``|k·Δα| ≤ window_rad``.
+
+    Examples
+    --------
+    >>> np.degrees(heading_candidates(np.radians(90))).round(6).tolist()
+    [0.0, 90.0, 180.0, 270.0]
+    >>> np.degrees(heading_candidates(np.radians(1), center_rad=0.0, window_rad=np.radians(2))).round(6).tolist()
+    [-2.0, -1.0, 0.0, 1.0, 2.0]
+    """
+    d = v.check_positive(delta_alpha_rad, "delta_alpha_rad")
+    if d > np.pi:
+        raise ValueError(f"`delta_alpha_rad` must be <= π; got {d}")
+    if center_rad is None:
+        if window_rad is not None:
+            raise ValueError("`window_rad` needs `center_rad` (tracking mode searches around a previous heading)")
+        n = int(np.floor(2 * np.pi / d + 1e-9))
+        return d * np.arange(n)
+    c = _check_real(center_rad, "center_rad")
+    w = v.check_positive(np.pi if window_rad is None else window_rad, "window_rad", allow_zero=True)
+    k = int(np.floor(w / d + 1e-9))
+    return c + d * np.arange(-k, k + 1)
+
+
+def scan_arrays(scan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(angles_rad, ranges_cells, hit)`` from a :class:`~slamlab.sim.Scan` or a 2/3-tuple of arrays."""
+    if isinstance(scan, Scan):
+        a, r, h = scan.angles_rad, scan.ranges_cells, scan.hit
+    elif isinstance(scan, tuple) and len(scan) in (2, 3):
+        a, r = scan[0], scan[1]
+        h = scan[2] if len(scan) == 3 else None
+    else:
+        raise TypeError(f"`scan` must be a Scan or a tuple (angles_rad, ranges_cells[, hit]); got "
+                        f"{type(scan).__name__}")
+    a = v.as_vector(a, "angles_rad")
+    r = v.as_vector(r, "ranges_cells")
+    if a.shape != r.shape:
+        raise ValueError(f"`angles_rad` and `ranges_cells` must have the same length; got {a.size} and {r.size}")
+    if np.any(r < 0):
+        raise ValueError(f"`ranges_cells` must be >= 0; got minimum {r.min()}")
+    if h is None:
+        h = np.ones(a.shape, dtype=bool)
+    else:
+        h = np.asarray(h)
+        if h.dtype != bool or h.shape != a.shape:
+            raise ValueError(f"`hit` must be a bool array of shape {a.shape}; got {h.dtype} {h.shape}")
+    if not h.any():
+        raise ValueError("`scan` has no return (every beam is a miss): nothing to localise with")
+    return a, r, h
+
+
+def _beam_samples(angles, ranges, hit, *, delta_l_cells, hit_offset_cells, step_cells, use_misses):
+    """Robot-frame sample points: free ones along the beams, obstacle ones at the ends (004 §7).
+
+    Free: ``0 ≤ t < l - Δl``; obstacle: ``l - Δl + ε ≤ t ≤ l + Δl + hit_offset`` (ε = 0.01 cell,
+    so a range ending on a cell face marks the cell behind the face).
+    """
+    use = hit | use_misses
+    a, r, h = angles[use], ranges[use], hit[use]
+    l_free = np.where(h, np.maximum(r - delta_l_cells - 1e-6, 0.0), r)
+    k = int(np.ceil(l_free.max() / step_cells)) + 1 if l_free.size else 1
+    t = step_cells * np.arange(k)
+    m = t[None, :] < l_free[:, None]
+    bi, ki = np.nonzero(m)
+    free = np.column_stack([t[ki] * np.cos(a[bi]), t[ki] * np.sin(a[bi])])
+    ah, rh = a[h], r[h]
+    lo, hi = -delta_l_cells + 0.01, delta_l_cells + hit_offset_cells
+    n_obs = max(int(np.ceil((hi - lo) / step_cells)) + 1, 1) if hi > lo else 1
+    offs = np.linspace(lo, max(hi, lo), n_obs)
+    to = (rh[:, None] + offs[None, :]).clip(min=0.0)
+    obs = np.column_stack([(to * np.cos(ah)[:, None]).ravel(), (to * np.sin(ah)[:, None]).ravel()])
+    return free, obs
+
+
+def rasterise_scan(angles_rad, ranges_cells, hit, headings_rad, *, a_c: float = -1.0, a_p: float = 1.0,
+                   a_n: float = 0.0, delta_l_cells: float = 0.0, hit_offset_cells: float = 0.5,
+                   step_cells: float = 0.5, use_misses: bool = False, l_max: int | None = None,
+                   dtype=np.float64) -> tuple[np.ndarray, int]:
+    """The images T_n of one scan at every candidate heading (004 §7), vectorised over beams and headings.
+
+    Parameters
+    ----------
+    angles_rad, ranges_cells : array_like, shape (m,)
+        Beams ``(α_i, l_i)`` in the robot frame, ranges in cells.
+    hit : array_like of bool, shape (m,)
+        Beams with a return; misses are skipped unless ``use_misses``.
+    headings_rad : array_like, shape (n,)
+        Candidate headings α0n.
+    a_c, a_p, a_n : float
+        004's constants for free, obstacle, unexplored cells.
+    delta_l_cells : float
+        ±Δl: obstacle marked from ``l - Δl`` to ``l + Δl`` (004); 0 marks one cell.
+    hit_offset_cells : float
+        Our choice: the obstacle mark sits this far beyond the measured range, since a
+        range ends on the face of the obstacle cell (0.5 = mid-cell).
+    step_cells : float
+        Sampling step along the beams (≤ 1; smaller marks every crossed cell).
+    use_misses : bool
+        Mark no-return beams free up to their (maximum) range (004 is silent; our option).
+    l_max : int, optional
+        Half-size; default ``ceil(max l_i + Δl + hit_offset)`` (004: ``l_max = max(l_i) + Δl``).
+    dtype : numpy dtype
+        Of the returned stack.
+
+    Returns
+    -------
+    T : numpy.ndarray, shape (n, S, S), ``S = 2(l_max + 2)``
+    origin : int
+        ``o = l_max + 2``: the robot's cell is ``T[:, o, o]``.
+
+    Examples
+    --------
+    >>> T, o = rasterise_scan([0.0], [1.5], [True], [0.0, np.pi / 2], a_c=-1, a_p=1)
+    >>> T.shape, o
+    ((2, 8, 8), 4)
+    >>> T[0, o, o:o + 4].tolist(), T[1, o:o + 4, o].tolist()
+    ([-1.0, -1.0, 1.0, 0.0], [-1.0, -1.0, 1.0, 0.0])
+    """
+    a, r, h = scan_arrays((angles_rad, ranges_cells, hit))
+    th = v.as_vector(headings_rad, "headings_rad")
+    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
+    dl = v.check_positive(delta_l_cells, "delta_l_cells", allow_zero=True)
+    ho = v.check_positive(hit_offset_cells, "hit_offset_cells", allow_zero=True)
+    st = v.check_positive(step_cells, "step_cells")
+    if st > 1:
+        raise ValueError(f"`step_cells` must be <= 1 (a larger step skips cells); got {st}")
+    reach = max(float(np.max(np.where(h | use_misses, r, 0.0))), 0.0) + (dl + ho if h.any() else 0.0)
+    if l_max is None:
+        l_max = int(np.ceil(reach))
+    else:
+        l_max = v.check_int(l_max, "l_max", minimum=0)
+        if l_max < reach - 1e-9:
+            raise ValueError(f"`l_max` must cover the longest beam ({reach:.2f} cells); got {l_max}")
+    o = l_max + 2
+    free, obs = _beam_samples(a, r, h, delta_l_cells=dl, hit_offset_cells=ho, step_cells=st, use_misses=use_misses)
+    stamps = _Stamps(free, obs, th, a_c, a_p, a_n, o, dtype)
+    return stamps.take(np.arange(th.size)), o
+
+
+class _Stamps:
+    """T_n for a list of headings, rasterising each heading modulo 90° once (quarter turns are exact on the grid).
+
+    A point ``(x, y) → (-y, x)`` under a quarter turn: ``T'[o + x, o - y] = T[o + y, o + x]``, i.e.
+    ``T'[i, j] = T[(2o - j) mod S, i]`` (the wrapped row/column is the outer ring, always a_n).
+    """
+
+    def __init__(self, free, obs, headings, a_c, a_p, a_n, o, dtype):
+        S = 2 * o
+        self.S, self.dtype = S, dtype
+        self.quarter = np.floor(np.mod(headings, 2 * np.pi) / (np.pi / 2) + 1e-9).astype(int) % 4
+        base = np.mod(headings, np.pi / 2)
+        base[base > np.pi / 2 - 1e-9] = 0.0
+        ub, self.inv = np.unique(np.round(base, 12), return_inverse=True)
+        self.Tb = np.full((ub.size, S, S), a_n, dtype=dtype)
+        _stamp(self.Tb, ub, free, obs, a_c, a_p, o)
+        self.Tb = self.Tb.reshape(ub.size, S * S)
+        i, j = np.divmod(np.arange(S * S), S)
+        p1 = ((2 * o - j) % S) * S + i
+        self.perm = [None, p1, p1[p1], p1[p1][p1]]
+
+    def take(self, sel: np.ndarray) -> np.ndarray:
+        """The stack ``T[sel]`` of shape ``(len(sel), S, S)``."""
+        out = np.empty((sel.size, self.S * self.S), dtype=self.dtype)
+        q = self.quarter[sel]
+        for k in range(4):
+            m = np.nonzero(q == k)[0]
+            if m.size:
+                block = self.Tb[self.inv[sel[m]]]
+                out[m] = block if k == 0 else np.take(block, self.perm[k], axis=1)
+        return out.reshape(sel.size, self.S, self.S)
+
+
+def _stamp(T: np.ndarray, headings: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p: float,
+           o: int) -> None:
+    """Write a_c at the free samples and then a_p at the obstacle samples of each heading (in place)."""
+    n, S, _ = T.shape
+    flat = T.reshape(-1)
+    big = n * S * S >= 2**24  # float32 holds integers exactly below 2**24
+    ft = np.float64 if big else np.float32
+    c = np.cos(headings).astype(ft)[:, None]
+    s = np.sin(headings).astype(ft)[:, None]
+    base = (np.arange(n, dtype=ft) * (S * S) + o * S + o + 0.5 * (S + 1))[:, None]
+    chunk = max(1, int(4e6 // max(free.shape[0], 1)))
+    for pts, val in ((free, a_c), (obs, a_p)):  # obstacle marks overwrite free ones
+        if pts.shape[0] == 0:
+            continue
+        px, py = pts[:, 0].astype(ft), pts[:, 1].astype(ft)
+        for k0 in range(0, n, chunk):
+            cc, ss = c[k0:k0 + chunk], s[k0:k0 + chunk]
+            x = cc * px
+            x -= ss * py
+            y = ss * px
+            y += cc * py
+            # floor(v + 0.5) for row and column, folded: idx = (floor(y+.5)+o)·S + floor(x+.5)+o + n·S²
+            np.floor(x + 0.5, out=x)
+            np.floor(y + 0.5, out=y)
+            y *= S
+            y += x
+            y += base[k0:k0 + chunk] - 0.5 * (S + 1)
+            flat[y.astype(np.int64).ravel()] = val
+
+
+def _fast_len(n: int) -> int:
+    return sfft.next_fast_len(n, real=True)
+
+
+class _MapSpectrum:
+    """rfft2 of the map zero-padded for the robot-inside-map shifts of an S×S stamp (computed once)."""
+
+    def __init__(self, Mv: np.ndarray, S: int, o: int, dtype, workers: int | None, L: tuple[int, int] | None = None):
+        H, W = Mv.shape
+        # circular correlation c[k] = Σ_i T[i]·Mp[(i + k) mod L] equals the linear one for the shifts
+        # k = row - o, row ∈ [0, H), when L ≥ H + o and L ≥ H + S - 1 - o (derivation in the module docstring)
+        need = (max(H + o, H + S - 1 - o), max(W + o, W + S - 1 - o))
+        self.L = (_fast_len(need[0]), _fast_len(need[1])) if L is None else L
+        if self.L[0] < need[0] or self.L[1] < need[1]:
+            raise ValueError(f"FFT size {self.L} too small for map {Mv.shape} and stamp {S}")
+        self.shape = (H, W)
+        self.S, self.o, self.dtype, self.workers = S, o, dtype, workers
+        self.FM = sfft.rfft2(Mv.astype(dtype, copy=False), s=self.L, workers=workers)
+        self.rows = (np.arange(H) - o) % self.L[0]
+        self.cols = (np.arange(W) - o) % self.L[1]
+
+    def forward(self, T: np.ndarray) -> np.ndarray:
+        """conj(rfft2(T)) at this spectrum's size (pruned: rfft on the S rows only, then fft along rows)."""
+        FT = sfft.rfft(T.astype(self.dtype, copy=False), n=self.L[1], axis=-1, workers=self.workers)
+        FT = sfft.fft(FT, n=self.L[0], axis=-2, workers=self.workers, overwrite_x=True)
+        return np.conjugate(FT, out=FT)
+
+    def inverse(self, FTc: np.ndarray) -> np.ndarray:
+        """Scores ``(n, H, W)`` from ``forward(T)``: product with the map spectrum, pruned irfft2."""
+        P = FTc * self.FM
+        c = sfft.ifft(P, axis=-2, workers=self.workers, overwrite_x=True)[:, self.rows]
+        c = sfft.irfft(c, n=self.L[1], axis=-1, workers=self.workers, overwrite_x=True)
+        return c[:, :, self.cols]
+
+    def scores(self, T: np.ndarray) -> np.ndarray:
+        return self.inverse(self.forward(T))
+
+
+def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol):
+    """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
+
+    Quarter turns: with ``R`` the quarter turn of the stamps, ``D_{T∘R⁻¹}(M) = rot90(D_T(rot90(M)), -1)``
+    (derivation in the notebook), so the spectrum of each base stamp (heading mod 90°) is computed once
+    and correlated with the four rotated maps' spectra.
+    Returns ``(best_val, (n, row, col), best_map, best_per_heading)``; ties within ``tol`` go to the
+    smallest heading index, then the first row and column.
+    """
+    H, W = Mv.shape
+    quarters = sorted(set(stamps.quarter.tolist()))
+    side = max(H, W)
+    L = _fast_len(max(side + o, side + S - 1 - o))
+    specs = {q: _MapSpectrum(np.ascontiguousarray(np.rot90(Mv, q)), S, o, dtype, workers, L=(L, L))
+             for q in quarters}
+    n_base = stamps.Tb.shape[0]
+    best_per = np.full(headings.size, -np.inf)
+    best_val, best_idx, best_map = -np.inf, None, None
+    for b0 in range(0, n_base, chunk):
+        b1 = min(b0 + chunk, n_base)
+        FTc = specs[quarters[0]].forward(stamps.Tb[b0:b1].reshape(b1 - b0, S, S))
+        for q in quarters:
+            heads = np.nonzero((stamps.quarter == q) & (stamps.inv >= b0) & (stamps.inv < b1))[0]
+            if heads.size == 0:
+                continue
+            D = specs[q].inverse(FTc[stamps.inv[heads] - b0])
+            if q:
+                D = np.rot90(D, -q, axes=(1, 2))
+            per = D.reshape(D.shape[0], -1).max(axis=1)
+            best_per[heads] = per
+            m = float(per.max())
+            if m > best_val + tol or (m >= best_val - tol and best_idx is not None and heads.min() < best_idx[0]):
+                cand = np.nonzero(per >= max(m, best_val) - tol)[0]
+                k = cand[np.argmin(heads[cand])]
+                if best_idx is None or m > best_val + tol or heads[k] < best_idx[0]:
+                    flat = int(np.argmax(D[k].ravel() >= max(m, best_val) - tol))
+                    best_val = max(m, best_val)
+                    best_idx = (int(heads[k]), *np.unravel_index(flat, D.shape[1:]))
+                    best_map = np.ascontiguousarray(D[k])
+    return best_val, best_idx, best_map, best_per
+
+
+def _direct_scores(Mv: np.ndarray, T: np.ndarray, o: int) -> np.ndarray:
+    """The definition Σ_{i,j} T[i, j]·M[row + i - o, col + j - o] (slow reference; loops over T's cells)."""
+    H, W = Mv.shape
+    n, S, _ = T.shape
+    pad = np.zeros((H + 2 * S, W + 2 * S))
+    pad[S:S + H, S:S + W] = Mv
+    out = np.zeros((n, H, W))
+    for i, j in zip(*np.nonzero(np.any(T != 0, axis=0)), strict=True):
+        block = pad[S + i - o:S + i - o + H, S + j - o:S + j - o + W]
+        out += T[:, i, j][:, None, None] * block[None]
+    return out
+
+
+def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.float64,
+               workers: int | None = None) -> np.ndarray:
+    """Correlation of every T_n with M, indexed by the robot's cell: ``D[n, row, col]`` (004 §7).
+
+    ``D[n, row, col] = Σ_{i,j} T_n[i, j]·M[row + i - o, col + j - o]`` with M = 0
+    (= a_n) outside the map; it is the block of 004's ``C_n`` whose robot cell lies
+    in the map (see the module docstring for the index mapping).
+
+    Parameters
+    ----------
+    M_values : array_like, shape (H, W)
+        The map with 004's constants (see :func:`slamlab.sim.grid_to_values`).
+    T : array_like, shape (n, S, S)
+        From :func:`rasterise_scan`.
+    origin : int
+        ``o``, the robot's cell in T.
+    method : {"batched", "fftconvolve", "direct"}
+        One ``scipy.fft`` rfft2 of all T_n against the map's rfft2 computed once;
+        ``scipy.signal.fftconvolve`` per heading; or the definition (slow).
+    dtype : numpy dtype
+        FFT precision of the batched method (float64 or float32).
+    workers : int, optional
+        ``scipy.fft`` worker threads of the batched method.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, H, W)
+
+    Examples
+    --------
+    >>> M = np.array([[0., 1.], [2., 3.]])
+    >>> T = np.zeros((1, 4, 4)); T[0, 2, 3] = 1.0  # robot at T[2, 2], cell one column to its right
+    >>> score_maps(M, T, 2).round(9).tolist()
+    [[[1.0, 0.0], [3.0, 0.0]]]
+    """
+    Mv = v.as_finite_array(M_values, "M_values", ndim=2)
+    if Mv.size == 0:
+        raise ValueError(f"`M_values` must not be empty; got shape {Mv.shape}")
+    T = v.as_finite_array(T, "T")
+    if T.ndim != 3 or T.shape[1] != T.shape[2] or T.shape[1] < 1:
+        raise ValueError(f"`T` must have shape (n, S, S); got shape {T.shape}")
+    o = v.check_int(origin, "origin", minimum=0, maximum=T.shape[1] - 1)
+    method = v.check_choice(method, "method", _METHODS)
+    if method == "batched":
+        return _MapSpectrum(Mv, T.shape[1], o, dtype, workers).scores(T)
+    if method == "direct":
+        return _direct_scores(Mv, T, o)
+    H, W = Mv.shape
+    S = T.shape[1]
+    out = np.empty((T.shape[0], H, W))
+    for n in range(T.shape[0]):
+        full = fftconvolve(Mv, T[n, ::-1, ::-1], mode="full")  # = correlation of M with T_n
+        a0 = S - 1 - o  # robot row = a + o - (S - 1)
+        out[n] = full[a0:a0 + H, a0:a0 + W]
+    return out
+
+
+@dataclass(frozen=True)
+class Localisation:
+    """Result of :func:`localise`: the pose at the correlation maximum (004 §7)."""
+
+    pose: np.ndarray  # (3,) x = col, y = row [cells], heading [rad] in [0, 2π) for a full search
+    row: int
+    col: int
+    heading_index: int
+    score: float
+    headings_rad: np.ndarray = field(repr=False)  # (n,) candidates
+    best_per_heading: np.ndarray = field(repr=False)  # (n,) max of each D_n
+    score_map: np.ndarray = field(repr=False)  # (H, W) D at the best heading
+
+    def __str__(self) -> str:
+        return (f"pose x={self.pose[0]:.0f}, y={self.pose[1]:.0f} cells, heading "
+                f"{np.degrees(self.pose[2]):.1f} deg (score {self.score:.1f})")
+
+
+def localise(grid, scan, *, delta_alpha_rad: float = np.radians(1.0), prior_heading_rad: float | None = None,
+             window_rad: float | None = None, a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0,
+             delta_l_cells: float = 0.0, hit_offset_cells: float = 0.5, step_cells: float = 0.5,
+             use_misses: bool = False, chunk: int | None = None, dtype=np.float64,
+             workers: int | None = None) -> Localisation:
+    """Pose of the robot on map ``grid`` from one scan: maximum of the correlation stack (004 §7).
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        The known map M as cell codes (see :mod:`slamlab.sim.grid`); it is turned
+        into values with ``a_c, a_p, a_n``.
+    scan : Scan or tuple
+        A :class:`~slamlab.sim.Scan` or ``(angles_rad, ranges_cells[, hit])``.
+    delta_alpha_rad : float
+        Heading step Δα (004: 1°).
+    prior_heading_rad, window_rad : float, optional
+        Tracking mode: search only ``prior ± window`` (default window ±π when only
+        the prior is given); full circle when the prior is None.
+    a_c, a_p, a_n : float
+        004's constants (sharpest peak at ``a_p = -a_c``; ``a_c = a_n = 0, a_p > 0``
+        is more robust to unmapped objects).
+    delta_l_cells, hit_offset_cells, step_cells, use_misses :
+        Rasterisation options, see :func:`rasterise_scan`.
+    chunk : int, optional
+        Base stamps (headings modulo 90°) per batched FFT call (default 8: fits the CPU caches
+        better than all at once).
+    dtype, workers :
+        FFT precision and threads (see :func:`score_maps`).
+
+    Returns
+    -------
+    Localisation
+        Ties within ``1e-9·max|D|`` go to the first heading, then the first row and column.
+
+    Examples
+    --------
+    >>> from slamlab.sim import Rangefinder, test_room_200
+    >>> M = test_room_200()
+    >>> scan = Rangefinder(n_beams=180, max_range_cells=60).scan(M, [70, 30, np.radians(40)])
+    >>> loc = localise(M, scan, delta_alpha_rad=np.radians(5))
+    >>> loc.col, loc.row, round(float(np.degrees(loc.pose[2])))
+    (70, 30, 40)
+    """
+    g = check_grid(grid)
+    a, r, h = scan_arrays(scan)
+    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
+    if prior_heading_rad is None and window_rad is not None:
+        raise ValueError("`window_rad` needs `prior_heading_rad` (tracking mode)")
+    headings = heading_candidates(delta_alpha_rad, center_rad=prior_heading_rad, window_rad=window_rad)
+    if chunk is not None:
+        chunk = v.check_int(chunk, "chunk", minimum=1)
+    Mv = grid_to_values(g, a_c, a_p, a_n)
+    dl = v.check_positive(delta_l_cells, "delta_l_cells", allow_zero=True)
+    ho = v.check_positive(hit_offset_cells, "hit_offset_cells", allow_zero=True)
+    st = v.check_positive(step_cells, "step_cells")
+    T0, o = rasterise_scan(a, r, h, headings[:1], a_c=a_c, a_p=a_p, a_n=a_n, delta_l_cells=dl,
+                           hit_offset_cells=ho, step_cells=st, use_misses=use_misses, dtype=dtype)
+    S = T0.shape[1]
+    free, obs = _beam_samples(a, r, h, delta_l_cells=dl, hit_offset_cells=ho, step_cells=st, use_misses=use_misses)
+    stamps = _Stamps(free, obs, headings, a_c, a_p, a_n, o, dtype)
+    n_marks = max(1, free.shape[0] + obs.shape[0])
+    amax = max(abs(a_c), abs(a_p), abs(a_n))
+    tol = (1e-9 if np.dtype(dtype) == np.float64 else 2e-5) * amax * amax * n_marks
+    best_val, best_idx, best_map, best = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=workers,
+                                                      chunk=8 if chunk is None else chunk, tol=tol)
+    n, row, col = (int(i) for i in best_idx)
+    heading = headings[n] if prior_heading_rad is not None else float(np.mod(headings[n], 2 * np.pi))
+    return Localisation(pose=np.array([float(col), float(row), heading]), row=row, col=col, heading_index=n,
+                        score=best_val, headings_rad=headings, best_per_heading=best, score_map=best_map)
+
+
+def heading_error(est_rad, true_rad):
+    """Absolute wrapped heading difference ``|wrap(est - true)|`` [rad]."""
+    return np.abs(wrap_angle(np.asarray(est_rad, dtype=float) - np.asarray(true_rad, dtype=float)))

@@ -1,0 +1,217 @@
+"""Reader for CARMEN laser logs: ``FLASER`` scans with poses and ``ODOM`` messages (plain or ``.gz``).
+
+API summary
+-----------
+- :func:`read_carmen` ``(path, *, max_range_m=None) -> CarmenLog``.
+- :class:`CarmenLog`: ``ranges_m`` (n_scans, n_beams) with NaN kept, ``valid``
+  mask, ``poses`` (laser pose per scan: x_m, y_m, heading_rad),
+  ``odom_poses`` (the odometry pose stored in each FLASER line), ``timestamps_s``,
+  ``odom`` (ODOM messages), ``params`` (PARAM lines), ``angles_rad`` and the
+  methods ``points(i)`` (scan ``i`` in world metres) and ``scan_cells(i, cell_m)``.
+- :func:`flaser_angles` ``(n_beams, fov_rad=π) -> (n,)``: the CARMEN beam layout.
+
+Formats handled (see each data set's PROVENANCE.md): the corrected Radish logs
+(``FLASER n r_1..r_n x y θ odom_x odom_y odom_θ ipc_ts host logger_ts``, plus
+``ODOM``, ``PARAM``, ``NEFF`` lines) and the MbICP SICK log (``FLASER`` lines
+only, without timestamps, ``NaN`` for invalid readings). Other message types
+are skipped and counted in ``CarmenLog.skipped``.
+"""
+
+from __future__ import annotations
+
+import gzip
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import _validate as v
+
+__all__ = ["CarmenLog", "flaser_angles", "read_carmen"]
+
+
+def flaser_angles(n_beams: int, fov_rad: float = np.pi) -> np.ndarray:
+    """Beam angles of a CARMEN front laser: first beam at ``-fov/2`` (the robot's right), counter-clockwise.
+
+    An odd beam count spans ``-fov/2 .. +fov/2`` inclusive (181 beams at 1°,
+    361 at 0.5°); an even count has the resolution ``fov/n`` and stops one step
+    short of ``+fov/2`` (180 beams: -90° .. +89°), as in the CARMEN/GMapping
+    convention described in the data's PROVENANCE.md.
+
+    Examples
+    --------
+    >>> np.degrees(flaser_angles(181))[[0, 1, -1]].round(6).tolist()
+    [-90.0, -89.0, 90.0]
+    >>> np.degrees(flaser_angles(180))[[0, 1, -1]].round(6).tolist()
+    [-90.0, -89.0, 89.0]
+    """
+    n = v.check_int(n_beams, "n_beams", minimum=2)
+    fov = v.check_positive(fov_rad, "fov_rad")
+    if n % 2:
+        return np.linspace(-fov / 2, fov / 2, n)
+    return -fov / 2 + fov * np.arange(n) / n
+
+
+@dataclass(frozen=True)
+class CarmenLog:
+    """A CARMEN laser log read by :func:`read_carmen`; metres and radians."""
+
+    path: str
+    ranges_m: np.ndarray  # (n_scans, n_beams), NaN where the log has NaN
+    valid: np.ndarray  # (n_scans, n_beams) bool: finite, > 0 and < max_range_m
+    poses: np.ndarray  # (n_scans, 3) laser pose of each FLASER line (x_m, y_m, heading_rad)
+    odom_poses: np.ndarray  # (n_scans, 3) odometry pose of each FLASER line
+    timestamps_s: np.ndarray  # (n_scans,) ipc timestamp, NaN when absent
+    odom: np.ndarray  # (n_odom, 4) ODOM messages: x_m, y_m, heading_rad, timestamp_s (NaN when absent)
+    max_range_m: float
+    params: dict = field(default_factory=dict)
+    skipped: dict = field(default_factory=dict)  # message type -> number of lines skipped
+
+    @property
+    def n_scans(self) -> int:
+        """Number of FLASER scans."""
+        return self.ranges_m.shape[0]
+
+    @property
+    def n_beams(self) -> int:
+        """Beams per scan."""
+        return self.ranges_m.shape[1]
+
+    @property
+    def angles_rad(self) -> np.ndarray:
+        """Beam angles relative to the robot heading (:func:`flaser_angles`)."""
+        return flaser_angles(self.n_beams)
+
+    def __str__(self) -> str:
+        return (f"CARMEN log {Path(self.path).name}: {self.n_scans} scans x {self.n_beams} beams, "
+                f"{self.odom.shape[0]} ODOM, {self.valid.mean():.1%} valid readings (< {self.max_range_m:g} m)")
+
+    def points(self, i: int, pose=None) -> np.ndarray:
+        """World points ``(x_m, y_m)`` of the valid readings of scan ``i`` seen from ``pose`` (default: its pose).
+
+        Returns
+        -------
+        numpy.ndarray, shape (k, 2)
+        """
+        i = v.check_int(i, "i", minimum=-self.n_scans, maximum=self.n_scans - 1)
+        p = self.poses[i] if pose is None else v.as_vector(pose, "pose", 3)
+        ok = self.valid[i]
+        th = p[2] + self.angles_rad[ok]
+        r = self.ranges_m[i, ok]
+        return np.column_stack([p[0] + r * np.cos(th), p[1] + r * np.sin(th)])
+
+    def scan_cells(self, i: int, cell_m: float):
+        """Scan ``i`` in cell units for the rangefinder chapters: ``(angles_rad, ranges_cells, hit)``.
+
+        Invalid and no-return beams get ``ranges_cells = max_range_m / cell_m`` and ``hit = False``.
+        """
+        i = v.check_int(i, "i", minimum=-self.n_scans, maximum=self.n_scans - 1)
+        cell = v.check_positive(cell_m, "cell_m")
+        ok = self.valid[i]
+        r = np.where(ok, np.nan_to_num(self.ranges_m[i], nan=0.0), self.max_range_m) / cell
+        return self.angles_rad, r, ok.copy()
+
+
+def _open_text(path: Path):
+    with open(path, "rb") as fh:
+        gz = fh.read(2) == b"\x1f\x8b"
+    return gzip.open(path, "rt", encoding="ascii", errors="replace") if gz else open(path, encoding="ascii",
+                                                                                         errors="replace")
+
+
+def _float(tok: str) -> float:
+    return float(tok)  # accepts "NaN", "nan", "inf"
+
+
+def read_carmen(path, *, max_range_m: float | None = None) -> CarmenLog:
+    """Read the ``FLASER``, ``ODOM`` and ``PARAM`` lines of a CARMEN log (plain text or gzip).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The log file (gzip detected from its magic bytes, not its name).
+    max_range_m : float, optional
+        Readings ``>= max_range_m`` are "no return" (``valid = False``). Default:
+        the largest finite reading of the log (the sensor's maximum value, which
+        the corrected Radish logs use for no return).
+
+    Returns
+    -------
+    CarmenLog
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``path`` does not exist.
+    ValueError
+        When the log holds no FLASER line, a FLASER line is short or
+        malformed, or the beam count changes between scans (the message names
+        the line number).
+    """
+    if not isinstance(path, (str, Path)):
+        raise TypeError(f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"CARMEN log not found: {p}")
+    if max_range_m is not None:
+        max_range_m = v.check_positive(max_range_m, "max_range_m")
+    ranges: list[list[float]] = []
+    poses: list[list[float]] = []
+    odom_p: list[list[float]] = []
+    stamps: list[float] = []
+    odom: list[list[float]] = []
+    params: dict[str, str] = {}
+    skipped: dict[str, int] = {}
+    n_beams = None
+    with _open_text(p) as fh:
+        for lineno, line in enumerate(fh, start=1):
+            tok = line.split()
+            if not tok or tok[0].startswith("#"):
+                continue
+            kind = tok[0]
+            try:
+                if kind == "FLASER":
+                    n = int(tok[1])
+                    if n < 2 or len(tok) < 2 + n + 6:
+                        raise ValueError(f"expected {n} ranges and 6 pose values, got {len(tok) - 2} fields")
+                    if n_beams is None:
+                        n_beams = n
+                    elif n != n_beams:
+                        raise ValueError(f"beam count {n} differs from the first scan's {n_beams}")
+                    vals = [_float(t) for t in tok[2:2 + n + 6]]
+                    ranges.append(vals[:n])
+                    poses.append(vals[n:n + 3])
+                    odom_p.append(vals[n + 3:n + 6])
+                    stamps.append(_float(tok[2 + n + 6]) if len(tok) > 2 + n + 6 else math.nan)
+                elif kind == "ODOM":
+                    vals = [_float(t) for t in tok[1:4]]
+                    if len(vals) != 3:
+                        raise ValueError(f"expected x y theta, got {len(tok) - 1} fields")
+                    stamp = _float(tok[7]) if len(tok) > 7 else math.nan
+                    odom.append([*vals, stamp])
+                elif kind == "PARAM":
+                    if len(tok) >= 3:
+                        params[tok[1]] = tok[2]
+                else:
+                    skipped[kind] = skipped.get(kind, 0) + 1
+            except (ValueError, IndexError) as exc:
+                raise ValueError(f"{p.name}, line {lineno}: malformed {kind} message: {exc}") from None
+    if not ranges:
+        raise ValueError(f"{p.name}: no FLASER message found")
+    R = np.array(ranges, dtype=float)
+    finite = np.isfinite(R)
+    if max_range_m is None:
+        max_range_m = float(R[finite].max()) if finite.any() else math.inf
+    with np.errstate(invalid="ignore"):
+        valid = finite & (R > 0) & (max_range_m > R)
+    P = np.array(poses, dtype=float)
+    O = np.array(odom_p, dtype=float)
+    for name, arr in (("pose", P), ("odometry pose", O)):
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"{p.name}: a FLASER {name} is not finite")
+    return CarmenLog(
+        path=str(p), ranges_m=R, valid=valid, poses=P, odom_poses=O, timestamps_s=np.array(stamps, dtype=float),
+        odom=np.array(odom, dtype=float).reshape(-1, 4), max_range_m=float(max_range_m), params=params,
+        skipped=skipped,
+    )

@@ -1,0 +1,183 @@
+"""Correlation localisation (004 §7): index mapping, three correlation methods, exact recovery."""
+
+import numpy as np
+import pytest
+from scipy.signal import correlate
+
+from slamlab import correlation as C
+from slamlab import sim as S
+
+
+def test_score_maps_three_methods_agree_with_scipy_correlate():
+    rng = np.random.default_rng(0)
+    M = rng.normal(size=(23, 17))
+    T = rng.normal(size=(3, 10, 10))
+    o = 5
+    D = {m: C.score_maps(M, T, o, method=m) for m in ("batched", "fftconvolve", "direct")}
+    for n in range(3):
+        full = correlate(M, T[n], mode="full", method="direct")  # C[a, b]; robot row = a + o - (S - 1)
+        a0 = 10 - 1 - o
+        ref = full[a0:a0 + 23, a0:a0 + 17]
+        for m in D:
+            np.testing.assert_allclose(D[m][n], ref, atol=1e-9, err_msg=m)
+    np.testing.assert_allclose(C.score_maps(M, T, o, dtype=np.float32), D["direct"], atol=1e-4)
+
+
+def test_index_mapping_closed_form():
+    # a single obstacle cell in M and a single mark in T: the score is nonzero only where the
+    # robot cell + (T offset) lands on the obstacle
+    M = np.zeros((30, 40))
+    M[12, 25] = 1.0
+    T = np.zeros((1, 12, 12))
+    o = 6
+    T[0, o + 3, o - 4] = 2.0  # 3 rows up, 4 columns left of the robot
+    for method in ("batched", "fftconvolve", "direct"):
+        D = C.score_maps(M, T, o, method=method)[0]
+        assert np.unravel_index(np.argmax(D), D.shape) == (12 - 3, 25 + 4)
+        assert D.max() == pytest.approx(2.0)
+        assert np.abs(D).sum() == pytest.approx(2.0)
+
+
+def _reference_stamp(angles, ranges, heading, S, o, a_c=-1.0, a_p=1.0, hit_offset=0.5, step=0.5):
+    """Independent plain rasterisation of one T_n (float64, per beam)."""
+    T = np.zeros((S, S))
+    for pts_val in ("free", "obs"):
+        for a, r in zip(angles, ranges, strict=True):
+            th = heading + a
+            t = np.arange(0.0, r - 1e-6, step) if pts_val == "free" else np.linspace(0.01, hit_offset, 2)
+            if pts_val == "obs":
+                t = r + t
+            col = np.floor(t * np.cos(th) + 0.5).astype(int) + o
+            row = np.floor(t * np.sin(th) + 0.5).astype(int) + o
+            T[row, col] = a_c if pts_val == "free" else a_p
+    return T
+
+
+def test_rasterise_matches_plain_reference():
+    M = S.test_room_200()
+    s = S.Rangefinder(n_beams=120, max_range_cells=80).scan(M, [70, 30, 0.0])
+    # headings off the axes: beams at multiples of 3° put no sample exactly on a cell face
+    headings = np.radians([1.0, 37.0, 91.0, 269.0, 359.0])
+    T, o = C.rasterise_scan(s.angles_rad, s.ranges_cells, s.hit, headings)
+    assert T.shape[1] == 2 * o
+    for n, th in enumerate(headings):
+        ref = _reference_stamp(s.angles_rad[s.hit], s.ranges_cells[s.hit], th, T.shape[1], o)
+        # float32 coordinates / quarter-turn reuse may round a sample lying on a cell face differently
+        assert np.count_nonzero(T[n] != ref) <= 3
+        assert np.count_nonzero(ref) > 500
+
+
+def test_quarter_turns_are_grid_rotations():
+    M = S.test_room_200()
+    s = S.Rangefinder(n_beams=90, max_range_cells=60).scan(M, [70, 30, 0.0])
+    T, o = C.rasterise_scan(s.angles_rad, s.ranges_cells, s.hit, np.radians([10.0, 100.0, 190.0, 280.0]))
+    # a quarter turn maps the robot-frame offset (dx, dy) to (-dy, dx): T'[o + dx, o - dy] = T[o + dy, o + dx]
+    for q in range(1, 4):
+        ref = np.zeros_like(T[0])
+        rows, cols = np.nonzero(T[0])
+        dy, dx = rows - o, cols - o
+        for _ in range(q):
+            dx, dy = -dy, dx
+        ref[o + dy, o + dx] = T[0][rows, cols]
+        assert np.array_equal(T[q], ref)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_noise_free_scan_comes_back_exactly(seed):
+    M = S.test_room_200()
+    P = S.random_free_poses(M, 4, margin_cells=2, rng=seed)
+    P[:, 2] = np.radians(np.round(np.degrees(P[:, 2])))  # on the Δα = 1° grid
+    rf = S.Rangefinder(n_beams=360, max_range_cells=100)
+    for p in P:
+        loc = C.localise(M, rf.scan(M, p))
+        assert (loc.col, loc.row) == (int(p[0]), int(p[1]))
+        assert loc.pose[2] == pytest.approx(np.mod(p[2], 2 * np.pi), abs=1e-9)
+
+
+def test_tracking_window_agrees_with_full_search_and_float32():
+    W = S.measurement_room_200()
+    M = S.test_room_200()
+    rf = S.Rangefinder(n_beams=360, max_range_cells=100, range_std_cells=0.3)
+    p = np.array([150.0, 80.0, 2.3])
+    s = rf.scan(W, p, rng=5)
+    full = C.localise(M, s)
+    track = C.localise(M, s, prior_heading_rad=np.radians(130.0), window_rad=np.radians(10))
+    f32 = C.localise(M, s, dtype=np.float32)
+    assert track.headings_rad.size == 21
+    assert (track.row, track.col) == (full.row, full.col) == (f32.row, f32.col) == (80, 150)
+    assert C.heading_error(track.pose[2], full.pose[2]) < 1e-9
+    assert C.heading_error(full.pose[2], p[2]) <= np.radians(1.0)
+    assert full.best_per_heading.size == 360
+    assert full.score == pytest.approx(full.best_per_heading.max())
+    assert full.score_map.shape == M.shape
+
+
+def test_sharpest_peak_needs_opposite_signs():
+    # with a_c = a_n = 0, free space carries no information: the peak can only be as sharp or flatter
+    M = S.test_room_200()
+    s = S.Rangefinder(n_beams=360, max_range_cells=100).scan(M, [60, 40, 0.5])
+    opp = C.localise(M, s, prior_heading_rad=0.5, window_rad=0.0)
+    pos = C.localise(M, s, prior_heading_rad=0.5, window_rad=0.0, a_c=0.0, a_p=1.0)
+    def rel_second(d, r, c):
+        d = d.copy()
+        d[max(r - 3, 0):r + 4, max(c - 3, 0):c + 4] = -np.inf
+        return d.max()
+    sharp_opp = (opp.score - rel_second(opp.score_map, opp.row, opp.col)) / opp.score
+    sharp_pos = (pos.score - rel_second(pos.score_map, pos.row, pos.col)) / pos.score
+    assert sharp_opp > sharp_pos
+
+
+def test_heading_candidates():
+    h = C.heading_candidates(np.radians(1.0))
+    assert h.size == 360
+    np.testing.assert_allclose(np.degrees(h[[0, 1, -1]]), [0, 1, 359])
+    assert C.heading_candidates(np.radians(7.0)).size == 51  # 51·7° = 357° < 360°
+
+
+def test_bad_input():
+    M = S.test_room_200()
+    scan = S.Rangefinder(n_beams=8, max_range_cells=50).scan(M, [70, 30, 0])
+    with pytest.raises(ValueError, match="`a_c` and `a_p` must differ"):
+        C.localise(M, scan, a_c=1.0, a_p=1.0)
+    with pytest.raises(TypeError, match="`a_n` must be a finite real"):
+        C.localise(M, scan, a_n=np.inf)
+    with pytest.raises(ValueError, match="`window_rad` needs `prior_heading_rad`"):
+        C.localise(M, scan, window_rad=0.1)
+    with pytest.raises(ValueError, match="`delta_alpha_rad` must be > 0"):
+        C.localise(M, scan, delta_alpha_rad=0.0)
+    with pytest.raises(TypeError, match="`scan` must be a Scan or a tuple"):
+        C.localise(M, [1, 2, 3])
+    with pytest.raises(ValueError, match="no return"):
+        C.localise(M, ([0.0, 1.0], [5.0, 5.0], np.array([False, False])))
+    with pytest.raises(ValueError, match="`ranges_cells` must be >= 0"):
+        C.localise(M, ([0.0], [-1.0]))
+    with pytest.raises(ValueError, match="same length"):
+        C.rasterise_scan([0.0, 1.0], [1.0], None, [0.0])
+    with pytest.raises(ValueError, match="`step_cells` must be <= 1"):
+        C.rasterise_scan([0.0], [1.0], None, [0.0], step_cells=2.0)
+    with pytest.raises(ValueError, match="`l_max` must cover the longest beam"):
+        C.rasterise_scan([0.0], [10.0], None, [0.0], l_max=3)
+    with pytest.raises(ValueError, match=r"`T` must have shape \(n, S, S\)"):
+        C.score_maps(np.zeros((4, 4)), np.zeros((3, 4)), 1)
+    with pytest.raises(ValueError, match="`method` must be one of"):
+        C.score_maps(np.zeros((4, 4)), np.zeros((1, 4, 4)), 1, method="fast")
+    with pytest.raises(ValueError, match="`origin` must be <= 3"):
+        C.score_maps(np.zeros((4, 4)), np.zeros((1, 4, 4)), 9)
+    with pytest.raises(ValueError, match="`M_values` must be finite"):
+        C.score_maps(np.full((4, 4), np.nan), np.zeros((1, 4, 4)), 1)
+    with pytest.raises(ValueError, match=r"only 0 .free., 1 .obstacle. or -1"):
+        C.localise(np.full((5, 5), 3), scan)
+    with pytest.raises(ValueError, match="`delta_alpha_rad` must be <= π"):
+        C.heading_candidates(4.0)
+
+
+def test_quarter_turn_search_equals_plain_stack_on_a_non_square_map():
+    # localise() correlates base stamps with four rotated maps; compare with the plain batched stack
+    M = S.test_room_200()[10:130, 5:190]
+    s = S.Rangefinder(n_beams=180, max_range_cells=60, range_std_cells=0.2).scan(M, [90, 60, 1.0], rng=3)
+    loc = C.localise(M, s, delta_alpha_rad=np.radians(3.0))
+    T, o = C.rasterise_scan(s.angles_rad, s.ranges_cells, s.hit, loc.headings_rad)
+    D = C.score_maps(S.grid_to_values(M), T, o, method="fftconvolve")
+    np.testing.assert_allclose(loc.best_per_heading, D.reshape(D.shape[0], -1).max(axis=1), atol=1e-8)
+    np.testing.assert_allclose(loc.score_map, D[loc.heading_index], atol=1e-8)
+    assert np.unravel_index(np.argmax(D), D.shape) == (loc.heading_index, loc.row, loc.col)

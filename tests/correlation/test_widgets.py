@@ -1,0 +1,29 @@
+"""Ch. 5 widgets: every slider combination gives a result or a readable message."""
+
+import matplotlib.pyplot as plt
+import pytest
+
+from slamlab import correlation as C
+
+
+def test_explore_localisation_messages(capsys):
+    w = C.explore_localisation()
+    capsys.readouterr()
+    for kw, expect in (({"a_c": 1.0, "a_p": 1.0}, "must differ"), ({"x": 101, "y": 50}, "not in free space"),
+                       ({"n_beams": 30, "delta_alpha_deg": 10.0, "extra_clutter": 20}, "pose x=")):
+        w.f(**{**w.kwargs, **kw})
+        out = capsys.readouterr().out
+        assert expect in out
+        assert "Traceback" not in out
+        plt.close("all")
+
+
+@pytest.mark.realdata
+def test_explore_intel_scan(capsys):
+    w = C.explore_intel_scan(scan=50)
+    capsys.readouterr()
+    w.f(**{**w.kwargs, "a_c": 1.0, "a_p": 1.0})
+    assert "Cannot run with these settings" in capsys.readouterr().out
+    w.f(**{**w.kwargs, "scan": 909, "exclude": 0})
+    assert "scan 909: error" in capsys.readouterr().out
+    plt.close("all")
