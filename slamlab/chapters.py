@@ -61,7 +61,7 @@ CHAPTERS: tuple[Chapter, ...] = (
     Chapter(6, "Correlation localisation on a known map", "06_correlation_localisation.ipynb",
             ("slamlab.correlation",), "004", "available"),
     Chapter(7, "Hough-transform SLAM", "07_hough_slam.ipynb",
-            ("slamlab.hough",), "004", "planned"),
+            ("slamlab.hough",), "004", "available"),
     Chapter(8, "Probabilistic localisation: Markov, MCL", "08_probabilistic_localisation.ipynb",
             ("slamlab.localisation",), "003 §2.2; 002", "planned"),
     Chapter(9, "Monocular mapping", "09_monocular_mapping.ipynb",

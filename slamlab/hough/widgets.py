@@ -1,0 +1,129 @@
+"""Widgets for Ch. 6: noise, clutter, Δθ, Δrho, H_min, scan choice and log choice (ipywidgets)."""
+
+from __future__ import annotations
+
+import math
+
+import ipywidgets as widgets
+import matplotlib.pyplot as plt
+
+from .experiments import run_real_log, run_sim_slam
+from .lines import find_peaks
+from .plot import plot_accumulator, plot_scan_lines, real_log_figure, sim_figure
+from .slam import HoughSlamParams, detect_lines
+from .transform import hough_polar
+
+__all__ = ["explore_accumulator", "explore_hough_slam", "explore_real_log"]
+
+_STYLE = {"description_width": "initial"}
+
+
+def _slider(cls, value, lo, hi, step, desc, **kw):
+    return cls(value=value, min=lo, max=hi, step=step, description=desc, continuous_update=False, style=_STYLE,
+               **kw)
+
+
+def _theta_choice(value):
+    return widgets.Dropdown(options=[0.25, 0.5, 1.0, 2.0, 3.0, 5.0], value=value, description="Δθ [°]",
+                            style=_STYLE)
+
+
+def explore_accumulator(**defaults):
+    """One scan of 004's path: its polar accumulator, the peaks above H_min and the lines they give."""
+    from .. import sim
+
+    d = {"pose_index": 20, "range_std_cells": 0.1, "clutter": False, "delta_theta_deg": 1.0, "delta_rho": 1.0,
+         "H_min": 15, "rng": 2010}
+    d.update(defaults)
+    path = sim.path_004()
+
+    def show(pose_index, range_std_cells, clutter, delta_theta_deg, delta_rho, H_min):
+        try:
+            world = sim.measurement_room_200() if clutter else sim.test_room_200()
+            rf = sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=range_std_cells)
+            s = rf.scan(world, path[int(pose_index)], rng=d["rng"])
+            phi, r = s.angles_rad[s.hit], s.ranges_cells[s.hit]
+            acc = hough_polar(phi, r, delta_rho=delta_rho, delta_theta_rad=math.radians(delta_theta_deg))
+            peaks = find_peaks(acc, int(H_min), max_lines=12)
+            lines = detect_lines(phi, r, HoughSlamParams(delta_rho=delta_rho,
+                                                         delta_theta_rad=math.radians(delta_theta_deg),
+                                                         H_min=int(H_min)))
+        except (ValueError, TypeError) as exc:
+            print(f"Cannot run with these settings: {exc}")
+            return
+        print(f"pose {int(pose_index)}: {phi.size} returns, accumulator {acc.size_theta_rho[0]}×"
+              f"{acc.size_theta_rho[1]} (θ×ρ), {len(peaks)} peaks, {len(lines)} lines after the refit")  # noqa: RUF001
+        fig, axs = plt.subplots(1, 2, figsize=(14, 5))
+        plot_accumulator(acc, peaks, ax=axs[0])
+        plot_scan_lines(phi, r, lines, ax=axs[1])
+        fig.tight_layout()
+        plt.show()
+
+    return widgets.interactive(
+        show,
+        pose_index=_slider(widgets.IntSlider, d["pose_index"], 0, path.shape[0] - 1, 1, "scan (pose n)"),
+        range_std_cells=_slider(widgets.FloatSlider, d["range_std_cells"], 0.0, 1.0, 0.05, "range σ [cells]"),
+        clutter=widgets.Checkbox(value=d["clutter"], description="unmapped clutter", style=_STYLE),
+        delta_theta_deg=_theta_choice(d["delta_theta_deg"]),
+        delta_rho=_slider(widgets.FloatSlider, d["delta_rho"], 0.25, 3.0, 0.25, "Δρ [cells]"),
+        H_min=_slider(widgets.IntSlider, d["H_min"], 3, 80, 1, "H_min"),
+    )
+
+
+def explore_hough_slam(**defaults):
+    """004's experiment with the knobs: noise, clutter, Δθ, Δrho, H_min, method -> table and figures."""
+    d = {"n_poses": 61, "range_std_cells": 0.1, "clutter": False, "delta_theta_deg": 1.0, "delta_rho": 1.0,
+         "H_min": 15, "method": "least_squares", "refine": True, "rng": 2010}
+    d.update(defaults)
+
+    def show(n_poses, range_std_cells, clutter, delta_theta_deg, delta_rho, H_min, method, refine):
+        try:
+            res = run_sim_slam(int(n_poses), range_std_cells=range_std_cells, clutter=clutter, with_icp=True,
+                               rng=d["rng"], delta_theta_rad=math.radians(delta_theta_deg), delta_rho=delta_rho,
+                               H_min=int(H_min), method=method, refine=refine)
+        except (ValueError, TypeError) as exc:
+            print(f"Cannot run with these settings: {exc}")
+            return
+        print(res.table())
+        sim_figure(res)
+        plt.show()
+
+    return widgets.interactive(
+        show,
+        n_poses=_slider(widgets.IntSlider, d["n_poses"], 21, 241, 10, "poses along the path"),
+        range_std_cells=_slider(widgets.FloatSlider, d["range_std_cells"], 0.0, 1.0, 0.05, "range σ [cells]"),
+        clutter=widgets.Checkbox(value=d["clutter"], description="unmapped clutter", style=_STYLE),
+        delta_theta_deg=_theta_choice(d["delta_theta_deg"]),
+        delta_rho=_slider(widgets.FloatSlider, d["delta_rho"], 0.25, 3.0, 0.25, "Δρ [cells]"),
+        H_min=_slider(widgets.IntSlider, d["H_min"], 3, 80, 1, "H_min"),
+        method=widgets.Dropdown(options=[("least squares (ours)", "least_squares"), ("two lines (004)", "two_lines")],
+                                value=d["method"], description="pose from", style=_STYLE),
+        refine=widgets.Checkbox(value=d["refine"], description="least-squares refit of lines (ours)", style=_STYLE),
+    )
+
+
+def explore_real_log(**defaults):
+    """Hough SLAM on a real log: log choice, number of scans, H_min and Δrho -> table and maps."""
+    d = {"name": "mbicp", "n_scans": 160, "step": 1, "H_min": 15, "delta_rho_cm": 2.0}
+    d.update(defaults)
+
+    def show(name, n_scans, step, H_min, delta_rho_cm):
+        try:
+            res = run_real_log(name, n_scans=int(n_scans), step=int(step), H_min=int(H_min),
+                               delta_rho=delta_rho_cm / 100.0)
+        except (ValueError, TypeError, FileNotFoundError) as exc:
+            print(f"Cannot run with these settings: {exc}")
+            return
+        print(res.table())
+        real_log_figure(res)
+        plt.show()
+
+    return widgets.interactive(
+        show,
+        name=widgets.Dropdown(options=[("MbICP SICK log", "mbicp"), ("Mines URG-04LX log", "urg04lx")],
+                              value=d["name"], description="log", style=_STYLE),
+        n_scans=_slider(widgets.IntSlider, d["n_scans"], 20, 800, 20, "scans"),
+        step=_slider(widgets.IntSlider, d["step"], 1, 5, 1, "use every k-th scan"),
+        H_min=_slider(widgets.IntSlider, d["H_min"], 5, 60, 1, "H_min"),
+        delta_rho_cm=_slider(widgets.FloatSlider, d["delta_rho_cm"], 0.5, 10.0, 0.5, "Δρ [cm]"),
+    )
