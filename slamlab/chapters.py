@@ -55,7 +55,7 @@ CHAPTERS: tuple[Chapter, ...] = (
     Chapter(3, "Feature matching: kd-tree and BBF", "03_feature_matching.ipynb",
             ("slamlab.features", "slamlab.kdtree"), "000 §1.4.3; 003 §3", "planned"),
     Chapter(4, "Landmark stores: kd-tree vs multi kd-tree", "04_landmark_stores.ipynb",
-            ("slamlab.kdtree",), "000 §3.4, §4", "planned"),
+            ("slamlab.kdtree",), "000 §3.4, §4", "available"),
     Chapter(5, "Stereo SLAM", "05_stereo_slam.ipynb",
             ("slamlab.stereo",), "000 §3", "planned"),
     Chapter(6, "Correlation localisation on a known map", "06_correlation_localisation.ipynb",

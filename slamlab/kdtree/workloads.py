@@ -1,0 +1,209 @@
+"""Descriptor streams that reproduce 000's two store runs (000 §4.2, Tables 1 and 2).
+
+000 measured its stores inside the stereo SLAM loop. We replace the camera by a
+generator (our addition) that produces, per iteration, the queries (~400) and the
+new points (several hundred) of a SLAM run with 64-d SURF-like descriptors:
+
+- a landmark's descriptor is drawn around one of ``n_clusters`` texture
+  prototypes (clustered, like real descriptors); SURF layout: 16 sub-regions x
+  ``(sum dx, sum dy, sum |dx|, sum |dy|)``, unit length, float32;
+- every new point starts a *track*: it is re-observed in each of the next
+  iterations with probability ``p_track`` (geometric track length), so recent
+  landmarks are re-sighted; ``n_old`` queries per iteration re-observe older
+  base landmarks (revisits, the loop of Table 1); ``n_clutter`` queries are
+  features of no stored landmark;
+- a re-observation is the landmark's descriptor plus Gaussian noise
+  ``sigma_obs`` (renormalised).
+
+Table 1 (loop, ~13000 points): base after 3 sightings within 7 iterations, the
+rest dropped. Table 2 (room, ~65000 points): every point base at once.
+``clustered=False`` draws descriptors uniformly on the unit sphere instead --
+the case where Best-Bin-First recall collapses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .. import _validate as v
+from .stores import _SightingBook
+
+__all__ = ["SCENARIOS", "Iteration", "Scenario", "Workload", "make_workload", "scenario", "surf_like_descriptors"]
+
+DIM = 64
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Parameters of a descriptor stream (our choices where 000 is silent)."""
+
+    name: str
+    n_iterations: int
+    n_new: int  # new points per iteration
+    p_track: float  # probability that a tracked landmark is re-seen in the next iteration
+    n_old: int  # queries re-observing older base landmarks per iteration
+    n_clutter: int  # queries of features that are not stored landmarks
+    base_seen_times: int  # 000: BaseSeenTimes (3 in Table 1; 1 = all base at once)
+    max_non_base_time: int = 7  # 000: MaxNonBaseTime
+    n_clusters: int = 256
+    sigma_cluster: float = 0.35  # spread of landmarks around their prototype (before normalising)
+    sigma_obs: float = 0.08  # descriptor noise of a re-observation (before normalising)
+    clustered: bool = True
+
+
+#: 000's two runs. Table 1: ~13000 stored points at the end; Table 2: ~65000.
+SCENARIOS = {
+    "table1": Scenario("table1", n_iterations=150, n_new=300, p_track=0.5, n_old=60, n_clutter=40,
+                       base_seen_times=3),
+    "table2": Scenario("table2", n_iterations=130, n_new=500, p_track=0.4, n_old=60, n_clutter=40,
+                       base_seen_times=1),
+}
+
+
+def scenario(name: str = "table2", **changes) -> Scenario:
+    """One of :data:`SCENARIOS` with fields changed, e.g. ``scenario("table2", n_iterations=20)``.
+
+    >>> scenario("table1", n_iterations=5).n_iterations
+    5
+    """
+    v.check_choice(name, "name", SCENARIOS)
+    try:
+        return replace(SCENARIOS[name], **changes)
+    except TypeError as e:
+        raise ValueError(f"unknown scenario field in {sorted(changes)}; fields are those of Scenario") from e
+
+
+def _normalise(X):
+    X /= np.linalg.norm(X, axis=1, keepdims=True) + 1e-12
+    return X
+
+
+def surf_like_descriptors(n: int, *, n_clusters: int = 256, sigma_cluster: float = 0.35, clustered: bool = True,
+                          rng=None, prototypes=None):
+    """``n`` unit 64-d SURF-like descriptors: 16 x (Σdx, Σdy, Σ|dx|, Σ|dy|) around texture prototypes.
+
+    Returns ``(X float32 (n, 64), prototypes (n_clusters, 64))``. With
+    ``clustered=False`` the descriptors are uniform on the unit sphere.
+
+    >>> X, P = surf_like_descriptors(5, rng=0)
+    >>> X.shape, X.dtype.name, bool(np.allclose(np.linalg.norm(X, axis=1), 1, atol=1e-5))
+    ((5, 64), 'float32', True)
+    """
+    n = v.check_int(n, "n", minimum=0)
+    rng = v.as_rng(rng)
+    if not clustered:
+        return _normalise(rng.standard_normal((n, DIM))).astype(np.float32), None
+    if prototypes is None:
+        n_clusters = v.check_int(n_clusters, "n_clusters", minimum=1)
+        g = rng.standard_normal((n_clusters, 16, 2)) * rng.gamma(2.0, 0.5, (n_clusters, 16, 1))
+        absg = np.abs(g) + np.abs(rng.standard_normal((n_clusters, 16, 2))) * 0.5
+        prototypes = _normalise(np.concatenate([g, absg], axis=2).reshape(n_clusters, DIM))
+    c = rng.integers(0, prototypes.shape[0], n)
+    X = prototypes[c] + sigma_cluster / np.sqrt(DIM) * rng.standard_normal((n, DIM))
+    X = X.reshape(n, 16, 4)
+    X[:, :, 2:] = np.abs(X[:, :, 2:])  # the |d| sums stay non-negative
+    return _normalise(X.reshape(n, DIM)).astype(np.float32), prototypes
+
+
+def _observe(X, sigma, rng):
+    Y = X.astype(np.float64) + sigma / np.sqrt(DIM) * rng.standard_normal(X.shape)
+    Y = Y.reshape(-1, 16, 4)
+    Y[:, :, 2:] = np.abs(Y[:, :, 2:])
+    return _normalise(Y.reshape(-1, DIM)).astype(np.float32)
+
+
+@dataclass(frozen=True)
+class Iteration:
+    """One SLAM iteration: the queries (with their true landmark, -1 = none) and the new points."""
+
+    queries: np.ndarray  # (M, 64) float32
+    truth: np.ndarray  # (M,) id of the landmark observed, -1 for clutter
+    new_X: np.ndarray  # (m, 64) float32
+    new_ids: np.ndarray  # (m,)
+
+    @property
+    def observed(self) -> np.ndarray:
+        """Ids re-sighted this iteration (what the base rule counts)."""
+        return self.truth[self.truth >= 0]
+
+
+@dataclass(frozen=True)
+class Workload:
+    """A descriptor stream and the number of stored points after each iteration."""
+
+    scenario: Scenario
+    iterations: tuple[Iteration, ...]
+    stored: np.ndarray  # (T,) points kept after each iteration (base + non-base), by the base rule
+
+    def __len__(self) -> int:
+        return len(self.iterations)
+
+    def __str__(self) -> str:
+        q = np.mean([it.queries.shape[0] for it in self.iterations])
+        return (f"workload {self.scenario.name}: {len(self)} iterations, {q:.0f} queries and "
+                f"{self.scenario.n_new} new points per iteration, {int(self.stored[-1])} stored at the end")
+
+
+def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload:
+    """Generate the descriptor stream of a scenario (000 §4.2 runs, reproduced synthetically).
+
+    >>> w = make_workload("table1", n_iterations=10, rng=0)
+    >>> len(w), w.iterations[0].queries.shape[1]
+    (10, 64)
+    """
+    if isinstance(name_or_scenario, Scenario):
+        sc = replace(name_or_scenario, **changes)
+    elif isinstance(name_or_scenario, str):
+        sc = scenario(name_or_scenario, **changes)
+    else:
+        raise TypeError(f"`name_or_scenario` must be a scenario name or a Scenario; got "
+                        f"{type(name_or_scenario).__name__}")
+    v.check_int(sc.n_iterations, "n_iterations", minimum=1)
+    v.check_int(sc.n_new, "n_new", minimum=1)
+    v.check_int(sc.n_old, "n_old", minimum=0)
+    v.check_int(sc.n_clutter, "n_clutter", minimum=0)
+    v.check_int(sc.base_seen_times, "base_seen_times", minimum=1)
+    v.check_int(sc.max_non_base_time, "max_non_base_time", minimum=1)
+    if not 0 <= sc.p_track < 1:
+        raise ValueError(f"`p_track` must be in [0, 1); got {sc.p_track}")
+    rng = v.as_rng(rng)
+    total = sc.n_iterations * sc.n_new
+    desc, protos = surf_like_descriptors(total, n_clusters=sc.n_clusters, sigma_cluster=sc.sigma_cluster,
+                                         clustered=sc.clustered, rng=rng)
+    # track lengths: re-seen in the next L iterations, P(L >= j) = p_track^j
+    L = rng.geometric(1.0 - sc.p_track, total) - 1
+    born = np.repeat(np.arange(sc.n_iterations), sc.n_new)
+    book = _SightingBook(sc.base_seen_times, sc.max_non_base_time)
+    alive = np.zeros(total, dtype=bool)
+    base = np.zeros(total, dtype=bool)
+    its, stored = [], []
+    for t in range(sc.n_iterations):
+        age = t - born
+        tracked = np.flatnonzero(alive & (age >= 1) & (age <= L))
+        min_age = sc.max_non_base_time if sc.base_seen_times > 1 else 0  # older than the tracks' window
+        old_pool = np.flatnonzero(base & alive & (age > min_age))
+        old = rng.choice(old_pool, min(sc.n_old, old_pool.size), replace=False) if old_pool.size else old_pool
+        seen = np.concatenate([tracked, old]).astype(np.int64)
+        Qs = _observe(desc[seen], sc.sigma_obs, rng) if seen.size else np.empty((0, DIM), np.float32)
+        clutter, _ = surf_like_descriptors(sc.n_clutter, sigma_cluster=sc.sigma_cluster, clustered=sc.clustered,
+                                           rng=rng, prototypes=protos)
+        Q = np.concatenate([Qs, clutter])
+        truth = np.concatenate([seen, np.full(sc.n_clutter, -1, dtype=np.int64)])
+        o = rng.permutation(Q.shape[0])
+        new_ids = np.arange(t * sc.n_new, (t + 1) * sc.n_new, dtype=np.int64)
+        its.append(Iteration(Q[o], truth[o], desc[new_ids], new_ids))
+        # the base rule, as the stores apply it (same order: observe, add, end of iteration)
+        if sc.base_seen_times > 1:
+            book.observe(seen)
+            book.add(new_ids)
+            promoted, dropped = book.step()
+            base[promoted] = True
+            alive[new_ids] = True
+            alive[dropped] = False
+        else:
+            base[new_ids] = True
+            alive[new_ids] = True
+        stored.append(int(alive.sum()))
+    return Workload(sc, tuple(its), np.array(stored))

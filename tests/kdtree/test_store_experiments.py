@@ -1,0 +1,86 @@
+"""Store comparison (000 Tables 1-2), crossover and C fitted on this machine: small runs."""
+
+import numpy as np
+import pytest
+
+from slamlab.kdtree.experiments import TABLES_000, fit_C, recall_at_1, run_crossover, run_store_comparison
+
+
+@pytest.fixture(scope="module")
+def table1():
+    return run_store_comparison("table1", n_iterations=12, stores=("rebuild", "multi", "brute"), n1=500, q=3.0)
+
+
+def test_comparison_counts_and_recall(table1):
+    r = table1
+    assert r.recall["brute"] == 1.0  # exact store against the exact reference
+    assert 0.85 < r.recall["rebuild"] <= 1.0
+    assert 0.85 < r.recall["multi"] <= 1.0
+    # the rebuilt tree rebuilds every kept point every iteration; the multi kd-tree far fewer
+    assert r.ops["rebuild"]["rebuilt_max"] == r.stored_end
+    assert r.ops["multi"]["rebuilt_mean"] < r.ops["rebuild"]["rebuilt_mean"]
+    # BBF examines at most `checks` points per tree
+    assert r.ops["rebuild"]["evals_max"] <= r.checks
+    t = r.table()
+    assert "recall@1 vs exact" in t
+    assert "Table 1" in t
+
+
+def test_timed_table_has_000s_figures(table1):
+    t = table1.timed_table()
+    for row in ("mean add", "max add", "mean search", "max search", "mean iteration", "max iteration"):
+        assert row in t
+    assert "<515" in t  # 000's multi kd-tree bound, Table 1
+    assert TABLES_000["table2"]["kd-tree"][0] == 524
+    ms = table1.times_ms("multi")
+    assert ms[4] == pytest.approx(np.mean(1e3 * (table1.add_s["multi"] + table1.search_s["multi"])))
+
+
+def test_table2_flann_and_all_base():
+    r = run_store_comparison("table2", n_iterations=6, stores=("flann", "multi"), n_new=300)
+    assert r.stored_end == 6 * 300  # all points base at once: nothing dropped
+    assert r.recall["flann"] > 0.85
+
+
+def test_crossover_small():
+    r = run_crossover((500, 2000), stores=("rebuild", "multi", "brute"), n_queries=100, n_new=200, n1=300, q=3.0,
+                      repeats=1)
+    assert r.recall["brute"].tolist() == [1.0, 1.0]
+    assert np.all(r.recall["multi"] > 0.8)
+    assert np.all(r.iteration_s("rebuild") > 0)
+    c = r.crossover()
+    assert np.isnan(c) or 500 <= c <= 2000
+    assert "stored points" in r.table()
+    assert "rebuilt kd-tree" in r.timed_table()
+
+
+def test_fit_C():
+    r = fit_C(n=3000, s=100, m=100)
+    assert r.C > 0
+    assert 500 <= r.n1 <= 20000
+    assert 1.5 <= r.q <= 10
+    assert "C =" in str(r)
+
+
+def test_recall_and_bad_input():
+    assert recall_at_1(np.array([[1.0, 2.0]]), np.array([[1.0, 2.0]])) == 1.0
+    with pytest.raises(ValueError, match="`stores` must be one of"):
+        run_store_comparison("table1", stores=("kd",), n_iterations=1)
+    with pytest.raises(ValueError, match="`stores` must name at least one store"):
+        run_store_comparison("table1", stores=(), n_iterations=1)
+    with pytest.raises(ValueError, match="`sizes` must be increasing"):
+        run_crossover((1000, 500))
+    with pytest.raises(ValueError, match="`n_iterations` must be >= 1"):
+        run_store_comparison("table1", n_iterations=0)
+
+
+def test_dimension_study_exact_search_visits_almost_all_leaves_in_64d():
+    from slamlab.kdtree.experiments import run_dimension_study
+
+    r = run_dimension_study((2, 64), n=2000, n_queries=40)
+    by = {row[0]: row for row in r.rows}
+    assert by["uniform 2-d"][2] < 5.0  # low dimension: exact search visits few leaves
+    assert by["uniform 64-d"][2] > 90.0  # 64-d: almost all
+    assert by["uniform 64-d"][4] < 0.5  # BBF recall collapses on uniform vectors
+    assert by["clustered SURF-like"][4] > 0.85  # and holds on clustered descriptors
+    assert "BBF recall@1" in r.table()
