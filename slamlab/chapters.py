@@ -57,7 +57,7 @@ CHAPTERS: tuple[Chapter, ...] = (
     Chapter(4, "Landmark stores: kd-tree vs multi kd-tree", "04_landmark_stores.ipynb",
             ("slamlab.kdtree",), "000 §3.4, §4", "available"),
     Chapter(5, "Stereo SLAM", "05_stereo_slam.ipynb",
-            ("slamlab.stereo",), "000 §3", "planned"),
+            ("slamlab.stereo",), "000 §3", "available"),
     Chapter(6, "Correlation localisation on a known map", "06_correlation_localisation.ipynb",
             ("slamlab.correlation",), "004", "available"),
     Chapter(7, "Hough-transform SLAM", "07_hough_slam.ipynb",

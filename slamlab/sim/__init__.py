@@ -86,7 +86,14 @@ __all__ += [
 
 # --- stereo arena, procedural lunar textures, stereo trajectories (000 §3.2, §3.7; Ch. 4) ---
 from .arena import R_BODY_CAM, StereoArena, StereoSim
-from .stereo_paths import LONG_PATH_WAYPOINTS, LOOP_WAYPOINTS, long_path, rectangular_loop, turn_in_place, waypoint_path
+from .stereo_paths import (
+    LONG_PATH_WAYPOINTS,
+    LOOP_WAYPOINTS,
+    long_path,
+    rectangular_loop,
+    turn_in_place,
+    waypoint_path,
+)
 from .textures import crater_heightfield, fractal_noise, lunar_texture
 
 __all__ += [

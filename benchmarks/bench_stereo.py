@@ -1,0 +1,113 @@
+"""Benchmark Ch. 4: stereo SLAM frame rate and per-stage times at 768×576 (000 §3: 2-3 Hz).
+
+Frames of the 360° turn in place are rendered first (rendering is not timed), then
+:class:`slamlab.stereo.StereoSLAM` runs on them with each detector. Per stage we print
+the mean wall time; the frame rate is given by wall clock and by this process's CPU
+time (other jobs share this 2-core machine; OpenCV may use both cores, so CPU time can
+exceed wall time). Two stages are also timed against an OpenCV reference in the same
+process: midpoint triangulation vs ``cv2.triangulatePoints`` (DLT) and the exact store
+query vs ``cv2.BFMatcher.knnMatch``.
+
+    python benchmarks/bench_stereo.py                    # 30 frames, ORB and SIFT
+    python benchmarks/bench_stereo.py --frames 73 --long # + the ~80 m run of 000 §4.2 (slow)
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import cv2
+import numpy as np
+
+import slamlab as sl
+from slamlab.stereo import STAGES, StereoSLAM, detect, stereo_match, triangulate_local
+
+SOURCE_HZ = 2.5  # 000 §3, conclusions: "about 2.5 Hz on average"
+GOAL_FPS = {"orb": 15.0, "sift": 3.0, "surf": 3.0}
+
+
+def best_wall(fn, repeat=5):
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), out
+
+
+def run_pipeline(frames, sim, detector):
+    slam = StereoSLAM(sim.rig, sim.T_body_left, detector=detector, rng=0)
+    c0, t0 = time.process_time(), time.perf_counter()
+    for left, right in frames:
+        slam.process(left, right)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    return slam, wall, cpu
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--frames", type=int, default=30)
+    ap.add_argument("--detectors", default="orb,sift")
+    ap.add_argument("--long", action="store_true", help="also run the ~80 m path in the 10x12 m room")
+    ap.add_argument("--markdown", default=None, help="write the tables to this file")
+    args = ap.parse_args(argv)
+
+    out = []
+
+    def say(s=""):
+        print(s)
+        out.append(s)
+
+    say(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+        f"numpy {np.__version__}, OpenCV {cv2.__version__}")  # fmt: skip
+    arena = sl.sim.StereoArena(seed=0)
+    sim = sl.sim.StereoSim(arena, rng=0)
+    poses = sl.sim.turn_in_place(np.deg2rad(5.0))[: args.frames]
+    t_render, frames = best_wall(lambda: [sim.render_pair(p) for p in poses], repeat=1)
+    say(f"render: {1000 * t_render / len(poses):.0f} ms per 768x576 stereo pair ({len(poses)} frames of the turn in place)")
+    say()
+    say("| detector | " + " | ".join(f"{s} ms" for s in STAGES) + " | frames/s (wall) | frames/s (CPU) | 000 | goal |")
+    say("|---|" + "---|" * (len(STAGES) + 4))
+    for det in args.detectors.split(","):
+        slam, wall, cpu = run_pipeline(frames, sim, det)
+        st = slam.stage_times()
+        cells = [f"{1000 * st[s][1:].mean():.1f}" for s in STAGES]
+        say(f"| {det} | " + " | ".join(cells) + f" | {len(frames) / wall:.2f} | {len(frames) / cpu:.2f} | {SOURCE_HZ} | {GOAL_FPS.get(det, '')} |")
+    say()
+    # stage micro-benchmarks against OpenCV, on one frame
+    left, right = frames[len(frames) // 2]
+    fl, fr = detect(left), detect(right)
+    sm = stereo_match(fl, fr, sim.rig)
+    cloud = triangulate_local(sim.rig, fl, fr, sm)
+    uvl, uvr = fl.uv[sm.left], fr.uv[sm.right]
+    P1 = sim.rig.left.K @ np.hstack([np.eye(3), np.zeros((3, 1))])
+    P2 = sim.rig.right.K @ np.hstack([sim.rig.R_rl, sim.rig.t_rl[:, None]])
+    t_ours, _ = best_wall(lambda: sl.geometry.triangulate_stereo(sim.rig, uvl, uvr))
+    t_cv, _ = best_wall(lambda: cv2.triangulatePoints(P1, P2, uvl.T.copy(), uvr.T.copy()))
+    slam, *_ = run_pipeline(frames, sim, "orb")
+    store = slam.store
+    Q = fl.descriptors[cloud.left]
+    t_store, _ = best_wall(lambda: store.query(Q, k=2), repeat=3)
+    bf = cv2.BFMatcher(cv2.NORM_HAMMING)
+    t_bf, _ = best_wall(lambda: bf.knnMatch(Q, store.X, k=2), repeat=3)
+    say("| stage | ours ms | OpenCV ms | ratio |")
+    say("|---|---|---|---|")
+    say(f"| midpoint triangulation, {len(uvl)} matches (vs cv2.triangulatePoints) | {1000 * t_ours:.2f} | {1000 * t_cv:.2f} | {t_ours / t_cv:.2f} |")
+    say(f"| exact store 2-NN, {len(Q)} queries x {len(store)} landmarks (vs BFMatcher.knnMatch) | {1000 * t_store:.1f} | {1000 * t_bf:.1f} | {t_store / t_bf:.2f} |")
+    if args.long:
+        say()
+        room = sl.sim.StereoArena(10.0, 12.0, seed=0)
+        path = sl.sim.long_path(0.25, np.deg2rad(15.0))
+        t0 = time.perf_counter()
+        res = sl.stereo.run_stereo_slam(path, name="long path", arena=room, rng=0)
+        say(f"long path (~80 m, {len(path)} frames): {res}; SLAM {res.fps:.2f} frames/s; total {time.perf_counter() - t0:.0f} s")
+    if args.markdown:
+        with open(args.markdown, "w") as f:
+            f.write("\n".join(out) + "\n")
+
+
+if __name__ == "__main__":
+    main()

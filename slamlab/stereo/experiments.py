@@ -1,0 +1,258 @@
+"""Ch. 4 experiments (000 §3.7): the stereo SLAM loop on rendered arena runs, against ground truth.
+
+``run_turn_in_place`` (000 §3.7.1) and ``run_closed_loop`` (000 §3.7.2) return a
+frozen :class:`StereoRunResult`; ``str(result)`` is a one-line summary and
+``result.table()`` prints our figures beside 000's. Timings live in ``stage_time_s``
+and ``fps`` only, never in the table.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as v
+from .._table import format_table
+from ..geometry import wrap_angle
+from ..geometry.camera import StereoRig
+from ..geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
+from ..sim.arena import StereoArena, StereoSim
+from ..sim.stereo_paths import rectangular_loop, turn_in_place
+from .slam import STAGES, StereoSLAM
+
+__all__ = [
+    "SIZES",
+    "KittiRunResult",
+    "StereoRunResult",
+    "run_closed_loop",
+    "run_kitti",
+    "run_stereo_slam",
+    "run_turn_in_place",
+]
+
+#: frame steps per size: (turn step deg, loop step m, loop turn step deg)
+SIZES = {"small": (10.0, 0.5, 20.0), "full": (5.0, 0.25, 15.0)}
+
+
+@dataclass(frozen=True)
+class StereoRunResult:
+    """One stereo SLAM run on a rendered trajectory, errors against the ground truth (000 §3.7)."""
+
+    name: str
+    detector: str
+    policy: str
+    n_frames: int
+    truth: np.ndarray = field(repr=False)  # (N, 3) x, y, yaw (unwrapped) in the map frame
+    estimate: np.ndarray = field(repr=False)  # (N, 3)
+    pos_err_m: np.ndarray = field(repr=False)  # (N,)
+    yaw_err_rad: np.ndarray = field(repr=False)  # (N,) wrapped estimate - truth
+    counts: dict = field(repr=False)
+    landmarks_xy: np.ndarray = field(repr=False)  # (K, 2) base landmarks in the map frame
+    degenerate: np.ndarray = field(repr=False)  # indices of frames that kept the last pose
+    stage_time_s: dict = field(repr=False, compare=False)  # per-frame stage times
+    fps: float = field(compare=False)  # SLAM frames per second (rendering excluded)
+
+    def __str__(self) -> str:
+        return (
+            f"{self.name}: {self.n_frames} frames, {self.detector}/{self.policy}, max position error "
+            f"{self.pos_err_m.max():.2f} m, max heading error {np.rad2deg(np.abs(self.yaw_err_rad).max()):.1f} deg, "
+            f"{len(self.degenerate)} degenerate frames"
+        )
+
+    # -- figures of 000 §3.7 -------------------------------------------------------------------------
+    def frame_at_turn(self, angle_rad: float) -> int:
+        """First frame whose true turned angle reaches ``angle_rad``."""
+        turned = np.abs(self.truth[:, 2] - self.truth[0, 2])
+        return int(np.argmax(turned >= angle_rad - 1e-9)) if np.any(turned >= angle_rad - 1e-9) else len(turned) - 1
+
+    @property
+    def position_spread_m(self) -> float:
+        """Largest distance between two estimated positions (000 §3.7.1: ~20 cm in the turn)."""
+        p = self.estimate[:, :2]
+        return float(np.max(np.linalg.norm(p[:, None] - p[None], axis=2)))
+
+    @property
+    def heading_error_ratio(self) -> float:
+        """Largest |heading error| / |turned angle| over frames turned at least 90° (000 §3.1: ≤ 10 %)."""
+        turned = np.abs(self.truth[:, 2] - self.truth[0, 2])
+        m = turned >= np.pi / 2 - 1e-9
+        return float(np.max(np.abs(self.yaw_err_rad[m]) / turned[m])) if m.any() else float("nan")
+
+    @property
+    def revisit_difference(self) -> tuple[float, float]:
+        """Estimated pose at the last frame minus at the first (same true place and heading): (m, rad)."""
+        d = self.estimate[-1] - self.estimate[0]
+        return float(np.hypot(d[0], d[1])), float(wrap_angle(d[2]))
+
+    def table(self) -> str:
+        """Our errors beside 000's figures and requirements (fixed precision)."""
+        deg = np.rad2deg
+        rows = [
+            ["frames (degenerate)", f"{self.n_frames} ({len(self.degenerate)})", ""],
+            ["max position error, m", f"{self.pos_err_m.max():.2f}", "<= 0.5 (req.)" if self.name == "closed loop" else "<= 0.15"],
+        ]
+        if self.name == "turn in place":
+            rows.append(["spread of positions, m", f"{self.position_spread_m:.2f}", "~0.20"])
+            i180 = self.frame_at_turn(np.pi)
+            rows.append(["heading error at 180 deg, deg", f"{deg(abs(self.yaw_err_rad[i180])):.1f}", "<= 5"])
+            rows.append(["heading error back at 0 deg, deg", f"{deg(abs(self.yaw_err_rad[-1])):.1f}", "2-3"])
+        else:
+            rows.append(["max heading error / turned angle, %", f"{100 * self.heading_error_ratio:.1f}", "<= 10 (req.; 000: 10)"])
+            dp, dyaw = self.revisit_difference
+            rows.append(["revisit: pose change, m", f"{dp:.2f}", "same pose (req.)"])
+            rows.append(["revisit: heading change, deg", f"{deg(abs(dyaw)):.1f}", "same pose (req.)"])
+        c = self.counts
+        rows.append(["stereo matches per frame (median)", f"{np.median(c['n_stereo']):.0f}", "~500 (<100 bad)"])
+        rows.append(["RANSAC inliers per frame (median)", f"{np.median(c['n_inliers'][1:]):.0f}", ""])
+        return format_table(["quantity", "ours", "000"], rows, title=f"{self.name} ({self.detector}, policy {self.policy})")
+
+    def timing_table(self) -> str:
+        """Mean time per stage in ms and frames per second (volatile: not for nbval)."""
+        rows = [[s, f"{1000 * np.mean(self.stage_time_s[s]):.1f}"] for s in STAGES]
+        rows.append(["frames/s", f"{self.fps:.2f}"])
+        return format_table(["stage", "ms/frame"], rows)
+
+
+def run_stereo_slam(
+    poses,
+    *,
+    name: str = "run",
+    arena: StereoArena | None = None,
+    rig: StereoRig | None = None,
+    camera_height_m: float = 0.4,
+    noise_std: float = 0.0,
+    drift_std_rad: float = 0.0,
+    progress=None,
+    rng=0,
+    **slam_kwargs,
+) -> StereoRunResult:
+    """Render ``poses`` (N, 3) in ``arena`` and run :class:`StereoSLAM` on them (000 §3.7).
+
+    The map frame is the first body pose; truth is expressed in it. ``slam_kwargs`` go to
+    :class:`StereoSLAM` (``detector``, ``policy``, ``ransac_iters``, ...).
+    """
+    poses = v.as_finite_array(poses, "poses", ndim=2)
+    if poses.shape[1] != 3 or len(poses) < 2:
+        raise ValueError(f"`poses` must have shape (N, 3) with N >= 2; got {poses.shape}")
+    r_sim, r_slam = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(2)
+    arena = StereoArena() if arena is None else arena
+    sim = StereoSim(arena, rig, camera_height_m=camera_height_m, noise_std=noise_std, drift_std_rad=drift_std_rad, rng=np.random.default_rng(r_sim))
+    slam = StereoSLAM(sim.rig, sim.T_body_left, rng=np.random.default_rng(r_slam), **slam_kwargs)
+    T0_inv = se3_inverse(se3_from_planar(*poses[0]))
+    truth = np.array([planar_from_se3(T0_inv @ se3_from_planar(*p)) for p in poses])
+    truth[:, 2] = poses[:, 2] - poses[0, 2]
+    t_slam = 0.0
+    for i, p in enumerate(poses):
+        left, right = sim.render_pair(p)
+        t = time.perf_counter()
+        slam.process(left, right)
+        t_slam += time.perf_counter() - t
+        if progress is not None:
+            progress(i)
+    est = slam.planar_trajectory
+    pos_err = np.hypot(*(est[:, :2] - truth[:, :2]).T)
+    yaw_err = wrap_angle(est[:, 2] - truth[:, 2])
+    return StereoRunResult(
+        name=name, detector=slam.detector, policy=slam.policy, n_frames=len(poses), truth=truth, estimate=est,
+        pos_err_m=pos_err, yaw_err_rad=np.asarray(yaw_err), counts=slam.counts(),
+        landmarks_xy=slam.landmark_map()[:, :2], degenerate=slam.degenerate_frames,
+        stage_time_s=slam.stage_times(), fps=len(poses) / t_slam,
+    )  # fmt: skip
+
+
+def run_turn_in_place(size: str = "small", *, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
+    """360° turn in place in the 6×8 m arena, facing a wall at the start (000 §3.7.1).
+
+    ``size="small"``: 10° per frame (37 frames); ``"full"``: 5° per frame (73 frames).
+    """
+    v.check_choice(size, "size", SIZES)
+    poses = turn_in_place(np.deg2rad(SIZES[size][0]), center_m=(3.0, 4.0), start_yaw_rad=np.pi / 2)
+    return run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
+
+
+def run_closed_loop(size: str = "small", *, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
+    """The closed, roughly rectangular 4×5 m loop in the 6×8 m arena, back to the start pose (000 §3.7.2).
+
+    ``size="small"``: 0.5 m and 20° per frame; ``"full"``: 0.25 m and 15° per frame.
+    """
+    v.check_choice(size, "size", SIZES)
+    _, step_m, turn_deg = SIZES[size]
+    poses = rectangular_loop(step_m, np.deg2rad(turn_deg))
+    return run_stereo_slam(poses, name="closed loop", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
+
+
+@dataclass(frozen=True)
+class KittiRunResult:
+    """StereoSLAM on the 20 KITTI frames of ``kitti-odometry-06-stereo`` against the ground truth."""
+
+    truth: np.ndarray = field(repr=False)  # (N, 4, 4) left-camera poses in the frame-0 camera frame
+    estimate: np.ndarray = field(repr=False)  # (N, 4, 4)
+    ate_m: float
+    ate_se3_m: float
+    rpe_m: float
+    final_error_m: float
+    path_length_m: float
+    n_degenerate: int
+    inliers_median: float
+    fps: float = field(compare=False)
+
+    def __str__(self) -> str:
+        return (f"KITTI 06, {len(self.truth)} frames: ATE {self.ate_m:.2f} m (after SE(3) alignment {self.ate_se3_m:.2f} m), "
+                f"final error {self.final_error_m:.2f} m over {self.path_length_m:.1f} m")  # fmt: skip
+
+    def table(self) -> str:
+        rows = [
+            ["frames (degenerate)", f"{len(self.truth)} ({self.n_degenerate})"],
+            ["ATE RMSE, no alignment, m", f"{self.ate_m:.2f}"],
+            ["ATE RMSE, SE(3)-aligned, m", f"{self.ate_se3_m:.2f}"],
+            ["RPE RMSE over 1 frame, m", f"{self.rpe_m:.2f}"],
+            ["final position error, m", f"{self.final_error_m:.2f}"],
+            ["final error / path length, %", f"{100 * self.final_error_m / self.path_length_m:.1f}"],
+            ["RANSAC inliers per frame (median)", f"{self.inliers_median:.0f}"],
+        ]
+        return format_table(["quantity", "ours"], rows, title="KITTI odometry 06, frames 0-19 (real data)")
+
+
+def run_kitti(folder=None, *, max_depth_m: float = 40.0, rng=0, **slam_kwargs) -> KittiRunResult:
+    """StereoSLAM on the 20 rectified KITTI stereo pairs of ``kitti-odometry-06-stereo`` (real data).
+
+    The calibration comes from the set's ``calib.txt`` (P0, P1: fx = 707 px, baseline 0.537 m); the
+    map frame is the first left-camera frame, as in KITTI's ``poses.txt``. ATE and RPE by
+    :mod:`slamlab.evaluation` (equal to evo's).
+    """
+    import cv2
+
+    from ..data import find_data
+    from ..evaluation import Trajectory, ate, rpe
+    from ..geometry.camera import PinholeCamera
+
+    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else folder
+    P = np.loadtxt(d / "calib.txt").reshape(2, 3, 4)
+    fx, cx, cy = P[0][0, 0], P[0][0, 2], P[0][1, 2]
+    cam = PinholeCamera(1226, 370, fx, fx, cx, cy)
+    rig = StereoRig(cam, cam, np.eye(3), np.array([P[1][0, 3] / fx, 0.0, 0.0]))
+    gt34 = np.loadtxt(d / "poses.txt").reshape(-1, 3, 4)
+    slam = StereoSLAM(rig, np.eye(4), max_depth_m=max_depth_m, rng=rng, **slam_kwargs)
+    t_slam = 0.0
+    for i in range(len(gt34)):
+        left = cv2.imread(str(d / "image_0" / f"{i:06d}.png"), cv2.IMREAD_GRAYSCALE)
+        right = cv2.imread(str(d / "image_1" / f"{i:06d}.png"), cv2.IMREAD_GRAYSCALE)
+        t = time.perf_counter()
+        slam.process(left, right)
+        t_slam += time.perf_counter() - t
+    est = slam.trajectory
+    truth = np.tile(np.eye(4), (len(gt34), 1, 1))
+    truth[:, :3, :] = gt34
+    ts = np.arange(len(gt34)) * 0.1  # KITTI runs at about 10 Hz
+    ref = Trajectory(truth[:, :3, 3], truth[:, :3, :3], ts)
+    ours = Trajectory(est[:, :3, 3], est[:, :3, :3], ts)
+    return KittiRunResult(
+        truth=truth, estimate=est, ate_m=float(ate(ref, ours, align="none").rmse),
+        ate_se3_m=float(ate(ref, ours, align="se3").rmse), rpe_m=float(rpe(ref, ours, delta=1).rmse),
+        final_error_m=float(np.linalg.norm(est[-1, :3, 3] - truth[-1, :3, 3])),
+        path_length_m=float(np.sum(np.linalg.norm(np.diff(truth[:, :3, 3], axis=0), axis=1))),
+        n_degenerate=len(slam.degenerate_frames), inliers_median=float(np.median(slam.counts()["n_inliers"][1:])),
+        fps=len(gt34) / t_slam,
+    )  # fmt: skip

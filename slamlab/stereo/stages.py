@@ -1,0 +1,463 @@
+"""The per-frame stages of the stereo SLAM pipeline (000 §3.3-3.6), callable one at a time.
+
+``detect`` → ``stereo_match`` → ``triangulate_local`` → ``match_to_map`` →
+``estimate_pose``; :class:`~slamlab.stereo.slam.StereoSLAM` runs them in a loop
+and refines / adds landmarks.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import cv2
+import numpy as np
+
+from .. import _validate as v
+from ..geometry.camera import StereoRig
+from ..geometry.ransac import ransac
+from ..geometry.registration import RigidTransform, umeyama
+from ..geometry.triangulation import triangulate_stereo
+
+__all__ = [
+    "DETECTORS",
+    "POLICIES",
+    "Features",
+    "LocalCloud",
+    "MapMatches",
+    "PoseEstimate",
+    "StereoMatches",
+    "detect",
+    "estimate_pose",
+    "match_to_map",
+    "select_oldest",
+    "stereo_match",
+    "triangulate_local",
+]
+
+POLICIES = ("oldest", "all")
+
+
+class Features(NamedTuple):
+    """Keypoints ``uv (N, 2)`` (column, row) and descriptors ``(N, D)`` (uint8 = binary / Hamming)."""
+
+    uv: np.ndarray
+    descriptors: np.ndarray
+
+    @property
+    def binary(self) -> bool:
+        return self.descriptors.dtype == np.uint8
+
+
+# --- detection: a tiny adapter keyed by `detector` (slamlab.features will replace it) -------------
+
+
+def _as_uint8(image):
+    img = v.as_image(image, "image")
+    if img.dtype == np.uint8:
+        return img
+    if np.issubdtype(img.dtype, np.floating) and img.max() <= 1.0:
+        img = img * 255.0
+    return np.clip(np.rint(img), 0, 255).astype(np.uint8)
+
+
+def _cv_features(det, img):
+    kps, desc = det.detectAndCompute(img, None)
+    if desc is None or not kps:
+        return np.empty((0, 2)), None
+    return np.array([k.pt for k in kps], dtype=np.float64), desc
+
+
+def _detect_orb(img, n_features):
+    uv, desc = _cv_features(cv2.ORB_create(nfeatures=n_features, fastThreshold=12), img)
+    return uv, np.empty((0, 32), np.uint8) if desc is None else desc
+
+
+def _detect_sift(img, n_features):
+    uv, desc = _cv_features(cv2.SIFT_create(nfeatures=n_features), img)
+    return uv, np.empty((0, 128), np.float32) if desc is None else desc.astype(np.float32)
+
+
+def _detect_surf(img, n_features):
+    # the features chapter's SURF (000 §1.4, §3.3); imported here so that chapter stays optional
+    from ..features import detect as features_detect
+
+    f = features_detect(img, "surf", max_points=n_features)
+    desc = np.empty((0, 64), np.float32) if f.descriptors is None else np.asarray(f.descriptors, np.float32)
+    return np.asarray(f.uv, np.float64).reshape(-1, 2), desc
+
+
+DETECTORS = {"orb": _detect_orb, "sift": _detect_sift, "surf": _detect_surf}
+
+
+def detect(image, detector: str = "orb", n_features: int = 2000) -> Features:
+    """Keypoints and descriptors of one image (000 §3.3; OpenCV ORB / SIFT for now).
+
+    000 uses SURF with about 2000 points per 768×576 image; SURF is absent from
+    our OpenCV: ``"surf"`` calls the features chapter's own SURF (``slamlab.features.detect``);
+    the default here is ORB (OpenCV), the fast one.
+
+    >>> img = (np.indices((64, 64)).sum(0) % 16 < 8).astype(np.uint8) * 255
+    >>> f = detect(img, n_features=50); f.uv.shape[1], f.descriptors.dtype
+    (2, dtype('uint8'))
+    """
+    v.check_choice(detector, "detector", DETECTORS)
+    n_features = v.check_int(n_features, "n_features", minimum=1)
+    uv, desc = DETECTORS[detector](_as_uint8(image), n_features)
+    return Features(uv, desc)
+
+
+# --- stereo matching: ratio rule + epipolar check (000 §3.3) ---------------------------------------
+
+
+class StereoMatches(NamedTuple):
+    """Indices ``left (M,)`` / ``right (M,)`` into the two keypoint sets and descriptor ``distance (M,)``."""
+
+    left: np.ndarray
+    right: np.ndarray
+    distance: np.ndarray
+
+
+def _check_features(f, name):
+    if not isinstance(f, Features):
+        raise TypeError(f"`{name}` must be Features (from `detect`); got {type(f).__name__}")
+    return f
+
+
+def stereo_match(
+    left: Features,
+    right: Features,
+    rig: StereoRig,
+    *,
+    ratio: float = 0.8,
+    epi_tol_px: float = 2.0,
+    max_distance: float | None = None,
+) -> StereoMatches:
+    """Left-right correspondences by descriptor, ratio rule and epipolar check (000 §3.3).
+
+    Candidates of a left keypoint are the right keypoints within ``epi_tol_px`` of its
+    epipolar line (from the calibrated ``rig``); the nearest candidate is kept when its
+    distance is below ``ratio`` × the second nearest (Lowe's rule; 000 does not say how it
+    matched — our choice) and when no other left keypoint claims it with a smaller distance.
+    """
+    _check_features(left, "left")
+    _check_features(right, "right")
+    if not isinstance(rig, StereoRig):
+        raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
+    ratio = v.check_probability(ratio, "ratio")
+    epi_tol_px = v.check_positive(epi_tol_px, "epi_tol_px")
+    empty = StereoMatches(np.empty(0, np.intp), np.empty(0, np.intp), np.empty(0))
+    if len(left.uv) == 0 or len(right.uv) == 0:
+        return empty
+    if left.descriptors.dtype != right.descriptors.dtype or left.descriptors.shape[1] != right.descriptors.shape[1]:
+        raise ValueError("`left` and `right` descriptors must have the same type and length")
+    # epipolar lines of the left points in the right image: l = F x_l, distance |l . x_r| / |l[:2]|
+    xl = np.column_stack([left.uv, np.ones(len(left.uv))])
+    lines = xl @ rig.F.T
+    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
+    lines = lines.astype(np.float32)
+    dist_px = lines[:, :2] @ right.uv.T.astype(np.float32)
+    dist_px += lines[:, 2:3]
+    np.abs(dist_px, out=dist_px)
+    mask = (dist_px <= epi_tol_px).view(np.uint8)
+    norm = cv2.NORM_HAMMING if left.binary else cv2.NORM_L2
+    knn = cv2.BFMatcher(norm).knnMatch(left.descriptors, right.descriptors, k=2, mask=mask)
+    # one short list of DMatch per keypoint: (query, train, d1, d2) rows
+    rows = [(m[0].queryIdx, m[0].trainIdx, m[0].distance, m[1].distance if len(m) > 1 else np.inf) for m in knn if m]
+    if not rows:
+        return empty
+    arr = np.array(rows)
+    li, ri, d1, d2 = arr[:, 0].astype(np.intp), arr[:, 1].astype(np.intp), arr[:, 2], arr[:, 3]
+    keep = d1 < ratio * d2
+    if max_distance is not None:
+        keep &= d1 <= v.check_positive(max_distance, "max_distance")
+    li, ri, d1 = li[keep], ri[keep], d1[keep]
+    # each right keypoint goes to its best left keypoint only
+    order = np.lexsort((d1, ri))
+    first = np.ones(order.size, dtype=bool)
+    first[1:] = ri[order][1:] != ri[order][:-1]
+    sel = np.sort(order[first])
+    return StereoMatches(li[sel], ri[sel], d1[sel])
+
+
+# --- local landmark cloud (000 §3.3) ----------------------------------------------------------------
+
+
+class LocalCloud(NamedTuple):
+    """Landmarks of one frame in the left-camera frame.
+
+    ``points (K, 3)``, their covariances ``cov (K, 3, 3)`` from the pixel error,
+    ``left (K,)`` indices of their left keypoints, ``gap_m (K,)`` ray gaps.
+    """
+
+    points: np.ndarray
+    cov: np.ndarray
+    left: np.ndarray
+    gap_m: np.ndarray
+
+
+def triangulate_local(
+    rig: StereoRig,
+    left: Features,
+    right: Features,
+    matches: StereoMatches,
+    *,
+    min_depth_m: float = 0.3,
+    max_depth_m: float = 10.0,
+    pixel_std: float = 0.5,
+) -> LocalCloud:
+    """Midpoint triangulation of the stereo matches, with covariances (000 §3.3).
+
+    Keeps points in front of both cameras with depth in ``[min_depth_m, max_depth_m]``.
+    The covariance (our addition, used by the landmark filter) is that of a stereo
+    point with ``pixel_std`` error per coordinate: lateral ``z σ / f``, depth
+    ``z² √2 σ / (f b)``, rotated along the viewing ray.
+    """
+    _check_features(left, "left")
+    _check_features(right, "right")
+    if not isinstance(matches, StereoMatches):
+        raise TypeError(f"`matches` must be StereoMatches; got {type(matches).__name__}")
+    pixel_std = v.check_positive(pixel_std, "pixel_std")
+    min_depth_m = v.check_positive(min_depth_m, "min_depth_m")
+    max_depth_m = v.check_positive(max_depth_m, "max_depth_m")
+    if len(matches.left) == 0:
+        return LocalCloud(np.empty((0, 3)), np.empty((0, 3, 3)), np.empty(0, np.intp), np.empty(0))
+    tri = triangulate_stereo(rig, left.uv[matches.left], right.uv[matches.right])
+    P = tri.points
+    ok = tri.valid & (P[:, 2] >= min_depth_m) & (P[:, 2] <= max_depth_m)
+    P = P[ok]
+    f = rig.left.fx
+    z = P[:, 2]
+    lat = (z * pixel_std / f) ** 2
+    dep = (z**2 * np.sqrt(2.0) * pixel_std / (f * rig.baseline_m)) ** 2
+    # covariance = lat I + (dep - lat) r r^T with r the unit viewing ray
+    r = P / np.linalg.norm(P, axis=1, keepdims=True)
+    cov = lat[:, None, None] * np.eye(3) + (dep - lat)[:, None, None] * (r[:, :, None] * r[:, None, :])
+    return LocalCloud(P, cov, matches.left[ok], tri.gap_m[ok])
+
+
+# --- local landmarks to map landmarks through a store (000 §3.4) -----------------------------------
+
+
+class MapMatches(NamedTuple):
+    """``local (M,)`` indices into the local cloud, ``ids (M,)`` landmark ids, ``distance (M,)``,
+    and ``unmatched (K - M,)`` local indices that found no landmark (candidates for new landmarks)."""
+
+    local: np.ndarray
+    ids: np.ndarray
+    distance: np.ndarray
+    unmatched: np.ndarray
+
+
+def match_to_map(
+    descriptors,
+    store,
+    *,
+    ratio: float = 0.8,
+    max_distance: float | None = None,
+    positions=None,
+    same_point_m: float | None = None,
+) -> MapMatches:
+    """Match local descriptors to the stored landmarks: 2-NN query + ratio rule, one local per landmark (000 §3.4).
+
+    With ``positions`` ((n, 3) landmark positions indexed by id) and ``same_point_m``, two nearest
+    landmarks closer than ``same_point_m`` to each other count as one physical point (a duplicate
+    added when a sighting was missed), so the ratio rule does not reject them (our addition:
+    without it, duplicates make every later sighting of a place ambiguous and the map stops
+    closing loops).
+
+    >>> from slamlab.stereo.store import ExactStore
+    >>> s = ExactStore(); s.add(np.array([[0.0, 0.0], [5.0, 0.0]]), [7, 8])
+    >>> m = match_to_map(np.array([[0.1, 0.0], [2.4, 0.0]]), s)
+    >>> m.local.tolist(), m.ids.tolist(), m.unmatched.tolist()
+    ([0], [7], [1])
+    """
+    D = np.asarray(descriptors)
+    if D.ndim != 2:
+        raise ValueError(f"`descriptors` must be 2-D (K, D); got shape {D.shape}")
+    ratio = v.check_probability(ratio, "ratio")
+    k = D.shape[0]
+    if k == 0 or len(store) == 0:
+        return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k))
+    dist, ids = store.query(D, k=2)
+    dist = np.asarray(dist, dtype=float)
+    ids = np.asarray(ids)
+    ok = (ids[:, 0] >= 0) & (dist[:, 0] < ratio * dist[:, 1])
+    if positions is not None and same_point_m is not None:
+        X = v.as_finite_array(positions, "positions", ndim=2)
+        same_point_m = v.check_positive(same_point_m, "same_point_m")
+        both = ~ok & (ids[:, 0] >= 0) & (ids[:, 1] >= 0)
+        if both.any():
+            gap = np.linalg.norm(X[ids[both, 0]] - X[ids[both, 1]], axis=1)
+            ok[np.flatnonzero(both)[gap < same_point_m]] = True
+    if max_distance is not None:
+        ok &= dist[:, 0] <= v.check_positive(max_distance, "max_distance")
+    loc = np.flatnonzero(ok)
+    lid, d = ids[ok, 0], dist[ok, 0]
+    # one local point per landmark: the closest descriptor wins
+    order = np.lexsort((d, lid))
+    first = np.ones(order.size, dtype=bool)
+    first[1:] = lid[order][1:] != lid[order][:-1]
+    sel = np.sort(order[first])
+    claimed = np.zeros(k, dtype=bool)
+    claimed[loc] = True  # ratio-passing points that lost a duplicate are neither matches nor new
+    return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed))
+
+
+# --- pose: absolute orientation inside RANSAC, oldest landmarks first (000 §3.5) -----------------
+
+
+def select_oldest(first_seen, n_min: int) -> np.ndarray:
+    """Indices of the matches whose landmarks were first seen longest ago (000 §3.5).
+
+    Sort by the frame of the first sighting and take the earliest ones until at
+    least ``n_min`` are gathered, with every landmark of the last frame included
+    ("seen as long ago as possible and at about the same time").
+
+    >>> select_oldest([5, 0, 3, 0, 9, 3], 3).tolist()
+    [1, 2, 3, 5]
+    """
+    fs = np.asarray(first_seen)
+    if fs.ndim != 1:
+        raise ValueError(f"`first_seen` must be 1-D; got shape {fs.shape}")
+    n_min = v.check_int(n_min, "n_min", minimum=1)
+    if fs.size <= n_min:
+        return np.arange(fs.size)
+    cut = np.sort(fs)[n_min - 1]
+    return np.flatnonzero(fs <= cut)
+
+
+class PoseEstimate(NamedTuple):
+    """Pose ``T`` (4, 4) mapping local points to the map, ``inliers (M,)`` over all matches,
+    ``converged``, ``n_used`` matches the final fit used, ``n_iters`` hypotheses."""
+
+    T: np.ndarray
+    inliers: np.ndarray
+    converged: bool
+    n_used: int
+    n_iters: int
+
+
+def _fit(src, dst, w):
+    return umeyama(src, dst, weights=w)
+
+
+def _residuals(T: RigidTransform, src, dst, w):
+    # residual in units of the per-point scale: sqrt(w) = 1 / scale
+    return np.linalg.norm(src @ T.R.T + T.t - dst, axis=1) * np.sqrt(w)
+
+
+def estimate_pose(
+    local_points,
+    map_points,
+    first_seen=None,
+    *,
+    depth_m=None,
+    policy: str = "all",
+    n_oldest: int = 40,
+    oldest_fraction: float = 0.5,
+    keep_fraction: float = 0.5,
+    loose_factor: float = 4.0,
+    max_correction_rad: float | None = None,
+    max_correction_m: float | None = None,
+    max_iters: int = 200,
+    threshold_m: float = 0.1,
+    depth_ref_m: float = 3.0,
+    min_inliers: int = 8,
+    rng=None,
+) -> PoseEstimate:
+    """Rotation + translation mapping the local cloud onto the map landmarks, by RANSAC + Umeyama (000 §3.5).
+
+    Parameters
+    ----------
+    local_points, map_points : (M, 3) matched points in the body frame and in the map frame.
+    first_seen : (M,) frame at which each matched landmark was first seen (for ``policy="oldest"``).
+    depth_m : (M,) depths of the local points: the inlier threshold grows as
+        ``threshold_m · max(1, (depth / depth_ref_m)²)`` (stereo depth error ∝ depth²; our choice),
+        and the final fit weights points by the inverse square of that scale.
+    policy : ``"oldest"`` — RANSAC on all matches gives a consensus pose; the matches within
+        ``loose_factor`` thresholds of it are candidates; the landmarks among them first seen
+        longest ago (:func:`select_oldest`: at least ``n_oldest`` and ``oldest_fraction`` of the
+        candidates — fewer, all from one edge of the view, leave yaw and sideways translation
+        nearly ambiguous) get a RANSAC of their own, whose pose wins when at least
+        ``keep_fraction`` of them agree, it keeps 80 % of the candidates within the loose band and
+        it differs from the consensus pose by at most ``max_correction_rad`` / ``max_correction_m``
+        (None = unbounded; a bound of 5° / 0.3 m also blocks the loop-closing correction)
+        (our reading of 000 §3.5: old landmarks correct the drift of the recent ones when a place
+        is revisited);
+        ``"all"`` — the pose is the least-squares fit on all RANSAC inliers.
+    max_iters : RANSAC hypotheses (000: about 200), minimal samples of 3, early exit at 99.9 % confidence.
+    min_inliers : inliers needed for a valid pose.
+
+    Raises
+    ------
+    ValueError if fewer than 3 matches are given.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0); P = rng.uniform(-2, 2, (30, 3))
+    >>> from slamlab.geometry import se3_from_planar
+    >>> T = se3_from_planar(0.5, -0.2, 0.3)
+    >>> est = estimate_pose(P, P @ T[:3, :3].T + T[:3, 3], rng=0)
+    >>> bool(np.allclose(est.T, T)), int(est.inliers.sum())
+    (True, 30)
+    """
+    src = v.as_finite_array(local_points, "local_points", ndim=2)
+    dst = v.as_finite_array(map_points, "map_points", ndim=2)
+    if src.shape != dst.shape or src.shape[1:] != (3,):
+        raise ValueError(f"`local_points` and `map_points` must both have shape (M, 3); got {src.shape} and {dst.shape}")
+    m = src.shape[0]
+    if m < 3:
+        raise ValueError(f"`local_points` must hold at least 3 matches for a 3-D pose; got {m}")
+    policy = v.check_choice(policy, "policy", POLICIES)
+    threshold_m = v.check_positive(threshold_m, "threshold_m")
+    depth_ref_m = v.check_positive(depth_ref_m, "depth_ref_m")
+    min_inliers = v.check_int(min_inliers, "min_inliers", minimum=3)
+    n_oldest = v.check_int(n_oldest, "n_oldest", minimum=3)
+    oldest_fraction = v.check_positive(oldest_fraction, "oldest_fraction")
+    keep_fraction = v.check_positive(keep_fraction, "keep_fraction", allow_zero=True)
+    loose_factor = v.check_positive(loose_factor, "loose_factor")
+    if oldest_fraction > 1:
+        raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {oldest_fraction}")
+    rng = v.as_rng(rng)
+    depth = np.linalg.norm(src, axis=1) if depth_m is None else v.as_vector(depth_m, "depth_m", m)
+    scale = np.maximum(1.0, (depth / depth_ref_m) ** 2)
+    w = 1.0 / scale**2
+    if first_seen is None:
+        first_seen = np.zeros(m, dtype=np.int64)
+    first_seen = np.asarray(first_seen)
+    if first_seen.shape != (m,):
+        raise ValueError(f"`first_seen` must have shape ({m},); got {first_seen.shape}")
+
+    r = ransac((src, dst, w), _fit, _residuals, 3, threshold_m, max_iters=max_iters, min_inliers=min_inliers, rng=rng)
+    if not r.converged:
+        return PoseEstimate(np.eye(4), np.zeros(m, dtype=bool), False, 0, r.n_iters)
+    Tm = r.model
+    used = np.flatnonzero(r.inliers)
+    if policy == "oldest":
+        # 000 §3.5: the pose from the landmarks first seen longest ago and at about the same time.
+        # Candidates: matches within `loose_factor` thresholds of the consensus pose (true matches to
+        # old landmarks that drifted apart from the recent map stay, random false matches go);
+        # then RANSAC again on the oldest of them, kept if most of them agree.
+        loose = np.flatnonzero(_residuals(Tm, src, dst, w) <= loose_factor * threshold_m)
+        n_min = max(n_oldest, int(np.ceil(oldest_fraction * loose.size)))
+        old = loose[select_oldest(first_seen[loose], n_min)]
+        if old.size >= 3:
+            r_old = ransac((src[old], dst[old], w[old]), _fit, _residuals, 3, threshold_m, max_iters=max_iters, rng=rng)
+            n_old = int(r_old.inliers.sum())
+            if r_old.converged and n_old >= max(min(min_inliers, old.size), keep_fraction * old.size):
+                # and it must still explain the candidates loosely: a wedge of old landmarks at one
+                # edge of the view can otherwise trade yaw for sideways translation
+                T_old = r_old.model
+                still = _residuals(T_old, src[loose], dst[loose], w[loose]) <= loose_factor * threshold_m
+                # the old landmarks may correct the consensus pose by a bounded amount only
+                d_rot = np.arccos(np.clip((np.trace(T_old.R @ Tm.R.T) - 1.0) / 2.0, -1.0, 1.0))
+                d_pos = np.linalg.norm(T_old.t - Tm.t)
+                bounded = (max_correction_rad is None or d_rot <= max_correction_rad) and (
+                    max_correction_m is None or d_pos <= max_correction_m
+                )
+                if still.mean() >= 0.8 and bounded:
+                    Tm, used = T_old, old[r_old.inliers]
+    inl = _residuals(Tm, src, dst, w) <= threshold_m
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = Tm.R, Tm.t
+    return PoseEstimate(T, inl, bool(inl.sum() >= min_inliers), int(used.size), r.n_iters)

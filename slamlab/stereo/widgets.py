@@ -1,0 +1,55 @@
+"""Widgets for Ch. 4: detector, RANSAC iterations, landmark policy, image noise and calibration drift."""
+
+from __future__ import annotations
+
+import ipywidgets as widgets
+from IPython.display import display
+
+from .experiments import run_closed_loop, run_turn_in_place
+from .plot import run_figure
+
+__all__ = ["explore_stereo_slam"]
+
+_STYLE = {"description_width": "initial"}
+
+
+def explore_stereo_slam(**defaults):
+    """Run the turn in place or the closed loop (small size) with the chosen settings -> table and plots.
+
+    Each change starts a run of 15-30 s; the run button (``manual``) avoids a run per slider step.
+    A bad combination prints its message instead of failing.
+    """
+    d = {"experiment": "turn in place", "detector": "orb", "policy": "all", "ransac_iters": 200,
+         "noise_std": 0.0, "drift_mrad": 0.0, "rng": 0}  # fmt: skip
+    d.update(defaults)
+
+    def show(experiment, detector, policy, ransac_iters, noise_std, drift_mrad):
+        run = run_turn_in_place if experiment == "turn in place" else run_closed_loop
+        bar = widgets.IntProgress(min=0, max=60, description="frames")
+        display(bar)
+        try:
+            res = run(
+                "small", detector=detector, policy=policy, ransac_iters=int(ransac_iters), noise_std=float(noise_std),
+                drift_std_rad=float(drift_mrad) * 1e-3, rng=d["rng"], progress=lambda i: setattr(bar, "value", i + 1),
+            )  # fmt: skip
+        except (ValueError, TypeError, ImportError) as exc:
+            print(f"Cannot run with these settings: {exc}")
+            return
+        print(res.table())
+        print(res.timing_table())
+        run_figure(res)
+
+    return widgets.interactive(
+        show,
+        {"manual": True, "manual_name": "run"},
+        experiment=widgets.Dropdown(options=["turn in place", "closed loop"], value=d["experiment"], description="experiment"),
+        detector=widgets.Dropdown(options=["orb", "sift", "surf"], value=d["detector"], description="detector"),
+        policy=widgets.Dropdown(options=["all", "oldest"], value=d["policy"], description="landmarks"),
+        ransac_iters=widgets.IntSlider(value=d["ransac_iters"], min=1, max=500, step=1, description="RANSAC iterations",
+                                       continuous_update=False, style=_STYLE),
+        noise_std=widgets.FloatSlider(value=d["noise_std"], min=0.0, max=20.0, step=0.5, description="image noise σ [grey]",
+                                      continuous_update=False, style=_STYLE),
+        drift_mrad=widgets.FloatSlider(value=d["drift_mrad"], min=0.0, max=5.0, step=0.1,
+                                       description="calibration drift [mrad/frame]", continuous_update=False, style=_STYLE),
+    )  # fmt: skip
+

@@ -1,0 +1,238 @@
+"""Per-frame stages of the stereo pipeline (000 §3.3-3.5) on rendered frames and exact data."""
+
+import cv2
+import numpy as np
+import pytest
+
+from slamlab.geometry import rotation_xyz, se3_from_planar
+from slamlab.sim.arena import StereoArena, StereoSim
+from slamlab.stereo import (
+    ExactStore,
+    Features,
+    StereoMatches,
+    check_store,
+    detect,
+    estimate_pose,
+    match_to_map,
+    select_oldest,
+    stereo_match,
+    triangulate_local,
+)
+
+POSE = np.array([3.0, 4.0, 1.2])
+
+
+@pytest.fixture(scope="module")
+def frame():
+    arena = StereoArena(seed=2)
+    sim = StereoSim(arena, rng=0)
+    left, right = sim.render_pair(POSE)
+    T = se3_from_planar(*POSE) @ sim.T_body_left
+    _, _, pts = arena.cast(sim.rig.left, T)
+    return sim, left, right, T, pts
+
+
+def test_detect_orb_and_sift(frame):
+    _, left, *_ = frame
+    f = detect(left, "orb", 1500)
+    assert 1000 < len(f.uv) <= 1500
+    assert f.descriptors.shape == (len(f.uv), 32)
+    assert f.binary
+    ref = cv2.ORB_create(nfeatures=1500, fastThreshold=12).detect(left, None)
+    np.testing.assert_allclose(f.uv, [k.pt for k in ref])
+    s = detect(left, "sift", 500)
+    assert s.descriptors.dtype == np.float32
+    assert s.descriptors.shape[1] == 128
+    # a float image in [0, 1] gives the same keypoints as its uint8 version
+    g = detect(left / 255.0, "orb", 1500)
+    np.testing.assert_allclose(g.uv, f.uv)
+
+
+def test_stereo_matches_and_triangulation_against_the_renderer(frame):
+    sim, left, right, T, pts = frame
+    fl, fr = detect(left), detect(right)
+    sm = stereo_match(fl, fr, sim.rig)
+    assert len(sm.left) > 500
+    assert len(np.unique(sm.right)) == len(sm.right)
+    # epipolar check: the rig is rectified, so matched rows agree within the tolerance
+    assert np.abs(fl.uv[sm.left, 1] - fr.uv[sm.right, 1]).max() <= 2.0 + 1e-9
+    cloud = triangulate_local(sim.rig, fl, fr, sm)
+    uv = np.rint(fl.uv[cloud.left]).astype(int)
+    truth_world = pts[uv[:, 1], uv[:, 0]]
+    ok = np.isfinite(truth_world[:, 0])
+    truth_cam = (truth_world[ok] - T[:3, 3]) @ T[:3, :3]
+    err = np.linalg.norm(cloud.points[ok] - truth_cam, axis=1)
+    sigma = np.sqrt(np.trace(cloud.cov[ok], axis1=1, axis2=2))
+    # ORB keypoints are quantised on its pyramid: allow 4 sigma (+1 cm for the pixel rounding above)
+    assert np.mean(err < 4 * sigma + 0.01) > 0.95
+    assert cloud.points[:, 2].min() >= 0.3
+    assert cloud.points[:, 2].max() <= 10.0
+
+
+def test_stereo_match_ratio_rule_on_synthetic_descriptors():
+    from slamlab.geometry import StereoRig
+
+    rig = StereoRig.parallel(0.2)
+    uv_l = np.array([[100.0, 50.0], [200.0, 80.0], [300.0, 120.0]])
+    uv_r = np.array([[90.0, 50.0], [190.0, 80.5], [150.0, 80.0], [290.0, 300.0]])
+    dl = np.array([[0] * 32, [255] * 32, [15] * 32], np.uint8)
+    dr = np.array([[0] * 32, [255] * 32, [255] * 32, [15] * 32], np.uint8)
+    sm = stereo_match(Features(uv_l, dl), Features(uv_r, dr), rig)
+    # 0 <-> 0 (unique on its row); 1 has two near-equal candidates on its row -> rejected by the ratio;
+    # 2's descriptor twin lies far off its epipolar line -> no match
+    assert sm.left.tolist() == [0]
+    assert sm.right.tolist() == [0]
+
+
+def test_exact_store_matches_numpy_brute_force():
+    rng = np.random.default_rng(0)
+    D = rng.integers(0, 256, (500, 32), dtype=np.uint8)
+    Q = rng.integers(0, 256, (50, 32), dtype=np.uint8)
+    s = ExactStore()
+    s.add(D, np.arange(1000, 1500))
+    dist, ids = s.query(Q, k=2)
+    bits = np.unpackbits(Q[:, None, :] ^ D[None, :, :], axis=2).sum(axis=2)
+    ref = np.sort(bits, axis=1)[:, :2]
+    np.testing.assert_array_equal(dist, ref)
+    np.testing.assert_array_equal(bits[np.arange(50), ids[:, 0] - 1000], ref[:, 0])
+    Df = rng.normal(size=(300, 64)).astype(np.float32)
+    Qf = rng.normal(size=(20, 64)).astype(np.float32)
+    s = ExactStore()
+    s.add(Df, np.arange(300))
+    dist, ids = s.query(Qf)
+    full = np.linalg.norm(Qf[:, None] - Df[None], axis=2)
+    np.testing.assert_allclose(dist, np.sort(full, axis=1)[:, :2], rtol=1e-5)
+    assert check_store(s) is s
+
+
+def test_exact_store_base_rule():
+    s = ExactStore(base_seen_times=3, max_non_base_time=7)
+    X = np.eye(4, dtype=np.float32)
+    s.add(X[:2], [0, 1])
+    for it in range(10):
+        if it in (1, 2):
+            s.observe([0])  # id 0 seen 3 times within 7 frames -> base
+        s.end_iteration()
+        if it == 6:
+            assert sorted(s.ids.tolist()) == [0, 1]
+        if it == 7:
+            assert s.ids.tolist() == [0]  # id 1 timed out
+            assert s.dropped_ids.tolist() == [1]
+    assert s.is_base.tolist() == [True]
+    d, i = s.query(X[:1], k=3)
+    assert i.tolist() == [[0, -1, -1]]
+    assert np.isinf(d[0, 1:]).all()
+
+
+def test_match_to_map_one_local_per_landmark():
+    s = ExactStore()
+    s.add(np.array([[0.0, 0.0], [10.0, 0.0]]), [5, 6])
+    m = match_to_map(np.array([[0.1, 0.0], [0.2, 0.0], [9.0, 0.0], [5.0, 0.0]]), s)
+    assert m.local.tolist() == [0, 2]
+    assert m.ids.tolist() == [5, 6]
+    assert m.unmatched.tolist() == [3]  # 1 lost landmark 5 to 0; 3 is ambiguous (ratio 1)
+
+
+def _pose_data(n=150, outliers=0.3, seed=0):
+    rng = np.random.default_rng(seed)
+    P = np.column_stack([rng.uniform(1, 6, n), rng.uniform(-2, 2, n), rng.uniform(0, 0.5, n)])
+    T = se3_from_planar(0.4, -0.3, 0.25)
+    T[:3, :3] = T[:3, :3] @ rotation_xyz(0.01, -0.005, 0.0)
+    Q = P @ T[:3, :3].T + T[:3, 3] + rng.normal(0, 0.005, P.shape)
+    bad = rng.random(n) < outliers
+    Q[bad] += rng.uniform(-2, 2, (bad.sum(), 3))
+    return P, Q, T, bad
+
+
+@pytest.mark.parametrize("policy", ["oldest", "all"])
+def test_estimate_pose_with_outliers(policy):
+    P, Q, T, bad = _pose_data()
+    first = np.random.default_rng(1).integers(0, 10, len(P))
+    est = estimate_pose(P, Q, first, policy=policy, rng=0)
+    assert est.converged
+    np.testing.assert_allclose(est.T, T, atol=0.02)
+    assert np.mean(est.inliers == ~bad) > 0.97
+    if policy == "oldest":
+        used_first = np.sort(first[~bad])[: est.n_used]
+        assert used_first.max() <= np.sort(first[~bad])[39]
+
+
+def test_estimate_pose_failure_and_bad_input():
+    rng = np.random.default_rng(0)
+    est = estimate_pose(rng.uniform(0, 5, (30, 3)), rng.uniform(0, 5, (30, 3)), threshold_m=0.01, rng=0)
+    assert not est.converged
+    np.testing.assert_array_equal(est.T, np.eye(4))
+    with pytest.raises(ValueError, match="at least 3 matches"):
+        estimate_pose(np.zeros((2, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="policy"):
+        estimate_pose(np.zeros((5, 3)), np.zeros((5, 3)), policy="newest")
+    with pytest.raises(ValueError, match="first_seen"):
+        estimate_pose(np.ones((5, 3)), np.ones((5, 3)), [1, 2])
+    with pytest.raises(ValueError, match="shape"):
+        estimate_pose(np.ones((5, 2)), np.ones((5, 2)))
+
+
+def test_select_oldest_takes_ties():
+    assert select_oldest([3, 3, 3, 1], 2).tolist() == [0, 1, 2, 3]
+    assert select_oldest([4, 2], 5).tolist() == [0, 1]
+    with pytest.raises(ValueError, match="n_min"):
+        select_oldest([1, 2], 0)
+
+
+def test_stage_bad_input(frame):
+    sim, left, *_ = frame
+    with pytest.raises(ValueError, match="detector"):
+        detect(left, "surf-xyz")
+    with pytest.raises(ValueError, match="must not be empty"):
+        detect(np.zeros((0, 0)))
+    with pytest.raises(ValueError, match="image"):
+        detect(np.zeros((4, 4, 4, 4)))
+    f = detect(left, n_features=100)
+    with pytest.raises(TypeError, match="rig"):
+        stereo_match(f, f, None)
+    with pytest.raises(TypeError, match="Features"):
+        stereo_match(f, "x", sim.rig)
+    with pytest.raises(ValueError, match="ratio"):
+        stereo_match(f, f, sim.rig, ratio=1.5)
+    with pytest.raises(TypeError, match="StereoMatches"):
+        triangulate_local(sim.rig, f, f, None)
+    empty = StereoMatches(np.empty(0, int), np.empty(0, int), np.empty(0))
+    assert len(triangulate_local(sim.rig, f, f, empty).points) == 0
+    with pytest.raises(ValueError, match="descriptors"):
+        match_to_map(np.zeros(3), ExactStore())
+    with pytest.raises(TypeError, match="lacks"):
+        check_store(object())
+    s = ExactStore()
+    s.add(np.zeros((2, 4), np.uint8), [0, 1])
+    with pytest.raises(ValueError, match="columns like the stored"):
+        s.query(np.zeros((1, 5), np.uint8))
+    with pytest.raises(ValueError, match="ids"):
+        s.add(np.zeros((2, 4), np.uint8), [0])
+
+
+def test_surf_from_the_features_chapter(frame):
+    pytest.importorskip("slamlab.features")
+    _, left, *_ = frame
+    f = detect(left, "surf", 300)
+    assert 0 < len(f.uv) <= 300
+    assert f.descriptors.shape == (len(f.uv), 64)
+    assert not f.binary
+
+
+def test_oldest_policy_follows_the_old_landmarks_when_the_map_drifted():
+    # 000 §3.5: 100 landmarks from frame 0 (exact) and 300 from frame 40, placed with a drifted pose
+    # (1 deg, 5 cm). "all" follows the recent majority; "oldest" follows the old landmarks.
+    rng = np.random.default_rng(5)
+    P = np.column_stack([rng.uniform(2, 5, 400), rng.uniform(-1.5, 1.5, 400), rng.uniform(-0.4, 0.1, 400)])
+    T = se3_from_planar(0.3, 0.1, 0.4)
+    drift = se3_from_planar(0.05, 0.0, np.deg2rad(1.0))
+    first = np.r_[np.zeros(100, int), np.full(300, 40)]
+    Q = P @ T[:3, :3].T + T[:3, 3]
+    Td = drift @ T
+    Q[100:] = P[100:] @ Td[:3, :3].T + Td[:3, 3]
+    Q += rng.normal(0, 0.003, Q.shape)
+    est_all = estimate_pose(P, Q, first, policy="all", threshold_m=0.04, rng=0)
+    est_old = estimate_pose(P, Q, first, policy="oldest", oldest_fraction=0.2, threshold_m=0.04, rng=0)
+    np.testing.assert_allclose(est_all.T, Td, atol=0.01)
+    np.testing.assert_allclose(est_old.T, T, atol=0.01)
+    assert est_old.inliers[:100].mean() > 0.95
