@@ -27,7 +27,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate as v
 from .._table import format_table
-from ..geometry import umeyama
+from ..geometry import se3_inverse, umeyama
 from .trajectory import Trajectory
 
 __all__ = ["ErrorStats", "align_trajectory", "associate", "ate", "rpe"]
@@ -161,17 +161,6 @@ def _pairs(traj: Trajectory, delta, delta_unit: str, all_pairs: bool):
     return ids[:-1], ids[1:]
 
 
-def _se3_inv(T: np.ndarray) -> np.ndarray:
-    """Rigid inverse ``[R^T, -R^T t]`` of (..., 4, 4) poses (not ``np.linalg.inv``: file rotations are
-    orthonormal only to their printed precision, and the pose is a rigid motion)."""
-    out = np.zeros_like(T)
-    Rt = np.swapaxes(T[..., :3, :3], -1, -2)
-    out[..., :3, :3] = Rt
-    out[..., :3, 3] = -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3])
-    out[..., 3, 3] = 1.0
-    return out
-
-
 def rpe(ref: Trajectory, est: Trajectory, *, delta=1, delta_unit: str = "frames", relation: str = "translation",
         align: str = "none", all_pairs: bool = False, pairs_from: str = "estimate",
         max_diff_s: float = 0.01) -> ErrorStats:
@@ -197,9 +186,9 @@ def rpe(ref: Trajectory, est: Trajectory, *, delta=1, delta_unit: str = "frames"
     if i.size == 0:
         raise ValueError("no pose pairs to evaluate (trajectory too short for this delta?)")
     Q, P = r.poses, e.poses
-    Q_rel = _se3_inv(Q[i]) @ Q[j]
-    P_rel = _se3_inv(P[i]) @ P[j]
-    E = _se3_inv(Q_rel) @ P_rel
+    Q_rel = se3_inverse(Q[i]) @ Q[j]
+    P_rel = se3_inverse(P[i]) @ P[j]
+    E = se3_inverse(Q_rel) @ P_rel
     if relation == "translation":
         return ErrorStats.from_errors(np.linalg.norm(E[:, :3, 3], axis=1), "m")
     ang = np.linalg.norm(Rotation.from_matrix(E[:, :3, :3]).as_rotvec(), axis=1)

@@ -28,14 +28,23 @@ def se3(R, t) -> np.ndarray:
 
 
 def se3_inverse(T) -> np.ndarray:
-    """Inverse of a rigid 4×4 transform: ``(R^T, -R^T t)``.
+    """Inverse of rigid 4×4 transforms, ``(R^T, -R^T t)``; batched over leading axes ``(..., 4, 4)``.
+
+    Not ``np.linalg.inv``: a pose read from a file is orthonormal only to its
+    printed precision, and its inverse is still the rigid one.
 
     >>> T = se3_from_planar(1.0, 2.0, 0.5); np.allclose(se3_inverse(T) @ T, np.eye(4))
     True
     """
-    T = v.as_matrix(T, "T", (4, 4))
-    R, t = T[:3, :3], T[:3, 3]
-    return se3(R.T, -R.T @ t)
+    T = v.as_finite_array(T, "T")
+    if T.ndim < 2 or T.shape[-2:] != (4, 4):
+        raise ValueError(f"`T` must have shape (4, 4) or (..., 4, 4); got {T.shape}")
+    out = np.zeros_like(T)
+    Rt = np.swapaxes(T[..., :3, :3], -1, -2)
+    out[..., :3, :3] = Rt
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
 
 
 def se3_from_planar(x_m: float, y_m: float, yaw_rad: float, z_m: float = 0.0) -> np.ndarray:
