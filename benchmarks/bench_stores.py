@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 import slamlab
-from slamlab.kdtree.experiments import TABLES_000, run_crossover, run_store_comparison
+from slamlab.kdtree.experiments import TABLES_000, record_stereo_stream, run_crossover, run_store_comparison
 from slamlab.kdtree.stores import BruteForceStore
 from slamlab.kdtree.workloads import surf_like_descriptors
 
@@ -100,6 +100,12 @@ def _print_workload(title, res, ref=None):
               f"({ref['kd-tree'][4] / ref['multi kd-tree'][4]:.1f}x)")
 
 
+def bench_recorded_stereo_stream(quick=False, detector="sift"):
+    """Replay the descriptor stream recorded from the stereo pipeline on the closed loop (issue 4)."""
+    w = record_stereo_stream(15 if quick else None, detector=detector)
+    return run_store_comparison(w, stores=("rebuild", "multi", "flann", "brute"))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="short runs (smoke test)")
@@ -158,6 +164,11 @@ def main(argv=None):
     print("\n## Crossover: mean iteration time (400 searches + 500 inserts) vs stored points")
     print(cx.timed_table())
     print(cx.table())
+    stereo = bench_recorded_stereo_stream(quick=q)
+    print(f"\n## {stereo.scenario}: a real descriptor stream recorded from the stereo chapter")
+    print(stereo.table())
+    print(stereo.timed_table(with_000=False))
+
     print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s; "
           f"load average at the end {os.getloadavg()[0]:.1f}")
     if args.markdown:

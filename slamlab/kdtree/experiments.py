@@ -18,7 +18,7 @@ from .. import _validate as v
 from .._table import format_table
 from .cost_model import calibrate_C, minimise_iter_time
 from .stores import STORE_NAMES, BruteForceStore, FlannStore, KDTree, make_store
-from .workloads import Scenario, make_workload, surf_like_descriptors
+from .workloads import Scenario, Workload, make_workload, surf_like_descriptors
 
 __all__ = [
     "TABLES_000",
@@ -28,6 +28,7 @@ __all__ = [
     "StoreComparisonResult",
     "fit_C",
     "recall_at_1",
+    "record_stereo_stream",
     "run_crossover",
     "run_dimension_study",
     "run_store_comparison",
@@ -94,7 +95,8 @@ class StoreComparisonResult:
             rows.append([label, *("n/a" if np.isnan(self.ops[s][key]) else fmt.format(self.ops[s][key])
                                   for s in self.stores)])
         rows.append(["recall@1 vs exact", *(f"{self.recall[s]:.3f}" for s in self.stores)])
-        title = (f"000 {self.scenario.replace('table', 'Table ')} workload: {self.n_iterations} iterations, "
+        name = f"000 {self.scenario.replace('table', 'Table ')}" if self.scenario in ("table1", "table2") else self.scenario
+        title = (f"{name} workload: {self.n_iterations} iterations, "
                  f"{self.stored_end} points at the end, ~{self.queries_per_iteration:.0f} queries per iteration; "
                  f"multi kd-tree n1 = {self.n1}, q = {self.q:g}; BBF checks = {self.checks}")
         return format_table(heads, rows, title=title)
@@ -177,6 +179,9 @@ def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flan
                          rng=2010, **scenario_changes) -> StoreComparisonResult:
     """Run 000's Table 1 (``"table1"``) or Table 2 (``"table2"``) workload through every store (000 §4.2).
 
+    ``scenario`` may also be a recorded :class:`~slamlab.kdtree.workloads.Workload`
+    (:class:`~slamlab.kdtree.workloads.RecordingStore`), replayed as recorded.
+
     ``n_iterations`` shortens the run (the notebook's small size). The base rule
     of the scenario is applied by every store (:func:`~slamlab.kdtree.stores.make_store`).
     """
@@ -185,9 +190,14 @@ def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flan
         raise ValueError("`stores` must name at least one store")
     for s in stores:
         v.check_choice(s, "stores", STORE_NAMES)
-    if n_iterations is not None:
-        scenario_changes["n_iterations"] = v.check_int(n_iterations, "n_iterations", minimum=1)
-    w = make_workload(scenario, rng=rng, **scenario_changes)
+    if isinstance(scenario, Workload):  # a recorded stream (e.g. RecordingStore.workload() of a stereo run)
+        if n_iterations is not None or scenario_changes:
+            raise ValueError("a recorded Workload is replayed as it is: no `n_iterations` or scenario changes")
+        w = scenario
+    else:
+        if n_iterations is not None:
+            scenario_changes["n_iterations"] = v.check_int(n_iterations, "n_iterations", minimum=1)
+        w = make_workload(scenario, rng=rng, **scenario_changes)
     sc: Scenario = w.scenario
     kw = _store_kwargs(n1, q, checks, leaf_size)
     recall, ops, add_s, search_s = {}, {}, {}, {}
@@ -442,3 +452,26 @@ def run_dimension_study(dims=(2, 8, 16, 64), *, n: int = 5000, n_queries: int = 
         rows.append((name, d, 100.0 * st.mean_leaves / tree.n_leaves, 100.0 * st.mean_distance_evals / tree.n,
                      recall_at_1(b, e)))
     return DimensionStudyResult(tuple(rows), n, n_queries, checks, leaf_size)
+
+
+def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0) -> Workload:
+    """Record the landmark-store calls of the stereo pipeline on 000's closed loop (our addition).
+
+    Runs :func:`slamlab.stereo.experiments.run_closed_loop` (small size: 57 frames;
+    ``n_frames`` keeps the first frames only) with an exact store wrapped in a
+    :class:`~slamlab.kdtree.workloads.RecordingStore`, and returns the recorded
+    :class:`~slamlab.kdtree.workloads.Workload` for :func:`run_store_comparison`.
+    ``detector="sift"`` gives 128-d float descriptors (OpenCV); ``"surf"`` the 64-d
+    SURF of the features chapter.
+    """
+    from ..sim.stereo_paths import rectangular_loop
+    from ..stereo.experiments import run_stereo_slam
+    from ..stereo.store import ExactStore
+    from .workloads import RecordingStore
+
+    poses = rectangular_loop(step_m=0.5, turn_step_rad=np.deg2rad(20.0))
+    if n_frames is not None:
+        poses = poses[: v.check_int(n_frames, "n_frames", minimum=2)]
+    rec = RecordingStore(ExactStore())
+    run_stereo_slam(poses, name="closed loop", detector=detector, store=rec, rng=rng)
+    return rec.workload(f"stereo closed loop, {len(poses)} frames ({detector.upper()}, recorded)")

@@ -119,13 +119,16 @@ class Iteration:
     """One SLAM iteration: the queries (with their true landmark, -1 = none) and the new points."""
 
     queries: np.ndarray  # (M, 64) float32
-    truth: np.ndarray  # (M,) id of the landmark observed, -1 for clutter
+    truth: np.ndarray  # (M,) id of the landmark observed, -1 for clutter (or unknown)
     new_X: np.ndarray  # (m, 64) float32
     new_ids: np.ndarray  # (m,)
+    observed_ids: np.ndarray | None = None  # set by a recorded stream: the ids the SLAM loop re-sighted
 
     @property
     def observed(self) -> np.ndarray:
         """Ids re-sighted this iteration (what the base rule counts)."""
+        if self.observed_ids is not None:
+            return self.observed_ids
         return self.truth[self.truth >= 0]
 
 
@@ -207,3 +210,67 @@ def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload
             alive[new_ids] = True
         stored.append(int(alive.sum()))
     return Workload(sc, tuple(its), np.array(stored))
+
+
+class RecordingStore:
+    """Wraps a landmark store and records every call as a descriptor stream (our addition).
+
+    The stereo pipeline (:class:`slamlab.stereo.StereoSLAM`) talks to its store
+    through ``query``, ``observe``, ``add`` and ``end_iteration``; this wrapper
+    passes each call on and keeps what it saw, one :class:`Iteration` per
+    ``end_iteration``. :meth:`workload` turns the recording into a
+    :class:`Workload` that :func:`~slamlab.kdtree.experiments.run_store_comparison`
+    replays through any store.
+    """
+
+    def __init__(self, store):
+        self.store = store
+        self.iterations: list[Iteration] = []
+        self._q, self._obs, self._X, self._ids = [], [], [], []
+
+    def __len__(self) -> int:
+        return len(self.store)
+
+    def query(self, Q, k: int = 2):
+        self._q.append(np.asarray(Q))
+        return self.store.query(Q, k=k)
+
+    def observe(self, ids) -> None:
+        self._obs.append(np.asarray(ids, dtype=np.int64))
+        self.store.observe(ids)
+
+    def add(self, X, ids) -> None:
+        self._X.append(np.asarray(X))
+        self._ids.append(np.asarray(ids, dtype=np.int64))
+        self.store.add(X, ids)
+
+    def end_iteration(self) -> None:
+        self.store.end_iteration()
+        Q = np.concatenate(self._q) if self._q else np.empty((0, 0), np.float32)
+        X = np.concatenate(self._X) if self._X else np.empty((0, Q.shape[1] if Q.ndim == 2 else 0), np.float32)
+        ids = np.concatenate(self._ids) if self._ids else np.empty(0, np.int64)
+        obs = np.concatenate(self._obs) if self._obs else np.empty(0, np.int64)
+        self.iterations.append(Iteration(Q, np.full(len(Q), -1, np.int64), X, ids, obs))
+        self._q, self._obs, self._X, self._ids = [], [], [], []
+
+    def workload(self, name: str = "recorded", *, base_seen_times: int = 3, max_non_base_time: int = 7) -> Workload:
+        """The recording as a :class:`Workload` (points stored per iteration counted by the base rule)."""
+        its = tuple(it for it in self.iterations if it.queries.size or it.new_X.size)
+        if not its:
+            raise ValueError("nothing was recorded: run the SLAM loop with this store first")
+        dim = next(it.queries.shape[1] for it in its if it.queries.size)
+        its = tuple(it if it.queries.size else Iteration(np.empty((0, dim), np.float32), it.truth, it.new_X,
+                                                         it.new_ids, it.observed_ids) for it in its)
+        book = _SightingBook(base_seen_times, max_non_base_time)
+        stored, n = [], 0
+        for it in its:  # the base rule, as the stores apply it: observe, add, end of iteration
+            n += len(it.new_ids)
+            if base_seen_times > 1:
+                book.observe(it.observed)
+                book.add(it.new_ids)
+                n -= len(book.step()[1])
+            stored.append(n)
+        sc = Scenario(name=name, n_iterations=len(its), n_new=max(1, int(np.mean([len(it.new_ids) for it in its]))),
+                      p_track=0.0, n_old=0, n_clutter=0, base_seen_times=base_seen_times,
+                      max_non_base_time=max_non_base_time)
+        return Workload(sc, its, np.asarray(stored))
