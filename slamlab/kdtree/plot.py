@@ -19,8 +19,8 @@ def plot_kdtree_2d(tree, *, query=None, events=None, ax=None, max_depth: int | N
         raise ValueError(f"`tree` must hold 2-D points to be drawn; got dimension {tree.dim}")
     t = tree.nodes
     P = tree.points
-    ax = new_axes(ax, title="kd-tree: median splits on the coordinate of largest spread", xlabel="x", ylabel="y",
-                  equal=True)
+    ax = new_axes(ax, title="kd-tree: median splits on the coordinate of largest spread", xlabel="x", ylabel="y")
+    ax.set_aspect("equal", adjustable="box")
     pad = 0.05 * (P.max(axis=0) - P.min(axis=0) + 1e-9)
     lo0, hi0 = P.min(axis=0) - pad, P.max(axis=0) + pad
     stack = [(0, lo0.copy(), hi0.copy())]

@@ -1,0 +1,106 @@
+"""Benchmark Ch. 2: detection time on 768x576 (ours vs OpenCV) and 2-NN matching cost (ours vs references).
+
+Usage: ``python benchmarks/bench_features.py [--quick]``. Prints, for each case, ours and the
+reference measured in the same process and their ratio. ``--quick`` uses smaller stores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import time
+
+import cv2
+import numpy as np
+
+import slamlab.features as F
+from slamlab.features.experiments import _matching_workload
+from slamlab.kdtree import KDTree
+
+
+def best_of(fn, repeats):
+    best = np.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def bench_detection(repeats=5):
+    img = cv2.resize(F.load_oxford_image("graf", 1), (768, 576), interpolation=cv2.INTER_AREA)
+    cases = {
+        "SURF ours (4e-4, 64-d)": lambda: F.detect(img, "surf", threshold=4e-4),
+        "SURF ours keypoints only": lambda: F.detect(img, "surf", threshold=4e-4, descriptors=False),
+        "SIFT OpenCV (128-d)": lambda: F.detect(img, "sift"),
+        "ORB OpenCV": lambda: F.detect(img, "orb"),
+        "FAST-9 OpenCV": lambda: F.detect(img, "fast-cv"),
+        "FAST-9 ours": lambda: F.detect(img, "fast", descriptors=False),
+    }
+    times = {k: best_of(fn, repeats) for k, fn in cases.items()}
+    sift = times["SIFT OpenCV (128-d)"]
+    fast_cv = times["FAST-9 OpenCV"]
+    print(f"Detection on graf img1 resized to 768x576 (best of {repeats})")
+    print(f"{'detector':28s} {'time [ms]':>10s} {'/ SIFT':>8s} {'/ FAST cv':>10s}")
+    for k, t in times.items():
+        print(f"{k:28s} {1000 * t:10.1f} {t / sift:8.2f} {t / fast_cv:10.1f}")
+    return times
+
+
+def _timed(fn, repeats):
+    """(best time, last result) of ``fn()``."""
+    best, out = np.inf, None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def _methods(Q, train, tree, ck, fl, n):
+    cases = {
+        "brute (BLAS)": lambda: F.knn2(Q, train, method="brute"),
+        "BBF 200 leaves (ours)": lambda: tree.query(Q, 2, max_leaves=200),
+        "FLANN kd, checks=200": lambda: F.knn2(Q, train, method="flann", tree=fl),
+        "cKDTree exact (scipy)": lambda: ck.query(Q.astype(np.float64), k=2),
+    }
+    if n <= 2000:
+        cases["kd-tree exact (ours)"] = lambda: tree.query(Q, 2)
+    return cases
+
+
+def bench_matching(sizes, n_queries=500, repeats=3):
+    """Time per ``n_queries`` 2-NN queries and recall of the true nearest neighbour."""
+    from scipy.spatial import cKDTree
+
+    print(f"\n2-NN of {n_queries} SURF queries (graf img2) against stores of SURF descriptors")
+    print(f"{'stored':>7s} {'method':26s} {'time [ms]':>10s} {'/ brute':>8s} {'NN recall':>10s}")
+    rows = []
+    for n in sizes:
+        _, q, train, _ = _matching_workload(n, n_queries, "graf", 2, 0.5 if n <= 13000 else 1.0, 5e-5)
+        Q = q.descriptors
+        tree = KDTree(train)
+        ck = cKDTree(train.astype(np.float64))
+        fl = cv2.flann_Index(np.ascontiguousarray(train, np.float32), {"algorithm": 1, "trees": 1})
+        results = {k: _timed(fn, 1 if "exact" in k else repeats)
+                   for k, fn in _methods(Q, train, tree, ck, fl, n).items()}
+        t_brute, (_, i_ref) = results["brute (BLAS)"]
+        for k, (t, (_, idx)) in results.items():
+            rec = np.mean(idx[:, 0] == i_ref[:, 0])
+            print(f"{n:7d} {k:26s} {1000 * t:10.1f} {t / t_brute:8.2f} {rec:10.3f}")
+            rows.append((n, k, t, t / t_brute, rec))
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args()
+    print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, python {platform.python_version()}, "
+          f"numpy {np.__version__}, opencv {cv2.__version__}")
+    bench_detection(3 if args.quick else 5)
+    bench_matching((2000, 13000) if args.quick else (2000, 13000, 65000))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,130 @@
+"""Feature detectors, descriptors and matching (000 §1.4; 003 §3.1).
+
+Ours: SURF from the paper (:func:`surf_detect`, :class:`SURF`), FAST
+(:func:`fast_detect`) and Moravec (:func:`moravec_detect`) for teaching; OpenCV:
+SIFT, ORB, MSER and FAST as the reference. Every detector returns
+:class:`Features`; :func:`detect` calls any of them by name. Matching rules
+(000's 2× rule, ratio, mutual check, Hamming) are in :mod:`.matching`,
+evaluation on the Oxford affine pairs in :mod:`.evaluation`.
+"""
+
+from .base import Features, to_gray_float, to_gray_uint8
+from .detect import DETECTORS, describe_surf, detect
+from .evaluation import (
+    OXFORD_SEQUENCES,
+    PairScores,
+    common_region,
+    correct_matches,
+    load_oxford_image,
+    load_oxford_pair,
+    project,
+    repeatability,
+)
+from .experiments import (
+    EVAL_DETECTORS,
+    descriptor_pool,
+    run_detector_summary,
+    run_knn_comparison,
+    run_pair_evaluation,
+    run_ratio_tradeoff,
+    run_recall_vs_leaves,
+    run_surf_threshold,
+)
+from .fast import fast_corner_mask, fast_detect, fast_score
+from .matching import (
+    KNN_METHODS,
+    Matches,
+    accept_000,
+    accept_ratio,
+    hamming_distances,
+    knn2,
+    match_descriptors,
+    mutual_mask,
+)
+from .moravec import moravec_detect, moravec_response
+from .opencv import fast_cv, features_from_keypoints, mser_cv, orb_cv, sift_cv
+from .plot import (
+    plot_box_filters,
+    plot_fast_circle,
+    plot_keypoints,
+    plot_matches,
+    plot_pair_evaluation,
+    plot_ratio_tradeoff,
+    plot_recall_vs_leaves,
+    plot_surf_threshold,
+)
+from .surf import (
+    SURF,
+    filter_sizes,
+    haar_xy,
+    hessian_response,
+    integral_image,
+    surf_describe,
+    surf_detect,
+    surf_orientation,
+    threshold_sweep,
+)
+
+__all__ = [
+    "DETECTORS",
+    "EVAL_DETECTORS",
+    "KNN_METHODS",
+    "OXFORD_SEQUENCES",
+    "SURF",
+    "Features",
+    "Matches",
+    "PairScores",
+    "accept_000",
+    "accept_ratio",
+    "common_region",
+    "correct_matches",
+    "describe_surf",
+    "descriptor_pool",
+    "detect",
+    "fast_corner_mask",
+    "fast_cv",
+    "fast_detect",
+    "fast_score",
+    "features_from_keypoints",
+    "filter_sizes",
+    "haar_xy",
+    "hamming_distances",
+    "hessian_response",
+    "integral_image",
+    "knn2",
+    "load_oxford_image",
+    "load_oxford_pair",
+    "match_descriptors",
+    "moravec_detect",
+    "moravec_response",
+    "mser_cv",
+    "mutual_mask",
+    "orb_cv",
+    "plot_box_filters",
+    "plot_fast_circle",
+    "plot_keypoints",
+    "plot_matches",
+    "plot_pair_evaluation",
+    "plot_ratio_tradeoff",
+    "plot_recall_vs_leaves",
+    "plot_surf_threshold",
+    "project",
+    "repeatability",
+    "run_detector_summary",
+    "run_knn_comparison",
+    "run_pair_evaluation",
+    "run_ratio_tradeoff",
+    "run_recall_vs_leaves",
+    "run_surf_threshold",
+    "sift_cv",
+    "surf_describe",
+    "surf_detect",
+    "surf_orientation",
+    "threshold_sweep",
+    "to_gray_float",
+    "to_gray_uint8",
+]
+
+from .widgets import explore_detectors, explore_matching
+
+__all__ += ["explore_detectors", "explore_matching"]

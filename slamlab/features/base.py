@@ -1,0 +1,113 @@
+"""One result type for every detector: keypoints and descriptors as numpy arrays (000 §1.4)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate as v
+
+__all__ = ["Features", "to_gray_float", "to_gray_uint8"]
+
+
+@dataclass(frozen=True)
+class Features:
+    """Keypoints and descriptors of one image (000 §1.4).
+
+    Attributes
+    ----------
+    uv : (N, 2) float
+        Pixel position (u, v) = (column, row), origin at the top-left pixel centre.
+    scale_px : (N,) float
+        Characteristic scale σ in pixels (SURF: 1.2·L/9 for filter size L; OpenCV
+        detectors: ``KeyPoint.size / 2``; FAST/Moravec: the radius of their support).
+    orientation_rad : (N,) float
+        Orientation in [0, 2π), image axes (u right, v down); 0 for upright/unoriented.
+    response : (N,) float
+        Detector strength (SURF: Hessian determinant; FAST: OpenCV score; Moravec: min SSD).
+    octave : (N,) int
+        Octave the point was found in (0 for single-scale detectors).
+    descriptors : (N, d) array or None
+        float32 (SIFT 128, SURF 64/128) or uint8 bytes of a binary descriptor (ORB 32).
+    method : str
+        Name of the detector.
+    """
+
+    uv: np.ndarray
+    scale_px: np.ndarray
+    orientation_rad: np.ndarray
+    response: np.ndarray
+    octave: np.ndarray
+    descriptors: np.ndarray | None = None
+    method: str = ""
+
+    def __post_init__(self):
+        n = len(self.uv)
+        for name in ("scale_px", "orientation_rad", "response", "octave"):
+            if len(getattr(self, name)) != n:
+                raise ValueError(f"`{name}` must have {n} entries to match `uv`; got {len(getattr(self, name))}")
+        if self.descriptors is not None and len(self.descriptors) != n:
+            raise ValueError(f"`descriptors` must have {n} rows to match `uv`; got {len(self.descriptors)}")
+
+    def __len__(self) -> int:
+        return len(self.uv)
+
+    @property
+    def is_binary(self) -> bool:
+        """True for binary descriptors (compared with the Hamming distance)."""
+        return self.descriptors is not None and self.descriptors.dtype == np.uint8
+
+    def __str__(self) -> str:
+        d = "no descriptors" if self.descriptors is None else f"{self.descriptors.shape[1]}-d descriptors"
+        return f"{self.method}: {len(self)} keypoints, {d}"
+
+    def subset(self, index) -> Features:
+        """The keypoints selected by a boolean mask or an index array."""
+        index = np.asarray(index)
+        return Features(self.uv[index], self.scale_px[index], self.orientation_rad[index], self.response[index],
+                        self.octave[index], None if self.descriptors is None else self.descriptors[index],
+                        self.method)
+
+    def strongest(self, n: int) -> Features:
+        """The ``n`` keypoints of largest response (stable order for ties)."""
+        n = v.check_int(n, "n", minimum=0)
+        order = np.argsort(-self.response, kind="stable")[:n]
+        return self.subset(np.sort(order))
+
+    @classmethod
+    def empty(cls, method: str = "", dim: int | None = None, dtype=np.float32) -> Features:
+        z = np.zeros(0)
+        desc = None if dim is None else np.zeros((0, dim), dtype=dtype)
+        return cls(np.zeros((0, 2)), z, z, z, np.zeros(0, dtype=np.int64), desc, method)
+
+
+def to_gray_float(image, name: str = "image") -> np.ndarray:
+    """Grey image as float64 in [0, 1] (uint8 / 255; float taken as given; colour averaged as BT.601).
+
+    >>> to_gray_float(np.array([[0, 255]], dtype=np.uint8)).tolist()
+    [[0.0, 1.0]]
+    """
+    img = v.as_image(image, name, allow_color=True)
+    if img.ndim == 3:
+        img = img[..., :3].astype(np.float64) @ np.array([0.299, 0.587, 0.114])
+        scale = 255.0 if np.asarray(image).dtype == np.uint8 else 1.0
+        return img / scale
+    if img.dtype == np.uint8:
+        return img.astype(np.float64) / 255.0
+    if img.dtype == np.bool_:
+        return img.astype(np.float64)
+    return img.astype(np.float64, copy=False)
+
+
+def to_gray_uint8(image, name: str = "image") -> np.ndarray:
+    """Grey uint8 image (float images are taken to be in [0, 1]); what OpenCV's detectors need."""
+    img = v.as_image(image, name, allow_color=True)
+    if img.dtype == np.uint8 and img.ndim == 2:
+        return img
+    if img.dtype == np.uint8:
+        import cv2
+
+        return cv2.cvtColor(np.ascontiguousarray(img[..., :3]), cv2.COLOR_RGB2GRAY)
+    g = to_gray_float(img, name)
+    return np.clip(np.rint(g * 255.0), 0, 255).astype(np.uint8)

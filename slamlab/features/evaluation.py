@@ -1,0 +1,160 @@
+"""Evaluation on image pairs with a ground-truth homography (Oxford affine set; 000 §1.4).
+
+Repeatability (our definition, position only, stated): map the keypoints of
+image 1 through H; keep only points in the common visible region (img1 points
+whose image lies inside img2, img2 points whose preimage lies inside img1); a
+correspondence is a pair closer than ``tol_px`` in image-2 pixels. The number of
+correspondences is ``min(#img1 points with an img2 point within tol,
+#img2 points with an img1 point within tol)`` and the repeatability is that
+number over ``min(n1, n2)`` of the common-region counts. Mikolajczyk et al.
+compare region overlaps (40 % overlap error) instead; ours ignores scale and
+shape.
+
+Matching: a match i→j is correct when ``|H·p_i - p_j| < tol_px``; precision =
+correct / matches; recall = correct / correspondences (the repeatable points).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .. import _validate as v
+from ..data import find_data
+from .base import Features
+from .matching import Matches
+
+__all__ = [
+    "OXFORD_SEQUENCES",
+    "PairScores",
+    "common_region",
+    "correct_matches",
+    "load_oxford_image",
+    "load_oxford_pair",
+    "project",
+    "repeatability",
+]
+
+OXFORD_SEQUENCES = ("bark", "boat", "graf", "trees", "ubc", "wall")
+
+
+def load_oxford_image(sequence: str, index: int, *, scale: float = 1.0) -> np.ndarray:
+    """Grey uint8 image ``img<index>`` of an Oxford sequence, optionally resized by ``scale`` (INTER_AREA)."""
+    import cv2
+
+    sequence = v.check_choice(sequence, "sequence", OXFORD_SEQUENCES)
+    index = v.check_int(index, "index", minimum=1, maximum=6)
+    scale = v.check_positive(scale, "scale")
+    path = Path(find_data(f"oxford-affine/{sequence}/img{index}.png"))
+    img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+    if img is None:
+        raise FileNotFoundError(f"could not read {path}")
+    if scale != 1.0:
+        h, w = img.shape
+        img = cv2.resize(img, (max(1, round(w * scale)), max(1, round(h * scale))), interpolation=cv2.INTER_AREA)
+    return img
+
+
+def load_oxford_pair(sequence: str, j: int, *, scale: float = 1.0):
+    """``(img1, img_j, H)``: grey images and the homography img1 → img_j (pixel centres, after ``scale``).
+
+    Resizing by ``s`` maps a pixel centre x to ``s·(x + 0.5) - 0.5``, so
+    ``H_s = S·H·S⁻¹`` with ``S = [[s, 0, s/2 - 1/2], [0, s, s/2 - 1/2], [0, 0, 1]]``.
+    """
+    j = v.check_int(j, "j", minimum=2, maximum=6)
+    img1 = load_oxford_image(sequence, 1, scale=scale)
+    img2 = load_oxford_image(sequence, j, scale=scale)
+    H = np.loadtxt(find_data(f"oxford-affine/{sequence}/H1to{j}p"))
+    s = float(scale)
+    S = np.array([[s, 0, s / 2 - 0.5], [0, s, s / 2 - 0.5], [0, 0, 1.0]])
+    H = S @ H @ np.linalg.inv(S)
+    return img1, img2, H / H[2, 2]
+
+
+def project(H, uv) -> np.ndarray:
+    """Apply a homography to (N, 2) pixel points.
+
+    >>> project(np.diag([2.0, 2.0, 1.0]), [[1.0, 2.0]]).tolist()
+    [[2.0, 4.0]]
+    """
+    H = v.as_matrix(H, "H", (3, 3))
+    uv = v.as_finite_array(uv, "uv").reshape(-1, 2)
+    p = uv @ H[:, :2].T + H[:, 2]
+    return p[:, :2] / p[:, 2:3]
+
+
+def _inside(uv, shape, margin):
+    h, w = shape[:2]
+    return (uv[:, 0] >= margin) & (uv[:, 0] <= w - 1 - margin) & (uv[:, 1] >= margin) & (uv[:, 1] <= h - 1 - margin)
+
+
+def common_region(f1: Features, f2: Features, H, shape1, shape2, *, margin_px: float = 0.0):
+    """Masks of the keypoints of each image that lie in the part of the scene both images see."""
+    H = v.as_matrix(H, "H", (3, 3))
+    in1 = _inside(project(H, f1.uv), shape2, margin_px) if len(f1) else np.zeros(0, dtype=bool)
+    in2 = _inside(project(np.linalg.inv(H), f2.uv), shape1, margin_px) if len(f2) else np.zeros(0, dtype=bool)
+    return in1, in2
+
+
+def _check_features(f, name):
+    if not isinstance(f, Features):
+        raise TypeError(f"`{name}` must be slamlab.features.Features; got {type(f).__name__}")
+    return f
+
+
+@dataclass(frozen=True)
+class PairScores:
+    """Repeatability and (optionally) matching scores of one detector on one image pair."""
+
+    n1: int  # keypoints of img1 in the common region
+    n2: int
+    correspondences: int
+    repeatability: float
+    matches: int = 0
+    correct: int = 0
+
+    @property
+    def precision(self) -> float:
+        return self.correct / self.matches if self.matches else float("nan")
+
+    @property
+    def recall(self) -> float:
+        return self.correct / self.correspondences if self.correspondences else float("nan")
+
+
+def repeatability(f1: Features, f2: Features, H, shape1, shape2, *, tol_px: float = 2.5) -> PairScores:
+    """Repeatability of keypoints under a known homography (position only; see the module notes).
+
+    >>> from slamlab.features.base import Features
+    >>> z = np.zeros(3)
+    >>> f = Features(np.array([[10.0, 10], [20, 20], [30, 5]]), z, z, z, z.astype(int))
+    >>> g = Features(np.array([[11.0, 10], [50, 50]]), np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2, int))
+    >>> r = repeatability(f, g, np.eye(3), (40, 40), (60, 60))
+    >>> (r.n1, r.n2, r.correspondences, r.repeatability)
+    (3, 1, 1, 1.0)
+    """
+    f1, f2 = _check_features(f1, "f1"), _check_features(f2, "f2")
+    tol_px = v.check_positive(tol_px, "tol_px")
+    in1, in2 = common_region(f1, f2, H, shape1, shape2)
+    p1 = project(H, f1.uv[in1]) if in1.any() else np.zeros((0, 2))
+    p2 = f2.uv[in2]
+    n1, n2 = len(p1), len(p2)
+    if n1 == 0 or n2 == 0:
+        return PairScores(n1, n2, 0, 0.0)
+    d12, _ = cKDTree(p2).query(p1)
+    d21, _ = cKDTree(p1).query(p2)
+    corr = int(min(np.count_nonzero(d12 < tol_px), np.count_nonzero(d21 < tol_px)))
+    return PairScores(n1, n2, corr, corr / min(n1, n2))
+
+
+def correct_matches(f1: Features, f2: Features, matches: Matches, H, *, tol_px: float = 2.5) -> np.ndarray:
+    """True for the matches (f1 as query, f2 as train) that H maps within ``tol_px``."""
+    f1, f2 = _check_features(f1, "f1"), _check_features(f2, "f2")
+    tol_px = v.check_positive(tol_px, "tol_px")
+    if len(matches) == 0:
+        return np.zeros(0, dtype=bool)
+    p = project(H, f1.uv[matches.query_idx])
+    return np.linalg.norm(p - f2.uv[matches.train_idx], axis=1) < tol_px

@@ -1,0 +1,532 @@
+"""Ch. 2 experiments (000 §1.4; 003 §3.1): detectors and matching on the Oxford affine pairs.
+
+Each ``run_*`` returns a frozen dataclass: ``str(result)`` is a one-line summary,
+``result.table()`` a fixed-precision text table (what the notebook prints and
+nbval compares); timings live in a separate ``times_s`` field, never in a table.
+``scale`` downsizes the images (INTER_AREA) to keep notebook runs short; the
+benchmark uses ``scale=1``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from .. import _validate as v
+from .._table import format_table
+from .base import Features
+from .detect import detect
+from .evaluation import OXFORD_SEQUENCES, correct_matches, load_oxford_image, load_oxford_pair, repeatability
+from .matching import accept_000, accept_ratio, knn2, match_descriptors
+from .surf import threshold_sweep
+
+__all__ = [
+    "EVAL_DETECTORS",
+    "DetectorSummaryResult",
+    "KnnComparisonResult",
+    "LeavesCurveResult",
+    "PairEvaluationResult",
+    "RatioTradeoffResult",
+    "SurfThresholdResult",
+    "descriptor_pool",
+    "run_detector_summary",
+    "run_knn_comparison",
+    "run_pair_evaluation",
+    "run_ratio_tradeoff",
+    "run_recall_vs_leaves",
+    "run_surf_threshold",
+]
+
+#: Detectors of the evaluation and the parameters we use (stated in the notebook).
+EVAL_DETECTORS = {
+    "SIFT": ("sift", {}),
+    "SURF": ("surf", {"threshold": 1e-4}),
+    "ORB": ("orb", {"n_features": 3000}),
+    "FAST": ("fast", {"threshold": 20}),
+}
+
+
+def _detect_named(img, name, n_points):
+    method, params = EVAL_DETECTORS[name]
+    params = dict(params)
+    if name == "ORB":
+        params["n_features"] = max(params["n_features"], 2 * n_points)
+    t0 = time.perf_counter()
+    f = detect(img, method, max_points=n_points, **params)
+    return f, time.perf_counter() - t0
+
+
+# --- repeatability and matching on image pairs ------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PairEvaluationResult:
+    """Repeatability and matching precision/recall per (sequence, img1→img_j, detector)."""
+
+    sequences: tuple[str, ...]
+    steps: tuple[int, ...]
+    detectors: tuple[str, ...]
+    scale: float
+    n_points: int
+    tol_px: float
+    rule: str
+    rep: np.ndarray = field(repr=False)  # (n_seq, n_steps, n_det)
+    precision: np.ndarray = field(repr=False)
+    recall: np.ndarray = field(repr=False)
+    n_matches: np.ndarray = field(repr=False)
+    n_correct: np.ndarray = field(repr=False)
+    times_s: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __str__(self) -> str:
+        means = ", ".join(f"{d} {np.nanmean(self.rep[:, :, k]):.2f}" for k, d in enumerate(self.detectors))
+        return (f"{len(self.sequences)} sequences x {len(self.steps)} pairs, {self.n_points} strongest points, "
+                f"tol {self.tol_px:g} px: mean repeatability {means}")
+
+    def _pivot(self, arr, fmt):
+        rows = []
+        for i, s in enumerate(self.sequences):
+            for j, st in enumerate(self.steps):
+                rows.append([s, f"1→{st}"] + [fmt(arr[i, j, k]) for k in range(len(self.detectors))])
+        rows.append(["mean", ""] + [fmt(np.nanmean(arr[:, :, k])) for k in range(len(self.detectors))])
+        return rows
+
+    def table(self) -> str:
+        """Repeatability (fraction of the common-region points found again within ``tol_px``)."""
+        title = (f"Repeatability, {self.n_points} strongest points per image, tolerance {self.tol_px:g} px, "
+                 f"images x{self.scale:g}")
+        return format_table(["sequence", "pair", *self.detectors], self._pivot(self.rep, lambda x: f"{x:.2f}"),
+                            title)
+
+    def matching_table(self) -> str:
+        """Precision / recall of the matches (rule stated in the title)."""
+        def fmt(pr):
+            return "—" if not np.isfinite(pr[0]) else f"{pr[0]:.2f}/{pr[1]:.2f}"
+
+        both = np.stack([self.precision, self.recall], axis=-1)
+        rows = []
+        for i, s in enumerate(self.sequences):
+            for j, st in enumerate(self.steps):
+                rows.append([s, f"1→{st}"] + [fmt(both[i, j, k]) for k in range(len(self.detectors))])
+        rows.append(["mean", ""] + [fmt(np.nanmean(both[:, :, k], axis=(0, 1))) for k in range(len(self.detectors))])
+        return format_table(["sequence", "pair", *self.detectors], rows,
+                            f"Matching precision/recall, rule {self.rule}, correct within {self.tol_px:g} px")
+
+
+def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
+                        detectors=("SIFT", "SURF", "ORB", "FAST"), scale: float = 0.5, n_points: int = 500,
+                        tol_px: float = 2.5, rule: str = "ratio", ratio: float = 0.8) -> PairEvaluationResult:
+    """Repeatability and matching precision/recall on img1 → img_j of Oxford sequences (000 §1.4).
+
+    Every detector keeps its ``n_points`` strongest keypoints per image (equal
+    budgets: with a fixed pixel tolerance a denser detector would look more
+    repeatable by chance). FAST corners carry upright SURF descriptors (σ = 2 px).
+    """
+    sequences = tuple(v.check_choice(s, "sequences", OXFORD_SEQUENCES) for s in sequences)
+    steps = tuple(v.check_int(j, "steps", minimum=2, maximum=6) for j in steps)
+    detectors = tuple(v.check_choice(d, "detectors", tuple(EVAL_DETECTORS)) for d in detectors)
+    if not sequences or not steps or not detectors:
+        raise ValueError("`sequences`, `steps` and `detectors` must not be empty")
+    scale = v.check_positive(scale, "scale")
+    n_points = v.check_int(n_points, "n_points", minimum=10)
+    tol_px = v.check_positive(tol_px, "tol_px")
+    rule = v.check_choice(rule, "rule", ("000", "ratio"))
+    shape = (len(sequences), len(steps), len(detectors))
+    rep, prec, rec = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
+    n_m, n_c = np.zeros(shape, dtype=int), np.zeros(shape, dtype=int)
+    times = {d: 0.0 for d in detectors}
+    n_det = {d: 0 for d in detectors}
+    for i, seq in enumerate(sequences):
+        first = {}
+        for j, st in enumerate(steps):
+            img1, img2, H = load_oxford_pair(seq, st, scale=scale)
+            for k, name in enumerate(detectors):
+                if name not in first:
+                    first[name], dt = _detect_named(img1, name, n_points)
+                    times[name] += dt
+                    n_det[name] += 1
+                f1 = first[name]
+                f2, dt = _detect_named(img2, name, n_points)
+                times[name] += dt
+                n_det[name] += 1
+                r = repeatability(f1, f2, H, img1.shape, img2.shape, tol_px=tol_px)
+                rep[i, j, k] = r.repeatability
+                m = match_descriptors(f1.descriptors, f2.descriptors, rule=rule, ratio=ratio)
+                c = correct_matches(f1, f2, m, H, tol_px=tol_px)
+                n_m[i, j, k], n_c[i, j, k] = len(m), int(c.sum())
+                prec[i, j, k] = c.mean() if len(m) else np.nan
+                rec[i, j, k] = c.sum() / r.correspondences if r.correspondences else np.nan
+    rule_txt = f"ratio {ratio:g}" if rule == "ratio" else "000 (d2 >= 2 d1)"
+    return PairEvaluationResult(sequences, steps, detectors, scale, n_points, tol_px, rule_txt, rep, prec, rec,
+                                n_m, n_c, {d: times[d] / max(n_det[d], 1) for d in detectors})
+
+
+# --- detectors on one image -----------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class DetectorSummaryResult:
+    """Keypoint counts of every detector on one image; mean detection times in ``times_s``."""
+
+    image_name: str
+    shape: tuple[int, int]
+    names: tuple[str, ...]
+    counts: tuple[int, ...]
+    dims: tuple[str, ...]
+    times_s: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __str__(self) -> str:
+        return f"{self.image_name} {self.shape[1]}x{self.shape[0]}: " + ", ".join(
+            f"{n} {c}" for n, c in zip(self.names, self.counts, strict=True))
+
+    def table(self) -> str:
+        rows = [[n, str(c), d] for n, c, d in zip(self.names, self.counts, self.dims, strict=True)]
+        return format_table(["detector", "keypoints", "descriptor"], rows,
+                            f"{self.image_name}, {self.shape[1]}x{self.shape[0]} pixels")
+
+    def timing_table(self) -> str:
+        """Detection (+ description) time per detector -- machine dependent, not for nbval."""
+        rows = [[n, f"{1000 * self.times_s[n]:.0f}"] for n in self.names]
+        return format_table(["detector", "time [ms]"], rows)
+
+
+_SUMMARY = {
+    "SURF (ours)": ("surf", {"threshold": 4e-4}),
+    "SIFT (OpenCV)": ("sift", {}),
+    "ORB (OpenCV)": ("orb", {"n_features": 2000}),
+    "FAST-9 (ours)": ("fast", {"threshold": 20, "descriptors": False}),
+    "FAST-9 (OpenCV)": ("fast-cv", {"threshold": 20}),
+    "Moravec (ours)": ("moravec", {"threshold": 0.1}),
+    "MSER (OpenCV)": ("mser", {}),
+}
+
+
+def run_detector_summary(sequence: str = "graf", index: int = 1, *, size=(768, 576), repeats: int = 1):
+    """Every detector on one Oxford image resized to ``size`` = (width, height) (000: 768×576)."""
+    import cv2
+
+    img = load_oxford_image(sequence, index)
+    w, h = (v.check_int(s, "size", minimum=16) for s in size)
+    img = cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA)
+    repeats = v.check_int(repeats, "repeats", minimum=1)
+    names, counts, dims, times = [], [], [], {}
+    for name, (method, params) in _SUMMARY.items():
+        params = dict(params)
+        best = np.inf
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            f = detect(img, method, **params)
+            best = min(best, time.perf_counter() - t0)
+        names.append(name)
+        counts.append(len(f))
+        dims.append("—" if f.descriptors is None else f"{f.descriptors.shape[1]}"
+                    + (" bytes" if f.is_binary else "-d"))
+        times[name] = best
+    return DetectorSummaryResult(f"{sequence}/img{index}", (h, w), tuple(names), tuple(counts), tuple(dims), times)
+
+
+# --- SURF threshold scale ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SurfThresholdResult:
+    """SURF point counts against the threshold on our response scale and OpenCV's (x 255²)."""
+
+    image_name: str
+    thresholds: np.ndarray
+    counts: np.ndarray
+    source_threshold: float
+    source_count: int
+
+    def __str__(self) -> str:
+        return (f"SURF on {self.image_name}: threshold {self.source_threshold:g} (000) gives {self.source_count} "
+                f"points on our scale")
+
+    def threshold_for(self, n_points: int) -> float:
+        """The largest tabulated threshold that still gives at least ``n_points``."""
+        ok = self.counts >= n_points
+        return float(self.thresholds[ok].max()) if ok.any() else float("nan")
+
+    def table(self) -> str:
+        rows = [[f"{t:.1e}", f"{t * 255**2:.3g}", f"{np.sqrt(t):.4f}", str(c)]
+                for t, c in zip(self.thresholds, self.counts, strict=True)]
+        return format_table(["ours (image in [0,1])", "OpenCV hessianThreshold", "sqrt(ours)", "points"], rows,
+                            f"SURF points vs threshold, {self.image_name}")
+
+
+def run_surf_threshold(sequence: str = "graf", index: int = 1, *, size=(768, 576),
+                       thresholds=(1e-5, 3e-5, 1e-4, 2e-4, 4e-4, 1e-3, 2.5e-3, 5e-3, 1e-2, 5e-2)):
+    """How many SURF points each threshold leaves on a 768×576 image; where 000's 0.05 falls (000 §3.3)."""
+    import cv2
+
+    img = load_oxford_image(sequence, index)
+    w, h = (v.check_int(s, "size", minimum=16) for s in size)
+    img = cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA)
+    th = np.sort(v.as_vector(thresholds, "thresholds"))
+    counts = threshold_sweep(img, th)
+    src = int(threshold_sweep(img, [0.05])[0])
+    return SurfThresholdResult(f"{sequence}/img{index} {w}x{h}", th, counts, 0.05, src)
+
+
+# --- descriptor matching: exact vs BBF vs FLANN vs brute ---------------------------------------------
+
+
+@lru_cache(maxsize=64)
+def _surf_cached(sequence, index, scale, threshold):
+    img = load_oxford_image(sequence, index, scale=scale)
+    return surf_features(img, threshold)
+
+
+def surf_features(img, threshold) -> Features:
+    return detect(img, "surf", threshold=threshold)
+
+
+def descriptor_pool(n: int, *, exclude: str = "graf", scale: float = 0.5, threshold: float = 5e-5) -> np.ndarray:
+    """``n`` SURF descriptors (float32) from the Oxford images other than ``exclude``'s (distractors)."""
+    n = v.check_int(n, "n", minimum=0)
+    out, have = [], 0
+    for seq in OXFORD_SEQUENCES:
+        if seq == exclude:
+            continue
+        for idx in range(1, 7):
+            if have >= n:
+                break
+            d = _surf_cached(seq, idx, float(scale), float(threshold)).descriptors
+            out.append(d[: n - have])
+            have += len(out[-1])
+    if have < n:
+        raise ValueError(f"the Oxford images give only {have} SURF descriptors at scale {scale:g}, threshold "
+                         f"{threshold:g}; asked for `n`={n}")
+    return np.concatenate(out) if out else np.zeros((0, 64), np.float32)
+
+
+def _matching_workload(n_stored, n_queries, sequence, j, scale, threshold):
+    img1, img2, H = load_oxford_pair(sequence, j, scale=scale)
+    f1 = surf_features(img1, threshold)
+    f2 = surf_features(img2, threshold)
+    n_true = min(len(f1), n_stored)
+    f1 = f1.strongest(n_true)
+    distract = descriptor_pool(n_stored - n_true, exclude=sequence, scale=scale, threshold=threshold)
+    train = np.concatenate([f1.descriptors, distract]) if len(distract) else f1.descriptors
+    q = f2.strongest(n_queries)
+    return f1, q, train, H
+
+
+@dataclass(frozen=True)
+class KnnComparisonResult:
+    """Per store size and method: recall of the true nearest neighbour, precision after the ratio rule."""
+
+    sizes: tuple[int, ...]
+    methods: tuple[str, ...]
+    n_queries: int
+    recall: np.ndarray = field(repr=False)  # (n_sizes, n_methods); NaN = not run
+    precision: np.ndarray = field(repr=False)
+    n_matches: np.ndarray = field(repr=False)
+    evals: np.ndarray = field(repr=False)  # mean distance evaluations per query (ours); NaN otherwise
+    times_s: np.ndarray = field(default=None, repr=False, compare=False)
+
+    def __str__(self) -> str:
+        return f"{self.n_queries} SURF queries against {', '.join(map(str, self.sizes))} stored descriptors"
+
+    def table(self) -> str:
+        rows = []
+        for i, n in enumerate(self.sizes):
+            for k, m in enumerate(self.methods):
+                if not np.isfinite(self.recall[i, k]):
+                    rows.append([str(n), m, "—", "—", "—", "—"])
+                    continue
+                ev = "—" if not np.isfinite(self.evals[i, k]) else f"{self.evals[i, k]:.0f}"
+                rows.append([str(n), m, f"{self.recall[i, k]:.3f}", str(int(self.n_matches[i, k])),
+                             f"{self.precision[i, k]:.3f}", ev])
+        return format_table(["stored", "method", "NN recall", "matches", "precision", "dist. evals/query"], rows,
+                            f"{self.n_queries} queries, 2-NN + ratio 0.8; NN recall = same nearest as brute force")
+
+    def timing_table(self) -> str:
+        rows = []
+        for i, n in enumerate(self.sizes):
+            brute = self.times_s[i, self.methods.index("brute")] if "brute" in self.methods else np.nan
+            for k, m in enumerate(self.methods):
+                t = self.times_s[i, k]
+                if np.isfinite(t):
+                    rows.append([str(n), m, f"{1000 * t:.1f}", f"{t / brute:.2f}" if np.isfinite(brute) else "—"])
+        return format_table(["stored", "method", f"time per {self.n_queries} queries [ms]", "/ brute"], rows)
+
+
+KNN_LABELS = ("brute", "kd-tree exact (ours)", "cKDTree exact (scipy)", "BBF 200 leaves (ours)",
+              "FLANN kd checks=200")
+
+
+def run_knn_comparison(sizes=(2000, 13000), *, n_queries: int = 500, max_leaves: int = 200, checks: int = 200,
+                       max_exact_ours: int = 2000, sequence: str = "graf", j: int = 2, scale: float = 0.5,
+                       threshold: float = 5e-5, tol_px: float = 2.5) -> KnnComparisonResult:
+    """Exact kd-tree vs BBF vs FLANN vs brute force on real SURF descriptors (000 §1.4.3).
+
+    The store holds img1's descriptors of ``sequence`` plus distractors from the
+    other sequences up to each size; the queries are img_j's strongest
+    ``n_queries``. Our exact tree runs only up to ``max_exact_ours`` points (in 64-d
+    it visits nearly every leaf and the lock-step numpy search is then slow).
+    """
+    from scipy.spatial import cKDTree
+
+    from ..kdtree import KDTree
+
+    sizes = tuple(v.check_int(n, "sizes", minimum=10) for n in sizes)
+    n_queries = v.check_int(n_queries, "n_queries", minimum=1)
+    shape = (len(sizes), len(KNN_LABELS))
+    rec, prec, nm, ev, tm = (np.full(shape, np.nan) for _ in range(5))
+    for i, n in enumerate(sizes):
+        f1, q, train, H = _matching_workload(n, n_queries, sequence, j, scale, threshold)
+        Q = q.descriptors
+        t0 = time.perf_counter()
+        d_ref, i_ref = knn2(Q, train, method="brute")
+        tm[i, 0] = time.perf_counter() - t0
+        results = {0: (d_ref, i_ref, np.nan)}
+        if n <= max_exact_ours:
+            tree = KDTree(train)
+            t0 = time.perf_counter()
+            d, idx = tree.query(Q, k=2)
+            tm[i, 1] = time.perf_counter() - t0
+            results[1] = (d, idx, tree.last_stats.mean_distance_evals)
+        ck = cKDTree(train.astype(np.float64))
+        t0 = time.perf_counter()
+        d, idx = ck.query(Q.astype(np.float64), k=2)
+        tm[i, 2] = time.perf_counter() - t0
+        results[2] = (d, idx, np.nan)
+        tree = KDTree(train)
+        t0 = time.perf_counter()
+        d, idx = tree.query(Q, k=2, max_leaves=max_leaves)
+        tm[i, 3] = time.perf_counter() - t0
+        results[3] = (d, idx, tree.last_stats.mean_distance_evals)
+        import cv2
+
+        fl = cv2.flann_Index(np.ascontiguousarray(train, np.float32), {"algorithm": 1, "trees": 1})
+        t0 = time.perf_counter()
+        d, idx = knn2(Q, train, method="flann", checks=checks, tree=fl)
+        tm[i, 4] = time.perf_counter() - t0
+        results[4] = (d, idx, np.nan)
+        for k, (d, idx, e) in results.items():
+            rec[i, k] = np.mean(idx[:, 0] == i_ref[:, 0])
+            keep = accept_ratio(d, 0.8)
+            qi = np.flatnonzero(keep)
+            ti = idx[qi, 0]
+            true = ti < len(f1)
+            from .evaluation import project
+
+            ok = np.zeros(qi.size, dtype=bool)
+            if true.any():
+                p = project(H, f1.uv[ti[true]])
+                ok[true] = np.linalg.norm(p - q.uv[qi[true]], axis=1) < tol_px
+            nm[i, k] = qi.size
+            prec[i, k] = ok.mean() if qi.size else np.nan
+            ev[i, k] = e
+    return KnnComparisonResult(sizes, KNN_LABELS, n_queries, rec, prec, nm, ev, tm)
+
+
+@dataclass(frozen=True)
+class LeavesCurveResult:
+    """Recall of the true nearest neighbour against the search budget: our BBF (leaves) and FLANN (checks)."""
+
+    n_stored: int
+    n_queries: int
+    budgets: np.ndarray
+    recall_bbf: np.ndarray
+    recall_flann: np.ndarray
+    evals_bbf: np.ndarray
+    exact_evals: float
+    times_s: np.ndarray = field(default=None, repr=False, compare=False)
+
+    def __str__(self) -> str:
+        return (f"BBF on {self.n_stored} SURF descriptors: recall {self.recall_bbf[-1]:.3f} at "
+                f"{int(self.budgets[-1])} leaves; exact search evaluates {self.exact_evals:.0f} points per query")
+
+    def table(self) -> str:
+        rows = [[str(int(b)), f"{rb:.3f}", f"{rf:.3f}", f"{e:.0f}"]
+                for b, rb, rf, e in zip(self.budgets, self.recall_bbf, self.recall_flann, self.evals_bbf,
+                                        strict=True)]
+        return format_table(["max_leaves / checks", "BBF recall", "FLANN recall", "BBF dist. evals"], rows,
+                            f"{self.n_queries} queries, {self.n_stored} stored 64-d SURF descriptors")
+
+
+def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, n_stored: int = 5000,
+                         n_queries: int = 300, sequence: str = "graf", j: int = 2, scale: float = 0.5,
+                         threshold: float = 5e-5) -> LeavesCurveResult:
+    """Recall of BBF and FLANN against the number of leaves / checks (000 §1.4.3: "about 200")."""
+    import cv2
+
+    from ..kdtree import KDTree
+
+    budgets = np.array([v.check_int(b, "budgets", minimum=1) for b in budgets])
+    _, q, train, _ = _matching_workload(n_stored, n_queries, sequence, j, scale, threshold)
+    Q = q.descriptors
+    _, i_ref = knn2(Q, train, method="brute")
+    tree = KDTree(train)
+    fl = cv2.flann_Index(np.ascontiguousarray(train, np.float32), {"algorithm": 1, "trees": 1})
+    rb, rf, eb, tm = [], [], [], []
+    for b in budgets:
+        t0 = time.perf_counter()
+        _, idx = tree.query(Q, k=2, max_leaves=int(b))
+        tm.append(time.perf_counter() - t0)
+        rb.append(np.mean(idx[:, 0] == i_ref[:, 0]))
+        eb.append(tree.last_stats.mean_distance_evals)
+        _, idf = knn2(Q, train, method="flann", checks=int(b), tree=fl)
+        rf.append(np.mean(idf[:, 0] == i_ref[:, 0]))
+    # exact search work on a subset of the queries (it is slow in 64-d)
+    tree.query(Q[:50], k=2)
+    exact = tree.last_stats.mean_distance_evals
+    return LeavesCurveResult(len(train), len(Q), budgets, np.array(rb), np.array(rf), np.array(eb), exact,
+                             np.array(tm))
+
+
+@dataclass(frozen=True)
+class RatioTradeoffResult:
+    """Precision and recall of the matches against the ratio (000's 2× rule = ratio 0.5)."""
+
+    detector: str
+    pair: str
+    ratios: np.ndarray
+    precision: np.ndarray
+    recall: np.ndarray
+    n_matches: np.ndarray
+    correspondences: int
+    source_row: tuple  # (matches, precision, recall) of 000's rule with max_dist
+
+    def __str__(self) -> str:
+        return f"{self.detector} on {self.pair}: {self.correspondences} repeatable points"
+
+    def table(self) -> str:
+        rows = [[f"{r:.2f}", str(int(n)), f"{p:.3f}", f"{rc:.3f}"]
+                for r, n, p, rc in zip(self.ratios, self.n_matches, self.precision, self.recall, strict=True)]
+        m, p, rc, md = self.source_row
+        rows.append([f"000: d2>=2d1, d1<={md:g}", str(m), f"{p:.3f}", f"{rc:.3f}"])
+        return format_table(["ratio d1/d2 <", "matches", "precision", "recall"], rows,
+                            f"{self.detector}, {self.pair}: ratio rule trade-off")
+
+
+def run_ratio_tradeoff(ratios=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), *, detector: str = "SURF",
+                       sequence: str = "graf", j: int = 2, scale: float = 0.5, n_points: int = 1000,
+                       tol_px: float = 2.5, max_dist: float = 0.3) -> RatioTradeoffResult:
+    """Precision/recall of the ratio rule and of 000's rule with an absolute limit (000 §1.4.3)."""
+    detector = v.check_choice(detector, "detector", tuple(EVAL_DETECTORS))
+    ratios = np.sort(v.as_vector(ratios, "ratios"))
+    img1, img2, H = load_oxford_pair(sequence, j, scale=scale)
+    f1, _ = _detect_named(img1, detector, n_points)
+    f2, _ = _detect_named(img2, detector, n_points)
+    r = repeatability(f1, f2, H, img1.shape, img2.shape, tol_px=tol_px)
+    d, idx = knn2(f1.descriptors, f2.descriptors)
+    from .matching import Matches
+
+    def score(keep):
+        q = np.flatnonzero(keep & (idx[:, 0] >= 0))
+        m = Matches(q, idx[q, 0], d[q, 0], d[q, 1])
+        c = correct_matches(f1, f2, m, H, tol_px=tol_px)
+        return len(q), (c.mean() if len(q) else np.nan), (c.sum() / r.correspondences if r.correspondences else
+                                                          np.nan)
+
+    res = [score(accept_ratio(d, float(x))) for x in ratios]
+    n, p, rc = (np.array(col) for col in zip(*res, strict=True))
+    md = float(max_dist) if detector != "ORB" else float(max_dist) * 256
+    src = score(accept_000(d, max_dist=md))
+    return RatioTradeoffResult(detector, f"{sequence} 1→{j} x{scale:g}", ratios, p, rc, n, r.correspondences,
+                               (src[0], src[1], src[2], md))

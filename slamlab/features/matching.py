@@ -1,0 +1,232 @@
+"""Matching rules for descriptors (000 §1.4.3): two nearest neighbours, 000's 2× rule, ratio, mutual check.
+
+000 §1.4.3: build a kd-tree on one set; for a query C find its two nearest
+neighbours A and B; accept C→A when ``d(C, B) >= 2·d(C, A)`` and ``d(C, A)`` is
+small enough. 000 gives no value for "small enough": ``max_dist`` is our
+parameter (default: no limit). The usual form is Lowe's ratio
+``d(C, A) < ratio·d(C, B)`` (000's rule is ratio 0.5 with ``>=``). A mutual
+(cross) check keeps C→A only when A's nearest neighbour in the query set is C.
+Binary descriptors (ORB) are compared with the Hamming distance (bits that differ).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate as v
+
+__all__ = [
+    "KNN_METHODS",
+    "Matches",
+    "accept_000",
+    "accept_ratio",
+    "hamming_distances",
+    "knn2",
+    "match_descriptors",
+    "mutual_mask",
+]
+
+KNN_METHODS = ("brute", "kdtree", "bbf", "flann")
+
+
+@dataclass(frozen=True)
+class Matches:
+    """Accepted matches: ``query_idx[i]`` ↔ ``train_idx[i]`` with distances d1 (nearest) and d2 (second)."""
+
+    query_idx: np.ndarray
+    train_idx: np.ndarray
+    d1: np.ndarray
+    d2: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.query_idx)
+
+    def __str__(self) -> str:
+        return f"{len(self)} matches"
+
+
+def _as_descriptors(D, name):
+    arr = np.asarray(D)
+    if arr.ndim != 2:
+        raise ValueError(f"`{name}` must be a 2-D (N, d) descriptor array; got shape {arr.shape}")
+    if arr.dtype == np.uint8:
+        return arr
+    return v.as_finite_array(arr, name, ndim=2, dtype=np.float32 if arr.dtype == np.float32 else np.float64)
+
+
+def hamming_distances(A, B) -> np.ndarray:
+    """Pairwise Hamming distances between binary descriptors packed as uint8 bytes.
+
+    >>> hamming_distances(np.array([[0b1011]], np.uint8), np.array([[0], [255]], np.uint8)).tolist()
+    [[3, 5]]
+    """
+    A, B = np.asarray(A), np.asarray(B)
+    if A.dtype != np.uint8 or B.dtype != np.uint8:
+        raise TypeError(f"binary descriptors must be uint8 arrays; got {A.dtype} and {B.dtype}")
+    if A.ndim != 2 or B.ndim != 2 or A.shape[1] != B.shape[1]:
+        raise ValueError(f"descriptors must be (N, bytes) arrays of equal width; got {A.shape} and {B.shape}")
+    out = np.empty((A.shape[0], B.shape[0]), dtype=np.int64)
+    step = max(1, 4_000_000 // max(1, B.size))
+    for a in range(0, A.shape[0], step):
+        out[a:a + step] = np.bitwise_count(A[a:a + step, None, :] ^ B[None, :, :]).sum(axis=2, dtype=np.int64)
+    return out
+
+
+def _brute_knn2(Q, T):
+    """Exact 2-NN by dense distances (BLAS for float, popcount for binary), query chunks."""
+    M, N = Q.shape[0], T.shape[0]
+    d = np.full((M, 2), np.inf)
+    idx = np.full((M, 2), -1, dtype=np.int64)
+    if N == 0:
+        return d, idx
+    k = min(2, N)
+    binary = Q.dtype == np.uint8
+    if not binary:
+        Q64, T64 = Q.astype(np.float64), T.astype(np.float64)
+        tn = (T64 * T64).sum(axis=1)
+    step = max(1, 2_000_000 // N)
+    for a in range(0, M, step):
+        if binary:
+            D = hamming_distances(Q[a:a + step], T).astype(np.float64)
+        else:
+            q = Q64[a:a + step]
+            D = np.maximum((q * q).sum(axis=1)[:, None] - 2.0 * q @ T64.T + tn[None, :], 0.0)
+        part = np.argpartition(D, k - 1, axis=1)[:, :k] if k < N else np.tile(np.arange(N), (D.shape[0], 1))
+        dp = np.take_along_axis(D, part, axis=1)
+        o = np.argsort(dp, axis=1, kind="stable")
+        idx[a:a + step, :k] = np.take_along_axis(part, o, axis=1)
+        d[a:a + step, :k] = np.take_along_axis(dp, o, axis=1)
+    if not binary:
+        # recompute the two kept distances exactly (the expansion above loses digits)
+        ok = idx >= 0
+        rows = np.nonzero(ok)
+        diff = Q64[rows[0]] - T64[idx[ok]]
+        d[ok] = np.sqrt((diff * diff).sum(axis=1))
+    return d, idx
+
+
+def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: int = 200,
+         leaf_size: int = 1, tree=None):
+    """Two nearest neighbours in ``train`` of every row of ``query`` (000 §1.4.3).
+
+    Parameters
+    ----------
+    query, train : (M, d), (N, d) descriptor arrays (float, or uint8 binary -> Hamming, brute only)
+    method : {'brute', 'kdtree', 'bbf', 'flann'}
+        Dense exact search, our exact kd-tree, our Best-Bin-First (``max_leaves``),
+        OpenCV FLANN (one randomised KD-tree, ``checks``).
+    tree : slamlab.kdtree.KDTree, optional
+        A tree already built on ``train`` (kdtree/bbf).
+
+    Returns
+    -------
+    dist : (M, 2) float
+    idx : (M, 2) int (-1 where train has fewer than 2 points)
+    """
+    Q = _as_descriptors(query, "query")
+    T = _as_descriptors(train, "train")
+    method = v.check_choice(method, "method", KNN_METHODS)
+    if Q.shape[1] != T.shape[1]:
+        raise ValueError(f"`query` and `train` must have the same descriptor length; got {Q.shape[1]} and "
+                         f"{T.shape[1]}")
+    binary = Q.dtype == np.uint8
+    if binary != (T.dtype == np.uint8):
+        raise TypeError("`query` and `train` must both be binary (uint8) or both real-valued")
+    if binary and method != "brute":
+        raise ValueError(f"binary descriptors are matched with method='brute' (Hamming); got {method!r}")
+    if Q.shape[0] == 0 or T.shape[0] == 0:
+        return np.full((Q.shape[0], 2), np.inf), np.full((Q.shape[0], 2), -1, dtype=np.int64)
+    if method == "brute":
+        return _brute_knn2(Q, T)
+    if method in ("kdtree", "bbf"):
+        from ..kdtree import KDTree
+
+        if tree is None:
+            tree = KDTree(T, leaf_size=leaf_size)
+        return tree.query(Q, k=2, max_leaves=None if method == "kdtree" else v.check_int(max_leaves, "max_leaves",
+                                                                                          minimum=1))
+    import cv2
+
+    checks = v.check_int(checks, "checks", minimum=1)
+    T32 = np.ascontiguousarray(T, dtype=np.float32)
+    index = tree if tree is not None else cv2.flann_Index(T32, {"algorithm": 1, "trees": 1})
+    k = min(2, T.shape[0])
+    idx, d2 = index.knnSearch(np.ascontiguousarray(Q, dtype=np.float32), k, params={"checks": checks})
+    d = np.full((Q.shape[0], 2), np.inf)
+    ids = np.full((Q.shape[0], 2), -1, dtype=np.int64)
+    d[:, :k] = np.sqrt(np.maximum(d2, 0))
+    ids[:, :k] = idx
+    return d, ids
+
+
+def accept_000(dist, *, factor: float = 2.0, max_dist: float = np.inf) -> np.ndarray:
+    """000's rule: accept C→A when d(C,B) >= factor·d(C,A) and d(C,A) <= max_dist (000 §1.4.3).
+
+    >>> accept_000(np.array([[0.1, 0.3], [0.2, 0.3], [0.5, 2.0]]), max_dist=0.4).tolist()
+    [True, False, False]
+    """
+    dist = np.asarray(dist, dtype=np.float64)
+    if dist.ndim != 2 or dist.shape[1] < 2:
+        raise ValueError(f"`dist` must have shape (M, 2) (nearest, second nearest); got {dist.shape}")
+    factor = v.check_positive(factor, "factor")
+    max_dist = float(max_dist) if np.isinf(max_dist) else v.check_positive(max_dist, "max_dist", allow_zero=True)
+    return (dist[:, 1] >= factor * dist[:, 0]) & (dist[:, 0] <= max_dist)
+
+
+def accept_ratio(dist, ratio: float = 0.8) -> np.ndarray:
+    """Lowe's ratio test: accept when d(C,A) < ratio·d(C,B).
+
+    >>> accept_ratio(np.array([[0.1, 0.3], [0.29, 0.3]]), 0.8).tolist()
+    [True, False]
+    """
+    dist = np.asarray(dist, dtype=np.float64)
+    if dist.ndim != 2 or dist.shape[1] < 2:
+        raise ValueError(f"`dist` must have shape (M, 2) (nearest, second nearest); got {dist.shape}")
+    ratio = v.check_positive(ratio, "ratio")
+    return dist[:, 0] < ratio * dist[:, 1]
+
+
+def mutual_mask(idx12, idx21) -> np.ndarray:
+    """True where query i's nearest train j has i as its own nearest query (cross check).
+
+    >>> mutual_mask(np.array([1, 0, 1]), np.array([1, 2])).tolist()
+    [False, True, True]
+    """
+    idx12 = np.asarray(idx12, dtype=np.int64)
+    idx21 = np.asarray(idx21, dtype=np.int64)
+    ok = (idx12 >= 0) & (idx12 < idx21.size)
+    out = np.zeros(idx12.size, dtype=bool)
+    out[ok] = idx21[idx12[ok]] == np.flatnonzero(ok)
+    return out
+
+
+def match_descriptors(query, train, *, rule: str = "000", factor: float = 2.0, ratio: float = 0.8,
+                      max_dist: float = np.inf, mutual: bool = False, method: str = "brute",
+                      max_leaves: int = 200, checks: int = 200) -> Matches:
+    """Match two descriptor sets with a 2-NN search and an acceptance rule (000 §1.4.3).
+
+    Parameters
+    ----------
+    rule : {'000', 'ratio', 'none'}
+        000's ``d2 >= factor·d1`` (with ``max_dist``), Lowe's ``d1 < ratio·d2`` (with
+        ``max_dist``), or every nearest neighbour (``max_dist`` only).
+    mutual : bool
+        Also require the reverse nearest neighbour to agree.
+    method : see :func:`knn2`.
+    """
+    rule = v.check_choice(rule, "rule", ("000", "ratio", "none"))
+    d, idx = knn2(query, train, method=method, max_leaves=max_leaves, checks=checks)
+    if rule == "000":
+        keep = accept_000(d, factor=factor, max_dist=max_dist)
+    elif rule == "ratio":
+        keep = accept_ratio(d, ratio) & (d[:, 0] <= max_dist)
+    else:
+        keep = d[:, 0] <= max_dist
+    keep &= idx[:, 0] >= 0
+    if mutual:
+        _, back = knn2(train, query, method=method, max_leaves=max_leaves, checks=checks)
+        keep &= mutual_mask(idx[:, 0], back[:, 0])
+    q = np.flatnonzero(keep)
+    return Matches(q, idx[q, 0], d[q, 0], d[q, 1])

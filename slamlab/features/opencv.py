@@ -1,0 +1,95 @@
+"""SIFT, ORB, MSER and FAST through OpenCV behind the slamlab interface (000 §1.4.1).
+
+OpenCV's SURF lives in the non-free contrib build and is absent from the
+headless wheel; our SURF is :mod:`slamlab.features.surf`.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from .. import _validate as v
+from .base import Features, to_gray_uint8
+
+__all__ = ["fast_cv", "features_from_keypoints", "mser_cv", "orb_cv", "sift_cv"]
+
+
+def features_from_keypoints(keypoints, descriptors, method: str) -> Features:
+    """Convert a list of ``cv2.KeyPoint`` (+ descriptor array) to :class:`Features`.
+
+    ``scale_px`` = ``size / 2``; OpenCV angles (degrees, -1 = none) become radians in
+    [0, 2π) (0 when absent); SIFT's packed octave byte is unpacked to the octave index.
+    """
+    k = len(keypoints)
+    if k == 0:
+        dim = None if descriptors is None else descriptors.shape[1] if descriptors.ndim == 2 else None
+        dt = np.uint8 if method == "ORB" else np.float32
+        return Features.empty(method, dim if dim is not None else (32 if method == "ORB" else 128
+                                                                    if method == "SIFT" else None), dt)
+    uv = np.array([kp.pt for kp in keypoints], dtype=np.float64)
+    size = np.array([kp.size for kp in keypoints], dtype=np.float64)
+    ang = np.array([kp.angle for kp in keypoints], dtype=np.float64)
+    ang = np.where(ang < 0, 0.0, np.deg2rad(ang) % (2 * np.pi))
+    resp = np.array([kp.response for kp in keypoints], dtype=np.float64)
+    octv = np.array([kp.octave for kp in keypoints], dtype=np.int64)
+    if method == "SIFT":
+        octv = octv & 255
+        octv = np.where(octv >= 128, octv - 256, octv)
+    return Features(uv, size / 2.0, ang, resp, octv, descriptors, method)
+
+
+def sift_cv(image, *, n_features: int = 0, contrast_threshold: float = 0.04, edge_threshold: float = 10.0,
+            sigma: float = 1.6, descriptors: bool = True) -> Features:
+    """OpenCV SIFT (000 §1.4.1): 128-d float descriptors."""
+    img = to_gray_uint8(image)
+    det = cv2.SIFT_create(nfeatures=v.check_int(n_features, "n_features", minimum=0),
+                          contrastThreshold=v.check_positive(contrast_threshold, "contrast_threshold"),
+                          edgeThreshold=v.check_positive(edge_threshold, "edge_threshold"),
+                          sigma=v.check_positive(sigma, "sigma"))
+    if descriptors:
+        kp, d = det.detectAndCompute(img, None)
+    else:
+        kp, d = det.detect(img, None), None
+    return features_from_keypoints(kp, d if d is not None or not descriptors else np.zeros((0, 128), np.float32),
+                                   "SIFT")
+
+
+def orb_cv(image, *, n_features: int = 2000, scale_factor: float = 1.2, n_levels: int = 8,
+           fast_threshold: int = 20, descriptors: bool = True) -> Features:
+    """OpenCV ORB: oriented FAST + rotated BRIEF, 256-bit descriptors as 32 uint8 (Hamming distance)."""
+    img = to_gray_uint8(image)
+    det = cv2.ORB_create(nfeatures=v.check_int(n_features, "n_features", minimum=1),
+                         scaleFactor=v.check_positive(scale_factor, "scale_factor"),
+                         nlevels=v.check_int(n_levels, "n_levels", minimum=1),
+                         fastThreshold=v.check_int(fast_threshold, "fast_threshold", minimum=0))
+    if descriptors:
+        kp, d = det.detectAndCompute(img, None)
+        if d is None:
+            d = np.zeros((0, 32), np.uint8)
+    else:
+        kp, d = det.detect(img, None), None
+    return features_from_keypoints(kp, d, "ORB")
+
+
+def fast_cv(image, *, threshold: int = 20, nonmax: bool = True) -> Features:
+    """OpenCV FAST (type 9_16), the reference for :func:`slamlab.features.fast_detect`."""
+    img = to_gray_uint8(image)
+    det = cv2.FastFeatureDetector_create(v.check_int(threshold, "threshold", minimum=0, maximum=255),
+                                         bool(nonmax), cv2.FAST_FEATURE_DETECTOR_TYPE_9_16)
+    return features_from_keypoints(det.detect(img, None), None, "FAST-cv")
+
+
+def mser_cv(image, *, delta: int = 5, min_area: int = 60, max_area: int = 14400) -> Features:
+    """OpenCV MSER regions as keypoints: centroid, σ = sqrt(area / π), no descriptor."""
+    img = to_gray_uint8(image)
+    det = cv2.MSER_create(delta=v.check_int(delta, "delta", minimum=1),
+                          min_area=v.check_int(min_area, "min_area", minimum=1),
+                          max_area=v.check_int(max_area, "max_area", minimum=1))
+    regions, _ = det.detectRegions(img)
+    k = len(regions)
+    if k == 0:
+        return Features.empty("MSER")
+    uv = np.array([r.mean(axis=0) for r in regions], dtype=np.float64)
+    area = np.array([len(r) for r in regions], dtype=np.float64)
+    return Features(uv, np.sqrt(area / np.pi), np.zeros(k), area, np.zeros(k, dtype=np.int64), None, "MSER")

@@ -1,0 +1,173 @@
+"""Plots for Ch. 2: keypoints, matches, box filters, the FAST circle, evaluation curves."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ..plotting import new_axes
+from .fast import CIRCLE_OFFSETS
+
+__all__ = [
+    "plot_box_filters",
+    "plot_fast_circle",
+    "plot_keypoints",
+    "plot_matches",
+    "plot_pair_evaluation",
+    "plot_ratio_tradeoff",
+    "plot_recall_vs_leaves",
+    "plot_surf_threshold",
+]
+
+_COLORS = {"SIFT": "tab:blue", "SURF": "tab:red", "ORB": "tab:green", "FAST": "tab:purple"}
+
+
+def plot_keypoints(image, features, *, ax=None, max_points: int = 400, color="tab:red", title=None,
+                   circles: bool = True):
+    """Keypoints on the image: circles of radius σ with an orientation tick (strongest ``max_points``)."""
+    ax = new_axes(ax, title=title or str(features))
+    ax.imshow(image, cmap="gray", interpolation="nearest")
+    f = features.strongest(max_points) if len(features) > max_points else features
+    if circles and len(f):
+        from matplotlib.collections import EllipseCollection, LineCollection
+
+        r = np.maximum(f.scale_px, 1.5)
+        ax.add_collection(EllipseCollection(2 * r, 2 * r, np.zeros(len(f)), units="xy", offsets=f.uv,
+                                            offset_transform=ax.transData, facecolors="none", edgecolors=color,
+                                            linewidths=0.7))
+        tip = f.uv + r[:, None] * np.column_stack([np.cos(f.orientation_rad), np.sin(f.orientation_rad)])
+        ax.add_collection(LineCollection(np.stack([f.uv, tip], axis=1), colors=color, linewidths=0.7))
+    else:
+        ax.plot(f.uv[:, 0], f.uv[:, 1], "+", color=color, markersize=4)
+    ax.set_xlim(-0.5, image.shape[1] - 0.5)
+    ax.set_ylim(image.shape[0] - 0.5, -0.5)
+    ax.set_axis_off()
+    return ax
+
+
+def plot_matches(img1, img2, f1, f2, matches, correct=None, *, ax=None, max_lines: int = 150, title=None):
+    """Two images side by side with match lines (green correct, red wrong when ``correct`` is given)."""
+    h = max(img1.shape[0], img2.shape[0])
+    canvas = np.zeros((h, img1.shape[1] + img2.shape[1]), dtype=float)
+    canvas[:img1.shape[0], :img1.shape[1]] = img1
+    canvas[:img2.shape[0], img1.shape[1]:] = img2
+    ax = new_axes(ax, title=title or f"{len(matches)} matches", figsize=(10, 4))
+    ax.imshow(canvas, cmap="gray", interpolation="nearest")
+    n = len(matches)
+    sel = np.linspace(0, n - 1, min(n, max_lines)).astype(int) if n else np.zeros(0, int)
+    from matplotlib.collections import LineCollection
+
+    p1 = f1.uv[matches.query_idx[sel]]
+    p2 = f2.uv[matches.train_idx[sel]] + np.array([img1.shape[1], 0])
+    colors = "yellow" if correct is None else np.where(np.asarray(correct)[sel], "lime", "red")
+    ax.add_collection(LineCollection(np.stack([p1, p2], axis=1), colors=colors, linewidths=0.6))
+    ax.set_xlim(-0.5, canvas.shape[1] - 0.5)
+    ax.set_ylim(h - 0.5, -0.5)
+    ax.set_axis_off()
+    return ax
+
+
+def plot_box_filters(L: int = 9, *, axes=None):
+    """The three SURF box filters Dxx, Dyy, Dxy of side L (weights +1 white, -1/-2 dark)."""
+    if axes is None:
+        _, axes = plt.subplots(1, 3, figsize=(8, 2.8))
+    l = L // 3
+    b = (L - 1) // 2
+    kxx = np.zeros((L, L))
+    kxx[b - l + 1:b + l, :] = 1.0
+    kxx[b - l + 1:b + l, b - l // 2:b - l // 2 + l] = -2.0
+    kyy = kxx.T
+    kxy = np.zeros((L, L))
+    kxy[b - l:b, b + 1:b + l + 1] = 1.0
+    kxy[b + 1:b + l + 1, b - l:b] = 1.0
+    kxy[b - l:b, b - l:b] = -1.0
+    kxy[b + 1:b + l + 1, b + 1:b + l + 1] = -1.0
+    for ax, k, name in zip(axes, (kxx, kyy, kxy), ("$D_{xx}$", "$D_{yy}$", "$D_{xy}$"), strict=True):
+        ax.imshow(k, cmap="gray", vmin=-2, vmax=1, interpolation="nearest")
+        ax.set_title(f"{name}, L = {L}")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.grid(False)
+    return axes
+
+
+def plot_fast_circle(image, row: int, col: int, threshold: int = 20, *, ax=None, half: int = 6):
+    """A patch around (row, col) with the 16 circle pixels marked brighter (+), darker (-) or similar.
+
+    Pixels are numbered as in 003's figure: 1 at the top, clockwise (v down).
+    """
+    ax = new_axes(ax, title=f"FAST circle at (u={col}, v={row}), t = {threshold}")
+    img = np.asarray(image)
+    patch = img[row - half:row + half + 1, col - half:col + half + 1].astype(int)
+    ax.imshow(patch, cmap="gray", vmin=0, vmax=255, interpolation="nearest",
+              extent=(col - half - 0.5, col + half + 0.5, row + half + 0.5, row - half - 0.5))
+    centre = int(img[row, col])
+    for n, (du, dv) in enumerate(CIRCLE_OFFSETS):
+        val = int(img[row + dv, col + du])
+        mark, color = ("+", "tab:red") if val > centre + threshold else ("-", "tab:blue") if (
+            val < centre - threshold) else ("·", "tab:gray")
+        label = (8 - n) % 16 + 1  # OpenCV's order starts below and turns the other way
+        ax.add_patch(plt.Circle((col + du, row + dv), 0.45, color=color, fill=False, linewidth=1.5))
+        ax.text(col + du, row + dv, f"{label}{mark}", color=color, ha="center", va="center", fontsize=8,
+                fontweight="bold")
+    ax.plot(col, row, "s", color="yellow", markersize=6, markerfacecolor="none")
+    ax.grid(False)
+    return ax
+
+
+def plot_pair_evaluation(result, *, axes=None):
+    """Repeatability and matching precision per viewpoint step, one panel per sequence."""
+    n = len(result.sequences)
+    if axes is None:
+        _, axes = plt.subplots(2, n, figsize=(4.5 * n, 6), squeeze=False)
+    axes = np.asarray(axes).reshape(2, n)
+    for i, seq in enumerate(result.sequences):
+        for row, (arr, name) in enumerate(((result.rep, "repeatability"), (result.precision, "precision"))):
+            ax = axes[row, i]
+            for k, det in enumerate(result.detectors):
+                ax.plot(result.steps, arr[i, :, k], "o-", color=_COLORS.get(det), label=det)
+            ax.set_title(f"{seq}: {name}")
+            ax.set_xlabel("img1 → img j")
+            ax.set_ylim(0, 1)
+            ax.set_xticks(result.steps)
+    axes[0, 0].legend(loc="best")
+    plt.tight_layout()
+    return axes
+
+
+def plot_recall_vs_leaves(result, *, ax=None):
+    """Recall of the true nearest neighbour against max_leaves (BBF) and checks (FLANN)."""
+    ax = new_axes(ax, title=f"Nearest-neighbour recall, {result.n_stored} stored descriptors",
+                  xlabel="max_leaves (BBF) / checks (FLANN)", ylabel="recall")
+    ax.semilogx(result.budgets, result.recall_bbf, "o-", label="BBF (ours)")
+    ax.semilogx(result.budgets, result.recall_flann, "s--", label="FLANN kd-tree")
+    ax.axvline(200, color="0.5", linestyle=":", label="000: ~200 leaves")
+    ax.set_ylim(0, 1.02)
+    ax.legend(loc="lower right")
+    return ax
+
+
+def plot_ratio_tradeoff(result, *, ax=None):
+    """Precision against recall as the ratio threshold varies; 000's rule marked."""
+    ax = new_axes(ax, title=f"Ratio rule, {result.detector} on {result.pair}", xlabel="recall",
+                  ylabel="precision")
+    ax.plot(result.recall, result.precision, "o-")
+    for r, x, y in zip(result.ratios, result.recall, result.precision, strict=True):
+        ax.annotate(f"{r:.1f}", (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8)
+    _, p, rc, _ = result.source_row
+    ax.plot([rc], [p], "r*", markersize=12, label="000: d2 ≥ 2·d1 with limit")
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1.05)
+    ax.legend(loc="lower left")
+    return ax
+
+
+def plot_surf_threshold(result, *, ax=None):
+    """SURF point count against the threshold on our scale; 000's '~2000 points' marked."""
+    ax = new_axes(ax, title=f"SURF points vs threshold, {result.image_name}", xlabel="threshold (ours)",
+                  ylabel="points")
+    ax.semilogx(result.thresholds, result.counts, "o-")
+    ax.axhline(2000, color="0.5", linestyle=":", label="000: ~2000 points")
+    ax.axvline(0.05, color="tab:red", linestyle="--", label="000: threshold 0.05")
+    ax.legend(loc="best")
+    return ax

@@ -1,0 +1,385 @@
+"""SURF written from the paper (Bay et al. 2006/2008; 000 §1.4.2, §3.3), vectorised numpy.
+
+Steps (Bay et al. 2008 §3-4, with OpenSURF's conventions that 000 cites [21]):
+
+1. integral image ``II`` of the grey image in [0, 1];
+2. box-filter approximations of the second derivatives of a Gaussian, filter side
+   ``L = 3·(2^(o+1)·(i+1) + 1)`` for octave ``o`` and interval ``i`` (9, 15, 21, 27;
+   15, 27, 39, 51; ...), evaluated on a grid of step ``init_step·2^o``; the
+   responses are divided by ``L²`` and the approximate Hessian determinant is
+   ``det = Dxx·Dyy - (0.9·Dxy)²``;
+3. threshold on ``det`` and 3×3×3 non-maximum suppression in (u, v, scale) within
+   each octave;
+4. quadratic interpolation of position and scale (offset ``-H⁻¹∇``, kept when every
+   component is below 0.5 grid steps); σ = 1.2·L/9;
+5. orientation: Haar responses (side 4σ) at the points of radius 6σ, weighted by a
+   Gaussian of 2.5σ, summed in a sliding 60° window (step 0.15 rad); the longest
+   sum gives the angle;
+6. descriptor: a 20σ square aligned with the orientation, 4×4 sub-regions of 5×5
+   samples, Haar responses (side 2σ) weighted by a Gaussian of 3.3σ, rotated to
+   the keypoint frame, per sub-region (Σdx, Σdy, Σ|dx|, Σ|dy|) -> 64-d; the extended
+   variant splits the sums by the sign of the other component -> 128-d; unit length.
+
+000 §3.3 settings: no initial downscale, initial step 2, 4 octaves, threshold
+0.05. **Response scale (our choice, stated):** ``det`` is computed on an image in
+[0, 1] with area-normalised filters -- OpenSURF's scale, where its default
+threshold is 0.0004. Read on that scale 000's 0.05 is about 100× OpenSURF's
+default and leaves only a handful of points on a real 576×768 image; the
+notebook tabulates the point count against the threshold and which scale makes
+0.05 give 000's "about 2000 points" (see :func:`threshold_sweep`).
+
+Everything is vectorised: the response maps are strided views of an
+edge-padded integral image, NMS is ``scipy.ndimage.maximum_filter`` on the
+(interval, row, column) stack, and orientation and descriptors gather Haar
+responses for all keypoints at once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+from .. import _validate as v
+from .base import Features, to_gray_float
+
+__all__ = [
+    "SURF",
+    "filter_sizes",
+    "haar_xy",
+    "hessian_response",
+    "integral_image",
+    "surf_describe",
+    "surf_detect",
+    "surf_orientation",
+    "threshold_sweep",
+]
+
+
+def integral_image(image) -> np.ndarray:
+    """Integral image with a zero first row and column: ``II[r, c] = Σ I[:r, :c]`` (Bay 2008 §3.1).
+
+    >>> integral_image(np.ones((2, 3)))[-1].tolist()
+    [0.0, 2.0, 4.0, 6.0]
+    """
+    img = to_gray_float(image)
+    H, W = img.shape
+    II = np.zeros((H + 1, W + 1))
+    np.cumsum(np.cumsum(img, axis=0), axis=1, out=II[1:, 1:])
+    return II
+
+
+def filter_sizes(n_octaves: int = 4, n_intervals: int = 4) -> np.ndarray:
+    """Box-filter sides ``L[o, i] = 3·(2^(o+1)·(i+1) + 1)`` (Bay 2008 §3.3).
+
+    >>> filter_sizes(2).tolist()
+    [[9, 15, 21, 27], [15, 27, 39, 51]]
+    """
+    o = np.arange(n_octaves)[:, None]
+    i = np.arange(n_intervals)[None, :]
+    return 3 * ((2 ** (o + 1)) * (i + 1) + 1)
+
+
+def _box(IIp, pad, step, nr, nc, r0, r1, c0, c1):
+    """Sums over rows [r + r0, r + r1) x cols [c + c0, c + c1) for every grid point (r, c) = step·(i, j).
+
+    ``IIp`` is the integral image edge-padded by ``pad``: edge padding of II is the
+    same as clipping the box to the image (zero outside).
+    """
+    def corner(dr, dc):
+        return IIp[pad + dr:pad + dr + step * nr:step, pad + dc:pad + dc + step * nc:step][:nr, :nc]
+
+    return corner(r1, c1) - corner(r0, c1) - corner(r1, c0) + corner(r0, c0)
+
+
+def hessian_response(II, L: int, step: int, *, IIp=None, pad: int | None = None):
+    """Approximate Hessian determinant and Laplacian sign on the grid of ``step`` (Bay 2008 §3.2).
+
+    Box layout of OpenSURF: lobe ``l = L/3``; Dxx = whole (2l-1)×L box minus 3× the
+    middle lobe; Dxy = four l×l boxes with signs (+ - / - +) around the centre. Each
+    D is divided by L² and ``det = Dxx·Dyy - 0.81·Dxy²``.
+
+    Returns
+    -------
+    det, trace : (ceil(H/step), ceil(W/step)) arrays
+    """
+    H, W = II.shape[0] - 1, II.shape[1] - 1
+    if IIp is None:
+        pad = L + step
+        IIp = np.pad(II, pad, mode="edge")
+    nr, nc = -(-H // step), -(-W // step)
+    l = L // 3
+    b = (L - 1) // 2
+    h = l // 2
+    Dxx = (_box(IIp, pad, step, nr, nc, -l + 1, l, -b, b + 1)
+           - 3.0 * _box(IIp, pad, step, nr, nc, -l + 1, l, -h, -h + l))
+    Dyy = (_box(IIp, pad, step, nr, nc, -b, b + 1, -l + 1, l)
+           - 3.0 * _box(IIp, pad, step, nr, nc, -h, -h + l, -l + 1, l))
+    Dxy = (_box(IIp, pad, step, nr, nc, -l, 0, 1, l + 1) + _box(IIp, pad, step, nr, nc, 1, l + 1, -l, 0)
+           - _box(IIp, pad, step, nr, nc, -l, 0, -l, 0) - _box(IIp, pad, step, nr, nc, 1, l + 1, 1, l + 1))
+    inv = 1.0 / (L * L)
+    Dxx *= inv
+    Dyy *= inv
+    Dxy *= inv
+    return Dxx * Dyy - 0.81 * Dxy * Dxy, Dxx + Dyy
+
+
+def _response_stacks(II, n_octaves, init_step):
+    L = filter_sizes(n_octaves)
+    pad = int(L.max()) + init_step * 2 ** (n_octaves - 1) + 2
+    IIp = np.pad(II, pad, mode="edge")
+    out = []
+    for o in range(n_octaves):
+        step = init_step * 2**o
+        dets, traces = zip(*(hessian_response(II, int(Li), step, IIp=IIp, pad=pad) for Li in L[o]), strict=True)
+        out.append((np.stack(dets), np.stack(traces), step))
+    return out
+
+
+def _extrema(II, *, threshold, n_octaves, init_step):
+    """Thresholded 3×3×3 maxima, interpolated (Bay 2008 §3.4; Brown & Lowe 2002)."""
+    H, W = II.shape[0] - 1, II.shape[1] - 1
+    L = filter_sizes(n_octaves)
+    res = {k: [] for k in ("u", "v", "L", "det", "octave", "sign")}
+    for o, (D, T, step) in enumerate(_response_stacks(II, n_octaves, init_step)):
+        nI, nr, nc = D.shape
+        if nr < 3 or nc < 3:
+            continue
+        M = ndimage.maximum_filter(D, size=3, mode="constant", cval=-np.inf)
+        peak = (D == M) & (threshold < D)
+        peak[0] = peak[-1] = False
+        peak[:, [0, -1], :] = False
+        peak[:, :, [0, -1]] = False
+        i, r, c = np.nonzero(peak)
+        # the largest filter of the 3x3x3 neighbourhood must lie inside the image
+        b_top = (L[o][np.minimum(i + 1, nI - 1)] - 1) // 2 + 1
+        rr, cc = r * step, c * step
+        ok = (rr - b_top >= 0) & (rr + b_top < H) & (cc - b_top >= 0) & (cc + b_top < W)
+        i, r, c = i[ok], r[ok], c[ok]
+        if i.size == 0:
+            continue
+        v0 = D[i, r, c]
+        dx = (D[i, r, c + 1] - D[i, r, c - 1]) / 2
+        dy = (D[i, r + 1, c] - D[i, r - 1, c]) / 2
+        ds = (D[i + 1, r, c] - D[i - 1, r, c]) / 2
+        dxx = D[i, r, c + 1] + D[i, r, c - 1] - 2 * v0
+        dyy = D[i, r + 1, c] + D[i, r - 1, c] - 2 * v0
+        dss = D[i + 1, r, c] + D[i - 1, r, c] - 2 * v0
+        dxy = (D[i, r + 1, c + 1] - D[i, r + 1, c - 1] - D[i, r - 1, c + 1] + D[i, r - 1, c - 1]) / 4
+        dxs = (D[i + 1, r, c + 1] - D[i + 1, r, c - 1] - D[i - 1, r, c + 1] + D[i - 1, r, c - 1]) / 4
+        dys = (D[i + 1, r + 1, c] - D[i + 1, r - 1, c] - D[i - 1, r + 1, c] + D[i - 1, r - 1, c]) / 4
+        Hm = np.stack([np.stack([dxx, dxy, dxs], -1), np.stack([dxy, dyy, dys], -1),
+                       np.stack([dxs, dys, dss], -1)], -2)
+        g = np.stack([dx, dy, ds], -1)
+        det = np.linalg.det(Hm)
+        good = np.abs(det) > 1e-300
+        off = np.zeros_like(g)
+        off[good] = -np.linalg.solve(Hm[good], g[good][..., None])[..., 0]
+        good &= np.all(np.abs(off) < 0.5, axis=1)
+        i, r, c, off, v0 = i[good], r[good], c[good], off[good], v0[good]
+        res["u"].append((c + off[:, 0]) * step)
+        res["v"].append((r + off[:, 1]) * step)
+        res["L"].append(L[o][i] + off[:, 2] * (L[o][1] - L[o][0]))
+        res["det"].append(v0)
+        res["octave"].append(np.full(i.size, o))
+        res["sign"].append(np.sign(T[i, r, c]))
+    if not res["u"]:
+        return {k: np.zeros(0) for k in res}
+    return {k: np.concatenate(val) for k, val in res.items()}
+
+
+def haar_xy(II, rows, cols, half):
+    """Haar wavelet responses of side ``2·half`` centred on integer pixels (Bay 2008 §4.1).
+
+    dx = right half minus left half, dy = lower half minus upper half (v down),
+    boxes clipped to the image. ``rows``, ``cols``, ``half`` broadcast together.
+    """
+    H, W = II.shape[0] - 1, II.shape[1] - 1
+    Wp = W + 1
+    flat = II.ravel()
+    r0 = np.clip(rows - half, 0, H) * Wp
+    rm = np.clip(rows, 0, H) * Wp
+    r1 = np.clip(rows + half, 0, H) * Wp
+    c0 = np.clip(cols - half, 0, W)
+    cm = np.clip(cols, 0, W)
+    c1 = np.clip(cols + half, 0, W)
+    A00, A01, A02 = flat[r0 + c0], flat[r0 + cm], flat[r0 + c1]
+    A10, A12 = flat[rm + c0], flat[rm + c1]
+    A20, A21, A22 = flat[r1 + c0], flat[r1 + cm], flat[r1 + c1]
+    right = A22 - A02 - A21 + A01
+    left = A21 - A01 - A20 + A00
+    lower = A22 - A12 - A20 + A10
+    upper = A12 - A02 - A10 + A00
+    return right - left, lower - upper
+
+
+_ORI_I, _ORI_J = np.meshgrid(np.arange(-6, 7), np.arange(-6, 7), indexing="ij")
+_ORI_MASK = _ORI_I**2 + _ORI_J**2 < 36
+_ORI_I, _ORI_J = _ORI_I[_ORI_MASK], _ORI_J[_ORI_MASK]  # 109 samples
+_ORI_G = np.exp(-(_ORI_I**2 + _ORI_J**2) / (2 * 2.5**2))
+
+
+def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_rad: float = 0.15,
+                     chunk: int = 1024) -> np.ndarray:
+    """Dominant orientation from Haar responses in a sliding 60° window (Bay 2008 §4.1).
+
+    Returns angles in [0, 2π), image axes (u right, v down).
+    """
+    uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+    s = np.maximum(np.rint(np.asarray(scale_px, dtype=np.float64)), 1).astype(np.int64)
+    K = uv.shape[0]
+    out = np.zeros(K)
+    starts = np.arange(0.0, 2 * np.pi, step_rad)
+    for a in range(0, K, chunk):
+        sl = slice(a, a + chunk)
+        ss = s[sl, None]
+        rows = np.rint(uv[sl, 1]).astype(np.int64)[:, None] + _ORI_J[None, :] * ss
+        cols = np.rint(uv[sl, 0]).astype(np.int64)[:, None] + _ORI_I[None, :] * ss
+        dx, dy = haar_xy(II, rows, cols, 2 * ss)
+        dx, dy = dx * _ORI_G, dy * _ORI_G
+        ang = np.arctan2(dy, dx) % (2 * np.pi)  # (k, 109)
+        # window sums from cumulative sums over the angle-sorted samples (doubled for the wrap)
+        k = ang.shape[0]
+        o = np.argsort(ang, axis=1)
+        a2 = np.take_along_axis(ang, o, axis=1)
+        a2 = np.concatenate([a2, a2 + 2 * np.pi], axis=1)  # (k, 218), sorted per row
+        n2 = a2.shape[1]
+        cx = np.zeros((k, n2 + 1))
+        cy = np.zeros((k, n2 + 1))
+        dxs, dys = np.take_along_axis(dx, o, axis=1), np.take_along_axis(dy, o, axis=1)
+        np.cumsum(np.concatenate([dxs, dxs], axis=1), axis=1, out=cx[:, 1:])
+        np.cumsum(np.concatenate([dys, dys], axis=1), axis=1, out=cy[:, 1:])
+        base = 20.0 * np.arange(k)[:, None]  # rows apart: angles < 4π < 20
+        flat = (a2 + base).ravel()
+        lo = np.searchsorted(flat, (starts[None, :] + base).ravel()).reshape(k, -1) - n2 * np.arange(k)[:, None]
+        hi = (np.searchsorted(flat, (starts[None, :] + window_rad + base).ravel()).reshape(k, -1)
+              - n2 * np.arange(k)[:, None])
+        sx = np.take_along_axis(cx, hi, axis=1) - np.take_along_axis(cx, lo, axis=1)
+        sy = np.take_along_axis(cy, hi, axis=1) - np.take_along_axis(cy, lo, axis=1)
+        best = np.argmax(sx * sx + sy * sy, axis=1)
+        kk = np.arange(best.size)
+        out[sl] = np.arctan2(sy[kk, best], sx[kk, best]) % (2 * np.pi)
+    return out
+
+
+_D_OFF = (np.arange(20) - 9.5)  # sample centres in units of σ along each axis
+_D_X, _D_Y = np.meshgrid(_D_OFF, _D_OFF, indexing="xy")  # (20, 20): rows = y, cols = x
+_D_X, _D_Y = _D_X.ravel(), _D_Y.ravel()
+_D_G = np.exp(-(_D_X**2 + _D_Y**2) / (2 * 3.3**2))
+
+
+def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, chunk: int = 1024):
+    """64-d (or extended 128-d) SURF descriptors, unit length (Bay 2008 §4.2).
+
+    Returns float32 ``(K, 64)`` or ``(K, 128)``.
+    """
+    uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+    sigma = np.asarray(scale_px, dtype=np.float64)
+    s_int = np.maximum(np.rint(sigma), 1).astype(np.int64)
+    th = np.asarray(orientation_rad, dtype=np.float64)
+    K = uv.shape[0]
+    dim = 128 if extended else 64
+    out = np.zeros((K, dim), dtype=np.float32)
+    for a in range(0, K, chunk):
+        sl = slice(a, a + chunk)
+        cs, sn = np.cos(th[sl])[:, None], np.sin(th[sl])[:, None]
+        sg = sigma[sl, None]
+        x = (_D_X * cs - _D_Y * sn) * sg  # rotate the sample grid by θ (u right, v down)
+        y = (_D_X * sn + _D_Y * cs) * sg
+        cols = np.rint(uv[sl, 0:1] + x).astype(np.int64)
+        rows = np.rint(uv[sl, 1:2] + y).astype(np.int64)
+        dx, dy = haar_xy(II, rows, cols, s_int[sl, None])
+        rx = (cs * dx + sn * dy) * _D_G  # responses in the keypoint frame
+        ry = (-sn * dx + cs * dy) * _D_G
+        if not extended:
+            feats = np.stack([rx, ry, np.abs(rx), np.abs(ry)], axis=-1)  # (k, 400, 4)
+        else:
+            neg_y, neg_x = ry < 0, rx < 0
+            feats = np.stack([np.where(neg_y, rx, 0), np.where(neg_y, np.abs(rx), 0),
+                              np.where(~neg_y, rx, 0), np.where(~neg_y, np.abs(rx), 0),
+                              np.where(neg_x, ry, 0), np.where(neg_x, np.abs(ry), 0),
+                              np.where(~neg_x, ry, 0), np.where(~neg_x, np.abs(ry), 0)], axis=-1)
+        k, nf = feats.shape[0], feats.shape[-1]
+        desc = feats.reshape(k, 4, 5, 4, 5, nf).sum(axis=(2, 4)).reshape(k, 16 * nf)
+        norm = np.linalg.norm(desc, axis=1, keepdims=True)
+        out[sl] = desc / np.where(norm > 0, norm, 1.0)
+    return out
+
+
+def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_step: int = 2,
+                upright: bool = False, extended: bool = False, descriptors: bool = True) -> Features:
+    """SURF keypoints and descriptors (Bay et al. 2008; 000 §1.4.2, settings of §3.3).
+
+    Parameters
+    ----------
+    image : (H, W) grey image (uint8, or float in [0, 1])
+    threshold : float
+        Minimum Hessian determinant on our response scale (image in [0, 1], filters
+        divided by L²; OpenSURF's default 0.0004). See the module notes for 000's 0.05.
+    n_octaves : int
+        Number of octaves (000: 4), 4 intervals each.
+    init_step : int
+        Sampling step of the first octave in pixels (000: 2); doubles every octave.
+    upright : bool
+        U-SURF: skip the orientation (all angles 0).
+    extended : bool
+        128-d descriptor instead of 64-d.
+    descriptors : bool
+        Compute descriptors (False: keypoints only).
+
+    Examples
+    --------
+    >>> yy, xx = np.mgrid[0:101, 0:101]
+    >>> blob = np.exp(-((xx - 50.0)**2 + (yy - 50.0)**2) / (2 * 4.0**2))
+    >>> f = surf_detect(blob, 1e-4)
+    >>> np.round(f.uv[np.argmax(f.response)]).tolist()
+    [50.0, 50.0]
+    """
+    img = to_gray_float(image)
+    threshold = v.check_positive(threshold, "threshold", allow_zero=True)
+    n_octaves = v.check_int(n_octaves, "n_octaves", minimum=1, maximum=6)
+    init_step = v.check_int(init_step, "init_step", minimum=1)
+    if min(img.shape) < 16:
+        raise ValueError(f"`image` must be at least 16x16 pixels for SURF; got shape {img.shape}")
+    II = integral_image(img)
+    ext = _extrema(II, threshold=threshold, n_octaves=n_octaves, init_step=init_step)
+    uv = np.column_stack([ext["u"], ext["v"]]) if ext["u"].size else np.zeros((0, 2))
+    sigma = 1.2 * ext["L"] / 9.0
+    ori = np.zeros(uv.shape[0]) if upright or uv.shape[0] == 0 else surf_orientation(II, uv, sigma)
+    desc = surf_describe(II, uv, sigma, ori, extended=extended) if descriptors else None
+    name = ("U-SURF" if upright else "SURF") + ("-128" if extended else "")
+    return Features(uv, sigma, ori, ext["det"], ext["octave"].astype(np.int64), desc, name)
+
+
+def threshold_sweep(image, thresholds, *, n_octaves: int = 4, init_step: int = 2) -> np.ndarray:
+    """Number of SURF keypoints for each threshold (one response computation)."""
+    img = to_gray_float(image)
+    th = v.as_vector(thresholds, "thresholds")
+    II = integral_image(img)
+    ext = _extrema(II, threshold=float(th.min()) if th.min() > 0 else 0.0, n_octaves=n_octaves,
+                   init_step=init_step)
+    return np.array([int(np.count_nonzero(ext["det"] > t)) for t in th])
+
+
+class SURF:
+    """SURF detector with its settings as state (000 §3.3 defaults): ``SURF(threshold).detect(image)``.
+
+    >>> SURF(threshold=0.001, upright=True).upright
+    True
+    """
+
+    def __init__(self, threshold: float = 0.0004, *, n_octaves: int = 4, init_step: int = 2,
+                 upright: bool = False, extended: bool = False):
+        self.threshold = v.check_positive(threshold, "threshold", allow_zero=True)
+        self.n_octaves = v.check_int(n_octaves, "n_octaves", minimum=1, maximum=6)
+        self.init_step = v.check_int(init_step, "init_step", minimum=1)
+        self.upright = bool(upright)
+        self.extended = bool(extended)
+
+    def __repr__(self) -> str:
+        return (f"SURF(threshold={self.threshold}, n_octaves={self.n_octaves}, init_step={self.init_step}, "
+                f"upright={self.upright}, extended={self.extended})")
+
+    def detect(self, image, *, descriptors: bool = True) -> Features:
+        """Keypoints (and descriptors) of ``image``."""
+        return surf_detect(image, self.threshold, n_octaves=self.n_octaves, init_step=self.init_step,
+                           upright=self.upright, extended=self.extended, descriptors=descriptors)

@@ -1,0 +1,99 @@
+"""One interface for every detector; Features validation; plots and widgets run without errors."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from scipy import ndimage
+
+import slamlab.features as F
+from slamlab.kdtree import KDTree, bbf_trace, plot_kdtree_2d
+
+
+def _image():
+    rng = np.random.default_rng(0)
+    img = np.full((120, 160), 90.0)
+    for _ in range(30):
+        r, c = rng.integers(0, 110), rng.integers(0, 150)
+        img[r:r + rng.integers(4, 25), c:c + rng.integers(4, 25)] = rng.integers(0, 256)
+    return np.clip(ndimage.gaussian_filter(img, 1.0), 0, 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize("method", F.DETECTORS)
+def test_every_detector_returns_features(method):
+    f = F.detect(_image(), method)
+    assert isinstance(f, F.Features)
+    assert f.uv.shape == (len(f), 2)
+    assert np.all((f.uv >= 0) & (f.uv < [160, 120]))
+    assert np.all((f.orientation_rad >= 0) & (f.orientation_rad < 2 * np.pi))
+    if f.descriptors is not None:
+        assert len(f.descriptors) == len(f)
+    g = F.detect(_image(), method, max_points=5)
+    assert len(g) <= 5
+
+
+def test_colour_and_float_images_are_accepted():
+    img = _image()
+    rgb = np.repeat(img[:, :, None], 3, axis=2)
+    a = F.detect(img, "surf", descriptors=False)
+    b = F.detect(rgb, "surf", descriptors=False)
+    c = F.detect(img / 255.0, "surf", descriptors=False)
+    np.testing.assert_allclose(a.uv, c.uv)
+    assert abs(len(a) - len(b)) <= 0.05 * len(a)
+
+
+def test_features_validation_and_helpers():
+    z = np.zeros(2)
+    with pytest.raises(ValueError, match="`scale_px` must have 2 entries"):
+        F.Features(np.zeros((2, 2)), np.zeros(3), z, z, z.astype(int))
+    with pytest.raises(ValueError, match="`descriptors` must have 2 rows"):
+        F.Features(np.zeros((2, 2)), z, z, z, z.astype(int), np.zeros((3, 64)))
+    f = F.Features(np.array([[1.0, 2], [3, 4]]), z, z, np.array([1.0, 5.0]), z.astype(int), None, "x")
+    assert f.strongest(1).uv.tolist() == [[3.0, 4.0]]
+    assert len(F.Features.empty("x", 64)) == 0
+    with pytest.raises(ValueError, match="`method` must be one of"):
+        F.detect(_image(), "akaze")
+    with pytest.raises(TypeError, match=r"`features` must be slamlab\.features\.Features"):
+        F.describe_surf(_image(), np.zeros((3, 2)))
+    with pytest.raises(TypeError, match=r"`f1` must be slamlab\.features\.Features"):
+        F.repeatability(np.zeros((3, 2)), f, np.eye(3), (10, 10), (10, 10))
+    with pytest.raises(ValueError, match=r"`H` must have shape \(3, 3\)"):
+        F.project(np.eye(2), [[0.0, 0.0]])
+
+
+def test_plots_run():
+    img = _image()
+    f = F.detect(img, "surf")
+    g = F.detect(np.ascontiguousarray(img[:, ::-1]), "surf")
+    m = F.match_descriptors(f.descriptors, g.descriptors, rule="ratio")
+    F.plot_keypoints(img, f)
+    F.plot_matches(img, img[:, ::-1], f, g, m, np.ones(len(m), bool))
+    F.plot_box_filters(15)
+    F.plot_fast_circle(img, 60, 80)
+    rng = np.random.default_rng(0)
+    tree = KDTree(rng.random((30, 2)))
+    _, _, ev = bbf_trace(tree, [0.5, 0.5], max_leaves=5)
+    plot_kdtree_2d(tree, query=[0.5, 0.5], events=ev)
+    with pytest.raises(ValueError, match="`tree` must hold 2-D points"):
+        plot_kdtree_2d(KDTree(rng.random((5, 3))))
+    plt.close("all")
+
+
+@pytest.mark.realdata
+def test_widgets_never_raise(shared_data):
+    w = F.explore_detectors()
+    for det in ("SURF (ours)", "FAST-9 (ours)", "MSER (OpenCV)"):
+        for frac in (0.0, 1.0):
+            w.children[0].value = det
+            w.children[1].value = frac
+            w.update()
+    m = F.explore_matching()
+    for det, leaves, ratio in (("ORB (OpenCV)", 200, 0.3), ("SURF (ours)", 0, 1.0), ("SURF (ours)", 10, 0.6)):
+        m.children[2].value = det
+        m.children[1].value = leaves
+        m.children[0].value = ratio
+        m.update()
+    plt.close("all")
