@@ -9,18 +9,15 @@ import numpy as np
 
 from ..sim.grid import add_clutter, measurement_room_200, test_room_200
 from ..sim.rangefinder import Rangefinder
+from ..widgets import STYLE as _STYLE
+from ..widgets import slider as _slider
 from .algorithm import heading_error, localise
 from .experiments import random_clutter
 from .plot import localisation_figure
 
 __all__ = ["explore_intel_scan", "explore_localisation"]
 
-_STYLE = {"description_width": "initial"}
 
-
-def _slider(cls, value, lo, hi, step, desc, **kw):
-    return cls(value=value, min=lo, max=hi, step=step, description=desc, continuous_update=False, style=_STYLE,
-               **kw)
 
 
 def explore_localisation(**defaults):

@@ -23,6 +23,7 @@ from .evaluation import (
 from .experiments import (
     EVAL_DETECTORS,
     descriptor_pool,
+    run_blob_scale,
     run_detector_summary,
     run_knn_comparison,
     run_pair_evaluation,
@@ -110,6 +111,7 @@ __all__ = [
     "plot_surf_threshold",
     "project",
     "repeatability",
+    "run_blob_scale",
     "run_detector_summary",
     "run_knn_comparison",
     "run_pair_evaluation",

@@ -25,6 +25,7 @@ from .surf import threshold_sweep
 
 __all__ = [
     "EVAL_DETECTORS",
+    "BlobScaleResult",
     "DetectorSummaryResult",
     "KnnComparisonResult",
     "LeavesCurveResult",
@@ -32,6 +33,7 @@ __all__ = [
     "RatioTradeoffResult",
     "SurfThresholdResult",
     "descriptor_pool",
+    "run_blob_scale",
     "run_detector_summary",
     "run_knn_comparison",
     "run_pair_evaluation",
@@ -530,3 +532,43 @@ def run_ratio_tradeoff(ratios=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), *, detec
     src = score(accept_000(d, max_dist=md))
     return RatioTradeoffResult(detector, f"{sequence} 1→{j} x{scale:g}", ratios, p, rc, n, r.correspondences,
                                (src[0], src[1], src[2], md))
+
+
+@dataclass(frozen=True)
+class BlobScaleResult:
+    """Where and at what scale our SURF finds a Gaussian blob of known size."""
+
+    sizes_px: np.ndarray
+    uv: np.ndarray  # (n, 2) position of the strongest keypoint
+    sigma_px: np.ndarray  # SURF scale of that keypoint
+    centre_px: float
+
+    def __str__(self) -> str:
+        r = self.sigma_px / self.sizes_px
+        return f"blob scale: SURF sigma / blob size {r.min():.2f}-{r.max():.2f} over sizes {self.sizes_px.tolist()}"
+
+    def table(self) -> str:
+        rows = [[f"{s:.0f}", f"{u:.2f}, {w:.2f}", f"{g:.2f}", f"{g / s:.2f}"]
+                for s, (u, w), g in zip(self.sizes_px, self.uv, self.sigma_px, strict=True)]
+        return format_table(["blob s [px]", "found at (u, v)", "SURF σ [px]", "σ / s"], rows)
+
+
+def run_blob_scale(sizes_px=(3.0, 4.0, 5.0, 6.0, 8.0), *, threshold: float = 1e-4, size_px: int = 161) -> BlobScaleResult:
+    """Detect a centred Gaussian blob ``exp(-r²/2s²)`` of each size with our SURF (000 §1.4; our check).
+
+    The strongest keypoint should sit at the centre; its SURF scale should grow in
+    proportion to ``s`` (a constant ``σ/s``).
+    """
+    from .surf import surf_detect
+
+    sizes = v.as_vector(sizes_px, "sizes_px")
+    size_px = v.check_int(size_px, "size_px", minimum=16)
+    c = (size_px - 1) / 2.0
+    yy, xx = np.mgrid[0:size_px, 0:size_px]
+    uv, sig = [], []
+    for s in sizes:  # one small image per size: a handful of detections, not a hot path
+        f = surf_detect(np.exp(-((xx - c) ** 2 + (yy - c) ** 2) / (2 * s**2)), threshold, descriptors=False)
+        k = int(np.argmax(f.response))
+        uv.append(f.uv[k])
+        sig.append(f.scale_px[k])
+    return BlobScaleResult(sizes, np.array(uv), np.array(sig), c)

@@ -6,6 +6,7 @@ import ipywidgets as widgets
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..widgets import STYLE as _STYLE
 from .detect import detect
 from .evaluation import OXFORD_SEQUENCES, correct_matches, load_oxford_pair, repeatability
 from .matching import Matches, accept_ratio, knn2
@@ -13,7 +14,6 @@ from .plot import plot_keypoints, plot_matches
 
 __all__ = ["explore_detectors", "explore_matching"]
 
-_STYLE = {"description_width": "initial"}
 
 # detector -> (method, threshold parameter name, default, min, max, step, log scale)
 _DETECTOR_KNOBS = {

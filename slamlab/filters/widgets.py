@@ -4,17 +4,13 @@ from __future__ import annotations
 
 import ipywidgets as widgets
 
+from ..widgets import slider as _slider
 from .experiments import run_cv_target, run_unicycle_comparison
 from .plot import cv_figure, unicycle_figure
 
 __all__ = ["explore_cv_target", "explore_unicycle"]
 
-_STYLE = {"description_width": "initial"}
 
-
-def _slider(cls, value, lo, hi, step, desc, **kw):
-    return cls(value=value, min=lo, max=hi, step=step, description=desc, continuous_update=False, style=_STYLE,
-               **kw)
 
 
 def explore_unicycle(**defaults):

@@ -8,10 +8,12 @@ from .experiments import (
     ExampleLineResult,
     RealLogResult,
     SimSlamResult,
+    check_pose_from_two_lines,
     pose_errors,
     run_example_line,
     run_real_log,
     run_sim_slam,
+    time_polar_vs_opencv,
 )
 from .icp import IcpResult, icp, icp_odometry, rigid_fit_2d
 from .lines import (
@@ -61,6 +63,7 @@ __all__ = [
     "association_probability",
     "build_map",
     "canonical_lines",
+    "check_pose_from_two_lines",
     "compose",
     "detect_lines",
     "find_peaks",
@@ -83,6 +86,7 @@ __all__ = [
     "scan_points_world",
     "select_line_pair",
     "theta_axis",
+    "time_polar_vs_opencv",
     "transform_lines",
 ]
 

@@ -34,10 +34,12 @@ __all__ = [
     "ExampleLineResult",
     "RealLogResult",
     "SimSlamResult",
+    "check_pose_from_two_lines",
     "pose_errors",
     "run_example_line",
     "run_real_log",
     "run_sim_slam",
+    "time_polar_vs_opencv",
 ]
 
 
@@ -371,3 +373,55 @@ def run_real_log(name: str = "urg04lx", *, n_scans: int | None = None, step: int
     title = {"urg04lx": "Mines URG-04LX log exp2.dat (raw wheel odometry)",
              "mbicp": "MbICP SICK log laserazosSM3.log (raw odometry)"}[name]
     return RealLogResult(title, res, odo, scans, m_slam, m_odo, idx, timing)
+
+
+def check_pose_from_two_lines(n_cases: int = 1000, *, rng=2010) -> float:
+    """Largest error of :func:`~slamlab.hough.pose.pose_from_two_lines` on exact random cases (004; our check).
+
+    Each case: a random pose change and two non-parallel lines; the lines seen
+    after the move are put into the flipped ``(-rho, theta + 180°)`` form and
+    back, then the pose is recovered. Returns ``max |estimate - truth|``.
+    """
+    from .lines import align_lines, transform_lines
+    from .pose import pose_from_two_lines
+
+    n_cases = v.check_int(n_cases, "n_cases", minimum=1)
+    g = v.as_rng(rng)
+    worst = 0.0
+    for _ in range(n_cases):  # a closed-form check per case, cheap
+        pose = g.uniform([-2, -2, -0.5], [2, 2, 0.5])
+        ri, ti = g.uniform(-8, 8, 2), g.uniform(-1.5, 1.5) + np.array([0.0, g.uniform(0.6, 2.5)])
+        rj, tj = transform_lines(ri, ti, pose)
+        rj, tj = canonical_lines(-rj, tj + np.pi)  # the flipped form
+        rj, tj = align_lines(rj, tj, ti - pose[2])  # back to the continuous one
+        got = pose_from_two_lines((ri[0], ti[0]), (ri[1], ti[1]), (rj[0], tj[0]), (rj[1], tj[1]))
+        worst = max(worst, float(np.abs(got - pose).max()))
+    return worst
+
+
+def time_polar_vs_opencv(*, cell_m: float = 0.05, r_max_m: float = 30.0, room_half_m: float = 5.0,
+                         n_beams: int = 1081, repeats: int = 20) -> dict:
+    """Median times of our polar transform and ``cv2.HoughLines`` on the same 1081-beam scan (004; our addition).
+
+    The scan is a square room (``room_half_m`` to each wall) seen over 270°;
+    OpenCV gets the scan rasterised at ``cell_m``. Returns the times in seconds,
+    the image size and the ratio OpenCV / ours (volatile: print only in ignored cells).
+    """
+    import cv2
+
+    phi = np.linspace(-0.75 * np.pi, 0.75 * np.pi, v.check_int(n_beams, "n_beams", minimum=2))
+    r = room_half_m / np.maximum(np.abs(np.cos(phi)), np.abs(np.sin(phi)))
+    img, _ = rasterise_scan(phi, r, cell=cell_m, r_max=r_max_m)
+
+    def median_s(fn):
+        fn()
+        t = []
+        for _ in range(v.check_int(repeats, "repeats", minimum=1)):
+            t0 = time.perf_counter()
+            fn()
+            t.append(time.perf_counter() - t0)
+        return float(np.median(t))
+
+    ours = median_s(lambda: hough_polar(phi, r, delta_rho=cell_m, r_max=r_max_m))
+    ref = median_s(lambda: cv2.HoughLines(img, 1, np.pi / 180, 30))
+    return {"ours_s": ours, "opencv_s": ref, "image_px": img.shape[0], "ratio": ref / ours}

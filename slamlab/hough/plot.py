@@ -28,7 +28,7 @@ def plot_accumulator(acc: HoughAccumulator, lines=None, *, ax=None, title: str =
     """The votes H(rho, θ) as an image, θ in degrees across, rho up; peaks circled when ``lines`` is given."""
     if not isinstance(acc, HoughAccumulator):
         raise TypeError(f"`acc` must be a HoughAccumulator; got {type(acc).__name__}")
-    ax = new_axes(ax, title=title, xlabel="θ [°]", ylabel="ρ")  # noqa: RUF001 - the source's symbol
+    ax = new_axes(ax, title=title, xlabel="θ [°]", ylabel="ρ")
     t = np.degrees(acc.theta_rad)
     dt, dr = math.degrees(acc.delta_theta_rad), acc.delta_rho
     extent = (t[0] - dt / 2, t[-1] + dt / 2, acc.rho[0] - dr / 2, acc.rho[-1] + dr / 2)

@@ -7,6 +7,8 @@ import math
 import ipywidgets as widgets
 import matplotlib.pyplot as plt
 
+from ..widgets import STYLE as _STYLE
+from ..widgets import slider as _slider
 from .experiments import run_real_log, run_sim_slam
 from .lines import find_peaks
 from .plot import plot_accumulator, plot_scan_lines, real_log_figure, sim_figure
@@ -15,12 +17,7 @@ from .transform import hough_polar
 
 __all__ = ["explore_accumulator", "explore_hough_slam", "explore_real_log"]
 
-_STYLE = {"description_width": "initial"}
 
-
-def _slider(cls, value, lo, hi, step, desc, **kw):
-    return cls(value=value, min=lo, max=hi, step=step, description=desc, continuous_update=False, style=_STYLE,
-               **kw)
 
 
 def _theta_choice(value):
@@ -52,7 +49,7 @@ def explore_accumulator(**defaults):
             print(f"Cannot run with these settings: {exc}")
             return
         print(f"pose {int(pose_index)}: {phi.size} returns, accumulator {acc.size_theta_rho[0]}×"
-              f"{acc.size_theta_rho[1]} (θ×ρ), {len(peaks)} peaks, {len(lines)} lines after the refit")  # noqa: RUF001
+              f"{acc.size_theta_rho[1]} (θ×ρ), {len(peaks)} peaks, {len(lines)} lines after the refit")
         fig, axs = plt.subplots(1, 2, figsize=(14, 5))
         plot_accumulator(acc, peaks, ax=axs[0])
         plot_scan_lines(phi, r, lines, ax=axs[1])

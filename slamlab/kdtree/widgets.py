@@ -3,20 +3,15 @@
 from __future__ import annotations
 
 import ipywidgets as widgets
-import matplotlib.pyplot as plt
 
+from ..widgets import slider as _slider
 from .cost_model import iter_time, run_cost_model
 from .experiments import run_store_comparison
 from .store_plot import plot_cost_contour, plot_iteration_times
 
 __all__ = ["explore_cost_model", "explore_stores"]
 
-_STYLE = {"description_width": "initial"}
 
-
-def _slider(cls, value, lo, hi, step, desc, **kw):
-    return cls(value=value, min=lo, max=hi, step=step, description=desc, continuous_update=False, style=_STYLE,
-               **kw)
 
 
 def explore_cost_model(**defaults):
@@ -41,7 +36,6 @@ def explore_cost_model(**defaults):
         ax = plot_cost_contour(res)
         ax.plot(n1, q, "s", color="orange", markersize=8, label="sliders")
         ax.legend(loc="upper right", facecolor="0.85")
-        plt.show()
 
     return widgets.interactive(
         show,
@@ -75,7 +69,6 @@ def explore_stores(**defaults):
         print(res.table())
         print(res.timed_table())
         plot_iteration_times(res)
-        plt.show()
 
     return widgets.interactive(
         show,

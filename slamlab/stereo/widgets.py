@@ -5,12 +5,12 @@ from __future__ import annotations
 import ipywidgets as widgets
 from IPython.display import display
 
+from ..widgets import STYLE as _STYLE
 from .experiments import run_closed_loop, run_turn_in_place
 from .plot import run_figure
 
 __all__ = ["explore_stereo_slam"]
 
-_STYLE = {"description_width": "initial"}
 
 
 def explore_stereo_slam(**defaults):

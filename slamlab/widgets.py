@@ -1,0 +1,24 @@
+"""Shared widget helpers for the chapters' ``explore_*`` functions (the one place for them).
+
+Every chapter's ``<topic>/widgets.py`` builds its sliders with :func:`slider` (no
+update while dragging) and labels its controls with :data:`STYLE` (wide descriptions).
+"""
+
+from __future__ import annotations
+
+__all__ = ["STYLE", "slider"]
+
+#: Label style shared by every control: wide descriptions are not cut off.
+STYLE = {"description_width": "initial"}
+
+
+def slider(cls, value, lo, hi, step, desc: str, **kw):
+    """An ipywidgets slider of class ``cls`` that updates on release only.
+
+    >>> import ipywidgets as widgets
+    >>> s = slider(widgets.FloatSlider, 0.5, 0.0, 1.0, 0.1, "noise")
+    >>> s.continuous_update, s.description
+    (False, 'noise')
+    """
+    return cls(value=value, min=lo, max=hi, step=step, description=desc, continuous_update=False, style=STYLE, **kw)
+
