@@ -48,7 +48,7 @@ class Features(NamedTuple):
         return self.descriptors.dtype == np.uint8
 
 
-# --- detection: a tiny adapter keyed by `detector` (slamlab.features will replace it) -------------
+# --- detection: OpenCV's ORB / SIFT with the pipeline's settings, our SURF from slamlab.features ---
 
 
 def _as_uint8(image):
@@ -89,15 +89,16 @@ def _detect_surf(img, n_features):
 DETECTORS = {"orb": _detect_orb, "sift": _detect_sift, "surf": _detect_surf}
 
 
-def detect(image, detector: str = "orb", n_features: int = 2000) -> Features:
-    """Keypoints and descriptors of one image (000 §3.3; OpenCV ORB / SIFT for now).
+def detect(image, detector: str = "surf", n_features: int = 2000) -> Features:
+    """Keypoints and descriptors of one image (000 §3.3).
 
     000 uses SURF with about 2000 points per 768×576 image; SURF is absent from
-    our OpenCV: ``"surf"`` calls the features chapter's own SURF (``slamlab.features.detect``);
-    the default here is ORB (OpenCV), the fast one.
+    our OpenCV, so ``"surf"`` (the default) is the features chapter's own SURF
+    (``slamlab.features.detect``; its threshold, not ``n_features``, limits it to about 600
+    points on the arena); ``"orb"`` and ``"sift"`` are OpenCV's (ORB is the fast one).
 
     >>> img = (np.indices((64, 64)).sum(0) % 16 < 8).astype(np.uint8) * 255
-    >>> f = detect(img, n_features=50); f.uv.shape[1], f.descriptors.dtype
+    >>> f = detect(img, "orb", n_features=50); f.uv.shape[1], f.descriptors.dtype
     (2, dtype('uint8'))
     """
     v.check_choice(detector, "detector", DETECTORS)

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from slamlab.geometry import StereoRig, wrap_angle
+from slamlab.kdtree.stores import MultiKDTree, NonBaseBuffer
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
 from slamlab.stereo import STAGES, ExactStore, StereoSLAM
@@ -51,7 +52,28 @@ def test_same_frame_twice_gives_identity_and_base_landmarks():
     # every landmark seen in three frames is now base (000 §3.4)
     assert rec.n_base == rec.n_inliers
     assert len(slam.landmark_map()) == rec.n_base
-    assert isinstance(slam.store, ExactStore)
+    # the default store is 000's: the multi kd-tree behind the non-base buffer (float descriptors)
+    assert isinstance(slam.store, NonBaseBuffer) and isinstance(slam.store.base, MultiKDTree)
+    assert len(slam.store.base) == rec.n_base
+
+
+def test_default_store_follows_the_descriptor_type():
+    rig = StereoRig.parallel()
+    assert isinstance(StereoSLAM(rig, detector="orb").store, ExactStore)  # Hamming: no kd-tree
+    assert isinstance(StereoSLAM(rig, detector="sift").store.base, MultiKDTree)
+
+
+def test_parallel_detection_gives_the_serial_result():
+    rig = StereoRig.parallel(0.2, 384, 288)
+    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    pairs = [sim.render_pair([3.0, 4.0, yaw]) for yaw in (0.0, 0.05, 0.1)]
+    runs = []
+    for parallel in (True, False):
+        slam = StereoSLAM(rig, sim.T_body_left, parallel_detect=parallel, rng=0)
+        runs.append([slam.process(*p) for p in pairs] and slam)
+    np.testing.assert_array_equal(runs[0].trajectory, runs[1].trajectory)
+    assert runs[0].records == runs[1].records
+    assert runs[0].records[-1].n_inliers > 20  # a real pose, not an empty run
 
 
 def test_degenerate_frames_keep_the_pose_and_are_counted():

@@ -48,11 +48,14 @@ def test_detect_orb_and_sift(frame):
     np.testing.assert_allclose(g.uv, f.uv)
 
 
-def test_stereo_matches_and_triangulation_against_the_renderer(frame):
+# SURF's large-scale blobs straddle depth edges (fence top against the floor behind), so a few more of
+# its points miss the surface pixel they are compared with (measured 0.94 against ORB's 0.996)
+@pytest.mark.parametrize("detector, n_min, within", [("orb", 500, 0.95), ("surf", 300, 0.90)])
+def test_stereo_matches_and_triangulation_against_the_renderer(frame, detector, n_min, within):
     sim, left, right, T, pts = frame
-    fl, fr = detect(left), detect(right)
+    fl, fr = detect(left, detector), detect(right, detector)
     sm = stereo_match(fl, fr, sim.rig)
-    assert len(sm.left) > 500
+    assert len(sm.left) > n_min
     assert len(np.unique(sm.right)) == len(sm.right)
     # epipolar check: the rig is rectified, so matched rows agree within the tolerance
     assert np.abs(fl.uv[sm.left, 1] - fr.uv[sm.right, 1]).max() <= 2.0 + 1e-9
@@ -63,8 +66,9 @@ def test_stereo_matches_and_triangulation_against_the_renderer(frame):
     truth_cam = (truth_world[ok] - T[:3, 3]) @ T[:3, :3]
     err = np.linalg.norm(cloud.points[ok] - truth_cam, axis=1)
     sigma = np.sqrt(np.trace(cloud.cov[ok], axis1=1, axis2=2))
-    # ORB keypoints are quantised on its pyramid: allow 4 sigma (+1 cm for the pixel rounding above)
-    assert np.mean(err < 4 * sigma + 0.01) > 0.95
+    # ORB keypoints are quantised on its pyramid, SURF's on its scale-space grid:
+    # allow 4 sigma (+1 cm for the pixel rounding above)
+    assert np.mean(err < 4 * sigma + 0.01) > within
     assert cloud.points[:, 2].min() >= 0.3
     assert cloud.points[:, 2].max() <= 10.0
 
