@@ -147,8 +147,8 @@ class StereoSLAM:
         self.max_non_base_time = v.check_int(max_non_base_time, "max_non_base_time", minimum=1)
         if store is None:
             store = default_store(self.detector, self.base_seen_times, self.max_non_base_time)
-        elif callable(store) and not hasattr(store, "query"):
-            store = store()
+        elif isinstance(store, type) or (callable(store) and not hasattr(store, "query")):
+            store = store()  # a class or a factory
         self.store = check_store(store)
         self.policy = v.check_choice(policy, "policy", POLICIES)
         self.ransac_iters = v.check_int(ransac_iters, "ransac_iters", minimum=1)
@@ -222,7 +222,7 @@ class StereoSLAM:
             self._finish(rec, times, t4, pts_body, np.zeros(len(pts_body), bool))
             return rec
         est = estimate_pose(
-            pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], depth_m=cloud.points[mm.local, 2],
+            pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], depth_m=cloud.points[mm.local, 2], cov=cov_body[mm.local],
             policy=self.policy, n_oldest=self.n_oldest, oldest_fraction=self.oldest_fraction, keep_fraction=self.keep_fraction,
             max_iters=self.ransac_iters,
             threshold_m=self.threshold_m, min_inliers=self.min_inliers, rng=self.rng,

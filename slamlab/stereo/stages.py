@@ -29,6 +29,7 @@ __all__ = [
     "detect",
     "estimate_pose",
     "match_to_map",
+    "pose_std",
     "select_oldest",
     "stereo_match",
     "triangulate_local",
@@ -151,23 +152,21 @@ def stereo_match(
         return empty
     if left.descriptors.dtype != right.descriptors.dtype or left.descriptors.shape[1] != right.descriptors.shape[1]:
         raise ValueError("`left` and `right` descriptors must have the same type and length")
-    # epipolar lines of the left points in the right image: l = F x_l, distance |l . x_r| / |l[:2]|
-    xl = np.column_stack([left.uv, np.ones(len(left.uv))])
-    lines = xl @ rig.F.T
-    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
-    lines = lines.astype(np.float32)
-    dist_px = lines[:, :2] @ right.uv.T.astype(np.float32)
-    dist_px += lines[:, 2:3]
-    np.abs(dist_px, out=dist_px)
-    mask = (dist_px <= epi_tol_px).view(np.uint8)
-    norm = cv2.NORM_HAMMING if left.binary else cv2.NORM_L2
-    knn = cv2.BFMatcher(norm).knnMatch(left.descriptors, right.descriptors, k=2, mask=mask)
-    # one short list of DMatch per keypoint: (query, train, d1, d2) rows
-    rows = [(m[0].queryIdx, m[0].trainIdx, m[0].distance, m[1].distance if len(m) > 1 else np.inf) for m in knn if m]
-    if not rows:
+    li, ri = _epipolar_pairs(left.uv, right.uv, rig.F, epi_tol_px)
+    if li.size == 0:
         return empty
-    arr = np.array(rows)
-    li, ri, d1, d2 = arr[:, 0].astype(np.intp), arr[:, 1].astype(np.intp), arr[:, 2], arr[:, 3]
+    d = _pair_distances(left.descriptors, right.descriptors, li, ri)
+    # pairs come grouped by left keypoint: nearest and second-nearest right keypoint per group
+    start = np.flatnonzero(np.r_[True, li[1:] != li[:-1]])
+    size = np.diff(np.r_[start, li.size])
+    d1 = np.minimum.reduceat(d, start)
+    at_min = np.flatnonzero(d == np.repeat(d1, size))
+    # one nearest per group (with a tie, d2 = d1 and the ratio rule rejects the keypoint anyway)
+    first_min = at_min[np.r_[True, li[at_min][1:] != li[at_min][:-1]]]
+    d_rest = d.copy()
+    d_rest[first_min] = np.inf
+    d2 = np.minimum.reduceat(d_rest, start)
+    li, ri = li[first_min], ri[first_min]
     keep = d1 < ratio * d2
     if max_distance is not None:
         keep &= d1 <= v.check_positive(max_distance, "max_distance")
@@ -178,6 +177,52 @@ def stereo_match(
     first[1:] = ri[order][1:] != ri[order][:-1]
     sel = np.sort(order[first])
     return StereoMatches(li[sel], ri[sel], d1[sel])
+
+
+def _epipolar_pairs(uv_left, uv_right, F, tol_px):
+    """All (left, right) keypoint pairs with the right point within ``tol_px`` of the left one's
+    epipolar line ``l = F x_l``, grouped by left index (ascending).
+
+    When every epipolar line is nearly horizontal (a rectified or nearly rectified rig), the
+    candidates come from a row-sorted list by binary search (a few per keypoint); otherwise every
+    pair is tested.
+    """
+    xl = np.column_stack([uv_left, np.ones(len(uv_left))])
+    lines = xl @ F.T
+    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
+    a, b, c = lines.T
+    n = len(uv_left)
+    if np.all(np.abs(b) > 0.5):
+        order = np.argsort(uv_right[:, 1], kind="stable")
+        ys = uv_right[order, 1]
+        x_lo, x_hi = uv_right[:, 0].min(), uv_right[:, 0].max()
+        y_lo, y_hi = -(a * x_lo + c) / b, -(a * x_hi + c) / b
+        pad = tol_px / np.abs(b) + 1e-9  # |a x + b y + c| <= tol  <=>  |y - y_line(x)| <= tol / |b|
+        lo = np.searchsorted(ys, np.minimum(y_lo, y_hi) - pad, side="left")
+        hi = np.searchsorted(ys, np.maximum(y_lo, y_hi) + pad, side="right")
+        cnt = hi - lo
+        li = np.repeat(np.arange(n), cnt)
+        ri = order[np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt - lo, cnt)]
+    else:
+        li, ri = np.divmod(np.arange(n * len(uv_right)), len(uv_right))
+    dist = np.abs(a[li] * uv_right[ri, 0] + b[li] * uv_right[ri, 1] + c[li])
+    keep = dist <= tol_px
+    return li[keep], ri[keep]
+
+
+def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
+    """Descriptor distance of each pair ``(A[ia], B[ib])``: Hamming for uint8, Euclidean otherwise."""
+    out = np.empty(ia.size)
+    for s0 in range(0, ia.size, block):
+        x, y = A[ia[s0:s0 + block]], B[ib[s0:s0 + block]]
+        if A.dtype == np.uint8:
+            if A.shape[1] % 8 == 0:  # 8 bytes at a time
+                x, y = x.view(np.uint64), y.view(np.uint64)
+            out[s0:s0 + block] = np.bitwise_count(x ^ y).sum(axis=1)
+        else:
+            dxy = x.astype(np.float32) - y
+            out[s0:s0 + block] = np.sqrt(np.einsum("ij,ij->i", dxy, dxy))
+    return out
 
 
 # --- local landmark cloud (000 §3.3) ----------------------------------------------------------------
@@ -327,6 +372,38 @@ def select_oldest(first_seen, n_min: int) -> np.ndarray:
     return np.flatnonzero(fs <= cut)
 
 
+def pose_std(points_map, cov_map, center=None) -> np.ndarray:
+    """Standard deviations of the 6 pose parameters (3 rotations, rad; 3 translations, m)
+    determined by matched points with covariances ``cov_map`` (Gauss-Newton information
+    ``Σ Jᵢᵀ Σᵢ⁻¹ Jᵢ``, ``Jᵢ = [-[pᵢ - c]ₓ, I]``; translations about ``center``, default the
+    points' mean). Our addition: it tells whether a set of landmarks is "sufficiently large
+    for computing the position" (000 §3.5). A wall of points straight ahead, with stereo depth
+    error much larger than the lateral error, leaves yaw and sideways translation nearly
+    interchangeable; this shows as large standard deviations.
+
+    >>> P = np.array([[1.0, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
+    >>> bool(np.all(np.isfinite(pose_std(P, np.tile(np.eye(3) * 1e-4, (4, 1, 1))))))
+    True
+    """
+    P = v.as_finite_array(points_map, "points_map", ndim=2)
+    C = np.asarray(cov_map, dtype=float)
+    if C.shape != (len(P), 3, 3):
+        raise ValueError(f"`cov_map` must have shape ({len(P)}, 3, 3); got {C.shape}")
+    c = P.mean(axis=0) if center is None else np.asarray(center, dtype=float)
+    q = P - c
+    J = np.zeros((len(P), 3, 6))
+    # d(R p)/d(rotation vector) = -[p]x
+    J[:, 0, 1], J[:, 0, 2] = q[:, 2], -q[:, 1]
+    J[:, 1, 0], J[:, 1, 2] = -q[:, 2], q[:, 0]
+    J[:, 2, 0], J[:, 2, 1] = q[:, 1], -q[:, 0]
+    J[:, :, 3:] = np.eye(3)
+    info = np.einsum("nki,nkl,nlj->ij", J, np.linalg.inv(C), J)
+    try:
+        return np.sqrt(np.diag(np.linalg.inv(info)))
+    except np.linalg.LinAlgError:
+        return np.full(6, np.inf)
+
+
 class PoseEstimate(NamedTuple):
     """Pose ``T`` (4, 4) mapping local points to the map, ``inliers (M,)`` over all matches,
     ``converged``, ``n_used`` matches the final fit used, ``n_iters`` hypotheses."""
@@ -353,11 +430,13 @@ def estimate_pose(
     first_seen=None,
     *,
     depth_m=None,
+    cov=None,
     policy: str = "all",
     n_oldest: int = 40,
     oldest_fraction: float = 0.5,
     keep_fraction: float = 0.5,
     loose_factor: float = 4.0,
+    max_std_factor: float | None = 2.0,
     max_correction_rad: float | None = None,
     max_correction_m: float | None = None,
     max_iters: int = 200,
@@ -379,13 +458,17 @@ def estimate_pose(
         ``loose_factor`` thresholds of it are candidates; the landmarks among them first seen
         longest ago (:func:`select_oldest`: at least ``n_oldest`` and ``oldest_fraction`` of the
         candidates — fewer, all from one edge of the view, leave yaw and sideways translation
-        nearly ambiguous) get a RANSAC of their own, whose pose wins when at least
+        nearly ambiguous) — extended by the next-oldest until, with ``cov`` given, no pose parameter is
+        more than ``max_std_factor`` times as uncertain as with all candidates (:func:`pose_std`;
+        "sufficiently large for computing the position") — get a RANSAC of their own, whose pose wins when at least
         ``keep_fraction`` of them agree, it keeps 80 % of the candidates within the loose band and
         it differs from the consensus pose by at most ``max_correction_rad`` / ``max_correction_m``
         (None = unbounded; a bound of 5° / 0.3 m also blocks the loop-closing correction)
         (our reading of 000 §3.5: old landmarks correct the drift of the recent ones when a place
         is revisited);
         ``"all"`` — the pose is the least-squares fit on all RANSAC inliers.
+    cov : (M, 3, 3) covariances of the local points (body frame), for the conditioning test of
+        ``policy="oldest"``; None skips the test.
     max_iters : RANSAC hypotheses (000: about 200), minimal samples of 3, early exit at 99.9 % confidence.
     min_inliers : inliers needed for a valid pose.
 
@@ -417,6 +500,12 @@ def estimate_pose(
     oldest_fraction = v.check_positive(oldest_fraction, "oldest_fraction")
     keep_fraction = v.check_positive(keep_fraction, "keep_fraction", allow_zero=True)
     loose_factor = v.check_positive(loose_factor, "loose_factor")
+    if max_std_factor is not None:
+        max_std_factor = v.check_positive(max_std_factor, "max_std_factor")
+    if cov is not None:
+        cov = np.asarray(cov, dtype=float)
+        if cov.shape != (m, 3, 3) or not np.all(np.isfinite(cov)):
+            raise ValueError(f"`cov` must be a finite ({m}, 3, 3) array; got shape {cov.shape}")
     if oldest_fraction > 1:
         raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {oldest_fraction}")
     rng = v.as_rng(rng)
@@ -442,6 +531,19 @@ def estimate_pose(
         loose = np.flatnonzero(_residuals(Tm, src, dst, w) <= loose_factor * threshold_m)
         n_min = max(n_oldest, int(np.ceil(oldest_fraction * loose.size)))
         old = loose[select_oldest(first_seen[loose], n_min)]
+        if cov is not None and max_std_factor is not None and old.size < loose.size:
+            # grow the set by first-sighting time until it determines the pose nearly as well as all candidates
+            cov_map = Tm.R @ cov[loose] @ Tm.R.T
+            pts_map = dst[loose]
+            center = pts_map.mean(axis=0)
+            ref = pose_std(pts_map, cov_map, center)
+            order = np.argsort(first_seen[loose], kind="stable")
+            times = np.unique(first_seen[loose])
+            for t_cut in times[times >= first_seen[old].max()]:
+                sel = order[first_seen[loose][order] <= t_cut]
+                if np.all(pose_std(pts_map[sel], cov_map[sel], center) <= max_std_factor * ref):
+                    break
+            old = loose[np.sort(sel)]
         if old.size >= 3:
             r_old = ransac((src[old], dst[old], w[old]), _fit, _residuals, 3, threshold_m, max_iters=max_iters, rng=rng)
             n_old = int(r_old.inliers.sum())

@@ -109,6 +109,8 @@ def test_policy_and_store_are_pluggable():
         slam.process(*sim.render_pair([3.0, 4.0, yaw]))
     assert slam.store is created[0]
     assert len(created[0]) > 0
+    # a class is a factory too
+    assert isinstance(StereoSLAM(rig, store=ExactStore).store, ExactStore)
     assert abs(float(wrap_angle(slam.planar_trajectory[-1, 2] - 0.05))) < np.deg2rad(1.0)
 
 

@@ -240,3 +240,40 @@ def test_oldest_policy_follows_the_old_landmarks_when_the_map_drifted():
     np.testing.assert_allclose(est_all.T, Td, atol=0.01)
     np.testing.assert_allclose(est_old.T, T, atol=0.01)
     assert est_old.inliers[:100].mean() > 0.95
+
+
+def _reference_stereo_match(fl, fr, rig, ratio=0.8, tol=2.0):
+    """OpenCV's masked 2-NN (cv2.BFMatcher.knnMatch) with the same ratio rule and right-uniqueness."""
+    xl = np.column_stack([fl.uv, np.ones(len(fl.uv))])
+    lines = xl @ rig.F.T
+    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
+    mask = (np.abs(lines[:, :2] @ fr.uv.T + lines[:, 2:3]) <= tol).astype(np.uint8)
+    norm = cv2.NORM_HAMMING if fl.binary else cv2.NORM_L2
+    best = {}
+    for m in cv2.BFMatcher(norm).knnMatch(fl.descriptors, fr.descriptors, k=2, mask=mask):
+        if m and m[0].distance < ratio * (m[1].distance if len(m) > 1 else np.inf):
+            q, t, d = m[0].queryIdx, m[0].trainIdx, m[0].distance
+            if t not in best or d < best[t][1]:
+                best[t] = (q, d)
+    pairs = sorted((q, t) for t, (q, _) in best.items())
+    return [p[0] for p in pairs], [p[1] for p in pairs]
+
+
+@pytest.mark.parametrize("detector", ["orb", "surf"])
+@pytest.mark.parametrize("rig_kind", ["rectified", "drifted", "vertical"])
+def test_stereo_match_equals_opencv_masked_knn(frame, detector, rig_kind):
+    from slamlab.geometry import StereoRig
+    from scipy.spatial.transform import Rotation
+
+    sim, left, right, *_ = frame
+    fl, fr = detect(left, detector), detect(right, detector)
+    rig = sim.rig
+    if rig_kind == "drifted":  # epipolar lines slanted: the row-sorted candidate search still applies
+        rig = StereoRig(rig.left, rig.right, Rotation.from_rotvec([0.0, 0.0, 0.01]).as_matrix() @ rig.R_rl, rig.t_rl)
+    elif rig_kind == "vertical":  # baseline along the columns: vertical lines, every pair is tested
+        rig = StereoRig(rig.left, rig.right, rig.R_rl, np.array([0.0, -0.2, 0.0]))
+    sm = stereo_match(fl, fr, rig)
+    ref_l, ref_r = _reference_stereo_match(fl, fr, rig)
+    assert len(ref_l) > 0
+    assert sm.left.tolist() == ref_l
+    assert sm.right.tolist() == ref_r
