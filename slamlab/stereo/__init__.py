@@ -2,9 +2,11 @@
 
 from .experiments import (
     SIZES,
+    DriftStudy,
     KittiRunResult,
     StereoRunResult,
     run_closed_loop,
+    run_drift_study,
     run_kitti,
     run_stereo_slam,
     run_turn_in_place,
@@ -34,6 +36,7 @@ __all__ = [
     "POLICIES",
     "SIZES",
     "STAGES",
+    "DriftStudy",
     "ExactStore",
     "Features",
     "FrameRecord",
@@ -54,6 +57,7 @@ __all__ = [
     "plot_run_map",
     "plot_triangulation",
     "run_closed_loop",
+    "run_drift_study",
     "run_figure",
     "run_kitti",
     "run_stereo_slam",

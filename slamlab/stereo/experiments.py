@@ -26,7 +26,9 @@ __all__ = [
     "SIZES",
     "KittiRunResult",
     "StereoRunResult",
+    "DriftStudy",
     "run_closed_loop",
+    "run_drift_study",
     "run_kitti",
     "run_stereo_slam",
     "run_turn_in_place",
@@ -162,25 +164,72 @@ def run_stereo_slam(
     )  # fmt: skip
 
 
-def run_turn_in_place(size: str = "small", *, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
+def _first(poses, n_frames):
+    return poses if n_frames is None else poses[: v.check_int(n_frames, "n_frames", minimum=2)]
+
+
+def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
     """360° turn in place in the 6×8 m arena, facing a wall at the start (000 §3.7.1).
 
-    ``size="small"``: 10° per frame (37 frames); ``"full"``: 5° per frame (73 frames).
+    ``size="small"``: 10° per frame (37 frames); ``"full"``: 5° per frame (73 frames);
+    ``n_frames`` keeps only the first frames (for quick checks).
     """
     v.check_choice(size, "size", SIZES)
-    poses = turn_in_place(np.deg2rad(SIZES[size][0]), center_m=(3.0, 4.0), start_yaw_rad=np.pi / 2)
+    poses = _first(turn_in_place(np.deg2rad(SIZES[size][0]), center_m=(3.0, 4.0), start_yaw_rad=np.pi / 2), n_frames)
     return run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
 
 
-def run_closed_loop(size: str = "small", *, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
+def run_closed_loop(size: str = "small", *, n_frames: int | None = None, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
     """The closed, roughly rectangular 4×5 m loop in the 6×8 m arena, back to the start pose (000 §3.7.2).
 
-    ``size="small"``: 0.5 m and 20° per frame; ``"full"``: 0.25 m and 15° per frame.
+    ``size="small"``: 0.5 m and 20° per frame (57 frames); ``"full"``: 0.25 m and 15° per frame;
+    ``n_frames`` keeps only the first frames (for quick checks).
     """
     v.check_choice(size, "size", SIZES)
     _, step_m, turn_deg = SIZES[size]
-    poses = rectangular_loop(step_m, np.deg2rad(turn_deg))
+    poses = _first(rectangular_loop(step_m, np.deg2rad(turn_deg)), n_frames)
     return run_stereo_slam(poses, name="closed loop", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
+
+
+@dataclass(frozen=True)
+class DriftStudy:
+    """Runs of one experiment at several calibration-drift levels (000 §3.2; our experiment)."""
+
+    experiment: str
+    drift_std_rad: tuple
+    runs: tuple = field(repr=False)  # StereoRunResult per level
+
+    def table(self) -> str:
+        """Errors, stereo matches and inliers per drift level (fixed precision)."""
+        rows = []
+        for d, r in zip(self.drift_std_rad, self.runs):
+            c = r.counts
+            # the random walk's typical accumulated angle at the last frame: sqrt(N) sigma per axis
+            rows.append([f"{1e3 * d:.1f}", f"{1e3 * d * np.sqrt(r.n_frames):.1f}", f"{r.pos_err_m.max():.2f}",
+                         f"{np.rad2deg(np.abs(r.yaw_err_rad).max()):.1f}", f"{np.median(c['n_stereo']):.0f}",
+                         f"{np.min(c['n_stereo']):.0f}", f"{np.median(c['n_inliers'][1:]):.0f}", f"{len(r.degenerate)}"])  # fmt: skip
+        head = ["drift, mrad/frame", "~drift at end, mrad", "max pos. err, m", "max heading err, deg",
+                "stereo matches (median)", "(min)", "inliers (median)", "degenerate"]  # fmt: skip
+        return format_table(head, rows, title=f"calibration drift of the right camera: {self.experiment} ({self.runs[0].detector})")
+
+
+def run_drift_study(
+    drift_std_rad=(0.0, 0.5e-3, 1e-3, 2e-3), experiment: str = "turn in place", size: str = "small", *, rng=0, **kwargs
+) -> DriftStudy:
+    """The same run at several calibration-drift levels (our experiment for 000 §3.2).
+
+    The right camera's orientation takes a random-walk step of ``drift_std_rad`` per axis and
+    frame while the pipeline keeps the nominal calibration; ``kwargs`` go to the run
+    (``detector``, ``policy``, ``n_frames``, ...). Every level uses the same seeds, so the level is
+    the only change.
+    """
+    runners = {"turn in place": run_turn_in_place, "closed loop": run_closed_loop}
+    v.check_choice(experiment, "experiment", runners)
+    levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
+    if min(levels) < 0:
+        raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
+    runs = tuple(runners[experiment](size, drift_std_rad=d, rng=rng, **kwargs) for d in levels)
+    return DriftStudy(experiment, levels, runs)
 
 
 @dataclass(frozen=True)

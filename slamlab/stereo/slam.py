@@ -97,6 +97,12 @@ class StereoSLAM:
         (:func:`~slamlab.stereo.stages.match_to_map`; None = plain ratio rule).
     state_var, pixel_std : the landmark filter's process variance (m²) and the pixel error that
         sets the observation covariance of a stereo point.
+    pose_std_m, pose_std_rad : uncertainty of the frame's pose added to the observation covariance
+        (``σ_t² + (σ_θ · range)²`` per axis; our addition: the observation in map coordinates carries
+        the pose error, and two nearly parallel stereo ellipsoids fused without it can throw a
+        landmark metres along its viewing ray).
+    update_gate : an inlier refines its landmark only when the innovation's squared Mahalanobis
+        distance is at most this (default: χ²₃ at 99.9 %; None = always).
     base_seen_times, max_non_base_time : 000 §3.4's base rule (3 sightings within 7 frames).
     rng : RANSAC's random stream.
 
@@ -133,6 +139,9 @@ class StereoSLAM:
         max_depth_m: float = 10.0,
         state_var: float = 1e-6,
         pixel_std: float = 0.5,
+        pose_std_m: float = 0.02,
+        pose_std_rad: float = float(np.deg2rad(0.5)),
+        update_gate: float | None = 16.27,
         base_seen_times: int = 3,
         max_non_base_time: int = 7,
         rng=None,
@@ -164,6 +173,9 @@ class StereoSLAM:
         self.max_depth_m = v.check_positive(max_depth_m, "max_depth_m")
         self.state_var = v.check_positive(state_var, "state_var", allow_zero=True)
         self.pixel_std = v.check_positive(pixel_std, "pixel_std")
+        self.pose_std_m = v.check_positive(pose_std_m, "pose_std_m", allow_zero=True)
+        self.pose_std_rad = v.check_positive(pose_std_rad, "pose_std_rad", allow_zero=True)
+        self.update_gate = None if update_gate is None else v.check_positive(update_gate, "update_gate")
         self.parallel_detect = bool(parallel_detect)
         self.rng = v.as_rng(rng)
         # landmarks (ids are row indices): position, covariance, bookkeeping
@@ -201,7 +213,7 @@ class StereoSLAM:
         times["triangulate"] = t3 - t2
         rec = FrameRecord(
             frame=self.frame, n_left=len(fl.uv), n_right=len(fr.uv), n_stereo=len(sm.left),
-            n_local=len(pts_body), n_map_matches=0, n_inliers=0, n_used=0, n_new=0, status="ok",
+            n_local=len(pts_body), n_map_matches=0, n_inliers=0, n_used=0, n_gated=0, n_new=0, status="ok",
         )  # fmt: skip
         if len(self.X) == 0:
             # first frame (or an empty map): it defines the map frame
@@ -240,8 +252,9 @@ class StereoSLAM:
         ids = mm.ids[est.inliers]
         loc = mm.local[est.inliers]
         Z = pts_body[loc] @ R.T + t
-        Rz = R @ cov_body[loc] @ R.T
-        self.X[ids], self.P[ids] = landmark_update(self.X[ids], landmark_predict(self.P[ids], self.state_var), Z, Rz)
+        pose_var = self.pose_std_m**2 + (self.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
+        Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
+        rec["n_gated"] = int((~self.refine_landmarks(ids, Z, Rz)).sum())
         self.n_seen[ids] += 1
         self.store.observe(ids)
         rec["n_inliers"] = len(ids)
@@ -253,6 +266,21 @@ class StereoSLAM:
         inl_mask[loc] = True
         self._finish(rec, times, t5, pts_body, inl_mask)
         return rec
+
+    def refine_landmarks(self, ids, Z, Rz) -> np.ndarray:
+        """Kalman-update landmarks ``ids`` with map-frame observations ``Z`` (covariances ``Rz``) (000 §3.6).
+
+        Observations whose innovation fails ``update_gate`` leave their landmark unchanged;
+        returns the mask of the updated ones.
+        """
+        P_pred = landmark_predict(self.P[ids], self.state_var)
+        ok = np.ones(len(ids), dtype=bool)
+        if self.update_gate is not None and len(ids):
+            innov = Z - self.X[ids]
+            ok = np.einsum("ni,ni->n", innov, np.linalg.solve(P_pred + Rz, innov[:, :, None])[:, :, 0]) <= self.update_gate
+        up = ids[ok]
+        self.X[up], self.P[up] = landmark_update(self.X[up], P_pred[ok], Z[ok], Rz[ok])
+        return ok
 
     def _add_landmarks(self, pts_body, cov_body, desc, T):
         R, t = T[:3, :3], T[:3, 3]

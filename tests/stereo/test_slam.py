@@ -131,3 +131,49 @@ def test_bad_input():
     slam = StereoSLAM(rig)
     with pytest.raises(ValueError, match="image"):
         slam.process(np.zeros((4, 4, 4, 4)), np.zeros((4, 4)))
+
+
+def test_calibration_drift_costs_stereo_matches():
+    from slamlab.stereo import run_drift_study
+
+    study = run_drift_study((0.0, 1e-3, 3e-3), n_frames=6, detector="orb", rng=0)
+    none, mild, strong = study.runs
+    # the right camera's random walk moves its image by ~1 px per mrad (f = 1055 px): the 2-px
+    # epipolar band keeps fewer stereo matches the stronger the drift, in every frame
+    assert np.all(mild.counts["n_stereo"] < none.counts["n_stereo"])
+    assert np.all(strong.counts["n_stereo"] < 0.5 * none.counts["n_stereo"])
+    assert len(none.degenerate) == 0 and none.pos_err_m.max() < 0.1
+    assert len(strong.degenerate) > 0  # tracking lost
+    assert "calibration drift" in study.table()
+    with pytest.raises(ValueError, match="drift_std_rad"):
+        run_drift_study((-1e-3,), n_frames=2)
+    with pytest.raises(ValueError, match="experiment"):
+        run_drift_study((0.0,), experiment="spiral")
+
+
+def test_update_gate_keeps_inconsistent_observations_from_throwing_landmarks():
+    # two stereo sightings 4 m away from viewpoints 10 deg apart: each ellipsoid is long along its ray
+    # (depth sigma 5 cm, lateral 3 mm). A 20 cm sideways disagreement (a pose error) fused without a
+    # gate moves the landmark far along the rays, much further than the disagreement itself
+    def ray_cov(direction):
+        r = np.asarray(direction, float) / np.linalg.norm(direction)
+        return 0.003**2 * np.eye(3) + (0.05**2 - 0.003**2) * np.outer(r, r)
+
+    P0 = ray_cov([1.0, 0.0, 0.0])[None]
+    R1 = ray_cov([np.cos(0.17), np.sin(0.17), 0.0])[None]
+    X0 = np.array([[4.0, 0.0, 0.0]])
+    Z_bad = X0 + [[0.0, 0.2, 0.0]]
+    Z_good = X0 + [[0.01, 0.002, 0.0]]
+    from slamlab.filters.landmark import landmark_update
+
+    X_fused, _ = landmark_update(X0, P0, Z_bad, R1)
+    assert np.linalg.norm(X_fused - X0) > 0.5  # the failure the gate prevents (0.2 m in, > 0.5 m out)
+    rig = StereoRig.parallel()
+    for gate, expect in ((16.27, [False, True]), (None, [True, True])):
+        slam = StereoSLAM(rig, update_gate=gate, pose_std_m=0.0, pose_std_rad=0.0, state_var=0.0)
+        slam.X, slam.P = np.vstack([X0, X0]), np.concatenate([P0, P0])
+        ok = slam.refine_landmarks(np.array([0, 1]), np.vstack([Z_bad, Z_good]), np.concatenate([R1, R1]))
+        assert ok.tolist() == expect
+        if gate is not None:
+            np.testing.assert_array_equal(slam.X[0], X0[0])  # untouched
+        assert np.linalg.norm(slam.X[1] - X0[0]) < 0.02  # a consistent sighting refines its landmark

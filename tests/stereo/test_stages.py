@@ -277,3 +277,41 @@ def test_stereo_match_equals_opencv_masked_knn(frame, detector, rig_kind):
     assert len(ref_l) > 0
     assert sm.left.tolist() == ref_l
     assert sm.right.tolist() == ref_r
+
+
+def test_pose_std_matches_monte_carlo_of_the_fit():
+    # isotropic point noise: the least-squares (Umeyama) pose scatter must equal pose_std's prediction
+    from scipy.spatial.transform import Rotation
+
+    from slamlab.geometry.registration import umeyama
+    from slamlab.stereo.stages import pose_std
+
+    rng = np.random.default_rng(3)
+    P = rng.uniform([-2, -1, 2], [2, 1, 6], (25, 3))
+    sigma = 0.02
+    pred = pose_std(P, np.tile(np.eye(3) * sigma**2, (len(P), 1, 1)))
+    c = P.mean(axis=0)
+    est = []
+    for _ in range(3000):
+        T = umeyama(P, P + rng.normal(0, sigma, P.shape))
+        est.append(np.r_[Rotation.from_matrix(T.R).as_rotvec(), T.R @ c + T.t - c])
+    mc = np.std(est, axis=0)
+    np.testing.assert_allclose(mc, pred, rtol=0.06)  # 3000 draws: std known to ~1.3 %
+
+
+def test_pose_std_sees_the_wall_ambiguity():
+    # a wall straight ahead, stereo-like covariance (depth sigma 20x the lateral one): yaw and
+    # sideways translation are poorly determined; adding near points at other depths fixes it
+    from slamlab.stereo.stages import pose_std
+
+    rng = np.random.default_rng(0)
+    wall = np.column_stack([rng.uniform(-1.3, 1.3, 60), rng.uniform(-0.2, 0.5, 60), np.full(60, 5.0)])
+    near = np.column_stack([rng.uniform(-0.8, 0.8, 60), rng.uniform(-0.4, 0.3, 60), rng.uniform(1.0, 3.0, 60)])
+    cov = np.diag([0.003**2, 0.003**2, 0.06**2])
+    s_wall = pose_std(wall, np.tile(cov, (60, 1, 1)), center=np.zeros(3))
+    both = np.vstack([wall, near])
+    s_both = pose_std(both, np.tile(cov, (120, 1, 1)), center=np.zeros(3))
+    assert s_wall[1] > 3 * s_both[1]  # yaw (about the camera's vertical axis)
+    assert s_wall[3] > 3 * s_both[3]  # sideways translation
+    with pytest.raises(ValueError, match="cov_map"):
+        pose_std(wall, np.eye(3))
