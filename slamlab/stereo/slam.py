@@ -88,9 +88,9 @@ class StereoSLAM:
         Hamming brute force for ORB).
     parallel_detect : detect keypoints of the two images in two threads (our addition; same
         result, about half the detection time on two cores).
-    policy : ``"all"`` (default: the pose from all RANSAC inliers) or ``"oldest"`` (000 §3.5: prefer
-        the landmarks first seen longest ago; it closes loops better but, on our full 360° turn,
-        can lock onto a wrong pose — see the Ch. 4 report; our default is the robust one).
+    policy : ``"oldest"`` (default, 000 §3.5: the pose from the landmarks first seen longest ago,
+        see :func:`~slamlab.stereo.stages.estimate_pose`; it pulls a revisited place back onto its
+        first pose) or ``"all"`` (the pose from all RANSAC inliers, to compare).
     ransac_iters : RANSAC hypotheses per frame (000: about 200).
     threshold_m, n_oldest, oldest_fraction, keep_fraction, min_inliers, ratio, epi_tol_px, max_depth_m : see the stage functions.
     same_point_m : two nearest landmarks this close count as one point in the ratio rule
@@ -125,7 +125,7 @@ class StereoSLAM:
         n_features: int = 2000,
         store=None,
         parallel_detect: bool = True,
-        policy: str = "all",
+        policy: str = "oldest",
         ransac_iters: int = 200,
         threshold_m: float = 0.1,
         n_oldest: int = 40,

@@ -431,7 +431,7 @@ def estimate_pose(
     *,
     depth_m=None,
     cov=None,
-    policy: str = "all",
+    policy: str = "oldest",
     n_oldest: int = 40,
     oldest_fraction: float = 0.5,
     keep_fraction: float = 0.5,

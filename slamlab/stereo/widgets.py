@@ -19,7 +19,7 @@ def explore_stereo_slam(**defaults):
     Each change starts a run of 15-30 s; the run button (``manual``) avoids a run per slider step.
     A bad combination prints its message instead of failing.
     """
-    d = {"experiment": "turn in place", "detector": "orb", "policy": "all", "ransac_iters": 200,
+    d = {"experiment": "turn in place", "detector": "surf", "policy": "oldest", "ransac_iters": 200,
          "noise_std": 0.0, "drift_mrad": 0.0, "rng": 0}  # fmt: skip
     d.update(defaults)
 
@@ -43,8 +43,8 @@ def explore_stereo_slam(**defaults):
         show,
         {"manual": True, "manual_name": "run"},
         experiment=widgets.Dropdown(options=["turn in place", "closed loop"], value=d["experiment"], description="experiment"),
-        detector=widgets.Dropdown(options=["orb", "sift", "surf"], value=d["detector"], description="detector"),
-        policy=widgets.Dropdown(options=["all", "oldest"], value=d["policy"], description="landmarks"),
+        detector=widgets.Dropdown(options=["surf", "orb", "sift"], value=d["detector"], description="detector"),
+        policy=widgets.Dropdown(options=["oldest", "all"], value=d["policy"], description="landmarks"),
         ransac_iters=widgets.IntSlider(value=d["ransac_iters"], min=1, max=500, step=1, description="RANSAC iterations",
                                        continuous_update=False, style=_STYLE),
         noise_std=widgets.FloatSlider(value=d["noise_std"], min=0.0, max=20.0, step=0.5, description="image noise σ [grey]",

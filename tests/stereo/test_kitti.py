@@ -29,13 +29,14 @@ def test_kitti_06_first_20_frames(shared_data):
     ref = Trajectory(gt[:, :, 3], gt[:, :, :3], t)
     ours = Trajectory(est[:, :3, 3], est[:, :3, :3], t)
     assert len(slam.degenerate_frames) == 0
-    # stated bounds (the car drives 22.7 m): we measured ATE 0.49 m unaligned / 0.30 m after SE(3),
-    # RPE 0.31 m per frame, final error 1.05 m (4.6 %)
-    assert ate(ref, ours, align="none").rmse < 0.8
-    assert ate(ref, ours, align="se3").rmse < 0.5
-    assert rpe(ref, ours, delta=1).rmse < 0.5
+    # stated bounds (the car drives 22.7 m), about twice what we measured with the defaults (our SURF,
+    # multi kd-tree, oldest-landmark policy; seed 0): ATE 0.18 m unaligned / 0.10 m after SE(3),
+    # RPE 0.14 m per frame, final error 0.10 m (0.45 %); ORB measured 0.66 / 0.32 / 0.35 / 1.17 m
+    assert ate(ref, ours, align="none").rmse < 0.35
+    assert ate(ref, ours, align="se3").rmse < 0.2
+    assert rpe(ref, ours, delta=1).rmse < 0.3
     final_err = np.linalg.norm(est[-1, :3, 3] - gt[-1, :, 3])
-    assert final_err < 0.1 * np.linalg.norm(gt[-1, :, 3])
+    assert final_err < 0.03 * np.linalg.norm(gt[-1, :, 3])
 
 
 @pytest.mark.realdata
@@ -45,6 +46,6 @@ def test_run_kitti_matches_the_manual_loop(shared_data):
     res = run_kitti(shared_data / "kitti-odometry-06-stereo")
     assert res.n_degenerate == 0
     assert res.path_length_m == pytest.approx(22.7, abs=0.1)
-    assert res.ate_se3_m < 0.5
-    assert res.final_error_m < 0.1 * res.path_length_m
+    assert res.ate_se3_m < 0.2
+    assert res.final_error_m < 0.03 * res.path_length_m
     assert "KITTI" in res.table()
