@@ -8,7 +8,9 @@ from .experiments import (
     run_closed_loop,
     run_drift_study,
     run_kitti,
+    run_policy_comparison,
     run_stereo_slam,
+    run_stereo_slam_variants,
     run_turn_in_place,
 )
 from .plot import plot_frame_stages, plot_run_errors, plot_run_map, plot_triangulation, run_figure
@@ -60,7 +62,9 @@ __all__ = [
     "run_drift_study",
     "run_figure",
     "run_kitti",
+    "run_policy_comparison",
     "run_stereo_slam",
+    "run_stereo_slam_variants",
     "run_turn_in_place",
     "select_oldest",
     "stereo_match",

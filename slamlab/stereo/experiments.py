@@ -21,6 +21,7 @@ from ..geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
 from ..sim.arena import StereoArena, StereoSim
 from ..sim.stereo_paths import rectangular_loop, turn_in_place
 from .slam import STAGES, StereoSLAM
+from .stages import POLICIES
 
 __all__ = [
     "SIZES",
@@ -30,7 +31,9 @@ __all__ = [
     "run_closed_loop",
     "run_drift_study",
     "run_kitti",
+    "run_policy_comparison",
     "run_stereo_slam",
+    "run_stereo_slam_variants",
     "run_turn_in_place",
 ]
 
@@ -135,37 +138,74 @@ def run_stereo_slam(
     The map frame is the first body pose; truth is expressed in it. ``slam_kwargs`` go to
     :class:`StereoSLAM` (``detector``, ``policy``, ``ransac_iters``, ...).
     """
+    return run_stereo_slam_variants(
+        poses, {"run": slam_kwargs}, name=name, arena=arena, rig=rig, camera_height_m=camera_height_m,
+        noise_std=noise_std, drift_std_rad=drift_std_rad, progress=progress, rng=rng,
+    )["run"]  # fmt: skip
+
+
+def run_stereo_slam_variants(
+    poses,
+    variants: dict,
+    *,
+    name: str = "run",
+    arena: StereoArena | None = None,
+    rig: StereoRig | None = None,
+    camera_height_m: float = 0.4,
+    noise_std: float = 0.0,
+    drift_std_rad: float = 0.0,
+    progress=None,
+    rng=0,
+) -> dict:
+    """Like :func:`run_stereo_slam`, for several :class:`StereoSLAM` settings on the same rendered frames.
+
+    ``variants`` maps a label to the ``StereoSLAM`` keyword arguments of one run; every run gets the
+    same RANSAC seed, so each result equals a separate :func:`run_stereo_slam` call. The frames are
+    rendered once (rendering costs about as much as our SURF).
+    """
     poses = v.as_finite_array(poses, "poses", ndim=2)
     if poses.shape[1] != 3 or len(poses) < 2:
         raise ValueError(f"`poses` must have shape (N, 3) with N >= 2; got {poses.shape}")
+    if not isinstance(variants, dict) or not variants:
+        raise TypeError("`variants` must be a non-empty dict of label -> StereoSLAM keyword arguments")
     r_sim, r_slam = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(2)
     arena = StereoArena() if arena is None else arena
     sim = StereoSim(arena, rig, camera_height_m=camera_height_m, noise_std=noise_std, drift_std_rad=drift_std_rad, rng=np.random.default_rng(r_sim))
-    slam = StereoSLAM(sim.rig, sim.T_body_left, rng=np.random.default_rng(r_slam), **slam_kwargs)
+    slams = {k: StereoSLAM(sim.rig, sim.T_body_left, rng=np.random.default_rng(r_slam), **kw) for k, kw in variants.items()}
     T0_inv = se3_inverse(se3_from_planar(*poses[0]))
     truth = np.array([planar_from_se3(T0_inv @ se3_from_planar(*p)) for p in poses])
     truth[:, 2] = poses[:, 2] - poses[0, 2]
-    t_slam = 0.0
+    t_slam = dict.fromkeys(slams, 0.0)
     for i, p in enumerate(poses):
         left, right = sim.render_pair(p)
-        t = time.perf_counter()
-        slam.process(left, right)
-        t_slam += time.perf_counter() - t
+        for k, slam in slams.items():
+            t = time.perf_counter()
+            slam.process(left, right)
+            t_slam[k] += time.perf_counter() - t
         if progress is not None:
             progress(i)
-    est = slam.planar_trajectory
-    pos_err = np.hypot(*(est[:, :2] - truth[:, :2]).T)
-    yaw_err = wrap_angle(est[:, 2] - truth[:, 2])
-    return StereoRunResult(
-        name=name, detector=slam.detector, policy=slam.policy, n_frames=len(poses), truth=truth, estimate=est,
-        pos_err_m=pos_err, yaw_err_rad=np.asarray(yaw_err), counts=slam.counts(),
-        landmarks_xy=slam.landmark_map()[:, :2], degenerate=slam.degenerate_frames,
-        stage_time_s=slam.stage_times(), fps=len(poses) / t_slam,
-    )  # fmt: skip
+    out = {}
+    for k, slam in slams.items():
+        est = slam.planar_trajectory
+        out[k] = StereoRunResult(
+            name=name, detector=slam.detector, policy=slam.policy, n_frames=len(poses), truth=truth, estimate=est,
+            pos_err_m=np.hypot(*(est[:, :2] - truth[:, :2]).T), yaw_err_rad=np.asarray(wrap_angle(est[:, 2] - truth[:, 2])),
+            counts=slam.counts(), landmarks_xy=slam.landmark_map()[:, :2], degenerate=slam.degenerate_frames,
+            stage_time_s=slam.stage_times(), fps=len(poses) / t_slam[k],
+        )  # fmt: skip
+    return out
 
 
 def _first(poses, n_frames):
     return poses if n_frames is None else poses[: v.check_int(n_frames, "n_frames", minimum=2)]
+
+
+def _poses(experiment: str, size: str) -> np.ndarray:
+    """Body poses of the turn in place or the closed loop at ``size`` (000 §3.7)."""
+    turn_deg, step_m, loop_turn_deg = SIZES[size]
+    if experiment == "turn in place":
+        return turn_in_place(np.deg2rad(turn_deg), center_m=(3.0, 4.0), start_yaw_rad=np.pi / 2)
+    return rectangular_loop(step_m, np.deg2rad(loop_turn_deg))
 
 
 def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
@@ -175,7 +215,7 @@ def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, arena
     ``n_frames`` keeps only the first frames (for quick checks).
     """
     v.check_choice(size, "size", SIZES)
-    poses = _first(turn_in_place(np.deg2rad(SIZES[size][0]), center_m=(3.0, 4.0), start_yaw_rad=np.pi / 2), n_frames)
+    poses = _first(_poses("turn in place", size), n_frames)
     return run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
 
 
@@ -186,9 +226,28 @@ def run_closed_loop(size: str = "small", *, n_frames: int | None = None, arena_s
     ``n_frames`` keeps only the first frames (for quick checks).
     """
     v.check_choice(size, "size", SIZES)
-    _, step_m, turn_deg = SIZES[size]
-    poses = _first(rectangular_loop(step_m, np.deg2rad(turn_deg)), n_frames)
+    poses = _first(_poses("closed loop", size), n_frames)
     return run_stereo_slam(poses, name="closed loop", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
+
+
+def run_policy_comparison(
+    experiment: str = "closed loop", size: str = "small", *, policies=("oldest", "all"), n_frames: int | None = None,
+    arena_seed: int = 0, rng=0, **kwargs,
+) -> tuple:
+    """The turn or the loop once per landmark policy, on the same rendered frames (000 §3.5).
+
+    Returns one :class:`StereoRunResult` per policy, in the order of ``policies``; ``kwargs`` go
+    to the run (``detector``, ``noise_std``, ...).
+    """
+    v.check_choice(size, "size", SIZES)
+    runs = {"turn in place": "turn", "closed loop": "loop"}
+    v.check_choice(experiment, "experiment", runs)
+    sim_keys = ("rig", "camera_height_m", "noise_std", "drift_std_rad", "progress")
+    sim_kw = {k: kwargs.pop(k) for k in sim_keys if k in kwargs}
+    poses = _first(_poses(experiment, size), n_frames)
+    variants = {p: {**kwargs, "policy": v.check_choice(p, "policy", POLICIES)} for p in policies}
+    res = run_stereo_slam_variants(poses, variants, name=experiment, arena=StereoArena(seed=arena_seed), rng=rng, **sim_kw)
+    return tuple(res[p] for p in policies)
 
 
 @dataclass(frozen=True)

@@ -177,3 +177,19 @@ def test_update_gate_keeps_inconsistent_observations_from_throwing_landmarks():
         if gate is not None:
             np.testing.assert_array_equal(slam.X[0], X0[0])  # untouched
         assert np.linalg.norm(slam.X[1] - X0[0]) < 0.02  # a consistent sighting refines its landmark
+
+
+def test_variants_on_shared_frames_equal_separate_runs(short_turn):
+    from slamlab.stereo import run_policy_comparison, run_stereo_slam_variants
+
+    poses, res = short_turn
+    both = run_stereo_slam_variants(poses, {"a": {}, "b": {"policy": "all"}}, name="turn in place", arena=StereoArena(seed=0), rng=0)
+    np.testing.assert_array_equal(both["a"].estimate, res.estimate)
+    alone = run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=0), rng=0, policy="all")
+    np.testing.assert_array_equal(both["b"].estimate, alone.estimate)
+    old, al = run_policy_comparison("turn in place", n_frames=3, detector="orb")
+    assert (old.policy, al.policy, old.n_frames) == ("oldest", "all", 3)
+    with pytest.raises(TypeError, match="variants"):
+        run_stereo_slam_variants(poses, {})
+    with pytest.raises(ValueError, match="policy"):
+        run_policy_comparison(policies=("newest",), n_frames=2)
