@@ -8,8 +8,12 @@ exceed wall time). Two stages are also timed against an OpenCV reference in the 
 process: midpoint triangulation vs ``cv2.triangulatePoints`` (DLT) and the exact store
 query vs ``cv2.BFMatcher.knnMatch``.
 
-    python benchmarks/bench_stereo.py                    # 30 frames, ORB and SIFT
-    python benchmarks/bench_stereo.py --frames 73 --long # + the ~80 m run of 000 §4.2 (slow)
+    python benchmarks/bench_stereo.py                    # 30 frames, ORB, SIFT and our SURF
+    python benchmarks/bench_stereo.py --drift            # + calibration drift on the loop (SURF, ~2 min)
+    python benchmarks/bench_stereo.py --long             # + the ~80 m run of 000 §4.2 (slow)
+
+Every run uses the pipeline's defaults (oldest-landmark policy; store: multi kd-tree for SURF/SIFT,
+exact Hamming brute force for ORB; the two images detected in two threads).
 """
 
 from __future__ import annotations
@@ -50,7 +54,8 @@ def run_pipeline(frames, sim, detector):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--frames", type=int, default=30)
-    ap.add_argument("--detectors", default="orb,sift")
+    ap.add_argument("--detectors", default="orb,sift,surf")
+    ap.add_argument("--drift", action="store_true", help="also run the calibration-drift study on the small loop")
     ap.add_argument("--long", action="store_true", help="also run the ~80 m path in the 10x12 m room")
     ap.add_argument("--markdown", default=None, help="write the tables to this file")
     args = ap.parse_args(argv)
@@ -79,7 +84,7 @@ def main(argv=None):
     say()
     # stage micro-benchmarks against OpenCV, on one frame
     left, right = frames[len(frames) // 2]
-    fl, fr = detect(left), detect(right)
+    fl, fr = detect(left, "orb"), detect(right, "orb")
     sm = stereo_match(fl, fr, sim.rig)
     cloud = triangulate_local(sim.rig, fl, fr, sm)
     uvl, uvr = fl.uv[sm.left], fr.uv[sm.right]
@@ -97,13 +102,28 @@ def main(argv=None):
     say("|---|---|---|---|")
     say(f"| midpoint triangulation, {len(uvl)} matches (vs cv2.triangulatePoints) | {1000 * t_ours:.2f} | {1000 * t_cv:.2f} | {t_ours / t_cv:.2f} |")
     say(f"| exact store 2-NN, {len(Q)} queries x {len(store)} landmarks (vs BFMatcher.knnMatch) | {1000 * t_store:.1f} | {1000 * t_bf:.1f} | {t_store / t_bf:.2f} |")
+    if args.drift:
+        say()
+        study = sl.stereo.run_drift_study((0.0, 0.2e-3, 0.5e-3, 1e-3, 2e-3), "closed loop", rng=0)
+        say("```")
+        say(study.table())
+        say("```")
     if args.long:
         say()
         room = sl.sim.StereoArena(10.0, 12.0, seed=0)
         path = sl.sim.long_path(0.25, np.deg2rad(15.0))
-        t0 = time.perf_counter()
-        res = sl.stereo.run_stereo_slam(path, name="long path", arena=room, rng=0)
-        say(f"long path (~80 m, {len(path)} frames): {res}; SLAM {res.fps:.2f} frames/s; total {time.perf_counter() - t0:.0f} s")
+        length_m = float(np.sum(np.hypot(*np.diff(path[:, :2], axis=0).T)))
+        for det in args.detectors.split(","):
+            t0 = time.perf_counter()
+            runs = sl.stereo.run_stereo_slam_variants(
+                path, {"oldest": {"detector": det}, "all": {"detector": det, "policy": "all"}}, name="long path", arena=room, rng=0
+            )
+            for label, res in runs.items():
+                say(f"long path ({length_m:.0f} m, {len(path)} frames), {det}, policy {label}: max position error "
+                    f"{res.pos_err_m.max():.2f} m, final {res.pos_err_m[-1]:.2f} m, max heading error "
+                    f"{np.rad2deg(np.abs(res.yaw_err_rad).max()):.1f} deg, {len(res.degenerate)} degenerate frames; "
+                    f"SLAM {res.fps:.2f} frames/s")  # fmt: skip
+            say(f"  ({time.perf_counter() - t0:.0f} s for both runs incl. rendering)")
     if args.markdown:
         with open(args.markdown, "w") as f:
             f.write("\n".join(out) + "\n")

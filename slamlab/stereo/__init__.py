@@ -1,14 +1,17 @@
 """Stereo SLAM (000 §3): per-frame stages, landmark store interface, the SLAM loop."""
 
 from .experiments import (
+    COMPARISON,
     SIZES,
     DriftStudy,
     KittiRunResult,
     StereoRunResult,
+    comparison_table,
+    experiment_poses,
     run_closed_loop,
+    run_comparison,
     run_drift_study,
     run_kitti,
-    run_policy_comparison,
     run_stereo_slam,
     run_stereo_slam_variants,
     run_turn_in_place,
@@ -34,6 +37,7 @@ from .store import ExactStore, check_store
 from .widgets import explore_stereo_slam
 
 __all__ = [
+    "COMPARISON",
     "DETECTORS",
     "POLICIES",
     "SIZES",
@@ -50,8 +54,10 @@ __all__ = [
     "StereoRunResult",
     "StereoSLAM",
     "check_store",
+    "comparison_table",
     "detect",
     "estimate_pose",
+    "experiment_poses",
     "explore_stereo_slam",
     "match_to_map",
     "plot_frame_stages",
@@ -59,10 +65,10 @@ __all__ = [
     "plot_run_map",
     "plot_triangulation",
     "run_closed_loop",
+    "run_comparison",
     "run_drift_study",
     "run_figure",
     "run_kitti",
-    "run_policy_comparison",
     "run_stereo_slam",
     "run_stereo_slam_variants",
     "run_turn_in_place",

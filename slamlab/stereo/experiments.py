@@ -21,17 +21,19 @@ from ..geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
 from ..sim.arena import StereoArena, StereoSim
 from ..sim.stereo_paths import rectangular_loop, turn_in_place
 from .slam import STAGES, StereoSLAM
-from .stages import POLICIES
 
 __all__ = [
+    "COMPARISON",
     "SIZES",
+    "DriftStudy",
     "KittiRunResult",
     "StereoRunResult",
-    "DriftStudy",
+    "comparison_table",
+    "experiment_poses",
     "run_closed_loop",
+    "run_comparison",
     "run_drift_study",
     "run_kitti",
-    "run_policy_comparison",
     "run_stereo_slam",
     "run_stereo_slam_variants",
     "run_turn_in_place",
@@ -200,8 +202,10 @@ def _first(poses, n_frames):
     return poses if n_frames is None else poses[: v.check_int(n_frames, "n_frames", minimum=2)]
 
 
-def _poses(experiment: str, size: str) -> np.ndarray:
-    """Body poses of the turn in place or the closed loop at ``size`` (000 §3.7)."""
+def experiment_poses(experiment: str, size: str = "small") -> np.ndarray:
+    """Body poses ``(N, 3)`` of the turn in place or the closed loop at ``size`` (000 §3.7)."""
+    v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
+    v.check_choice(size, "size", SIZES)
     turn_deg, step_m, loop_turn_deg = SIZES[size]
     if experiment == "turn in place":
         return turn_in_place(np.deg2rad(turn_deg), center_m=(3.0, 4.0), start_yaw_rad=np.pi / 2)
@@ -215,7 +219,7 @@ def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, arena
     ``n_frames`` keeps only the first frames (for quick checks).
     """
     v.check_choice(size, "size", SIZES)
-    poses = _first(_poses("turn in place", size), n_frames)
+    poses = _first(experiment_poses("turn in place", size), n_frames)
     return run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
 
 
@@ -226,28 +230,53 @@ def run_closed_loop(size: str = "small", *, n_frames: int | None = None, arena_s
     ``n_frames`` keeps only the first frames (for quick checks).
     """
     v.check_choice(size, "size", SIZES)
-    poses = _first(_poses("closed loop", size), n_frames)
+    poses = _first(experiment_poses("closed loop", size), n_frames)
     return run_stereo_slam(poses, name="closed loop", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
 
 
-def run_policy_comparison(
-    experiment: str = "closed loop", size: str = "small", *, policies=("oldest", "all"), n_frames: int | None = None,
-    arena_seed: int = 0, rng=0, **kwargs,
-) -> tuple:
-    """The turn or the loop once per landmark policy, on the same rendered frames (000 §3.5).
+#: the default comparison of :func:`run_comparison`: 000's pipeline, and ORB with and without §3.5's policy
+COMPARISON = {
+    "SURF, oldest": {},
+    "ORB, oldest": {"detector": "orb"},
+    "ORB, all": {"detector": "orb", "policy": "all"},
+}
 
-    Returns one :class:`StereoRunResult` per policy, in the order of ``policies``; ``kwargs`` go
-    to the run (``detector``, ``noise_std``, ...).
+
+def run_comparison(
+    experiment: str = "closed loop", size: str = "small", variants: dict | None = None, *, n_frames: int | None = None,
+    arena_seed: int = 0, rng=0, **sim_kwargs,
+) -> dict:
+    """The turn or the loop once per pipeline setting, on the same rendered frames (000 §3.5, §3.7).
+
+    ``variants`` maps a label to :class:`StereoSLAM` keyword arguments (default :data:`COMPARISON`);
+    ``sim_kwargs`` go to the renderer (``noise_std``, ``drift_std_rad``, ``camera_height_m``, ``progress``).
+    Returns label -> :class:`StereoRunResult`; :func:`comparison_table` prints them side by side.
     """
     v.check_choice(size, "size", SIZES)
-    runs = {"turn in place": "turn", "closed loop": "loop"}
-    v.check_choice(experiment, "experiment", runs)
-    sim_keys = ("rig", "camera_height_m", "noise_std", "drift_std_rad", "progress")
-    sim_kw = {k: kwargs.pop(k) for k in sim_keys if k in kwargs}
-    poses = _first(_poses(experiment, size), n_frames)
-    variants = {p: {**kwargs, "policy": v.check_choice(p, "policy", POLICIES)} for p in policies}
-    res = run_stereo_slam_variants(poses, variants, name=experiment, arena=StereoArena(seed=arena_seed), rng=rng, **sim_kw)
-    return tuple(res[p] for p in policies)
+    v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
+    poses = _first(experiment_poses(experiment, size), n_frames)
+    return run_stereo_slam_variants(poses, COMPARISON if variants is None else variants, name=experiment,
+                                    arena=StereoArena(seed=arena_seed), rng=rng, **sim_kwargs)  # fmt: skip
+
+
+def comparison_table(results: dict) -> str:
+    """000's figures for the turn or the loop, one column per run of :func:`run_comparison`."""
+    runs = list(results.values())
+    if not runs:
+        raise ValueError("`results` is empty")
+    deg = np.rad2deg
+    rows = [["max position error, m", *(f"{r.pos_err_m.max():.2f}" for r in runs)]]
+    if runs[0].name == "turn in place":
+        rows.append(["spread of positions, m", *(f"{r.position_spread_m:.2f}" for r in runs)])
+        rows.append(["heading error at 180 deg, deg", *(f"{deg(abs(r.yaw_err_rad[r.frame_at_turn(np.pi)])):.1f}" for r in runs)])
+        rows.append(["heading error back at 0 deg, deg", *(f"{deg(abs(r.yaw_err_rad[-1])):.1f}" for r in runs)])
+    else:
+        rows.append(["max heading error / turned angle, %", *(f"{100 * r.heading_error_ratio:.1f}" for r in runs)])
+        rows.append(["revisit: pose change, m", *(f"{r.revisit_difference[0]:.2f}" for r in runs)])
+        rows.append(["revisit: heading change, deg", *(f"{deg(abs(r.revisit_difference[1])):.1f}" for r in runs)])
+    rows.append(["degenerate frames", *(f"{len(r.degenerate)}" for r in runs)])
+    rows.append(["RANSAC inliers per frame (median)", *(f"{np.median(r.counts['n_inliers'][1:]):.0f}" for r in runs)])
+    return format_table(["quantity", *results], rows, title=f"{runs[0].name}, {runs[0].n_frames} frames")
 
 
 @dataclass(frozen=True)
@@ -261,7 +290,7 @@ class DriftStudy:
     def table(self) -> str:
         """Errors, stereo matches and inliers per drift level (fixed precision)."""
         rows = []
-        for d, r in zip(self.drift_std_rad, self.runs):
+        for d, r in zip(self.drift_std_rad, self.runs, strict=True):
             c = r.counts
             # the random walk's typical accumulated angle at the last frame: sqrt(N) sigma per axis
             rows.append([f"{1e3 * d:.1f}", f"{1e3 * d * np.sqrt(r.n_frames):.1f}", f"{r.pos_err_m.max():.2f}",

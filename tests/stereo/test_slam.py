@@ -53,7 +53,8 @@ def test_same_frame_twice_gives_identity_and_base_landmarks():
     assert rec.n_base == rec.n_inliers
     assert len(slam.landmark_map()) == rec.n_base
     # the default store is 000's: the multi kd-tree behind the non-base buffer (float descriptors)
-    assert isinstance(slam.store, NonBaseBuffer) and isinstance(slam.store.base, MultiKDTree)
+    assert isinstance(slam.store, NonBaseBuffer)
+    assert isinstance(slam.store.base, MultiKDTree)
     assert len(slam.store.base) == rec.n_base
 
 
@@ -142,7 +143,8 @@ def test_calibration_drift_costs_stereo_matches():
     # epipolar band keeps fewer stereo matches the stronger the drift, in every frame
     assert np.all(mild.counts["n_stereo"] < none.counts["n_stereo"])
     assert np.all(strong.counts["n_stereo"] < 0.5 * none.counts["n_stereo"])
-    assert len(none.degenerate) == 0 and none.pos_err_m.max() < 0.1
+    assert len(none.degenerate) == 0
+    assert none.pos_err_m.max() < 0.1
     assert len(strong.degenerate) > 0  # tracking lost
     assert "calibration drift" in study.table()
     with pytest.raises(ValueError, match="drift_std_rad"):
@@ -162,8 +164,8 @@ def test_update_gate_keeps_inconsistent_observations_from_throwing_landmarks():
     P0 = ray_cov([1.0, 0.0, 0.0])[None]
     R1 = ray_cov([np.cos(0.17), np.sin(0.17), 0.0])[None]
     X0 = np.array([[4.0, 0.0, 0.0]])
-    Z_bad = X0 + [[0.0, 0.2, 0.0]]
-    Z_good = X0 + [[0.01, 0.002, 0.0]]
+    Z_bad = X0 + np.array([[0.0, 0.2, 0.0]])
+    Z_good = X0 + np.array([[0.01, 0.002, 0.0]])
     from slamlab.filters.landmark import landmark_update
 
     X_fused, _ = landmark_update(X0, P0, Z_bad, R1)
@@ -180,16 +182,21 @@ def test_update_gate_keeps_inconsistent_observations_from_throwing_landmarks():
 
 
 def test_variants_on_shared_frames_equal_separate_runs(short_turn):
-    from slamlab.stereo import run_policy_comparison, run_stereo_slam_variants
+    from slamlab.stereo import comparison_table, run_comparison, run_stereo_slam_variants
 
     poses, res = short_turn
     both = run_stereo_slam_variants(poses, {"a": {}, "b": {"policy": "all"}}, name="turn in place", arena=StereoArena(seed=0), rng=0)
     np.testing.assert_array_equal(both["a"].estimate, res.estimate)
     alone = run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=0), rng=0, policy="all")
     np.testing.assert_array_equal(both["b"].estimate, alone.estimate)
-    old, al = run_policy_comparison("turn in place", n_frames=3, detector="orb")
-    assert (old.policy, al.policy, old.n_frames) == ("oldest", "all", 3)
+    cmp = run_comparison("turn in place", n_frames=3)
+    assert [(r.detector, r.policy, r.n_frames) for r in cmp.values()] == [("surf", "oldest", 3), ("orb", "oldest", 3), ("orb", "all", 3)]
+    table = comparison_table(cmp)
+    assert "ORB, all" in table
+    assert "heading error back at 0 deg" in table
     with pytest.raises(TypeError, match="variants"):
         run_stereo_slam_variants(poses, {})
     with pytest.raises(ValueError, match="policy"):
-        run_policy_comparison(policies=("newest",), n_frames=2)
+        run_comparison(variants={"x": {"policy": "newest"}}, n_frames=2)
+    with pytest.raises(ValueError, match="experiment"):
+        run_comparison("spiral")

@@ -50,7 +50,7 @@ def test_detect_orb_and_sift(frame):
 
 # SURF's large-scale blobs straddle depth edges (fence top against the floor behind), so a few more of
 # its points miss the surface pixel they are compared with (measured 0.94 against ORB's 0.996)
-@pytest.mark.parametrize("detector, n_min, within", [("orb", 500, 0.95), ("surf", 300, 0.90)])
+@pytest.mark.parametrize(("detector", "n_min", "within"), [("orb", 500, 0.95), ("surf", 300, 0.90)])
 def test_stereo_matches_and_triangulation_against_the_renderer(frame, detector, n_min, within):
     sim, left, right, T, pts = frame
     fl, fr = detect(left, detector), detect(right, detector)
@@ -262,8 +262,9 @@ def _reference_stereo_match(fl, fr, rig, ratio=0.8, tol=2.0):
 @pytest.mark.parametrize("detector", ["orb", "surf"])
 @pytest.mark.parametrize("rig_kind", ["rectified", "drifted", "vertical"])
 def test_stereo_match_equals_opencv_masked_knn(frame, detector, rig_kind):
-    from slamlab.geometry import StereoRig
     from scipy.spatial.transform import Rotation
+
+    from slamlab.geometry import StereoRig
 
     sim, left, right, *_ = frame
     fl, fr = detect(left, detector), detect(right, detector)
