@@ -86,6 +86,10 @@ class StereoSLAM:
     store : a landmark store with the interface of :mod:`slamlab.stereo.store`, or a factory
         returning one; default :func:`default_store` (multi kd-tree for SURF/SIFT, exact
         Hamming brute force for ORB).
+    view_margin_deg : match only the landmarks in front of the last pose's left camera, within its
+        horizontal field of view widened by this angle on each side and ``1.5 max_depth_m`` (our
+        addition, for long runs: with the exact store the query then grows with the visible part
+        of the map, not the whole map); None (default) searches the whole map, as 000 does.
     parallel_detect : detect keypoints of the two images in two threads (our addition; same
         result, about half the detection time on two cores).
     policy : ``"oldest"`` (default, 000 §3.5: the pose from the landmarks first seen longest ago,
@@ -124,6 +128,7 @@ class StereoSLAM:
         detector: str = "surf",
         n_features: int = 2000,
         store=None,
+        view_margin_deg: float | None = None,
         parallel_detect: bool = True,
         policy: str = "oldest",
         ransac_iters: int = 200,
@@ -177,6 +182,7 @@ class StereoSLAM:
         self.pose_std_rad = v.check_positive(pose_std_rad, "pose_std_rad", allow_zero=True)
         self.update_gate = None if update_gate is None else v.check_positive(update_gate, "update_gate")
         self.parallel_detect = bool(parallel_detect)
+        self.view_margin_deg = None if view_margin_deg is None else v.check_positive(view_margin_deg, "view_margin_deg", allow_zero=True)
         self.rng = v.as_rng(rng)
         # landmarks (ids are row indices): position, covariance, bookkeeping
         self.X = np.empty((0, 3))
@@ -225,7 +231,8 @@ class StereoSLAM:
                 rec["status"] = "too_few_points"
             self._finish(rec, times, t3, pts_body, np.zeros(len(pts_body), bool))
             return rec
-        mm = match_to_map(desc, self.store, ratio=self.map_ratio, positions=self.X, same_point_m=self.same_point_m)
+        cand = None if self.view_margin_deg is None else self.landmarks_in_view(self.view_margin_deg)
+        mm = match_to_map(desc, self.store, ratio=self.map_ratio, positions=self.X, same_point_m=self.same_point_m, candidates=cand)
         t4 = clock()
         times["map_match"] = t4 - t3
         rec["n_map_matches"] = len(mm.local)
@@ -266,6 +273,19 @@ class StereoSLAM:
         inl_mask[loc] = True
         self._finish(rec, times, t5, pts_body, inl_mask)
         return rec
+
+    def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
+        """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
+        within its horizontal field of view widened by ``margin_deg`` per side and ``1.5 max_depth_m``."""
+        T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
+        T_wc = T @ self.T_body_left
+        Xc = (self.X - T_wc[:3, 3]) @ T_wc[:3, :3]
+        cam = self.rig.left
+        half = np.arctan2(max(cam.cx, cam.width_px - cam.cx), cam.fx) + np.deg2rad(margin_deg)
+        z = Xc[:, 2]
+        keep = self.alive & (z > 0) & (np.abs(np.arctan2(Xc[:, 0], z)) <= half)
+        keep &= np.einsum("ij,ij->i", Xc, Xc) <= (1.5 * self.max_depth_m) ** 2
+        return np.flatnonzero(keep)
 
     def refine_landmarks(self, ids, Z, Rz) -> np.ndarray:
         """Kalman-update landmarks ``ids`` with map-frame observations ``Z`` (covariances ``Rz``) (000 §3.6).

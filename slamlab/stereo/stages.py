@@ -302,6 +302,7 @@ def match_to_map(
     max_distance: float | None = None,
     positions=None,
     same_point_m: float | None = None,
+    candidates=None,
 ) -> MapMatches:
     """Match local descriptors to the stored landmarks: 2-NN query + ratio rule, one local per landmark (000 §3.4).
 
@@ -310,6 +311,10 @@ def match_to_map(
     added when a sighting was missed), so the ratio rule does not reject them (our addition:
     without it, duplicates make every later sighting of a place ambiguous and the map stops
     closing loops).
+
+    With ``candidates`` (landmark ids), only those landmarks may match: a store with a
+    ``query_among`` method (:class:`~slamlab.stereo.store.ExactStore`) searches just them; with any
+    other store the nearest neighbour must be one of them.
 
     >>> from slamlab.stereo.store import ExactStore
     >>> s = ExactStore(); s.add(np.array([[0.0, 0.0], [5.0, 0.0]]), [7, 8])
@@ -324,10 +329,16 @@ def match_to_map(
     k = D.shape[0]
     if k == 0 or len(store) == 0:
         return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k))
-    dist, ids = store.query(D, k=2)
+    cand = None if candidates is None else np.asarray(candidates, dtype=np.int64).ravel()
+    if cand is not None and callable(getattr(store, "query_among", None)):
+        dist, ids = store.query_among(D, cand, k=2)
+    else:
+        dist, ids = store.query(D, k=2)
     dist = np.asarray(dist, dtype=float)
     ids = np.asarray(ids)
     ok = (ids[:, 0] >= 0) & (dist[:, 0] < ratio * dist[:, 1])
+    if cand is not None:
+        ok &= np.isin(ids[:, 0], cand)
     if positions is not None and same_point_m is not None:
         X = v.as_finite_array(positions, "positions", ndim=2)
         same_point_m = v.check_positive(same_point_m, "same_point_m")

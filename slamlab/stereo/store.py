@@ -119,17 +119,28 @@ class ExactStore:
         """The ``k`` nearest stored descriptors of each row of ``Q``: ``(dist (M, k), ids (M, k))``."""
         k = v.check_int(k, "k", minimum=1)
         Q = self._check(Q, "Q")
+        return self._knn(Q, self.X, self.ids, k)
+
+    def query_among(self, Q, among, k: int = 2) -> tuple[np.ndarray, np.ndarray]:
+        """Like :meth:`query`, searching only the stored landmarks whose ids are in ``among``."""
+        k = v.check_int(k, "k", minimum=1)
+        Q = self._check(Q, "Q")
+        rows = np.isin(self.ids, np.asarray(among, dtype=np.int64).ravel())
+        return self._knn(Q, None if self.X is None else self.X[rows], self.ids[rows], k)
+
+    @staticmethod
+    def _knn(Q, X, X_ids, k):
         m = Q.shape[0]
         dist = np.full((m, k), np.inf)
         ids = np.full((m, k), -1, dtype=np.int64)
-        if m == 0 or len(self) == 0:
+        if m == 0 or X is None or len(X_ids) == 0:
             return dist, ids
         if Q.dtype == np.uint8:
-            d, nidx = cv2.batchDistance(Q, self.X, cv2.CV_32S, normType=cv2.NORM_HAMMING, K=min(k, len(self)))
+            d, nidx = cv2.batchDistance(Q, X, cv2.CV_32S, normType=cv2.NORM_HAMMING, K=min(k, len(X_ids)))
         else:
-            d, nidx = cv2.batchDistance(Q, self.X, cv2.CV_32F, normType=cv2.NORM_L2, K=min(k, len(self)))
+            d, nidx = cv2.batchDistance(Q, X, cv2.CV_32F, normType=cv2.NORM_L2, K=min(k, len(X_ids)))
         kk = nidx.shape[1]
         ok = nidx >= 0
         dist[:, :kk] = np.where(ok, d, np.inf)
-        ids[:, :kk] = np.where(ok, self.ids[np.maximum(nidx, 0)], -1)
+        ids[:, :kk] = np.where(ok, X_ids[np.maximum(nidx, 0)], -1)
         return dist, ids

@@ -347,3 +347,46 @@ def test_oldest_policy_grows_an_ill_conditioned_oldest_set():
     assert with_cov[:, 1].mean() < 0.2 * without[:, 1].mean()  # measured 2 mm vs 20 cm
     with pytest.raises(ValueError, match="cov"):
         estimate_pose(L, M, first_seen, cov=covs[:5])
+
+
+def test_exact_store_query_among_and_candidates_in_match_to_map():
+    rng = np.random.default_rng(1)
+    D = rng.integers(0, 256, (400, 32), dtype=np.uint8)
+    Q = D[:30] ^ np.uint8(1)  # one bit away from landmarks 0..29
+    s = ExactStore()
+    s.add(D, np.arange(100, 500))
+    among = np.arange(100, 500, 2)  # even ids only
+    dist, ids = s.query_among(Q, among, k=2)
+    bits = np.unpackbits(Q[:, None, :] ^ D[None, ::2, :], axis=2).sum(axis=2)  # the even rows
+    np.testing.assert_array_equal(dist, np.sort(bits, axis=1)[:, :2])
+    assert np.isin(ids, among).all()
+    # match_to_map: the exact store searches only the candidates ...
+    mm = match_to_map(Q, s, candidates=among)
+    assert set(mm.ids.tolist()) <= set(among.tolist())
+    assert sorted(mm.ids.tolist()) == list(range(100, 130, 2))  # the even twins match, the odd ones find none
+    # ... and a store without query_among has its nearest neighbours filtered
+    class Plain:
+        def __init__(self, inner):
+            self.inner = inner
+
+        def query(self, Q, k=2):
+            return self.inner.query(Q, k)
+
+        def __len__(self):
+            return len(self.inner)
+
+    mm2 = match_to_map(Q, Plain(s), candidates=among)
+    assert sorted(mm2.ids.tolist()) == list(range(100, 130, 2))
+
+
+def test_view_gate_keeps_the_landmarks_in_front():
+    from slamlab.geometry import StereoRig
+    from slamlab.stereo import StereoSLAM
+
+    slam = StereoSLAM(StereoRig.parallel(), np.eye(4), max_depth_m=10.0)
+    # camera frame: x right, z forward (T_body_left = I); 40 deg field of view -> +-20 deg
+    slam.X = np.array([[0.0, 0.0, 3.0], [3.0 * np.tan(np.deg2rad(25)), 0, 3.0], [0.0, 0.0, -3.0], [0.0, 0.0, 16.0]])
+    slam.alive = np.ones(4, bool)
+    assert slam.landmarks_in_view(0.0).tolist() == [0]
+    assert slam.landmarks_in_view(10.0).tolist() == [0, 1]  # 25 deg < 20 + 10
+    assert slam.landmarks_in_view(10.0, T_body=np.diag([-1.0, 1.0, -1.0, 1.0])).tolist() == [2]  # turned around
