@@ -15,11 +15,13 @@ __all__ = [
     "localisation_figure",
     "plot_error_distribution",
     "plot_grid",
+    "plot_grids",
     "plot_heading_profile",
     "plot_intel",
     "plot_localisation",
     "plot_score_map",
     "plot_stamp",
+    "plot_stamps",
     "plot_table1",
 ]
 
@@ -45,6 +47,28 @@ def plot_stamp(T_n, origin: int, *, a_c: float = -1.0, a_p: float = 1.0, ax=None
     ax.set_ylabel("row of T_n")
     ax.plot(origin, origin, "+", color="tab:red", ms=12, mew=2)
     return ax
+
+
+def plot_stamps(T, origin: int, headings_deg=(0, 30, 135), *, a_c: float = -1.0, a_p: float = 1.0):
+    """Several images T_n side by side (004 §7), one per heading index in ``headings_deg``; returns the figure."""
+    headings = tuple(int(n) for n in headings_deg)
+    fig, axes = plt.subplots(1, len(headings), figsize=(4.7 * len(headings), 4.6), squeeze=False)
+    for ax, n in zip(axes[0], headings, strict=True):
+        plot_stamp(T[n], origin, a_c=a_c, a_p=a_p, ax=ax, title=f"T_n at α0n = {n}° (a_c white, a_p black, a_n grey)")
+    fig.tight_layout()
+    return fig
+
+
+def plot_grids(grids, titles):
+    """Grids side by side with 004's colours (:func:`plot_grid`); returns the figure."""
+    grids, titles = list(grids), list(titles)
+    if len(grids) != len(titles):
+        raise ValueError(f"`titles` must have one entry per grid ({len(grids)}); got {len(titles)}")
+    fig, axes = plt.subplots(1, len(grids), figsize=(5.5 * len(grids), 5.2), squeeze=False)
+    for ax, g, t in zip(axes[0], grids, titles, strict=True):
+        plot_grid(g, ax=ax, title=t)
+    fig.tight_layout()
+    return fig
 
 
 def _pose_arrow(ax, pose, length, **kw):

@@ -45,7 +45,9 @@ from .matching import (
 from .moravec import moravec_detect, moravec_response
 from .opencv import fast_cv, features_from_keypoints, mser_cv, orb_cv, sift_cv
 from .plot import (
+    DETECTOR_GALLERY,
     plot_box_filters,
+    plot_detector_gallery,
     plot_fast_circle,
     plot_keypoints,
     plot_matches,
@@ -68,6 +70,7 @@ from .surf import (
 
 __all__ = [
     "DETECTORS",
+    "DETECTOR_GALLERY",
     "EVAL_DETECTORS",
     "KNN_METHODS",
     "OXFORD_SEQUENCES",
@@ -102,6 +105,7 @@ __all__ = [
     "mutual_mask",
     "orb_cv",
     "plot_box_filters",
+    "plot_detector_gallery",
     "plot_fast_circle",
     "plot_keypoints",
     "plot_matches",

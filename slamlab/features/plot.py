@@ -9,7 +9,9 @@ from ..plotting import new_axes
 from .fast import CIRCLE_OFFSETS
 
 __all__ = [
+    "DETECTOR_GALLERY",
     "plot_box_filters",
+    "plot_detector_gallery",
     "plot_fast_circle",
     "plot_keypoints",
     "plot_matches",
@@ -18,6 +20,34 @@ __all__ = [
     "plot_recall_vs_leaves",
     "plot_surf_threshold",
 ]
+
+#: the detectors of notebook 02's gallery: (title, method, parameters of ``slamlab.features.detect``)
+DETECTOR_GALLERY = (
+    ("SURF (ours)", "surf", {"threshold": 4e-4}),
+    ("SIFT (OpenCV)", "sift", {}),
+    ("ORB (OpenCV)", "orb", {}),
+    ("FAST-9 (ours)", "fast", {"threshold": 20}),
+    ("Moravec (ours)", "moravec", {"threshold": 0.1}),
+    ("MSER (OpenCV)", "mser", {}),
+)
+
+
+def plot_detector_gallery(image, detectors=DETECTOR_GALLERY, *, max_points: int = 300, ncols: int = 3):
+    """Keypoints of several detectors on one image, one panel each (000 §1.4); returns the figure."""
+    from .detect import detect
+
+    detectors = tuple(detectors)
+    nrows = -(-len(detectors) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4 * ncols, 3.25 * nrows), squeeze=False)
+    for ax in axes.ravel()[len(detectors):]:
+        ax.set_visible(False)
+    for ax, (name, method, params) in zip(axes.ravel(), detectors, strict=False):
+        f = detect(image, method, descriptors=False, **params)
+        plot_keypoints(image, f, ax=ax, max_points=max_points, title=f"{name}: {len(f)} points",
+                       circles=method in ("surf", "sift", "orb", "mser"))
+    fig.tight_layout()
+    return fig
+
 
 _COLORS = {"SIFT": "tab:blue", "SURF": "tab:red", "ORB": "tab:green", "FAST": "tab:purple"}
 

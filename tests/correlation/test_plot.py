@@ -2,6 +2,7 @@
 
 import matplotlib.pyplot as plt
 import numpy as np
+import pytest
 
 from slamlab import correlation as C
 from slamlab import sim as S
@@ -18,6 +19,13 @@ def test_plots_draw():
     T, o = C.rasterise_scan(scan.angles_rad, scan.ranges_cells, scan.hit, [0.0])
     ax = C.plot_stamp(T[0], o)
     assert ax.images[0].get_array().shape == T[0].shape
+    T3, _ = C.rasterise_scan(scan.angles_rad, scan.ranges_cells, scan.hit, np.radians([0.0, 30.0, 60.0]))
+    fig = C.plot_stamps(T3, o, (0, 2))
+    assert [ax.get_title()[:14] for ax in fig.axes] == ["T_n at α0n = 0", "T_n at α0n = 2"]
+    fig = C.plot_grids([M, M[:100]], ["a", "b"])
+    assert [ax.images[0].get_array().shape for ax in fig.axes] == [(200, 200), (100, 200)]
+    with pytest.raises(ValueError, match="titles"):
+        C.plot_grids([M], ["a", "b"])
     t1 = C.run_table1(2, rng=1)
     ax = C.plot_table1(t1, M)
     assert len(ax.lines) >= 4

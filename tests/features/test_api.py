@@ -70,6 +70,10 @@ def test_plots_run():
     g = F.detect(np.ascontiguousarray(img[:, ::-1]), "surf")
     m = F.match_descriptors(f.descriptors, g.descriptors, rule="ratio")
     F.plot_keypoints(img, f)
+    fig = F.plot_detector_gallery(img, F.DETECTOR_GALLERY[:2] + F.DETECTOR_GALLERY[3:5])
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert [ax.get_title().split(":")[0] for ax in visible] == ["SURF (ours)", "SIFT (OpenCV)", "FAST-9 (ours)", "Moravec (ours)"]
+    assert len(fig.axes) == 6  # a 2x3 grid, two panels hidden
     F.plot_matches(img, img[:, ::-1], f, g, m, np.ones(len(m), bool))
     F.plot_box_filters(15)
     F.plot_fast_circle(img, 60, 80)
