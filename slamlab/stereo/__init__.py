@@ -17,7 +17,7 @@ from .experiments import (
     run_turn_in_place,
 )
 from .plot import plot_frame_stages, plot_run_errors, plot_run_map, plot_triangulation, run_figure
-from .slam import STAGES, FrameRecord, StereoSLAM
+from .slam import BINARY_DETECTORS, STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
     DETECTORS,
     POLICIES,
@@ -37,6 +37,7 @@ from .store import ExactStore, check_store
 from .widgets import explore_stereo_slam
 
 __all__ = [
+    "BINARY_DETECTORS",
     "COMPARISON",
     "DETECTORS",
     "POLICIES",
@@ -55,6 +56,7 @@ __all__ = [
     "StereoSLAM",
     "check_store",
     "comparison_table",
+    "default_store",
     "detect",
     "estimate_pose",
     "experiment_poses",

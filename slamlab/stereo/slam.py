@@ -30,6 +30,8 @@ from .stages import (
 )
 from .store import ExactStore, check_store
 
+__all__ = ["BINARY_DETECTORS", "STAGES", "FrameRecord", "StereoSLAM", "default_store"]
+
 #: detectors whose descriptors are binary (Hamming): the kd-tree stores do not apply to them
 BINARY_DETECTORS = ("orb",)
 
@@ -60,7 +62,6 @@ def default_store(detector: str, base_seen_times: int = 3, max_non_base_time: in
 
     return make_store("multi", base_seen_times=base_seen_times, max_non_base_time=max_non_base_time)
 
-__all__ = ["BINARY_DETECTORS", "STAGES", "FrameRecord", "StereoSLAM", "default_store"]
 
 #: the per-frame stages whose times are recorded
 STAGES = ("detect", "stereo", "triangulate", "map_match", "pose", "update")
