@@ -25,6 +25,7 @@ from .stages import (
     detect,
     estimate_pose,
     match_to_map,
+    pose_std,
     stereo_match,
     triangulate_local,
 )
@@ -106,6 +107,11 @@ class StereoSLAM:
         (``σ_t² + (σ_θ · range)²`` per axis; our addition: the observation in map coordinates carries
         the pose error, and two nearly parallel stereo ellipsoids fused without it can throw a
         landmark metres along its viewing ray).
+    max_rot_std_rad : a pose whose inliers leave a rotation standard deviation above this
+        (:func:`~slamlab.stereo.stages.pose_std` with the stereo covariances) is not trusted: the frame
+        keeps the last pose and adds nothing, like a RANSAC failure (status ``"ill_conditioned"``;
+        our addition; None = accept every converged pose). On the 80 m run the median frame shows
+        0.3 mrad, the 99th percentile 5 mrad; the pose that went 1.08 m wrong showed 14 mrad.
     update_gate : an inlier refines its landmark only when the innovation's squared Mahalanobis
         distance is at most this (default: χ²₃ at 99.9 %; None = always).
     base_seen_times, max_non_base_time : 000 §3.4's base rule (3 sightings within 7 frames).
@@ -148,6 +154,7 @@ class StereoSLAM:
         pose_std_m: float = 0.02,
         pose_std_rad: float = float(np.deg2rad(0.5)),
         update_gate: float | None = 16.27,
+        max_rot_std_rad: float | None = 0.01,
         base_seen_times: int = 3,
         max_non_base_time: int = 7,
         rng=None,
@@ -182,6 +189,7 @@ class StereoSLAM:
         self.pose_std_m = v.check_positive(pose_std_m, "pose_std_m", allow_zero=True)
         self.pose_std_rad = v.check_positive(pose_std_rad, "pose_std_rad", allow_zero=True)
         self.update_gate = None if update_gate is None else v.check_positive(update_gate, "update_gate")
+        self.max_rot_std_rad = None if max_rot_std_rad is None else v.check_positive(max_rot_std_rad, "max_rot_std_rad")
         self.parallel_detect = bool(parallel_detect)
         self.view_margin_deg = None if view_margin_deg is None else v.check_positive(view_margin_deg, "view_margin_deg", allow_zero=True)
         self.rng = v.as_rng(rng)
@@ -254,6 +262,14 @@ class StereoSLAM:
             rec["status"] = "ransac_failed"
             self._finish(rec, times, t5, pts_body, np.zeros(len(pts_body), bool))
             return rec
+        if self.max_rot_std_rad is not None:
+            R = est.T[:3, :3]
+            inl = mm.local[est.inliers]
+            std = pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)
+            if not np.max(std[:3]) <= self.max_rot_std_rad:
+                rec["status"] = "ill_conditioned"
+                self._finish(rec, times, t5, pts_body, np.zeros(len(pts_body), bool))
+                return rec
         self.T = est.T
         R, t = est.T[:3, :3], est.T[:3, 3]
         # refine re-seen landmarks with the static Kalman filter (000 §3.6)
@@ -364,7 +380,7 @@ class StereoSLAM:
 
     @property
     def degenerate_frames(self) -> np.ndarray:
-        """Indices of frames that kept the last pose (too few points / matches, RANSAC failure)."""
+        """Indices of frames that kept the last pose (too few points / matches, RANSAC failure, ill-conditioned pose)."""
         return np.array([r["frame"] for r in self.records if r["status"] not in ("ok", "init")], dtype=np.int64)
 
     def landmark_map(self, base_only: bool = True) -> np.ndarray:

@@ -200,3 +200,24 @@ def test_variants_on_shared_frames_equal_separate_runs(short_turn):
         run_comparison(variants={"x": {"policy": "newest"}}, n_frames=2)
     with pytest.raises(ValueError, match="experiment"):
         run_comparison("spiral")
+
+
+def test_ill_conditioned_poses_are_not_trusted():
+    # the rotation std of a normal frame is ~0.3-1.4 mrad: a limit of 1 urad rejects every pose, and a
+    # rejected frame behaves like a RANSAC failure (pose kept, nothing added, counted as degenerate)
+    rig = StereoRig.parallel(0.2, 384, 288)
+    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    pairs = [sim.render_pair([3.0, 4.0, yaw]) for yaw in (0.0, 0.05)]
+    strict = StereoSLAM(rig, sim.T_body_left, max_rot_std_rad=1e-6, rng=0)
+    loose = StereoSLAM(rig, sim.T_body_left, max_rot_std_rad=None, rng=0)
+    for slam in (strict, loose):
+        for p in pairs:
+            slam.process(*p)
+    assert strict.records[1].status == "ill_conditioned"
+    assert strict.degenerate_frames.tolist() == [1]
+    np.testing.assert_array_equal(strict.poses[1], strict.poses[0])
+    assert strict.records[1].n_new == 0
+    assert loose.records[1].status == "ok"
+    assert abs(float(wrap_angle(loose.planar_trajectory[1, 2] - 0.05))) < np.deg2rad(1.0)
+    with pytest.raises(ValueError, match="max_rot_std_rad"):
+        StereoSLAM(rig, max_rot_std_rad=-1.0)
