@@ -16,7 +16,7 @@ from .experiments import (
     run_stereo_slam_variants,
     run_turn_in_place,
 )
-from .plot import plot_frame_stages, plot_run_errors, plot_run_map, plot_triangulation, run_figure
+from .plot import plot_frame_stages, plot_kitti, plot_run_errors, plot_run_map, plot_triangulation, run_figure
 from .slam import BINARY_DETECTORS, STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
     DETECTORS,
@@ -63,6 +63,7 @@ __all__ = [
     "explore_stereo_slam",
     "match_to_map",
     "plot_frame_stages",
+    "plot_kitti",
     "plot_run_errors",
     "plot_run_map",
     "plot_triangulation",

@@ -8,7 +8,7 @@ import numpy as np
 from ..geometry.triangulation import triangulate_midpoint
 from ..plotting import STYLE, new_axes
 
-__all__ = ["plot_frame_stages", "plot_run_errors", "plot_run_map", "plot_triangulation", "run_figure"]
+__all__ = ["plot_frame_stages", "plot_kitti", "plot_run_errors", "plot_run_map", "plot_triangulation", "run_figure"]
 
 
 def plot_triangulation(*, ax=None, baseline_m: float = 0.4, skew_m: float = 0.15):
@@ -93,7 +93,7 @@ def plot_run_errors(result, *, axes=None, label: str | None = None):
     """Position and heading error per frame against the ground truth."""
     if axes is None:
         _fig, axes = plt.subplots(1, 2, figsize=(11, 3.5))
-    label = label or result.policy
+    label = label or f"{result.detector}, {result.policy}"
     axes[0].plot(result.pos_err_m, label=label)
     axes[0].set_xlabel("frame")
     axes[0].set_ylabel("position error [m]")
@@ -116,3 +116,15 @@ def run_figure(result, *, others=()):
         plot_run_errors(r, axes=axes)
     fig.tight_layout()
     return fig
+
+
+def plot_kitti(result, *, ax=None):
+    """KITTI run seen from above: the left camera's path (x right, z forward) against the ground truth."""
+    ax = new_axes(ax, title="KITTI 06, frames 0-19: path from above", xlabel="x [m]", ylabel="z (forward) [m]",
+                  equal=True)  # fmt: skip
+    gt, est = result.truth[:, :3, 3], result.estimate[:, :3, 3]
+    ax.plot(gt[:, 0], gt[:, 2], **{**STYLE["truth"], "marker": "."}, label="ground truth")
+    ax.plot(est[:, 0], est[:, 2], **{**STYLE["estimate"], "marker": "."}, label="estimate")
+    ax.plot(gt[0, 0], gt[0, 2], "o", color="black", label="start")
+    ax.legend(loc="best", fontsize=8)
+    return ax

@@ -8,7 +8,13 @@ from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
 from slamlab.stereo import detect, stereo_match, triangulate_local
 from slamlab.stereo.experiments import run_stereo_slam
-from slamlab.stereo.plot import plot_frame_stages, plot_run_errors, plot_run_map, plot_triangulation
+from slamlab.stereo.plot import (
+    plot_frame_stages,
+    plot_kitti,
+    plot_run_errors,
+    plot_run_map,
+    plot_triangulation,
+)
 
 
 def test_plots():
@@ -31,6 +37,7 @@ def test_plots():
     plt.close(ax.figure)
     axes = plot_run_errors(res)
     np.testing.assert_allclose(axes[0].lines[0].get_ydata(), res.pos_err_m)
+    assert axes[0].get_legend().get_texts()[0].get_text() == "surf, oldest"  # detector and policy
     plt.close(axes[0].figure)
 
 
@@ -41,3 +48,16 @@ def test_widget_builds_without_running():
     names = [getattr(c, "description", "") for c in w.children]
     assert "landmarks" in names
     assert "run" in names  # manual: nothing runs until the button is pressed
+
+
+def test_plot_kitti_draws_the_paths_from_above():
+    from types import SimpleNamespace
+
+    T = np.tile(np.eye(4), (3, 1, 1))
+    T[:, 2, 3] = [0.0, 1.0, 2.0]  # forward along z
+    E = T.copy()
+    E[:, 0, 3] = 0.1
+    ax = plot_kitti(SimpleNamespace(truth=T, estimate=E))
+    np.testing.assert_allclose(ax.lines[0].get_xydata(), [[0, 0], [0, 1], [0, 2]])
+    np.testing.assert_allclose(ax.lines[1].get_xydata(), [[0.1, 0], [0.1, 1], [0.1, 2]])
+    plt.close(ax.figure)
