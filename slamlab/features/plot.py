@@ -13,6 +13,7 @@ __all__ = [
     "plot_box_filters",
     "plot_detector_gallery",
     "plot_fast_circle",
+    "plot_keypoint_pair",
     "plot_keypoints",
     "plot_matches",
     "plot_pair_evaluation",
@@ -45,6 +46,15 @@ def plot_detector_gallery(image, detectors=DETECTOR_GALLERY, *, max_points: int 
         f = detect(image, method, descriptors=False, **params)
         plot_keypoints(image, f, ax=ax, max_points=max_points, title=f"{name}: {len(f)} points",
                        circles=method in ("surf", "sift", "orb", "mser"))
+    fig.tight_layout()
+    return fig
+
+
+def plot_keypoint_pair(img1, f1, img2, f2, titles=("image 1", "image 2")):
+    """Keypoints of two images side by side (:func:`plot_keypoints`); returns the figure."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    plot_keypoints(img1, f1, ax=axes[0], title=titles[0])
+    plot_keypoints(img2, f2, ax=axes[1], title=titles[1])
     fig.tight_layout()
     return fig
 

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import ipywidgets as widgets
-import matplotlib.pyplot as plt
 import numpy as np
 
 from ..widgets import STYLE as _STYLE
 from .detect import detect
 from .evaluation import OXFORD_SEQUENCES, correct_matches, load_oxford_pair, repeatability
 from .matching import Matches, accept_ratio, knn2
-from .plot import plot_keypoints, plot_matches
+from .plot import plot_keypoint_pair, plot_matches
 
 __all__ = ["explore_detectors", "explore_matching"]
 
@@ -59,10 +58,7 @@ def explore_detectors(**defaults):
         print(f"{detector}, {next(iter(params))} = {shown}: img1 {len(f1)} points, img{step} {len(f2)} points, "
               f"repeatability {r.repeatability:.2f} ({r.correspondences} of min({r.n1}, {r.n2}))")
         if draw:
-            _, axes = plt.subplots(1, 2, figsize=(10, 4))
-            plot_keypoints(img1, f1, ax=axes[0], title=f"{sequence} img1")
-            plot_keypoints(img2, f2, ax=axes[1], title=f"{sequence} img{step}")
-            plt.show()
+            plot_keypoint_pair(img1, f1, img2, f2, (f"{sequence} img1", f"{sequence} img{step}"))
 
     return widgets.interactive(
         show,
@@ -116,9 +112,7 @@ def explore_matching(**defaults):
               f"{note}: {len(m)} matches, precision {c.mean() if len(m) else float('nan'):.2f}, "
               f"recall {c.sum() / max(r.correspondences, 1):.2f}")
         if draw:
-            _, ax = plt.subplots(figsize=(10, 4))
-            plot_matches(img1, img2, f1, f2, m, c, ax=ax)
-            plt.show()
+            plot_matches(img1, img2, f1, f2, m, c)
 
     return widgets.interactive(
         show,

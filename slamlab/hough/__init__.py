@@ -28,6 +28,7 @@ from .lines import (
 )
 from .mapping import BuiltMap, build_map, map_agreement, scan_points_world
 from .plot import (
+    accumulator_figure,
     example_figure,
     plot_accumulator,
     plot_built_map,
@@ -96,6 +97,7 @@ __all__ += [
     "ExampleLineResult",
     "RealLogResult",
     "SimSlamResult",
+    "accumulator_figure",
     "example_figure",
     "explore_accumulator",
     "explore_hough_slam",

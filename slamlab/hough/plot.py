@@ -11,6 +11,7 @@ from ..plotting import STYLE, new_axes
 from .transform import HoughAccumulator
 
 __all__ = [
+    "accumulator_figure",
     "example_figure",
     "plot_accumulator",
     "plot_built_map",
@@ -61,6 +62,15 @@ def plot_scan_lines(bearings_rad, ranges, lines=None, *, ax=None, title: str = "
     ax.set_ylim(-1.1 * span, 1.1 * span)
     ax.legend(loc="upper right", fontsize=8)
     return ax
+
+
+def accumulator_figure(acc: HoughAccumulator, peaks, bearings_rad, ranges, lines):
+    """A scan's accumulator with its peaks beside the scan and the refitted lines; returns the figure."""
+    fig, axs = plt.subplots(1, 2, figsize=(14, 5))
+    plot_accumulator(acc, peaks, ax=axs[0])
+    plot_scan_lines(bearings_rad, ranges, lines, ax=axs[1])
+    fig.tight_layout()
+    return fig
 
 
 def example_figure(result):

@@ -5,19 +5,16 @@ from __future__ import annotations
 import math
 
 import ipywidgets as widgets
-import matplotlib.pyplot as plt
 
 from ..widgets import STYLE as _STYLE
 from ..widgets import slider as _slider
 from .experiments import run_real_log, run_sim_slam
 from .lines import find_peaks
-from .plot import plot_accumulator, plot_scan_lines, real_log_figure, sim_figure
+from .plot import accumulator_figure, real_log_figure, sim_figure
 from .slam import HoughSlamParams, detect_lines
 from .transform import hough_polar
 
 __all__ = ["explore_accumulator", "explore_hough_slam", "explore_real_log"]
-
-
 
 
 def _theta_choice(value):
@@ -50,11 +47,7 @@ def explore_accumulator(**defaults):
             return
         print(f"pose {int(pose_index)}: {phi.size} returns, accumulator {acc.size_theta_rho[0]}×"
               f"{acc.size_theta_rho[1]} (θ×ρ), {len(peaks)} peaks, {len(lines)} lines after the refit")
-        fig, axs = plt.subplots(1, 2, figsize=(14, 5))
-        plot_accumulator(acc, peaks, ax=axs[0])
-        plot_scan_lines(phi, r, lines, ax=axs[1])
-        fig.tight_layout()
-        plt.show()
+        accumulator_figure(acc, peaks, phi, r, lines)
 
     return widgets.interactive(
         show,
@@ -83,7 +76,6 @@ def explore_hough_slam(**defaults):
             return
         print(res.table())
         sim_figure(res)
-        plt.show()
 
     return widgets.interactive(
         show,
@@ -113,7 +105,6 @@ def explore_real_log(**defaults):
             return
         print(res.table())
         real_log_figure(res)
-        plt.show()
 
     return widgets.interactive(
         show,

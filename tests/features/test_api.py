@@ -102,3 +102,10 @@ def test_widgets_never_raise(shared_data, capsys):
         out = capsys.readouterr().out
         assert out.strip(), "the widget printed nothing"
     plt.close("all")
+    # drawing: one figure each, made by the plot module (two keypoint panels; one match panel)
+    w.f(**{**w.kwargs, "draw": True})
+    assert [len(plt.figure(n).axes) for n in plt.get_fignums()] == [2]
+    plt.close("all")
+    m.f(**{**m.kwargs, "draw": True})
+    assert [len(plt.figure(n).axes) for n in plt.get_fignums()] == [1]
+    plt.close("all")

@@ -20,6 +20,8 @@ def test_accumulator_widget(capsys, kw):
     out = capsys.readouterr().out
     assert out.strip()
     assert "Traceback" not in out
+    if "Cannot run" not in out:  # the accumulator and the scan with its lines
+        assert [len(matplotlib.pyplot.figure(n).axes) for n in matplotlib.pyplot.get_fignums()][-1] >= 2
     matplotlib.pyplot.close("all")
 
 
