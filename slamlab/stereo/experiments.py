@@ -24,6 +24,7 @@ from .slam import STAGES, StereoSLAM
 
 __all__ = [
     "COMPARISON",
+    "SIM_KEYS",
     "SIZES",
     "DriftStudy",
     "KittiRunResult",
@@ -122,28 +123,19 @@ class StereoRunResult:
         return format_table(["stage", "ms/frame"], rows)
 
 
-def run_stereo_slam(
-    poses,
-    *,
-    name: str = "run",
-    arena: StereoArena | None = None,
-    rig: StereoRig | None = None,
-    camera_height_m: float = 0.4,
-    noise_std: float = 0.0,
-    drift_std_rad: float = 0.0,
-    progress=None,
-    rng=0,
-    **slam_kwargs,
-) -> StereoRunResult:
-    """Render ``poses`` (N, 3) in ``arena`` and run :class:`StereoSLAM` on them (000 §3.7).
+#: keyword arguments of the runs that go to the renderer rather than to :class:`StereoSLAM`
+SIM_KEYS = ("arena", "rig", "camera_height_m", "noise_std", "drift_std_rad", "progress")
 
-    The map frame is the first body pose; truth is expressed in it. ``slam_kwargs`` go to
-    :class:`StereoSLAM` (``detector``, ``policy``, ``ransac_iters``, ...).
+
+def run_stereo_slam(poses, *, name: str = "run", rng=0, **kwargs) -> StereoRunResult:
+    """Render ``poses`` (N, 3) in an arena and run :class:`StereoSLAM` on them (000 §3.7).
+
+    The map frame is the first body pose; truth is expressed in it. Keywords in :data:`SIM_KEYS`
+    go to the renderer (see :func:`run_stereo_slam_variants`), the others to :class:`StereoSLAM`
+    (``detector``, ``policy``, ``ransac_iters``, ...).
     """
-    return run_stereo_slam_variants(
-        poses, {"run": slam_kwargs}, name=name, arena=arena, rig=rig, camera_height_m=camera_height_m,
-        noise_std=noise_std, drift_std_rad=drift_std_rad, progress=progress, rng=rng,
-    )["run"]  # fmt: skip
+    sim = {k: kwargs.pop(k) for k in SIM_KEYS if k in kwargs}
+    return run_stereo_slam_variants(poses, {"run": kwargs}, name=name, rng=rng, **sim)["run"]
 
 
 def run_stereo_slam_variants(
@@ -164,6 +156,11 @@ def run_stereo_slam_variants(
     ``variants`` maps a label to the ``StereoSLAM`` keyword arguments of one run; every run gets the
     same RANSAC seed, so each result equals a separate :func:`run_stereo_slam` call. The frames are
     rendered once (rendering costs about as much as our SURF).
+
+    Renderer: ``arena`` (default the 6×8 m :class:`~slamlab.sim.arena.StereoArena`), ``rig`` (default
+    the 768×576, 40° pair with a 0.2 m baseline), ``camera_height_m``, ``noise_std`` (grey levels),
+    ``drift_std_rad`` (random-walk step of the right camera's orientation per frame) and
+    ``progress(i)``, called after each frame.
     """
     poses = v.as_finite_array(poses, "poses", ndim=2)
     if poses.shape[1] != 3 or len(poses) < 2:

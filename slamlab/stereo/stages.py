@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-import cv2
 import numpy as np
 
 from .. import _validate as v
@@ -49,45 +48,16 @@ class Features(NamedTuple):
         return self.descriptors.dtype == np.uint8
 
 
-# --- detection: OpenCV's ORB / SIFT with the pipeline's settings, our SURF from slamlab.features ---
+# --- detection: the features chapter's detectors with the pipeline's settings (000 §3.3) ------------
 
-
-def _as_uint8(image):
-    img = v.as_image(image, "image")
-    if img.dtype == np.uint8:
-        return img
-    if np.issubdtype(img.dtype, np.floating) and img.max() <= 1.0:
-        img = img * 255.0
-    return np.clip(np.rint(img), 0, 255).astype(np.uint8)
-
-
-def _cv_features(det, img):
-    kps, desc = det.detectAndCompute(img, None)
-    if desc is None or not kps:
-        return np.empty((0, 2)), None
-    return np.array([k.pt for k in kps], dtype=np.float64), desc
-
-
-def _detect_orb(img, n_features):
-    uv, desc = _cv_features(cv2.ORB_create(nfeatures=n_features, fastThreshold=12), img)
-    return uv, np.empty((0, 32), np.uint8) if desc is None else desc
-
-
-def _detect_sift(img, n_features):
-    uv, desc = _cv_features(cv2.SIFT_create(nfeatures=n_features), img)
-    return uv, np.empty((0, 128), np.float32) if desc is None else desc.astype(np.float32)
-
-
-def _detect_surf(img, n_features):
-    # the features chapter's SURF (000 §1.4, §3.3); imported here so that chapter stays optional
-    from ..features import detect as features_detect
-
-    f = features_detect(img, "surf", max_points=n_features)
-    desc = np.empty((0, 64), np.float32) if f.descriptors is None else np.asarray(f.descriptors, np.float32)
-    return np.asarray(f.uv, np.float64).reshape(-1, 2), desc
-
-
-DETECTORS = {"orb": _detect_orb, "sift": _detect_sift, "surf": _detect_surf}
+#: detector -> (keyword that caps the number of keypoints, further parameters of ``slamlab.features.detect``);
+#: ORB's FAST threshold 12 (OpenCV: 20) finds 2000 points on the arena's fence
+DETECTORS = {
+    "orb": ("n_features", {"fast_threshold": 12}),
+    "sift": ("n_features", {}),
+    "surf": ("max_points", {}),
+}
+_DESCRIPTOR_SHAPE = {"orb": (32, np.uint8), "sift": (128, np.float32), "surf": (64, np.float32)}
 
 
 def detect(image, detector: str = "surf", n_features: int = 2000) -> Features:
@@ -102,10 +72,16 @@ def detect(image, detector: str = "surf", n_features: int = 2000) -> Features:
     >>> f = detect(img, "orb", n_features=50); f.uv.shape[1], f.descriptors.dtype
     (2, dtype('uint8'))
     """
+    from ..features import detect as features_detect  # the features chapter stays an optional import
+    from ..features import to_gray_uint8
+
     v.check_choice(detector, "detector", DETECTORS)
     n_features = v.check_int(n_features, "n_features", minimum=1)
-    uv, desc = DETECTORS[detector](_as_uint8(image), n_features)
-    return Features(uv, desc)
+    cap, params = DETECTORS[detector]
+    f = features_detect(to_gray_uint8(image), detector, **{cap: n_features}, **params)
+    dim, dtype = _DESCRIPTOR_SHAPE[detector]
+    desc = np.empty((0, dim), dtype) if f.descriptors is None else np.asarray(f.descriptors, dtype)
+    return Features(np.asarray(f.uv, np.float64).reshape(-1, 2), desc)
 
 
 # --- stereo matching: ratio rule + epipolar check (000 §3.3) ---------------------------------------
@@ -401,18 +377,30 @@ def pose_std(points_map, cov_map, center=None) -> np.ndarray:
     if C.shape != (len(P), 3, 3):
         raise ValueError(f"`cov_map` must have shape ({len(P)}, 3, 3); got {C.shape}")
     c = P.mean(axis=0) if center is None else np.asarray(center, dtype=float)
-    q = P - c
+    return _std_from_information(_point_information(P, C, c).sum(axis=0))
+
+
+def _point_information(P, C, center) -> np.ndarray:
+    """(N, 6, 6) Gauss-Newton information ``Jᵢᵀ Cᵢ⁻¹ Jᵢ`` of each point about ``center``."""
+    q = P - center
     J = np.zeros((len(P), 3, 6))
     # d(R p)/d(rotation vector) = -[p]x
     J[:, 0, 1], J[:, 0, 2] = q[:, 2], -q[:, 1]
     J[:, 1, 0], J[:, 1, 2] = -q[:, 2], q[:, 0]
     J[:, 2, 0], J[:, 2, 1] = q[:, 1], -q[:, 0]
     J[:, :, 3:] = np.eye(3)
-    info = np.einsum("nki,nkl,nlj->ij", J, np.linalg.inv(C), J)
-    try:
-        return np.sqrt(np.diag(np.linalg.inv(info)))
-    except np.linalg.LinAlgError:
-        return np.full(6, np.inf)
+    CiJ = np.linalg.solve(C, J)
+    return np.einsum("nki,nkj->nij", J, CiJ)
+
+
+def _std_from_information(info) -> np.ndarray:
+    """Standard deviations from (..., 6, 6) information matrices; inf where one is singular."""
+    info = np.asarray(info)
+    out = np.full(info.shape[:-1], np.inf)
+    ok = np.linalg.cond(info) < 1e12
+    if ok.any():
+        out[ok] = np.sqrt(np.diagonal(np.linalg.inv(info[ok]), axis1=-2, axis2=-1))
+    return out
 
 
 class PoseEstimate(NamedTuple):
@@ -544,17 +532,18 @@ def estimate_pose(
         old = loose[select_oldest(first_seen[loose], n_min)]
         if cov is not None and max_std_factor is not None and old.size < loose.size:
             # grow the set by first-sighting time until it determines the pose nearly as well as all candidates
-            cov_map = Tm.R @ cov[loose] @ Tm.R.T
+            # (cumulative information over the loose candidates sorted by first sighting)
             pts_map = dst[loose]
-            center = pts_map.mean(axis=0)
-            ref = pose_std(pts_map, cov_map, center)
+            info = _point_information(pts_map, Tm.R @ cov[loose] @ Tm.R.T, pts_map.mean(axis=0))
             order = np.argsort(first_seen[loose], kind="stable")
-            times = np.unique(first_seen[loose])
-            for t_cut in times[times >= first_seen[old].max()]:
-                sel = order[first_seen[loose][order] <= t_cut]
-                if np.all(pose_std(pts_map[sel], cov_map[sel], center) <= max_std_factor * ref):
-                    break
-            old = loose[np.sort(sel)]
+            fs = first_seen[loose][order]
+            cum = np.cumsum(info[order], axis=0)
+            ends = np.flatnonzero(np.r_[fs[1:] != fs[:-1], True])  # last candidate of each sighting time
+            ends = ends[fs[ends] >= first_seen[old].max()]
+            std = _std_from_information(cum[ends])
+            good = np.all(std <= max_std_factor * _std_from_information(cum[-1]), axis=1)
+            cut = ends[np.argmax(good)] if good.any() else len(order) - 1
+            old = loose[np.sort(order[: cut + 1])]
         if old.size >= 3:
             r_old = ransac((src[old], dst[old], w[old]), _fit, _residuals, 3, threshold_m, max_iters=max_iters, rng=rng)
             n_old = int(r_old.inliers.sum())
