@@ -21,6 +21,7 @@ from .experiments import (
     run_intel_localisation,
     run_monte_carlo,
     run_table1,
+    time_localise,
 )
 from .mapping import GridFrame, occupancy_grid_from_scans
 from .plot import (
@@ -74,4 +75,5 @@ __all__ = [
     "run_table1",
     "scan_arrays",
     "score_maps",
+    "time_localise",
 ]

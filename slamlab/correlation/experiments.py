@@ -33,6 +33,7 @@ __all__ = [
     "run_intel_localisation",
     "run_monte_carlo",
     "run_table1",
+    "time_localise",
 ]
 
 #: 004 Table 1: α0, α0 est [rad], X, X est, Y, Y est [cells].
@@ -427,3 +428,13 @@ def run_intel_localisation(scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 
     err_a = heading_error(est_m[:, 2], true_m[:, 2])
     example = log.points(int(idx[0]), est_m[0])
     return IntelResult(idx, true_m, est_m, err_p, err_a, cell, rmax, ex, G, frame, example, time.perf_counter() - t0)
+
+
+def time_localise(grid, scan, *, dtypes=(np.float64, np.float32)) -> dict:
+    """Wall time in seconds of one full 360° :func:`localise` per dtype (volatile: print only in ignored cells)."""
+    out = {}
+    for dt in dtypes:
+        t0 = time.perf_counter()
+        localise(grid, scan, dtype=dt)
+        out[np.dtype(dt).name] = time.perf_counter() - t0
+    return out

@@ -41,18 +41,27 @@ __all__ = [
 OXFORD_SEQUENCES = ("bark", "boat", "graf", "trees", "ubc", "wall")
 
 
-def load_oxford_image(sequence: str, index: int, *, scale: float = 1.0) -> np.ndarray:
-    """Grey uint8 image ``img<index>`` of an Oxford sequence, optionally resized by ``scale`` (INTER_AREA)."""
+def load_oxford_image(sequence: str, index: int, *, scale: float = 1.0, size=None) -> np.ndarray:
+    """Grey uint8 image ``img<index>`` of an Oxford sequence, resized by ``scale`` or to
+    ``size = (width_px, height_px)`` (INTER_AREA; e.g. 000's camera, (768, 576))."""
     import cv2
 
     sequence = v.check_choice(sequence, "sequence", OXFORD_SEQUENCES)
     index = v.check_int(index, "index", minimum=1, maximum=6)
     scale = v.check_positive(scale, "scale")
+    if size is not None:
+        if scale != 1.0:
+            raise ValueError(f"give `scale` or `size`, not both; got scale={scale}, size={size}")
+        if len(size) != 2:
+            raise ValueError(f"`size` must be (width_px, height_px); got {size}")
+        size = (v.check_int(size[0], "size[0]", minimum=1), v.check_int(size[1], "size[1]", minimum=1))
     path = Path(find_data(f"oxford-affine/{sequence}/img{index}.png"))
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
         raise FileNotFoundError(f"could not read {path}")
-    if scale != 1.0:
+    if size is not None:
+        img = cv2.resize(img, size, interpolation=cv2.INTER_AREA)
+    elif scale != 1.0:
         h, w = img.shape
         img = cv2.resize(img, (max(1, round(w * scale)), max(1, round(h * scale))), interpolation=cv2.INTER_AREA)
     return img

@@ -33,3 +33,11 @@ def test_plots_draw():
     axes = C.plot_error_distribution(mc)
     assert len(axes) == 2
     plt.close("all")
+
+
+def test_time_localise_reports_each_dtype():
+    M = S.test_room_200()
+    scan = S.Rangefinder(n_beams=90, max_range_cells=60).scan(M, [70, 30, 0.3])
+    t = C.time_localise(M, scan)
+    assert set(t) == {"float64", "float32"}
+    assert all(v > 0 for v in t.values())

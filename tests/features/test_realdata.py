@@ -97,3 +97,16 @@ def test_experiment_bad_input():
         F.run_pair_evaluation(("graf",), (2,), detectors=("AKAZE",))
     with pytest.raises(ValueError, match="`index` must be <= 6"):
         F.load_oxford_image("graf", 7)
+    with pytest.raises(ValueError, match="not both"):
+        F.load_oxford_image("graf", 1, scale=0.5, size=(768, 576))
+    with pytest.raises(ValueError, match="size"):
+        F.load_oxford_image("graf", 1, size=(768,))
+
+
+def test_load_oxford_image_to_000s_size(shared_data):
+    import cv2
+
+    img = F.load_oxford_image("graf", 1)
+    img768 = F.load_oxford_image("graf", 1, size=(768, 576))
+    assert img768.shape == (576, 768)  # rows, columns
+    np.testing.assert_array_equal(img768, cv2.resize(img, (768, 576), interpolation=cv2.INTER_AREA))
