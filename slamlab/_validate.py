@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from collections.abc import Callable, Iterable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -20,6 +22,7 @@ __all__ = [
     "as_image",
     "as_matrix",
     "as_measurement",
+    "as_path",
     "as_rng",
     "as_vector",
     "check_callable",
@@ -213,3 +216,19 @@ def check_callable(value: Any, name: str) -> Callable:
     if not callable(value):
         raise TypeError(f"`{name}` must be callable; got {type(value).__name__}")
     return value
+
+
+def as_path(value: Any, name: str = "path", *, kind: str = "any") -> Path:
+    """A ``str`` or ``os.PathLike`` as a :class:`pathlib.Path` that exists (``kind``: "file", "dir" or "any").
+
+    >>> as_path(".", kind="dir").is_dir()
+    True
+    """
+    if isinstance(value, bool) or not isinstance(value, (str, os.PathLike)):
+        raise TypeError(f"`{name}` must be a str or os.PathLike path; got {type(value).__name__}")
+    p = Path(value)
+    exists = {"file": p.is_file, "dir": p.is_dir, "any": p.exists}[check_choice(kind, "kind", ("file", "dir", "any"))]
+    if not exists():
+        what = {"file": "file", "dir": "folder", "any": "file or folder"}[kind]
+        raise FileNotFoundError(f"`{name}`: no {what} at {p}")
+    return p

@@ -333,7 +333,26 @@ def test_check_callable():
 
 def test_every_public_check_is_tested():
     tested = {
-        "as_covariance", "as_finite_array", "as_image", "as_matrix", "as_measurement", "as_rng", "as_vector",
+        "as_covariance", "as_finite_array", "as_image", "as_matrix", "as_measurement", "as_path", "as_rng", "as_vector",
         "check_callable", "check_choice", "check_int", "check_positive", "check_probability",
     }
     assert set(v.__all__) == tested
+
+
+# --- as_path -------------------------------------------------------------------------------------
+
+
+def test_as_path_accepts_str_and_pathlike(tmp_path):
+    f = tmp_path / "log.txt"
+    f.write_text("x")
+    assert v.as_path(str(f), kind="file") == f
+    assert v.as_path(tmp_path, kind="dir") == tmp_path
+
+
+def test_as_path_errors_name_the_argument(tmp_path):
+    with pytest.raises(TypeError, match=r"`log` must be a str or os\.PathLike path; got int"):
+        v.as_path(3, "log")
+    with pytest.raises(FileNotFoundError, match="`log`: no file at"):
+        v.as_path(tmp_path / "missing.log", "log", kind="file")
+    with pytest.raises(FileNotFoundError, match="`folder`: no folder at"):
+        v.as_path(tmp_path / "a.txt", "folder", kind="dir")
