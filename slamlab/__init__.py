@@ -14,10 +14,12 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
-from . import chapters, data, filters, geometry, plotting, sim
+from . import chapters, data, geometry
 
 __version__ = "0.1.0"
 
+# Every other subpackage (filters, sim, plotting, features, ...) is imported on first use by
+# __getattr__ below, so `import slamlab` loads no ipywidgets, matplotlib.pyplot or cv2 (tested).
 __all__ = ["__version__", "chapters", "data", "filters", "geometry", "notebook_setup", "plotting", "sim"]
 
 

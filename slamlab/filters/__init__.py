@@ -5,11 +5,13 @@ thin classes keep state (``KalmanFilter``, ``ExtendedKalmanFilter``,
 ``UnscentedKalmanFilter``, ``LandmarkFilter``).
 """
 
+from .._lazy import lazy_exports
 from ._linalg import CholeskyError, symmetrize
 from .consistency import chi2_interval, nees, nis
 from .ekf import ExtendedKalmanFilter, check_jacobian, ekf_predict, ekf_update, numerical_jacobian
 from .experiments import (
     default_landmarks,
+    ours_vs_source,
     run_cv_target,
     run_joseph_vs_short,
     run_landmark_filter,
@@ -19,7 +21,6 @@ from .experiments import (
 )
 from .kalman import KalmanFilter, Update, kf_predict, kf_update
 from .landmark import LandmarkFilter, landmark_predict, landmark_update
-from .plot import cv_figure, plot_cv_example, plot_joseph, plot_nees, plot_unicycle_paths, unicycle_figure
 from .ukf import (
     UnscentedKalmanFilter,
     sigma_points,
@@ -55,13 +56,17 @@ __all__ = [
     "unscented_transform",
 ]
 
-from .widgets import explore_cv_target, explore_unicycle
+# plots (pyplot) and widgets (ipywidgets) load on first use: `import slamlab.filters` stays light
+_PLOT = ("cv_figure", "plot_cv_example", "plot_joseph", "plot_nees", "plot_unicycle_paths", "unicycle_figure")
+__getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"),
+                                               **dict.fromkeys(("explore_cv_target", "explore_unicycle"), ".widgets")})
 
 __all__ += [
     "cv_figure",
     "default_landmarks",
     "explore_cv_target",
     "explore_unicycle",
+    "ours_vs_source",
     "plot_cv_example",
     "plot_joseph",
     "plot_nees",

@@ -68,11 +68,43 @@ def test_plots_and_widgets_run(capsys):
     P.cv_figure(E.run_cv_target(n_runs=2, n_steps=10, rng=1))
     P.plot_joseph(E.run_joseph_vs_short(n_samples=1000, rng=1))
     w = W.explore_unicycle(n_runs=2, n_steps=10)
-    # extreme slider values: a result or a readable message, never a traceback
-    w.f(n_runs=1, range_std_m=0.01, bearing_std_deg=0.5, omega_std_degps=0.0, init_heading_std_deg=120.0,
-        alpha=1e-4, beta=0.0, kappa=-2.0, stabilising_noise=0.25)
+    capsys.readouterr()  # drop what the widget printed for its defaults
+    # extreme slider values: the widget prints the library's own table for those values (no traceback);
+    # with kappa = -2 and a tiny alpha W_c^0 is so negative that the augmented UKF's covariance stops
+    # being positive definite: the table must count that run as failed, not hide it
+    knobs = {"range_std_m": 0.01, "bearing_std_deg": 0.5, "omega_std_degps": 0.0, "init_heading_std_deg": 120.0,
+             "alpha": 1e-4, "beta": 0.0, "kappa": -2.0, "stabilising_noise": 0.25}
+    w.f(n_runs=1, **knobs)
     out = capsys.readouterr().out
-    assert "filter" in out or "Cannot run" in out
+    expected = E.run_unicycle_comparison(1, 10, rng=2010, **knobs)
+    assert expected.table() in out
+    assert "Traceback" not in out
+    assert expected.failures[expected.filters.index("UKF-aug")] == 1
     W.explore_cv_target(n_runs=2, n_steps=5).f(accel_std=0.0, pos_std_m=0.05)
     assert "position RMSE" in capsys.readouterr().out
     matplotlib.pyplot.close("all")
+
+
+def test_ours_vs_source_verdicts_follow_the_results():
+    from dataclasses import replace
+
+    cv = E.run_cv_target(n_runs=20, n_steps=30, rng=3)
+    jo = E.run_joseph_vs_short(n_samples=2000, rng=3)
+    uni = E.run_unicycle_comparison(n_runs=4, n_steps=20, filters=("LKF", "EKF", "UKF-aug"), rng=3)
+    wide = E.run_unicycle_comparison(n_runs=4, n_steps=20, filters=("LKF", "EKF", "UKF-aug"), alpha=1.0,
+                                     kappa=1.0, rng=3)
+    st = E.run_stabilising_noise(scales=(1.0, 8.0), n_runs=4, n_steps=20, rng=3)
+    lm = E.run_landmark_filter(n_landmarks=400, n_sightings=10, rng=3)
+    table = E.ours_vs_source(cv, jo, uni, wide, st, lm)
+    kf_row = next(line for line in table.splitlines() if "KF is optimal" in line)
+    assert f"RMSE {cv.rmse_pos_m:.3f} m vs raw {cv.rmse_meas_m:.3f} m" in kf_row
+    # a KF worse than the raw measurements must not be called optimal
+    bad = replace(cv, rmse_pos_m=cv.rmse_meas_m + 1.0)
+    bad_row = next(line for line in E.ours_vs_source(bad, jo, uni, wide, st, lm).splitlines()
+                   if "KF is optimal" in line)
+    assert bad_row.rstrip().endswith("no")
+    # the landmark filter's error after n sightings is one sighting's / sqrt(n) (running mean): verdict yes
+    lm_row = next(line for line in table.splitlines() if "landmark KF" in line)
+    assert lm_row.rstrip().endswith("yes (000 gives no numbers)")
+    with pytest.raises(TypeError, match="`joseph` must be a JosephResult; got CVTargetResult"):
+        E.ours_vs_source(cv, cv, uni, wide, st, lm)
