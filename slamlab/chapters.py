@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CHAPTERS", "SHARED_TOPICS", "Chapter", "chapter_table", "get_chapter"]
+__all__ = ["CHAPTERS", "SHARED_TOPICS", "Chapter", "chapter_table", "get_chapter", "overview_vs_source"]
 
 
 @dataclass(frozen=True)
@@ -109,3 +109,22 @@ def chapter_table() -> str:
     lines = [fmt(head), "  ".join("-" * w for w in widths)]
     lines += [fmt(r) for r in rows]
     return "\n".join(lines)
+
+
+#: What notebook 00 takes from 000 §1, §1.1 and what it does with it: (item, 000, here).
+OVERVIEW_VS_SOURCE: tuple[tuple[str, str, str], ...] = (
+    ("definition of SLAM (§1)", "given, with requirements on the pose and the map", "summarised in English"),
+    ("five subtasks (§1)", "listed in this order", "same order; numbered in the figure"),
+    ("standard scheme (§1.1, Fig. 2)", "a figure (its image is not in our text)", "redrawn from §1.1's description"),
+)
+
+
+def overview_vs_source() -> str:
+    """Notebook 00's *Ours vs the source* table (000 §1, §1.1): nothing is measured, so it is a fixed table.
+
+    >>> print(overview_vs_source().splitlines()[1].split())
+    ['item', '000', 'here']
+    """
+    from ._table import format_table
+
+    return format_table(["item", "000", "here"], OVERVIEW_VS_SOURCE, title="Ours vs the source (000 §1, §1.1)")
