@@ -64,9 +64,21 @@ def test_bad_experiment_arguments():
 
 def test_plots_and_widgets_run(capsys):
     res = E.run_unicycle_comparison(n_runs=2, n_steps=20, rng=1)
-    P.unicycle_figure(res)
-    P.cv_figure(E.run_cv_target(n_runs=2, n_steps=10, rng=1))
-    P.plot_joseph(E.run_joseph_vs_short(n_samples=1000, rng=1))
+    fig = P.unicycle_figure(res)
+    paths, nees_ax = fig.axes
+    drawn = {line.get_label(): line for line in paths.get_lines()}
+    # every filter's estimate of run 1 is drawn with its own data, beside the truth
+    for i, name in enumerate(res.filters):
+        np.testing.assert_array_equal(drawn[name].get_xydata(), res.example_est[i][:, :2])
+    np.testing.assert_array_equal(drawn["truth"].get_xydata(), res.example_truth[:, :2])
+    nees_lines = {line.get_label(): line.get_ydata() for line in nees_ax.get_lines()}
+    np.testing.assert_array_equal(nees_lines["EKF"], res.anees[res.filters.index("EKF")])
+    cv = E.run_cv_target(n_runs=2, n_steps=10, rng=1)
+    kf_line = next(line for line in P.cv_figure(cv).axes[1].get_lines() if line.get_label() == "KF")
+    np.testing.assert_array_equal(kf_line.get_ydata(), cv.anees)
+    jo = E.run_joseph_vs_short(n_samples=1000, rng=1)
+    joseph_line = next(line for line in P.plot_joseph(jo).get_lines() if line.get_label() == "Joseph")
+    np.testing.assert_array_equal(joseph_line.get_ydata(), jo.var_joseph)
     w = W.explore_unicycle(n_runs=2, n_steps=10)
     capsys.readouterr()  # drop what the widget printed for its defaults
     # extreme slider values: the widget prints the library's own table for those values (no traceback);
@@ -80,8 +92,10 @@ def test_plots_and_widgets_run(capsys):
     assert expected.table() in out
     assert "Traceback" not in out
     assert expected.failures[expected.filters.index("UKF-aug")] == 1
-    W.explore_cv_target(n_runs=2, n_steps=5).f(accel_std=0.0, pos_std_m=0.05)
-    assert "position RMSE" in capsys.readouterr().out
+    w_cv = W.explore_cv_target(n_runs=2, n_steps=5)
+    capsys.readouterr()
+    w_cv.f(accel_std=0.0, pos_std_m=0.05)
+    assert E.run_cv_target(2, 5, accel_std=0.0, pos_std_m=0.05, rng=2010).table() in capsys.readouterr().out
     matplotlib.pyplot.close("all")
 
 
