@@ -46,3 +46,10 @@ def test_bad_input(tmp_path):
         rpe(t, t, delta=10)
     with pytest.raises(ValueError, match="trajectories without timestamps must have equal length"):
         associate(Trajectory.from_poses(t.poses[:3]), Trajectory.from_poses(t.poses))
+
+
+def test_non_numeric_token_names_file_line_and_token(tmp_path):
+    f = tmp_path / "est.txt"
+    f.write_text("0 0 0 0 0 0 0 1\n1 0 0 x1 0 0 0 1\n")
+    with pytest.raises(ValueError, match=r"est\.txt:2: 'x1' is not a number in a TUM line"):
+        read_tum(str(f))
