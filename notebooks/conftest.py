@@ -11,7 +11,12 @@ nbval runs cells here the way Jupyter does, with history. Nothing else changes.
 
 from __future__ import annotations
 
+import os
+
 from nbval import kernel as _nbval_kernel
+
+# The kernels nbval starts inherit this: no progress bars in the compared outputs (slamlab._progress).
+os.environ["SLAMLAB_PROGRESS"] = "0"
 
 
 def _execute_cell_input_with_history(self, cell_input, allow_stdin=None):

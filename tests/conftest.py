@@ -17,6 +17,9 @@ from slamlab import data as sl_data
 
 REQUIRE_ENV = "SLAMLAB_REQUIRE_REALDATA"
 
+# No progress bars on the tests' stderr, nor in the kernels nbval starts (they inherit this environment).
+os.environ["SLAMLAB_PROGRESS"] = "0"
+
 
 def _require_realdata() -> bool:
     return os.environ.get(REQUIRE_ENV, "").strip() not in ("", "0")

@@ -8,7 +8,7 @@ Usage::
     python tools/run_notebooks.py --check         # validate stored notebooks only
 
 Execution runs each notebook with a fresh python kernel of *this* interpreter
-(cwd = ``notebooks/``, ``MPLBACKEND=Agg``, 600 s per cell), then fails, naming
+(cwd = ``notebooks/``, ``MPLBACKEND=Agg``, ``SLAMLAB_PROGRESS=0``, 600 s per cell), then fails, naming
 the notebook and the cell, if any cell has an error output or printed to
 stderr (a warning printed by a cell is a bug to fix in the code, not to hide).
 On success it strips volatile metadata (widget state, execution timings,
@@ -168,6 +168,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"no notebooks found in {NOTEBOOK_DIR}", file=sys.stderr)
         return 1
     os.environ["MPLBACKEND"] = "Agg"
+    os.environ["SLAMLAB_PROGRESS"] = "0"  # no progress bars in the stored outputs (nbval's reference)
     failed = []
     for path in paths:
         if args.check:
