@@ -32,7 +32,7 @@ import numpy as np
 from . import _validate as v
 from ._progress import progress_bar
 
-__all__ = ["grid_points", "result_row", "sweep"]
+__all__ = ["grid_points", "result_row", "root_seed_sequence", "sweep"]
 
 BACKENDS = ("sequential", "loky", "dask")
 
@@ -67,6 +67,25 @@ def grid_points(grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | Non
             raise ValueError("`grid` must hold at least one point; got an empty sequence")
         return points
     raise TypeError(f"`grid` must be a mapping name -> values, a sequence of points or None; got {type(grid).__name__}")
+
+
+def root_seed_sequence(seed, name: str = "seed") -> np.random.SeedSequence:
+    """The ``SeedSequence`` the runs' streams are spawned from: ``SeedSequence(seed)`` for an int or None,
+    the sequence itself, or a Generator's own (so ``Generator.spawn`` and :func:`sweep` give the same streams).
+
+    >>> root_seed_sequence(7).entropy
+    7
+    """
+    if isinstance(seed, np.random.SeedSequence):
+        return seed
+    if isinstance(seed, np.random.Generator):
+        return seed.bit_generator.seed_seq
+    if seed is None or (isinstance(seed, numbers.Integral) and not isinstance(seed, bool)):
+        if seed is not None and seed < 0:
+            raise ValueError(f"`{name}` must be non-negative; got {seed}")
+        return np.random.SeedSequence(seed)
+    raise TypeError(f"`{name}` must be a numpy Generator, an int seed, a SeedSequence or None; "
+                    f"got {type(seed).__name__}")
 
 
 def _is_scalar(x: Any) -> bool:
@@ -135,8 +154,8 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
         See :func:`grid_points`.
     seeds : int
         Replicates per grid point (each with its own random stream).
-    seed : int
-        Root entropy of the ``SeedSequence`` every run's stream is spawned from.
+    seed : int, SeedSequence or Generator
+        Where every run's stream is spawned from (see :func:`root_seed_sequence`).
     n_jobs : int
         Parallel workers (``-1``: one per core).
     backend : {"sequential", "loky", "dask"}, optional
@@ -168,7 +187,7 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
     v.check_callable(fn, "fn")
     points = grid_points(grid)
     n_rep = v.check_int(seeds, "seeds", minimum=1)
-    root = v.check_int(seed, "seed", minimum=0)
+    root = root_seed_sequence(seed)
     n_jobs = v.check_int(n_jobs, "n_jobs", minimum=-1)
     if n_jobs == 0:
         raise ValueError("`n_jobs` must be a positive number of workers or -1 (one per core); got 0")
@@ -185,7 +204,7 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
         raise ValueError(f"`{rng_arg}` is given by sweep from the seeds; do not put it in `grid` or `fixed`")
 
     tasks = [(p, r) for p in points for r in range(n_rep)]
-    children = np.random.SeedSequence(root).spawn(len(tasks))
+    children = root.spawn(len(tasks))
     bar = progress_bar(total=len(tasks), desc=getattr(fn, "__name__", "sweep"), progress=progress)
     rows: list[dict[str, Any]] = []
     try:

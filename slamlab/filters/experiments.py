@@ -54,17 +54,6 @@ def _nanmean(a) -> float:
     return float(a[ok].mean()) if ok.any() else float("nan")
 
 
-def _spawn(rng, n):
-    """``n`` independent Generators from one seed / Generator (SeedSequence.spawn)."""
-    if isinstance(rng, np.random.Generator):
-        return rng.spawn(n)
-    if isinstance(rng, (int, np.integer)) or rng is None or isinstance(rng, np.random.SeedSequence):
-        ss = rng if isinstance(rng, np.random.SeedSequence) else np.random.SeedSequence(rng)
-        return [np.random.default_rng(s) for s in ss.spawn(n)]
-    v.as_rng(rng)  # raises the standard TypeError
-    return []
-
-
 # --- constant-velocity target: the KF is optimal --------------------------------------------------
 
 
@@ -107,37 +96,50 @@ class CVTargetResult:
         return format_table(["quantity", "value"], rows)
 
 
+def _cv_run(*, F, Q, H, R, P0, n_steps: int, rng: np.random.Generator) -> dict:
+    """One Monte Carlo run of the constant-velocity target: squared errors, NEES and NIS per step."""
+    x_true0 = rng.multivariate_normal(np.array([0.0, 1.0, 0.0, 0.5]), P0)
+    X, Z = simulate_linear(F, Q, H, R, x_true0, n_steps, rng=rng)
+    kf = KalmanFilter(np.array([0.0, 1.0, 0.0, 0.5]), P0, F, Q, H, R)
+    est = np.empty_like(X)
+    nees_k, nis_k = np.empty(n_steps), np.empty(n_steps)
+    var_pred = 0.0
+    for k in range(n_steps):
+        kf.predict()
+        kf.update(Z[k])
+        est[k] = kf.x
+        nees_k[k] = nees(X[k] - kf.x, kf.P)
+        nis_k[k] = nees(kf.y, kf.S)
+        var_pred += kf.P[0, 0] + kf.P[2, 2]
+    return {"se_pos": float(np.sum((est[:, [0, 2]] - X[:, [0, 2]]) ** 2)),
+            "se_meas": float(np.sum((Z - X[:, [0, 2]]) ** 2)), "var_pred": var_pred,
+            "nees": nees_k, "nis": nis_k, "example": (X, Z, est)}
+
+
+def _monte_carlo(run, n_runs: int, rng, n_jobs: int, progress, **fixed):
+    """``n_runs`` seeded runs of ``run`` on :func:`slamlab.sweep.sweep` (run r draws from child r of ``rng``)."""
+    from ..sweep import root_seed_sequence, sweep
+
+    table = sweep(run, None, seeds=n_runs, seed=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress, fixed=fixed)
+    failed = table["error"].notna()
+    if failed.any():
+        raise RuntimeError(f"{int(failed.sum())} Monte Carlo run(s) failed; first: {table['error'][failed].iloc[0]}")
+    return table
+
+
 def run_cv_target(n_runs: int = 50, n_steps: int = 50, *, dt_s: float = 1.0, accel_std: float = 0.2,
-                  pos_std_m: float = 1.0, rng=2010) -> CVTargetResult:
-    """Track a 2-D constant-velocity target with the KF over seeded Monte Carlo runs."""
+                  pos_std_m: float = 1.0, rng=2010, n_jobs: int = 1, progress: bool | None = None) -> CVTargetResult:
+    """Track a 2-D constant-velocity target with the KF over seeded Monte Carlo runs (on :func:`~slamlab.sweep.sweep`)."""
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=1)
     F, Q, H, R = constant_velocity_model(dt_s, accel_std, pos_std_m, dims=2)
     P0 = np.diag([pos_std_m**2, 1.0, pos_std_m**2, 1.0])
-    nees_all, nis_all = np.empty((n_runs, n_steps)), np.empty((n_runs, n_steps))
-    se_pos, se_meas, var_pred = 0.0, 0.0, 0.0
-    example = None
-    for r, g in enumerate(_spawn(rng, n_runs)):
-        x_true0 = g.multivariate_normal(np.array([0.0, 1.0, 0.0, 0.5]), P0)
-        X, Z = simulate_linear(F, Q, H, R, x_true0, n_steps, rng=g)
-        kf = KalmanFilter(np.array([0.0, 1.0, 0.0, 0.5]), P0, F, Q, H, R)
-        est = np.empty_like(X)
-        for k in range(n_steps):
-            kf.predict()
-            kf.update(Z[k])
-            est[k] = kf.x
-            nees_all[r, k] = nees(X[k] - kf.x, kf.P)
-            nis_all[r, k] = nees(kf.y, kf.S)
-            var_pred += kf.P[0, 0] + kf.P[2, 2]
-        se_pos += np.sum((est[:, [0, 2]] - X[:, [0, 2]]) ** 2)
-        se_meas += np.sum((Z - X[:, [0, 2]]) ** 2)
-        if example is None:
-            example = (X, Z, est)
+    runs = _monte_carlo(_cv_run, n_runs, rng, n_jobs, progress, F=F, Q=Q, H=H, R=R, P0=P0, n_steps=n_steps)
     n = n_runs * n_steps
     return CVTargetResult(
-        n_runs, n_steps, float(np.sqrt(se_pos / n)), float(np.sqrt(se_meas / n)), float(np.sqrt(var_pred / n)),
-        nees_all.mean(axis=0), nis_all.mean(axis=0), chi2_interval(4, n_runs), chi2_interval(2, n_runs),
-        *example,
+        n_runs, n_steps, float(np.sqrt(runs["se_pos"].sum() / n)), float(np.sqrt(runs["se_meas"].sum() / n)),
+        float(np.sqrt(runs["var_pred"].sum() / n)), np.stack(runs["nees"]).mean(axis=0),
+        np.stack(runs["nis"]).mean(axis=0), chi2_interval(4, n_runs), chi2_interval(2, n_runs), *runs["example"][0],
     )
 
 
@@ -291,13 +293,47 @@ class _LinearisedKF:
         self.dx, self.P, *_ = _update(self.dx, self.P, y, H, self.sensor.R)
 
 
+def _unicycle_run(*, filters, model, sensor, U, P0, alpha, beta, kappa, q_scale, rng) -> dict:
+    """One Monte Carlo run of every filter on the same simulated unicycle path (see run_unicycle_comparison)."""
+    n_steps, nf = U.shape[0], len(filters)
+    x_true0 = np.zeros(3)
+    X, Z = simulate_unicycle(model, sensor, x_true0, U, rng=rng)
+    x0 = x_true0 + rng.multivariate_normal(np.zeros(3), P0)
+    filt = _make_filters(filters, x0, P0, model, sensor, U[0], alpha, beta, kappa, q_scale)
+    if "LKF" in filters:
+        filt["LKF"] = _LinearisedKF(x0, P0, model, sensor, q_scale)
+    est = np.full((nf, n_steps, 3), np.nan)
+    cov = np.full((nf, n_steps, 3, 3), np.nan)
+    err = np.full((nf, n_steps, 3), np.nan)
+    nees_k = np.full((nf, n_steps), np.nan)
+    failed = np.zeros(nf, dtype=bool)
+    for i, name in enumerate(filters):
+        f = filt[name]
+        try:
+            for k in range(n_steps):
+                if name in ("EKF", "UKF-add"):
+                    f.Q = q_scale * model.Q(f.x, U[k])
+                f.predict(U[k])
+                f.update(Z[k])
+                est[i, k] = f.x
+                cov[i, k] = f.P
+        except (np.linalg.LinAlgError, ValueError):  # a numerical failure: counted, left out of the averages
+            failed[i] = True
+            est[i], cov[i] = np.nan, np.nan
+            continue
+        err[i] = model.residual(X, est[i])
+        nees_k[i] = nees(err[i], cov[i])
+    return {"err": err, "nees": nees_k, "failed": failed, "example": (X, est, cov)}
+
+
 def run_unicycle_comparison(n_runs: int = 30, n_steps: int = 60, *, filters=FILTER_NAMES,
                             range_std_m: float = 0.5, bearing_std_deg: float = 10.0,
                             v_std_mps: float = 0.2, omega_std_degps: float = 10.0,
                             init_pos_std_m: float = 1.0, init_heading_std_deg: float = 90.0,
                             landmarks_m=None, dt_s: float = 0.5, speed_mps: float = 1.0,
                             turn_rate_degps: float = 11.46, alpha: float = 1e-3, beta: float = 2.0,
-                            kappa: float = 0.0, stabilising_noise: float = 1.0, rng=2010) -> UnicycleResult:
+                            kappa: float = 0.0, stabilising_noise: float = 1.0, rng=2010, n_jobs: int = 1,
+                            progress: bool | None = None) -> UnicycleResult:
     """Compare the linearised KF, EKF and augmented/additive UKF on a range-bearing unicycle (000 §1.2).
 
     The robot drives a circle (``speed_mps``, ``turn_rate_degps``); its control
@@ -319,45 +355,20 @@ def run_unicycle_comparison(n_runs: int = 30, n_steps: int = 60, *, filters=FILT
     sensor = RangeBearingSensor(lm, range_std_m, np.deg2rad(bearing_std_deg))
     U = np.tile([speed_mps, np.deg2rad(turn_rate_degps)], (n_steps, 1))
     P0 = np.diag([init_pos_std_m**2, init_pos_std_m**2, np.deg2rad(init_heading_std_deg) ** 2])
-    nf = len(filters)
-    se_pos, se_head = np.zeros(nf), np.zeros(nf)
-    counts = np.zeros(nf)
-    nees_sum, nees_cnt = np.zeros((nf, n_steps)), np.zeros((nf, n_steps))
-    failures = np.zeros(nf, dtype=int)
-    run_rmse = np.full((nf, n_runs), np.nan)
-    ex_truth = ex_est = ex_P = None
-    for r, g in enumerate(_spawn(rng, n_runs)):
-        x_true0 = np.zeros(3)
-        X, Z = simulate_unicycle(model, sensor, x_true0, U, rng=g)
-        x0 = x_true0 + g.multivariate_normal(np.zeros(3), P0)
-        filt = _make_filters(filters, x0, P0, model, sensor, U[0], alpha, beta, kappa, q_scale)
-        if "LKF" in filters:
-            filt["LKF"] = _LinearisedKF(x0, P0, model, sensor, q_scale)
-        est = np.full((nf, n_steps, 3), np.nan)
-        cov = np.full((nf, n_steps, 3, 3), np.nan)
-        for i, name in enumerate(filters):
-            f = filt[name]
-            try:
-                for k in range(n_steps):
-                    if name in ("EKF", "UKF-add"):
-                        f.Q = q_scale * model.Q(f.x, U[k])
-                    f.predict(U[k])
-                    f.update(Z[k])
-                    est[i, k] = f.x
-                    cov[i, k] = f.P
-            except (np.linalg.LinAlgError, ValueError):
-                failures[i] += 1
-                est[i], cov[i] = np.nan, np.nan
-                continue
-            err = model.residual(X, est[i])
-            se_pos[i] += np.sum(err[:, :2] ** 2)
-            run_rmse[i, r] = np.sqrt(np.mean(np.sum(err[:, :2] ** 2, axis=1)))
-            se_head[i] += np.sum(err[:, 2] ** 2)
-            counts[i] += n_steps
-            nees_sum[i] += nees(err, cov[i])
-            nees_cnt[i] += 1
-        if r == 0:
-            ex_truth, ex_est, ex_P = X, est, cov
+    runs = _monte_carlo(_unicycle_run, n_runs, rng, n_jobs, progress, filters=filters, model=model, sensor=sensor,
+                        U=U, P0=P0, alpha=alpha, beta=beta, kappa=kappa, q_scale=q_scale)
+    ok = ~np.stack(runs["failed"])  # (n_runs, nf)
+    err = np.stack(runs["err"])  # (n_runs, nf, n_steps, 3), NaN for a failed filter
+    sq_pos = np.sum(err[..., :2] ** 2, axis=-1)  # (n_runs, nf, n_steps)
+    se_pos = np.where(ok, sq_pos.sum(axis=-1), 0.0).sum(axis=0)
+    se_head = np.where(ok, np.sum(err[..., 2] ** 2, axis=-1), 0.0).sum(axis=0)
+    counts = ok.sum(axis=0) * n_steps
+    failures = (~ok).sum(axis=0)
+    run_rmse = np.where(ok, np.sqrt(np.mean(sq_pos, axis=-1)), np.nan).T  # (nf, n_runs)
+    nees_runs = np.stack(runs["nees"])  # (n_runs, nf, n_steps)
+    nees_sum = np.where(ok[..., None], nees_runs, 0.0).sum(axis=0)
+    nees_cnt = np.broadcast_to(ok.sum(axis=0)[:, None], nees_sum.shape).astype(float)
+    ex_truth, ex_est, ex_P = runs["example"][0]
     with np.errstate(invalid="ignore", divide="ignore"):
         rmse_pos = np.sqrt(se_pos / counts)
         rmse_head = np.sqrt(se_head / counts)

@@ -122,3 +122,15 @@ def test_ours_vs_source_verdicts_follow_the_results():
     assert lm_row.rstrip().endswith("yes (000 gives no numbers)")
     with pytest.raises(TypeError, match="`joseph` must be a JosephResult; got CVTargetResult"):
         E.ours_vs_source(cv, cv, uni, wide, st, lm)
+
+
+def test_monte_carlo_runs_are_the_same_on_two_workers():
+    """The NEES studies run on slamlab.sweep: one seeded stream per run, whichever process runs it."""
+    one = E.run_unicycle_comparison(n_runs=4, n_steps=15, rng=7)
+    two = E.run_unicycle_comparison(n_runs=4, n_steps=15, rng=7, n_jobs=2)
+    assert one.table() == two.table()
+    np.testing.assert_array_equal(one.anees, two.anees)
+    # run r draws from child r of SeedSequence(rng), as Generator.spawn does
+    from_gen = E.run_cv_target(n_runs=3, n_steps=5, rng=np.random.default_rng(7))
+    from_int = E.run_cv_target(n_runs=3, n_steps=5, rng=7)
+    np.testing.assert_array_equal(from_gen.anees, from_int.anees)
