@@ -9,7 +9,7 @@ PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
 	-p no:cacheprovider
 
-.PHONY: venv lab test notebooks lint bench lock clean distclean
+.PHONY: venv lab test notebooks report lint bench lock clean distclean
 
 ## venv: create .venv if missing and install slamlab[test] from constraints.txt (again only when those change)
 venv: $(STAMP)
@@ -31,6 +31,10 @@ test: venv
 ## notebooks: re-execute every notebook in place (refreshes nbval's stored reference outputs)
 notebooks: venv
 	MPLBACKEND=Agg $(BIN)/python tools/run_notebooks.py
+
+## report: run one notebook with other parameters into reports/, e.g. make report NB=01 PARAMS="CV_RUNS=10 SEED=7"
+report: venv
+	MPLBACKEND=Agg $(BIN)/python tools/report.py $(NB) $(PARAMS)
 
 ## lint: ruff
 lint: venv
