@@ -22,7 +22,7 @@ from pathlib import Path
 import nbformat
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from run_notebooks import NOTEBOOK_DIR, _kernel_manager  # noqa: E402
+from run_notebooks import NOTEBOOK_DIR, _kernel_manager
 
 PROBE = ("import resource as _r\n"
          "print('PEAK_RSS_KIB', _r.getrusage(_r.RUSAGE_SELF).ru_maxrss, _r.getrusage(_r.RUSAGE_CHILDREN).ru_maxrss)")
