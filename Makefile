@@ -20,9 +20,11 @@ $(STAMP): pyproject.toml constraints.txt
 	$(BIN)/python -m pip install -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
-## lab: start JupyterLab on notebooks/
+## lab: start JupyterLab on notebooks/ (as root too, as the Jupyter Docker stacks do: containers and lab VMs)
+LAB_ARGS ?=
+ROOT_ARGS := $(if $(filter 0,$(shell id -u)),--allow-root,)
 lab: venv
-	$(BIN)/jupyter lab notebooks/
+	$(BIN)/jupyter lab $(ROOT_ARGS) $(LAB_ARGS) notebooks/
 
 ## test: the whole suite in one pytest run: unit tests, doctests, every notebook under nbval
 test: venv
