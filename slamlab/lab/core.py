@@ -1,0 +1,231 @@
+"""Self-checks for the lab assignments: the student's function against the library's on seeded cases.
+
+A :class:`Task` names the library's reference function, the cases to try (seeded random
+ones and the edge cases that matter), how to compare results, and one hint. :func:`check`
+runs a student's function on every case and reports, in a few lines, the first case that
+fails (its inputs, the expected and the received values, the hint), or "passed", or "not
+done yet" while the function still raises ``NotImplementedError`` (what nbgrader's student
+version holds). An exception raised by the student's code is shown as one short message
+pointing at the student's own line, never as a traceback through slamlab.
+
+Under nbgrader's autograder (``NBGRADER_EXECUTION`` set) a check that does not pass raises
+``AssertionError`` with the same short message, so the cell scores zero; everywhere else a
+check only prints and returns its :class:`CheckResult`.
+"""
+
+from __future__ import annotations
+
+import os
+import traceback
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Case", "CheckResult", "ExplorationTask", "Task", "answer", "check", "register", "task"]
+
+_PKG_DIR = str(Path(__file__).resolve().parent.parent)
+_REGISTRY: dict[str, Task | ExplorationTask] = {}
+
+
+@dataclass(frozen=True)
+class Case:
+    """One call to try: a label for the report, keyword arguments, and whether it is an edge case."""
+
+    label: str
+    kwargs: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Task:
+    """An implementation task: the student's function must agree with ``reference`` on every case.
+
+    ``cases(rng)`` returns the cases (seeded random ones first, then edge cases); ``compare(expected,
+    received)`` returns None when they agree, else a short description of the difference.
+    """
+
+    task_id: str
+    title: str
+    reference: Callable[..., Any]
+    cases: Callable[[np.random.Generator], list[Case]]
+    hint: str
+    compare: Callable[[Any, Any], str | None] = field(default=None)
+    points: int = 1
+
+
+@dataclass(frozen=True)
+class ExplorationTask:
+    """A question answered with a number found by running an experiment; ``accept(value)`` says if it is right."""
+
+    task_id: str
+    question: str
+    expected: Callable[[], float]
+    rtol: float = 0.0
+    atol: float = 0.0
+    hint: str = ""
+    points: int = 1
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """What a check found: ``status`` is "passed", "failed", "error" or "not done yet"."""
+
+    task_id: str
+    status: str
+    message: str
+
+    @property
+    def passed(self) -> bool:
+        return self.status == "passed"
+
+    def __str__(self) -> str:
+        return self.message
+
+
+def register(t: Task | ExplorationTask) -> Task | ExplorationTask:
+    """Add a task to the registry (ids are unique)."""
+    if t.task_id in _REGISTRY:
+        raise ValueError(f"task id {t.task_id!r} is registered twice")
+    _REGISTRY[t.task_id] = t
+    return t
+
+
+def task(task_id: str) -> Task | ExplorationTask:
+    """The registered task ``task_id``."""
+    _load_tasks()
+    try:
+        return _REGISTRY[task_id]
+    except KeyError:
+        known = ", ".join(sorted(_REGISTRY))
+        raise ValueError(f"`task_id` must be one of {known}; got {task_id!r}") from None
+
+
+def _load_tasks() -> None:
+    from . import tasks_filters  # noqa: F401  (registers on import)
+
+
+def all_tasks() -> dict[str, Task | ExplorationTask]:
+    """Every registered task by id."""
+    _load_tasks()
+    return dict(_REGISTRY)
+
+
+# --- comparing ----------------------------------------------------------------------------------
+
+
+def allclose(rtol: float = 1e-7, atol: float = 1e-9) -> Callable[[Any, Any], str | None]:
+    """Compare arrays, scalars or tuples of them elementwise with ``rtol``/``atol``."""
+
+    def compare(expected, received) -> str | None:
+        if isinstance(expected, tuple):
+            if not isinstance(received, (tuple, list)) or len(received) != len(expected):
+                got = f"a {type(received).__name__}" + (f" of {len(received)}" if hasattr(received, "__len__") else "")
+                return f"expected a tuple of {len(expected)} values; got {got}"
+            for i, (e, r) in enumerate(zip(expected, received, strict=True)):
+                diff = compare(e, r)
+                if diff is not None:
+                    return f"item {i} of the returned tuple: {diff}"
+            return None
+        e = np.asarray(expected, dtype=float)
+        try:
+            r = np.asarray(received, dtype=float)
+        except (TypeError, ValueError):
+            return f"expected numbers; got {type(received).__name__}"
+        if r.shape != e.shape:
+            return f"expected shape {e.shape}; got shape {r.shape}"
+        if not np.allclose(r, e, rtol=rtol, atol=atol, equal_nan=True):
+            k = np.unravel_index(np.argmax(np.abs(r - e)), e.shape) if e.shape else ()
+            return f"largest difference at index {tuple(int(i) for i in k)}: expected {float(e[k]):.6g}, got {float(r[k]):.6g}"
+        return None
+
+    return compare
+
+
+# --- running a student's function ---------------------------------------------------------------
+
+
+def _student_line(exc: BaseException) -> str:
+    """Where in the student's code ``exc`` was raised: the last frame outside slamlab."""
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if not f.filename.startswith(_PKG_DIR)]
+    if not frames:
+        return "inside a library call your function made"
+    f = frames[-1]
+    where = f"line {f.lineno} of your cell" if "ipykernel" in f.filename or f.filename.startswith("<") \
+        else f"{Path(f.filename).name}, line {f.lineno}"
+    return f"{where}: {f.line}" if f.line else where
+
+
+def _fmt(value: Any) -> str:
+    with np.printoptions(precision=6, suppress=False, threshold=20, linewidth=100):
+        if isinstance(value, dict):
+            return ", ".join(f"{k}={_fmt(v)}" for k, v in value.items())
+        if isinstance(value, tuple):
+            return "(" + ", ".join(_fmt(v) for v in value) + ")"
+        return np.array2string(np.asarray(value), separator=", ") if isinstance(value, (list, np.ndarray)) \
+            else repr(value)
+
+
+def _finish(result: CheckResult, quiet: bool) -> CheckResult:
+    if not quiet:
+        print(result.message)
+    if os.environ.get("NBGRADER_EXECUTION") and not result.passed:
+        raise AssertionError(result.message)
+    return result
+
+
+def check(task_id: str, fn: Callable, *, seed: int = 0, quiet: bool = False) -> CheckResult:
+    """Run the student's ``fn`` on the task's cases; print and return pass, the first failure, or "not done yet"."""
+    t = task(task_id)
+    if not isinstance(t, Task):
+        raise TypeError(f"{task_id!r} is answered with a number: use sl.lab.answer({task_id!r}, value)")
+    if not callable(fn):
+        return _finish(CheckResult(task_id, "failed", f"{t.title}: expected a function; got {type(fn).__name__}"),
+                       quiet)
+    compare = t.compare or allclose()
+    cases = t.cases(np.random.default_rng(seed))
+    for n, case in enumerate(cases, start=1):
+        expected = t.reference(**case.kwargs)
+        try:
+            received = fn(**{k: _copy(v) for k, v in case.kwargs.items()})
+        except NotImplementedError:
+            return _finish(CheckResult(task_id, "not done yet", f"{t.title}: not done yet."), quiet)
+        except Exception as exc:  # noqa: BLE001 (the student's error becomes a short message)
+            msg = (f"{t.title}: case {n} of {len(cases)} ({case.label}) raised {type(exc).__name__}: {exc}\n"
+                   f"  at {_student_line(exc)}\n  inputs: {_fmt(case.kwargs)}\n  hint: {t.hint}")
+            return _finish(CheckResult(task_id, "error", msg), quiet)
+        diff = compare(expected, received)
+        if diff is not None:
+            msg = (f"{t.title}: case {n} of {len(cases)} ({case.label}) is wrong: {diff}\n"
+                   f"  inputs: {_fmt(case.kwargs)}\n  expected: {_fmt(expected)}\n  received: {_fmt(received)}\n"
+                   f"  hint: {t.hint}")
+            return _finish(CheckResult(task_id, "failed", msg), quiet)
+    return _finish(CheckResult(task_id, "passed", f"{t.title}: passed ({len(cases)} cases)."), quiet)
+
+
+def _copy(value):
+    """Each call gets its own copy, so a function that changes its inputs cannot change the next case."""
+    return value.copy() if isinstance(value, np.ndarray) else value
+
+
+def answer(task_id: str, value, *, quiet: bool = False) -> CheckResult:
+    """Check a number found by experiment against the library's own run (within the task's tolerance)."""
+    t = task(task_id)
+    if not isinstance(t, ExplorationTask):
+        raise TypeError(f"{task_id!r} is an implementation task: use sl.lab.check({task_id!r}, your_function)")
+    if value is None or value is Ellipsis:
+        return _finish(CheckResult(task_id, "not done yet", f"{t.question} — not done yet."), quiet)
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return _finish(CheckResult(task_id, "failed", f"{t.question} — expected a number; got {value!r}"), quiet)
+    exp = float(t.expected())
+    if abs(x - exp) <= t.atol + t.rtol * abs(exp):
+        return _finish(CheckResult(task_id, "passed", f"{t.question} — {x:g}: passed."), quiet)
+    return _finish(CheckResult(task_id, "failed", f"{t.question} — {x:g} is not it. Hint: {t.hint}"), quiet)
+
+
+def tasks_of(prefix: str) -> Iterable[str]:
+    """Ids of the registered tasks starting with ``prefix`` (e.g. "01.")."""
+    return sorted(k for k in all_tasks() if k.startswith(prefix))
