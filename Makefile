@@ -9,7 +9,7 @@ PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
 	-p no:cacheprovider
 
-.PHONY: venv lab test notebooks report lint bench lock clean distclean
+.PHONY: venv lab test notebooks report student autograde lint bench lock clean distclean
 
 ## venv: create .venv if missing and install slamlab[test] from constraints.txt (again only when those change)
 venv: $(STAMP)
@@ -37,6 +37,14 @@ notebooks: venv
 ## report: run one notebook with other parameters into reports/, e.g. make report NB=01 PARAMS="CV_RUNS=10 SEED=7"
 report: venv
 	MPLBACKEND=Agg $(BIN)/python tools/report.py $(NB) $(PARAMS)
+
+## student: the labs without their solutions (nbgrader generate_assignment) in build/student/
+student: venv
+	$(BIN)/python tools/labs.py student
+
+## autograde: grade SUBMISSIONS=<folder of <student>/<NN_topic_lab>.ipynb>; writes build/course/grades.csv
+autograde: venv
+	$(BIN)/python tools/labs.py autograde $(SUBMISSIONS)
 
 ## lint: ruff
 lint: venv

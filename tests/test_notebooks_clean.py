@@ -11,6 +11,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+LABS = sorted((ROOT / "notebooks" / "labs").glob("*_lab.ipynb"))
 
 FIRST_CELL = re.compile(
     r"%matplotlib inline\n"
@@ -33,7 +34,7 @@ runner = _load_runner()
 
 def test_there_are_notebooks():
     assert NOTEBOOKS, "no notebooks/*.ipynb"
-    assert runner.default_notebooks() == NOTEBOOKS
+    assert runner.default_notebooks() == NOTEBOOKS + LABS
 
 
 def test_filenames_numbered_uniquely():
@@ -45,7 +46,7 @@ def test_filenames_numbered_uniquely():
     assert len(numbers) == len(set(numbers)), f"repeated notebook numbers: {numbers}"
 
 
-@pytest.fixture(params=NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
+@pytest.fixture(params=NOTEBOOKS + LABS, ids=[p.name for p in NOTEBOOKS + LABS])
 def notebook(request):
     return request.param, nbformat.read(request.param, as_version=4)
 

@@ -3,7 +3,7 @@
 
 Usage::
 
-    python tools/run_notebooks.py                 # every notebooks/*.ipynb, sorted
+    python tools/run_notebooks.py                 # every notebooks/*.ipynb and labs/*_lab.ipynb
     python tools/run_notebooks.py notebooks/01_kalman_filters.ipynb
     python tools/run_notebooks.py --check         # validate stored notebooks only
 
@@ -43,8 +43,8 @@ VOLATILE_LANGUAGE_INFO = ("version",)
 
 
 def default_notebooks() -> list[Path]:
-    """Every ``notebooks/*.ipynb``, sorted by name."""
-    return sorted(NOTEBOOK_DIR.glob("*.ipynb"))
+    """Every ``notebooks/*.ipynb``, then every lab ``notebooks/labs/*_lab.ipynb``, sorted by name."""
+    return sorted(NOTEBOOK_DIR.glob("*.ipynb")) + sorted((NOTEBOOK_DIR / "labs").glob("*_lab.ipynb"))
 
 
 def _cell_label(index: int, cell) -> str:

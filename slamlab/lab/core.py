@@ -210,10 +210,22 @@ def _copy(value):
 
 
 def answer(task_id: str, value, *, quiet: bool = False) -> CheckResult:
-    """Check a number found by experiment against the library's own run (within the task's tolerance)."""
+    """Check a number found by experiment against the library's own run (within the task's tolerance).
+
+    ``value`` is the number, or a function returning it (called here; ``NotImplementedError``
+    from it means "not done yet", as in nbgrader's student version).
+    """
     t = task(task_id)
     if not isinstance(t, ExplorationTask):
         raise TypeError(f"{task_id!r} is an implementation task: use sl.lab.check({task_id!r}, your_function)")
+    if callable(value):  # a function that runs the experiment and returns the number
+        try:
+            value = value()
+        except NotImplementedError:
+            value = None
+        except Exception as exc:  # noqa: BLE001 (the student's error becomes a short message)
+            msg = f"{t.question} — your function raised {type(exc).__name__}: {exc}\n  at {_student_line(exc)}"
+            return _finish(CheckResult(task_id, "error", msg), quiet)
     if value is None or value is Ellipsis:
         return _finish(CheckResult(task_id, "not done yet", f"{t.question} — not done yet."), quiet)
     try:

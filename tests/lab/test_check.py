@@ -127,3 +127,16 @@ def test_task_lookup_errors():
         lab.check("01.explore.q_scale", kf_predict)
     with pytest.raises(TypeError, match=r"use sl\.lab\.check"):
         lab.answer("01.kf_predict", 3)
+
+
+def test_exploration_answer_given_as_a_function():
+    def todo():
+        raise NotImplementedError
+
+    def broken():
+        return 1 / 0
+
+    assert lab.answer("01.explore.q_scale", todo, quiet=True).status == "not done yet"
+    res = lab.answer("01.explore.q_scale", broken, quiet=True)
+    assert res.status == "error"
+    assert "return 1 / 0" in res.message

@@ -1,0 +1,106 @@
+#!/usr/bin/env python
+"""Student versions of the labs and autograding, with nbgrader (``pip install 'slamlab[course]'``).
+
+Usage::
+
+    python tools/labs.py student [--out build/student]     # make student
+    python tools/labs.py autograde SUBMISSIONS [--course build/course]   # make autograde SUBMISSIONS=...
+
+``student`` copies ``notebooks/labs/*_lab.ipynb`` (nbgrader's source format: solutions between
+``### BEGIN SOLUTION`` / ``### END SOLUTION``, graded cells with ids and points) into an nbgrader
+course folder as the assignment ``labs``, runs ``nbgrader generate_assignment`` and copies the
+student versions to ``--out``. ``autograde`` takes a folder holding one sub-folder per student
+(``SUBMISSIONS/<student_id>/<NN_topic_lab>.ipynb``), runs ``nbgrader autograde`` and writes
+``grades.csv`` (``nbgrader export``) into the course folder, printing its path.
+On a JupyterHub with nbgrader's own course set-up, the same notebooks go into ``source/`` there.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+LAB_DIR = ROOT / "notebooks" / "labs"
+ASSIGNMENT = "labs"
+
+
+def _nbgrader(course: Path, *args: str) -> None:
+    env = dict(os.environ)
+    # nbgrader calls `alembic` (its database migrations) by name: this interpreter's scripts must be on PATH
+    env["PATH"] = str(Path(sys.executable).parent) + os.pathsep + env.get("PATH", "")
+    env.setdefault("MPLBACKEND", "Agg")
+    env.setdefault("SLAMLAB_PROGRESS", "0")
+    cmd = [sys.executable, "-m", "nbgrader", *args, f"--CourseDirectory.root={course}"]
+    proc = subprocess.run(cmd, cwd=course, env=env, capture_output=True, text=True, check=False)
+    if proc.returncode != 0 or "[ERROR]" in proc.stderr or "| ERROR]" in proc.stderr:
+        raise SystemExit(f"nbgrader {' '.join(args)} failed:\n{proc.stderr[-3000:]}")
+
+
+def lab_notebooks() -> list[Path]:
+    """Every lab notebook, ``notebooks/labs/NN_topic_lab.ipynb``."""
+    return sorted(LAB_DIR.glob("*_lab.ipynb"))
+
+
+def make_student(out: Path, course: Path) -> list[Path]:
+    """Generate the student versions into ``out``; return their paths."""
+    source = course / "source" / ASSIGNMENT
+    if source.exists():
+        shutil.rmtree(source)
+    source.mkdir(parents=True)
+    for nb in lab_notebooks():
+        shutil.copy2(nb, source / nb.name)
+    _nbgrader(course, "generate_assignment", ASSIGNMENT, "--force")
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for nb in sorted((course / "release" / ASSIGNMENT).glob("*.ipynb")):
+        shutil.copy2(nb, out / nb.name)
+        written.append(out / nb.name)
+    return written
+
+
+def autograde(submissions: Path, course: Path) -> Path:
+    """Autograde ``submissions/<student>/*.ipynb``; return the path of the grades CSV."""
+    if not (course / "source" / ASSIGNMENT).is_dir():
+        make_student(course / "student", course)  # the gradebook needs the assignment first
+    students = sorted(p for p in submissions.iterdir() if p.is_dir())
+    if not students:
+        raise SystemExit(f"no student folders in {submissions}")
+    for student in students:
+        dst = course / "submitted" / student.name / ASSIGNMENT
+        if dst.exists():
+            shutil.rmtree(dst)
+        dst.mkdir(parents=True)
+        for nb in student.glob("*_lab.ipynb"):
+            shutil.copy2(nb, dst / nb.name)
+    _nbgrader(course, "autograde", ASSIGNMENT, "--force")
+    _nbgrader(course, "export", "--to=grades.csv")
+    return course / "grades.csv"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    st = sub.add_parser("student", help="write the student versions")
+    st.add_argument("--out", type=Path, default=ROOT / "build" / "student")
+    st.add_argument("--course", type=Path, default=ROOT / "build" / "course")
+    ag = sub.add_parser("autograde", help="grade a folder of submissions")
+    ag.add_argument("submissions", type=Path)
+    ag.add_argument("--course", type=Path, default=ROOT / "build" / "course")
+    args = parser.parse_args(argv)
+    course = args.course.resolve()
+    course.mkdir(parents=True, exist_ok=True)
+    if args.command == "student":
+        for path in make_student(args.out.resolve(), course):
+            print(path)
+    else:
+        print(autograde(args.submissions.resolve(), course))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
