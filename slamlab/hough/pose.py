@@ -23,7 +23,7 @@ import numpy as np
 from .. import _validate as v
 from ..geometry import wrap_angle
 
-__all__ = ["PoseChange", "compose", "pose_from_lines", "pose_from_two_lines", "select_line_pair"]
+__all__ = ["PoseChange", "pose_from_lines", "pose_from_two_lines", "select_line_pair"]
 
 
 @dataclass(frozen=True)
@@ -198,15 +198,3 @@ def pose_from_lines(rho_i, theta_i_rad, rho_j, theta_j_rad, votes=None, *, metho
         return fail
     change = float(np.ptp(wrap_angle(dphi_all[use] - dphi)))
     return PoseChange(np.array([t[0], t[1], dphi]), True, use, change)
-
-
-def compose(pose_a, delta) -> np.ndarray:
-    """``pose_a ⊕ delta``: a pose ``(x, y, φ)`` moved by ``delta`` given in its own frame.
-
-    >>> compose((1.0, 2.0, np.pi / 2), (3.0, 0.0, 0.1)).round(12).tolist()
-    [1.0, 5.0, 1.670796326795]
-    """
-    x, y, phi = v.as_vector(pose_a, "pose_a", 3)
-    dx, dy, dphi = v.as_vector(delta, "delta", 3)
-    c, s = math.cos(phi), math.sin(phi)
-    return np.array([x + c * dx - s * dy, y + s * dx + c * dy, phi + dphi])
