@@ -467,9 +467,14 @@ def time_polar_vs_opencv(*, cell_m: float = 0.05, r_max_m: float = 30.0, room_ha
 
 
 def ours_vs_source(sim: SimSlamResult, *, example: ExampleLineResult | None = None,
-                   exact: SimSlamResult | None = None, real=()) -> str:
+                   exact: SimSlamResult | None = None, variants=(), two_lines_error: float | None = None,
+                   real=()) -> str:
     """The notebook's closing table: 004's statements (§Hough SLAM, Fig. 5-11) and 000 §1.3.2's odometry
-    figures beside ours, computed from the runs' results."""
+    figures beside ours, computed from the runs' results.
+
+    ``variants``: ``(label, SimSlamResult)`` pairs (e.g. 004's two-line pose, no refit);
+    ``two_lines_error``: :func:`check_pose_from_two_lines`'s result; ``real``: :class:`RealLogResult` objects.
+    """
     if not isinstance(sim, SimSlamResult):
         raise TypeError(f"`sim` must be a SimSlamResult; got {type(sim).__name__}")
 
@@ -485,11 +490,17 @@ def ours_vs_source(sim: SimSlamResult, *, example: ExampleLineResult | None = No
                   f"{example.classic_size[0]}×{example.classic_size[1]}")],
                  ["example line found (rho, θ°), polar", "(10, 45)",
                   f"({example.polar_line[0]:.1f}, {example.polar_line[1]:.1f})"]]
+    if two_lines_error is not None:
+        rows.append(["pose from two lines, exact synthetic cases: largest error", "formula (lost, reconstructed)",
+                     f"{two_lines_error:.1e}"])
     if exact is not None:
         rows.append([f"max |Ex| / |Ey|, |Ea|, range σ = {exact.range_std_cells:g} (Fig. 10)",
                      "orders of magnitude below 1 cell, 1°", maxima(exact)])
     rows.append([f"max |Ex| / |Ey|, |Ea|, range σ = {sim.range_std_cells:g} (Fig. 10)",
                  "orders of magnitude below 1 cell, 1°", maxima(sim)])
+    for label, r in variants:
+        rows.append([f"{label}: max |Ex| / |Ey|, |Ea| (Fig. 10)", "orders of magnitude below 1 cell, 1°",
+                     f"{maxima(r)}; {int(r.slam.lost.sum())} lost"])
     agree = map_agreement(sim.built_map, sim.reference_map)
     rows.append(["built map: obstacle cells on a true obstacle (±1 cell) (Fig. 11)", "every shape kept",
                  f"{agree['precision']:.0%}"])

@@ -71,7 +71,7 @@ class Scan:
     --------
     >>> s = Scan([0.0, np.pi / 2], [2.0, 5.0], [True, False], unit="cell", max_range=5.0, pose=[1, 1, 0])
     >>> print(s)
-    Scan of 2 beams, 1 returns, max range 5 cell
+    Scan of 2 beams, 1 returns, max range 5 cells
     >>> s.points().tolist()
     [[3.0, 1.0]]
     """
@@ -116,7 +116,7 @@ class Scan:
 
     def __str__(self) -> str:
         return (f"Scan of {self.n_beams} beams, {int(self.valid.sum())} returns, "
-                f"max range {self.max_range:g} {self.unit}")
+                f"max range {self.max_range:g} {'cells' if self.unit == 'cell' else self.unit}")
 
     def points(self, pose=None) -> np.ndarray:
         """World points ``(x, y)`` of the returns, seen from ``pose``.
