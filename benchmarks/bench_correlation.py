@@ -109,8 +109,7 @@ def main():
     truth = np.array([60.0, 40.0, np.radians(30.0)])
     scan = rf.scan(W, truth, rng=1)
     headings = sl.correlation.heading_candidates(np.radians(1.0))
-    t_rast, (T, o) = best_of(lambda: sl.correlation.rasterise_scan(scan,
-                                                                    headings))
+    t_rast, (T, o) = best_of(lambda: sl.correlation.rasterise_scan(scan, headings, dtype="float64"))
     Mv = sl.sim.grid_to_values(M)
     print(f"\nCase 1: 360 headings, map 200x200, T_n {T.shape[1]}x{T.shape[1]}; rasterising all T_n took {t_rast:.3f} s")
     t_ref, p_ref = best_of(lambda: peak_fftconvolve(Mv, T, o), repeat=2)
@@ -143,7 +142,7 @@ def main():
     Ms = M[20:80, 0:60]
     s_small = sl.sim.Rangefinder(n_beams=90, max_range_cells=15.0).scan(Ms, [20.0, 25.0, np.radians(30.0)])
     hs = sl.correlation.heading_candidates(np.radians(10.0))
-    Ts, os_ = sl.correlation.rasterise_scan(s_small, hs)
+    Ts, os_ = sl.correlation.rasterise_scan(s_small, hs, dtype="float64")
     Mvs = sl.sim.grid_to_values(Ms)
     t_dir, p_dir = best_of(lambda: peak_direct(Mvs, Ts, os_), repeat=1)
     t_fc, p_fc = best_of(lambda: peak_fftconvolve(Mvs, Ts, os_))

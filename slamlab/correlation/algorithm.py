@@ -139,13 +139,9 @@ def _beam_samples(angles, ranges, hit, *, delta_l_cells, hit_offset_cells, step_
     return free, obs
 
 
-def rasterise_scan(scan: Scan, headings_rad, *, a_c: float = -1.0, a_p: float = 1.0,
-                   a_n: float = 0.0, delta_l_cells: float = 0.0, hit_offset_cells: float = 0.5,
-                   step_cells: float = 0.5, use_misses: bool = False, l_max: int | None = None,
-                   dtype=np.float64) -> tuple[np.ndarray, int]:
+def rasterise_scan(scan: Scan, headings_rad, *, params: LocaliseParams | None = None, l_max: int | None = None,
+                   **overrides) -> tuple[np.ndarray, int]:
     """The images T_n of one scan at every candidate heading (004 §7), vectorised over beams and headings.
-
-    The keyword defaults are those of :class:`LocaliseParams`.
 
     Parameters
     ----------
@@ -154,21 +150,13 @@ def rasterise_scan(scan: Scan, headings_rad, *, a_c: float = -1.0, a_p: float = 
         return (``valid`` False) are skipped unless ``use_misses``.
     headings_rad : array_like, shape (n,)
         Candidate headings α0n.
-    a_c, a_p, a_n : float
-        004's constants for free, obstacle, unexplored cells.
-    delta_l_cells : float
-        ±Δl: obstacle marked from ``l - Δl`` to ``l + Δl`` (004); 0 marks one cell.
-    hit_offset_cells : float
-        Our choice: the obstacle mark sits this far beyond the measured range, since a
-        range ends on the face of the obstacle cell (0.5 = mid-cell).
-    step_cells : float
-        Sampling step along the beams (≤ 1; smaller marks every crossed cell).
-    use_misses : bool
-        Mark no-return beams free up to their (maximum) range (004 is silent; our option).
+    params, **overrides
+        The :class:`LocaliseParams` that :func:`localise` uses: 004's constants
+        ``a_c, a_p, a_n``, ±Δl ``delta_l_cells``, ``hit_offset_cells`` (the obstacle mark
+        sits this far beyond the range, which ends on the obstacle cell's face),
+        ``step_cells``, ``use_misses`` and ``dtype`` (of the returned stack).
     l_max : int, optional
         Half-size; default ``ceil(max l_i + Δl + hit_offset)`` (004: ``l_max = max(l_i) + Δl``).
-    dtype : numpy dtype
-        Of the returned stack.
 
     Returns
     -------
@@ -184,15 +172,10 @@ def rasterise_scan(scan: Scan, headings_rad, *, a_c: float = -1.0, a_p: float = 
     >>> T[0, o, o:o + 4].tolist(), T[1, o:o + 4, o].tolist()
     ([-1.0, -1.0, 1.0, 0.0], [-1.0, -1.0, 1.0, 0.0])
     """
+    p = LocaliseParams.resolve(params, **overrides)
     a, r, h = _scan_beams(scan)
     th = v.as_vector(headings_rad, "headings_rad")
-    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
-    dl = v.check_positive(delta_l_cells, "delta_l_cells", allow_zero=True)
-    ho = v.check_positive(hit_offset_cells, "hit_offset_cells", allow_zero=True)
-    st = v.check_positive(step_cells, "step_cells")
-    if st > 1:
-        raise ValueError(f"`step_cells` must be <= 1 (a larger step skips cells); got {st}")
-    reach = max(float(np.max(np.where(h | use_misses, r, 0.0))), 0.0) + (dl + ho if h.any() else 0.0)
+    reach = _reach(r, h, p)
     if l_max is None:
         l_max = int(np.ceil(reach))
     else:
@@ -200,9 +183,15 @@ def rasterise_scan(scan: Scan, headings_rad, *, a_c: float = -1.0, a_p: float = 
         if l_max < reach - 1e-9:
             raise ValueError(f"`l_max` must cover the longest beam ({reach:.2f} cells); got {l_max}")
     o = l_max + 2
-    free, obs = _beam_samples(a, r, h, delta_l_cells=dl, hit_offset_cells=ho, step_cells=st, use_misses=use_misses)
-    stamps = _Stamps(free, obs, th, a_c, a_p, a_n, o, dtype)
+    free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
+                              step_cells=p.step_cells, use_misses=p.use_misses)
+    stamps = _Stamps(free, obs, th, p.a_c, p.a_p, p.a_n, o, np.dtype(p.dtype))
     return stamps.take(np.arange(th.size)), o
+
+
+def _reach(r, h, p) -> float:
+    """Longest marked distance of a beam: its range plus ±Δl and the obstacle offset (cells)."""
+    return float(np.max(np.where(h | p.use_misses, r, 0.0))) + p.delta_l_cells + p.hit_offset_cells
 
 
 class _Stamps:
@@ -527,8 +516,7 @@ def _localise(g, a, r, h, headings, p: LocaliseParams, *, tracking: bool) -> Loc
     Mv = grid_to_values(g, p.a_c, p.a_p, p.a_n)
     free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
                               step_cells=p.step_cells, use_misses=p.use_misses)
-    reach = float(np.max(np.where(h | p.use_misses, r, 0.0))) + p.delta_l_cells + p.hit_offset_cells
-    o = int(np.ceil(reach)) + 2
+    o = int(np.ceil(_reach(r, h, p))) + 2
     S = 2 * o
     stamps = _Stamps(free, obs, headings, p.a_c, p.a_p, p.a_n, o, dtype)
     n_marks = max(1, free.shape[0] + obs.shape[0])
