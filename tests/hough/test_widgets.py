@@ -67,3 +67,18 @@ def test_slam_widget_extremes(capsys):
     out = capsys.readouterr().out
     assert "Cannot run with these settings: `delta_rho` must be > 0" in out
     matplotlib.pyplot.close("all")
+
+
+@pytest.mark.realdata
+def test_real_log_widget(capsys):
+    w = W.explore_real_log(n_scans=40)
+    capsys.readouterr()
+    matplotlib.pyplot.close("all")
+    w.f(**{**w.kwargs, "name": "urg04lx", "n_scans": 40})
+    out = capsys.readouterr().out
+    assert out.startswith("URG-04LX log exp2.dat (raw odometry)")
+    assert re.search(r"scans used\s+40\n", out)
+    assert len(_figures()) == 1
+    w.f(**{**w.kwargs, "H_min": 0})
+    assert "Cannot run with these settings: `H_min` must be >= 1; got 0" in capsys.readouterr().out
+    matplotlib.pyplot.close("all")
