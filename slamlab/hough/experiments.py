@@ -322,13 +322,10 @@ def log_format(path) -> str:
     CARMEN lines start with a message name (``FLASER``, ``ODOM``, ``PARAM`` …); a
     URG-04LX line of the Mines format is 707 numbers.
     """
-    import gzip
+    from ..io.carmen import _open_text  # plain text or gzip, told apart by the magic bytes
 
     p = v.as_path(path, "path", kind="file")
-    with open(p, "rb") as fh:
-        gz = fh.read(2) == b"\x1f\x8b"
-    opener = gzip.open if gz else open
-    with opener(p, "rt", encoding="ascii", errors="replace") as fh:
+    with _open_text(p) as fh:
         for line in fh:
             tok = line.split()
             if not tok or tok[0].startswith("#"):

@@ -44,7 +44,7 @@ def _optional_pose(value, name):
     return None if value is None else check_pose(value, name).copy()
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compare fields explicitly, not with ==
 class Scan:
     """One scan: beams ``(α_i, l_i)`` relative to the sensor heading, with validity and poses (004 §7).
 

@@ -238,3 +238,21 @@ def test_hough_slam_params_check_every_field():
     assert a.rho.tolist() == b.rho.tolist()
     with pytest.raises(TypeError, match=r"`scan` must be a slamlab.scans.Scan"):
         h.detect_lines((phi, r), H_min=20)
+
+
+def test_log_format_from_the_first_data_line(tmp_path):
+    import gzip
+
+    carmen = tmp_path / "a.log.gz"
+    with gzip.open(carmen, "wt") as fh:
+        fh.write("# comment\nFLASER 2 1 2 0 0 0 0 0 0\n")
+    urg = tmp_path / "b.txt"
+    urg.write_text("\n123 4 5\n")
+    empty = tmp_path / "c.log"
+    empty.write_text("# only a comment\n")
+    assert E.log_format(carmen) == "carmen"
+    assert E.log_format(str(urg)) == "urg04lx"
+    with pytest.raises(ValueError, match=r"c\.log: empty log"):
+        E.log_format(empty)
+    with pytest.raises(ValueError, match="`fmt` must be one of"):
+        E.run_real_log(str(urg), fmt="kitti")
