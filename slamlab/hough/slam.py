@@ -28,10 +28,10 @@ from .._params import Params, param
 from ..geometry import wrap_angle
 from ..geometry.se2 import check_pose, se2_compose
 from ..scans import Scan
-from .association import LineHistory, associate, association_probability
-from .lines import Lines, find_peaks, merge_duplicates, refine_lines, transform_lines
-from .pose import pose_from_lines
-from .transform import hough_polar
+from .association import LineHistory, _associate, _association_probability
+from .lines import Lines, _find_peaks, _merge_duplicates, _refine_lines, _transform_lines
+from .pose import _pose_from_lines
+from .transform import _hough_polar, theta_axis
 
 __all__ = ["HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
 
@@ -75,9 +75,7 @@ class HoughSlamParams(Params):
 
     def check(self) -> None:
         v.check_positive(self.delta_rho, "delta_rho")
-        v.check_positive(self.delta_theta_rad, "delta_theta_rad")
-        if self.delta_theta_rad > math.pi:
-            raise ValueError(f"`delta_theta_rad` must be <= π; got {self.delta_theta_rad}")
+        theta_axis(self.delta_theta_rad)  # > 0 and divides 180°
         for name in ("r_max", "suppress_rho", "suppress_theta_rad", "band", "max_gap", "b", "rho_tol", "gate"):
             _optional_positive(getattr(self, name), name)
         v.check_int(self.H_min, "H_min", minimum=1)
@@ -139,22 +137,24 @@ def detect_lines(scan: Scan, params: HoughSlamParams | None = None, **overrides)
     (10.0, 45.0)
     """
     p = HoughSlamParams.resolve(params, **overrides)
-    return _detect(*_returns(scan), p)
+    return _detect(*_returns(scan), p, theta_axis(p.delta_theta_rad))
 
 
-def _detect(bearings_rad, ranges, params: HoughSlamParams) -> Lines:
+def _detect(bearings_rad, ranges, params: HoughSlamParams, theta: np.ndarray) -> Lines:
+    """:func:`detect_lines` on checked settings (``theta``: the θ axis of ``params``), once per scan."""
     if bearings_rad.size == 0:
         return Lines(np.empty(0), np.empty(0), np.empty(0, int))
-    acc = hough_polar(bearings_rad, ranges, delta_rho=params.delta_rho, delta_theta_rad=params.delta_theta_rad,
-                      r_max=params.r_max)
-    lines = find_peaks(acc, params.H_min, suppress_rho=params.suppress_rho,
-                       suppress_theta_rad=params.suppress_theta_rad, max_lines=params.max_lines)
+    r_max = float(ranges.max()) if params.r_max is None else params.r_max
+    acc = _hough_polar(bearings_rad, ranges, params.delta_rho, theta, params.delta_theta_rad, r_max)
+    s_rho = 3 * acc.delta_rho if params.suppress_rho is None else params.suppress_rho
+    s_theta = 3 * acc.delta_theta_rad if params.suppress_theta_rad is None else params.suppress_theta_rad
+    lines = _find_peaks(acc, params.H_min, s_rho, s_theta, params.max_lines)
     if params.refine and len(lines):
         band = params.delta_rho if params.band is None else params.band
-        lines = refine_lines(lines, bearings_rad, ranges, band=band, max_gap=params.max_gap)
+        lines = _refine_lines(lines, bearings_rad, ranges, band, 3, params.max_gap)
         keep = lines.votes >= max(2, params.H_min // 2)  # a peak whose band holds few points is spurious
-        lines = merge_duplicates(Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep]),
-                                 rho_tol=params.delta_rho, theta_tol_rad=params.delta_theta_rad)
+        lines = _merge_duplicates(Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep]),
+                                  params.delta_rho, params.delta_theta_rad)
     return lines
 
 
@@ -165,9 +165,8 @@ def _relative(history, n1, n2, params):
     if common.size < 2:
         return None, common.size
     votes = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
-    pc = pose_from_lines(l1.rho[i1], l1.theta_rad[i1], l2.rho[i2], l2.theta_rad[i2], votes, method=params.method,
-                         angle_tol_rad=params.angle_tol_rad, min_angle_rad=params.min_angle_rad,
-                         rho_tol=params.rho_tol)
+    pc = _pose_from_lines(l1.rho[i1], l1.theta_rad[i1], l2.rho[i2], l2.theta_rad[i2], votes, params.method,
+                          params.angle_tol_rad, params.min_angle_rad, np.inf if params.rho_tol is None else params.rho_tol)
     return (pc.pose if pc.ok else None), common.size
 
 
@@ -232,6 +231,7 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     if len(units) > 1:
         raise ValueError(f"`scans` must all have one unit; got {sorted(units)}")
     returns = [_returns(s, f"scans[{k}]") for k, s in enumerate(scans)]
+    theta = theta_axis(params.delta_theta_rad)  # the settings are checked once, here
     n = len(scans)
     U = np.zeros((n - 1, 3)) if odometry is None else v.as_finite_array(odometry, "odometry", ndim=2)
     if U.shape != (n - 1, 3):
@@ -245,16 +245,17 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     history = LineHistory()
     keyframe = 0
     for k in range(n):
-        lines = _detect(*returns[k], params)
+        lines = _detect(*returns[k], params, theta)
         n_lines[k] = len(lines)
         if k == 0:
             history.add_scan(lines, np.full(len(lines), -1))
             continue
         prev_ids, prev = history.scan(k - 1)
-        pr, pt = transform_lines(prev.rho, prev.theta_rad, U[k - 1])
-        P = association_probability(lines, Lines(pr, pt, prev.votes), a=params.a, b=params.b,
-                                    a_theta_rad=params.a_theta_rad, parallel_tol_rad=params.parallel_tol_rad)
-        match = associate(P, p_min=params.p_min)
+        pr, pt = _transform_lines(prev.rho, prev.theta_rad, U[k - 1])
+        P = _association_probability(lines, Lines(pr, pt, prev.votes), params.a,
+                                     params.a if params.b is None else params.b, params.a_theta_rad,
+                                     params.parallel_tol_rad)
+        match = _associate(P, params.p_min)
         ids = np.where(match >= 0, prev_ids[np.clip(match, 0, None)] if prev_ids.size else -1, -1)
         history.add_scan(lines, ids)
         guess = se2_compose(poses[k - 1], U[k - 1])

@@ -221,7 +221,7 @@ def test_hough_slam_params_check_every_field():
     p = h.HoughSlamParams()
     assert set(p.sources()) == set(h.HoughSlamParams.field_names())
     assert all(p.sources().values())
-    bad = {"delta_rho": 0.0, "delta_theta_rad": -1.0, "r_max": 0.0, "H_min": 0, "max_lines": 1,
+    bad = {"delta_rho": 0.0, "delta_theta_rad": 0.7, "r_max": 0.0, "H_min": 0, "max_lines": 1,
            "suppress_rho": -1.0, "suppress_theta_rad": 0.0, "refine": "yes", "band": -0.1, "max_gap": 0.0,
            "a": 0.0, "b": -1.0, "a_theta_rad": 0.0, "parallel_tol_rad": -0.1, "p_min": 1.5, "method": "svd",
            "angle_tol_rad": -1.0, "rho_tol": 0.0, "min_angle_rad": 2.0, "min_common": 1, "gate": 0.0,
