@@ -507,13 +507,13 @@ def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_he
     if prior_heading_rad is None and window_rad is not None:
         raise ValueError("`window_rad` needs `prior_heading_rad` (tracking mode)")
     headings = heading_candidates(p.delta_alpha_rad, center_rad=prior_heading_rad, window_rad=window_rad)
-    return _localise(g, a, r, h, headings, p, tracking=prior_heading_rad is not None)
+    return _localise(grid_to_values(g, p.a_c, p.a_p, p.a_n), a, r, h, headings, p,
+                     tracking=prior_heading_rad is not None)
 
 
-def _localise(g, a, r, h, headings, p: LocaliseParams, *, tracking: bool) -> Localisation:
-    """The search itself, on checked arguments (called once per scan by the experiments)."""
+def _localise(Mv, a, r, h, headings, p: LocaliseParams, *, tracking: bool) -> Localisation:
+    """The search itself, on checked arguments: ``Mv`` the map in 004's values (called per scan by the runs)."""
     dtype = np.dtype(p.dtype)
-    Mv = grid_to_values(g, p.a_c, p.a_p, p.a_n)
     free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
                               step_cells=p.step_cells, use_misses=p.use_misses)
     o = int(np.ceil(_reach(r, h, p))) + 2

@@ -21,7 +21,7 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
-from ..scans import GridFrame, Scan, check_grid, occupancy_grid
+from ..scans import GridFrame, Scan, grid_to_values, occupancy_grid
 from ..sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
 from ..sim.paths import random_free_poses
 from ..sim.rangefinder import Rangefinder
@@ -91,12 +91,12 @@ def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int
 
 def _localise_many(M, W, poses, rf, rng, p: LocaliseParams):
     """Cast and localise one scan per pose; the map and settings were checked once by the caller."""
-    g = check_grid(M)
+    Mv = grid_to_values(M, p.a_c, p.a_p, p.a_n)
     headings = heading_candidates(p.delta_alpha_rad)
     est = np.empty_like(poses)
     for k, pose in enumerate(poses):
         scan = rf.scan(W, pose, rng)
-        est[k] = _localise(g, *_scan_beams(scan), headings, p, tracking=False).pose
+        est[k] = _localise(Mv, *_scan_beams(scan), headings, p, tracking=False).pose
     return est
 
 
@@ -324,12 +324,12 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     pm, hm, ep = np.empty((k, n)), np.empty((k, n)), np.empty((k, n))
     failed = np.zeros((k, n), bool)
     maps = []
-    g = check_grid(M)
     headings = heading_candidates(base.delta_alpha_rad)
     t0 = time.perf_counter()
     for j, q in enumerate(settings):
+        Mv = grid_to_values(M, q.a_c, q.a_p, q.a_n)
         for i, (p, s) in enumerate(zip(poses, scans, strict=True)):
-            loc = _localise(g, *_scan_beams(s), headings, q, tracking=False)
+            loc = _localise(Mv, *_scan_beams(s), headings, q, tracking=False)
             pm[j, i], hm[j, i] = _margins(loc)
             ep[j, i] = np.hypot(*(loc.pose[:2] - p[:2]))
             failed[j, i] = ep[j, i] > FAIL_CELLS or np.degrees(heading_error(loc.pose[2], p[2])) > FAIL_DEG
@@ -466,11 +466,11 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     t0 = time.perf_counter()
     leave = sorted({j for i in idx for j in range(max(0, i - ex), min(log.n_scans, i + ex + 1))})
     G, frame, scans_c, _Pc = log_grid(log, cell_m=cell, max_range_m=rmax, leave_out=leave)
-    G = check_grid(G)
+    Mv = grid_to_values(G, p.a_c, p.a_p, p.a_n)
     headings = heading_candidates(p.delta_alpha_rad)
     est = np.empty((idx.size, 3))
     for k, i in enumerate(idx):
-        est[k] = _localise(G, *_scan_beams(scans_c[i], f"scan {i}"), headings, p, tracking=False).pose
+        est[k] = _localise(Mv, *_scan_beams(scans_c[i], f"scan {i}"), headings, p, tracking=False).pose
     est_m = frame.to_metres(est)
     true_m = log.poses[idx]
     err_p = np.hypot(*(est_m[:, :2] - true_m[:, :2]).T)
