@@ -109,15 +109,14 @@ def main():
     truth = np.array([60.0, 40.0, np.radians(30.0)])
     scan = rf.scan(W, truth, rng=1)
     headings = sl.correlation.heading_candidates(np.radians(1.0))
-    t_rast, (T, o) = best_of(lambda: sl.correlation.rasterise_scan(scan.angles_rad, scan.ranges_cells, scan.hit,
-                                                                    headings))
+    t_rast, (T, o) = best_of(lambda: sl.correlation.rasterise_scan(scan, headings, dtype="float64"))
     Mv = sl.sim.grid_to_values(M)
     print(f"\nCase 1: 360 headings, map 200x200, T_n {T.shape[1]}x{T.shape[1]}; rasterising all T_n took {t_rast:.3f} s")
     t_ref, p_ref = best_of(lambda: peak_fftconvolve(Mv, T, o), repeat=2)
     t_ref32, p_ref32 = best_of(lambda: peak_fftconvolve(Mv.astype(np.float32), T.astype(np.float32), o), repeat=2)
     rows = [("per-heading scipy.signal.fftconvolve (reference)", t_ref, p_ref),
             ("per-heading fftconvolve on float32 arrays", t_ref32, p_ref32)]
-    free, obs = _beam_samples(scan.angles_rad, scan.ranges_cells, scan.hit, delta_l_cells=0.0, hit_offset_cells=0.5,
+    free, obs = _beam_samples(scan.bearings_rad, scan.ranges, scan.valid, delta_l_cells=0.0, hit_offset_cells=0.5,
                               step_cells=0.5, use_misses=False)
     for label, dt, workers, trick in (("ours, batched float64, no quarter-turn reuse", np.float64, None, False),
                                       ("ours, batched float64", np.float64, None, True),
@@ -134,7 +133,7 @@ def main():
     for label, t, p in rows:
         print(f"{label:>50}  {t:9.3f}  {t_ref / t:8.2f}  {tuple(int(i) for i in p[1])} / {p[0]:.1f} / "
               f"{same_peak(p, p_ref)}")
-    t_loc, loc = best_of(lambda: sl.correlation.localise(M, scan))
+    t_loc, loc = best_of(lambda: sl.correlation.localise(M, scan, dtype="float64"))
     t_loc32, _loc32 = best_of(lambda: sl.correlation.localise(M, scan, dtype=np.float32))
     print(f"\nend to end localise() (rasterise + correlate + peak), CPU time: float64 {t_loc:.3f} s, float32 {t_loc32:.3f} s; "
           f"pose {loc.col}, {loc.row}, {np.degrees(loc.pose[2]):.0f} deg (truth 60, 40, 30)")
@@ -143,7 +142,7 @@ def main():
     Ms = M[20:80, 0:60]
     s_small = sl.sim.Rangefinder(n_beams=90, max_range_cells=15.0).scan(Ms, [20.0, 25.0, np.radians(30.0)])
     hs = sl.correlation.heading_candidates(np.radians(10.0))
-    Ts, os_ = sl.correlation.rasterise_scan(s_small.angles_rad, s_small.ranges_cells, s_small.hit, hs)
+    Ts, os_ = sl.correlation.rasterise_scan(s_small, hs, dtype="float64")
     Mvs = sl.sim.grid_to_values(Ms)
     t_dir, p_dir = best_of(lambda: peak_direct(Mvs, Ts, os_), repeat=1)
     t_fc, p_fc = best_of(lambda: peak_fftconvolve(Mvs, Ts, os_))

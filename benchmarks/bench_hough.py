@@ -48,7 +48,7 @@ def make_scans(n_scans=5, n_beams=1081, cell_m=0.05, max_range_m=30.0, rng=0):
     out = []
     for p in poses:
         s = rf.scan(room, p, rng)
-        out.append((s.angles_rad[s.hit], s.ranges_cells[s.hit] * cell_m))
+        out.append((s.bearings_rad[s.valid], s.ranges[s.valid] * cell_m))
     return out
 
 

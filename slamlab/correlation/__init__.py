@@ -1,79 +1,72 @@
 """Correlation localisation on a known map from a scanning rangefinder (004 §7; Ch. 5)."""
 
+from .._lazy import lazy_exports
 from .algorithm import (
     Localisation,
+    LocaliseParams,
     check_constants,
     heading_candidates,
     heading_error,
     localise,
     rasterise_scan,
-    scan_arrays,
     score_maps,
 )
 from .experiments import (
+    DEFAULT_CARMEN_LOG,
     SOURCE_TABLE1,
     ConstantsResult,
-    IntelResult,
+    LogLocalisationResult,
     MonteCarloResult,
     Table1Result,
+    log_grid,
+    ours_vs_source,
     random_clutter,
     run_constants_study,
-    run_intel_localisation,
+    run_log_localisation,
     run_monte_carlo,
     run_table1,
     time_localise,
 )
-from .mapping import GridFrame, occupancy_grid_from_scans
-from .plot import (
-    constants_figure,
-    localisation_figure,
-    plot_error_distribution,
-    plot_grid,
-    plot_grids,
-    plot_heading_profile,
-    plot_intel,
-    plot_localisation,
-    plot_score_map,
-    plot_stamp,
-    plot_stamps,
-    plot_table1,
-)
-from .widgets import explore_intel_scan, explore_localisation
 
-__all__ = [
-    "SOURCE_TABLE1",
-    "ConstantsResult",
-    "GridFrame",
-    "IntelResult",
-    "Localisation",
-    "MonteCarloResult",
-    "Table1Result",
-    "check_constants",
+_PLOT = (
     "constants_figure",
-    "explore_intel_scan",
-    "explore_localisation",
-    "heading_candidates",
-    "heading_error",
     "localisation_figure",
-    "localise",
-    "occupancy_grid_from_scans",
     "plot_error_distribution",
     "plot_grid",
     "plot_grids",
     "plot_heading_profile",
-    "plot_intel",
     "plot_localisation",
+    "plot_log_localisation",
     "plot_score_map",
     "plot_stamp",
     "plot_stamps",
     "plot_table1",
+)
+_WIDGETS = ("explore_localisation", "explore_log_scan")
+__getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
+
+__all__ = [
+    "DEFAULT_CARMEN_LOG",
+    "SOURCE_TABLE1",
+    "ConstantsResult",
+    "Localisation",
+    "LocaliseParams",
+    "LogLocalisationResult",
+    "MonteCarloResult",
+    "Table1Result",
+    "check_constants",
+    "heading_candidates",
+    "heading_error",
+    "localise",
+    "log_grid",
+    "ours_vs_source",
     "random_clutter",
     "rasterise_scan",
     "run_constants_study",
-    "run_intel_localisation",
+    "run_log_localisation",
     "run_monte_carlo",
     "run_table1",
-    "scan_arrays",
     "score_maps",
     "time_localise",
 ]
+__all__ += list(_PLOT + _WIDGETS)  # loaded on first use

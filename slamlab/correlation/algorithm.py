@@ -4,15 +4,19 @@ API summary
 -----------
 - :func:`heading_candidates` — the headings α0n = n·Δα (full circle) or a window
   around a previous heading (tracking mode).
-- :func:`rasterise_scan` ``(angles, ranges, hit, headings, ...) -> (T, origin)``: the
+- :func:`rasterise_scan` ``(scan, headings, ...) -> (T, origin)``: the
   images T_n of 004 (a_c along each beam, a_p at its end or over ±Δl, a_n
   elsewhere), vectorised over beams and headings.
 - :func:`score_maps` ``(M_values, T, origin, method) -> (n, H, W)``: the
   correlation C_n(k, p) = Σ M(x, y)·T_n(x - k, y - p) re-indexed by the robot's
   cell, by one batched FFT (``"batched"``), per heading with
   ``scipy.signal.fftconvolve`` (``"fftconvolve"``) or by the definition (``"direct"``).
-- :func:`localise` ``(grid, scan, ...) -> Localisation``: the maximum of the 3-D stack
-  → heading and position, streamed over heading chunks (bounded memory).
+- :func:`localise` ``(grid, scan, *, params=None, **overrides) -> Localisation``: the
+  maximum of the 3-D stack → heading and position, streamed over heading chunks
+  (bounded memory); its settings are one :class:`LocaliseParams`.
+
+Scans are :class:`slamlab.scans.Scan` objects in cell units (``scan.to_cells(cell_m)``
+for a metric scan).
 
 Index mapping (0-based; 004's ``x = x0 + Ma - xc + 1`` is 1-based Matlab ``xcorr2``)
 -------------------------------------------------------------------------------------
@@ -26,11 +30,12 @@ when the robot is at map cell ``(row, col)``. The full linear correlation
 
 and :func:`score_maps` returns exactly the ``H × W`` block of C whose robot cell
 lies inside the map, indexed by that cell: ``D[n, row, col]``. The estimate is
-the pose ``(x, y) = (col, row)`` (x along columns, see :mod:`slamlab.sim.grid`).
+the pose ``(x, y) = (col, row)`` (x along columns, see :mod:`slamlab.scans.grid`).
 """
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,18 +43,18 @@ import scipy.fft as sfft
 from scipy.signal import fftconvolve
 
 from .. import _validate as v
+from .._params import Params, param
 from ..geometry import wrap_angle
-from ..sim.grid import check_grid, grid_to_values
-from ..sim.rangefinder import Scan
+from ..scans import Scan, check_grid, grid_to_values
 
 __all__ = [
     "Localisation",
+    "LocaliseParams",
     "check_constants",
     "heading_candidates",
     "heading_error",
     "localise",
     "rasterise_scan",
-    "scan_arrays",
     "score_maps",
 ]
 
@@ -100,31 +105,15 @@ def heading_candidates(delta_alpha_rad: float, *, center_rad: float | None = Non
     return c + d * np.arange(-k, k + 1)
 
 
-def scan_arrays(scan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(angles_rad, ranges_cells, hit)`` from a :class:`~slamlab.sim.Scan` or a 2/3-tuple of arrays."""
-    if isinstance(scan, Scan):
-        a, r, h = scan.angles_rad, scan.ranges_cells, scan.hit
-    elif isinstance(scan, tuple) and len(scan) in (2, 3):
-        a, r = scan[0], scan[1]
-        h = scan[2] if len(scan) == 3 else None
-    else:
-        raise TypeError(f"`scan` must be a Scan or a tuple (angles_rad, ranges_cells[, hit]); got "
-                        f"{type(scan).__name__}")
-    a = v.as_vector(a, "angles_rad")
-    r = v.as_vector(r, "ranges_cells")
-    if a.shape != r.shape:
-        raise ValueError(f"`angles_rad` and `ranges_cells` must have the same length; got {a.size} and {r.size}")
-    if np.any(r < 0):
-        raise ValueError(f"`ranges_cells` must be >= 0; got minimum {r.min()}")
-    if h is None:
-        h = np.ones(a.shape, dtype=bool)
-    else:
-        h = np.asarray(h)
-        if h.dtype != bool or h.shape != a.shape:
-            raise ValueError(f"`hit` must be a bool array of shape {a.shape}; got {h.dtype} {h.shape}")
-    if not h.any():
-        raise ValueError("`scan` has no return (every beam is a miss): nothing to localise with")
-    return a, r, h
+def _scan_beams(scan, name: str = "scan") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(bearings_rad, ranges_cells, valid)`` of a cell-unit :class:`~slamlab.scans.Scan` with a return."""
+    if not isinstance(scan, Scan):
+        raise TypeError(f"`{name}` must be a slamlab.scans.Scan; got {type(scan).__name__}")
+    if scan.unit != "cell":
+        raise ValueError(f"`{name}` must be in cell units; got unit {scan.unit!r} (use scan.to_cells(cell_m))")
+    if not scan.valid.any():
+        raise ValueError(f"`{name}` has no return (every beam is a miss): nothing to localise with")
+    return scan.bearings_rad, scan.ranges, scan.valid
 
 
 def _beam_samples(angles, ranges, hit, *, delta_l_cells, hit_offset_cells, step_cells, use_misses):
@@ -150,35 +139,24 @@ def _beam_samples(angles, ranges, hit, *, delta_l_cells, hit_offset_cells, step_
     return free, obs
 
 
-def rasterise_scan(angles_rad, ranges_cells, hit, headings_rad, *, a_c: float = -1.0, a_p: float = 1.0,
-                   a_n: float = 0.0, delta_l_cells: float = 0.0, hit_offset_cells: float = 0.5,
-                   step_cells: float = 0.5, use_misses: bool = False, l_max: int | None = None,
-                   dtype=np.float64) -> tuple[np.ndarray, int]:
+def rasterise_scan(scan: Scan, headings_rad, *, params: LocaliseParams | None = None, l_max: int | None = None,
+                   **overrides) -> tuple[np.ndarray, int]:
     """The images T_n of one scan at every candidate heading (004 §7), vectorised over beams and headings.
 
     Parameters
     ----------
-    angles_rad, ranges_cells : array_like, shape (m,)
-        Beams ``(α_i, l_i)`` in the robot frame, ranges in cells.
-    hit : array_like of bool, shape (m,)
-        Beams with a return; misses are skipped unless ``use_misses``.
+    scan : Scan
+        Beams ``(α_i, l_i)`` in the robot frame, in cell units; beams without a
+        return (``valid`` False) are skipped unless ``use_misses``.
     headings_rad : array_like, shape (n,)
         Candidate headings α0n.
-    a_c, a_p, a_n : float
-        004's constants for free, obstacle, unexplored cells.
-    delta_l_cells : float
-        ±Δl: obstacle marked from ``l - Δl`` to ``l + Δl`` (004); 0 marks one cell.
-    hit_offset_cells : float
-        Our choice: the obstacle mark sits this far beyond the measured range, since a
-        range ends on the face of the obstacle cell (0.5 = mid-cell).
-    step_cells : float
-        Sampling step along the beams (≤ 1; smaller marks every crossed cell).
-    use_misses : bool
-        Mark no-return beams free up to their (maximum) range (004 is silent; our option).
+    params, **overrides
+        The :class:`LocaliseParams` that :func:`localise` uses: 004's constants
+        ``a_c, a_p, a_n``, ±Δl ``delta_l_cells``, ``hit_offset_cells`` (the obstacle mark
+        sits this far beyond the range, which ends on the obstacle cell's face),
+        ``step_cells``, ``use_misses`` and ``dtype`` (of the returned stack).
     l_max : int, optional
         Half-size; default ``ceil(max l_i + Δl + hit_offset)`` (004: ``l_max = max(l_i) + Δl``).
-    dtype : numpy dtype
-        Of the returned stack.
 
     Returns
     -------
@@ -188,21 +166,16 @@ def rasterise_scan(angles_rad, ranges_cells, hit, headings_rad, *, a_c: float = 
 
     Examples
     --------
-    >>> T, o = rasterise_scan([0.0], [1.5], [True], [0.0, np.pi / 2], a_c=-1, a_p=1)
+    >>> T, o = rasterise_scan(Scan([0.0], [1.5], [True]), [0.0, np.pi / 2], a_c=-1, a_p=1)
     >>> T.shape, o
     ((2, 8, 8), 4)
     >>> T[0, o, o:o + 4].tolist(), T[1, o:o + 4, o].tolist()
     ([-1.0, -1.0, 1.0, 0.0], [-1.0, -1.0, 1.0, 0.0])
     """
-    a, r, h = scan_arrays((angles_rad, ranges_cells, hit))
+    p = LocaliseParams.resolve(params, **overrides)
+    a, r, h = _scan_beams(scan)
     th = v.as_vector(headings_rad, "headings_rad")
-    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
-    dl = v.check_positive(delta_l_cells, "delta_l_cells", allow_zero=True)
-    ho = v.check_positive(hit_offset_cells, "hit_offset_cells", allow_zero=True)
-    st = v.check_positive(step_cells, "step_cells")
-    if st > 1:
-        raise ValueError(f"`step_cells` must be <= 1 (a larger step skips cells); got {st}")
-    reach = max(float(np.max(np.where(h | use_misses, r, 0.0))), 0.0) + (dl + ho if h.any() else 0.0)
+    reach = _reach(r, h, p)
     if l_max is None:
         l_max = int(np.ceil(reach))
     else:
@@ -210,9 +183,15 @@ def rasterise_scan(angles_rad, ranges_cells, hit, headings_rad, *, a_c: float = 
         if l_max < reach - 1e-9:
             raise ValueError(f"`l_max` must cover the longest beam ({reach:.2f} cells); got {l_max}")
     o = l_max + 2
-    free, obs = _beam_samples(a, r, h, delta_l_cells=dl, hit_offset_cells=ho, step_cells=st, use_misses=use_misses)
-    stamps = _Stamps(free, obs, th, a_c, a_p, a_n, o, dtype)
+    free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
+                              step_cells=p.step_cells, use_misses=p.use_misses)
+    stamps = _Stamps(free, obs, th, p.a_c, p.a_p, p.a_n, o, np.dtype(p.dtype))
     return stamps.take(np.arange(th.size)), o
+
+
+def _reach(r, h, p) -> float:
+    """Longest marked distance of a beam: its range plus ±Δl and the obstacle offset (cells)."""
+    return float(np.max(np.where(h | p.use_misses, r, 0.0))) + p.delta_l_cells + p.hit_offset_cells
 
 
 class _Stamps:
@@ -382,7 +361,7 @@ def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.fl
     Parameters
     ----------
     M_values : array_like, shape (H, W)
-        The map with 004's constants (see :func:`slamlab.sim.grid_to_values`).
+        The map with 004's constants (see :func:`slamlab.scans.grid_to_values`).
     T : array_like, shape (n, S, S)
         From :func:`rasterise_scan`.
     origin : int
@@ -446,40 +425,72 @@ class Localisation:
                 f"{np.degrees(self.pose[2]):.1f} deg (score {self.score:.1f})")
 
 
-def localise(grid, scan, *, delta_alpha_rad: float = np.radians(1.0), prior_heading_rad: float | None = None,
-             window_rad: float | None = None, a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0,
-             delta_l_cells: float = 0.0, hit_offset_cells: float = 0.5, step_cells: float = 0.5,
-             use_misses: bool = False, chunk: int | None = None, dtype=np.float64,
-             workers: int | None = None) -> Localisation:
+@dataclass(frozen=True)
+class LocaliseParams(Params):
+    """Every setting of :func:`localise` and of the ``run_*`` experiments built on it (004 §7).
+
+    ``prior_heading_rad`` / ``window_rad`` (tracking mode) are per call, not settings.
+    """
+
+    delta_alpha_rad: float = param(float(np.radians(1.0)), "004 §7: Δα = 1°")
+    a_c: float = param(-1.0, "004 §7: a_c < 0 < a_p, a_n = 0; sharpest peak at a_p = -a_c")
+    a_p: float = param(1.0, "004 §7")
+    a_n: float = param(0.0, "004 §7: conditions (1)-(3) give a_n = 0")
+    delta_l_cells: float = param(0.0, "004 §7: ±Δl, value not given (0 marks one cell)")
+    hit_offset_cells: float = param(0.5, "ours: a range ends on the obstacle cell's face")
+    step_cells: float = param(0.5, "ours: sampling step along a beam")
+    use_misses: bool = param(False, "ours: 004 is silent on beams without a return")
+    chunk: int = param(8, "ours: base stamps per batched FFT call (CPU caches)")
+    dtype: str = param("float32", "ours: float32 FFTs find the float64 peak (test) in about half the time")
+    workers: int | None = param(None, "ours: scipy.fft threads (None = scipy's default)")
+
+    def __post_init__(self) -> None:
+        with contextlib.suppress(TypeError):  # accept numpy dtypes (np.float32) too; check() names a bad one
+            object.__setattr__(self, "dtype", np.dtype(self.dtype).name)
+        super().__post_init__()
+
+    def check(self) -> None:
+        d = v.check_positive(self.delta_alpha_rad, "delta_alpha_rad")
+        if d > np.pi:
+            raise ValueError(f"`delta_alpha_rad` must be <= π; got {d}")
+        check_constants(self.a_c, self.a_p, self.a_n)
+        v.check_positive(self.delta_l_cells, "delta_l_cells", allow_zero=True)
+        v.check_positive(self.hit_offset_cells, "hit_offset_cells", allow_zero=True)
+        st = v.check_positive(self.step_cells, "step_cells")
+        if st > 1:
+            raise ValueError(f"`step_cells` must be <= 1 (a larger step skips cells); got {st}")
+        if not isinstance(self.use_misses, (bool, np.bool_)):
+            raise TypeError(f"`use_misses` must be a bool; got {type(self.use_misses).__name__}")
+        v.check_int(self.chunk, "chunk", minimum=1)
+        v.check_choice(self.dtype, "dtype", ("float32", "float64"))
+        if self.workers is not None:
+            v.check_int(self.workers, "workers", minimum=1)
+
+
+def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_heading_rad: float | None = None,
+             window_rad: float | None = None, **overrides) -> Localisation:
     """Pose of the robot on map ``grid`` from one scan: maximum of the correlation stack (004 §7).
 
     Parameters
     ----------
     grid : array_like of int, shape (H, W)
-        The known map M as cell codes (see :mod:`slamlab.sim.grid`); it is turned
+        The known map M as cell codes (see :mod:`slamlab.scans.grid`); it is turned
         into values with ``a_c, a_p, a_n``.
-    scan : Scan or tuple
-        A :class:`~slamlab.sim.Scan` or ``(angles_rad, ranges_cells[, hit])``.
-    delta_alpha_rad : float
-        Heading step Δα (004: 1°).
+    scan : Scan
+        A :class:`~slamlab.scans.Scan` in cell units.
+    params : LocaliseParams, optional
+        The settings (Δα, 004's constants a_c/a_p/a_n, rasterisation, FFT dtype…).
     prior_heading_rad, window_rad : float, optional
         Tracking mode: search only ``prior ± window`` (default window ±π when only
         the prior is given); full circle when the prior is None.
-    a_c, a_p, a_n : float
-        004's constants (sharpest peak at ``a_p = -a_c``; ``a_c = a_n = 0, a_p > 0``
-        is more robust to unmapped objects).
-    delta_l_cells, hit_offset_cells, step_cells, use_misses :
-        Rasterisation options, see :func:`rasterise_scan`.
-    chunk : int, optional
-        Base stamps (headings modulo 90°) per batched FFT call (default 8: fits the CPU caches
-        better than all at once).
-    dtype, workers :
-        FFT precision and threads (see :func:`score_maps`).
+    **overrides
+        Fields of :class:`LocaliseParams` to change, e.g. ``delta_alpha_rad=np.radians(5)``.
 
     Returns
     -------
     Localisation
-        Ties within ``1e-9·max|D|`` go to the first heading, then the first row and column.
+        Ties within ``1e-9·max|D|`` (float64; ``2e-5·…`` float32) go to the first
+        heading, then the first row and column.
 
     Examples
     --------
@@ -490,30 +501,31 @@ def localise(grid, scan, *, delta_alpha_rad: float = np.radians(1.0), prior_head
     >>> loc.col, loc.row, round(float(np.degrees(loc.pose[2])))
     (70, 30, 40)
     """
+    p = LocaliseParams.resolve(params, **overrides)
     g = check_grid(grid)
-    a, r, h = scan_arrays(scan)
-    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
+    a, r, h = _scan_beams(scan)
     if prior_heading_rad is None and window_rad is not None:
         raise ValueError("`window_rad` needs `prior_heading_rad` (tracking mode)")
-    headings = heading_candidates(delta_alpha_rad, center_rad=prior_heading_rad, window_rad=window_rad)
-    if chunk is not None:
-        chunk = v.check_int(chunk, "chunk", minimum=1)
-    Mv = grid_to_values(g, a_c, a_p, a_n)
-    dl = v.check_positive(delta_l_cells, "delta_l_cells", allow_zero=True)
-    ho = v.check_positive(hit_offset_cells, "hit_offset_cells", allow_zero=True)
-    st = v.check_positive(step_cells, "step_cells")
-    T0, o = rasterise_scan(a, r, h, headings[:1], a_c=a_c, a_p=a_p, a_n=a_n, delta_l_cells=dl,
-                           hit_offset_cells=ho, step_cells=st, use_misses=use_misses, dtype=dtype)
-    S = T0.shape[1]
-    free, obs = _beam_samples(a, r, h, delta_l_cells=dl, hit_offset_cells=ho, step_cells=st, use_misses=use_misses)
-    stamps = _Stamps(free, obs, headings, a_c, a_p, a_n, o, dtype)
+    headings = heading_candidates(p.delta_alpha_rad, center_rad=prior_heading_rad, window_rad=window_rad)
+    return _localise(grid_to_values(g, p.a_c, p.a_p, p.a_n), a, r, h, headings, p,
+                     tracking=prior_heading_rad is not None)
+
+
+def _localise(Mv, a, r, h, headings, p: LocaliseParams, *, tracking: bool) -> Localisation:
+    """The search itself, on checked arguments: ``Mv`` the map in 004's values (called per scan by the runs)."""
+    dtype = np.dtype(p.dtype)
+    free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
+                              step_cells=p.step_cells, use_misses=p.use_misses)
+    o = int(np.ceil(_reach(r, h, p))) + 2
+    S = 2 * o
+    stamps = _Stamps(free, obs, headings, p.a_c, p.a_p, p.a_n, o, dtype)
     n_marks = max(1, free.shape[0] + obs.shape[0])
-    amax = max(abs(a_c), abs(a_p), abs(a_n))
-    tol = (1e-9 if np.dtype(dtype) == np.float64 else 2e-5) * amax * amax * n_marks
-    best_val, best_idx, best_map, best = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=workers,
-                                                      chunk=8 if chunk is None else chunk, tol=tol)
+    amax = max(abs(p.a_c), abs(p.a_p), abs(p.a_n))
+    tol = (1e-9 if dtype == np.float64 else 2e-5) * amax * amax * n_marks
+    best_val, best_idx, best_map, best = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=p.workers,
+                                                      chunk=p.chunk, tol=tol)
     n, row, col = (int(i) for i in best_idx)
-    heading = headings[n] if prior_heading_rad is not None else float(np.mod(headings[n], 2 * np.pi))
+    heading = headings[n] if tracking else float(np.mod(headings[n], 2 * np.pi))
     return Localisation(pose=np.array([float(col), float(row), heading]), row=row, col=col, heading_index=n,
                         score=best_val, headings_rad=headings, best_per_heading=best, score_map=best_map)
 

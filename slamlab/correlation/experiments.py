@@ -1,4 +1,8 @@
-"""Ch. 5 experiments (004 §7): Table 1, a Monte Carlo study, the constants a_c/a_p, the Intel log.
+"""Ch. 5 experiments (004 §7): Table 1, a Monte Carlo study, the constants a_c/a_p, a real CARMEN log.
+
+Every ``run_*`` takes ``params=`` (a :class:`~slamlab.correlation.LocaliseParams`, the
+same settings and defaults as :func:`~slamlab.correlation.localise`) plus overrides
+of its fields.
 
 Each ``run_*`` returns a frozen dataclass: ``str(result)`` is a one-line summary,
 ``result.table()`` a fixed-precision text table (what the notebook prints and
@@ -8,6 +12,7 @@ nbval compares); arrays for plotting live in fields, timings in ``time_s``
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
 
@@ -16,21 +21,22 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
-from ..sim.grid import add_clutter, check_grid, free_cells, measurement_room_200, test_room_200
+from ..scans import GridFrame, Scan, grid_to_values, occupancy_grid
+from ..sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
 from ..sim.paths import random_free_poses
 from ..sim.rangefinder import Rangefinder
-from .algorithm import check_constants, heading_error, localise
-from .mapping import GridFrame, occupancy_grid_from_scans
+from .algorithm import LocaliseParams, _localise, _scan_beams, heading_candidates, heading_error, localise
 
 __all__ = [
     "SOURCE_TABLE1",
     "ConstantsResult",
-    "IntelResult",
+    "LogLocalisationResult",
     "MonteCarloResult",
     "Table1Result",
+    "log_grid",
     "random_clutter",
     "run_constants_study",
-    "run_intel_localisation",
+    "run_log_localisation",
     "run_monte_carlo",
     "run_table1",
     "time_localise",
@@ -83,13 +89,14 @@ def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int
     return [("disc", int(c), int(rw), r) for rw, c in pick]
 
 
-def _localise_many(M, W, poses, rf, rng, *, delta_alpha_rad, a_c, a_p, a_n, delta_l_cells, dtype):
+def _localise_many(M, W, poses, rf, rng, p: LocaliseParams):
+    """Cast and localise one scan per pose; the map and settings were checked once by the caller."""
+    Mv = grid_to_values(M, p.a_c, p.a_p, p.a_n)
+    headings = heading_candidates(p.delta_alpha_rad)
     est = np.empty_like(poses)
-    for k, p in enumerate(poses):
-        scan = rf.scan(W, p, rng)
-        loc = localise(M, scan, delta_alpha_rad=delta_alpha_rad, a_c=a_c, a_p=a_p, a_n=a_n,
-                       delta_l_cells=delta_l_cells, dtype=dtype)
-        est[k] = loc.pose
+    for k, pose in enumerate(poses):
+        scan = rf.scan(W, pose, rng)
+        est[k] = _localise(Mv, *_scan_beams(scan), headings, p, tracking=False).pose
     return est
 
 
@@ -114,6 +121,7 @@ class Table1Result:
     err_y_cells: np.ndarray
     range_std_cells: float
     n_beams: int
+    params: LocaliseParams = field(default_factory=LocaliseParams, repr=False)
     time_s: float = field(default=0.0, compare=False)
 
     def __str__(self) -> str:
@@ -135,7 +143,7 @@ class Table1Result:
                      f"{s_ey.max():.0f}"])
         head = ["#", "α0", "α0 est", "X", "X est", "Y", "Y est", "err α0", "err X", "err Y"]
         title = (f"Ours: {self.n_beams} beams over 360°, range σ = {self.range_std_cells:g} cell, 0.1-cell "
-                 f"quantisation, Δα = 1°, clutter (rad, cells)")
+                 f"quantisation, Δα = {np.degrees(self.params.delta_alpha_rad):g}°, clutter (rad, cells)")
         return format_table(head, rows, title=title)
 
     def source_table(self) -> str:
@@ -149,29 +157,26 @@ class Table1Result:
 
 
 def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int = 360,
-               max_range_cells: float = 100.0, clutter: bool = True, delta_alpha_deg: float = 1.0,
-               a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0, delta_l_cells: float = 0.0,
-               dtype=np.float32, rng=2010) -> Table1Result:
+               max_range_cells: float = 100.0, clutter: bool = True, params: LocaliseParams | None = None,
+               rng=2010, **overrides) -> Table1Result:
     """Localise the robot from no prior at ``n_poses`` random free poses of the test room (004 Table 1).
 
     The robot stands on whole cells with a uniform random heading; the scan is
     cast in the measurement room (unmapped clutter) with Gaussian range noise and
     0.1-cell quantisation, and localised on the mapped room M by the full 360°
     search. 004 does not give σ, the beam count or the range limit: ours are
-    parameters.
+    parameters. ``params`` / ``**overrides``: the :class:`LocaliseParams` of every localisation.
     """
+    p = LocaliseParams.resolve(params, **overrides)
     n = v.check_int(n_poses, "n_poses", minimum=1)
-    dalpha = np.radians(v.check_positive(delta_alpha_deg, "delta_alpha_deg"))
-    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
     rf = _sensor(n_beams, max_range_cells, range_std_cells)
     rng = v.as_rng(rng)
     M, W = _worlds(clutter, 0, rng)
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     t0 = time.perf_counter()
-    est = _localise_many(M, W, poses, rf, rng, delta_alpha_rad=dalpha, a_c=a_c, a_p=a_p, a_n=a_n,
-                         delta_l_cells=delta_l_cells, dtype=dtype)
+    est = _localise_many(M, W, poses, rf, rng, p)
     ea, ex, ey = _errors(poses, est)
-    return Table1Result(poses, est, ea, ex, ey, float(range_std_cells), int(n_beams), time.perf_counter() - t0)
+    return Table1Result(poses, est, ea, ex, ey, float(range_std_cells), int(n_beams), p, time.perf_counter() - t0)
 
 
 # --- Monte Carlo -------------------------------------------------------------------------------------
@@ -219,25 +224,23 @@ class MonteCarloResult:
 
 
 def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, n_beams: int = 360,
-                    max_range_cells: float = 100.0, extra_clutter: int = 0, delta_alpha_deg: float = 1.0,
-                    a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0, dtype=np.float32,
-                    rng=2011) -> MonteCarloResult:
+                    max_range_cells: float = 100.0, extra_clutter: int = 0, params: LocaliseParams | None = None,
+                    rng=2011, **overrides) -> MonteCarloResult:
     """Full 360° localisation at many random poses: error distribution and failure rate (our addition).
 
     ``size``: ``"small"`` (12 poses, the notebook), ``"full"`` (200) or an int.
+    ``params`` / ``**overrides``: the :class:`LocaliseParams` of every localisation.
     """
+    p = LocaliseParams.resolve(params, **overrides)
     n = _SIZES[v.check_choice(size, "size", _SIZES)] if isinstance(size, str) else v.check_int(size, "size",
                                                                                                  minimum=1)
-    dalpha = np.radians(v.check_positive(delta_alpha_deg, "delta_alpha_deg"))
-    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
     ec = v.check_int(extra_clutter, "extra_clutter", minimum=0)
     rf = _sensor(n_beams, max_range_cells, range_std_cells)
     rng = v.as_rng(rng)
     M, W = _worlds(True, ec, rng)
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     t0 = time.perf_counter()
-    est = _localise_many(M, W, poses, rf, rng, delta_alpha_rad=dalpha, a_c=a_c, a_p=a_p, a_n=a_n,
-                         delta_l_cells=0.0, dtype=dtype)
+    est = _localise_many(M, W, poses, rf, rng, p)
     ea, ex, ey = _errors(poses, est)
     ep = np.hypot(ex, ey)
     failed = (ep > FAIL_CELLS) | (np.degrees(ea) > FAIL_DEG)
@@ -292,8 +295,8 @@ def _margins(loc, heading_window=3):
 
 def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std_cells: float = 0.3,
                         n_beams: int = 360, max_range_cells: float = 100.0,
-                        choices=((-1.0, 1.0, 0.0), (0.0, 1.0, 0.0)), dtype=np.float32,
-                        rng=2012) -> ConstantsResult:
+                        choices=((-1.0, 1.0, 0.0), (0.0, 1.0, 0.0)), params: LocaliseParams | None = None,
+                        rng=2012, **overrides) -> ConstantsResult:
     """Compare 004's constant choices on the same cluttered scans (004 §7).
 
     004: the peak is sharpest at ``a_p = -a_c``; with unmapped objects,
@@ -302,11 +305,14 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     discs). Our sharpness measures: the half-maximum area of the score map at the
     best heading (cells scoring at least halfway from the median to the peak), the
     heading margin (peak minus the best score ≥ 3° away, over peak minus the median
-    over headings), and the failure rate.
+    over headings), and the failure rate. ``params`` / ``**overrides``: the other
+    :class:`LocaliseParams` fields (each choice replaces ``a_c, a_p, a_n``).
     """
+    base = LocaliseParams.resolve(params, **overrides)
     n = v.check_int(n_poses, "n_poses", minimum=1)
     ec = v.check_int(extra_clutter, "extra_clutter", minimum=0)
-    consts = tuple(check_constants(*c) for c in choices)
+    settings = tuple(base.replace(a_c=float(c[0]), a_p=float(c[1]), a_n=float(c[2])) for c in choices)
+    consts = tuple((q.a_c, q.a_p, q.a_n) for q in settings)
     if not consts:
         raise ValueError("`choices` must hold at least one (a_c, a_p, a_n) triple")
     rf = _sensor(n_beams, max_range_cells, range_std_cells)
@@ -318,30 +324,79 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     pm, hm, ep = np.empty((k, n)), np.empty((k, n)), np.empty((k, n))
     failed = np.zeros((k, n), bool)
     maps = []
+    headings = heading_candidates(base.delta_alpha_rad)
     t0 = time.perf_counter()
-    for j, (a_c, a_p, a_n) in enumerate(consts):
+    for j, q in enumerate(settings):
+        Mv = grid_to_values(M, q.a_c, q.a_p, q.a_n)
         for i, (p, s) in enumerate(zip(poses, scans, strict=True)):
-            loc = localise(M, s, a_c=a_c, a_p=a_p, a_n=a_n, dtype=dtype)
+            loc = _localise(Mv, *_scan_beams(s), headings, q, tracking=False)
             pm[j, i], hm[j, i] = _margins(loc)
             ep[j, i] = np.hypot(*(loc.pose[:2] - p[:2]))
             failed[j, i] = ep[j, i] > FAIL_CELLS or np.degrees(heading_error(loc.pose[2], p[2])) > FAIL_DEG
         h0 = np.radians(np.round(np.degrees(poses[0, 2])))
-        maps.append(localise(M, scans[0], a_c=a_c, a_p=a_p, a_n=a_n, prior_heading_rad=h0, window_rad=0.0,
-                             dtype=dtype).score_map)
+        maps.append(localise(M, scans[0], params=q, prior_heading_rad=h0, window_rad=0.0).score_map)
     labels = tuple(f"a_c={c[0]:g}, a_p={c[1]:g}, a_n={c[2]:g}" for c in consts)
     return ConstantsResult(labels, consts, pm, hm, failed.mean(axis=1), ep, ec, tuple(maps), poses[0].copy(),
                            time.perf_counter() - t0)
 
 
-# --- real data: the Intel Research Lab log -------------------------------------------------------------
+# --- real data: a CARMEN log with (corrected) poses ----------------------------------------------------
+
+#: The default log of :func:`run_log_localisation` (found by :func:`slamlab.data.find_data`).
+DEFAULT_CARMEN_LOG = "carmen-radish-corrected/intel-corrected.log.gz"
+
+
+def _carmen_log(path):
+    """A :class:`~slamlab.io.CarmenLog` from a path (str / os.PathLike; default the Intel log) or a read log."""
+    from ..io import CarmenLog, read_carmen
+
+    if isinstance(path, CarmenLog):
+        return path
+    if path is None:
+        from ..data import find_data
+
+        path = find_data(DEFAULT_CARMEN_LOG)
+    elif isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"`path` must be a str, os.PathLike or CarmenLog; got {type(path).__name__}")
+    return read_carmen(path)
+
+
+def _limited(scan: Scan, max_range_m: float) -> Scan:
+    """Readings at or beyond ``max_range_m`` become "no return" at ``max_range_m``."""
+    ok = scan.valid & (scan.ranges < max_range_m)
+    return Scan(scan.bearings_rad, np.where(ok, scan.ranges, max_range_m), ok, unit=scan.unit,
+                max_range=max_range_m, time_s=scan.time_s, odom_pose=scan.odom_pose, pose=scan.pose)
+
+
+def log_grid(log, *, cell_m: float = 0.2, max_range_m: float = 10.0, leave_out=()):
+    """Map of a CARMEN log from its logged poses, leaving out some scans (for localising them on it).
+
+    Returns ``(grid, frame, scans_cells, poses_cells)``: the :func:`~slamlab.scans.occupancy_grid`
+    (rule ``"count"``) of every scan not in ``leave_out``, its :class:`~slamlab.scans.GridFrame`,
+    and every scan and pose in cell units.
+    """
+    cell = v.check_positive(cell_m, "cell_m")
+    rmax = v.check_positive(max_range_m, "max_range_m")
+    scans_m = [_limited(s, rmax) for s in log.scans()]
+    pts = np.vstack([s.points(q) for s, q in zip(log.scans(range(0, log.n_scans, 10)), log.poses[::10],
+                                                    strict=True)])
+    pts = pts[np.hypot(*(pts - log.poses[:, :2].mean(axis=0)).T) < rmax + np.ptp(log.poses[:, :2], axis=0).max()]
+    frame = GridFrame.around(np.vstack([log.poses[:, :2], pts]), cell, 1.0)
+    Pc = frame.to_cells(log.poses)
+    scans_c = [s.to_cells(cell) for s in scans_m]
+    keep = np.ones(log.n_scans, bool)
+    keep[np.asarray(list(leave_out), dtype=np.int64)] = False
+    G = occupancy_grid([s for s, k in zip(scans_c, keep, strict=True) if k], Pc[keep], frame.shape).grid
+    return G, frame, scans_c, Pc
 
 
 @dataclass(frozen=True)
-class IntelResult:
-    """Correlation localisation of Intel-lab scans on a grid built from the corrected poses (real data)."""
+class LogLocalisationResult:
+    """Correlation localisation of scans of a CARMEN log on a grid built from its logged poses (real data)."""
 
+    name: str  # the log's file name
     scan_indices: np.ndarray
-    true_poses_m: np.ndarray  # (n, 3) corrected poses
+    true_poses_m: np.ndarray  # (n, 3) logged poses
     est_poses_m: np.ndarray  # (n, 3)
     err_pos_m: np.ndarray
     err_heading_rad: np.ndarray
@@ -350,53 +405,56 @@ class IntelResult:
     exclude: int
     grid: np.ndarray = field(repr=False)
     frame: GridFrame = field(repr=False)
-    example_points_m: np.ndarray = field(default=None, repr=False)  # scan 0 drawn at its estimated pose
+    example_points_m: np.ndarray = field(default=None, repr=False)  # the first scan drawn at its estimated pose
+    params: LocaliseParams = field(default_factory=LocaliseParams, repr=False)
     time_s: float = field(default=0.0, compare=False)
 
     @property
     def success(self) -> np.ndarray:
-        """Within 2 cells and 5° of the corrected pose."""
+        """Within 2 cells and 5° of the logged pose."""
         return (self.err_pos_m <= FAIL_CELLS * self.cell_m) & (np.degrees(self.err_heading_rad) <= FAIL_DEG)
 
     def __str__(self) -> str:
-        return (f"Intel log: {self.success.sum()}/{self.success.size} scans localised within "
+        return (f"{self.name}: {self.success.sum()}/{self.success.size} scans localised within "
                 f"{FAIL_CELLS * self.cell_m:.1f} m and {FAIL_DEG:g}° from no prior")
 
     def table(self) -> str:
         rows = [[int(i), f"{t[0]:.2f}", f"{t[1]:.2f}", f"{np.degrees(wrap_angle(t[2])):.1f}", f"{e[0]:.2f}",
-                 f"{e[1]:.2f}", f"{np.degrees(wrap_angle(e[2])):.1f}", f"{dp:.2f}", f"{np.degrees(da):.1f}", "yes" if ok else "NO"]
+                 f"{e[1]:.2f}", f"{np.degrees(wrap_angle(e[2])):.1f}", f"{dp:.2f}", f"{np.degrees(da):.1f}",
+                 "yes" if ok else "NO"]
                 for i, t, e, dp, da, ok in zip(self.scan_indices, self.true_poses_m, self.est_poses_m,
                                                self.err_pos_m, self.err_heading_rad, self.success, strict=True)]
-        title = (f"Intel Research Lab, corrected log: grid {self.grid.shape[0]}x{self.grid.shape[1]} cells of "
+        title = (f"{self.name} (CARMEN, logged laser poses): grid {self.grid.shape[0]}x{self.grid.shape[1]} cells of "
                  f"{self.cell_m:g} m from the other scans (±{self.exclude} scans left out), ranges < "
-                 f"{self.max_range_m:g} m, Δα = 1°, no prior")
+                 f"{self.max_range_m:g} m, Δα = {np.degrees(self.params.delta_alpha_rad):g}°, no prior")
         return format_table(["scan", "x [m]", "y [m]", "θ [°]", "x est", "y est", "θ est", "err [m]", "err [°]",
                              "ok"], rows, title=title)
 
 
-def run_intel_localisation(scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *, cell_m: float = 0.2,
-                           max_range_m: float = 10.0, exclude: int = 10, a_c: float = -1.0, a_p: float = 1.0,
-                           a_n: float = 0.0, log=None, dtype=np.float32) -> IntelResult:
-    """Localise scans of the corrected Intel log on a grid built from its corrected poses (real data).
+def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *,
+                         cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int = 10,
+                         params: LocaliseParams | None = None, **overrides) -> LogLocalisationResult:
+    """Localise scans of a CARMEN log on a grid built from the log's own poses (real data).
 
     The grid (``cell_m`` cells, 004's three values) is built from every scan except
     ``±exclude`` scans around each test scan, so a scan is never matched against
     cells it drew itself (our stricter choice). Each test scan is then localised
-    from no prior (full 360°, Δα = 1°) and compared with its corrected pose.
+    from no prior (full 360°) and compared with its logged pose (SLAM-corrected in
+    the Radish logs; for a raw log, its odometry).
 
     Parameters
     ----------
-    log : CarmenLog, optional
-        The already-read log; default: read ``carmen-radish-corrected/intel-corrected.log.gz``
-        from the shared data folder.
+    path : str, os.PathLike or CarmenLog, optional
+        Any CARMEN log (plain or gzip); default the corrected Intel Research Lab log
+        (``carmen-radish-corrected/intel-corrected.log.gz`` via :func:`slamlab.data.find_data`).
+        Results are labelled with the file name.
+    scan_indices : sequence of int
+        The scans to localise.
+    params, **overrides
+        :class:`LocaliseParams` of every localisation.
     """
-    from ..data import find_data
-    from ..io import CarmenLog, read_carmen
-
-    if log is None:
-        log = read_carmen(find_data("carmen-radish-corrected/intel-corrected.log.gz"))
-    elif not isinstance(log, CarmenLog):
-        raise TypeError(f"`log` must be a CarmenLog; got {type(log).__name__}")
+    p = LocaliseParams.resolve(params, **overrides)
+    log = _carmen_log(path)
     cell = v.check_positive(cell_m, "cell_m")
     rmax = v.check_positive(max_range_m, "max_range_m")
     ex = v.check_int(exclude, "exclude", minimum=0)
@@ -405,36 +463,65 @@ def run_intel_localisation(scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 
         raise ValueError(f"`scan_indices` must be a non-empty list of ints; got {scan_indices!r}")
     if idx.min() < 0 or idx.max() >= log.n_scans:
         raise ValueError(f"`scan_indices` must lie in [0, {log.n_scans - 1}]; got {idx.min()}..{idx.max()}")
-    a_c, a_p, a_n = check_constants(a_c, a_p, a_n)
-    valid = log.valid & (np.nan_to_num(log.ranges_m) < rmax)
-    R = np.where(valid, np.nan_to_num(log.ranges_m), rmax) / cell
-    pts = np.vstack([log.points(i) for i in range(0, log.n_scans, 10)])
-    pts = pts[np.hypot(*(pts - log.poses[:, :2].mean(axis=0)).T) < rmax + np.ptp(log.poses[:, :2], axis=0).max()]
-    frame = GridFrame.around(np.vstack([log.poses[:, :2], pts]), cell, 1.0)
-    Pc = frame.to_cells(log.poses)
-    keep = np.ones(log.n_scans, bool)
-    for i in idx:
-        keep[max(0, i - ex):i + ex + 1] = False
     t0 = time.perf_counter()
-    G = occupancy_grid_from_scans(log.angles_rad, R[keep], valid[keep], Pc[keep], frame.shape)
-    G = check_grid(G)
+    leave = sorted({j for i in idx for j in range(max(0, i - ex), min(log.n_scans, i + ex + 1))})
+    G, frame, scans_c, _Pc = log_grid(log, cell_m=cell, max_range_m=rmax, leave_out=leave)
+    Mv = grid_to_values(G, p.a_c, p.a_p, p.a_n)
+    headings = heading_candidates(p.delta_alpha_rad)
     est = np.empty((idx.size, 3))
     for k, i in enumerate(idx):
-        loc = localise(G, (log.angles_rad, R[i], valid[i]), a_c=a_c, a_p=a_p, a_n=a_n, dtype=dtype)
-        est[k] = loc.pose
+        est[k] = _localise(Mv, *_scan_beams(scans_c[i], f"scan {i}"), headings, p, tracking=False).pose
     est_m = frame.to_metres(est)
     true_m = log.poses[idx]
     err_p = np.hypot(*(est_m[:, :2] - true_m[:, :2]).T)
     err_a = heading_error(est_m[:, 2], true_m[:, 2])
-    example = log.points(int(idx[0]), est_m[0])
-    return IntelResult(idx, true_m, est_m, err_p, err_a, cell, rmax, ex, G, frame, example, time.perf_counter() - t0)
+    example = log.scan(int(idx[0])).points(est_m[0])
+    return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, cell, rmax, ex, G, frame,
+                                 example, p, time.perf_counter() - t0)
 
 
-def time_localise(grid, scan, *, dtypes=(np.float64, np.float32)) -> dict:
+def time_localise(grid, scan, *, dtypes=("float64", "float32")) -> dict:
     """Wall time in seconds of one full 360° :func:`localise` per dtype (volatile: print only in ignored cells)."""
     out = {}
     for dt in dtypes:
         t0 = time.perf_counter()
-        localise(grid, scan, dtype=dt)
+        localise(grid, scan, dtype=np.dtype(dt).name)
         out[np.dtype(dt).name] = time.perf_counter() - t0
     return out
+
+
+def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = None,
+                   constants: ConstantsResult | None = None, log: LogLocalisationResult | None = None) -> str:
+    """The notebook's closing table: 004's figures (§7, Table 1) beside ours, from the runs' results.
+
+    >>> print(ours_vs_source(run_table1(2, rng=1)).splitlines()[0])
+    Ours vs the source (004 §7)
+    """
+    if not isinstance(table1, Table1Result):
+        raise TypeError(f"`table1` must be a Table1Result; got {type(table1).__name__}")
+    src = SOURCE_TABLE1
+    s_ea, s_ex, s_ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
+    t = table1
+    rows = [
+        ["Table 1: poses", f"{src.shape[0]}", f"{t.true_poses.shape[0]}"],
+        ["Table 1: max position error [cells]", f"{max(s_ex.max(), s_ey.max()):.0f}",
+         f"{max(t.err_x_cells.max(), t.err_y_cells.max()):.0f}"],
+        ["Table 1: max heading error [rad]", f"{s_ea.max():.4f}", f"{t.err_heading_rad.max():.4f}"],
+        ["Table 1: range noise σ [cells]", "not given", f"{t.range_std_cells:g}"],
+    ]
+    if monte_carlo is not None:
+        mc = monte_carlo
+        rows += [[f"Monte Carlo ({mc.n_poses} poses): position exact", "no study", f"{np.mean(mc.err_pos_cells == 0):.1%}"],
+                 [f"Monte Carlo ({mc.n_poses} poses): failures (> 2 cells or > 5°)", "no study",
+                  f"{mc.failure_rate:.1%}"]]
+    if constants is not None:
+        c = constants
+        for k, lb in enumerate(c.labels):
+            rows.append([f"{lb}: heading margin / half-max area [cells]",
+                         "sharpest at a_p = -a_c" if k == 0 else "more robust to clutter",
+                         f"{np.median(c.heading_margin[k]):.3f} / {np.median(c.half_max_area[k]):.0f}"])
+            rows.append([f"{lb}: failures in the crowded room", "not measured", f"{c.failure_rate[k]:.0%}"])
+    if log is not None:
+        rows.append([f"real log {log.name}: scans within {FAIL_CELLS * log.cell_m:.1f} m and {FAIL_DEG:g}°",
+                     "none (simulation only)", f"{int(log.success.sum())}/{log.success.size}"])
+    return format_table(["quantity", "004", "ours"], rows, title="Ours vs the source (004 §7)")

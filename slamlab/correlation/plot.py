@@ -1,4 +1,4 @@
-"""Plots for Ch. 5 (004 §7): maps, localised scans, score maps, Table 1, error distributions, the Intel log."""
+"""Plots for Ch. 5 (004 §7): maps, localised scans, score maps, Table 1, error distributions, a real CARMEN log."""
 
 from __future__ import annotations
 
@@ -7,8 +7,6 @@ import numpy as np
 from matplotlib.colors import ListedColormap
 
 from ..plotting import STYLE, new_axes
-from ..sim.rangefinder import scan_to_points
-from .algorithm import scan_arrays
 
 __all__ = [
     "constants_figure",
@@ -17,8 +15,8 @@ __all__ = [
     "plot_grid",
     "plot_grids",
     "plot_heading_profile",
-    "plot_intel",
     "plot_localisation",
+    "plot_log_localisation",
     "plot_score_map",
     "plot_stamp",
     "plot_stamps",
@@ -79,8 +77,7 @@ def _pose_arrow(ax, pose, length, **kw):
 def plot_localisation(grid, scan, loc, truth=None, *, ax=None, title="Scan drawn at the estimated pose"):
     """The map, the scan's returns drawn from the estimated pose, the true and estimated poses."""
     ax = plot_grid(grid, ax=ax, title=title)
-    a, r, h = scan_arrays(scan)
-    pts = scan_to_points(a, r, loc.pose, h)
+    pts = scan.points(loc.pose)
     ax.plot(pts[:, 0], pts[:, 1], **{**STYLE["measurement"], "markersize": 2.5}, label="scan at estimate")
     if truth is not None:
         ax.plot(truth[0], truth[1], "o", color="black", mfc="none", ms=9, label="true pose")
@@ -172,19 +169,19 @@ def constants_figure(result, grid):
     return fig
 
 
-def plot_intel(result, *, ax=None):
-    """Intel grid (metres), corrected poses of the test scans, estimates and the first scan at its estimate."""
+def plot_log_localisation(result, *, ax=None):
+    """A log's grid (metres), the logged poses of the test scans, estimates and the first scan at its estimate."""
     f = result.frame
     extent = (f.x0_m - f.cell_m / 2, f.x0_m + (f.shape[1] - 0.5) * f.cell_m,
               f.y0_m - f.cell_m / 2, f.y0_m + (f.shape[0] - 0.5) * f.cell_m)
-    ax = plot_grid(result.grid, ax=ax, extent=extent, title="Intel lab: grid from corrected poses, scans localised",
+    ax = plot_grid(result.grid, ax=ax, extent=extent, title=f"{result.name}: grid from the logged poses, scans localised",
                    figsize=(8, 8))
     if result.example_points_m is not None:
         pts = result.example_points_m
         ax.plot(pts[:, 0], pts[:, 1], **{**STYLE["measurement"], "markersize": 2.5},
                 label=f"scan {result.scan_indices[0]} at its estimate")
     t, e = result.true_poses_m, result.est_poses_m
-    ax.plot(t[:, 0], t[:, 1], "o", color="black", mfc="none", ms=9, label="corrected pose")
+    ax.plot(t[:, 0], t[:, 1], "o", color="black", mfc="none", ms=9, label="logged pose")
     ok = result.success
     ax.plot(e[ok, 0], e[ok, 1], "x", color=STYLE["estimate"]["color"], ms=8, mew=2, label="estimate (ok)")
     if (~ok).any():

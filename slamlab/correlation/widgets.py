@@ -12,10 +12,10 @@ from ..sim.rangefinder import Rangefinder
 from ..widgets import STYLE as _STYLE
 from ..widgets import slider as _slider
 from .algorithm import heading_error, localise
-from .experiments import random_clutter
+from .experiments import _carmen_log, log_grid, random_clutter
 from .plot import localisation_figure
 
-__all__ = ["explore_intel_scan", "explore_localisation"]
+__all__ = ["explore_localisation", "explore_log_scan"]
 
 
 
@@ -41,8 +41,7 @@ def explore_localisation(**defaults):
             truth = np.array([float(x), float(y), np.radians(heading_deg)])
             rf = Rangefinder(n_beams=int(n_beams), max_range_cells=100.0, range_std_cells=range_std_cells)
             scan = rf.scan(W, truth, rng=d["rng"])
-            loc = localise(M, scan, delta_alpha_rad=np.radians(delta_alpha_deg), a_c=a_c, a_p=a_p,
-                           dtype=np.float32)
+            loc = localise(M, scan, delta_alpha_rad=float(np.radians(delta_alpha_deg)), a_c=a_c, a_p=a_p)
         except (ValueError, TypeError) as exc:
             print(f"Cannot run with these settings: {exc}")
             return
@@ -65,46 +64,35 @@ def explore_localisation(**defaults):
     )
 
 
-@functools.lru_cache(maxsize=1)
-def _intel_map(cell_m: float, max_range_m: float):
-    from ..data import find_data
-    from ..io import read_carmen
-    from .mapping import GridFrame
-
-    log = read_carmen(find_data("carmen-radish-corrected/intel-corrected.log.gz"))
-    valid = log.valid & (np.nan_to_num(log.ranges_m) < max_range_m)
-    R = np.where(valid, np.nan_to_num(log.ranges_m), max_range_m) / cell_m
-    pts = np.vstack([log.points(i) for i in range(0, log.n_scans, 10)])
-    pts = pts[np.hypot(*(pts - log.poses[:, :2].mean(axis=0)).T) < max_range_m + 40]
-    frame = GridFrame.around(np.vstack([log.poses[:, :2], pts]), cell_m, 1.0)
-    return log, frame, R, valid, frame.to_cells(log.poses)
+@functools.lru_cache(maxsize=2)
+def _log(path):
+    return _carmen_log(path)
 
 
-def explore_intel_scan(**defaults):
-    """Pick a scan of the corrected Intel log and a_c/a_p; it is localised on a grid built without its neighbours."""
-    from .mapping import occupancy_grid_from_scans
-
+def explore_log_scan(path=None, **defaults):
+    """Pick a scan of a CARMEN log (default: the corrected Intel log) and a_c/a_p; it is localised on a grid
+    built from the log's poses without its neighbours (what :func:`run_log_localisation` does)."""
     d = {"scan": 250, "a_c": -1.0, "a_p": 1.0, "exclude": 10, "cell_m": 0.2, "max_range_m": 10.0}
     d.update(defaults)
+    log = _log(path)
 
     def show(scan, a_c, a_p, exclude):
         try:
-            log, frame, R, valid, Pc = _intel_map(d["cell_m"], d["max_range_m"])
-            keep = np.ones(log.n_scans, bool)
-            keep[max(0, scan - exclude):scan + exclude + 1] = False
-            G = occupancy_grid_from_scans(log.angles_rad, R[keep], valid[keep], Pc[keep], frame.shape)
-            loc = localise(G, (log.angles_rad, R[scan], valid[scan]), a_c=a_c, a_p=a_p, dtype=np.float32)
-        except (ValueError, TypeError, FileNotFoundError) as exc:
+            leave = range(max(0, scan - exclude), min(log.n_scans, scan + exclude + 1))
+            G, frame, scans_c, Pc = log_grid(log, cell_m=d["cell_m"], max_range_m=d["max_range_m"], leave_out=leave)
+            loc = localise(G, scans_c[scan], a_c=a_c, a_p=a_p)
+        except (ValueError, TypeError) as exc:
             print(f"Cannot run with these settings: {exc}")
             return
         est = frame.to_metres(loc.pose[None])[0]
         err = np.hypot(*(est[:2] - log.poses[scan, :2]))
-        print(f"scan {scan}: error {err:.2f} m, {np.degrees(heading_error(est[2], log.poses[scan, 2])):.1f}°")
-        localisation_figure(G, (log.angles_rad, R[scan], valid[scan]), loc, Pc[scan])
+        print(f"{log.name} scan {scan}: error {err:.2f} m, "
+              f"{np.degrees(heading_error(est[2], log.poses[scan, 2])):.1f}°")
+        localisation_figure(G, scans_c[scan], loc, Pc[scan])
 
     return widgets.interactive(
         show,
-        scan=_slider(widgets.IntSlider, d["scan"], 0, 909, 1, "scan"),
+        scan=_slider(widgets.IntSlider, min(d["scan"], log.n_scans - 1), 0, log.n_scans - 1, 1, "scan"),
         a_c=_slider(widgets.FloatSlider, d["a_c"], -2.0, 2.0, 0.25, "a_c (free)"),
         a_p=_slider(widgets.FloatSlider, d["a_p"], -2.0, 2.0, 0.25, "a_p (obstacle)"),
         exclude=_slider(widgets.IntSlider, d["exclude"], 0, 50, 1, "scans left out of the map (±)"),

@@ -1,14 +1,21 @@
 """Hough-transform SLAM from a scanning rangefinder (004): polar and classic Hough transforms,
-peaks above H_min, line association and history, pose from two lines, map building, an ICP
-baseline and the experiments of notebook 07.
+peaks above H_min, line association and history, pose from two lines, an ICP baseline and the
+experiments of notebook 07. Scans are :class:`slamlab.scans.Scan` objects; maps come from
+:func:`slamlab.scans.occupancy_grid`.
 """
 
+from .._lazy import lazy_exports
 from .association import LineHistory, associate, association_probability
 from .experiments import (
+    LOG_PARAMS,
+    ODOMETRY_NOISE,
+    SHARED_LOGS,
     ExampleLineResult,
     RealLogResult,
     SimSlamResult,
     check_pose_from_two_lines,
+    log_format,
+    ours_vs_source,
     pose_errors,
     run_example_line,
     run_real_log,
@@ -26,18 +33,8 @@ from .lines import (
     refine_lines,
     transform_lines,
 )
-from .mapping import BuiltMap, build_map, map_agreement, scan_points_world
-from .plot import (
-    accumulator_figure,
-    example_figure,
-    plot_accumulator,
-    plot_built_map,
-    plot_pose_errors,
-    plot_scan_lines,
-    real_log_figure,
-    sim_figure,
-)
-from .pose import PoseChange, compose, pose_from_lines, pose_from_two_lines, select_line_pair
+from .mapping import map_agreement
+from .pose import PoseChange, pose_from_lines, pose_from_two_lines, select_line_pair
 from .slam import HoughSlamParams, HoughSlamResult, detect_lines, hough_slam
 from .transform import (
     HoughAccumulator,
@@ -50,8 +47,24 @@ from .transform import (
     theta_axis,
 )
 
+_PLOT = (
+    "accumulator_figure",
+    "example_figure",
+    "plot_accumulator",
+    "plot_built_map",
+    "plot_pose_errors",
+    "plot_scan_lines",
+    "real_log_figure",
+    "sim_figure",
+)
+_WIDGETS = ("explore_accumulator", "explore_hough_slam", "explore_real_log")
+__getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
+
 __all__ = [
-    "BuiltMap",
+    "LOG_PARAMS",
+    "ODOMETRY_NOISE",
+    "SHARED_LOGS",
+    "ExampleLineResult",
     "HoughAccumulator",
     "HoughSlamParams",
     "HoughSlamResult",
@@ -59,13 +72,13 @@ __all__ = [
     "LineHistory",
     "Lines",
     "PoseChange",
+    "RealLogResult",
+    "SimSlamResult",
     "align_lines",
     "associate",
     "association_probability",
-    "build_map",
     "canonical_lines",
     "check_pose_from_two_lines",
-    "compose",
     "detect_lines",
     "find_peaks",
     "hough_classic",
@@ -77,39 +90,22 @@ __all__ = [
     "line_difference",
     "line_scan",
     "lines_about_centre",
+    "log_format",
     "map_agreement",
     "merge_duplicates",
+    "ours_vs_source",
+    "pose_errors",
     "pose_from_lines",
     "pose_from_two_lines",
     "rasterise_scan",
     "refine_lines",
     "rigid_fit_2d",
-    "scan_points_world",
+    "run_example_line",
+    "run_real_log",
+    "run_sim_slam",
     "select_line_pair",
     "theta_axis",
     "time_polar_vs_opencv",
     "transform_lines",
 ]
-
-from .widgets import explore_accumulator, explore_hough_slam, explore_real_log
-
-__all__ += [
-    "ExampleLineResult",
-    "RealLogResult",
-    "SimSlamResult",
-    "accumulator_figure",
-    "example_figure",
-    "explore_accumulator",
-    "explore_hough_slam",
-    "explore_real_log",
-    "plot_accumulator",
-    "plot_built_map",
-    "plot_pose_errors",
-    "plot_scan_lines",
-    "pose_errors",
-    "real_log_figure",
-    "run_example_line",
-    "run_real_log",
-    "run_sim_slam",
-    "sim_figure",
-]
+__all__ += list(_PLOT + _WIDGETS)  # loaded on first use

@@ -70,6 +70,11 @@ def association_probability(new: Lines, old: Lines, *, a: float, b: float | None
     b = a if b is None else v.check_positive(b, "b")
     a_theta = v.check_positive(a_theta_rad, "a_theta_rad")
     tol = v.check_positive(parallel_tol_rad, "parallel_tol_rad")
+    return _association_probability(new, old, a, b, a_theta, tol)
+
+
+def _association_probability(new: Lines, old: Lines, a: float, b: float, a_theta: float, tol: float) -> np.ndarray:
+    """:func:`association_probability` on checked arguments."""
     if len(new) == 0 or len(old) == 0:
         return np.zeros((len(new), len(old)))
     d_rho, d_theta = line_difference(new.rho[:, None], new.theta_rad[:, None], old.rho[None, :],
@@ -102,6 +107,11 @@ def associate(P, *, p_min: float = 0.05, one_to_one: bool = True) -> np.ndarray:
     """
     P = v.as_finite_array(P, "P", ndim=2)
     p_min = v.check_positive(p_min, "p_min", allow_zero=True)
+    return _associate(P, p_min, one_to_one)
+
+
+def _associate(P: np.ndarray, p_min: float, one_to_one: bool = True) -> np.ndarray:
+    """:func:`associate` on a checked matrix."""
     match = np.full(P.shape[0], -1, dtype=np.int64)
     if P.size == 0:
         return match

@@ -8,17 +8,21 @@ there is one); timings live in their own field, never in the table.
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
+from ..geometry.se2 import se2_relative
+from ..scans import GridFrame, OccupancyGrid, occupancy_grid, scan_to_points
 from .icp import icp_odometry
 from .lines import canonical_lines, find_peaks
-from .mapping import BuiltMap, build_map, map_agreement
+from .mapping import map_agreement
 from .slam import HoughSlamParams, HoughSlamResult, hough_slam
 from .transform import (
     HoughAccumulator,
@@ -41,6 +45,9 @@ __all__ = [
     "run_sim_slam",
     "time_polar_vs_opencv",
 ]
+
+#: The shared logs run by the notebook, found by :func:`slamlab.data.find_data`.
+SHARED_LOGS = {"urg04lx": "mines-urg04lx-odometry/exp2.dat", "mbicp": "mbicp-laserazos-sick/laserazosSM3.log"}
 
 
 def pose_errors(estimate, truth) -> np.ndarray:
@@ -135,6 +142,11 @@ def run_example_line(rho: float = 10.0, theta_deg: float = 45.0, r_max: float = 
         int(lp.votes[0]), int(lc.votes[0]), timing, polar, classic, img, (phi, r))
 
 
+#: Our odometry model of :func:`run_sim_slam` at ``odometry_noise = 1`` (004 gives none; 000 §1.3.2 asks for
+#: at most 2 cm per metre and 2° per 45° of turn).
+ODOMETRY_NOISE = {"trans_std_frac": 0.05, "rot_std_rad": 0.01, "drift_rad_per_cell": 0.002}
+
+
 # --- 004's experiment: the 121-pose path on the test room -------------------------------------
 
 
@@ -146,11 +158,12 @@ class SimSlamResult:
     slam: HoughSlamResult = field(repr=False)
     odometry: np.ndarray = field(repr=False)  # (n, 3) integrated odometry
     icp: np.ndarray | None = field(repr=False)  # (n, 3) chained ICP, None when not run
-    built_map: BuiltMap = field(repr=False)
+    built_map: OccupancyGrid = field(repr=False)
     reference_map: np.ndarray = field(repr=False)
     range_std_cells: float = 0.0
     clutter: bool = False
     timing_s: dict = field(default_factory=dict, compare=False)
+    odometry_noise: float = 1.0
 
     @property
     def errors(self) -> dict[str, np.ndarray]:
@@ -222,30 +235,29 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
     timing = {}
     t0 = time.perf_counter()
     scans = sim.simulate_scans(world, truth, rf, rng=np.random.default_rng(seeds[0]))
-    odo = sim.simulate_odometry(truth, trans_std_frac=0.05 * noise, rot_std_rad=0.01 * noise,
-                                drift_rad_per_cell=0.002 * noise, rng=np.random.default_rng(seeds[1]))
+    odo = sim.simulate_odometry(truth, **{k: x * noise for k, x in ODOMETRY_NOISE.items()},
+                                rng=np.random.default_rng(seeds[1]))
     timing["simulate"] = time.perf_counter() - t0
-    S = [(s.angles_rad, s.ranges_cells, s.hit) for s in scans]
     start_pose = truth[0]
     if start == "correlation":
         from ..correlation import localise
 
         t0 = time.perf_counter()
-        start_pose = localise(room, scans[0], delta_alpha_rad=math.radians(1.0)).pose
+        start_pose = localise(room, scans[0]).pose  # LocaliseParams defaults: Δα = 1° (004 §7)
         timing["correlation"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    res = hough_slam(S, start_pose, odo.increments, params, **overrides)
+    res = hough_slam(scans, start_pose, odo.increments, params, **overrides)
     timing["hough_slam"] = time.perf_counter() - t0
     icp_poses = None
     if with_icp:
         t0 = time.perf_counter()
-        pts = [np.column_stack([r[h] * np.cos(a[h]), r[h] * np.sin(a[h])]) for a, r, h in S]
+        pts = [scan_to_points(s.bearings_rad, s.ranges, None, s.valid) for s in scans]
         icp_poses, _ = icp_odometry(pts, truth[0], odo.increments, max_dist=3.0)
         timing["icp"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    built = build_map(S, res.poses, shape=room.shape, origin=(0.0, 0.0), free_step=1.0)
+    built = occupancy_grid(scans, res.poses, room.shape, rule="count", step_cells=1.0)
     timing["build_map"] = time.perf_counter() - t0
-    return SimSlamResult(truth, res, odo.poses, icp_poses, built, room, sigma, bool(clutter), timing)
+    return SimSlamResult(truth, res, odo.poses, icp_poses, built, room, sigma, bool(clutter), timing, noise)
 
 
 # --- real laser logs ---------------------------------------------------------------------------
@@ -255,13 +267,14 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
 class RealLogResult:
     """Hough SLAM on a real log beside integrated odometry (no ground truth in these logs)."""
 
-    name: str
+    name: str  # title: format and file name
     slam: HoughSlamResult = field(repr=False)
     odometry: np.ndarray = field(repr=False)  # (n, 3)
-    scans: list = field(repr=False)
-    map_slam: BuiltMap = field(repr=False)
-    map_odometry: BuiltMap = field(repr=False)
+    scans: list = field(repr=False)  # the Scans used (metres)
+    map_slam: OccupancyGrid = field(repr=False)
+    map_odometry: OccupancyGrid = field(repr=False)
     scan_index: np.ndarray = field(repr=False)  # which scans of the log were used
+    frame: GridFrame | None = field(default=None, repr=False)  # metric frame of both maps
     timing_s: dict = field(default_factory=dict, compare=False)
 
     @property
@@ -295,45 +308,61 @@ class RealLogResult:
         return format_table(["quantity", "value"], rows, title=self.name)
 
 
-#: Per-log settings (ours): file, rho resolution, thresholds in metres.
-_LOGS = {
-    "urg04lx": {"file": "mines-urg04lx-odometry/exp2.dat",
-                "params": {"delta_rho": 0.02, "H_min": 15, "a": 0.15, "max_gap": 0.2, "rho_tol": 0.05,
-                           "band": 0.03, "r_max": 4.0}},
-    "mbicp": {"file": "mbicp-laserazos-sick/laserazosSM3.log",
-              "params": {"delta_rho": 0.02, "H_min": 15, "a": 0.15, "max_gap": 0.3, "rho_tol": 0.05,
-                         "band": 0.03, "r_max": 8.0}},
+#: Per-format settings (ours): rho resolution and thresholds in metres; ``r_max`` None = the log's range limit.
+LOG_PARAMS = {
+    "urg04lx": {"delta_rho": 0.02, "H_min": 15, "a": 0.15, "max_gap": 0.2, "rho_tol": 0.05, "band": 0.03},
+    "carmen": {"delta_rho": 0.02, "H_min": 15, "a": 0.15, "max_gap": 0.3, "rho_tol": 0.05, "band": 0.03},
 }
+_FORMAT_NAMES = {"urg04lx": "URG-04LX", "carmen": "CARMEN"}
 
 
-def _load_log(name):
-    from ..data import find_data
+def log_format(path) -> str:
+    """``"carmen"`` or ``"urg04lx"``: the format of a laser log, from its first data line.
 
-    path = find_data(_LOGS[name]["file"])
-    if name == "urg04lx":
-        from ..io.urg04lx import read_urg04lx_log, urg04lx_odometry, urg04lx_sensor_increments
+    CARMEN lines start with a message name (``FLASER``, ``ODOM``, ``PARAM`` …); a
+    URG-04LX line of the Mines format is 707 numbers.
+    """
+    from ..io.carmen import _open_text  # plain text or gzip, told apart by the magic bytes
+
+    p = v.as_path(path, "path", kind="file")
+    with _open_text(p) as fh:
+        for line in fh:
+            tok = line.split()
+            if not tok or tok[0].startswith("#"):
+                continue
+            try:
+                float(tok[0])
+            except ValueError:
+                return "carmen"
+            return "urg04lx"
+    raise ValueError(f"{p.name}: empty log")
+
+
+def _load_log(path, fmt):
+    """Scans (metres) and odometry poses of a log; the log's range limit."""
+    if fmt == "urg04lx":
+        from ..io.urg04lx import read_urg04lx_log
 
         log = read_urg04lx_log(path)
-        scans = [log.scan(k) for k in range(len(log))]
-        start = np.zeros(3)
-        from ..sim import compose_poses
-
-        odo = compose_poses(start, urg04lx_sensor_increments(urg04lx_odometry(log.ticks)))
-        return scans, odo
+        return log.scans(), log.odometry_poses(), log.max_range_m
     from ..io.carmen import read_carmen
 
     log = read_carmen(path)
-    scans = [log.scan_cells(k, 1.0) for k in range(log.n_scans)]
-    return scans, log.odom_poses.copy()
+    return log.scans(), log.odom_poses.copy(), log.max_range_m
 
 
-def run_real_log(name: str = "urg04lx", *, n_scans: int | None = None, step: int = 1, cell_m: float = 0.05,
-                 params: HoughSlamParams | None = None, **overrides) -> RealLogResult:
-    """Hough SLAM on a real log with raw odometry: the URG-04LX log or the MbICP SICK log.
+def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = None, step: int = 1,
+                 cell_m: float = 0.05, params: HoughSlamParams | None = None, **overrides) -> RealLogResult:
+    """Hough SLAM on a real laser log with raw odometry (a URG-04LX log of the Mines format or a CARMEN log).
 
     Parameters
     ----------
-    name : {"urg04lx", "mbicp"}
+    path : str or os.PathLike, optional
+        Any log of either format; default the Mines URG-04LX log (``SHARED_LOGS["urg04lx"]``
+        found by :func:`slamlab.data.find_data`). The result's title is the format and the
+        file name.
+    fmt : {"urg04lx", "carmen"}, optional
+        The format; default: guessed from the first line (:func:`log_format`).
     n_scans : int, optional
         Use only the first ``n_scans`` scans of the log (after ``step``).
     step : int
@@ -341,24 +370,29 @@ def run_real_log(name: str = "urg04lx", *, n_scans: int | None = None, step: int
     cell_m : float
         Cell of the built maps.
     params, **overrides
-        Defaults are our per-log settings (Δrho = 2 cm, H_min = 15, a = 0.15 m, ...).
+        Defaults are our per-format settings :data:`LOG_PARAMS` (Δrho = 2 cm, H_min = 15,
+        a = 0.15 m, …) with ``r_max`` = the log's range limit.
     """
-    name = v.check_choice(name, "name", tuple(_LOGS))
+    if path is None:
+        from ..data import find_data
+
+        path = find_data(SHARED_LOGS["urg04lx"])
+    elif isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"`path` must be a str or os.PathLike; got {type(path).__name__}")
+    fmt = log_format(path) if fmt is None else v.check_choice(fmt, "fmt", tuple(LOG_PARAMS))
     step = v.check_int(step, "step", minimum=1)
     cell_m = v.check_positive(cell_m, "cell_m")
     timing = {}
     t0 = time.perf_counter()
-    scans, odo = _load_log(name)
+    scans, odo, max_range_m = _load_log(path, fmt)
     timing["read"] = time.perf_counter() - t0
     idx = np.arange(0, len(scans), step)
     if n_scans is not None:
         idx = idx[: v.check_int(n_scans, "n_scans", minimum=2)]
     scans = [scans[k] for k in idx]
     odo = odo[idx]
-    from ..sim import relative_poses
-
-    U = relative_poses(odo)
-    base = HoughSlamParams(**_LOGS[name]["params"]) if params is None else params
+    U = se2_relative(odo[:-1], odo[1:])
+    base = HoughSlamParams(**LOG_PARAMS[fmt], r_max=float(max_range_m)) if params is None else params
     t0 = time.perf_counter()
     res = hough_slam(scans, odo[0], U, base, **overrides)
     timing["hough_slam"] = time.perf_counter() - t0
@@ -366,13 +400,14 @@ def run_real_log(name: str = "urg04lx", *, n_scans: int | None = None, step: int
     pts = np.concatenate([odo[:, :2], res.poses[:, :2]])
     lo = pts.min(axis=0) - 9.0
     span = np.ceil((pts.max(axis=0) + 9.0 - lo) / cell_m).astype(int)
-    shape = (int(span[1]), int(span[0]))
-    m_slam = build_map(scans, res.poses, shape=shape, cell=cell_m, origin=tuple(lo), free_space=False)
-    m_odo = build_map(scans, odo, shape=shape, cell=cell_m, origin=tuple(lo), free_space=False)
+    frame = GridFrame(float(lo[0]), float(lo[1]), cell_m, (int(span[1]), int(span[0])))
+    scans_c = [s.to_cells(cell_m) for s in scans]
+    m_slam, m_odo = (occupancy_grid(scans_c, frame.to_cells(P), frame.shape, rule="endpoints", hit_offset_cells=0.0)
+                     for P in (res.poses, odo))
     timing["build_map"] = time.perf_counter() - t0
-    title = {"urg04lx": "Mines URG-04LX log exp2.dat (raw wheel odometry)",
-             "mbicp": "MbICP SICK log laserazosSM3.log (raw odometry)"}[name]
-    return RealLogResult(title, res, odo, scans, m_slam, m_odo, idx, timing)
+    name = Path(path).name
+    title = f"{_FORMAT_NAMES[fmt]} log {name} (raw odometry)"
+    return RealLogResult(title, res, odo, scans, m_slam, m_odo, idx, frame, timing)
 
 
 def check_pose_from_two_lines(n_cases: int = 1000, *, rng=2010) -> float:
@@ -425,3 +460,58 @@ def time_polar_vs_opencv(*, cell_m: float = 0.05, r_max_m: float = 30.0, room_ha
     ours = median_s(lambda: hough_polar(phi, r, delta_rho=cell_m, r_max=r_max_m))
     ref = median_s(lambda: cv2.HoughLines(img, 1, np.pi / 180, 30))
     return {"ours_s": ours, "opencv_s": ref, "image_px": img.shape[0], "ratio": ref / ours}
+
+
+
+def ours_vs_source(sim: SimSlamResult, *, example: ExampleLineResult | None = None,
+                   exact: SimSlamResult | None = None, variants=(), two_lines_error: float | None = None,
+                   real=()) -> str:
+    """The notebook's closing table: 004's statements (§Hough SLAM, Fig. 5-11) and 000 §1.3.2's odometry
+    figures beside ours, computed from the runs' results.
+
+    ``variants``: ``(label, SimSlamResult)`` pairs (e.g. 004's two-line pose, no refit);
+    ``two_lines_error``: :func:`check_pose_from_two_lines`'s result; ``real``: :class:`RealLogResult` objects.
+    """
+    if not isinstance(sim, SimSlamResult):
+        raise TypeError(f"`sim` must be a SimSlamResult; got {type(sim).__name__}")
+
+    def maxima(r):
+        e = r.errors["Hough SLAM"]
+        return (f"{np.abs(e[:, 0]).max():.2f} / {np.abs(e[:, 1]).max():.2f} cell, "
+                f"{np.degrees(np.abs(e[:, 2]).max()):.2f}°")
+
+    rows = []
+    if example is not None:
+        rows += [["example line: accumulator polar / classic (θ × rho)", "180×33 / 180×93",
+                  (f"{example.polar_size[0]}×{example.polar_size[1]} / "
+                  f"{example.classic_size[0]}×{example.classic_size[1]}")],
+                 ["example line found (rho, θ°), polar", "(10, 45)",
+                  f"({example.polar_line[0]:.1f}, {example.polar_line[1]:.1f})"]]
+    if two_lines_error is not None:
+        rows.append(["pose from two lines, exact synthetic cases: largest error", "formula (lost, reconstructed)",
+                     f"{two_lines_error:.1e}"])
+    if exact is not None:
+        rows.append([f"max |Ex| / |Ey|, |Ea|, range σ = {exact.range_std_cells:g} (Fig. 10)",
+                     "orders of magnitude below 1 cell, 1°", maxima(exact)])
+    rows.append([f"max |Ex| / |Ey|, |Ea|, range σ = {sim.range_std_cells:g} (Fig. 10)",
+                 "orders of magnitude below 1 cell, 1°", maxima(sim)])
+    for label, r in variants:
+        rows.append([f"{label}: max |Ex| / |Ey|, |Ea| (Fig. 10)", "orders of magnitude below 1 cell, 1°",
+                     f"{maxima(r)}; {int(r.slam.lost.sum())} lost"])
+    agree = map_agreement(sim.built_map, sim.reference_map)
+    rows.append(["built map: obstacle cells on a true obstacle (±1 cell) (Fig. 11)", "every shape kept",
+                 f"{agree['precision']:.0%}"])
+    final = {k: e[-1] for k, e in sim.errors.items()}
+    rows.append(["final error: Hough SLAM vs odometry", "better (argued, no numbers)",
+                 "; ".join(f"{k} {math.hypot(e[0], e[1]):.2f} cell, {math.degrees(abs(e[2])):.2f}°"
+                           for k, e in final.items())])
+    n = {k: x * sim.odometry_noise for k, x in ODOMETRY_NOISE.items()}
+    rows += [["odometry translation noise (000 §1.3.2: ≤ 2 cm per m)", "2 %",
+              f"{100 * n['trans_std_frac']:g} % of each step (σ)"],
+             ["odometry turn error (000 §1.3.2: ≤ 2° per 45° of turn)", "4.4 %",
+              (f"σ {math.degrees(n['rot_std_rad']):.2f}° per step + {math.degrees(n['drift_rad_per_cell']):.2f}° "
+              f"per cell travelled")]]
+    for r in real:
+        rows.append([f"{r.name}: obstacle cells per 100 returns, SLAM / odometry map", "no real data",
+                     f"{r.sharpness('slam'):.1f} / {r.sharpness('odometry'):.1f}"])
+    return format_table(["quantity", "source", "ours"], rows, title="Ours vs the source (004 §Hough SLAM; 000 §1.3.2)")

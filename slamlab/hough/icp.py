@@ -15,7 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import _validate as v
-from .pose import compose
+from ..geometry.se2 import se2_compose, se2_transform
 
 __all__ = ["IcpResult", "icp", "icp_odometry", "rigid_fit_2d"]
 
@@ -54,8 +54,7 @@ def rigid_fit_2d(src, dst) -> np.ndarray:
     cs, cd = src.mean(axis=0), dst.mean(axis=0)
     S = (src - cs).T @ (dst - cd)
     phi = math.atan2(S[0, 1] - S[1, 0], S[0, 0] + S[1, 1])
-    c, s = math.cos(phi), math.sin(phi)
-    t = cd - np.array([c * cs[0] - s * cs[1], s * cs[0] + c * cs[1]])
+    t = cd - se2_transform([0.0, 0.0, phi], cs)
     return np.array([t[0], t[1], phi])
 
 
@@ -95,8 +94,7 @@ def icp(source, target, init=(0.0, 0.0, 0.0), *, max_iter: int = 50, tol: float 
     kd = cKDTree(dst) if tree is None else tree
     converged, it, rmse, n_in = False, 0, float("nan"), 0
     for it in range(1, max_iter + 1):  # noqa: B007 - the count is returned
-        c, s = math.cos(pose[2]), math.sin(pose[2])
-        moved = src @ np.array([[c, s], [-s, c]]) + pose[:2]
+        moved = se2_transform(pose, src)
         dist, idx = kd.query(moved, distance_upper_bound=max_dist)
         ok = np.isfinite(dist)
         n_in = int(ok.sum())
@@ -143,5 +141,5 @@ def icp_odometry(points, start_pose=(0.0, 0.0, 0.0), init_increments=None, *, ma
         tree = cKDTree(_points(pts[k - 1], f"points[{k - 1}]"))
         res = icp(pts[k], pts[k - 1], U[k - 1], max_dist=max_dist, max_iter=max_iter, tree=tree)
         conv[k - 1] = res.converged
-        poses.append(compose(poses[-1], res.pose))
+        poses.append(se2_compose(poses[-1], res.pose))
     return np.array(poses), conv

@@ -133,6 +133,11 @@ def find_peaks(acc: HoughAccumulator, H_min: int, *, suppress_rho: float | None 
                else v.check_positive(suppress_theta_rad, "suppress_theta_rad", allow_zero=True))
     if max_lines is not None:
         max_lines = v.check_int(max_lines, "max_lines", minimum=1)
+    return _find_peaks(acc, H_min, s_rho, s_theta, max_lines)
+
+
+def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float, max_lines: int | None) -> Lines:
+    """:func:`find_peaks` on checked arguments (suppression windows resolved)."""
     H = acc.H
     n_theta = H.shape[1]
     empty = Lines(np.empty(0), np.empty(0), np.empty(0, dtype=np.int64))
@@ -207,6 +212,11 @@ def merge_duplicates(lines: Lines, *, rho_tol: float, theta_tol_rad: float) -> L
         raise TypeError(f"`lines` must be Lines; got {type(lines).__name__}")
     rho_tol = v.check_positive(rho_tol, "rho_tol", allow_zero=True)
     theta_tol = v.check_positive(theta_tol_rad, "theta_tol_rad", allow_zero=True)
+    return _merge_duplicates(lines, rho_tol, theta_tol)
+
+
+def _merge_duplicates(lines: Lines, rho_tol: float, theta_tol: float) -> Lines:
+    """:func:`merge_duplicates` on checked arguments."""
     order = np.argsort(-lines.votes, kind="stable")
     keep = order[_greedy_keep(lines.rho[order], lines.theta_rad[order], rho_tol, theta_tol)]
     return Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep])
@@ -245,13 +255,18 @@ def refine_lines(lines: Lines, bearings_rad, ranges, *, band: float = 1.0, n_ite
         raise ValueError(f"`bearings_rad` and `ranges` must have the same length; got {phi.size} and {r.size}")
     band = v.check_positive(band, "band")
     n_iter = v.check_int(n_iter, "n_iter", minimum=1)
+    gap = None if max_gap is None else v.check_positive(max_gap, "max_gap")
+    return _refine_lines(lines, phi, r, band, n_iter, gap)
+
+
+def _refine_lines(lines: Lines, phi, r, band: float, n_iter: int, gap: float | None) -> Lines:
+    """:func:`refine_lines` on checked arguments."""
     if len(lines) == 0:
         return lines
     ok = r > 0
     x, y = r[ok] * np.cos(phi[ok]), r[ok] * np.sin(phi[ok])
     rho, theta = lines.rho.copy(), lines.theta_rad.copy()
     n = np.zeros(rho.size)
-    gap = None if max_gap is None else v.check_positive(max_gap, "max_gap")
     band_l = np.full(rho.size, band)
     for _ in range(n_iter):
         dist = np.abs(np.multiply.outer(np.cos(theta), x) + np.multiply.outer(np.sin(theta), y) - rho[:, None])
@@ -300,6 +315,11 @@ def transform_lines(rho, theta_rad, pose) -> tuple[np.ndarray, np.ndarray]:
     """
     rho = v.as_finite_array(rho, "rho")
     theta = v.as_finite_array(theta_rad, "theta_rad")
-    dx, dy, dphi = v.as_vector(pose, "pose", 3)
+    return _transform_lines(rho, theta, v.as_vector(pose, "pose", 3))
+
+
+def _transform_lines(rho, theta, pose) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`transform_lines` on checked arrays."""
+    dx, dy, dphi = pose
     return rho - (dx * np.cos(theta) + dy * np.sin(theta)), theta - dphi
 

@@ -110,13 +110,17 @@ def plot_pose_errors(errors, *, ax=None, title: str = "Hough SLAM errors (cf. 00
     return ax
 
 
-def plot_built_map(built, *, truth=None, estimate=None, ax=None, title: str = "Built map (cf. 004 Fig. 11)"):
-    """The three-valued built map (obstacle black, free white, unexplored grey) with the paths."""
+def plot_built_map(built, *, frame=None, truth=None, estimate=None, ax=None,
+                   title: str = "Built map (cf. 004 Fig. 11)"):
+    """The three-valued built map (obstacle black, free white, unexplored grey) with the paths.
+
+    ``frame``: the map's :class:`~slamlab.scans.GridFrame` (default: cell units, cell (0, 0) at the origin).
+    """
     ax = new_axes(ax, title=title, xlabel="x", ylabel="y", equal=True)
     g = built.grid
     shown = np.where(g == 1, 0.0, np.where(g == 0, 1.0, 0.75))
     h_, w_ = g.shape
-    ox, oy, c = built.origin[0], built.origin[1], built.cell
+    ox, oy, c = (0.0, 0.0, 1.0) if frame is None else (frame.x0_m, frame.y0_m, frame.cell_m)
     ax.imshow(shown, origin="lower", cmap="gray", vmin=0, vmax=1, interpolation="nearest",
               extent=(ox - c / 2, ox + (w_ - 0.5) * c, oy - c / 2, oy + (h_ - 0.5) * c))
     if truth is not None:
@@ -147,12 +151,9 @@ def sim_figure(result):
 def real_log_figure(result, *, every: int = 2):
     """A real log: the map and path from Hough SLAM beside those from integrated odometry."""
     fig, axs = plt.subplots(1, 2, figsize=(14, 6.5))
-    from .mapping import scan_points_world
-
     for ax, poses, name, color in ((axs[0], result.slam.poses, "Hough SLAM", STYLE["estimate"]["color"]),
                                    (axs[1], result.odometry, "integrated odometry", "tab:orange")):
-        pts = [scan_points_world(s[0][s[2]], s[1][s[2]], poses[k]) for k, s in enumerate(result.scans)
-               if k % every == 0]
+        pts = [s.points(poses[k]) for k, s in enumerate(result.scans) if k % every == 0]
         pts = np.concatenate(pts) if pts else np.empty((0, 2))
         ax = new_axes(ax, title=f"{name}", xlabel="x [m]", ylabel="y [m]", equal=True)
         ax.plot(pts[:, 0], pts[:, 1], ",", color="0.15", alpha=0.5)

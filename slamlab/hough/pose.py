@@ -23,7 +23,7 @@ import numpy as np
 from .. import _validate as v
 from ..geometry import wrap_angle
 
-__all__ = ["PoseChange", "compose", "pose_from_lines", "pose_from_two_lines", "select_line_pair"]
+__all__ = ["PoseChange", "pose_from_lines", "pose_from_two_lines", "select_line_pair"]
 
 
 @dataclass(frozen=True)
@@ -73,6 +73,11 @@ def pose_from_two_lines(line_i1, line_i2, line_j1, line_j2, *, angle_tol_rad: fl
     (r_i2, t_i2), (r_j2, t_j2) = _pair(line_i2, line_j2, "line_2")
     tol = v.check_positive(angle_tol_rad, "angle_tol_rad", allow_zero=True)
     min_angle = v.check_positive(min_angle_rad, "min_angle_rad", allow_zero=True)
+    return _pose_from_two_lines(r_i1, t_i1, r_i2, t_i2, r_j1, t_j1, r_j2, t_j2, tol, min_angle)
+
+
+def _pose_from_two_lines(r_i1, t_i1, r_i2, t_i2, r_j1, t_j1, r_j2, t_j2, tol, min_angle) -> np.ndarray:
+    """:func:`pose_from_two_lines` on checked numbers (the geometric conditions are still checked)."""
     D = math.sin(t_i2 - t_i1)
     if abs(D) < math.sin(min_angle) or abs(D) == 0.0:
         raise ValueError(f"the two lines must be at least {math.degrees(min_angle):.1f} degrees apart; "
@@ -106,6 +111,11 @@ def select_line_pair(theta_i_rad, theta_j_rad, votes=None, *, angle_tol_rad: flo
     w = np.ones_like(ti) if votes is None else v.as_finite_array(votes, "votes", ndim=1)
     if w.shape != ti.shape:
         raise ValueError(f"`votes` must have one entry per line ({ti.size}); got {w.size}")
+    return _select_line_pair(ti, tj, w, angle_tol_rad, min_angle_rad)
+
+
+def _select_line_pair(ti, tj, w, angle_tol_rad, min_angle_rad) -> tuple[int, int] | None:
+    """:func:`select_line_pair` on checked arrays."""
     if ti.size < 2:
         return None
     s = np.abs(np.sin(ti[None, :] - ti[:, None]))
@@ -165,16 +175,20 @@ def pose_from_lines(rho_i, theta_i_rad, rho_j, theta_j_rad, votes=None, *, metho
     w = np.ones_like(ri) if votes is None else v.as_finite_array(votes, "votes", ndim=1)
     if w.shape != ri.shape:
         raise ValueError(f"`votes` must have one entry per line ({ri.size}); got {w.size}")
+    return _pose_from_lines(ri, ti, rj, tj, w, method, tol, min_angle_rad, rho_tol)
+
+
+def _pose_from_lines(ri, ti, rj, tj, w, method, tol, min_angle_rad, rho_tol) -> PoseChange:
+    """:func:`pose_from_lines` on checked arguments (``rho_tol`` = inf for none)."""
     fail = PoseChange(np.full(3, np.nan), False, np.empty(0, dtype=np.int64),
                       message=f"no pair of non-parallel lines with an unchanged angle among {ri.size}")
     if method == "two_lines":
-        pair = select_line_pair(ti, tj, w, angle_tol_rad=tol, min_angle_rad=min_angle_rad)
+        pair = _select_line_pair(ti, tj, w, tol, min_angle_rad)
         if pair is None:
             return fail
         a, b = pair
         change = float(wrap_angle((ti[b] - ti[a]) - (tj[b] - tj[a])))
-        pose = pose_from_two_lines((ri[a], ti[a]), (ri[b], ti[b]), (rj[a], tj[a]), (rj[b], tj[b]),
-                                   angle_tol_rad=tol, min_angle_rad=min_angle_rad)
+        pose = _pose_from_two_lines(ri[a], ti[a], ri[b], ti[b], rj[a], tj[a], rj[b], tj[b], tol, min_angle_rad)
         return PoseChange(pose, True, np.array([a, b]), change)
     if ri.size < 2:
         return fail
@@ -182,8 +196,7 @@ def pose_from_lines(rho_i, theta_i_rad, rho_j, theta_j_rad, votes=None, *, metho
     ref = _weighted_median(dphi_all, w)
     use = np.flatnonzero(np.abs(wrap_angle(dphi_all - ref)) <= tol)
     for _ in range(4):
-        if select_line_pair(ti[use], tj[use], w[use], angle_tol_rad=2 * tol + 1e-12,
-                            min_angle_rad=min_angle_rad) is None:
+        if _select_line_pair(ti[use], tj[use], w[use], 2 * tol + 1e-12, min_angle_rad) is None:
             return fail
         ww = w[use]
         dphi = ref + float(np.sum(ww * wrap_angle(dphi_all[use] - ref)) / ww.sum())
@@ -198,15 +211,3 @@ def pose_from_lines(rho_i, theta_i_rad, rho_j, theta_j_rad, votes=None, *, metho
         return fail
     change = float(np.ptp(wrap_angle(dphi_all[use] - dphi)))
     return PoseChange(np.array([t[0], t[1], dphi]), True, use, change)
-
-
-def compose(pose_a, delta) -> np.ndarray:
-    """``pose_a ⊕ delta``: a pose ``(x, y, φ)`` moved by ``delta`` given in its own frame.
-
-    >>> compose((1.0, 2.0, np.pi / 2), (3.0, 0.0, 0.1)).round(12).tolist()
-    [1.0, 5.0, 1.670796326795]
-    """
-    x, y, phi = v.as_vector(pose_a, "pose_a", 3)
-    dx, dy, dphi = v.as_vector(delta, "delta", 3)
-    c, s = math.cos(phi), math.sin(phi)
-    return np.array([x + c * dx - s * dy, y + s * dx + c * dy, phi + dphi])

@@ -18,63 +18,83 @@ the odometry increment is used (the step is marked ``lost``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import _validate as v
+from .._params import Params, param
 from ..geometry import wrap_angle
-from .association import LineHistory, associate, association_probability
-from .lines import Lines, find_peaks, merge_duplicates, refine_lines, transform_lines
-from .pose import compose, pose_from_lines
-from .transform import hough_polar
+from ..geometry.se2 import check_pose, se2_compose
+from ..scans import Scan
+from .association import LineHistory, _associate, _association_probability
+from .lines import Lines, _find_peaks, _merge_duplicates, _refine_lines, _transform_lines
+from .pose import _pose_from_lines
+from .transform import _hough_polar, theta_axis
 
 __all__ = ["HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
 
 
+def _optional_positive(value, name):
+    if value is not None:
+        v.check_positive(value, name)
+
+
 @dataclass(frozen=True)
-class HoughSlamParams:
-    """Every knob of the loop; those 004 does not fix are our choices (see each comment)."""
+class HoughSlamParams(Params):
+    """Every knob of the loop, each with its source; those 004 does not fix are ours.
 
-    delta_rho: float = 1.0  # Δrho (004: 1 cell)
-    delta_theta_rad: float = math.pi / 180  # Δθ (004: 1°)
-    r_max: float | None = None  # longest range used (default: each scan's longest)
-    H_min: int = 15  # votes needed for a line (004: a parameter, value not given)
-    max_lines: int = 12  # strongest lines kept per scan (ours)
-    suppress_rho: float | None = None  # false-neighbour window (ours: 3 Δrho)
-    suppress_theta_rad: float | None = None  # (ours: 3 Δθ)
-    refine: bool = True  # least-squares refit of each line (ours)
-    band: float | None = None  # refit band (ours: Δrho)
-    max_gap: float | None = 4.0  # refit: cut the band's points at gaps longer than this (ours)
-    a: float = 3.0  # largest displacement between scans (004: a = b)
-    b: float | None = None
-    a_theta_rad: float = math.radians(4.0)  # largest rotation between scans left after odometry (ours)
-    parallel_tol_rad: float = math.radians(3.0)
-    p_min: float = 0.05  # below this P a line is new (ours)
-    method: str = "least_squares"  # "two_lines" = 004's, "least_squares" = ours
-    angle_tol_rad: float = math.radians(0.5)  # "the angle between the lines did not change"
-    rho_tol: float | None = 0.3  # least squares: lines with a larger residual are dropped (ours)
-    min_angle_rad: float = math.radians(30.0)  # smallest angle of a usable pair (ours)
-    min_common: int = 3  # keyframe moves when fewer lines are shared (ours)
-    gate: float | None = None  # reject a pose farther than this from odometry's (ours; None: off)
-    gate_theta_rad: float = math.radians(10.0)
-    partial: bool = True  # only parallel lines: move along them from odometry (ours)
+    Lengths (``delta_rho``, ``r_max``, ``band``, ``max_gap``, ``a``, ``b``, ``rho_tol``,
+    ``gate``) are in the scans' unit (cells in simulation, metres on a real log).
+    """
 
-    def validated(self) -> HoughSlamParams:
-        """A copy with every field checked (raises ValueError/TypeError naming the field)."""
+    delta_rho: float = param(1.0, "004 §Hough SLAM: Δrho = 1 cell")
+    delta_theta_rad: float = param(math.pi / 180, "004 §Hough SLAM: Δθ = 1°")
+    r_max: float | None = param(None, "ours: longest range used (None: each scan's longest)")
+    H_min: int = param(15, "004 §Hough SLAM: a parameter, value not given")
+    max_lines: int = param(12, "ours: strongest lines kept per scan")
+    suppress_rho: float | None = param(None, "ours: false-neighbour window (None: 3 Δrho)")
+    suppress_theta_rad: float | None = param(None, "ours: false-neighbour window (None: 3 Δθ)")
+    refine: bool = param(True, "ours: least-squares refit of each line")
+    band: float | None = param(None, "ours: refit band (None: Δrho)")
+    max_gap: float | None = param(4.0, "ours: refit cuts the band's points at longer gaps")
+    a: float = param(3.0, "004 §Hough SLAM: a = b = largest displacement between scans")
+    b: float | None = param(None, "004 §Hough SLAM: a = b (None: b = a)")
+    a_theta_rad: float = param(math.radians(4.0), "ours: largest rotation left after odometry")
+    parallel_tol_rad: float = param(math.radians(3.0), "ours: lines this close in θ are parallel")
+    p_min: float = param(0.05, "ours: below this P a line is new")
+    method: str = param("least_squares", "ours ('two_lines' = 004's)")
+    angle_tol_rad: float = param(math.radians(0.5), "004: the angle between the lines did not change (tol. ours)")
+    rho_tol: float | None = param(0.3, "ours: least squares drops lines with a larger residual")
+    min_angle_rad: float = param(math.radians(30.0), "ours: smallest angle of a usable pair")
+    min_common: int = param(3, "ours: the reference scan moves when fewer lines are shared")
+    gate: float | None = param(None, "ours: reject a pose farther than this from odometry's (None: off)")
+    gate_theta_rad: float = param(math.radians(10.0), "ours: heading gate")
+    partial: bool = param(True, "ours: only parallel lines → move along them from odometry")
+
+    def check(self) -> None:
         v.check_positive(self.delta_rho, "delta_rho")
-        v.check_positive(self.delta_theta_rad, "delta_theta_rad")
-        if self.r_max is not None:
-            v.check_positive(self.r_max, "r_max")
+        theta_axis(self.delta_theta_rad)  # > 0 and divides 180°
+        for name in ("r_max", "suppress_rho", "suppress_theta_rad", "band", "max_gap", "b", "rho_tol", "gate"):
+            _optional_positive(getattr(self, name), name)
         v.check_int(self.H_min, "H_min", minimum=1)
         v.check_int(self.max_lines, "max_lines", minimum=2)
+        for name in ("refine", "partial"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
         v.check_positive(self.a, "a")
         v.check_positive(self.a_theta_rad, "a_theta_rad")
+        v.check_positive(self.parallel_tol_rad, "parallel_tol_rad", allow_zero=True)
+        if v.check_probability(self.p_min, "p_min") >= 1.0:
+            raise ValueError(f"`p_min` must lie in [0, 1); got {self.p_min}")
         v.check_choice(self.method, "method", ("two_lines", "least_squares"))
+        v.check_positive(self.angle_tol_rad, "angle_tol_rad", allow_zero=True)
+        v.check_positive(self.min_angle_rad, "min_angle_rad", allow_zero=True)
+        if self.min_angle_rad > math.pi / 2:
+            raise ValueError(f"`min_angle_rad` must be <= π/2; got {self.min_angle_rad}")
         v.check_int(self.min_common, "min_common", minimum=2)
-        if self.gate is not None:
-            v.check_positive(self.gate, "gate")
-        return self
+        v.check_positive(self.gate_theta_rad, "gate_theta_rad")
 
 
 @dataclass(frozen=True)
@@ -95,41 +115,47 @@ class HoughSlamResult:
                 f"{self.history.n_ids} lines tracked, {np.unique(self.reference[1:]).size} reference scans")
 
 
-def detect_lines(bearings_rad, ranges, params: HoughSlamParams) -> Lines:
+def _returns(scan, name: str = "scan") -> tuple[np.ndarray, np.ndarray]:
+    """Bearings and ranges of the returns of a :class:`~slamlab.scans.Scan` (any unit)."""
+    if not isinstance(scan, Scan):
+        raise TypeError(f"`{name}` must be a slamlab.scans.Scan; got {type(scan).__name__}")
+    use = scan.valid & (scan.ranges > 0)
+    return scan.bearings_rad[use], scan.ranges[use]
+
+
+def detect_lines(scan: Scan, params: HoughSlamParams | None = None, **overrides) -> Lines:
     """Lines of one scan: polar Hough, peaks above H_min, optional refit (004 §Hough SLAM).
+
+    ``params`` / ``**overrides``: the :class:`HoughSlamParams` (lengths in the scan's unit).
 
     Examples
     --------
     >>> from slamlab.hough import line_scan
     >>> phi, r = line_scan(10.0, np.radians(45.0), r_max=16.0)
-    >>> lines = detect_lines(phi, r, HoughSlamParams(H_min=20))
+    >>> lines = detect_lines(Scan(phi, r, np.ones(phi.size, bool)), H_min=20)
     >>> round(float(lines.rho[0]), 6), round(float(np.degrees(lines.theta_rad[0])), 6)
     (10.0, 45.0)
     """
-    if not isinstance(params, HoughSlamParams):
-        raise TypeError(f"`params` must be HoughSlamParams; got {type(params).__name__}")
-    acc = hough_polar(bearings_rad, ranges, delta_rho=params.delta_rho, delta_theta_rad=params.delta_theta_rad,
-                      r_max=params.r_max)
-    lines = find_peaks(acc, params.H_min, suppress_rho=params.suppress_rho,
-                       suppress_theta_rad=params.suppress_theta_rad, max_lines=params.max_lines)
+    p = HoughSlamParams.resolve(params, **overrides)
+    return _detect(*_returns(scan), p, theta_axis(p.delta_theta_rad))
+
+
+def _detect(bearings_rad, ranges, params: HoughSlamParams, theta: np.ndarray) -> Lines:
+    """:func:`detect_lines` on checked settings (``theta``: the θ axis of ``params``), once per scan."""
+    if bearings_rad.size == 0:
+        return Lines(np.empty(0), np.empty(0), np.empty(0, int))
+    r_max = float(ranges.max()) if params.r_max is None else params.r_max
+    acc = _hough_polar(bearings_rad, ranges, params.delta_rho, theta, params.delta_theta_rad, r_max)
+    s_rho = 3 * acc.delta_rho if params.suppress_rho is None else params.suppress_rho
+    s_theta = 3 * acc.delta_theta_rad if params.suppress_theta_rad is None else params.suppress_theta_rad
+    lines = _find_peaks(acc, params.H_min, s_rho, s_theta, params.max_lines)
     if params.refine and len(lines):
         band = params.delta_rho if params.band is None else params.band
-        lines = refine_lines(lines, bearings_rad, ranges, band=band, max_gap=params.max_gap)
+        lines = _refine_lines(lines, bearings_rad, ranges, band, 3, params.max_gap)
         keep = lines.votes >= max(2, params.H_min // 2)  # a peak whose band holds few points is spurious
-        lines = merge_duplicates(Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep]),
-                                 rho_tol=params.delta_rho, theta_tol_rad=params.delta_theta_rad)
+        lines = _merge_duplicates(Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep]),
+                                  params.delta_rho, params.delta_theta_rad)
     return lines
-
-
-def _scan_arrays(scan, n):
-    if not (isinstance(scan, tuple) and len(scan) == 3):
-        raise TypeError(f"`scans[{n}]` must be a (bearings_rad, ranges, hit) tuple; got {type(scan).__name__}")
-    phi = v.as_finite_array(scan[0], f"scans[{n}] bearings_rad", ndim=1)
-    r = v.as_finite_array(scan[1], f"scans[{n}] ranges", ndim=1)
-    hit = np.asarray(scan[2], dtype=bool)
-    if not (phi.shape == r.shape == hit.shape):
-        raise ValueError(f"`scans[{n}]` arrays must have one length; got {phi.size}, {r.size}, {hit.size}")
-    return phi[hit & (r > 0)], r[hit & (r > 0)]
 
 
 def _relative(history, n1, n2, params):
@@ -139,17 +165,9 @@ def _relative(history, n1, n2, params):
     if common.size < 2:
         return None, common.size
     votes = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
-    pc = pose_from_lines(l1.rho[i1], l1.theta_rad[i1], l2.rho[i2], l2.theta_rad[i2], votes, method=params.method,
-                         angle_tol_rad=params.angle_tol_rad, min_angle_rad=params.min_angle_rad,
-                         rho_tol=params.rho_tol)
+    pc = _pose_from_lines(l1.rho[i1], l1.theta_rad[i1], l2.rho[i2], l2.theta_rad[i2], votes, params.method,
+                          params.angle_tol_rad, params.min_angle_rad, np.inf if params.rho_tol is None else params.rho_tol)
     return (pc.pose if pc.ok else None), common.size
-
-
-def _relative_pose(a, b):
-    """b's pose in a's frame."""
-    c, s_ = math.cos(a[2]), math.sin(a[2])
-    d = b[:2] - a[:2]
-    return np.array([c * d[0] + s_ * d[1], -s_ * d[0] + c * d[1], b[2] - a[2]])
 
 
 def _partial(history, n1, n2, prior, params):
@@ -183,14 +201,15 @@ def _partial(history, n1, n2, prior, params):
     return np.array([t[0], t[1], ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())])
 
 
-def hough_slam(scans, start_pose=(0.0, 0.0, 0.0), odometry=None, params: HoughSlamParams | None = None,
-               **overrides) -> HoughSlamResult:
+def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
+               params: HoughSlamParams | None = None, **overrides) -> HoughSlamResult:
     """Run Hough-transform SLAM over a sequence of scans (004 Fig. 2, Fig. 4).
 
     Parameters
     ----------
-    scans : sequence of (bearings_rad, ranges, hit) tuples
-        Bearings relative to the sensor heading; ``hit`` marks real returns.
+    scans : sequence of Scan
+        :class:`~slamlab.scans.Scan` objects, all in one unit (cells or metres); the
+        lengths of ``params`` are read in that unit.
     start_pose : (3,) array_like
         Pose of the first scan (004: given by correlation localisation).
     odometry : (n-1, 3) array_like, optional
@@ -204,22 +223,21 @@ def hough_slam(scans, start_pose=(0.0, 0.0, 0.0), odometry=None, params: HoughSl
     -------
     HoughSlamResult
     """
-    params = (HoughSlamParams() if params is None else params)
-    if not isinstance(params, HoughSlamParams):
-        raise TypeError(f"`params` must be HoughSlamParams; got {type(params).__name__}")
-    try:
-        params = replace(params, **overrides).validated()
-    except TypeError as exc:
-        raise TypeError(f"unknown HoughSlamParams field in {sorted(overrides)}: {exc}") from None
+    params = HoughSlamParams.resolve(params, **overrides)
     scans = list(scans)
     if len(scans) == 0:
         raise ValueError("`scans` must hold at least one scan; got 0")
+    units = {s.unit for s in scans if isinstance(s, Scan)}
+    if len(units) > 1:
+        raise ValueError(f"`scans` must all have one unit; got {sorted(units)}")
+    returns = [_returns(s, f"scans[{k}]") for k, s in enumerate(scans)]
+    theta = theta_axis(params.delta_theta_rad)  # the settings are checked once, here
     n = len(scans)
     U = np.zeros((n - 1, 3)) if odometry is None else v.as_finite_array(odometry, "odometry", ndim=2)
     if U.shape != (n - 1, 3):
         raise ValueError(f"`odometry` must have shape ({n - 1}, 3) = one (dx, dy, dθ) per step; got {U.shape}")
     poses = np.zeros((n, 3))
-    poses[0] = v.as_vector(start_pose, "start_pose", 3)
+    poses[0] = check_pose(start_pose, "start_pose")
     lost = np.zeros(n, dtype=bool)
     partial = np.zeros(n, dtype=bool)
     ref = np.full(n, -1, dtype=np.int64)
@@ -227,26 +245,26 @@ def hough_slam(scans, start_pose=(0.0, 0.0, 0.0), odometry=None, params: HoughSl
     history = LineHistory()
     keyframe = 0
     for k in range(n):
-        phi, r = _scan_arrays(scans[k], k)
-        lines = detect_lines(phi, r, params) if phi.size else Lines(np.empty(0), np.empty(0), np.empty(0, int))
+        lines = _detect(*returns[k], params, theta)
         n_lines[k] = len(lines)
         if k == 0:
             history.add_scan(lines, np.full(len(lines), -1))
             continue
         prev_ids, prev = history.scan(k - 1)
-        pr, pt = transform_lines(prev.rho, prev.theta_rad, U[k - 1])
-        P = association_probability(lines, Lines(pr, pt, prev.votes), a=params.a, b=params.b,
-                                    a_theta_rad=params.a_theta_rad, parallel_tol_rad=params.parallel_tol_rad)
-        match = associate(P, p_min=params.p_min)
+        pr, pt = _transform_lines(prev.rho, prev.theta_rad, U[k - 1])
+        P = _association_probability(lines, Lines(pr, pt, prev.votes), params.a,
+                                     params.a if params.b is None else params.b, params.a_theta_rad,
+                                     params.parallel_tol_rad)
+        match = _associate(P, params.p_min)
         ids = np.where(match >= 0, prev_ids[np.clip(match, 0, None)] if prev_ids.size else -1, -1)
         history.add_scan(lines, ids)
-        guess = compose(poses[k - 1], U[k - 1])
+        guess = se2_compose(poses[k - 1], U[k - 1])
         pose = None
         for n1 in dict.fromkeys((keyframe, k - 1)):
             delta, _ = _relative(history, n1, k, params)
             if delta is None:
                 continue
-            cand = compose(poses[n1], delta)
+            cand = se2_compose(poses[n1], delta)
             if params.gate is not None and odometry is not None and (
                     math.hypot(*(cand[:2] - guess[:2])) > params.gate
                     or abs(float(wrap_angle(cand[2] - guess[2]))) > params.gate_theta_rad):
@@ -256,11 +274,13 @@ def hough_slam(scans, start_pose=(0.0, 0.0, 0.0), odometry=None, params: HoughSl
         if pose is None and params.partial and odometry is not None:
             delta = _partial(history, k - 1, k, U[k - 1], params)
             if delta is not None:
-                pose, ref[k], partial[k] = compose(poses[k - 1], delta), k - 1, True
+                pose, ref[k], partial[k] = se2_compose(poses[k - 1], delta), k - 1, True
         if pose is None:
             pose, lost[k], ref[k] = guess, True, k - 1
         poses[k] = pose
         _, n_common = _relative(history, keyframe, k, params) if ref[k] == keyframe else (None, 0)
         if lost[k] or ref[k] != keyframe or n_common < params.min_common:
             keyframe = k
+    # headings unwrapped along the run, starting at the given start heading
+    poses[:, 2] = np.unwrap(poses[:, 2]) + (poses[0, 2] - np.unwrap(poses[:, 2])[0])
     return HoughSlamResult(poses, lost, n_lines, ref, history, params, partial)

@@ -126,6 +126,11 @@ def hough_polar(bearings_rad, ranges, *, delta_rho: float = 1.0, delta_theta_rad
     if r_max is None:
         r_max = float(r.max()) if r.size else d_rho
     r_max = v.check_positive(r_max, "r_max")
+    return _hough_polar(phi, r, d_rho, theta, float(delta_theta_rad), r_max)
+
+
+def _hough_polar(phi, r, d_rho, theta, delta_theta_rad, r_max) -> HoughAccumulator:
+    """:func:`hough_polar` on checked arguments (``theta`` from :func:`theta_axis`, ``r_max > 0``)."""
     keep = (r > 0) & (r <= r_max)
     n_half = math.ceil(r_max / d_rho - 1e-9)
     n_rho, n_theta = 2 * n_half + 1, theta.size
@@ -140,7 +145,7 @@ def hough_polar(bearings_rad, ranges, *, delta_rho: float = 1.0, delta_theta_rad
     idx += (n_half + 0.5) + n_rho * np.arange(n_theta)
     counts = np.bincount(idx.astype(np.intp).ravel(), minlength=n_rho * n_theta)
     H = counts.reshape(n_theta, n_rho).T
-    return HoughAccumulator(H, rho_axis, theta, d_rho, float(delta_theta_rad))
+    return HoughAccumulator(H, rho_axis, theta, d_rho, delta_theta_rad)
 
 
 def rasterise_scan(bearings_rad, ranges, *, cell: float = 1.0, r_max: float | None = None,

@@ -8,10 +8,10 @@ import ipywidgets as widgets
 
 from ..widgets import STYLE as _STYLE
 from ..widgets import slider as _slider
-from .experiments import run_real_log, run_sim_slam
+from .experiments import SHARED_LOGS, run_real_log, run_sim_slam
 from .lines import find_peaks
 from .plot import accumulator_figure, real_log_figure, sim_figure
-from .slam import HoughSlamParams, detect_lines
+from .slam import detect_lines
 from .transform import hough_polar
 
 __all__ = ["explore_accumulator", "explore_hough_slam", "explore_real_log"]
@@ -36,12 +36,11 @@ def explore_accumulator(**defaults):
             world = sim.measurement_room_200() if clutter else sim.test_room_200()
             rf = sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=range_std_cells)
             s = rf.scan(world, path[int(pose_index)], rng=d["rng"])
-            phi, r = s.angles_rad[s.hit], s.ranges_cells[s.hit]
+            phi, r = s.bearings_rad[s.valid], s.ranges[s.valid]
             acc = hough_polar(phi, r, delta_rho=delta_rho, delta_theta_rad=math.radians(delta_theta_deg))
             peaks = find_peaks(acc, int(H_min), max_lines=12)
-            lines = detect_lines(phi, r, HoughSlamParams(delta_rho=delta_rho,
-                                                         delta_theta_rad=math.radians(delta_theta_deg),
-                                                         H_min=int(H_min)))
+            lines = detect_lines(s, delta_rho=delta_rho, delta_theta_rad=math.radians(delta_theta_deg),
+                                 H_min=int(H_min))
         except (ValueError, TypeError) as exc:
             print(f"Cannot run with these settings: {exc}")
             return
@@ -98,7 +97,9 @@ def explore_real_log(**defaults):
 
     def show(name, n_scans, step, H_min, delta_rho_cm):
         try:
-            res = run_real_log(name, n_scans=int(n_scans), step=int(step), H_min=int(H_min),
+            from ..data import find_data
+
+            res = run_real_log(find_data(SHARED_LOGS[name]), n_scans=int(n_scans), step=int(step), H_min=int(H_min),
                                delta_rho=delta_rho_cm / 100.0)
         except (ValueError, TypeError, FileNotFoundError) as exc:
             print(f"Cannot run with these settings: {exc}")

@@ -6,8 +6,9 @@ API summary
 - :class:`CarmenLog`: ``ranges_m`` (n_scans, n_beams) with NaN kept, ``valid``
   mask, ``poses`` (laser pose per scan: x_m, y_m, heading_rad),
   ``odom_poses`` (the odometry pose stored in each FLASER line), ``timestamps_s``,
-  ``odom`` (ODOM messages), ``params`` (PARAM lines), ``angles_rad`` and the
-  methods ``points(i)`` (scan ``i`` in world metres) and ``scan_cells(i, cell_m)``.
+  ``odom`` (ODOM messages), ``params`` (PARAM lines), ``bearings_rad``, ``name``
+  (the file name, for labels) and ``scan(i)`` / ``scans()``: the scans as
+  :class:`slamlab.scans.Scan` objects in metres.
 - :func:`flaser_angles` ``(n_beams, fov_rad=π) -> (n,)``: the CARMEN beam layout.
 
 Formats handled (see each data set's PROVENANCE.md): the corrected Radish logs
@@ -27,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _validate as v
+from ..scans import Scan
 
 __all__ = ["CarmenLog", "flaser_angles", "read_carmen"]
 
@@ -79,38 +81,42 @@ class CarmenLog:
         return self.ranges_m.shape[1]
 
     @property
-    def angles_rad(self) -> np.ndarray:
+    def bearings_rad(self) -> np.ndarray:
         """Beam angles relative to the robot heading (:func:`flaser_angles`)."""
         return flaser_angles(self.n_beams)
 
+    @property
+    def name(self) -> str:
+        """The log's file name (what results are labelled with)."""
+        return Path(self.path).name
+
     def __str__(self) -> str:
-        return (f"CARMEN log {Path(self.path).name}: {self.n_scans} scans x {self.n_beams} beams, "
+        return (f"CARMEN log {self.name}: {self.n_scans} scans x {self.n_beams} beams, "
                 f"{self.odom.shape[0]} ODOM, {self.valid.mean():.1%} valid readings (< {self.max_range_m:g} m)")
 
-    def points(self, i: int, pose=None) -> np.ndarray:
-        """World points ``(x_m, y_m)`` of the valid readings of scan ``i`` seen from ``pose`` (default: its pose).
+    def scan(self, i: int) -> Scan:
+        """Scan ``i`` as a :class:`~slamlab.scans.Scan` in metres.
 
-        Returns
-        -------
-        numpy.ndarray, shape (k, 2)
+        ``pose`` is the FLASER line's laser pose (SLAM-corrected in the corrected Radish
+        logs, the odometry in the MbICP log), ``odom_pose`` its odometry pose. Invalid
+        readings get ``ranges = max_range_m`` and ``valid = False``.
         """
         i = v.check_int(i, "i", minimum=-self.n_scans, maximum=self.n_scans - 1)
-        p = self.poses[i] if pose is None else v.as_vector(pose, "pose", 3)
-        ok = self.valid[i]
-        th = p[2] + self.angles_rad[ok]
-        r = self.ranges_m[i, ok]
-        return np.column_stack([p[0] + r * np.cos(th), p[1] + r * np.sin(th)])
+        return self._scan(i, self.bearings_rad)
 
-    def scan_cells(self, i: int, cell_m: float):
-        """Scan ``i`` in cell units for the rangefinder chapters: ``(angles_rad, ranges_cells, hit)``.
-
-        Invalid and no-return beams get ``ranges_cells = max_range_m / cell_m`` and ``hit = False``.
-        """
-        i = v.check_int(i, "i", minimum=-self.n_scans, maximum=self.n_scans - 1)
-        cell = v.check_positive(cell_m, "cell_m")
+    def _scan(self, i, bearings):
+        fill = self.max_range_m if np.isfinite(self.max_range_m) else 0.0
         ok = self.valid[i]
-        r = np.where(ok, np.nan_to_num(self.ranges_m[i], nan=0.0), self.max_range_m) / cell
-        return self.angles_rad, r, ok.copy()
+        return Scan(bearings, np.where(ok, self.ranges_m[i], fill), ok, unit="m", max_range=self.max_range_m,
+                    time_s=self.timestamps_s[i], odom_pose=self.odom_poses[i],
+                    pose=self.poses[i])
+
+    def scans(self, indices=None) -> list[Scan]:
+        """Every scan (or those at ``indices``) as :class:`~slamlab.scans.Scan` objects."""
+        idx = range(self.n_scans) if indices is None else [
+            v.check_int(int(i), "indices[k]", minimum=-self.n_scans, maximum=self.n_scans - 1) for i in indices]
+        b = self.bearings_rad
+        return [self._scan(i, b) for i in idx]
 
 
 def _open_text(path: Path):
@@ -133,8 +139,10 @@ def read_carmen(path, *, max_range_m: float | None = None) -> CarmenLog:
         The log file (gzip detected from its magic bytes, not its name).
     max_range_m : float, optional
         Readings ``>= max_range_m`` are "no return" (``valid = False``). Default:
-        the largest finite reading of the log (the sensor's maximum value, which
-        the corrected Radish logs use for no return).
+        when the log marks invalid readings with ``NaN`` (the MbICP log), the largest
+        reading rounded up to a whole metre (MbICP: 7.999 → 8 m, its reader's
+        ``0 < r < 8``); otherwise the largest reading of the log (the sensor's
+        maximum value, which the corrected Radish logs use for no return).
 
     Returns
     -------
@@ -149,11 +157,7 @@ def read_carmen(path, *, max_range_m: float | None = None) -> CarmenLog:
         malformed, or the beam count changes between scans (the message names
         the line number).
     """
-    if not isinstance(path, (str, Path)):
-        raise TypeError(f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
-    p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"CARMEN log not found: {p}")
+    p = v.as_path(path, "path", kind="file")
     if max_range_m is not None:
         max_range_m = v.check_positive(max_range_m, "max_range_m")
     ranges: list[list[float]] = []
@@ -202,7 +206,12 @@ def read_carmen(path, *, max_range_m: float | None = None) -> CarmenLog:
     R = np.array(ranges, dtype=float)
     finite = np.isfinite(R)
     if max_range_m is None:
-        max_range_m = float(R[finite].max()) if finite.any() else math.inf
+        if not finite.any():
+            max_range_m = math.inf
+        elif np.isnan(R).any():  # NaN marks invalid readings: every finite reading below the limit is valid
+            max_range_m = float(np.floor(R[finite].max()) + 1.0)
+        else:
+            max_range_m = float(R[finite].max())
     with np.errstate(invalid="ignore"):
         valid = finite & (R > 0) & (max_range_m > R)
     P = np.array(poses, dtype=float)

@@ -28,6 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import _validate as v
+from ..geometry.se2 import se2_compose, se2_integrate, se2_inverse
+from ..scans import Scan
 
 __all__ = [
     "URG04LX_FOV_RAD",
@@ -55,21 +57,46 @@ class UrgLog:
     ranges_m: np.ndarray = field(repr=False)  # (n, 682)
     bearings_rad: np.ndarray = field(repr=False)  # (682,)
     path: str = ""
+    max_range_m: float = 4.0
 
     def __len__(self) -> int:
         return int(self.ranges_m.shape[0])
 
+    @property
+    def name(self) -> str:
+        """The log's file name (what results are labelled with)."""
+        return Path(self.path).name
+
     def __str__(self) -> str:
         valid = np.isfinite(self.ranges_m).mean()
-        return (f"URG-04LX log {Path(self.path).name}: {len(self)} scans of {self.ranges_m.shape[1]} beams over "
+        return (f"URG-04LX log {self.name}: {len(self)} scans of {self.ranges_m.shape[1]} beams over "
                 f"{self.time_s[-1]:.1f} s, {valid:.0%} valid ranges")
 
-    def scan(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(bearings_rad, ranges_m, hit)`` of scan ``k`` (invalid ranges set to 0, hit False)."""
+    def odometry_poses(self, *, offset_m: float = 0.145) -> np.ndarray:
+        """The laser's pose per scan integrated from the wheel ticks, starting at ``(0, 0, 0)``; ``(n, 3)``."""
+        return se2_integrate(np.zeros(3), urg04lx_sensor_increments(urg04lx_odometry(self.ticks),
+                                                                    offset_m=offset_m))
+
+    def scan(self, k: int) -> Scan:
+        """Scan ``k`` as a :class:`~slamlab.scans.Scan` in metres (no return: ``valid`` False, range = max range).
+
+        ``odom_pose`` is the laser's pose integrated from the wheel ticks (:meth:`odometry_poses`).
+        """
         k = v.check_int(k, "k", minimum=-len(self), maximum=len(self) - 1)
+        return self._scan(k, self.odometry_poses()[k])
+
+    def _scan(self, k, odom_pose):
         r = self.ranges_m[k]
-        hit = np.isfinite(r)
-        return self.bearings_rad, np.where(hit, r, 0.0), hit
+        ok = np.isfinite(r)
+        return Scan(self.bearings_rad, np.where(ok, r, self.max_range_m), ok, unit="m", max_range=self.max_range_m,
+                    time_s=self.time_s[k], odom_pose=odom_pose)
+
+    def scans(self, indices=None) -> list[Scan]:
+        """Every scan (or those at ``indices``) as :class:`~slamlab.scans.Scan` objects."""
+        odo = self.odometry_poses()
+        idx = range(len(self)) if indices is None else [
+            v.check_int(int(i), "indices[k]", minimum=-len(self), maximum=len(self) - 1) for i in indices]
+        return [self._scan(k, odo[k]) for k in idx]
 
 
 def urg04lx_bearings(n_beams: int = URG04LX_N_BEAMS, fov_rad: float = URG04LX_FOV_RAD) -> np.ndarray:
@@ -97,29 +124,40 @@ def read_urg04lx_log(path, *, max_range_m: float = 4.0) -> UrgLog:
     Raises
     ------
     FileNotFoundError, ValueError
-        When the file is missing or a line does not have 707 numbers.
+        When the file is missing, or a line does not have 707 numbers or holds a
+        token that is not a number (the message names the file and line).
     """
-    p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"URG-04LX log not found: {p}")
+    p = v.as_path(path, "path", kind="file")
     max_range_m = v.check_positive(max_range_m, "max_range_m")
     rows = []
-    with p.open() as fh:
+    with p.open(encoding="ascii", errors="replace") as fh:
         for lineno, line in enumerate(fh, 1):
             if not line.strip():
                 continue
             fields = line.split()
             if len(fields) != _N_FIELDS:
                 raise ValueError(f"{p.name} line {lineno}: expected {_N_FIELDS} numbers; got {len(fields)}")
-            rows.append(fields)
+            try:
+                rows.append(np.array(fields, dtype=float))
+            except ValueError:
+                bad = next(i for i, t in enumerate(fields) if not _is_number(t))
+                raise ValueError(f"{p.name} line {lineno}: field {bad} is not a number: {fields[bad]!r}") from None
     if not rows:
         raise ValueError(f"{p.name}: no scans")
-    data = np.array(rows, dtype=float)
+    data = np.array(rows)
     ranges = data[:, _FIRST_RANGE:_FIRST_RANGE + URG04LX_N_BEAMS] / 1000.0
     bad = (ranges < _MIN_VALID_MM / 1000.0) | (ranges > max_range_m)
     ranges[bad] = np.nan
     t = (data[:, 0] - data[0, 0]) * 1e-6
-    return UrgLog(t, data[:, 2:4].astype(np.int64), ranges, urg04lx_bearings(), str(p))
+    return UrgLog(t, data[:, 2:4].astype(np.int64), ranges, urg04lx_bearings(), str(p), float(max_range_m))
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
 
 
 def urg04lx_odometry(ticks, *, wheel_radius_m: float = 0.077, half_axle_m: float = 0.165,
@@ -166,7 +204,7 @@ def urg04lx_sensor_increments(increments, *, offset_m: float = 0.145) -> np.ndar
     U = v.as_finite_array(increments, "increments", ndim=2)
     if U.shape[1] != 3:
         raise ValueError(f"`increments` must have shape (n, 3); got shape {U.shape}")
-    o = float(offset_m)
-    c, s = np.cos(U[:, 2]), np.sin(U[:, 2])
-    # o⁻¹ ⊕ u ⊕ o with o = (o, 0, 0): translation R(-0)·(-o) + t + R(θ)·(o, 0)
-    return np.column_stack([U[:, 0] + o * c - o, U[:, 1] + o * s, U[:, 2]])
+    o = np.array([float(offset_m), 0.0, 0.0])
+    out = se2_compose(se2_compose(se2_inverse(o), U), o)
+    out[:, 2] = U[:, 2]  # keep the increment's turn as given (not re-wrapped)
+    return out

@@ -15,6 +15,11 @@ __all__ = [
     "simulate_unicycle",
 ]
 
+# --- the 2-D layer lives in slamlab.scans; sim re-exports its grid codes and Scan for convenience ---
+from ..scans import Scan
+
+__all__ += ["Scan"]
+
 # --- occupancy grids, scanning rangefinder, odometry and paths (004; Ch. 5-6) ---
 from .grid import (
     FREE,
@@ -38,13 +43,8 @@ from .paths import PATH_004_SEGMENTS, PATH_004_START, path_004, piecewise_path, 
 from .rangefinder import (
     Odometry,
     Rangefinder,
-    Scan,
     beam_angles,
     cast_rays,
-    check_pose,
-    compose_poses,
-    relative_poses,
-    scan_to_points,
     simulate_odometry,
     simulate_scans,
 )
@@ -65,8 +65,6 @@ __all__ += [
     "cast_rays",
     "cell_to_world",
     "check_grid",
-    "check_pose",
-    "compose_poses",
     "free_cells",
     "grid_from_text",
     "grid_to_text",
@@ -76,8 +74,6 @@ __all__ += [
     "path_004",
     "piecewise_path",
     "random_free_poses",
-    "relative_poses",
-    "scan_to_points",
     "simulate_odometry",
     "simulate_scans",
     "test_room_200",

@@ -17,7 +17,6 @@ walls and the floor) at once and samples the textures bilinearly.
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
 from .. import _validate as v
@@ -36,6 +35,8 @@ MIP_LEVELS = 4  # texture pyramid levels: a pixel samples the level matching its
 
 def _mip_levels(tex, n):
     """Gaussian pyramid ``[tex, pyrDown(tex), ...]`` (pixel ``i`` of level ``k`` sits at ``2^k i``)."""
+    import cv2  # lazy: `import slamlab.sim` must not load OpenCV
+
     levels = [tex]
     for _ in range(n - 1):
         if min(levels[-1].shape) < 4:

@@ -4,22 +4,18 @@ API summary
 -----------
 - Cell codes: :data:`FREE` (= 0, 004's a_c), :data:`OBSTACLE` (= 1, a_p),
   :data:`UNEXPLORED` (= -1, a_n); grids are ``int8`` arrays ``grid[row, col]``.
-- :func:`world_to_cell` / :func:`cell_to_world`: the ONE grid ↔ world mapping.
-- :func:`make_grid`, :func:`check_grid`, :func:`free_cells`, :func:`grid_to_values`.
+- Re-exported from :mod:`slamlab.scans.grid` (where they live): the codes,
+  :func:`world_to_cell` / :func:`cell_to_world`, :func:`make_grid`, :func:`check_grid`,
+  :func:`grid_to_values`.
+- :func:`free_cells`.
 - :func:`test_room_200` (the mapped room, read from ``data/test_room_200.txt``),
   :func:`build_test_room_200` (how that file was made), :func:`add_clutter` and
   :func:`measurement_room_200` (the room with unmapped chair legs, people's legs
   and bins, 004 Fig. 3b), :data:`TEST_ROOM_CLUTTER`.
 - :func:`grid_to_text` / :func:`grid_from_text`: the text format of the data file.
 
-Conventions (used by every ``slamlab.sim`` module)
---------------------------------------------------
-Everything is in **cell units**. A world point is ``(x, y)`` with ``x`` along the
-columns and ``y`` along the rows: cell ``grid[row, col]`` is the unit square
-centred on ``(x, y) = (col, row)``, i.e. covering ``[col - 0.5, col + 0.5) ×
-[row - 0.5, row + 0.5)``. A pose is ``(x, y, heading_rad)``; the heading is
-measured from the +x axis towards +y (counter-clockwise when the map is drawn
-with ``origin="lower"``, as every slamlab plot does).
+Conventions: those of :mod:`slamlab.scans.grid` (cell units, cell ``(row, col)``
+centred on ``(x, y) = (col, row)``, poses ``(x, y, heading_rad)``).
 """
 
 from __future__ import annotations
@@ -30,6 +26,17 @@ from pathlib import Path
 import numpy as np
 
 from .. import _validate as v
+from ..scans.grid import (
+    _CODES,
+    FREE,
+    OBSTACLE,
+    UNEXPLORED,
+    cell_to_world,
+    check_grid,
+    grid_to_values,
+    make_grid,
+    world_to_cell,
+)
 
 __all__ = [
     "FREE",
@@ -50,16 +57,6 @@ __all__ = [
     "world_to_cell",
 ]
 
-#: Free space (004's a_c, white in Fig. 3).
-FREE = 0
-#: Known obstacle: walls, furniture (004's a_p, black in Fig. 3).
-OBSTACLE = 1
-#: Unexplored space (004's a_n).
-UNEXPLORED = -1
-
-_CHARS = {FREE: ".", OBSTACLE: "#", UNEXPLORED: "~"}
-_CODES = {c: k for k, c in _CHARS.items()}
-
 #: Unmapped clutter of the measurement room (004 Fig. 3b), our choice of objects:
 #: ``("disc", x, y, radius)`` or ``("rect", x0, y0, x1, y1)`` (inclusive cells).
 TEST_ROOM_CLUTTER: tuple[tuple, ...] = (
@@ -75,95 +72,6 @@ TEST_ROOM_CLUTTER: tuple[tuple, ...] = (
     # bins
     ("disc", 10, 100, 2.5), ("disc", 190, 60, 2.5), ("disc", 110, 185, 2.5),
 )
-
-
-def world_to_cell(xy) -> np.ndarray:
-    """World point(s) ``(x, y)`` [cells] → integer ``(row, col)`` of the containing cell.
-
-    The one grid ↔ world mapping of slamlab (see the module docstring):
-    ``row = floor(y + 0.5)``, ``col = floor(x + 0.5)``.
-
-    Parameters
-    ----------
-    xy : array_like, shape (..., 2)
-        Points in cell units.
-
-    Returns
-    -------
-    numpy.ndarray of int64, shape (..., 2)
-        ``[..., 0]`` = row, ``[..., 1]`` = col (not clipped to any grid).
-
-    Examples
-    --------
-    >>> world_to_cell([[3.4, 7.6], [0.0, -0.5]]).tolist()
-    [[8, 3], [0, 0]]
-    """
-    xy = v.as_finite_array(xy, "xy")
-    if xy.ndim == 0 or xy.shape[-1] != 2:
-        raise ValueError(f"`xy` must have shape (..., 2); got shape {xy.shape}")
-    rc = np.floor(xy[..., ::-1] + 0.5)
-    return rc.astype(np.int64)
-
-
-def cell_to_world(rc) -> np.ndarray:
-    """Integer ``(row, col)`` → the world point ``(x, y)`` at the cell centre (inverse of :func:`world_to_cell`).
-
-    >>> cell_to_world([[8, 3]]).tolist()
-    [[3.0, 8.0]]
-    """
-    rc = v.as_finite_array(rc, "rc")
-    if rc.ndim == 0 or rc.shape[-1] != 2:
-        raise ValueError(f"`rc` must have shape (..., 2); got shape {rc.shape}")
-    return rc[..., ::-1].copy()
-
-
-def make_grid(n_rows: int, n_cols: int, fill: int = FREE) -> np.ndarray:
-    """A new ``int8`` grid of the given size filled with one cell code (004 §7).
-
-    >>> make_grid(2, 3, UNEXPLORED)
-    array([[-1, -1, -1],
-           [-1, -1, -1]], dtype=int8)
-    """
-    n_rows = v.check_int(n_rows, "n_rows", minimum=1)
-    n_cols = v.check_int(n_cols, "n_cols", minimum=1)
-    if fill not in _CHARS:
-        raise ValueError(f"`fill` must be FREE (0), OBSTACLE (1) or UNEXPLORED (-1); got {fill!r}")
-    return np.full((n_rows, n_cols), fill, dtype=np.int8)
-
-
-def check_grid(grid, name: str = "grid") -> np.ndarray:
-    """Validate an occupancy grid: 2-D, integer codes in {FREE, OBSTACLE, UNEXPLORED}; returned as ``int8``.
-
-    >>> check_grid([[0, 1], [-1, 0]]).dtype
-    dtype('int8')
-    """
-    arr = v.as_image(grid, name)
-    if not (np.issubdtype(arr.dtype, np.integer) or arr.dtype == np.bool_):
-        if np.issubdtype(arr.dtype, np.floating) and np.all(arr == np.round(arr)):
-            arr = arr.astype(np.int64)
-        else:
-            raise TypeError(f"`{name}` must hold integer cell codes (0 free, 1 obstacle, -1 unexplored); "
-                            f"got dtype {arr.dtype}")
-    bad = ~np.isin(arr, (FREE, OBSTACLE, UNEXPLORED))
-    if bad.any():
-        raise ValueError(f"`{name}` must hold only 0 (free), 1 (obstacle) or -1 (unexplored); "
-                         f"got {int(bad.sum())} other value(s), e.g. {arr[bad][0]}")
-    return arr.astype(np.int8, copy=False)
-
-
-def grid_to_values(grid, a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0, dtype=np.float64) -> np.ndarray:
-    """Map the cell codes to 004's constants: free → ``a_c``, obstacle → ``a_p``, unexplored → ``a_n`` (004 §7).
-
-    >>> grid_to_values([[0, 1, -1]], a_c=-1, a_p=1, a_n=0)
-    array([[-1.,  1.,  0.]])
-    """
-    g = check_grid(grid)
-    for name, val in (("a_c", a_c), ("a_p", a_p), ("a_n", a_n)):
-        if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(val):
-            raise TypeError(f"`{name}` must be a finite real number; got {val!r}")
-    lut = np.array([a_n, a_c, a_p], dtype=dtype)  # index = code + 1
-    return lut[g.astype(np.intp) + 1]
 
 
 def free_cells(grid, margin_cells: int = 0) -> np.ndarray:

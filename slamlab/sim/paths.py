@@ -21,8 +21,8 @@ import numpy as np
 
 from .. import _validate as v
 from ..geometry import wrap_angle
+from ..geometry.se2 import check_pose
 from .grid import free_cells
-from .rangefinder import check_pose
 
 __all__ = ["PATH_004_SEGMENTS", "PATH_004_START", "path_004", "piecewise_path", "random_free_poses"]
 
@@ -73,7 +73,7 @@ def piecewise_path(start_pose, segments: Sequence[tuple]) -> np.ndarray:
             pts = np.column_stack([np.full(n, p[0]), np.full(n, p[1]), p[2] + amount * k])
         else:
             pts = np.column_stack([p[0] + amount * k * np.cos(p[2]), p[1] + amount * k * np.sin(p[2]),
-                                   np.full(n, p[2])])
+                                   np.full(n, p[2])])  # unwrapped heading: the path's points are exact
         out.extend(pts)
         p = pts[-1].copy()
     P = np.array(out)

@@ -8,13 +8,12 @@ API summary
 - :class:`Rangefinder` (beam count, field of view, maximum range, Gaussian range
   noise, range quantisation) with ``.scan(grid, pose, rng) -> Scan``;
   :func:`simulate_scans` for a whole path.
-- :class:`Scan` (angles, ranges, hit mask, true pose) and :func:`scan_to_points`
-  (hits → world points).
-- :func:`relative_poses`, :func:`compose_poses`: body-frame increments ↔ poses.
+- The scans are :class:`slamlab.scans.Scan` objects in cell units (``unit="cell"``,
+  ``pose`` = the true pose); increments ↔ poses use :mod:`slamlab.geometry.se2`.
 - :func:`simulate_odometry` → :class:`Odometry` (noisy increments with
   configurable drift and the integrated odometry path).
 
-Conventions are those of :mod:`slamlab.sim.grid`: points ``(x, y)`` with x along
+Conventions are those of :mod:`slamlab.scans.grid`: points ``(x, y)`` with x along
 columns, y along rows, cell ``(row, col)`` centred on ``(col, row)``; poses
 ``(x, y, heading_rad)``; a beam at angle ``α_i`` points along ``heading + α_i``.
 A beam stops at the first OBSTACLE cell (free and unexplored cells are
@@ -25,45 +24,22 @@ beam that reaches ``max_range_cells`` or leaves the grid returns
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _validate as v
-from ..geometry import wrap_angle
-from .grid import OBSTACLE, check_grid
+from ..geometry.se2 import check_pose, check_poses, se2_integrate, se2_relative
+from ..scans import OBSTACLE, Scan, check_grid
 
 __all__ = [
     "Odometry",
     "Rangefinder",
-    "Scan",
     "beam_angles",
     "cast_rays",
-    "check_pose",
-    "compose_poses",
-    "relative_poses",
-    "scan_to_points",
     "simulate_odometry",
     "simulate_scans",
 ]
-
-
-def check_pose(pose, name: str = "pose") -> np.ndarray:
-    """A finite pose ``(x, y, heading_rad)`` as a float vector of length 3.
-
-    >>> check_pose([1, 2, 0.5])
-    array([1. , 2. , 0.5])
-    """
-    return v.as_vector(pose, name, 3)
-
-
-def _check_poses(poses, name: str = "poses") -> np.ndarray:
-    arr = v.as_finite_array(poses, name)
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"`{name}` must have shape (n, 3) = (x, y, heading_rad) rows; got shape {arr.shape}")
-    if arr.shape[0] == 0:
-        raise ValueError(f"`{name}` must hold at least one pose; got shape {arr.shape}")
-    return arr
 
 
 def beam_angles(n_beams: int = 360, fov_rad: float = 2 * np.pi) -> np.ndarray:
@@ -165,58 +141,6 @@ def cast_rays(grid, pose, angles_rad, max_range_cells: float) -> tuple[np.ndarra
 
 
 @dataclass(frozen=True)
-class Scan:
-    """One rangefinder scan: beams ``(α_i, l_i)`` in cells and the true pose it was taken from (004 §7)."""
-
-    angles_rad: np.ndarray  # (n,) relative to the heading
-    ranges_cells: np.ndarray  # (n,) measured (noisy, quantised); max range where no return
-    hit: np.ndarray  # (n,) bool: a return was measured
-    pose: np.ndarray = field(default=None)  # (3,) true pose, None for real data
-    max_range_cells: float = np.inf
-
-    def __str__(self) -> str:
-        return (f"Scan of {self.angles_rad.size} beams, {int(self.hit.sum())} returns, "
-                f"max range {self.max_range_cells:g} cells")
-
-    def points(self, pose=None) -> np.ndarray:
-        """World points ``(x, y)`` of the returns seen from ``pose`` (default: the true pose)."""
-        return scan_to_points(self.angles_rad, self.ranges_cells, self.pose if pose is None else pose, self.hit)
-
-
-def scan_to_points(angles_rad, ranges_cells, pose, hit=None) -> np.ndarray:
-    """Polar beams ``(α_i, l_i)`` seen from ``pose`` → world points ``(x, y)`` (004 §7).
-
-    Parameters
-    ----------
-    angles_rad, ranges_cells : array_like, shape (n,)
-    pose : array_like, shape (3,)
-    hit : array_like of bool, shape (n,), optional
-        Keep only these beams.
-
-    Returns
-    -------
-    numpy.ndarray, shape (k, 2)
-
-    Examples
-    --------
-    >>> scan_to_points([0.0, np.pi / 2], [2.0, 3.0], [1.0, 1.0, 0.0]).round(12).tolist()
-    [[3.0, 1.0], [1.0, 4.0]]
-    """
-    a = v.as_vector(angles_rad, "angles_rad")
-    rr = v.as_vector(ranges_cells, "ranges_cells")
-    if a.shape != rr.shape:
-        raise ValueError(f"`angles_rad` and `ranges_cells` must have the same length; got {a.size} and {rr.size}")
-    p = check_pose(pose)
-    if hit is not None:
-        m = np.asarray(hit)
-        if m.dtype != bool or m.shape != a.shape:
-            raise ValueError(f"`hit` must be a bool array of shape {a.shape}; got {m.dtype} {m.shape}")
-        a, rr = a[m], rr[m]
-    th = p[2] + a
-    return np.column_stack([p[0] + rr * np.cos(th), p[1] + rr * np.sin(th)])
-
-
-@dataclass(frozen=True)
 class Rangefinder:
     """A scanning rangefinder: beams, field of view, range limit, Gaussian noise, quantisation (004 §7).
 
@@ -237,7 +161,7 @@ class Rangefinder:
     --------
     >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 8] = 1
     >>> s = Rangefinder(n_beams=4, max_range_cells=20).scan(g, [2.0, 2.0, 0.0])
-    >>> s.ranges_cells.tolist(), s.hit.tolist()
+    >>> s.ranges.tolist(), s.valid.tolist()
     ([5.5, 20.0, 20.0, 20.0], [True, False, False, False])
     """
 
@@ -273,59 +197,24 @@ class Rangefinder:
         """Measure the scan seen from ``pose`` in ``grid`` (noise drawn from ``rng``)."""
         ang = self.angles_rad
         true_r, hit = cast_rays(grid, pose, ang, self.max_range_cells)
-        return Scan(ang, self.measure(true_r, hit, rng), hit, check_pose(pose).copy(), float(self.max_range_cells))
+        return Scan(ang, self.measure(true_r, hit, rng), hit, unit="cell", max_range=float(self.max_range_cells),
+                    pose=check_pose(pose))
 
 
 def simulate_scans(grid, poses, rangefinder: Rangefinder | None = None, rng=None) -> list[Scan]:
-    """One :class:`Scan` per pose of a path (004 §8), noise from one seeded stream.
+    """One :class:`~slamlab.scans.Scan` per pose of a path (004 §8), noise from one seeded stream.
 
     >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 8] = 1
-    >>> [float(s.ranges_cells[0]) for s in simulate_scans(g, [[2, 2, 0], [3, 2, 0]], Rangefinder(4, max_range_cells=9))]
+    >>> [float(s.ranges[0]) for s in simulate_scans(g, [[2, 2, 0], [3, 2, 0]], Rangefinder(4, max_range_cells=9))]
     [5.5, 4.5]
     """
     rf = Rangefinder() if rangefinder is None else rangefinder
     if not isinstance(rf, Rangefinder):
         raise TypeError(f"`rangefinder` must be a Rangefinder; got {type(rf).__name__}")
-    P = _check_poses(poses)
+    P = check_poses(poses)
     g = check_grid(grid)
     rng = v.as_rng(rng)
     return [rf.scan(g, p, rng) for p in P]
-
-
-def relative_poses(poses) -> np.ndarray:
-    """Body-frame increments ``(dx, dy, dθ)`` between consecutive poses: ``p_{k+1} = p_k ⊕ u_k``.
-
-    >>> relative_poses([[0, 0, np.pi / 2], [0, 2, np.pi]]).round(12).tolist()
-    [[2.0, 0.0, 1.570796326795]]
-    """
-    P = _check_poses(poses)
-    d = np.diff(P[:, :2], axis=0)
-    c, s = np.cos(P[:-1, 2]), np.sin(P[:-1, 2])
-    return np.column_stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1], wrap_angle(np.diff(P[:, 2]))])
-
-
-def compose_poses(start_pose, increments) -> np.ndarray:
-    """Integrate body-frame increments from ``start_pose`` (inverse of :func:`relative_poses`), vectorised.
-
-    Returns
-    -------
-    numpy.ndarray, shape (n + 1, 3)
-        The start pose followed by one pose per increment (headings wrapped to [-π, π)).
-
-    Examples
-    --------
-    >>> compose_poses([0, 0, np.pi / 2], [[2, 0, np.pi / 4]]).round(12).tolist()
-    [[0.0, 0.0, 1.570796326795], [0.0, 2.0, 2.356194490192]]
-    """
-    p0 = check_pose(start_pose, "start_pose")
-    U = v.as_finite_array(increments, "increments")
-    if U.ndim != 2 or U.shape[1] != 3:
-        raise ValueError(f"`increments` must have shape (n, 3) = (dx, dy, dθ) rows; got shape {U.shape}")
-    th = p0[2] + np.concatenate([[0.0], np.cumsum(U[:, 2])])
-    c, s = np.cos(th[:-1]), np.sin(th[:-1])
-    dxy = np.column_stack([c * U[:, 0] - s * U[:, 1], s * U[:, 0] + c * U[:, 1]])
-    xy = p0[:2] + np.concatenate([np.zeros((1, 2)), np.cumsum(dxy, axis=0)])
-    return np.column_stack([xy, wrap_angle(th)])
 
 
 @dataclass(frozen=True)
@@ -370,7 +259,7 @@ def simulate_odometry(poses, *, trans_std_frac: float = 0.0, rot_std_rad: float 
     >>> simulate_odometry(P, scale_error=0.5).poses[:, 0].tolist()
     [0.0, 1.5, 3.0]
     """
-    P = _check_poses(poses)
+    P = check_poses(poses)
     sf = v.check_positive(trans_std_frac, "trans_std_frac", allow_zero=True)
     sr = v.check_positive(rot_std_rad, "rot_std_rad", allow_zero=True)
     for name, val in (("scale_error", scale_error), ("drift_rad_per_cell", drift_rad_per_cell)):
@@ -378,7 +267,7 @@ def simulate_odometry(poses, *, trans_std_frac: float = 0.0, rot_std_rad: float 
                 or not np.isfinite(val):
             raise TypeError(f"`{name}` must be a finite real number; got {val!r}")
     rng = v.as_rng(rng)
-    U = relative_poses(P) if P.shape[0] > 1 else np.zeros((0, 3))
+    U = se2_relative(P[:-1], P[1:])
     d = np.hypot(U[:, 0], U[:, 1])
     noise = rng.standard_normal(U.shape)
     meas = np.column_stack([
@@ -386,4 +275,4 @@ def simulate_odometry(poses, *, trans_std_frac: float = 0.0, rot_std_rad: float 
         (1 + scale_error) * U[:, 1] + sf * d * noise[:, 1],
         U[:, 2] + drift_rad_per_cell * d + sr * noise[:, 2],
     ])
-    return Odometry(meas, compose_poses(P[0], meas), U)
+    return Odometry(meas, se2_integrate(P[0], meas), U)

@@ -6,6 +6,7 @@ from scipy.signal import correlate
 
 from slamlab import correlation as C
 from slamlab import sim as S
+from slamlab.scans import Scan
 
 
 def test_score_maps_three_methods_agree_with_scipy_correlate():
@@ -58,10 +59,10 @@ def test_rasterise_matches_plain_reference():
     s = S.Rangefinder(n_beams=120, max_range_cells=80).scan(M, [70, 30, 0.0])
     # headings off the axes: beams at multiples of 3° put no sample exactly on a cell face
     headings = np.radians([1.0, 37.0, 91.0, 269.0, 359.0])
-    T, o = C.rasterise_scan(s.angles_rad, s.ranges_cells, s.hit, headings)
+    T, o = C.rasterise_scan(s, headings)
     assert T.shape[1] == 2 * o
     for n, th in enumerate(headings):
-        ref = _reference_stamp(s.angles_rad[s.hit], s.ranges_cells[s.hit], th, T.shape[1], o)
+        ref = _reference_stamp(s.bearings_rad[s.valid], s.ranges[s.valid], th, T.shape[1], o)
         # float32 coordinates / quarter-turn reuse may round a sample lying on a cell face differently
         assert np.count_nonzero(T[n] != ref) <= 3
         assert np.count_nonzero(ref) > 500
@@ -70,7 +71,7 @@ def test_rasterise_matches_plain_reference():
 def test_quarter_turns_are_grid_rotations():
     M = S.test_room_200()
     s = S.Rangefinder(n_beams=90, max_range_cells=60).scan(M, [70, 30, 0.0])
-    T, o = C.rasterise_scan(s.angles_rad, s.ranges_cells, s.hit, np.radians([10.0, 100.0, 190.0, 280.0]))
+    T, o = C.rasterise_scan(s, np.radians([10.0, 100.0, 190.0, 280.0]))
     # a quarter turn maps the robot-frame offset (dx, dy) to (-dy, dx): T'[o + dx, o - dy] = T[o + dy, o + dx]
     for q in range(1, 4):
         ref = np.zeros_like(T[0])
@@ -100,15 +101,18 @@ def test_tracking_window_agrees_with_full_search_and_float32():
     rf = S.Rangefinder(n_beams=360, max_range_cells=100, range_std_cells=0.3)
     p = np.array([150.0, 80.0, 2.3])
     s = rf.scan(W, p, rng=5)
-    full = C.localise(M, s)
-    track = C.localise(M, s, prior_heading_rad=np.radians(130.0), window_rad=np.radians(10))
-    f32 = C.localise(M, s, dtype=np.float32)
+    full = C.localise(M, s, dtype="float64")
+    track = C.localise(M, s, prior_heading_rad=np.radians(130.0), window_rad=np.radians(10), dtype="float64")
+    f32 = C.localise(M, s)  # the default: float32
+    assert C.LocaliseParams().dtype == "float32"
     assert track.headings_rad.size == 21
     assert (track.row, track.col) == (full.row, full.col) == (f32.row, f32.col) == (80, 150)
     assert C.heading_error(track.pose[2], full.pose[2]) < 1e-9
     assert C.heading_error(full.pose[2], p[2]) <= np.radians(1.0)
     assert full.best_per_heading.size == 360
     assert full.score == pytest.approx(full.best_per_heading.max())
+    assert f32.score == pytest.approx(full.score, rel=1e-5)
+    assert C.heading_error(f32.pose[2], full.pose[2]) < 1e-9
     assert full.score_map.shape == M.shape
 
 
@@ -145,18 +149,26 @@ def test_bad_input():
         C.localise(M, scan, window_rad=0.1)
     with pytest.raises(ValueError, match="`delta_alpha_rad` must be > 0"):
         C.localise(M, scan, delta_alpha_rad=0.0)
-    with pytest.raises(TypeError, match="`scan` must be a Scan or a tuple"):
+    with pytest.raises(TypeError, match=r"`scan` must be a slamlab.scans.Scan; got list"):
         C.localise(M, [1, 2, 3])
+    with pytest.raises(TypeError, match=r"`scan` must be a slamlab.scans.Scan; got tuple"):
+        C.localise(M, ([0.0], [5.0], np.array([True])))
     with pytest.raises(ValueError, match="no return"):
-        C.localise(M, ([0.0, 1.0], [5.0, 5.0], np.array([False, False])))
-    with pytest.raises(ValueError, match="`ranges_cells` must be >= 0"):
-        C.localise(M, ([0.0], [-1.0]))
-    with pytest.raises(ValueError, match="same length"):
-        C.rasterise_scan([0.0, 1.0], [1.0], None, [0.0])
+        C.localise(M, Scan([0.0, 1.0], [5.0, 5.0], np.array([False, False])))
+    with pytest.raises(ValueError, match="`scan` must be in cell units; got unit 'm'"):
+        C.localise(M, Scan([0.0], [5.0], [True], unit="m"))
     with pytest.raises(ValueError, match="`step_cells` must be <= 1"):
-        C.rasterise_scan([0.0], [1.0], None, [0.0], step_cells=2.0)
+        C.rasterise_scan(Scan([0.0], [1.0], [True]), [0.0], step_cells=2.0)
+    with pytest.raises(ValueError, match="`step_cells` must be <= 1"):
+        C.localise(M, scan, step_cells=2.0)
+    with pytest.raises(ValueError, match="`dtype` must be one of"):
+        C.localise(M, scan, dtype="float16")
+    with pytest.raises(TypeError, match=r"LocaliseParams has no field.*'delta_alpha_deg'"):
+        C.localise(M, scan, delta_alpha_deg=1.0)
+    with pytest.raises(TypeError, match="`params` must be a LocaliseParams or None; got dict"):
+        C.localise(M, scan, params={"a_c": 0.0})
     with pytest.raises(ValueError, match="`l_max` must cover the longest beam"):
-        C.rasterise_scan([0.0], [10.0], None, [0.0], l_max=3)
+        C.rasterise_scan(Scan([0.0], [10.0], [True]), [0.0], l_max=3)
     with pytest.raises(ValueError, match=r"`T` must have shape \(n, S, S\)"):
         C.score_maps(np.zeros((4, 4)), np.zeros((3, 4)), 1)
     with pytest.raises(ValueError, match="`method` must be one of"):
@@ -175,9 +187,35 @@ def test_quarter_turn_search_equals_plain_stack_on_a_non_square_map():
     # localise() correlates base stamps with four rotated maps; compare with the plain batched stack
     M = S.test_room_200()[10:130, 5:190]
     s = S.Rangefinder(n_beams=180, max_range_cells=60, range_std_cells=0.2).scan(M, [90, 60, 1.0], rng=3)
-    loc = C.localise(M, s, delta_alpha_rad=np.radians(3.0))
-    T, o = C.rasterise_scan(s.angles_rad, s.ranges_cells, s.hit, loc.headings_rad)
+    loc = C.localise(M, s, delta_alpha_rad=np.radians(3.0), dtype="float64")
+    T, o = C.rasterise_scan(s, loc.headings_rad)
     D = C.score_maps(S.grid_to_values(M), T, o, method="fftconvolve")
     np.testing.assert_allclose(loc.best_per_heading, D.reshape(D.shape[0], -1).max(axis=1), atol=1e-8)
     np.testing.assert_allclose(loc.score_map, D[loc.heading_index], atol=1e-8)
     assert np.unravel_index(np.argmax(D), D.shape) == (loc.heading_index, loc.row, loc.col)
+
+
+def test_params_every_field_checked_and_sourced():
+    p = C.LocaliseParams()
+    assert set(p.sources()) == set(C.LocaliseParams.field_names())
+    assert all(p.sources().values())
+    assert p.delta_alpha_rad == pytest.approx(np.radians(1.0))
+    bad = {"delta_alpha_rad": 0.0, "a_c": "x", "a_p": -1.0, "a_n": np.nan, "delta_l_cells": -1.0,
+           "hit_offset_cells": -0.1, "step_cells": 0.0, "use_misses": 1, "chunk": 0, "dtype": "int8",
+           "workers": 0}
+    for name, value in bad.items():
+        with pytest.raises((TypeError, ValueError), match=f"`{name}`"):
+            C.LocaliseParams(**{name: value})
+    # the a_c = a_p rule names both
+    with pytest.raises(ValueError, match="`a_c` and `a_p` must differ"):
+        C.LocaliseParams(a_c=1.0, a_p=1.0)
+    assert "004 §7" in p.table()
+
+
+def test_localise_params_object_equals_overrides():
+    M = S.test_room_200()
+    s = S.Rangefinder(n_beams=90, max_range_cells=60).scan(M, [70, 30, 0.3])
+    p = C.LocaliseParams(delta_alpha_rad=np.radians(5.0), a_c=0.0)
+    a = C.localise(M, s, params=p)
+    b = C.localise(M, s, delta_alpha_rad=np.radians(5.0), a_c=0.0)
+    assert (a.row, a.col, a.heading_index, a.score) == (b.row, b.col, b.heading_index, b.score)

@@ -1,4 +1,6 @@
-"""Ch. 5 experiments, the occupancy-grid builder and the real Intel log."""
+"""Ch. 5 experiments and a real CARMEN log given by path."""
+
+import shutil
 
 import numpy as np
 import pytest
@@ -43,61 +45,68 @@ def test_monte_carlo_small():
         C.run_monte_carlo("huge")
 
 
-def test_constants_study_runs_both_choices():
-    r = C.run_constants_study(2, extra_clutter=10, rng=1)
-    assert r.half_max_area.shape == (2, 2)
+def test_constants_study_runs_both_choices_and_checks_the_sharper_peak():
+    r = C.run_constants_study(3, extra_clutter=10, rng=1)
+    assert r.half_max_area.shape == (2, 3)
     assert len(r.example_maps) == 2
     assert r.example_maps[0].shape == (200, 200)
     assert "a_c=0, a_p=1" in r.table()
+    # 004 §7: the peak is sharpest at a_p = -a_c. In heading it is (a larger margin, every pose);
+    # in position a_c = -1 scores free space too, a broad hill: its half-maximum area is the larger one
+    assert np.all(r.heading_margin[0] > r.heading_margin[1])
+    assert np.all(r.half_max_area[0] > r.half_max_area[1])
+    # the example maps (at the first pose's heading) peak within one cell of its true cell for both choices
+    p0 = r.example_pose
+    for m in r.example_maps:
+        row, col = np.unravel_index(np.argmax(m), m.shape)
+        assert max(abs(row - p0[1]), abs(col - p0[0])) <= 1
     with pytest.raises(ValueError, match="`a_c` and `a_p` must differ"):
         C.run_constants_study(1, choices=((1.0, 1.0, 0.0),))
 
 
-def test_occupancy_grid_from_exact_scans_reproduces_the_room():
-    # scans cast in the test room from many poses, mapped back: walls hit come back as obstacles
-    M = S.test_room_200()
-    rf = S.Rangefinder(n_beams=720, max_range_cells=150, quantum_cells=0)
-    poses = S.random_free_poses(M, 40, margin_cells=3, rng=2)
-    scans = [rf.scan(M, p) for p in poses]
-    R = np.array([s.ranges_cells for s in scans])
-    H = np.array([s.hit for s in scans])
-    G = C.occupancy_grid_from_scans(rf.angles_rad, R, H, poses, M.shape)
-    seen = G != S.UNEXPLORED
-    assert seen.mean() > 0.7
-    # every cell labelled obstacle is an obstacle of M; free cells are free in M
-    assert np.all(M[G == S.OBSTACLE] == S.OBSTACLE)
-    assert np.mean(M[G == S.FREE] == S.FREE) > 0.999
+def test_run_params_and_overrides():
+    r = C.run_table1(1, rng=5, delta_alpha_rad=np.radians(2.0))
+    assert r.params.delta_alpha_rad == pytest.approx(np.radians(2.0))
+    assert "Δα = 2°" in r.table()
+    assert C.run_table1(1, rng=5, params=C.LocaliseParams(delta_alpha_rad=np.radians(2.0))).est_poses.tolist() \
+        == r.est_poses.tolist()
+    # the run_* and localise share one default set
+    assert C.run_table1(1, rng=5).params == C.LocaliseParams()
 
 
-def test_grid_frame_round_trip():
-    f = C.GridFrame.around([[0.0, 0.0], [3.0, 1.0]], 0.5, 1.0)
-    assert f.shape == (7, 11)
-    P = np.array([[1.2, 0.7, 0.3]])
-    np.testing.assert_allclose(f.to_metres(f.to_cells(P)), P)
-
-
-def test_bad_input():
-    with pytest.raises(ValueError, match="`hit` must be a bool array"):
-        C.occupancy_grid_from_scans([0.0], [[1.0]], [[1]], [[0, 0, 0]], (3, 3))
-    with pytest.raises(TypeError, match="`shape` must be a \\(rows, cols\\) tuple"):
-        C.occupancy_grid_from_scans([0.0], [[1.0]], [[True]], [[0, 0, 0]], 3)
-    with pytest.raises(ValueError, match="`poses_cells` must have shape"):
-        C.occupancy_grid_from_scans([0.0], [[1.0]], [[True]], [[0, 0]], (3, 3))
-    with pytest.raises(ValueError, match="`points_m` must hold at least one point"):
-        C.GridFrame.around(np.zeros((0, 2)), 0.1)
-    with pytest.raises(TypeError, match="`log` must be a CarmenLog"):
-        C.run_intel_localisation(log="intel")
+def test_bad_input(tmp_path):
+    with pytest.raises(TypeError, match=r"`path` must be a str, os.PathLike or CarmenLog; got int"):
+        C.run_log_localisation(3)
+    with pytest.raises(FileNotFoundError, match=r"no file at .*missing.log"):
+        C.run_log_localisation(str(tmp_path / "missing.log"))
+    with pytest.raises(TypeError, match=r"LocaliseParams has no field.*'delta_alpha_deg'"):
+        C.run_table1(1, delta_alpha_deg=1.0)
+    with pytest.raises(TypeError, match="`table1` must be a Table1Result"):
+        C.ours_vs_source(None)
 
 
 @pytest.mark.realdata
-def test_intel_localisation_from_no_prior(shared_data):
+def test_log_localisation_from_no_prior(shared_data):
     log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
     idx = (50, 150, 350, 450, 550, 750, 850, 250, 650)
-    r = C.run_intel_localisation(idx, log=log)
+    r = C.run_log_localisation(log, idx)
     # bound: at least 6 of 9 scans within 2 cells (0.4 m) and 5° of the corrected pose, from no prior;
     # the successful ones within 0.25 m and 2° (the grid is 0.2 m, headings 1°)
     assert r.success.sum() >= 6
     assert np.all(r.err_pos_m[r.success] <= 0.25)
     assert np.all(np.degrees(r.err_heading_rad[r.success]) <= 2.0)
     assert r.grid.shape[0] > 100
-    assert "Intel Research Lab" in r.table()
+    assert "intel-corrected.log.gz (CARMEN" in r.table()
+
+
+@pytest.mark.realdata
+def test_log_localisation_takes_any_path_and_labels_from_it(shared_data, tmp_path):
+    copy = tmp_path / "my_lab_run.log.gz"
+    shutil.copy(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz", copy)
+    r = C.run_log_localisation(str(copy), (150,), delta_alpha_rad=np.radians(2.0))
+    assert r.name == "my_lab_run.log.gz"
+    assert str(r).startswith("my_lab_run.log.gz:")
+    assert r.table().startswith("my_lab_run.log.gz (CARMEN")
+    assert "Intel" not in r.table()
+    assert "intel" not in r.table()
+    assert "my_lab_run.log.gz" in C.ours_vs_source(C.run_table1(1, rng=1), log=r)

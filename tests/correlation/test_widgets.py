@@ -19,11 +19,11 @@ def test_explore_localisation_messages(capsys):
 
 
 @pytest.mark.realdata
-def test_explore_intel_scan(capsys):
-    w = C.explore_intel_scan(scan=50)
+def test_explore_log_scan(capsys):
+    w = C.explore_log_scan(scan=50)
     capsys.readouterr()
     w.f(**{**w.kwargs, "a_c": 1.0, "a_p": 1.0})
     assert "Cannot run with these settings" in capsys.readouterr().out
     w.f(**{**w.kwargs, "scan": 909, "exclude": 0})
-    assert "scan 909: error" in capsys.readouterr().out
+    assert "intel-corrected.log.gz scan 909: error" in capsys.readouterr().out
     plt.close("all")

@@ -179,13 +179,6 @@ def test_line_history_matrix():
         hist.add_scan(h.Lines(np.array([1.0]), np.array([0.0]), np.array([5])), [0, 1])
 
 
-def test_compose_matches_sim_compose_poses():
-    from slamlab.sim import compose_poses
-
-    p0, u = np.array([1.0, 2.0, 0.3]), np.array([0.5, -0.2, 0.1])
-    assert np.allclose(h.compose(p0, u), compose_poses(p0, u[None])[1])
-
-
 @pytest.mark.parametrize(
     ("call", "exc", "match"),
     [

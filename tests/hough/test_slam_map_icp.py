@@ -1,13 +1,20 @@
 """Hough SLAM loop, map building, ICP baseline and the experiments (004 Fig. 9-11), incl. real logs."""
 
 import math
+import shutil
 
 import numpy as np
 import pytest
 
 import slamlab.hough as h
 from slamlab import sim
+from slamlab.geometry import se2_relative
 from slamlab.hough import experiments as E
+from slamlab.scans import Scan, occupancy_grid
+
+
+def _increments(P):
+    return se2_relative(P[:-1], P[1:])
 
 
 def kabsch(a, b):
@@ -38,11 +45,9 @@ def test_icp_recovers_a_sim_scan_motion():
     p0, p1 = np.array([70.0, 60.0, 0.3]), np.array([71.0, 60.5, 0.33])
     pts = []
     for p in (p0, p1):
-        s = rf.scan(room, p)
-        pts.append(np.column_stack([s.ranges_cells[s.hit] * np.cos(s.angles_rad[s.hit]),
-                                    s.ranges_cells[s.hit] * np.sin(s.angles_rad[s.hit])]))
+        pts.append(rf.scan(room, p).points([0.0, 0.0, 0.0]))  # in the sensor frame
     res = h.icp(pts[1], pts[0], max_dist=3.0)
-    true = sim.relative_poses(np.array([p0, p1]))[0]
+    true = se2_relative(p0, p1)
     assert res.converged
     assert np.hypot(*(res.pose[:2] - true[:2])) < 0.2  # beams hit different points: not exact
     assert abs(res.pose[2] - true[2]) < math.radians(0.5)
@@ -52,8 +57,7 @@ def test_build_map_with_true_poses_matches_the_room():
     room = sim.test_room_200()
     P = sim.path_004(31)
     scans = sim.simulate_scans(room, P, sim.Rangefinder(n_beams=360, max_range_cells=100.0), rng=0)
-    S = [(s.angles_rad, s.ranges_cells, s.hit) for s in scans]
-    m = h.build_map(S, P, shape=room.shape, origin=(0.0, 0.0))
+    m = occupancy_grid(scans, P, room.shape, step_cells=1.0)
     # a return lies on the face of the obstacle cell it entered, so it may round to the free cell before
     # it: within one cell every return is on an obstacle
     agree = h.map_agreement(m, room, tolerance_cells=1)
@@ -78,8 +82,7 @@ def test_hough_slam_exact_scans_without_noise_track_the_first_leg():
     room = sim.test_room_200()
     P = sim.path_004(121)[:40]
     scans = sim.simulate_scans(room, P, sim.Rangefinder(n_beams=360, max_range_cells=100.0, quantum_cells=0.0))
-    S = [(s.angles_rad, s.ranges_cells, s.hit) for s in scans]
-    res = h.hough_slam(S, P[0], sim.relative_poses(P))
+    res = h.hough_slam(scans, P[0], _increments(P))
     err = E.pose_errors(res.poses, P)
     assert np.abs(err[:, :2]).max() < 0.1
     assert np.degrees(np.abs(err[:, 2]).max()) < 0.1
@@ -89,11 +92,11 @@ def test_hough_slam_without_odometry_and_params():
     room = sim.test_room_200()
     P = sim.path_004(121)[12:30]  # the first leg, 1.6 cells a step
     scans = sim.simulate_scans(room, P, sim.Rangefinder(n_beams=360, max_range_cells=100.0), rng=1)
-    S = [(s.angles_rad, s.ranges_cells, s.hit) for s in scans]
+    S = scans
     res = h.hough_slam(S, P[0])
     assert np.abs(E.pose_errors(res.poses, P)[:, :2]).max() < 0.5
     assert "scans" in str(res)
-    with pytest.raises(TypeError, match="unknown HoughSlamParams field"):
+    with pytest.raises(TypeError, match=r"HoughSlamParams has no field.*'bogus'"):
         h.hough_slam(S, P[0], bogus=1)
     with pytest.raises(ValueError, match="`H_min` must be >= 1"):
         h.hough_slam(S, P[0], H_min=0)
@@ -101,8 +104,10 @@ def test_hough_slam_without_odometry_and_params():
         h.hough_slam(S, P[0], np.zeros((3, 3)))
     with pytest.raises(ValueError, match="at least one scan"):
         h.hough_slam([], P[0])
-    with pytest.raises(TypeError, match=r"`scans\[0\]` must be a \(bearings_rad, ranges, hit\) tuple"):
-        h.hough_slam([np.zeros(3)], P[0])
+    with pytest.raises(TypeError, match=r"`scans\[0\]` must be a slamlab.scans.Scan; got tuple"):
+        h.hough_slam([(np.zeros(3), np.ones(3), np.ones(3, bool))], P[0])
+    with pytest.raises(ValueError, match="`scans` must all have one unit"):
+        h.hough_slam([S[0], S[1].to_metres(0.05)], P[0])
 
 
 def test_partial_update_in_a_corridor():
@@ -119,8 +124,8 @@ def test_partial_update_in_a_corridor():
             r = np.where(c * rs > 1e-9, rs / np.where(np.abs(c) > 1e-12, c, 1.0), np.inf)
             rng_ = np.minimum(rng_, r)
         hit = rng_ < 30.0
-        scans.append((phi, np.where(hit, rng_, 0.0), hit))
-    odo = sim.relative_poses(truth)
+        scans.append(Scan(phi, np.where(hit, rng_, 30.0), hit, max_range=30.0))
+    odo = _increments(truth)
     odo_biased = odo.copy()
     odo_biased[:, 1] += 0.1  # odometry wrong across the corridor
     res = h.hough_slam(scans, truth[0], odo_biased, delta_rho=0.1, H_min=20)
@@ -159,8 +164,10 @@ def test_experiment_tables_and_errors():
         E.run_sim_slam(3)
     with pytest.raises(ValueError, match="`start` must be one of"):
         E.run_sim_slam(41, start="gps")
-    with pytest.raises(ValueError, match="`name` must be one of"):
+    with pytest.raises(FileNotFoundError, match="no file at nope"):
         E.run_real_log("nope")
+    with pytest.raises(TypeError, match=r"`path` must be a str or os.PathLike; got int"):
+        E.run_real_log(3)
     with pytest.raises(ValueError, match=r"must both have shape \(n, 3\)"):
         E.pose_errors(np.zeros((2, 3)), np.zeros((3, 3)))
 
@@ -175,19 +182,77 @@ def test_whole_system_starts_from_correlation():
 
 
 @pytest.mark.realdata
-def test_real_mbicp_log_map_is_sharper_than_odometry():
-    res = E.run_real_log("mbicp", n_scans=300)
+def test_real_mbicp_log_map_is_sharper_than_odometry(shared_data):
+    res = E.run_real_log(shared_data / E.SHARED_LOGS["mbicp"], n_scans=300)
     # stated bounds (ours): the Hough map draws walls with fewer cells than odometry's, and most steps
     # find a usable pair of lines
     assert res.sharpness("slam") < 0.75 * res.sharpness("odometry")
     assert res.slam.lost.mean() < 0.1
     assert res.slam.lost.mean() + res.slam.partial.mean() < 0.4
     assert res.odometry.shape == (300, 3)
+    assert res.name == "CARMEN log laserazosSM3.log (raw odometry)"
+    assert res.slam.params.r_max == 8.0  # the log's range limit (PROVENANCE: 0 < r < 8 m)
 
 
 @pytest.mark.realdata
 def test_real_urg_log_runs_with_raw_odometry():
-    res = E.run_real_log("urg04lx", n_scans=300)
+    res = E.run_real_log(n_scans=300)  # the default: the shared URG-04LX log
     assert res.slam.lost.mean() < 0.35
     assert res.sharpness("slam") < res.sharpness("odometry")
     assert np.median(res.slam.n_lines) >= 5
+    assert res.name == "URG-04LX log exp2.dat (raw odometry)"
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize(("key", "new_name", "label"), [("urg04lx", "hallway_run.dat", "URG-04LX"),
+                                                        ("mbicp", "office.clf", "CARMEN")])
+def test_real_log_takes_any_path_and_labels_from_it(shared_data, tmp_path, key, new_name, label):
+    copy = tmp_path / new_name
+    shutil.copy(shared_data / E.SHARED_LOGS[key], copy)
+    res = E.run_real_log(str(copy), n_scans=20)
+    assert E.log_format(copy) == {"URG-04LX": "urg04lx", "CARMEN": "carmen"}[label]
+    assert res.name == f"{label} log {new_name} (raw odometry)"
+    assert res.table().splitlines()[0].startswith(res.name)
+    assert "exp2" not in res.table()
+    assert "laserazos" not in res.table()
+
+
+def test_hough_slam_params_check_every_field():
+    p = h.HoughSlamParams()
+    assert set(p.sources()) == set(h.HoughSlamParams.field_names())
+    assert all(p.sources().values())
+    bad = {"delta_rho": 0.0, "delta_theta_rad": 0.7, "r_max": 0.0, "H_min": 0, "max_lines": 1,
+           "suppress_rho": -1.0, "suppress_theta_rad": 0.0, "refine": "yes", "band": -0.1, "max_gap": 0.0,
+           "a": 0.0, "b": -1.0, "a_theta_rad": 0.0, "parallel_tol_rad": -0.1, "p_min": 1.5, "method": "svd",
+           "angle_tol_rad": -1.0, "rho_tol": 0.0, "min_angle_rad": 2.0, "min_common": 1, "gate": 0.0,
+           "gate_theta_rad": 0.0, "partial": None}
+    assert set(bad) == set(h.HoughSlamParams.field_names())  # every field has a failing value
+    for name, value in bad.items():
+        with pytest.raises((TypeError, ValueError), match=f"`{name}`"):
+            h.HoughSlamParams(**{name: value})
+    # detect_lines takes a Scan and the same params / overrides
+    phi, r = h.line_scan(10.0, math.radians(45.0), r_max=16.0)
+    s = Scan(phi, r, np.ones(phi.size, bool))
+    a = h.detect_lines(s, h.HoughSlamParams(H_min=20))
+    b = h.detect_lines(s, H_min=20)
+    assert a.rho.tolist() == b.rho.tolist()
+    with pytest.raises(TypeError, match=r"`scan` must be a slamlab.scans.Scan"):
+        h.detect_lines((phi, r), H_min=20)
+
+
+def test_log_format_from_the_first_data_line(tmp_path):
+    import gzip
+
+    carmen = tmp_path / "a.log.gz"
+    with gzip.open(carmen, "wt") as fh:
+        fh.write("# comment\nFLASER 2 1 2 0 0 0 0 0 0\n")
+    urg = tmp_path / "b.txt"
+    urg.write_text("\n123 4 5\n")
+    empty = tmp_path / "c.log"
+    empty.write_text("# only a comment\n")
+    assert E.log_format(carmen) == "carmen"
+    assert E.log_format(str(urg)) == "urg04lx"
+    with pytest.raises(ValueError, match=r"c\.log: empty log"):
+        E.log_format(empty)
+    with pytest.raises(ValueError, match="`fmt` must be one of"):
+        E.run_real_log(str(urg), fmt="kitti")

@@ -8,6 +8,7 @@ from scipy.spatial import cKDTree
 
 from slamlab.data import find_data
 from slamlab.io import flaser_angles, read_carmen
+from slamlab.scans import Scan
 
 LOG = """# a comment
 PARAM robot_frontlaser_offset 0.0 nohost 0
@@ -31,8 +32,16 @@ def test_synthetic_log(tmp_path, compress):
     assert (L.n_scans, L.n_beams) == (2, 3)
     np.testing.assert_array_equal(L.ranges_m[1], [4.0, 0.0, 3.0])
     assert np.isnan(L.ranges_m[0, 2])
-    # default max range = the largest reading (4.0) means no return; 0 and NaN are invalid
-    assert L.valid.tolist() == [[True, True, False], [False, False, True]]
+    # the log marks invalid readings with NaN (the MbICP convention): the limit is the largest
+    # reading rounded up to the next whole metre (4.0 -> 5 m), so 4.0 is a return; 0 and NaN are not
+    assert L.max_range_m == 5.0
+    assert L.valid.tolist() == [[True, True, False], [True, False, True]]
+    # without NaN (the Radish convention) the largest reading is the sensor's "no return" value
+    nonan = tmp_path / "nonan.log"
+    nonan.write_text(LOG.replace("NaN", "2.5"))
+    L2 = read_carmen(nonan)
+    assert L2.max_range_m == 4.0
+    assert L2.valid.tolist() == [[True, True, True], [False, False, True]]
     np.testing.assert_array_equal(L.poses[0], [1.5, -2.0, 0.5])
     np.testing.assert_array_equal(L.odom_poses[0], [1.6, -2.1, 0.4])
     np.testing.assert_array_equal(L.timestamps_s, [13.0, 14.0])
@@ -40,11 +49,19 @@ def test_synthetic_log(tmp_path, compress):
     assert L.params == {"robot_frontlaser_offset": "0.0"}
     assert L.skipped == {"NEFF": 1, "ROBOTLASER1": 1}
     # 3 beams over 180°: -90, 0, +90; beam 0 of scan 0 (1 m, at -90° + heading 0.5 rad)
-    pts = L.points(0)
+    s0 = L.scan(0)
+    assert isinstance(s0, Scan)
+    assert (s0.unit, s0.max_range, s0.time_s) == ("m", 5.0, 13.0)
+    np.testing.assert_array_equal(s0.pose, [1.5, -2.0, 0.5])
+    np.testing.assert_array_equal(s0.odom_pose, [1.6, -2.1, 0.4])
+    pts = s0.points()
     np.testing.assert_allclose(pts[0], [1.5 + np.cos(0.5 - np.pi / 2), -2.0 + np.sin(0.5 - np.pi / 2)])
-    _ang, r, hit = L.scan_cells(0, 0.5)
-    np.testing.assert_allclose(r, [2.0, 4.0, 8.0])
-    assert hit.tolist() == [True, True, False]
+    c = s0.to_cells(0.5)
+    np.testing.assert_allclose(c.ranges, [2.0, 4.0, 10.0])  # the NaN beam: no return at the 5 m limit
+    assert c.valid.tolist() == [True, True, False]
+    np.testing.assert_allclose(c.pose, [3.0, -4.0, 0.5])
+    assert [s.time_s for s in L.scans()] == [13.0, 14.0]
+    assert L.name == path.name
     assert "2 scans x 3 beams" in str(L)
     # an explicit max range keeps the 4 m reading
     assert read_carmen(path, max_range_m=10.0).valid[1, 0]
@@ -60,9 +77,9 @@ def test_flaser_angles_layouts():
 
 
 def test_bad_input(tmp_path):
-    with pytest.raises(FileNotFoundError, match="CARMEN log not found"):
+    with pytest.raises(FileNotFoundError, match=r"`path`: no file at .*missing.log"):
         read_carmen(tmp_path / "missing.log")
-    with pytest.raises(TypeError, match="`path` must be a str"):
+    with pytest.raises(TypeError, match=r"`path` must be a str or os.PathLike"):
         read_carmen(3)
     (tmp_path / "empty.log").write_text("ODOM 0 0 0 0 0 0 1 h 1\n")
     with pytest.raises(ValueError, match="no FLASER message"):
@@ -73,9 +90,12 @@ def test_bad_input(tmp_path):
     (tmp_path / "mixed.log").write_text("FLASER 2 1 2 0 0 0 0 0 0\nFLASER 3 1 2 3 0 0 0 0 0 0\n")
     with pytest.raises(ValueError, match=r"line 2: .*beam count 3 differs"):
         read_carmen(tmp_path / "mixed.log")
-    (tmp_path / "bad.log").write_text("FLASER 2 1 x 0 0 0 0 0 0\n")
-    with pytest.raises(ValueError, match="malformed FLASER"):
-        read_carmen(tmp_path / "bad.log")
+    (tmp_path / "bad.log").write_text("ODOM 0 0 0\nFLASER 2 1 x 0 0 0 0 0 0\n")
+    with pytest.raises(ValueError, match=r"bad.log, line 2: malformed FLASER message: could not convert .*'x'"):
+        read_carmen(str(tmp_path / "bad.log"))
+    (tmp_path / "odom.log").write_text("FLASER 2 1 2 0 0 0 0 0 0\nODOM 0 y 0\n")
+    with pytest.raises(ValueError, match=r"odom.log, line 2: malformed ODOM message"):
+        read_carmen(tmp_path / "odom.log")
     with pytest.raises(ValueError, match="`max_range_m` must be > 0"):
         read_carmen(tmp_path / "bad.log", max_range_m=0)
     with pytest.raises(ValueError, match="`n_beams` must be >= 2"):
@@ -86,7 +106,7 @@ def _consecutive_overlap(L, step=5):
     """Median nearest-neighbour distance [m] between scan i and i+1 drawn at their stored poses."""
     med = []
     for i in range(0, L.n_scans - 1, step):
-        a, b = L.points(i), L.points(i + 1)
+        a, b = L.scan(i).points(), L.scan(i + 1).points()
         a = a[np.hypot(*(a - L.poses[i, :2]).T) < 8]
         b = b[np.hypot(*(b - L.poses[i + 1, :2]).T) < 8]
         if len(a) > 50 and len(b) > 50:
@@ -116,8 +136,18 @@ def test_intel_corrected_log():
 
 @pytest.mark.realdata
 def test_mbicp_sick_log():
-    L = read_carmen(find_data("mbicp-laserazos-sick/laserazosSM3.log"), max_range_m=8.0)
+    L = read_carmen(find_data("mbicp-laserazos-sick/laserazosSM3.log"))
     assert (L.n_scans, L.n_beams) == (778, 361)
+    # PROVENANCE: beam i at -π/2 + i·π/(n-1), valid when 0 < r < 8 m (the source's reader)
+    np.testing.assert_allclose(L.bearings_rad, -np.pi / 2 + np.arange(361) * np.pi / 360)
+    assert L.max_range_m == 8.0
+    R = L.ranges_m
+    with np.errstate(invalid="ignore"):
+        np.testing.assert_array_equal(L.valid, np.isfinite(R) & (R > 0) & (R < 8.0))
+    s = L.scan(5)
+    assert s.unit == "m"
+    assert s.max_range == 8.0
+    assert s.valid.sum() == L.valid[5].sum()
     nan_frac = np.isnan(L.ranges_m).mean()
     assert 0.06 < nan_frac < 0.075  # PROVENANCE: about 6.8 %
     ok = L.ranges_m[L.valid]

@@ -7,13 +7,14 @@ import pytest
 
 import slamlab.hough as h
 from slamlab.data import find_data
+from slamlab.geometry import se2_compose, se2_integrate
 from slamlab.io.urg04lx import (
     read_urg04lx_log,
     urg04lx_bearings,
     urg04lx_odometry,
     urg04lx_sensor_increments,
 )
-from slamlab.sim import compose_poses
+from slamlab.scans import Scan
 
 
 def write_log(path, n=3):
@@ -38,19 +39,33 @@ def test_reader_on_a_synthetic_file(tmp_path):
     assert log.ranges_m[2, 5] == pytest.approx(1.002)
     assert np.allclose(log.time_s, [0.0, 0.1, 0.2])
     assert log.ticks[2].tolist() == [200, 240]
-    _phi, r, hit = log.scan(1)
-    assert hit[:3].tolist() == [False, False, False]
-    assert r[0] == 0.0
-    assert "3 scans" in str(log)
+    s = log.scan(1)
+    assert isinstance(s, Scan)
+    assert s.valid[:3].tolist() == [False, False, False]
+    assert (s.ranges[0], s.max_range, s.unit) == (4.0, 4.0, "m")  # no return: the range limit
+    assert s.time_s == pytest.approx(0.1)
+    np.testing.assert_allclose(s.odom_pose, log.odometry_poses()[1])
+    assert [x.time_s for x in log.scans()] == pytest.approx([0.0, 0.1, 0.2])
+    assert log.name == "tiny.dat"
+    assert "tiny.dat: 3 scans" in str(log)
 
 
 def test_reader_errors(tmp_path):
-    with pytest.raises(FileNotFoundError, match="URG-04LX log not found"):
+    with pytest.raises(FileNotFoundError, match=r"`path`: no file at .*missing.dat"):
         read_urg04lx_log(tmp_path / "missing.dat")
     bad = tmp_path / "bad.dat"
     bad.write_text("1 2 3\n")
     with pytest.raises(ValueError, match="line 1: expected 707 numbers; got 3"):
         read_urg04lx_log(bad)
+    p = tmp_path / "token.dat"
+    write_log(p)
+    lines = p.read_text().splitlines()
+    fields = lines[1].split()
+    fields[30] = "12a4"
+    lines[1] = " ".join(fields)
+    p.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"token.dat line 2: field 30 is not a number: '12a4'"):
+        read_urg04lx_log(str(p))
     empty = tmp_path / "empty.dat"
     empty.write_text("\n")
     with pytest.raises(ValueError, match="no scans"):
@@ -73,7 +88,7 @@ def test_odometry_kinematics():
     # an arc: integrating many small steps lands on the circle of the exact arc
     n = 1000
     ticks = np.column_stack([np.arange(n + 1) * 2, np.arange(n + 1) * 3])
-    pose = compose_poses((0, 0, 0), urg04lx_odometry(ticks))[-1]
+    pose = se2_integrate((0, 0, 0), urg04lx_odometry(ticks))[-1]
     dl, dr = 2 * n * 2 * math.pi * R / 2000, 3 * n * 2 * math.pi * R / 2000
     th = (dr - dl) / (2 * b)
     radius = (dl + dr) / 2 / th
@@ -89,8 +104,12 @@ def test_sensor_increments_match_composition():
     got = urg04lx_sensor_increments(U, offset_m=off)
     for u, g in zip(U, got, strict=True):
         # o⁻¹ ⊕ u ⊕ o with o = (off, 0, 0)
-        expected = h.compose(h.compose((-off, 0.0, 0.0), u), (off, 0.0, 0.0))
-        assert np.allclose(g, expected)
+        expected = se2_compose(se2_compose((-off, 0.0, 0.0), u), (off, 0.0, 0.0))
+        assert np.allclose(g[:2], expected[:2])
+        assert g[2] == pytest.approx(u[2])
+    # closed form: a quarter turn in place moves a sensor 1 m ahead by (-1, 1)
+    np.testing.assert_allclose(urg04lx_sensor_increments([[0.0, 0.0, np.pi / 2]], offset_m=1.0),
+                               [[-1.0, 1.0, np.pi / 2]], atol=1e-12)
 
 
 def test_bearings():
@@ -120,8 +139,7 @@ def test_real_log_rotation_sense_agrees_with_icp():
     for k in turns:
         pts = []
         for j in (k, k + 1):
-            phi, r, hit = log.scan(int(j))
-            pts.append(np.column_stack([r[hit] * np.cos(phi[hit]), r[hit] * np.sin(phi[hit])]))
+            pts.append(log.scan(int(j)).points([0.0, 0.0, 0.0]))
         res = h.icp(pts[1], pts[0], max_dist=0.3)
         agree += np.sign(res.pose[2]) == np.sign(U[k, 2])
     assert agree >= 6

@@ -103,8 +103,11 @@ def test_noise_and_drift():
     drift = StereoSim(arena, drift_std_rad=0.01, rng=0)
     for _ in range(5):
         drift.render_pair([1.5, 2.0, 0.5])
-    # a random walk of 5 steps: the accumulated angles are of order 0.01 sqrt(5)
-    assert 0 < np.linalg.norm(drift.drift_rad) < 0.2
+    # a random walk: each render adds N(0, σ²) to each of the 3 angles, drawn first from the sim's stream
+    # (no image noise here), so the drift after 5 renders is the sum of the stream's first 5 draws
+    steps = np.random.default_rng(0).normal(0.0, 0.01, (5, 3))
+    np.testing.assert_allclose(drift.drift_rad, steps.sum(axis=0), rtol=0, atol=1e-15)
+    assert not np.allclose(drift.render_pair([1.5, 2.0, 0.5])[1], clean[1])  # the right camera drifts
     assert np.array_equal(drift.render_pair([1.5, 2.0, 0.5])[0], clean[0])  # the left camera does not drift
 
 

@@ -81,15 +81,15 @@ def test_noise_and_quantisation():
     rf = R.Rangefinder(n_beams=4000, max_range_cells=300, range_std_cells=0.5, quantum_cells=0.1)
     s = rf.scan(g, [100.0, 100.0, 0.0], rng=1)
     exact, _ = R.cast_rays(g, [100.0, 100.0, 0.0], rf.angles_rad, 300)
-    err = s.ranges_cells - exact
+    err = s.ranges - exact
     assert abs(err.std() - 0.5) < 0.03
     assert abs(err.mean()) < 0.03
-    assert np.allclose(s.ranges_cells * 10, np.round(s.ranges_cells * 10), atol=1e-9)
+    assert np.allclose(s.ranges * 10, np.round(s.ranges * 10), atol=1e-9)
     # seeded: same scan twice
-    assert np.array_equal(s.ranges_cells, rf.scan(g, [100.0, 100.0, 0.0], rng=1).ranges_cells)
+    assert np.array_equal(s.ranges, rf.scan(g, [100.0, 100.0, 0.0], rng=1).ranges)
     # noise-free, unquantised = exact
     s0 = R.Rangefinder(n_beams=4000, max_range_cells=300, quantum_cells=0).scan(g, [100.0, 100.0, 0.0])
-    assert np.array_equal(s0.ranges_cells, exact)
+    assert np.array_equal(s0.ranges, exact)
 
 
 def test_scan_points_land_on_obstacles():
@@ -97,21 +97,32 @@ def test_scan_points_land_on_obstacles():
     s = R.Rangefinder(n_beams=720, max_range_cells=150, quantum_cells=0).scan(M, [70.0, 30.0, 0.4])
     pts = s.points()
     # step 1e-6 beyond the face: inside the obstacle cell
-    th = 0.4 + s.angles_rad[s.hit]
+    th = 0.4 + s.bearings_rad[s.valid]
     inner = pts + 1e-6 * np.column_stack([np.cos(th), np.sin(th)])
     rc = G.world_to_cell(inner)
     assert np.all(M[rc[:, 0], rc[:, 1]] == G.OBSTACLE)
 
 
-def test_relative_compose_round_trip():
+def test_scan_is_the_shared_scan_type():
+    from slamlab.scans import Scan
+
+    s = R.Rangefinder(n_beams=8, max_range_cells=50).scan(G.test_room_200(), [70.0, 30.0, 0.4])
+    assert isinstance(s, Scan)
+    assert (s.unit, s.max_range) == ("cell", 50.0)
+    np.testing.assert_array_equal(s.pose, [70.0, 30.0, 0.4])
+    assert np.all(s.ranges[~s.valid] == 50.0)  # no return: the range limit
+
+
+def test_odometry_increments_are_se2_relative_poses():
+    from slamlab.geometry import se2_relative
+
     rng = np.random.default_rng(5)
     P = np.column_stack([rng.uniform(0, 100, (30, 2)), rng.uniform(-np.pi, np.pi, 30)])
-    U = R.relative_poses(P)
-    Q = R.compose_poses(P[0], U)
-    np.testing.assert_allclose(Q[:, :2], P[:, :2], atol=1e-9)
-    np.testing.assert_allclose(wrap_angle(Q[:, 2] - P[:, 2]), 0, atol=1e-9)
-    # one increment checked by hand: move 1 ahead facing +y
-    assert R.relative_poses([[0, 0, np.pi / 2], [0, 1, np.pi / 2]]).round(12).tolist() == [[1.0, 0.0, 0.0]]
+    odo = R.simulate_odometry(P)
+    for k in range(29):
+        np.testing.assert_allclose(odo.true_increments[k], se2_relative(P[k], P[k + 1]), atol=1e-12)
+    np.testing.assert_allclose(odo.poses[:, :2], P[:, :2], atol=1e-9)
+    np.testing.assert_allclose(wrap_angle(odo.poses[:, 2] - P[:, 2]), 0, atol=1e-9)
 
 
 def test_odometry_drift_closed_form():
@@ -132,9 +143,9 @@ def test_simulate_scans_uses_one_stream():
     M = G.test_room_200()
     rf = R.Rangefinder(n_beams=90, range_std_cells=0.3)
     a = R.simulate_scans(M, [[70, 30, 0], [70, 30, 0]], rf, rng=7)
-    assert not np.array_equal(a[0].ranges_cells, a[1].ranges_cells)  # independent noise per scan
+    assert not np.array_equal(a[0].ranges, a[1].ranges)  # independent noise per scan
     b = R.simulate_scans(M, [[70, 30, 0], [70, 30, 0]], rf, rng=7)
-    assert np.array_equal(a[1].ranges_cells, b[1].ranges_cells)
+    assert np.array_equal(a[1].ranges, b[1].ranges)
     assert "90 beams" in str(a[0])
 
 
@@ -152,14 +163,8 @@ def test_bad_input():
         R.Rangefinder(n_beams=0)
     with pytest.raises(ValueError, match="`range_std_cells` must be >= 0"):
         R.Rangefinder(range_std_cells=-1)
-    with pytest.raises(ValueError, match="same length"):
-        R.scan_to_points([0.0, 1.0], [1.0], [0, 0, 0])
-    with pytest.raises(ValueError, match="`hit` must be a bool array"):
-        R.scan_to_points([0.0], [1.0], [0, 0, 0], hit=[1])
     with pytest.raises(ValueError, match="`poses` must have shape \\(n, 3\\)"):
-        R.relative_poses([[0, 0]])
-    with pytest.raises(ValueError, match="`increments` must have shape"):
-        R.compose_poses([0, 0, 0], [1, 2, 3])
+        R.simulate_odometry([[0, 0]])
     with pytest.raises(TypeError, match="`scale_error` must be a finite real"):
         R.simulate_odometry([[0, 0, 0], [1, 0, 0]], scale_error="x")
     with pytest.raises(TypeError, match="`rangefinder` must be a Rangefinder"):

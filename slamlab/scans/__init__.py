@@ -1,0 +1,39 @@
+"""The 2-D layer: one Scan type, scan → points, occupancy grids and the likelihood field (004 §7).
+
+Produced alike by the simulator (:mod:`slamlab.sim`) and the log readers
+(:mod:`slamlab.io`); used by correlation localisation, Hough SLAM and
+localisation. Nothing here imports :mod:`slamlab.sim`.
+"""
+
+from .grid import (
+    FREE,
+    OBSTACLE,
+    UNEXPLORED,
+    GridFrame,
+    cell_to_world,
+    check_grid,
+    grid_to_values,
+    make_grid,
+    world_to_cell,
+)
+from .occupancy import RULES, OccupancyGrid, likelihood_field, occupancy_grid
+from .scan import UNITS, Scan, scan_to_points
+
+__all__ = [
+    "FREE",
+    "OBSTACLE",
+    "RULES",
+    "UNEXPLORED",
+    "UNITS",
+    "GridFrame",
+    "OccupancyGrid",
+    "Scan",
+    "cell_to_world",
+    "check_grid",
+    "grid_to_values",
+    "likelihood_field",
+    "make_grid",
+    "occupancy_grid",
+    "scan_to_points",
+    "world_to_cell",
+]
