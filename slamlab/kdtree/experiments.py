@@ -17,7 +17,8 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from .cost_model import calibrate_C, minimise_iter_time
-from .stores import STORE_NAMES, BruteForceStore, FlannStore, KDTree, make_store
+from .stores import STORE_NAMES, BruteForceStore, FlannStore, make_store
+from .tree import KDTree
 from .workloads import Scenario, Workload, make_workload, surf_like_descriptors
 
 __all__ = [
@@ -28,7 +29,6 @@ __all__ = [
     "StoreComparisonResult",
     "fit_C",
     "recall_at_1",
-    "record_stereo_stream",
     "run_crossover",
     "run_dimension_study",
     "run_store_comparison",
@@ -452,26 +452,3 @@ def run_dimension_study(dims=(2, 8, 16, 64), *, n: int = 5000, n_queries: int = 
         rows.append((name, d, 100.0 * st.mean_leaves / tree.n_leaves, 100.0 * st.mean_distance_evals / tree.n,
                      recall_at_1(b, e)))
     return DimensionStudyResult(tuple(rows), n, n_queries, checks, leaf_size)
-
-
-def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0) -> Workload:
-    """Record the landmark-store calls of the stereo pipeline on 000's closed loop (our addition).
-
-    Runs :func:`slamlab.stereo.experiments.run_closed_loop` (small size: 57 frames;
-    ``n_frames`` keeps the first frames only) with an exact store wrapped in a
-    :class:`~slamlab.kdtree.workloads.RecordingStore`, and returns the recorded
-    :class:`~slamlab.kdtree.workloads.Workload` for :func:`run_store_comparison`.
-    ``detector="sift"`` gives 128-d float descriptors (OpenCV); ``"surf"`` the 64-d
-    SURF of the features chapter.
-    """
-    from ..sim.stereo_paths import rectangular_loop
-    from ..stereo.experiments import run_stereo_slam
-    from ..stereo.store import ExactStore
-    from .workloads import RecordingStore
-
-    poses = rectangular_loop(step_m=0.5, turn_step_rad=np.deg2rad(20.0))
-    if n_frames is not None:
-        poses = poses[: v.check_int(n_frames, "n_frames", minimum=2)]
-    rec = RecordingStore(ExactStore())
-    run_stereo_slam(poses, name="closed loop", detector=detector, store=rec, rng=rng)
-    return rec.workload(f"stereo closed loop, {len(poses)} frames ({detector.upper()}, recorded)")

@@ -6,7 +6,7 @@ import numpy as np
 from slamlab.geometry import StereoRig
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
-from slamlab.stereo import detect, stereo_match, triangulate_local
+from slamlab.stereo import detect_features, stereo_match, triangulate_local
 from slamlab.stereo.experiments import run_stereo_slam
 from slamlab.stereo.plot import (
     plot_frame_stages,
@@ -25,7 +25,7 @@ def test_plots():
     arena = StereoArena(seed=0)
     sim = StereoSim(arena, rig, rng=0)
     left, right = sim.render_pair([3.0, 4.0, 1.0])
-    fl, fr = detect(left, n_features=500), detect(right, n_features=500)
+    fl, fr = detect_features(left, n_features=500), detect_features(right, n_features=500)
     sm = stereo_match(fl, fr, rig)
     cloud = triangulate_local(rig, fl, fr, sm)
     axes = plot_frame_stages(left, right, fl, fr, sm, cloud, np.arange(len(cloud.points)) % 2 == 0)
