@@ -18,6 +18,8 @@ from .evaluation import (
     correct_matches,
     load_oxford_image,
     load_oxford_pair,
+    oxford_folder,
+    oxford_label,
     project,
     repeatability,
 )
@@ -96,6 +98,8 @@ __all__ = [
     "mser_cv",
     "mutual_mask",
     "orb_cv",
+    "oxford_folder",
+    "oxford_label",
     "project",
     "ratio_rule",
     "repeatability",
