@@ -42,6 +42,8 @@ __all__ = [
     "RatioTradeoffResult",
     "SurfThresholdResult",
     "descriptor_pool",
+    "matching_vs_source",
+    "ours_vs_source",
     "run_blob_scale",
     "run_detector_summary",
     "run_knn_comparison",
@@ -588,3 +590,61 @@ def run_blob_scale(sizes_px=(3.0, 4.0, 5.0, 6.0, 8.0), *, threshold: float = 1e-
         uv.append(f.uv[k])
         sig.append(f.scale_px[k])
     return BlobScaleResult(sizes, np.array(uv), np.array(sig), c)
+
+
+def ours_vs_source(threshold: SurfThresholdResult, summary: DetectorSummaryResult,
+                   pairs: PairEvaluationResult) -> str:
+    """000's statements on SIFT and SURF (000 §1.4, §3.3) beside our numbers from the chapter's runs.
+
+    ``threshold``: :func:`run_surf_threshold`; ``summary``: :func:`run_detector_summary`; ``pairs``:
+    :func:`run_pair_evaluation` with SIFT and SURF among its detectors.
+    """
+    counts = dict(zip(summary.names, summary.counts, strict=True))
+    surf = next(c for n, c in counts.items() if n.startswith("SURF"))
+    sift = next(c for n, c in counts.items() if n.startswith("SIFT"))
+    rows = [
+        [f"SURF points at threshold {threshold.source_threshold:g}", "~2000 (576x768, §3.3)",
+         f"{threshold.source_count} ({threshold.image_name})"],
+        ["SURF threshold for >= 2000 points", "0.05 (scale not stated)", f"{threshold.threshold_for(2000):.1e}"],
+        ["SIFT points", "~2000 on ~500x500 (§1.4.1)", f"{sift} ({summary.image_name})"],
+        ["SURF vs SIFT points", "SURF finds fewer (§1.4.2)", f"{surf} vs {sift}"],
+    ]
+    det = list(pairs.detectors)
+    if "SIFT" in det and "SURF" in det:
+        k_sift, k_surf = det.index("SIFT"), det.index("SURF")
+        for i, seq in enumerate(pairs.sequences):
+            for j, st in enumerate(pairs.steps[:2]):
+                rows.append([f"repeatability {seq} 1→{st}: SURF vs SIFT", "SURF more stable (§1.4.2)",
+                             f"{pairs.rep[i, j, k_surf]:.2f} vs {pairs.rep[i, j, k_sift]:.2f}"])
+    return format_table(["quantity", "000", "ours"], rows, title="Detectors: 000 beside ours (times: timing tables)")
+
+
+def matching_vs_source(curve: LeavesCurveResult, trade: RatioTradeoffResult, knn: KnnComparisonResult) -> str:
+    """000 §1.4.3's statements on kd-tree search and the 2× rule beside our numbers from the chapter's runs.
+
+    ``curve``: :func:`run_recall_vs_leaves`; ``trade``: :func:`run_ratio_tradeoff`; ``knn``:
+    :func:`run_knn_comparison`.
+    """
+    rows = []
+    at200 = np.flatnonzero(curve.budgets == 200)
+    if at200.size:
+        rows.append([f"BBF, 200 leaves: NN recall ({curve.n_stored} stored)", "'in most cases the nearest'",
+                     f"{curve.recall_bbf[at200[0]]:.3f}"])
+    m_bbf = [i for i, m in enumerate(knn.methods) if m.startswith("BBF")]
+    m_brute = [i for i, m in enumerate(knn.methods) if m == "brute"]
+    if m_bbf and m_brute:
+        for s, size in enumerate(knn.sizes):
+            b, e = m_bbf[0], m_brute[0]
+            rows.append([f"BBF vs exact at {size} stored: recall / precision after ratio 0.8", "a close point if not",
+                         f"{knn.recall[s, b]:.3f} / {knn.precision[s, b]:.3f} (exact {knn.precision[s, e]:.3f})"])
+    rows.append([f"exact 64-d search: points evaluated per query ({curve.n_stored} stored)",
+                 "kd-trees lose efficiency in high dimension", f"{curve.exact_evals:.0f}"])
+    m, p, r, md = trade.source_row
+    rows.append([f"000's rule d2 >= 2 d1, d1 <= {md:g} ({trade.pair}): matches, precision, recall", "accepted as correct",
+                 f"{m}, {p:.3f}, {r:.3f}"])
+    i8 = np.flatnonzero(np.isclose(trade.ratios, 0.8))
+    if i8.size:
+        k = i8[0]
+        rows.append(["ratio 0.8 (Lowe's usual): matches, precision, recall", "—",
+                     f"{trade.n_matches[k]}, {trade.precision[k]:.3f}, {trade.recall[k]:.3f}"])
+    return format_table(["quantity", "000", "ours"], rows, title="Matching: 000 beside ours (times: timing tables)")

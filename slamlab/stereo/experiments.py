@@ -33,6 +33,7 @@ __all__ = [
     "StereoRunResult",
     "comparison_table",
     "experiment_poses",
+    "ours_vs_source",
     "record_stereo_stream",
     "run_closed_loop",
     "run_comparison",
@@ -457,3 +458,47 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
         n_degenerate=len(slam.degenerate_frames), inliers_median=float(np.median(slam.counts()["n_inliers"][1:])),
         fps=n / t_slam,
     )  # fmt: skip
+
+
+def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None = None,
+                   kitti: KittiRunResult | None = None) -> str:
+    """000's figures (§3.1 requirements, §3.7 results) beside ours, from the chapter's runs.
+
+    ``turn``: :func:`run_turn_in_place`; ``loops``: :func:`run_comparison` of the closed loop
+    (label -> result; the first is 000's pipeline); ``drift``: :func:`run_drift_study`;
+    ``kitti``: :func:`run_kitti`. Frame rates are timings and stay out (``timing_table``).
+    """
+    deg = np.rad2deg
+    runs = list(loops.items())
+    if not runs:
+        raise ValueError("`loops` is empty")
+    (label0, loop0), others = runs[0], runs[1:]
+
+    def per_run(fmt):
+        main = fmt(loop0)
+        return main + ("" if not others else " (" + "; ".join(f"{k}: {fmt(r)}" for k, r in others) + ")")
+
+    i180 = turn.frame_at_turn(np.pi)
+    rows = [
+        ["turn: max position error, m", "<= 0.15", f"{turn.pos_err_m.max():.2f}"],
+        ["turn: spread of positions, m", "~0.20", f"{turn.position_spread_m:.2f}"],
+        ["turn: heading error at 180 deg, deg", "<= 5", f"{deg(abs(turn.yaw_err_rad[i180])):.1f}"],
+        ["turn: heading error back at 0 deg, deg", "2-3", f"{deg(abs(turn.yaw_err_rad[-1])):.1f}"],
+        [f"loop ({label0}): max position error, m", "<= 0.5 (req.)", per_run(lambda r: f"{r.pos_err_m.max():.2f}")],
+        ["loop: max heading error / turned angle, %", "<= 10 (req.); 000: 10",
+         per_run(lambda r: f"{100 * r.heading_error_ratio:.1f}")],
+        ["loop: revisit pose change, m / deg", "same pose (req.)",
+         per_run(lambda r: f"{r.revisit_difference[0]:.2f} / {deg(abs(r.revisit_difference[1])):.1f}")],
+        ["loop: stereo matches per frame (median)", "~500 (<100 bad)",
+         per_run(lambda r: f"{np.median(r.counts['n_stereo']):.0f}")],
+    ]
+    if drift is not None:
+        levels = ", ".join(f"{1e3 * d:g}: {r.pos_err_m.max():.2f} m / {deg(np.abs(r.yaw_err_rad).max()):.1f} deg"
+                           for d, r in zip(drift.drift_std_rad, drift.runs, strict=True))
+        rows.append([f"calibration drift (mrad/frame): max error, {drift.experiment}, {drift.runs[0].n_frames} frames",
+                     "'tends to change'", levels])
+    if kitti is not None:
+        rows.append([f"real data ({kitti.name}, {len(kitti.truth)} frames): ATE / SE(3)-aligned / final, m",
+                     "— (no ground truth)", (f"{kitti.ate_m:.2f} / {kitti.ate_se3_m:.2f} / {kitti.final_error_m:.2f} "
+                                             f"over {kitti.path_length_m:.1f} m")])
+    return format_table(["quantity", "000", "ours"], rows, title="Stereo SLAM: 000 beside ours (frame rates: timing tables)")

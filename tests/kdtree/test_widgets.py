@@ -17,7 +17,7 @@ def test_cost_model_widget_extremes(capsys):
     out = capsys.readouterr().out
     # the widget prints the model's value at the sliders and the optimum of the same run_cost_model call
     here = float(iter_time(500, 1.5, n=5000, s=10, m=5000, C=50.0))
-    _, bn1, bq, best, _ = run_cost_model(n=5000, s=10, m=5000, C=50.0).readings[0]
+    _, bn1, bq, best, _ = run_cost_model(n=5000, s=10, m=5000, C=50.0).optimum
     assert out.strip() == (f"iterTime at n1 = 500, q = 1.50: {here:.3g} steps, {here / best:.3f} x the optimum "
                            f"(n1 = {bn1:.0f}, q = {bq:.2f})")
     assert here >= best
