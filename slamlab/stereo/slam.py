@@ -130,14 +130,6 @@ class StereoSLAM:
         self.last_inlier_map = np.empty((0, 3))
 
     # -- the loop ------------------------------------------------------------------------------------
-    @property
-    def detector(self) -> str:
-        return self.params.detector
-
-    @property
-    def policy(self) -> str:
-        return self.params.policy
-
     def _check_pair(self, left, right):
         """The images' shapes: equal to each other and to the rig's image size (grey or colour)."""
         sl, sr = np.shape(left), np.shape(right)

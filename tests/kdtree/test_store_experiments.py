@@ -125,3 +125,18 @@ def test_dimension_study_exact_search_visits_almost_all_leaves_in_64d():
     assert by["uniform 64-d"][4] < 0.5  # BBF recall collapses on uniform vectors
     assert by["clustered SURF-like"][4] > 0.85  # and holds on clustered descriptors
     assert "BBF recall@1" in r.table()
+
+
+def test_ours_vs_source_prints_the_runs_figures(table1):
+    from slamlab.kdtree.cost_model import run_cost_model
+    from slamlab.kdtree.experiments import ours_vs_source, run_dimension_study
+
+    cost = run_cost_model()
+    dim = run_dimension_study((8, 64), n=500, n_queries=20)
+    t2 = run_store_comparison("table2", n_iterations=3, stores=("rebuild", "multi"), n1=500, q=3.0)
+    table = ours_vs_source(cost, dim, table1, t2)
+    assert f"n1 = {cost.literal[1]:.0f}, q = {cost.literal[2]:.2f}" in table
+    assert f"n1 = {cost.optimum[1]:.0f}, q = {cost.optimum[2]:.2f}" in table
+    assert f"{table1.recall['rebuild']:.3f} / {table1.recall['multi']:.3f}" in table
+    assert f"{t2.stored_end} (3 iterations)" in table
+    assert "8.98" in table

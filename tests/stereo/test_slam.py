@@ -269,3 +269,17 @@ def test_colour_frames_follow_the_channel_order():
     rec_g = grey.process(cv2.cvtColor(bgr_l, cv2.COLOR_BGR2GRAY), cv2.cvtColor(bgr_r, cv2.COLOR_BGR2GRAY))
     rec_c = colour.process(bgr_l, bgr_r)
     assert rec_c == rec_g
+
+
+def test_ours_vs_source_prints_the_runs_figures(short_turn):
+    from slamlab.stereo import ours_vs_source
+
+    _, res = short_turn
+    table = ours_vs_source(res, {"SURF, oldest": res, "again": res})
+    row = next(line for line in table.splitlines() if line.strip().startswith("turn: max position error"))
+    assert "<= 0.15" in row
+    assert row.split()[-1] == f"{res.pos_err_m.max():.2f}"
+    assert f"{res.pos_err_m.max():.2f} (again: {res.pos_err_m.max():.2f})" in table
+    assert f"{100 * res.heading_error_ratio:.1f}" in table
+    with pytest.raises(ValueError, match="`loops` is empty"):
+        ours_vs_source(res, {})
