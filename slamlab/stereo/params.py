@@ -67,6 +67,7 @@ class StereoParams(Params):
     map_ratio: float = param(0.8, "ours: ratio rule against the landmark store")
     same_point_m: float | None = param(None, "ours: two nearest landmarks this close count as one (None: off)")
     view_margin_deg: float | None = param(None, "ours: match only landmarks in view (None: the whole map, as 000)")
+    view_depth_factor: float = param(1.5, "ours: the view gate keeps landmarks up to this times max_depth_m away")
     base_seen_times: int = param(3, "000 §3.4: BaseSeenTimes = 3")
     max_non_base_time: int = param(7, "000 §3.4: MaxNonBaseTime = 7")
     # -- pose (000 §3.5) ------------------------------------------------------------------------------
@@ -106,6 +107,7 @@ class StereoParams(Params):
         v.check_probability(self.map_ratio, "map_ratio")
         _optional_positive(self.same_point_m, "same_point_m")
         _optional_positive(self.view_margin_deg, "view_margin_deg", allow_zero=True)
+        v.check_positive(self.view_depth_factor, "view_depth_factor")
         v.check_int(self.base_seen_times, "base_seen_times", minimum=1)
         v.check_int(self.max_non_base_time, "max_non_base_time", minimum=1)
         v.check_choice(self.policy, "policy", POLICIES)

@@ -230,7 +230,8 @@ class StereoSLAM:
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
-        within its horizontal field of view widened by ``margin_deg`` per side and ``1.5 max_depth_m``."""
+        within its horizontal field of view widened by ``margin_deg`` per side and up to
+        ``params.view_depth_factor × params.max_depth_m`` (1.5 × 10 m by default) away."""
         T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
         T_wc = T @ self.T_body_left
         Xc = (self.X - T_wc[:3, 3]) @ T_wc[:3, :3]
@@ -238,7 +239,7 @@ class StereoSLAM:
         half = np.arctan2(max(cam.cx, cam.width_px - cam.cx), cam.fx) + np.deg2rad(margin_deg)
         z = Xc[:, 2]
         keep = self.alive & (z > 0) & (np.abs(np.arctan2(Xc[:, 0], z)) <= half)
-        keep &= np.einsum("ij,ij->i", Xc, Xc) <= (1.5 * self.params.max_depth_m) ** 2
+        keep &= np.einsum("ij,ij->i", Xc, Xc) <= (self.params.view_depth_factor * self.params.max_depth_m) ** 2
         return np.flatnonzero(keep)
 
     def refine_landmarks(self, ids, Z, Rz) -> np.ndarray:

@@ -283,3 +283,15 @@ def test_ours_vs_source_prints_the_runs_figures(short_turn):
     assert f"{100 * res.heading_error_ratio:.1f}" in table
     with pytest.raises(ValueError, match="`loops` is empty"):
         ours_vs_source(res, {})
+
+
+@pytest.mark.parametrize("name", StereoParams.field_names())
+def test_every_param_is_checked(name):
+    import dataclasses
+
+    default = getattr(StereoParams(), name)
+    bad = {str: "no-such-choice", bool: "yes"}.get(type(default), -1.0)
+    with pytest.raises((ValueError, TypeError), match=f"`{name}`"):
+        StereoParams(**{name: bad})
+    assert dataclasses.fields(StereoParams)  # frozen dataclass fields, each with a source
+    assert StereoParams.sources()[name].startswith(("000 §", "ours"))
