@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 
 import slamlab as sl
-from slamlab.stereo import STAGES, StereoSLAM, detect, stereo_match, triangulate_local
+from slamlab.stereo import STAGES, StereoSLAM, detect_features, stereo_match, triangulate_local
 
 SOURCE_HZ = 2.5  # 000 §3, conclusions: "about 2.5 Hz on average"
 GOAL_FPS = {"orb": 15.0, "sift": 3.0, "surf": 3.0}
@@ -84,7 +84,7 @@ def main(argv=None):
     say()
     # stage micro-benchmarks against OpenCV, on one frame
     left, right = frames[len(frames) // 2]
-    fl, fr = detect(left, "orb"), detect(right, "orb")
+    fl, fr = detect_features(left, detector="orb"), detect_features(right, detector="orb")
     sm = stereo_match(fl, fr, sim.rig)
     cloud = triangulate_local(sim.rig, fl, fr, sm)
     uvl, uvr = fl.uv[sm.left], fr.uv[sm.right]
@@ -97,7 +97,7 @@ def main(argv=None):
     Q = fl.descriptors[cloud.left]
     t_store, _ = best_wall(lambda: store.query(Q, k=2), repeat=3)
     bf = cv2.BFMatcher(cv2.NORM_HAMMING)
-    t_bf, _ = best_wall(lambda: bf.knnMatch(Q, store.X, k=2), repeat=3)
+    t_bf, _ = best_wall(lambda: bf.knnMatch(Q, store.points, k=2), repeat=3)
     say("| stage | ours ms | OpenCV ms | ratio |")
     say("|---|---|---|---|")
     say(f"| midpoint triangulation, {len(uvl)} matches (vs cv2.triangulatePoints) | {1000 * t_ours:.2f} | {1000 * t_cv:.2f} | {t_ours / t_cv:.2f} |")

@@ -26,9 +26,10 @@ import time
 import numpy as np
 
 import slamlab
-from slamlab.kdtree.experiments import TABLES_000, record_stereo_stream, run_crossover, run_store_comparison
+from slamlab.kdtree.experiments import TABLES_000, run_crossover, run_store_comparison
 from slamlab.kdtree.stores import BruteForceStore
 from slamlab.kdtree.workloads import surf_like_descriptors
+from slamlab.stereo import record_stereo_stream
 
 _LABEL = {"rebuild": "kd-tree (rebuilt)", "multi": "buffer + multi kd-tree", "flann": "FLANN (rebuilt)",
           "brute": "brute force (BLAS)"}

@@ -8,7 +8,8 @@ SIFT, ORB, MSER and FAST as the reference. Every detector returns
 evaluation on the Oxford affine pairs in :mod:`.evaluation`.
 """
 
-from .base import Features, to_gray_float, to_gray_uint8
+from .._lazy import lazy_exports
+from .base import CHANNEL_ORDERS, Features, to_gray_float, to_gray_uint8
 from .detect import DETECTORS, describe_surf, detect
 from .evaluation import (
     OXFORD_SEQUENCES,
@@ -17,6 +18,8 @@ from .evaluation import (
     correct_matches,
     load_oxford_image,
     load_oxford_pair,
+    oxford_folder,
+    oxford_label,
     project,
     repeatability,
 )
@@ -37,26 +40,15 @@ from .matching import (
     Matches,
     accept_000,
     accept_ratio,
+    best_per_target,
     hamming_distances,
     knn2,
     match_descriptors,
     mutual_mask,
+    ratio_rule,
 )
 from .moravec import moravec_detect, moravec_response
 from .opencv import fast_cv, features_from_keypoints, mser_cv, orb_cv, sift_cv
-from .plot import (
-    DETECTOR_GALLERY,
-    plot_box_filters,
-    plot_detector_gallery,
-    plot_fast_circle,
-    plot_keypoint_pair,
-    plot_keypoints,
-    plot_matches,
-    plot_pair_evaluation,
-    plot_ratio_tradeoff,
-    plot_recall_vs_leaves,
-    plot_surf_threshold,
-)
 from .surf import (
     SURF,
     filter_sizes,
@@ -70,8 +62,8 @@ from .surf import (
 )
 
 __all__ = [
+    "CHANNEL_ORDERS",
     "DETECTORS",
-    "DETECTOR_GALLERY",
     "EVAL_DETECTORS",
     "KNN_METHODS",
     "OXFORD_SEQUENCES",
@@ -81,6 +73,7 @@ __all__ = [
     "PairScores",
     "accept_000",
     "accept_ratio",
+    "best_per_target",
     "common_region",
     "correct_matches",
     "describe_surf",
@@ -105,17 +98,10 @@ __all__ = [
     "mser_cv",
     "mutual_mask",
     "orb_cv",
-    "plot_box_filters",
-    "plot_detector_gallery",
-    "plot_fast_circle",
-    "plot_keypoint_pair",
-    "plot_keypoints",
-    "plot_matches",
-    "plot_pair_evaluation",
-    "plot_ratio_tradeoff",
-    "plot_recall_vs_leaves",
-    "plot_surf_threshold",
+    "oxford_folder",
+    "oxford_label",
     "project",
+    "ratio_rule",
     "repeatability",
     "run_blob_scale",
     "run_detector_summary",
@@ -133,6 +119,13 @@ __all__ = [
     "to_gray_uint8",
 ]
 
-from .widgets import explore_detectors, explore_matching
-
-__all__ += ["explore_detectors", "explore_matching"]
+#: plotting (pyplot) and widget (ipywidgets) names load on first use
+_LAZY = {
+    **dict.fromkeys(("DETECTOR_GALLERY", "plot_box_filters", "plot_detector_gallery", "plot_fast_circle",
+                     "plot_keypoint_pair", "plot_keypoints", "plot_matches", "plot_pair_evaluation",
+                     "plot_ratio_tradeoff", "plot_recall_vs_leaves", "plot_surf_threshold"), ".plot"),
+    "explore_detectors": ".widgets",
+    "explore_matching": ".widgets",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY)
+__all__ += list(_LAZY)

@@ -8,7 +8,7 @@ import numpy as np
 
 from .. import _validate as v
 
-__all__ = ["Features", "to_gray_float", "to_gray_uint8"]
+__all__ = ["CHANNEL_ORDERS", "Features", "to_gray_float", "to_gray_uint8"]
 
 
 @dataclass(frozen=True)
@@ -82,17 +82,29 @@ class Features:
         return cls(np.zeros((0, 2)), z, z, z, np.zeros(0, dtype=np.int64), desc, method)
 
 
-def to_gray_float(image, name: str = "image") -> np.ndarray:
-    """Grey image as float64 in [0, 1] (uint8 / 255; float taken as given; colour averaged as BT.601).
+#: channel orders of colour images: "rgb" (numpy / matplotlib / imageio) or "bgr" (``cv2.imread``)
+CHANNEL_ORDERS = ("rgb", "bgr")
+_BT601 = np.array([0.299, 0.587, 0.114])
+
+
+def to_gray_float(image, name: str = "image", *, channel_order: str = "rgb") -> np.ndarray:
+    """Grey image as float64 in [0, 1] (uint8 / 255; float taken as given; colour weighted as BT.601).
+
+    ``channel_order`` says how a colour image's channels are ordered: ``"rgb"`` (default:
+    numpy, matplotlib, imageio) or ``"bgr"`` (what ``cv2.imread`` returns).
 
     >>> to_gray_float(np.array([[0, 255]], dtype=np.uint8)).tolist()
     [[0.0, 1.0]]
+    >>> bgr = np.array([[[255, 0, 0]]], np.uint8)  # pure blue in OpenCV's order
+    >>> round(float(to_gray_float(bgr, channel_order="bgr")[0, 0]), 3)
+    0.114
     """
     img = v.as_image(image, name, allow_color=True)
     if img.ndim == 3:
-        img = img[..., :3].astype(np.float64) @ np.array([0.299, 0.587, 0.114])
+        w = _BT601 if v.check_choice(channel_order, "channel_order", CHANNEL_ORDERS) == "rgb" else _BT601[::-1]
+        g = img[..., :3].astype(np.float64) @ w
         scale = 255.0 if np.asarray(image).dtype == np.uint8 else 1.0
-        return img / scale
+        return g / scale
     if img.dtype == np.uint8:
         return img.astype(np.float64) / 255.0
     if img.dtype == np.bool_:
@@ -100,14 +112,21 @@ def to_gray_float(image, name: str = "image") -> np.ndarray:
     return img.astype(np.float64, copy=False)
 
 
-def to_gray_uint8(image, name: str = "image") -> np.ndarray:
-    """Grey uint8 image (float images are taken to be in [0, 1]); what OpenCV's detectors need."""
+def to_gray_uint8(image, name: str = "image", *, channel_order: str = "rgb") -> np.ndarray:
+    """Grey uint8 image (float images are taken to be in [0, 1]); what OpenCV's detectors need.
+
+    A uint8 colour image is converted by OpenCV (``cv2.COLOR_RGB2GRAY`` or, with
+    ``channel_order="bgr"``, ``cv2.COLOR_BGR2GRAY``: the same values as ``cv2.imread(...,
+    cv2.IMREAD_GRAYSCALE)`` of a colour file read in colour).
+    """
     img = v.as_image(image, name, allow_color=True)
     if img.dtype == np.uint8 and img.ndim == 2:
         return img
     if img.dtype == np.uint8:
         import cv2
 
-        return cv2.cvtColor(np.ascontiguousarray(img[..., :3]), cv2.COLOR_RGB2GRAY)
-    g = to_gray_float(img, name)
+        code = {"rgb": cv2.COLOR_RGB2GRAY, "bgr": cv2.COLOR_BGR2GRAY}[
+            v.check_choice(channel_order, "channel_order", CHANNEL_ORDERS)]
+        return cv2.cvtColor(np.ascontiguousarray(img[..., :3]), code)
+    g = to_gray_float(img, name, channel_order=channel_order)
     return np.clip(np.rint(g * 255.0), 0, 255).astype(np.uint8)

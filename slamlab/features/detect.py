@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as v
-from .base import Features, to_gray_float
+from .base import Features, to_gray_float, to_gray_uint8
 from .fast import fast_detect
 from .moravec import moravec_detect
 from .opencv import fast_cv, mser_cv, orb_cv, sift_cv
@@ -35,17 +35,22 @@ def describe_surf(image, features: Features, *, scale_px: float | None = None, u
 
 
 def detect(image, method: str = "surf", *, descriptors: bool = True, max_points: int | None = None,
-           **params) -> Features:
+           channel_order: str = "rgb", **params) -> Features:
     """Keypoints (and descriptors) of ``image`` by ``method`` (000 §1.4).
 
     Parameters
     ----------
-    image : (H, W) grey image (uint8 or float in [0, 1]); colour is converted (RGB).
+    image : (H, W) grey image (uint8 or float in [0, 1]), or (H, W, 3) colour, converted once
+        to grey here (float for our SURF and Moravec, uint8 for the others).
     method : {'surf', 'sift', 'orb', 'fast', 'fast-cv', 'moravec', 'mser'}
         Ours: surf, fast, moravec. OpenCV: sift, orb, fast-cv, mser.
     descriptors : bool
         Compute descriptors where the method has them; our FAST gets upright SURF
         descriptors at σ = 2 px (our choice, so that FAST can be matched).
+    channel_order : {'rgb', 'bgr'}
+        Channel order of a colour image: ``"rgb"`` (default: numpy, matplotlib, imageio) or
+        ``"bgr"`` (``cv2.imread``); a BGR image then gives exactly ``cv2.cvtColor(img,
+        cv2.COLOR_BGR2GRAY)`` for the uint8 detectors.
     max_points : int, optional
         Keep the strongest ``max_points`` keypoints (by response).
     **params
@@ -59,6 +64,9 @@ def detect(image, method: str = "surf", *, descriptors: bool = True, max_points:
     ([[20.0, 20.0]], (1, 64))
     """
     method = v.check_choice(method, "method", DETECTORS)
+    if np.ndim(image) == 3:  # colour: one conversion, in the stated channel order
+        gray = to_gray_float if method in ("surf", "moravec") else to_gray_uint8
+        image = gray(image, channel_order=channel_order)
     if method == "surf":
         f = surf_detect(image, descriptors=descriptors, **params)
     elif method == "sift":

@@ -34,20 +34,50 @@ __all__ = [
     "correct_matches",
     "load_oxford_image",
     "load_oxford_pair",
+    "oxford_folder",
+    "oxford_label",
     "project",
     "repeatability",
 ]
 
+#: the Oxford affine sequences of the shared data folder, loadable by name (any other folder by path)
 OXFORD_SEQUENCES = ("bark", "boat", "graf", "trees", "ubc", "wall")
+_IMAGE_SUFFIXES = (".png", ".ppm", ".pgm", ".jpg", ".tif")
 
 
-def load_oxford_image(sequence: str, index: int, *, scale: float = 1.0, size=None) -> np.ndarray:
-    """Grey uint8 image ``img<index>`` of an Oxford sequence, resized by ``scale`` or to
-    ``size = (width_px, height_px)`` (INTER_AREA; e.g. 000's camera, (768, 576))."""
+def oxford_folder(sequence) -> Path:
+    """The folder of an Oxford-layout sequence: a shared sequence's name (:data:`OXFORD_SEQUENCES`,
+    found by :func:`slamlab.data.find_data`) or a ``str`` / ``os.PathLike`` path to any folder with
+    ``img1.<ext> ... imgN.<ext>`` and the homographies ``H1to2p ... H1toNp`` (the Oxford layout)."""
+    if isinstance(sequence, str) and sequence in OXFORD_SEQUENCES:
+        return Path(find_data(f"oxford-affine/{sequence}/H1to2p")).parent
+    if isinstance(sequence, str) and not any(c in sequence for c in "/\\") and not Path(sequence).exists():
+        raise ValueError(f"`sequence` must be one of {OXFORD_SEQUENCES} or the path of an Oxford-layout folder; "
+                         f"got {sequence!r}")
+    return v.as_path(sequence, "sequence", kind="dir")
+
+
+def oxford_label(sequence) -> str:
+    """The name of a sequence for tables and titles: the folder's name."""
+    return sequence if isinstance(sequence, str) and sequence in OXFORD_SEQUENCES else oxford_folder(sequence).name
+
+
+def _image_file(folder: Path, index: int) -> Path:
+    for suffix in _IMAGE_SUFFIXES:
+        path = folder / f"img{index}{suffix}"
+        if path.is_file():
+            return path
+    raise FileNotFoundError(f"no image img{index} ({', '.join(_IMAGE_SUFFIXES)}) in {folder}")
+
+
+def load_oxford_image(sequence, index: int, *, scale: float = 1.0, size=None) -> np.ndarray:
+    """Grey uint8 image ``img<index>`` of an Oxford-layout sequence (name or folder path, see
+    :func:`oxford_folder`), resized by ``scale`` or to ``size = (width_px, height_px)``
+    (INTER_AREA; e.g. 000's camera, (768, 576)). Colour files are read as OpenCV's grey."""
     import cv2
 
-    sequence = v.check_choice(sequence, "sequence", OXFORD_SEQUENCES)
-    index = v.check_int(index, "index", minimum=1, maximum=6)
+    folder = oxford_folder(sequence)
+    index = v.check_int(index, "index", minimum=1)
     scale = v.check_positive(scale, "scale")
     if size is not None:
         if scale != 1.0:
@@ -55,7 +85,7 @@ def load_oxford_image(sequence: str, index: int, *, scale: float = 1.0, size=Non
         if len(size) != 2:
             raise ValueError(f"`size` must be (width_px, height_px); got {size}")
         size = (v.check_int(size[0], "size[0]", minimum=1), v.check_int(size[1], "size[1]", minimum=1))
-    path = Path(find_data(f"oxford-affine/{sequence}/img{index}.png"))
+    path = _image_file(folder, index)
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
         raise FileNotFoundError(f"could not read {path}")
@@ -67,16 +97,23 @@ def load_oxford_image(sequence: str, index: int, *, scale: float = 1.0, size=Non
     return img
 
 
-def load_oxford_pair(sequence: str, j: int, *, scale: float = 1.0):
+def load_oxford_pair(sequence, j: int, *, scale: float = 1.0):
     """``(img1, img_j, H)``: grey images and the homography img1 → img_j (pixel centres, after ``scale``).
 
-    Resizing by ``s`` maps a pixel centre x to ``s·(x + 0.5) - 0.5``, so
+    ``sequence``: a shared sequence's name or the path of any Oxford-layout folder
+    (:func:`oxford_folder`). Resizing by ``s`` maps a pixel centre x to ``s·(x + 0.5) - 0.5``, so
     ``H_s = S·H·S⁻¹`` with ``S = [[s, 0, s/2 - 1/2], [0, s, s/2 - 1/2], [0, 0, 1]]``.
     """
-    j = v.check_int(j, "j", minimum=2, maximum=6)
-    img1 = load_oxford_image(sequence, 1, scale=scale)
-    img2 = load_oxford_image(sequence, j, scale=scale)
-    H = np.loadtxt(find_data(f"oxford-affine/{sequence}/H1to{j}p"))
+    folder = oxford_folder(sequence)
+    j = v.check_int(j, "j", minimum=2)
+    img1 = load_oxford_image(folder, 1, scale=scale)
+    img2 = load_oxford_image(folder, j, scale=scale)
+    h_path = folder / f"H1to{j}p"
+    if not h_path.is_file():
+        raise FileNotFoundError(f"no homography file {h_path}")
+    H = np.loadtxt(h_path)
+    if H.shape != (3, 3):
+        raise ValueError(f"{h_path} must hold a 3x3 homography; got shape {H.shape}")
     s = float(scale)
     S = np.array([[s, 0, s / 2 - 0.5], [0, s, s / 2 - 0.5], [0, 0, 1.0]])
     H = S @ H @ np.linalg.inv(S)

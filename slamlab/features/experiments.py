@@ -9,6 +9,7 @@ benchmark uses ``scale=1``.
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -19,7 +20,15 @@ from .. import _validate as v
 from .._table import format_table
 from .base import Features
 from .detect import detect
-from .evaluation import OXFORD_SEQUENCES, correct_matches, load_oxford_image, load_oxford_pair, repeatability
+from .evaluation import (
+    OXFORD_SEQUENCES,
+    correct_matches,
+    load_oxford_image,
+    load_oxford_pair,
+    oxford_folder,
+    oxford_label,
+    repeatability,
+)
 from .matching import accept_000, accept_ratio, knn2, match_descriptors
 from .surf import threshold_sweep
 
@@ -33,6 +42,8 @@ __all__ = [
     "RatioTradeoffResult",
     "SurfThresholdResult",
     "descriptor_pool",
+    "matching_vs_source",
+    "ours_vs_source",
     "run_blob_scale",
     "run_detector_summary",
     "run_knn_comparison",
@@ -122,12 +133,19 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
                         tol_px: float = 2.5, rule: str = "ratio", ratio: float = 0.8) -> PairEvaluationResult:
     """Repeatability and matching precision/recall on img1 → img_j of Oxford sequences (000 §1.4).
 
+    ``sequences``: names of the shared sequences (:data:`OXFORD_SEQUENCES`) or ``str`` /
+    ``os.PathLike`` paths of any Oxford-layout folders (``img1..imgN`` + ``H1to2p..``); tables
+    name them by folder name.
+
     Every detector keeps its ``n_points`` strongest keypoints per image (equal
     budgets: with a fixed pixel tolerance a denser detector would look more
     repeatable by chance). FAST corners carry upright SURF descriptors (σ = 2 px).
     """
-    sequences = tuple(v.check_choice(s, "sequences", OXFORD_SEQUENCES) for s in sequences)
-    steps = tuple(v.check_int(j, "steps", minimum=2, maximum=6) for j in steps)
+    if isinstance(sequences, (str, os.PathLike)):
+        sequences = (sequences,)
+    folders = tuple(oxford_folder(s) for s in sequences)
+    labels = tuple(oxford_label(s) for s in sequences)
+    steps = tuple(v.check_int(j, "steps", minimum=2) for j in steps)
     detectors = tuple(v.check_choice(d, "detectors", tuple(EVAL_DETECTORS)) for d in detectors)
     if not sequences or not steps or not detectors:
         raise ValueError("`sequences`, `steps` and `detectors` must not be empty")
@@ -140,7 +158,7 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
     n_m, n_c = np.zeros(shape, dtype=int), np.zeros(shape, dtype=int)
     times = {d: 0.0 for d in detectors}
     n_det = {d: 0 for d in detectors}
-    for i, seq in enumerate(sequences):
+    for i, seq in enumerate(folders):
         first = {}
         for j, st in enumerate(steps):
             img1, img2, H = load_oxford_pair(seq, st, scale=scale)
@@ -161,7 +179,7 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
                 prec[i, j, k] = c.mean() if len(m) else np.nan
                 rec[i, j, k] = c.sum() / r.correspondences if r.correspondences else np.nan
     rule_txt = f"ratio {ratio:g}" if rule == "ratio" else "000 (d2 >= 2 d1)"
-    return PairEvaluationResult(sequences, steps, detectors, scale, n_points, tol_px, rule_txt, rep, prec, rec,
+    return PairEvaluationResult(labels, steps, detectors, scale, n_points, tol_px, rule_txt, rep, prec, rec,
                                 n_m, n_c, {d: times[d] / max(n_det[d], 1) for d in detectors})
 
 
@@ -226,7 +244,7 @@ def run_detector_summary(sequence: str = "graf", index: int = 1, *, size=(768, 5
         dims.append("—" if f.descriptors is None else f"{f.descriptors.shape[1]}"
                     + (" bytes" if f.is_binary else "-d"))
         times[name] = best
-    return DetectorSummaryResult(f"{sequence}/img{index}", (h, w), tuple(names), tuple(counts), tuple(dims), times)
+    return DetectorSummaryResult(f"{oxford_label(sequence)}/img{index}", (h, w), tuple(names), tuple(counts), tuple(dims), times)
 
 
 # --- SURF threshold scale ---------------------------------------------------------------------------
@@ -269,7 +287,7 @@ def run_surf_threshold(sequence: str = "graf", index: int = 1, *, size=(768, 576
     th = np.sort(v.as_vector(thresholds, "thresholds"))
     counts = threshold_sweep(img, th)
     src = int(threshold_sweep(img, [0.05])[0])
-    return SurfThresholdResult(f"{sequence}/img{index} {w}x{h}", th, counts, 0.05, src)
+    return SurfThresholdResult(f"{oxford_label(sequence)}/img{index} {w}x{h}", th, counts, 0.05, src)
 
 
 # --- descriptor matching: exact vs BBF vs FLANN vs brute ---------------------------------------------
@@ -530,7 +548,7 @@ def run_ratio_tradeoff(ratios=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), *, detec
     n, p, rc = (np.array(col) for col in zip(*res, strict=True))
     md = float(max_dist) if detector != "ORB" else float(max_dist) * 256
     src = score(accept_000(d, max_dist=md))
-    return RatioTradeoffResult(detector, f"{sequence} 1→{j} x{scale:g}", ratios, p, rc, n, r.correspondences,
+    return RatioTradeoffResult(detector, f"{oxford_label(sequence)} 1→{j} x{scale:g}", ratios, p, rc, n, r.correspondences,
                                (src[0], src[1], src[2], md))
 
 
@@ -572,3 +590,61 @@ def run_blob_scale(sizes_px=(3.0, 4.0, 5.0, 6.0, 8.0), *, threshold: float = 1e-
         uv.append(f.uv[k])
         sig.append(f.scale_px[k])
     return BlobScaleResult(sizes, np.array(uv), np.array(sig), c)
+
+
+def ours_vs_source(threshold: SurfThresholdResult, summary: DetectorSummaryResult,
+                   pairs: PairEvaluationResult) -> str:
+    """000's statements on SIFT and SURF (000 §1.4, §3.3) beside our numbers from the chapter's runs.
+
+    ``threshold``: :func:`run_surf_threshold`; ``summary``: :func:`run_detector_summary`; ``pairs``:
+    :func:`run_pair_evaluation` with SIFT and SURF among its detectors.
+    """
+    counts = dict(zip(summary.names, summary.counts, strict=True))
+    surf = next(c for n, c in counts.items() if n.startswith("SURF"))
+    sift = next(c for n, c in counts.items() if n.startswith("SIFT"))
+    rows = [
+        [f"SURF points at threshold {threshold.source_threshold:g}", "~2000 (576x768, §3.3)",
+         f"{threshold.source_count} ({threshold.image_name})"],
+        ["SURF threshold for >= 2000 points", "0.05 (scale not stated)", f"{threshold.threshold_for(2000):.1e}"],
+        ["SIFT points", "~2000 on ~500x500 (§1.4.1)", f"{sift} ({summary.image_name})"],
+        ["SURF vs SIFT points", "SURF finds fewer (§1.4.2)", f"{surf} vs {sift}"],
+    ]
+    det = list(pairs.detectors)
+    if "SIFT" in det and "SURF" in det:
+        k_sift, k_surf = det.index("SIFT"), det.index("SURF")
+        for i, seq in enumerate(pairs.sequences):
+            for j, st in enumerate(pairs.steps[:2]):
+                rows.append([f"repeatability {seq} 1→{st}: SURF vs SIFT", "SURF more stable (§1.4.2)",
+                             f"{pairs.rep[i, j, k_surf]:.2f} vs {pairs.rep[i, j, k_sift]:.2f}"])
+    return format_table(["quantity", "000", "ours"], rows, title="Detectors: 000 beside ours (times: timing tables)")
+
+
+def matching_vs_source(curve: LeavesCurveResult, trade: RatioTradeoffResult, knn: KnnComparisonResult) -> str:
+    """000 §1.4.3's statements on kd-tree search and the 2× rule beside our numbers from the chapter's runs.
+
+    ``curve``: :func:`run_recall_vs_leaves`; ``trade``: :func:`run_ratio_tradeoff`; ``knn``:
+    :func:`run_knn_comparison`.
+    """
+    rows = []
+    at200 = np.flatnonzero(curve.budgets == 200)
+    if at200.size:
+        rows.append([f"BBF, 200 leaves: NN recall ({curve.n_stored} stored)", "'in most cases the nearest'",
+                     f"{curve.recall_bbf[at200[0]]:.3f}"])
+    m_bbf = [i for i, m in enumerate(knn.methods) if m.startswith("BBF")]
+    m_brute = [i for i, m in enumerate(knn.methods) if m == "brute"]
+    if m_bbf and m_brute:
+        for s, size in enumerate(knn.sizes):
+            b, e = m_bbf[0], m_brute[0]
+            rows.append([f"BBF vs exact at {size} stored: recall / precision after ratio 0.8", "a close point if not",
+                         f"{knn.recall[s, b]:.3f} / {knn.precision[s, b]:.3f} (exact {knn.precision[s, e]:.3f})"])
+    rows.append([f"exact 64-d search: points evaluated per query ({curve.n_stored} stored)",
+                 "kd-trees lose efficiency in high dimension", f"{curve.exact_evals:.0f}"])
+    m, p, r, md = trade.source_row
+    rows.append([f"000's rule d2 >= 2 d1, d1 <= {md:g} ({trade.pair}): matches, precision, recall", "accepted as correct",
+                 f"{m}, {p:.3f}, {r:.3f}"])
+    i8 = np.flatnonzero(np.isclose(trade.ratios, 0.8))
+    if i8.size:
+        k = i8[0]
+        rows.append(["ratio 0.8 (Lowe's usual): matches, precision, recall", "—",
+                     f"{trade.n_matches[k]}, {trade.precision[k]:.3f}, {trade.recall[k]:.3f}"])
+    return format_table(["quantity", "000", "ours"], rows, title="Matching: 000 beside ours (times: timing tables)")

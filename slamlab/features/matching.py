@@ -16,16 +16,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
+from ..kdtree.knn import exact_knn, hamming_distances, pad_knn
+from ..kdtree.tree import KDTree
 
 __all__ = [
     "KNN_METHODS",
     "Matches",
     "accept_000",
     "accept_ratio",
+    "best_per_target",
     "hamming_distances",
     "knn2",
     "match_descriptors",
     "mutual_mask",
+    "ratio_rule",
 ]
 
 KNN_METHODS = ("brute", "kdtree", "bbf", "flann")
@@ -54,57 +58,6 @@ def _as_descriptors(D, name):
     if arr.dtype == np.uint8:
         return arr
     return v.as_finite_array(arr, name, ndim=2, dtype=np.float32 if arr.dtype == np.float32 else np.float64)
-
-
-def hamming_distances(A, B) -> np.ndarray:
-    """Pairwise Hamming distances between binary descriptors packed as uint8 bytes.
-
-    >>> hamming_distances(np.array([[0b1011]], np.uint8), np.array([[0], [255]], np.uint8)).tolist()
-    [[3, 5]]
-    """
-    A, B = np.asarray(A), np.asarray(B)
-    if A.dtype != np.uint8 or B.dtype != np.uint8:
-        raise TypeError(f"binary descriptors must be uint8 arrays; got {A.dtype} and {B.dtype}")
-    if A.ndim != 2 or B.ndim != 2 or A.shape[1] != B.shape[1]:
-        raise ValueError(f"descriptors must be (N, bytes) arrays of equal width; got {A.shape} and {B.shape}")
-    out = np.empty((A.shape[0], B.shape[0]), dtype=np.int64)
-    step = max(1, 4_000_000 // max(1, B.size))
-    for a in range(0, A.shape[0], step):
-        out[a:a + step] = np.bitwise_count(A[a:a + step, None, :] ^ B[None, :, :]).sum(axis=2, dtype=np.int64)
-    return out
-
-
-def _brute_knn2(Q, T):
-    """Exact 2-NN by dense distances (BLAS for float, popcount for binary), query chunks."""
-    M, N = Q.shape[0], T.shape[0]
-    d = np.full((M, 2), np.inf)
-    idx = np.full((M, 2), -1, dtype=np.int64)
-    if N == 0:
-        return d, idx
-    k = min(2, N)
-    binary = Q.dtype == np.uint8
-    if not binary:
-        Q64, T64 = Q.astype(np.float64), T.astype(np.float64)
-        tn = (T64 * T64).sum(axis=1)
-    step = max(1, 2_000_000 // N)
-    for a in range(0, M, step):
-        if binary:
-            D = hamming_distances(Q[a:a + step], T).astype(np.float64)
-        else:
-            q = Q64[a:a + step]
-            D = np.maximum((q * q).sum(axis=1)[:, None] - 2.0 * q @ T64.T + tn[None, :], 0.0)
-        part = np.argpartition(D, k - 1, axis=1)[:, :k] if k < N else np.tile(np.arange(N), (D.shape[0], 1))
-        dp = np.take_along_axis(D, part, axis=1)
-        o = np.argsort(dp, axis=1, kind="stable")
-        idx[a:a + step, :k] = np.take_along_axis(part, o, axis=1)
-        d[a:a + step, :k] = np.take_along_axis(dp, o, axis=1)
-    if not binary:
-        # recompute the two kept distances exactly (the expansion above loses digits)
-        ok = idx >= 0
-        rows = np.nonzero(ok)
-        diff = Q64[rows[0]] - T64[idx[ok]]
-        d[ok] = np.sqrt((diff * diff).sum(axis=1))
-    return d, idx
 
 
 def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: int = 200,
@@ -139,10 +92,8 @@ def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: 
     if Q.shape[0] == 0 or T.shape[0] == 0:
         return np.full((Q.shape[0], 2), np.inf), np.full((Q.shape[0], 2), -1, dtype=np.int64)
     if method == "brute":
-        return _brute_knn2(Q, T)
+        return exact_knn(Q, T, 2)
     if method in ("kdtree", "bbf"):
-        from ..kdtree import KDTree
-
         if tree is None:
             tree = KDTree(T, leaf_size=leaf_size)
         return tree.query(Q, k=2, max_leaves=None if method == "kdtree" else v.check_int(max_leaves, "max_leaves",
@@ -154,11 +105,36 @@ def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: 
     index = tree if tree is not None else cv2.flann_Index(T32, {"algorithm": 1, "trees": 1})
     k = min(2, T.shape[0])
     idx, d2 = index.knnSearch(np.ascontiguousarray(Q, dtype=np.float32), k, params={"checks": checks})
-    d = np.full((Q.shape[0], 2), np.inf)
-    ids = np.full((Q.shape[0], 2), -1, dtype=np.int64)
-    d[:, :k] = np.sqrt(np.maximum(d2, 0))
-    ids[:, :k] = idx
-    return d, ids
+    return pad_knn(np.sqrt(np.maximum(d2, 0)), idx, 2)
+
+
+def ratio_rule(d1, d2, ratio: float) -> np.ndarray:
+    """Lowe's ratio rule on nearest / second-nearest distances: ``d1 < ratio·d2``.
+
+    The one copy of the rule, without argument checks (callers check ``ratio`` once);
+    :func:`accept_ratio` is the checked version on an (M, 2) array.
+
+    >>> ratio_rule(np.array([0.1, 0.29]), np.array([0.3, 0.3]), 0.8).tolist()
+    [True, False]
+    """
+    return d1 < ratio * d2
+
+
+def best_per_target(target, dist) -> np.ndarray:
+    """Indices (ascending) of the candidates to keep so that each target keeps only its closest one.
+
+    ``target (M,)`` are the ids the candidates point at, ``dist (M,)`` their distances; ties go
+    to the first candidate. Used for one-to-one matching (one right keypoint per left one, one
+    local point per landmark).
+
+    >>> best_per_target(np.array([7, 3, 7, 3]), np.array([0.5, 0.2, 0.1, 0.2])).tolist()
+    [1, 2]
+    """
+    target = np.asarray(target)
+    order = np.lexsort((np.asarray(dist), target))
+    first = np.ones(order.size, dtype=bool)
+    first[1:] = target[order][1:] != target[order][:-1]
+    return np.sort(order[first])
 
 
 def accept_000(dist, *, factor: float = 2.0, max_dist: float = np.inf) -> np.ndarray:
@@ -185,7 +161,7 @@ def accept_ratio(dist, ratio: float = 0.8) -> np.ndarray:
     if dist.ndim != 2 or dist.shape[1] < 2:
         raise ValueError(f"`dist` must have shape (M, 2) (nearest, second nearest); got {dist.shape}")
     ratio = v.check_positive(ratio, "ratio")
-    return dist[:, 0] < ratio * dist[:, 1]
+    return ratio_rule(dist[:, 0], dist[:, 1], ratio)
 
 
 def mutual_mask(idx12, idx21) -> np.ndarray:

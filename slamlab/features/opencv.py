@@ -1,12 +1,12 @@
 """SIFT, ORB, MSER and FAST through OpenCV behind the slamlab interface (000 §1.4.1).
 
 OpenCV's SURF lives in the non-free contrib build and is absent from the
-headless wheel; our SURF is :mod:`slamlab.features.surf`.
+headless wheel; our SURF is :mod:`slamlab.features.surf`. cv2 is imported inside the
+functions, so ``import slamlab.features`` stays light.
 """
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
 from .. import _validate as v
@@ -42,6 +42,8 @@ def features_from_keypoints(keypoints, descriptors, method: str) -> Features:
 def sift_cv(image, *, n_features: int = 0, contrast_threshold: float = 0.04, edge_threshold: float = 10.0,
             sigma: float = 1.6, descriptors: bool = True) -> Features:
     """OpenCV SIFT (000 §1.4.1): 128-d float descriptors."""
+    import cv2
+
     img = to_gray_uint8(image)
     det = cv2.SIFT_create(nfeatures=v.check_int(n_features, "n_features", minimum=0),
                           contrastThreshold=v.check_positive(contrast_threshold, "contrast_threshold"),
@@ -58,6 +60,8 @@ def sift_cv(image, *, n_features: int = 0, contrast_threshold: float = 0.04, edg
 def orb_cv(image, *, n_features: int = 2000, scale_factor: float = 1.2, n_levels: int = 8,
            fast_threshold: int = 20, descriptors: bool = True) -> Features:
     """OpenCV ORB: oriented FAST + rotated BRIEF, 256-bit descriptors as 32 uint8 (Hamming distance)."""
+    import cv2
+
     img = to_gray_uint8(image)
     det = cv2.ORB_create(nfeatures=v.check_int(n_features, "n_features", minimum=1),
                          scaleFactor=v.check_positive(scale_factor, "scale_factor"),
@@ -74,6 +78,8 @@ def orb_cv(image, *, n_features: int = 2000, scale_factor: float = 1.2, n_levels
 
 def fast_cv(image, *, threshold: int = 20, nonmax: bool = True) -> Features:
     """OpenCV FAST (type 9_16), the reference for :func:`slamlab.features.fast_detect`."""
+    import cv2
+
     img = to_gray_uint8(image)
     det = cv2.FastFeatureDetector_create(v.check_int(threshold, "threshold", minimum=0, maximum=255),
                                          bool(nonmax), cv2.FAST_FEATURE_DETECTOR_TYPE_9_16)
@@ -82,6 +88,8 @@ def fast_cv(image, *, threshold: int = 20, nonmax: bool = True) -> Features:
 
 def mser_cv(image, *, delta: int = 5, min_area: int = 60, max_area: int = 14400) -> Features:
     """OpenCV MSER regions as keypoints: centroid, σ = sqrt(area / π), no descriptor."""
+    import cv2
+
     img = to_gray_uint8(image)
     det = cv2.MSER_create(delta=v.check_int(delta, "delta", minimum=1),
                           min_area=v.check_int(min_area, "min_area", minimum=1),

@@ -1,27 +1,84 @@
-"""kd-trees for descriptor matching and landmark stores (000 §1.4.3, §3.4, §4).
+"""kd-trees, exact k-NN and the landmark stores (000 §1.4.3, §3.4, §4).
 
-``KDTree(points, ids, leaf_size=1)`` builds a balanced static tree (median split on the
-coordinate of largest spread); ``tree.query(Q, k=2, max_leaves=None)`` returns the k
-nearest neighbours exactly, or by Best-Bin-First after ``max_leaves`` leaves;
-``tree.last_stats`` counts the work. :func:`bbf_trace` is the one-query teaching version.
-The landmark stores of 000 §3.4 (``stores``), their workloads, the multi kd-tree cost
-model (``cost_model``), experiments, plots and widgets are submodules.
+The generic layer under the features and stereo chapters (it imports neither):
+
+- ``KDTree(points, ids, leaf_size=1)`` builds a balanced static tree (median split on the
+  coordinate of largest spread); ``tree.query(Q, k=2, max_leaves=None)`` returns the k
+  nearest neighbours exactly, or by Best-Bin-First after ``max_leaves`` leaves;
+  ``tree.last_stats`` counts the work. :func:`bbf_trace` is the one-query teaching version.
+- :func:`exact_knn` (brute force, Hamming or Euclidean), :func:`pad_knn`, :func:`merge_knn`
+  (:mod:`.knn`): the one exact 2-NN and the one "pad to k".
+- :class:`LandmarkStore`, the interface every store implements, the stores of 000 §3.4
+  and §4 and the base rule (:func:`base_rule`, :class:`SightingBook`) in :mod:`.stores`;
+  their workloads, the multi kd-tree cost model (:mod:`.cost_model`), experiments, plots
+  (loaded on first use) and widgets.
 """
 
-from . import cost_model, experiments, store_plot, stores, widgets, workloads
-from .plot import plot_kdtree_2d
+import importlib
+
+from .._lazy import lazy_exports
+from . import cost_model, experiments, stores, workloads
+from .knn import exact_knn, hamming_distances, merge_knn, pad_knn
+from .stores import (
+    BruteForceStore,
+    ExactStore,
+    FlannStore,
+    LandmarkStore,
+    MultiKDTree,
+    NonBaseBuffer,
+    RebuildStore,
+    SightingBook,
+    base_rule,
+    make_store,
+)
 from .tree import KDTree, SearchStats, bbf_trace, build_kdtree
 
+_LAZY = {
+    "plot_kdtree_2d": ".plot",
+    "plot_cost_surface": ".store_plot",
+    "plot_cost_contour": ".store_plot",
+    "plot_multi_tree_sizes": ".store_plot",
+    "plot_crossover": ".store_plot",
+    "plot_iteration_times": ".store_plot",
+    "explore_cost_model": ".widgets",
+    "explore_stores": ".widgets",
+}
+_SUBMODULES = ("plot", "store_plot", "widgets")
+_lazy_getattr, _lazy_dir = lazy_exports(__name__, _LAZY)
+
+
+def __getattr__(name):
+    if name in _SUBMODULES:  # pyplot / ipywidgets modules load on first use
+        return importlib.import_module(f".{name}", __name__)
+    return _lazy_getattr(name)
+
+
+def __dir__():
+    return sorted(set(_lazy_dir()) | set(_SUBMODULES))
+
+
 __all__ = [
+    "BruteForceStore",
+    "ExactStore",
+    "FlannStore",
     "KDTree",
+    "LandmarkStore",
+    "MultiKDTree",
+    "NonBaseBuffer",
+    "RebuildStore",
     "SearchStats",
+    "SightingBook",
+    "base_rule",
     "bbf_trace",
     "build_kdtree",
     "cost_model",
+    "exact_knn",
     "experiments",
-    "plot_kdtree_2d",
-    "store_plot",
+    "hamming_distances",
+    "make_store",
+    "merge_knn",
+    "pad_knn",
     "stores",
-    "widgets",
     "workloads",
 ]
+__all__ += list(_LAZY)

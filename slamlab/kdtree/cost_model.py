@@ -16,14 +16,20 @@ calibrated by 000 from one tree (``s = 526`` searches in 79 ms, ``m = 678``
 inserts in 750 ms at ``n = 44828``, an insert costing a rebuild of all ``n``
 points): ``C = (79/526)/(750/44828) = 8.98``.
 
-Which reading lands on 000's optimum (``q = 5.5, n1 ≈ 3500`` read off a Maple
-plot for ``n = 50000, s = m = 500, C = 9``) is for :func:`run_cost_model` to
-show: the build term ``n1 log n1`` and ``p`` at its upper bound (real) give
-``n1 ≈ 3430, q ≈ 5.3``; without the build term the optimum runs to the edge.
-The Appendix's own text differs from §4.1.2 in two places that we read as
-slips: its ``searchKd`` multiplies the ``p(p-1)/2 log q`` term by ``C`` and its
-``iterTime = addKd + C searchKd`` lacks the factor ``s``; taken literally they
-give ``n1 ≈ 1200, q ≈ 2.3``, far from 000's plot.
+The Appendix's Maple text, literally (:func:`search_kd`, :func:`add_kd`,
+``iter_time(..., reading="literal")``)::
+
+    searchKd = p log n1 + C p(p-1)/2 log q
+    addKd    = n1 log n1 + m q p log n1 + m q/2 p(p-1) log q     (build term + T_modify)
+    iterTime = addKd + C searchKd                                 (s := 500 defined, unused)
+
+gives the optimum ``n1 ≈ 1200, q ≈ 2.3``, far from the ``q = 5.5, n1 ≈ 3500`` that
+000 reads off its Maple plot (``n = 50000, s = m = 500, C = 9``). One change brings
+it back: the search term becomes §4.1.2's ``C s T_search`` (``C`` on the whole search,
+which has no ``C`` inside, times ``s`` searches): ``iterTime = addKd + C s T_search``
+(``reading="adjusted"``, the default) gives ``n1 ≈ 3430, q ≈ 5.3``. Without the build
+term (§4.1.2's ``f``) the optimum runs to the edge ``n1 = 20000``.
+:func:`run_cost_model` prints every reading's optimum.
 """
 
 from __future__ import annotations
@@ -37,18 +43,23 @@ from .._table import format_table
 
 __all__ = [
     "P_RULES",
+    "READINGS",
     "CostModelResult",
+    "add_kd",
     "calibrate_C",
     "iter_time",
     "minimise_iter_time",
     "p_bounds",
     "run_cost_model",
+    "search_kd",
     "t_modify",
     "t_search",
 ]
 
 #: How ``p`` is taken from the bounds (3): 000's surface uses a real ``p``.
 P_RULES = ("upper", "lower", "integer")
+#: "literal": the Appendix as printed, ``addKd + C searchKd``; "adjusted": ``addKd + C s T_search``
+READINGS = ("adjusted", "literal")
 
 
 def p_bounds(n, n1, q):
@@ -94,19 +105,49 @@ def t_modify(n1, q, p, m):
     return m * q * t_search(n1, q, p)
 
 
-def iter_time(n1, q, *, n: float = 50000, s: float = 500, m: float = 500, C: float = 9.0,
-              p_rule: str = "upper", build_term: bool = True):
-    """Per-iteration cost ``[n1 log2 n1] + T_modify + C s T_search`` (000 Appendix), element-wise.
+def search_kd(n1, q, p, C):
+    """The Appendix's ``searchKd = p log2 n1 + C p(p-1)/2 log2 q``, literally (``C`` inside).
 
-    ``p_rule`` picks ``p`` from the bounds (3); ``build_term=False`` drops
-    ``n1 log2 n1`` (§4.1.2's ``f = T_modify + C s T_search``).
+    >>> float(search_kd(1024, 2.0, 2, 9.0))
+    29.0
+    """
+    n1, q, p = (np.asarray(a, dtype=float) for a in (n1, q, p))
+    return p * np.log2(n1) + C * p * (p - 1.0) / 2.0 * np.log2(q)
+
+
+def add_kd(n1, q, p, m):
+    """The Appendix's ``addKd = n1 log2 n1 + m q p log2 n1 + m q/2 p(p-1) log2 q`` (build term + ``T_modify``).
+
+    >>> float(add_kd(1024, 2.0, 1, 10))
+    10440.0
+    """
+    n1 = np.asarray(n1, dtype=float)
+    return n1 * np.log2(n1) + t_modify(n1, q, p, m)
+
+
+def iter_time(n1, q, *, n: float = 50000, s: float = 500, m: float = 500, C: float = 9.0,
+              p_rule: str = "upper", build_term: bool = True, reading: str = "adjusted"):
+    """Per-iteration cost of the multi kd-tree (000 Appendix, §4.1.2), element-wise.
+
+    ``reading="literal"``: the Appendix as printed, ``addKd + C searchKd`` (``s`` unused);
+    ``"adjusted"`` (default): ``addKd + C s T_search``, the search term of §4.1.2 (the one
+    change that lands on 000's optimum). ``p_rule`` picks ``p`` from the bounds (3);
+    ``build_term=False`` drops ``n1 log2 n1`` (§4.1.2's ``f = T_modify + C s T_search``).
+
+    >>> round(float(iter_time(3500, 5.5) / iter_time(1200, 2.3)), 3), round(float(
+    ...     iter_time(3500, 5.5, reading="literal") / iter_time(1200, 2.3, reading="literal")), 3)
+    (0.717, 1.45)
     """
     v.check_choice(p_rule, "p_rule", P_RULES)
+    v.check_choice(reading, "reading", READINGS)
     n1 = np.asarray(n1, dtype=float)
     q = np.asarray(q, dtype=float)
     if np.any(n1 <= 1) or np.any(q <= 1):
         raise ValueError("`n1` and `q` must be > 1")
     p = _p(n, n1, q, p_rule)
+    if reading == "literal":
+        out = add_kd(n1, q, p, m) + C * search_kd(n1, q, p, C)
+        return out if build_term else out - n1 * np.log2(n1)
     out = t_modify(n1, q, p, m) + C * s * t_search(n1, q, p)
     return out + n1 * np.log2(n1) if build_term else out
 
@@ -127,7 +168,7 @@ def calibrate_C(s: float, t_search_s: float, m: float, t_modify_s: float, n: flo
 
 
 def minimise_iter_time(*, n: float = 50000, s: float = 500, m: float = 500, C: float = 9.0, p_rule: str = "upper",
-                       build_term: bool = True, n1_range=(500.0, 20000.0), q_range=(1.5, 10.0),
+                       build_term: bool = True, reading: str = "adjusted", n1_range=(500.0, 20000.0), q_range=(1.5, 10.0),
                        grid: tuple[int, int] = (391, 171)):
     """Grid minimum of :func:`iter_time` over ``n1_range × q_range`` (000's Maple plot ranges).
 
@@ -136,7 +177,7 @@ def minimise_iter_time(*, n: float = 50000, s: float = 500, m: float = 500, C: f
     """
     N1 = np.linspace(*n1_range, grid[0])
     Q = np.linspace(*q_range, grid[1])
-    F = iter_time(N1[:, None], Q[None, :], n=n, s=s, m=m, C=C, p_rule=p_rule, build_term=build_term)
+    F = iter_time(N1[:, None], Q[None, :], n=n, s=s, m=m, C=C, p_rule=p_rule, build_term=build_term, reading=reading)
     i, j = np.unravel_index(np.argmin(F), F.shape)
     return float(N1[i]), float(Q[j]), float(F[i, j]), N1, Q, F
 
@@ -150,23 +191,35 @@ class CostModelResult:
     m: float
     C: float
     readings: tuple[tuple[str, float, float, float, bool], ...]  # (name, n1, q, cost, at_edge)
-    flat_n1: tuple[float, float]  # n1 range within 1 % of the minimum (main reading)
+    flat_n1: tuple[float, float]  # n1 range within 1 % of the minimum (the adjusted reading)
     flat_q: tuple[float, float]
     N1: np.ndarray = field(repr=False)
     Q: np.ndarray = field(repr=False)
-    F: np.ndarray = field(repr=False)  # main reading's surface
+    F: np.ndarray = field(repr=False)  # the adjusted reading's surface
+
+    @property
+    def literal(self):
+        """``(name, n1, q, cost, at_edge)`` of the Appendix as printed."""
+        return self.readings[0]
+
+    @property
+    def optimum(self):
+        """``(name, n1, q, cost, at_edge)`` of the adjusted reading (``addKd + C s T_search``)."""
+        return self.readings[1]
 
     def __str__(self) -> str:
-        _name, n1, q, _, _ = self.readings[0]
-        return (f"multi kd-tree optimum (first reading): n1 = {n1:.0f}, q = {q:.2f} for n = {self.n:.0f}, "
-                f"s = {self.s:.0f}, m = {self.m:.0f}, C = {self.C:.2f} (000: n1 ≈ 3500, q = 5.5)")
+        _, n1l, ql, _, _ = self.literal
+        _, n1, q, _, _ = self.optimum
+        return (f"multi kd-tree optimum for n = {self.n:.0f}, s = {self.s:.0f}, m = {self.m:.0f}, C = {self.C:.2f}: "
+                f"Appendix as printed n1 = {n1l:.0f}, q = {ql:.2f}; with C s T_search n1 = {n1:.0f}, q = {q:.2f} "
+                f"(000: n1 ≈ 3500, q = 5.5)")
 
     def table(self) -> str:
         rows = [[name, f"{n1:.0f}", f"{q:.2f}", "edge of the range" if edge else ""]
                 for name, n1, q, _, edge in self.readings]
         rows.append(["000 (read off its Maple plot)", "3500", "5.50", ""])
         t = format_table(["reading of 000's formulas", "n1", "q", "note"], rows)
-        return (t + f"\nwithin 1 % of the minimum (first reading): n1 {self.flat_n1[0]:.0f}-{self.flat_n1[1]:.0f},"
+        return (t + f"\nwithin 1 % of the minimum (adjusted reading): n1 {self.flat_n1[0]:.0f}-{self.flat_n1[1]:.0f},"
                 f" q {self.flat_q[0]:.2f}-{self.flat_q[1]:.2f}")
 
 
@@ -177,18 +230,19 @@ def run_cost_model(*, n: float = 50000, s: float = 500, m: float = 500, C: float
     m = v.check_positive(m, "m")
     C = v.check_positive(C, "C")
     specs = [
-        ("Appendix: n1 log n1 + T_modify + C s T_search, p upper (real)", "upper", True),
-        ("same, p at the lower bound (real)", "lower", True),
-        ("same, p integer (trees actually needed)", "integer", True),
-        ("§4.1.2 f = T_modify + C s T_search (no build term)", "upper", False),
+        ("Appendix as printed: addKd + C searchKd, p upper (real)", "upper", True, "literal"),
+        ("changed search term: addKd + C s T_search", "upper", True, "adjusted"),
+        ("same, p at the lower bound (real)", "lower", True, "adjusted"),
+        ("same, p integer (trees actually needed)", "integer", True, "adjusted"),
+        ("§4.1.2 f = T_modify + C s T_search (no build term)", "upper", False, "adjusted"),
     ]
     readings = []
     main = None
-    for name, rule, build in specs:
-        n1, q, val, N1, Q, F = minimise_iter_time(n=n, s=s, m=m, C=C, p_rule=rule, build_term=build)
+    for name, rule, build, reading in specs:
+        n1, q, val, N1, Q, F = minimise_iter_time(n=n, s=s, m=m, C=C, p_rule=rule, build_term=build, reading=reading)
         edge = n1 in (N1[0], N1[-1]) or q in (Q[0], Q[-1])
         readings.append((name, n1, q, val, bool(edge)))
-        if main is None:
+        if main is None and reading == "adjusted":
             main = (N1, Q, F)
     N1, Q, F = main
     near = 1.01 * F.min() >= F

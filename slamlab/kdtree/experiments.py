@@ -17,7 +17,8 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from .cost_model import calibrate_C, minimise_iter_time
-from .stores import STORE_NAMES, BruteForceStore, FlannStore, KDTree, make_store
+from .stores import STORE_NAMES, BruteForceStore, FlannStore, make_store
+from .tree import KDTree
 from .workloads import Scenario, Workload, make_workload, surf_like_descriptors
 
 __all__ = [
@@ -27,8 +28,8 @@ __all__ = [
     "DimensionStudyResult",
     "StoreComparisonResult",
     "fit_C",
+    "ours_vs_source",
     "recall_at_1",
-    "record_stereo_stream",
     "run_crossover",
     "run_dimension_study",
     "run_store_comparison",
@@ -454,24 +455,34 @@ def run_dimension_study(dims=(2, 8, 16, 64), *, n: int = 5000, n_queries: int = 
     return DimensionStudyResult(tuple(rows), n, n_queries, checks, leaf_size)
 
 
-def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0) -> Workload:
-    """Record the landmark-store calls of the stereo pipeline on 000's closed loop (our addition).
+def ours_vs_source(cost, dimension: DimensionStudyResult, table1: StoreComparisonResult,
+                   table2: StoreComparisonResult, real: StoreComparisonResult | None = None) -> str:
+    """000's figures beside ours, from the chapter's runs (000 §4, Appendix); timings stay in the timed tables.
 
-    Runs :func:`slamlab.stereo.experiments.run_closed_loop` (small size: 57 frames;
-    ``n_frames`` keeps the first frames only) with an exact store wrapped in a
-    :class:`~slamlab.kdtree.workloads.RecordingStore`, and returns the recorded
-    :class:`~slamlab.kdtree.workloads.Workload` for :func:`run_store_comparison`.
-    ``detector="sift"`` gives 128-d float descriptors (OpenCV); ``"surf"`` the 64-d
-    SURF of the features chapter.
+    ``cost``: :func:`~slamlab.kdtree.cost_model.run_cost_model`; ``dimension``:
+    :func:`run_dimension_study`; ``table1`` / ``table2``: :func:`run_store_comparison` of the
+    scenarios (with the stores "rebuild" and "multi"); ``real``: the recorded stereo stream's.
     """
-    from ..sim.stereo_paths import rectangular_loop
-    from ..stereo.experiments import run_stereo_slam
-    from ..stereo.store import ExactStore
-    from .workloads import RecordingStore
-
-    poses = rectangular_loop(step_m=0.5, turn_step_rad=np.deg2rad(20.0))
-    if n_frames is not None:
-        poses = poses[: v.check_int(n_frames, "n_frames", minimum=2)]
-    rec = RecordingStore(ExactStore())
-    run_stereo_slam(poses, name="closed loop", detector=detector, store=rec, rng=rng)
-    return rec.workload(f"stereo closed loop, {len(poses)} frames ({detector.upper()}, recorded)")
+    _, n1_lit, q_lit, _, _ = cost.literal
+    _, n1, q, _, _ = cost.optimum
+    exact64 = [r for r in dimension.rows if r[1] == 64]
+    rows = [
+        ["optimum n1, q: the Appendix as printed", "n1 ≈ 3500, q = 5.5 (plot)", f"n1 = {n1_lit:.0f}, q = {q_lit:.2f}"],
+        ["optimum n1, q: search term C s T_search", "n1 ≈ 3500, q = 5.5 (plot)", f"n1 = {n1:.0f}, q = {q:.2f}"],
+        ["within 1 % of that optimum", "—", (f"n1 {cost.flat_n1[0]:.0f}-{cost.flat_n1[1]:.0f}, "
+                                              f"q {cost.flat_q[0]:.2f}-{cost.flat_q[1]:.2f}")],
+        ["C = C1/C2 from 000's one-tree timings", "≈ 9", f"{calibrate_C(526, 0.079, 678, 0.750, 44828):.2f}"],
+    ]
+    if exact64:
+        rows.append(["exact search in 64-d: leaves visited", "O(log n) per search",
+                     "; ".join(f"{d}: {lv:.0f} %" for d, _, lv, _, _ in exact64)])
+    for name, res, n_000 in (("Table 1", table1, "~13000"), ("Table 2", table2, "65000")):
+        rows.append([f"{name}: points stored at the end", n_000, f"{res.stored_end} ({res.n_iterations} iterations)"])
+        rows.append([f"{name}: recall@1 kd-tree / multi", "— (not measured)",
+                     f"{res.recall['rebuild']:.3f} / {res.recall['multi']:.3f}"])
+    rows.append(["multi: mean points rebuilt per iteration", "~3000-point tree update",
+                 f"{table2.ops['multi']['rebuilt_mean']:.0f} (Table 2), {table1.ops['multi']['rebuilt_mean']:.0f} (Table 1)"])
+    if real is not None:
+        rows.append(["real stereo stream: recall@1 kd-tree / multi", "—",
+                     f"{real.recall['rebuild']:.3f} / {real.recall['multi']:.3f} ({real.stored_end} points)"])
+    return format_table(["quantity", "000", "ours"], rows, title="Landmark stores: 000 beside ours (times: timed tables)")

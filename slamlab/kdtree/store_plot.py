@@ -30,7 +30,7 @@ def plot_cost_surface(result, *, ax=None, cmap: str = "viridis"):
     s = max(1, N1.size // 60), max(1, Q.size // 60)
     ax.plot_surface(X[::s[0], ::s[1]], Y[::s[0], ::s[1]], F[::s[0], ::s[1]] / 1e6, cmap=cmap, linewidth=0,
                     antialiased=True, alpha=0.9)
-    _, n1, q, val, _ = result.readings[0]
+    _, n1, q, val, _ = result.optimum
     ax.scatter([n1], [q], [val / 1e6], color="red", s=40, depthshade=False, label=f"optimum n1={n1:.0f}, q={q:.2f}")
     ax.set_xlabel("n1")
     ax.set_ylabel("q")
@@ -48,7 +48,7 @@ def plot_cost_contour(result, *, ax=None, levels: int = 30, mark_000: bool = Tru
     cs = ax.contourf(N1, Q, F.T / 1e6, levels=levels, cmap="viridis")
     ax.figure.colorbar(cs, ax=ax, label="iterTime [10^6 steps]")
     ax.contour(N1, Q, F.T, levels=[1.01 * F.min()], colors="white", linewidths=1.2)
-    _, n1, q, _, _ = result.readings[0]
+    _, n1, q, _, _ = result.optimum
     ax.plot(n1, q, "o", color="red", markersize=8, label=f"our optimum n1={n1:.0f}, q={q:.2f}")
     if mark_000:
         ax.plot(3500, 5.5, "x", color="white", markersize=10, mew=2, label="000: n1≈3500, q=5.5")

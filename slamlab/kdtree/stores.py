@@ -1,51 +1,65 @@
-"""Landmark descriptor stores: one rebuilt tree, the multi kd-tree, the non-base buffer (000 §3.4, §4).
+"""Landmark descriptor stores: the one store interface and every store (000 §3.4, §4).
 
-Every store keeps a growing set of k-dimensional descriptors with integer ids and
-has the same interface:
+Every store derives from :class:`LandmarkStore` (an abstract base class) and keeps a
+growing set of descriptors with integer ids:
 
 - ``add(X, ids)`` -- new points of this iteration (their first sighting);
 - ``observe(ids)`` -- ids re-sighted this iteration (used by the base rule);
 - ``end_iteration()`` -- apply the base rule / rebuild (part of the "add" time);
-- ``query(Q, k=2) -> (dist, ids)`` -- the k nearest stored points of every query;
+- ``query(Q, k=2) -> (dist, ids)`` -- the k nearest stored points of every query
+  (``inf`` / ``-1`` where the store holds fewer than k: :func:`~slamlab.kdtree.knn.pad_knn`);
+- ``query_among(Q, among, k=2)`` -- the k nearest among the stored points whose ids are
+  in ``among``, exactly (the stereo pipeline's view gate);
 - ``len(store)`` and ``store.counters`` -- points rebuilt, trees searched, nodes
   visited, distance evaluations (the operation counts the analysis needs).
 
+The base rule of 000 §3.4 is written once, in :func:`base_rule` (a point becomes *base*
+after ``BaseSeenTimes = 3`` sightings; a non-base point first seen
+``MaxNonBaseTime = 7`` iterations ago is dropped), kept per point by
+:class:`SightingBook`; every store and the stereo pipeline use them.
+
 Stores of 000: :class:`RebuildStore` (first method: one static tree rebuilt every
 iteration from kept + new points) and :class:`MultiKDTree` (second method: trees
-of maximum sizes ``n1, q n1, q^2 n1, ...``) behind a :class:`NonBaseBuffer`
-(points seen fewer than ``BaseSeenTimes = 3`` times and first seen at most
-``MaxNonBaseTime = 7`` iterations ago). References (our addition):
-:class:`BruteForceStore` (exact, BLAS, running top-2 over cache-sized blocks) and
-:class:`FlannStore` (OpenCV's randomised kd-trees, ``checks = 200``).
+of maximum sizes ``n1, q n1, q^2 n1, ...``) behind a :class:`NonBaseBuffer`.
+Exact references (our addition): :class:`ExactStore` (brute force, Hamming for binary
+``uint8`` descriptors, Euclidean for float ones, with the base rule; the stereo
+pipeline's store for ORB), :class:`BruteForceStore` (the same without the base rule)
+and :class:`FlannStore` (OpenCV's randomised kd-trees, ``checks = 200``).
 
 The tree inside a store is chosen with ``tree``: ``"bbf"`` -- the teaching
 :class:`~slamlab.kdtree.tree.KDTree` searched by Best-Bin-First with ``checks``
 points examined per tree (000 §1.4.3: "about 200"), ``"exact"`` -- the same tree
 searched exactly, ``"ckdtree"`` -- scipy's exact ``cKDTree``, ``"brute"`` --
-:class:`BruteForceStore` (exact; used for the buffer in front of brute force). In 64 dimensions
-an exact tree search visits almost every leaf, so only ``"bbf"`` is fast.
+:func:`~slamlab.kdtree.knn.exact_knn` (exact; used for the buffer in front of brute
+force). In 64 dimensions an exact tree search visits almost every leaf, so only
+``"bbf"`` is fast.
 """
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, fields
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import _validate as v
+from .knn import exact_knn, merge_knn, pad_knn
 from .tree import KDTree
 
 __all__ = [
     "STORE_NAMES",
     "TREE_KINDS",
     "BruteForceStore",
+    "ExactStore",
     "FlannStore",
     "LandmarkStore",
     "MultiKDTree",
     "NonBaseBuffer",
     "RebuildStore",
+    "SightingBook",
     "StoreCounters",
+    "base_rule",
     "make_store",
     "merge_knn",
     "multi_tree_sizes",
@@ -74,35 +88,84 @@ class StoreCounters:
             setattr(self, f.name, 0)
 
 
-def merge_knn(dists, ids, k: int = 2):
-    """Merge per-tree k-NN lists into the k nearest overall (000 §4: a query searches every tree).
+def base_rule(seen, age, base_seen_times: int, max_non_base_time: int):
+    """000 §3.4's base rule: ``(is_base, timed_out)`` per point from its sightings and age.
 
-    Parameters
-    ----------
-    dists, ids : lists of (M, k_i) arrays
-        Distances (``inf`` for missing) and ids (-1 for missing) from each tree.
+    A point is *base* once seen ``base_seen_times`` times (000: ``BaseSeenTimes = 3``); a
+    non-base point whose first sighting is ``max_non_base_time`` iterations old (000:
+    ``MaxNonBaseTime = 7``) times out and is dropped. ``age`` = iterations since the first
+    sighting (0 in the iteration it was first seen).
 
-    >>> d, i = merge_knn([np.array([[1.0, 3.0]]), np.array([[2.0, np.inf]])],
-    ...                  [np.array([[10, 11]]), np.array([[20, -1]])])
-    >>> d.tolist(), i.tolist()
-    ([[1.0, 2.0]], [[10, 20]])
+    >>> b, late = base_rule(np.array([3, 1, 2]), np.array([2, 7, 6]), 3, 7)
+    >>> b.tolist(), late.tolist()
+    ([True, False, False], [False, True, False])
     """
-    D = np.concatenate(dists, axis=1)
-    idx = np.concatenate(ids, axis=1)
-    o = np.argsort(D, axis=1, kind="stable")[:, :k]
-    D, idx = np.take_along_axis(D, o, axis=1), np.take_along_axis(idx, o, axis=1)
-    if D.shape[1] < k:  # fewer candidates than k: pad
-        pad = k - D.shape[1]
-        D = np.concatenate([D, np.full((D.shape[0], pad), np.inf)], axis=1)
-        idx = np.concatenate([idx, np.full((idx.shape[0], pad), -1, dtype=idx.dtype)], axis=1)
-    return D, idx
+    seen = np.asarray(seen)
+    is_base = seen >= base_seen_times
+    return is_base, ~is_base & (np.asarray(age) >= max_non_base_time)
 
 
-def _as_points(X, name, dim=None):
+class SightingBook:
+    """Seen counts and first-sighting iterations of non-base points; :meth:`step` applies :func:`base_rule`.
+
+    >>> book = SightingBook(3, 7)
+    >>> book.add(np.array([1, 2])); book.step()[0].tolist()
+    []
+    >>> for _ in range(2):
+    ...     book.observe(np.array([1])); promoted, dropped = book.step()
+    >>> promoted.tolist(), book.ids.tolist()
+    ([1], [2])
+    """
+
+    def __init__(self, base_seen_times: int, max_non_base_time: int):
+        self.base_seen_times = base_seen_times
+        self.max_non_base_time = max_non_base_time
+        self.ids = np.empty(0, dtype=np.int64)  # sorted
+        self.seen = np.empty(0, dtype=np.int64)
+        self.first = np.empty(0, dtype=np.int64)
+        self.iteration = 0
+
+    def add(self, ids):
+        allid = np.concatenate([self.ids, ids])
+        o = np.argsort(allid, kind="stable")
+        self.ids = allid[o]
+        self.seen = np.concatenate([self.seen, np.ones(ids.size, dtype=np.int64)])[o]
+        self.first = np.concatenate([self.first, np.full(ids.size, self.iteration, dtype=np.int64)])[o]
+
+    def observe(self, ids):
+        if not self.ids.size or not ids.size:
+            return
+        pos = np.searchsorted(self.ids, ids)
+        pos = np.minimum(pos, self.ids.size - 1)
+        hit = self.ids[pos] == ids
+        self.seen += np.bincount(pos[hit], minlength=self.ids.size)
+
+    def step(self):
+        """End the iteration: return (ids that became base, ids that timed out); forget both."""
+        base, late = base_rule(self.seen, self.iteration - self.first, self.base_seen_times,
+                               self.max_non_base_time)
+        promoted, dropped = self.ids[base], self.ids[late]
+        keep = ~(base | late)
+        self.ids, self.seen, self.first = self.ids[keep], self.seen[keep], self.first[keep]
+        self.iteration += 1
+        return promoted, dropped
+
+
+def _as_points(X, name, dim=None, dtype=None, binary_ok=False):
+    """Descriptors as float32 (or uint8 where the store compares binary descriptors)."""
     X = np.asarray(X)
     if X.dtype.kind not in "fiu":
         raise TypeError(f"`{name}` must be a numeric array; got dtype {X.dtype}")
-    X = v.as_finite_array(X, name, ndim=2, dtype=np.float32)
+    if X.dtype == np.uint8 and binary_ok and dtype != np.float32:
+        if X.ndim != 2:
+            raise ValueError(f"`{name}` must be a 2-D (N, d) descriptor array; got shape {X.shape}")
+    else:
+        if dtype == np.uint8:
+            raise TypeError(f"`{name}` must be uint8 (binary) like the stored descriptors; got {X.dtype}")
+        if X.dtype == np.uint8 and X.ndim == 2 and not binary_ok:
+            raise TypeError(f"`{name}`: binary (uint8) descriptors need an exact store (ExactStore, "
+                            "BruteForceStore); a kd-tree compares float descriptors")
+        X = v.as_finite_array(X, name, ndim=2, dtype=np.float32)
     if dim is not None and X.shape[1] != dim:
         raise ValueError(f"`{name}` must have shape (N, {dim}) to match the store; got shape {X.shape}")
     return X
@@ -165,8 +228,7 @@ class _Tree:
         if kind == "ckdtree":
             self._t = cKDTree(X, leafsize=leaf_size, balanced_tree=True, compact_nodes=False)
         elif kind == "brute":
-            self._t = BruteForceStore()
-            self._t.add(X, ids)
+            self._t = X
         else:
             self._t = KDTree(X, ids, leaf_size=leaf_size)
         self.max_leaves = None if kind != "bbf" else max(1, -(-checks // leaf_size))
@@ -178,10 +240,10 @@ class _Tree:
             d, i = self._t.query(Q, kk)
             d, i = d.reshape(Q.shape[0], kk), i.reshape(Q.shape[0], kk)
             out_i = np.where(np.isfinite(d), self.ids[np.minimum(i, self.n - 1)], -1)
-            return d, out_i
+            return pad_knn(d, out_i, k)
         if self.kind == "brute":
             counters.distance_evals += Q.shape[0] * self.n
-            return self._t.query(Q, k)
+            return exact_knn(Q, self._t, k, self.ids)
         d, i = self._t.query(Q, k, max_leaves=self.max_leaves)
         st = self._t.last_stats
         counters.nodes_visited += int(st.nodes_visited.sum())
@@ -189,15 +251,24 @@ class _Tree:
         return d, i
 
 
-class LandmarkStore:
-    """Interface of a growing descriptor store (000 §3.4); see the module docstring."""
+class LandmarkStore(ABC):
+    """The landmark-store interface (000 §3.4): every store, and the stereo pipeline's, derives from it.
+
+    Subclasses implement ``_add(X, ids)`` (checked batch), ``_query(Q, k)`` (checked, non-empty),
+    ``_stored() -> (X, ids)`` (every stored point) and ``__len__``; ``observe`` and
+    ``end_iteration`` do nothing unless the store applies the base rule or rebuilds.
+    ``query_among`` is exact (brute force over the selected points) for every store.
+    """
 
     name = "store"
     insert_only = True
+    #: True for the stores that compare binary uint8 descriptors by Hamming distance (exact stores)
+    binary_ok = False
 
     def __init__(self):
         self.counters = StoreCounters()
         self.dim: int | None = None
+        self.dtype = None
 
     # -- interface ---------------------------------------------------------------------------------
     def add(self, X, ids) -> None:
@@ -211,31 +282,58 @@ class LandmarkStore:
         """Record re-sightings of stored ids this iteration (only the base rule uses them)."""
         _as_ids(ids, "ids")
 
-    def end_iteration(self) -> None:
+    def end_iteration(self) -> None:  # noqa: B027 (a no-op unless the store rebuilds or applies the base rule)
         """Close an iteration (apply the base rule, rebuild what the store rebuilds)."""
 
     def query(self, Q, k: int = 2):
         """The ``k`` nearest stored points of every row of ``Q``: ``(dist (M, k), ids (M, k))``."""
-        Q = _as_points(Q, "Q", self.dim)
-        k = v.check_int(k, "k", minimum=1)
-        self.counters.queries += Q.shape[0]
+        Q, k = self._check_query(Q, k)
         if len(self) == 0 or Q.shape[0] == 0:
-            return np.full((Q.shape[0], k), np.inf), np.full((Q.shape[0], k), -1, dtype=np.int64)
+            return pad_knn(np.empty((Q.shape[0], 0)), np.empty((Q.shape[0], 0), dtype=np.int64), k)
         return self._query(Q, k)
 
+    def query_among(self, Q, among, k: int = 2):
+        """Like :meth:`query`, searching only (and exactly) the stored points whose ids are in ``among``."""
+        Q, k = self._check_query(Q, k)
+        among = _as_ids(np.asarray(among).ravel(), "among")
+        X, ids = self._stored()
+        rows = np.isin(ids, among)
+        self.counters.distance_evals += Q.shape[0] * int(rows.sum())
+        return exact_knn(Q, X[rows], k, ids[rows])
+
+    @abstractmethod
     def __len__(self) -> int:
-        raise NotImplementedError
+        """Number of stored points."""
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n={len(self)})"
 
+    # -- what a store implements --------------------------------------------------------------------
+    @abstractmethod
+    def _add(self, X, ids) -> None:
+        """Store a checked, non-empty batch."""
+
+    @abstractmethod
+    def _query(self, Q, k):
+        """k-NN of a checked, non-empty query batch in a non-empty store."""
+
+    @abstractmethod
+    def _stored(self):
+        """``(X (n, d), ids (n,))``: every stored point."""
+
     # -- helpers -----------------------------------------------------------------------------------
     def _check_batch(self, X, ids):
-        X = _as_points(X, "X", self.dim)
+        X = _as_points(X, "X", self.dim, self.dtype, self.binary_ok)
         ids = _as_ids(ids, "ids", X.shape[0])
         if self.dim is None and X.shape[0]:
-            self.dim = X.shape[1]
+            self.dim, self.dtype = X.shape[1], X.dtype
         return X, ids
+
+    def _check_query(self, Q, k):
+        Q = _as_points(Q, "Q", self.dim, self.dtype, self.binary_ok)
+        k = v.check_int(k, "k", minimum=1)
+        self.counters.queries += Q.shape[0]
+        return Q, k
 
 
 def _check_tree_args(tree, leaf_size, checks):
@@ -246,7 +344,7 @@ def _check_tree_args(tree, leaf_size, checks):
 
 
 class _PointSet:
-    """Points + ids in a growing float32 buffer (capacity doubling; no per-add copy of everything)."""
+    """Points + ids in a growing buffer (capacity doubling; no per-add copy of everything)."""
 
     def __init__(self):
         self.X = np.empty((0, 0), dtype=np.float32)
@@ -255,9 +353,9 @@ class _PointSet:
 
     def append(self, X, ids):
         need = self.n + X.shape[0]
-        if self.X.shape[0] < need or self.X.shape[1] != X.shape[1]:
+        if self.X.shape[0] < need or self.X.shape[1] != X.shape[1] or self.X.dtype != X.dtype:
             cap = max(need, 2 * self.X.shape[0], 1024)
-            Xn = np.empty((cap, X.shape[1]), dtype=np.float32)
+            Xn = np.empty((cap, X.shape[1]), dtype=X.dtype)
             In = np.empty(cap, dtype=np.int64)
             if self.n:
                 Xn[:self.n], In[:self.n] = self.X[:self.n], self.ids[:self.n]
@@ -279,70 +377,19 @@ class _PointSet:
         return self.ids[:self.n]
 
 
-class _SightingBook:
-    """The base rule of 000 §3.4: seen counts and first-sighting iterations of non-base points."""
+class _BaseRuleStore(LandmarkStore):
+    """Points in one buffer; with ``base_seen_times > 1`` non-base points that time out are dropped."""
 
-    def __init__(self, base_seen_times, max_non_base_time):
-        self.base_seen_times = base_seen_times
-        self.max_non_base_time = max_non_base_time
-        self.ids = np.empty(0, dtype=np.int64)  # sorted
-        self.seen = np.empty(0, dtype=np.int64)
-        self.first = np.empty(0, dtype=np.int64)
-        self.iteration = 0
-
-    def add(self, ids):
-        allid = np.concatenate([self.ids, ids])
-        o = np.argsort(allid, kind="stable")
-        self.ids = allid[o]
-        self.seen = np.concatenate([self.seen, np.ones(ids.size, dtype=np.int64)])[o]
-        self.first = np.concatenate([self.first, np.full(ids.size, self.iteration, dtype=np.int64)])[o]
-
-    def observe(self, ids):
-        if not self.ids.size or not ids.size:
-            return
-        pos = np.searchsorted(self.ids, ids)
-        pos = np.minimum(pos, self.ids.size - 1)
-        hit = self.ids[pos] == ids
-        self.seen += np.bincount(pos[hit], minlength=self.ids.size)
-
-    def step(self):
-        """End the iteration: return (ids that became base, ids that timed out); forget both."""
-        base = self.seen >= self.base_seen_times
-        late = ~base & (self.iteration - self.first >= self.max_non_base_time)
-        promoted, dropped = self.ids[base], self.ids[late]
-        keep = ~(base | late)
-        self.ids, self.seen, self.first = self.ids[keep], self.seen[keep], self.first[keep]
-        self.iteration += 1
-        return promoted, dropped
-
-
-class RebuildStore(LandmarkStore):
-    """000's first method: one static tree rebuilt every iteration from kept + new points (000 §3.4).
-
-    With ``base_seen_times > 1`` the store applies the base rule itself and drops
-    non-base points that time out (Table 1 scenario), so it holds the same points
-    as :class:`NonBaseBuffer` + :class:`MultiKDTree`.
-
-    >>> rng = np.random.default_rng(0)
-    >>> s = RebuildStore(tree="ckdtree")
-    >>> s.add(rng.random((50, 4)), np.arange(50)); s.end_iteration()
-    >>> d, i = s.query(s.points[:3]); i[:, 0].tolist()
-    [0, 1, 2]
-    """
-
-    name = "kd-tree (rebuild)"
     insert_only = False
 
-    def __init__(self, *, tree: str = "bbf", leaf_size: int = 8, checks: int = 200, base_seen_times: int = 1,
-                 max_non_base_time: int = 7):
+    def __init__(self, base_seen_times: int, max_non_base_time: int):
         super().__init__()
-        self.tree_kind, self.leaf_size, self.checks = _check_tree_args(tree, leaf_size, checks)
         bst = v.check_int(base_seen_times, "base_seen_times", minimum=1)
         mnt = v.check_int(max_non_base_time, "max_non_base_time", minimum=1)
         self._pts = _PointSet()
-        self._book = _SightingBook(bst, mnt) if bst > 1 else None
-        self._tree: _Tree | None = None
+        self._book = SightingBook(bst, mnt) if bst > 1 else None
         self._dirty = False
+        self.dropped_ids = np.empty(0, dtype=np.int64)  # ids that timed out at the last end_iteration
 
     def _add(self, X, ids):
         self._pts.append(X, ids)
@@ -357,10 +404,50 @@ class RebuildStore(LandmarkStore):
 
     def end_iteration(self):
         if self._book is not None:
-            _, dropped = self._book.step()
-            if dropped.size:
-                self._pts.keep(~np.isin(self._pts.point_ids, dropped))
+            _, self.dropped_ids = self._book.step()
+            if self.dropped_ids.size:
+                self._pts.keep(~np.isin(self._pts.point_ids, self.dropped_ids))
                 self._dirty = True
+
+    def _stored(self):
+        return self._pts.points, self._pts.point_ids
+
+    @property
+    def points(self):
+        return self._pts.points
+
+    @property
+    def ids(self):
+        return self._pts.point_ids
+
+    def __len__(self):
+        return self._pts.n
+
+
+class RebuildStore(_BaseRuleStore):
+    """000's first method: one static tree rebuilt every iteration from kept + new points (000 §3.4).
+
+    With ``base_seen_times > 1`` the store applies the base rule itself and drops
+    non-base points that time out (Table 1 scenario), so it holds the same points
+    as :class:`NonBaseBuffer` + :class:`MultiKDTree`.
+
+    >>> rng = np.random.default_rng(0)
+    >>> s = RebuildStore(tree="ckdtree")
+    >>> s.add(rng.random((50, 4)), np.arange(50)); s.end_iteration()
+    >>> d, i = s.query(s.points[:3]); i[:, 0].tolist()
+    [0, 1, 2]
+    """
+
+    name = "kd-tree (rebuild)"
+
+    def __init__(self, *, tree: str = "bbf", leaf_size: int = 8, checks: int = 200, base_seen_times: int = 1,
+                 max_non_base_time: int = 7):
+        super().__init__(base_seen_times, max_non_base_time)
+        self.tree_kind, self.leaf_size, self.checks = _check_tree_args(tree, leaf_size, checks)
+        self._tree: _Tree | None = None
+
+    def end_iteration(self):
+        super().end_iteration()
         if self._dirty:
             self._rebuild()
 
@@ -379,16 +466,57 @@ class RebuildStore(LandmarkStore):
             self._rebuild()
         return self._tree.query(Q, k, self.counters)
 
-    @property
-    def points(self):
-        return self._pts.points
+
+class ExactStore(_BaseRuleStore):
+    """Exact brute-force store with 000's base rule (000 §3.4; our exact reference).
+
+    Hamming distance for binary ``uint8`` descriptors (ORB: a kd-tree does not apply),
+    Euclidean for float ones, by :func:`~slamlab.kdtree.knn.exact_knn`. Non-base points
+    first seen ``max_non_base_time`` iterations ago are dropped (``dropped_ids``);
+    ``base_seen_times = 1`` keeps every point (:class:`BruteForceStore`).
+
+    Examples
+    --------
+    >>> s = ExactStore()
+    >>> s.add(np.array([[0, 0], [3, 0]], np.float32), [10, 11]); s.end_iteration()
+    >>> s.query(np.array([[1, 0]], np.float32))
+    (array([[1., 2.]]), array([[10, 11]]))
+    """
+
+    name = "exact (brute force)"
+    binary_ok = True
+
+    def __init__(self, base_seen_times: int = 3, max_non_base_time: int = 7):
+        super().__init__(base_seen_times, max_non_base_time)
 
     @property
-    def ids(self):
-        return self._pts.point_ids
+    def is_base(self) -> np.ndarray:
+        """(n,) True for stored points that reached ``base_seen_times`` sightings."""
+        if self._book is None:
+            return np.ones(self._pts.n, dtype=bool)
+        return ~np.isin(self._pts.point_ids, self._book.ids)
 
-    def __len__(self):
-        return self._pts.n
+    def _query(self, Q, k):
+        self.counters.trees_searched += 1
+        self.counters.distance_evals += Q.shape[0] * self._pts.n
+        return exact_knn(Q, self._pts.points, k, self._pts.point_ids)
+
+
+class BruteForceStore(ExactStore):
+    """Exact search by brute force, every point kept (no base rule; the reference of Tables 1-2).
+
+    >>> rng = np.random.default_rng(0)
+    >>> s = BruteForceStore()
+    >>> X = rng.random((100, 8)); s.add(X, np.arange(100))
+    >>> d, i = s.query(X[[5, 50]]); i[:, 0].tolist()
+    [5, 50]
+    """
+
+    name = "brute force"
+    insert_only = True
+
+    def __init__(self):
+        super().__init__(base_seen_times=1)
 
 
 class MultiKDTree(LandmarkStore):
@@ -484,101 +612,16 @@ class MultiKDTree(LandmarkStore):
         res = [t.query(Q, k, self.counters) for t in self._trees if t is not None]
         return merge_knn([r[0] for r in res], [r[1] for r in res], k)
 
+    def _stored(self):
+        if not self._X:
+            return np.empty((0, self.dim or 0), np.float32), np.empty(0, np.int64)
+        return np.concatenate(self._X), np.concatenate(self._ids)
+
     def __len__(self):
         return sum(self.sizes)
 
     def __repr__(self):
         return f"MultiKDTree(n1={self.n1}, q={self.q}, sizes={self.sizes})"
-
-
-class BruteForceStore(LandmarkStore):
-    """Exact search on BLAS with a running top-2 over cache-sized blocks (our addition).
-
-    The squared distance is ``|q|^2 + |x|^2 - 2 q.x``; one GEMM per block of
-    ``block`` database rows computes ``|x|^2/2 - q.x`` (the database is kept as
-    ``[x, |x|^2/2]`` and queries as ``[-q, 1]``, so the GEMM writes the ranking key
-    directly) and the best two per query are kept; the full distance matrix is
-    never written. The winners' distances are then recomputed directly in float64.
-
-    >>> rng = np.random.default_rng(0)
-    >>> s = BruteForceStore(block=16)
-    >>> X = rng.random((100, 8)); s.add(X, np.arange(100))
-    >>> d, i = s.query(X[[5, 50]]); i[:, 0].tolist()
-    [5, 50]
-    """
-
-    name = "brute force (BLAS)"
-
-    def __init__(self, *, block: int = 8192):
-        super().__init__()
-        self.block = v.check_int(block, "block", minimum=1)
-        self._A = np.empty((0, 0), dtype=np.float32)  # (cap, k+1): [x, |x|^2/2]
-        self._ids = np.empty(0, dtype=np.int64)
-        self._n = 0
-        self._buf: np.ndarray | None = None
-
-    def _add(self, X, ids):
-        need = self._n + X.shape[0]
-        if self._A.shape[0] < need:
-            cap = max(need, 2 * self._A.shape[0], 1024)
-            A = np.empty((cap, X.shape[1] + 1), dtype=np.float32)
-            In = np.empty(cap, dtype=np.int64)
-            if self._n:
-                A[:self._n] = self._A[:self._n]
-                In[:self._n] = self._ids[:self._n]
-            self._A, self._ids = A, In
-        self._A[self._n:need, :-1] = X
-        self._A[self._n:need, -1] = 0.5 * np.einsum("ij,ij->i", X, X)
-        self._ids[self._n:need] = ids
-        self._n = need
-
-    def _query(self, Q, k):
-        M, n, B = Q.shape[0], self._n, self.block
-        Qa = np.empty((M, Q.shape[1] + 1), dtype=np.float32)
-        Qa[:, :-1] = -Q
-        Qa[:, -1] = 1.0
-        if self._buf is None or self._buf.shape[0] != M or self._buf.shape[1] < min(B, n):
-            self._buf = np.empty((M, min(B, n)), dtype=np.float32)  # reused while the shapes allow
-        rows = np.arange(M)
-        kk = min(k, n)
-        best_v = np.full((M, kk), np.inf, dtype=np.float32)
-        best_i = np.zeros((M, kk), dtype=np.int64)
-        for s0 in range(0, n, B):
-            s1 = min(s0 + B, n)
-            G = self._buf[:, :s1 - s0]
-            np.matmul(Qa, self._A[s0:s1].T, out=G)  # |x|^2/2 - q.x for the block
-            if kk <= 2 and s1 - s0 >= kk:
-                i1 = np.argmin(G, axis=1)
-                v1 = G[rows, i1]
-                if kk == 2:
-                    G[rows, i1] = np.inf
-                    i2 = np.argmin(G, axis=1)
-                    v2 = G[rows, i2]
-                    cv = np.concatenate([best_v, v1[:, None], v2[:, None]], axis=1)
-                    ci = np.concatenate([best_i, (i1 + s0)[:, None], (i2 + s0)[:, None]], axis=1)
-                else:
-                    cv = np.concatenate([best_v, v1[:, None]], axis=1)
-                    ci = np.concatenate([best_i, (i1 + s0)[:, None]], axis=1)
-            else:
-                cv = np.concatenate([best_v, G], axis=1)
-                ci = np.concatenate([best_i, np.broadcast_to(np.arange(s0, s1), G.shape)], axis=1)
-            o = np.argsort(cv, axis=1, kind="stable")[:, :kk]
-            best_v, best_i = np.take_along_axis(cv, o, axis=1), np.take_along_axis(ci, o, axis=1)
-        self.counters.trees_searched += 1
-        self.counters.distance_evals += M * n
-        # distances of the winners recomputed directly (the GEMM form loses digits to cancellation)
-        diff = self._A[best_i, :-1].astype(np.float64) - Q[:, None, :].astype(np.float64)
-        d = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
-        o = np.argsort(d, axis=1, kind="stable")
-        d, best_i = np.take_along_axis(d, o, axis=1), np.take_along_axis(best_i, o, axis=1)
-        out_i = self._ids[best_i]
-        if kk < k:
-            d = np.concatenate([d, np.full((M, k - kk), np.inf)], axis=1)
-            out_i = np.concatenate([out_i, np.full((M, k - kk), -1, dtype=np.int64)], axis=1)
-        return d, out_i
-
-    def __len__(self):
-        return self._n
 
 
 class FlannStore(LandmarkStore):
@@ -631,10 +674,10 @@ class FlannStore(LandmarkStore):
         idx = idx.reshape(Q.shape[0], kk).astype(np.int64)
         d = np.sqrt(np.maximum(d2.reshape(Q.shape[0], kk).astype(np.float64), 0.0))
         out_i = np.where(idx >= 0, self._id_map[np.maximum(idx, 0)], -1)
-        if kk < k:
-            d = np.concatenate([d, np.full((Q.shape[0], k - kk), np.inf)], axis=1)
-            out_i = np.concatenate([out_i, np.full((Q.shape[0], k - kk), -1, dtype=np.int64)], axis=1)
-        return d, out_i
+        return pad_knn(d, out_i, k)
+
+    def _stored(self):
+        return self._pts.points, self._pts.point_ids
 
     def __len__(self):
         return self._pts.n
@@ -674,7 +717,7 @@ class NonBaseBuffer(LandmarkStore):
         self.tree_kind, self.leaf_size, self.checks = _check_tree_args(tree, leaf_size, checks)
         bst = v.check_int(base_seen_times, "base_seen_times", minimum=1)
         mnt = v.check_int(max_non_base_time, "max_non_base_time", minimum=1)
-        self._book = _SightingBook(bst, mnt)
+        self._book = SightingBook(bst, mnt)
         self._pts = _PointSet()
         self._tree: _Tree | None = None
         self.n_promoted = 0
@@ -725,6 +768,12 @@ class NonBaseBuffer(LandmarkStore):
         if len(self.base):
             parts.append(self.base.query(Q, k))
         return merge_knn([p[0] for p in parts], [p[1] for p in parts], k)
+
+    def _stored(self):
+        X, ids = self.base._stored()
+        if not self._pts.n:
+            return X, ids
+        return np.concatenate([self._pts.points, X.astype(self._pts.points.dtype)]), np.concatenate([self._pts.point_ids, ids])
 
     @property
     def all_counters(self) -> StoreCounters:

@@ -30,7 +30,7 @@ def explore_cost_model(**defaults):
         except (ValueError, TypeError) as exc:
             print(f"Cannot run with these settings: {exc}")
             return
-        _, bn1, bq, best, _ = res.readings[0]
+        _, bn1, bq, best, _ = res.optimum
         print(f"iterTime at n1 = {n1:.0f}, q = {q:.2f}: {here:.3g} steps, {here / best:.3f} x the optimum "
               f"(n1 = {bn1:.0f}, q = {bq:.2f})")
         ax = plot_cost_contour(res)

@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .. import _validate as v
-from .stores import _SightingBook
+from .stores import LandmarkStore, SightingBook
 
 __all__ = ["SCENARIOS", "Iteration", "Scenario", "Workload", "make_workload", "scenario", "surf_like_descriptors"]
 
@@ -178,7 +178,7 @@ def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload
     # track lengths: re-seen in the next L iterations, P(L >= j) = p_track^j
     L = rng.geometric(1.0 - sc.p_track, total) - 1
     born = np.repeat(np.arange(sc.n_iterations), sc.n_new)
-    book = _SightingBook(sc.base_seen_times, sc.max_non_base_time)
+    book = SightingBook(sc.base_seen_times, sc.max_non_base_time)
     alive = np.zeros(total, dtype=bool)
     base = np.zeros(total, dtype=bool)
     its, stored = [], []
@@ -212,19 +212,24 @@ def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload
     return Workload(sc, tuple(its), np.array(stored))
 
 
-class RecordingStore:
+class RecordingStore(LandmarkStore):
     """Wraps a landmark store and records every call as a descriptor stream (our addition).
 
     The stereo pipeline (:class:`slamlab.stereo.StereoSLAM`) talks to its store
-    through ``query``, ``observe``, ``add`` and ``end_iteration``; this wrapper
+    through the :class:`~slamlab.kdtree.stores.LandmarkStore` interface; this wrapper
     passes each call on and keeps what it saw, one :class:`Iteration` per
     ``end_iteration``. :meth:`workload` turns the recording into a
     :class:`Workload` that :func:`~slamlab.kdtree.experiments.run_store_comparison`
     replays through any store.
     """
 
-    def __init__(self, store):
+    def __init__(self, store: LandmarkStore):
+        if not isinstance(store, LandmarkStore):
+            raise TypeError(f"`store` must be a LandmarkStore; got {type(store).__name__}")
+        super().__init__()
         self.store = store
+        self.binary_ok = store.binary_ok
+        self.name = f"recording of {store.name}"
         self.iterations: list[Iteration] = []
         self._q, self._obs, self._X, self._ids = [], [], [], []
 
@@ -235,6 +240,10 @@ class RecordingStore:
         self._q.append(np.asarray(Q))
         return self.store.query(Q, k=k)
 
+    def query_among(self, Q, among, k: int = 2):
+        self._q.append(np.asarray(Q))
+        return self.store.query_among(Q, among, k=k)
+
     def observe(self, ids) -> None:
         self._obs.append(np.asarray(ids, dtype=np.int64))
         self.store.observe(ids)
@@ -243,6 +252,15 @@ class RecordingStore:
         self._X.append(np.asarray(X))
         self._ids.append(np.asarray(ids, dtype=np.int64))
         self.store.add(X, ids)
+
+    def _add(self, X, ids):  # pragma: no cover - add() forwards
+        self.store.add(X, ids)
+
+    def _query(self, Q, k):  # pragma: no cover - query() forwards
+        return self.store.query(Q, k)
+
+    def _stored(self):
+        return self.store._stored()
 
     def end_iteration(self) -> None:
         self.store.end_iteration()
@@ -261,7 +279,7 @@ class RecordingStore:
         dim = next(it.queries.shape[1] for it in its if it.queries.size)
         its = tuple(it if it.queries.size else Iteration(np.empty((0, dim), np.float32), it.truth, it.new_X,
                                                          it.new_ids, it.observed_ids) for it in its)
-        book = _SightingBook(base_seen_times, max_non_base_time)
+        book = SightingBook(base_seen_times, max_non_base_time)
         stored, n = [], 0
         for it in its:  # the base rule, as the stores apply it: observe, add, end of iteration
             n += len(it.new_ids)

@@ -1,13 +1,22 @@
-"""Stereo SLAM (000 §3): per-frame stages, landmark store interface, the SLAM loop."""
+"""Stereo SLAM (000 §3): settings, per-frame stages, the SLAM loop, experiments.
 
+Uses the features chapter (:func:`slamlab.features.detect`, the ratio rule) and the
+landmark stores of :mod:`slamlab.kdtree`; nothing below imports this package. Plots and
+widgets load on first use.
+"""
+
+from .._lazy import lazy_exports
 from .experiments import (
     COMPARISON,
+    KITTI_PARAMS,
     SIZES,
     DriftStudy,
     KittiRunResult,
     StereoRunResult,
     comparison_table,
     experiment_poses,
+    ours_vs_source,
+    record_stereo_stream,
     run_closed_loop,
     run_comparison,
     run_drift_study,
@@ -16,61 +25,63 @@ from .experiments import (
     run_stereo_slam_variants,
     run_turn_in_place,
 )
-from .plot import plot_frame_stages, plot_kitti, plot_run_errors, plot_run_map, plot_triangulation, run_figure
-from .slam import BINARY_DETECTORS, STAGES, FrameRecord, StereoSLAM, default_store
+from .kitti import kitti_rig, read_kitti_calib, read_kitti_image, read_kitti_poses
+from .params import STEREO_DETECTORS, RenderParams, StereoParams
+from .slam import STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
-    DETECTORS,
-    POLICIES,
-    Features,
     LocalCloud,
     MapMatches,
     PoseEstimate,
     StereoMatches,
-    detect,
+    detect_features,
     estimate_pose,
     match_to_map,
+    pose_std,
     select_oldest,
     stereo_match,
     triangulate_local,
 )
-from .store import ExactStore, check_store
-from .widgets import explore_stereo_slam
+
+_LAZY = {
+    **dict.fromkeys(("plot_frame_stages", "plot_kitti", "plot_run_errors", "plot_run_map", "plot_triangulation",
+                     "run_figure"), ".plot"),
+    "explore_stereo_slam": ".widgets",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 
 __all__ = [
-    "BINARY_DETECTORS",
     "COMPARISON",
-    "DETECTORS",
-    "POLICIES",
+    "KITTI_PARAMS",
     "SIZES",
     "STAGES",
+    "STEREO_DETECTORS",
     "DriftStudy",
-    "ExactStore",
-    "Features",
     "FrameRecord",
     "KittiRunResult",
     "LocalCloud",
     "MapMatches",
     "PoseEstimate",
+    "RenderParams",
     "StereoMatches",
+    "StereoParams",
     "StereoRunResult",
     "StereoSLAM",
-    "check_store",
     "comparison_table",
     "default_store",
-    "detect",
+    "detect_features",
     "estimate_pose",
     "experiment_poses",
-    "explore_stereo_slam",
+    "kitti_rig",
     "match_to_map",
-    "plot_frame_stages",
-    "plot_kitti",
-    "plot_run_errors",
-    "plot_run_map",
-    "plot_triangulation",
+    "ours_vs_source",
+    "pose_std",
+    "read_kitti_calib",
+    "read_kitti_image",
+    "read_kitti_poses",
+    "record_stereo_stream",
     "run_closed_loop",
     "run_comparison",
     "run_drift_study",
-    "run_figure",
     "run_kitti",
     "run_stereo_slam",
     "run_stereo_slam_variants",
@@ -79,3 +90,4 @@ __all__ = [
     "stereo_match",
     "triangulate_local",
 ]
+__all__ += list(_LAZY)

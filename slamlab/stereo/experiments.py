@@ -18,19 +18,23 @@ from .._table import format_table
 from ..geometry import wrap_angle
 from ..geometry.camera import StereoRig
 from ..geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
+from ..kdtree.stores import ExactStore, LandmarkStore
+from ..kdtree.workloads import RecordingStore, Workload
 from ..sim.arena import StereoArena, StereoSim
 from ..sim.stereo_paths import rectangular_loop, turn_in_place
+from .params import RenderParams, StereoParams
 from .slam import STAGES, StereoSLAM
 
 __all__ = [
     "COMPARISON",
-    "SIM_KEYS",
     "SIZES",
     "DriftStudy",
     "KittiRunResult",
     "StereoRunResult",
     "comparison_table",
     "experiment_poses",
+    "ours_vs_source",
+    "record_stereo_stream",
     "run_closed_loop",
     "run_comparison",
     "run_drift_study",
@@ -49,8 +53,7 @@ class StereoRunResult:
     """One stereo SLAM run on a rendered trajectory, errors against the ground truth (000 §3.7)."""
 
     name: str
-    detector: str
-    policy: str
+    params: StereoParams = field(repr=False)
     n_frames: int
     truth: np.ndarray = field(repr=False)  # (N, 3) x, y, yaw (unwrapped) in the map frame
     estimate: np.ndarray = field(repr=False)  # (N, 3)
@@ -61,6 +64,14 @@ class StereoRunResult:
     degenerate: np.ndarray = field(repr=False)  # indices of frames that kept the last pose
     stage_time_s: dict = field(repr=False, compare=False)  # per-frame stage times
     fps: float = field(compare=False)  # SLAM frames per second (rendering excluded)
+
+    @property
+    def detector(self) -> str:
+        return self.params.detector
+
+    @property
+    def policy(self) -> str:
+        return self.params.policy
 
     def __str__(self) -> str:
         return (
@@ -123,19 +134,18 @@ class StereoRunResult:
         return format_table(["stage", "ms/frame"], rows)
 
 
-#: keyword arguments of the runs that go to the renderer rather than to :class:`StereoSLAM`
-SIM_KEYS = ("arena", "rig", "camera_height_m", "noise_std", "drift_std_rad", "progress")
-
-
-def run_stereo_slam(poses, *, name: str = "run", rng=0, **kwargs) -> StereoRunResult:
+def run_stereo_slam(poses, *, name: str = "run", params: StereoParams | None = None, store=None,
+                    render: RenderParams | None = None, arena: StereoArena | None = None, rig: StereoRig | None = None,
+                    progress=None, rng=0, **overrides) -> StereoRunResult:
     """Render ``poses`` (N, 3) in an arena and run :class:`StereoSLAM` on them (000 §3.7).
 
-    The map frame is the first body pose; truth is expressed in it. Keywords in :data:`SIM_KEYS`
-    go to the renderer (see :func:`run_stereo_slam_variants`), the others to :class:`StereoSLAM`
-    (``detector``, ``policy``, ``ransac_iters``, ...).
+    The map frame is the first body pose; truth is expressed in it. ``params`` plus ``overrides``
+    set the pipeline (:class:`StereoParams`), ``store`` its landmark store (or a factory),
+    ``render`` / ``arena`` / ``rig`` / ``progress`` the renderer (see :func:`run_stereo_slam_variants`).
     """
-    sim = {k: kwargs.pop(k) for k in SIM_KEYS if k in kwargs}
-    return run_stereo_slam_variants(poses, {"run": kwargs}, name=name, rng=rng, **sim)["run"]
+    p = StereoParams.resolve(params, **overrides)
+    return run_stereo_slam_variants(poses, {name: p}, name=name, store=store, render=render, arena=arena, rig=rig,
+                                    progress=progress, rng=rng)[name]
 
 
 def run_stereo_slam_variants(
@@ -143,34 +153,53 @@ def run_stereo_slam_variants(
     variants: dict,
     *,
     name: str = "run",
+    params: StereoParams | None = None,
+    store=None,
+    render: RenderParams | None = None,
     arena: StereoArena | None = None,
     rig: StereoRig | None = None,
-    camera_height_m: float = 0.4,
-    noise_std: float = 0.0,
-    drift_std_rad: float = 0.0,
     progress=None,
     rng=0,
 ) -> dict:
-    """Like :func:`run_stereo_slam`, for several :class:`StereoSLAM` settings on the same rendered frames.
+    """Like :func:`run_stereo_slam`, for several pipeline settings on the same rendered frames.
 
-    ``variants`` maps a label to the ``StereoSLAM`` keyword arguments of one run; every run gets the
-    same RANSAC seed, so each result equals a separate :func:`run_stereo_slam` call. The frames are
-    rendered once (rendering costs about as much as our SURF).
+    ``variants`` maps a label to a :class:`StereoParams` or to a dict of overrides of ``params``
+    (default ``StereoParams()``); every run gets the same RANSAC seed, so each result equals a
+    separate :func:`run_stereo_slam` call. The frames are rendered once (rendering costs about as
+    much as our SURF). ``store``: a landmark store (one variant only) or a factory (default: each
+    run's :func:`~slamlab.stereo.slam.default_store`).
 
-    Renderer: ``arena`` (default the 6×8 m :class:`~slamlab.sim.arena.StereoArena`), ``rig`` (default
-    the 768×576, 40° pair with a 0.2 m baseline), ``camera_height_m``, ``noise_std`` (grey levels),
-    ``drift_std_rad`` (random-walk step of the right camera's orientation per frame) and
+    Renderer: ``render`` (:class:`RenderParams`: ``camera_height_m``, ``noise_std`` in grey levels,
+    ``drift_std_rad`` = random-walk step of the right camera's orientation per frame,
+    ``arena_seed``), ``arena`` (default the 6×8 m :class:`~slamlab.sim.arena.StereoArena` of
+    ``render.arena_seed``), ``rig`` (default the 768×576, 40° pair with a 0.2 m baseline) and
     ``progress(i)``, called after each frame.
     """
     poses = v.as_finite_array(poses, "poses", ndim=2)
     if poses.shape[1] != 3 or len(poses) < 2:
         raise ValueError(f"`poses` must have shape (N, 3) with N >= 2; got {poses.shape}")
     if not isinstance(variants, dict) or not variants:
-        raise TypeError("`variants` must be a non-empty dict of label -> StereoSLAM keyword arguments")
+        raise TypeError("`variants` must be a non-empty dict of label -> StereoParams or dict of overrides")
+    base = StereoParams.resolve(params)
+    settings = {}
+    for label, var in variants.items():
+        if isinstance(var, StereoParams):
+            settings[label] = var
+        elif isinstance(var, dict):
+            settings[label] = base.replace(**var)
+        else:
+            raise TypeError(f"`variants[{label!r}]` must be a StereoParams or a dict of overrides; got {type(var).__name__}")
+    if isinstance(store, LandmarkStore) and len(settings) > 1:
+        raise ValueError("a `store` instance serves one run; give a factory for several variants")
+    if progress is not None:
+        v.check_callable(progress, "progress")
+    render = RenderParams.resolve(render)
     r_sim, r_slam = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(2)
-    arena = StereoArena() if arena is None else arena
-    sim = StereoSim(arena, rig, camera_height_m=camera_height_m, noise_std=noise_std, drift_std_rad=drift_std_rad, rng=np.random.default_rng(r_sim))
-    slams = {k: StereoSLAM(sim.rig, sim.T_body_left, rng=np.random.default_rng(r_slam), **kw) for k, kw in variants.items()}
+    arena = StereoArena(seed=render.arena_seed) if arena is None else arena
+    sim = StereoSim(arena, rig, camera_height_m=render.camera_height_m, noise_std=render.noise_std,
+                    drift_std_rad=render.drift_std_rad, rng=np.random.default_rng(r_sim))
+    slams = {k: StereoSLAM(sim.rig, sim.T_body_left, params=p, store=store, rng=np.random.default_rng(r_slam))
+             for k, p in settings.items()}
     T0_inv = se3_inverse(se3_from_planar(*poses[0]))
     truth = np.array([planar_from_se3(T0_inv @ se3_from_planar(*p)) for p in poses])
     truth[:, 2] = poses[:, 2] - poses[0, 2]
@@ -187,7 +216,7 @@ def run_stereo_slam_variants(
     for k, slam in slams.items():
         est = slam.planar_trajectory
         out[k] = StereoRunResult(
-            name=name, detector=slam.detector, policy=slam.policy, n_frames=len(poses), truth=truth, estimate=est,
+            name=name, params=slam.params, n_frames=len(poses), truth=truth, estimate=est,
             pos_err_m=np.hypot(*(est[:, :2] - truth[:, :2]).T), yaw_err_rad=np.asarray(wrap_angle(est[:, 2] - truth[:, 2])),
             counts=slam.counts(), landmarks_xy=slam.landmark_map()[:, :2], degenerate=slam.degenerate_frames,
             stage_time_s=slam.stage_times(), fps=len(poses) / t_slam[k],
@@ -209,26 +238,32 @@ def experiment_poses(experiment: str, size: str = "small") -> np.ndarray:
     return rectangular_loop(step_m, np.deg2rad(loop_turn_deg))
 
 
-def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
+def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, params: StereoParams | None = None,
+                    store=None, render: RenderParams | None = None, progress=None, rng=0, **overrides) -> StereoRunResult:
     """360° turn in place in the 6×8 m arena, facing a wall at the start (000 §3.7.1).
 
     ``size="small"``: 10° per frame (37 frames); ``"full"``: 5° per frame (73 frames);
-    ``n_frames`` keeps only the first frames (for quick checks).
+    ``n_frames`` keeps only the first frames (for quick checks). ``params`` + ``overrides``:
+    :class:`StereoParams`; ``render``: :class:`RenderParams`.
     """
     v.check_choice(size, "size", SIZES)
     poses = _first(experiment_poses("turn in place", size), n_frames)
-    return run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
+    return run_stereo_slam(poses, name="turn in place", params=params, store=store, render=render, progress=progress, rng=rng,
+                           **overrides)
 
 
-def run_closed_loop(size: str = "small", *, n_frames: int | None = None, arena_seed: int = 0, rng=0, **kwargs) -> StereoRunResult:
+def run_closed_loop(size: str = "small", *, n_frames: int | None = None, params: StereoParams | None = None,
+                    store=None, render: RenderParams | None = None, progress=None, rng=0, **overrides) -> StereoRunResult:
     """The closed, roughly rectangular 4×5 m loop in the 6×8 m arena, back to the start pose (000 §3.7.2).
 
     ``size="small"``: 0.5 m and 20° per frame (57 frames); ``"full"``: 0.25 m and 15° per frame;
-    ``n_frames`` keeps only the first frames (for quick checks).
+    ``n_frames`` keeps only the first frames (for quick checks). ``params`` + ``overrides``:
+    :class:`StereoParams`; ``render``: :class:`RenderParams`.
     """
     v.check_choice(size, "size", SIZES)
     poses = _first(experiment_poses("closed loop", size), n_frames)
-    return run_stereo_slam(poses, name="closed loop", arena=StereoArena(seed=arena_seed), rng=rng, **kwargs)
+    return run_stereo_slam(poses, name="closed loop", params=params, store=store, render=render, progress=progress, rng=rng,
+                           **overrides)
 
 
 #: the default comparison of :func:`run_comparison`: 000's pipeline, and ORB with and without §3.5's policy
@@ -241,19 +276,19 @@ COMPARISON = {
 
 def run_comparison(
     experiment: str = "closed loop", size: str = "small", variants: dict | None = None, *, n_frames: int | None = None,
-    arena_seed: int = 0, rng=0, **sim_kwargs,
+    params: StereoParams | None = None, render: RenderParams | None = None, progress=None, rng=0,
 ) -> dict:
     """The turn or the loop once per pipeline setting, on the same rendered frames (000 §3.5, §3.7).
 
-    ``variants`` maps a label to :class:`StereoSLAM` keyword arguments (default :data:`COMPARISON`);
-    ``sim_kwargs`` go to the renderer (``noise_std``, ``drift_std_rad``, ``camera_height_m``, ``progress``).
+    ``variants`` maps a label to a :class:`StereoParams` or to overrides of ``params`` (default
+    :data:`COMPARISON`); ``render``: :class:`RenderParams` (``noise_std``, ``drift_std_rad``, ...).
     Returns label -> :class:`StereoRunResult`; :func:`comparison_table` prints them side by side.
     """
     v.check_choice(size, "size", SIZES)
     v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
     poses = _first(experiment_poses(experiment, size), n_frames)
     return run_stereo_slam_variants(poses, COMPARISON if variants is None else variants, name=experiment,
-                                    arena=StereoArena(seed=arena_seed), rng=rng, **sim_kwargs)  # fmt: skip
+                                    params=params, render=render, progress=progress, rng=rng)
 
 
 def comparison_table(results: dict) -> str:
@@ -299,28 +334,51 @@ class DriftStudy:
 
 
 def run_drift_study(
-    drift_std_rad=(0.0, 0.5e-3, 1e-3, 2e-3), experiment: str = "turn in place", size: str = "small", *, rng=0, **kwargs
+    drift_std_rad=(0.0, 0.5e-3, 1e-3, 2e-3), experiment: str = "turn in place", size: str = "small", *,
+    n_frames: int | None = None, params: StereoParams | None = None, render: RenderParams | None = None, rng=0,
+    **overrides,
 ) -> DriftStudy:
     """The same run at several calibration-drift levels (our experiment for 000 §3.2).
 
     The right camera's orientation takes a random-walk step of ``drift_std_rad`` per axis and
-    frame while the pipeline keeps the nominal calibration; ``kwargs`` go to the run
-    (``detector``, ``policy``, ``n_frames``, ...). Every level uses the same seeds, so the level is
-    the only change.
+    frame while the pipeline keeps the nominal calibration; ``params`` + ``overrides`` set the
+    pipeline (``detector``, ``policy``, ...), ``render`` the rest of the renderer. Every level uses
+    the same seeds, so the level is the only change.
     """
     runners = {"turn in place": run_turn_in_place, "closed loop": run_closed_loop}
     v.check_choice(experiment, "experiment", runners)
     levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
     if min(levels) < 0:
         raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
-    runs = tuple(runners[experiment](size, drift_std_rad=d, rng=rng, **kwargs) for d in levels)
+    p = StereoParams.resolve(params, **overrides)
+    render = RenderParams.resolve(render)
+    runs = tuple(runners[experiment](size, n_frames=n_frames, params=p, render=render.replace(drift_std_rad=d), rng=rng)
+                 for d in levels)
     return DriftStudy(experiment, levels, runs)
+
+
+def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0) -> Workload:
+    """Record the landmark-store calls of the stereo pipeline on 000's closed loop (our addition).
+
+    Runs the closed loop (small size: 57 frames; ``n_frames`` keeps the first frames only) with an
+    :class:`~slamlab.kdtree.ExactStore` wrapped in a :class:`~slamlab.kdtree.workloads.RecordingStore`,
+    and returns the recorded :class:`~slamlab.kdtree.workloads.Workload` for
+    :func:`slamlab.kdtree.experiments.run_store_comparison`. ``detector="sift"`` gives 128-d float
+    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter.
+    """
+    p = StereoParams(detector=detector)
+    rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
+    run_closed_loop("small", n_frames=n_frames, params=p, store=rec, rng=rng)
+    n = len(rec.iterations)
+    return rec.workload(f"stereo closed loop, {n} frames ({detector.upper()}, recorded)",
+                        base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
 
 
 @dataclass(frozen=True)
 class KittiRunResult:
-    """StereoSLAM on the 20 KITTI frames of ``kitti-odometry-06-stereo`` against the ground truth."""
+    """StereoSLAM on a KITTI odometry sequence against its ground truth (real data)."""
 
+    name: str  # the sequence folder's name
     truth: np.ndarray = field(repr=False)  # (N, 4, 4) left-camera poses in the frame-0 camera frame
     estimate: np.ndarray = field(repr=False)  # (N, 4, 4)
     ate_m: float
@@ -333,8 +391,8 @@ class KittiRunResult:
     fps: float = field(compare=False)
 
     def __str__(self) -> str:
-        return (f"KITTI 06, {len(self.truth)} frames: ATE {self.ate_m:.2f} m (after SE(3) alignment {self.ate_se3_m:.2f} m), "
-                f"final error {self.final_error_m:.2f} m over {self.path_length_m:.1f} m")  # fmt: skip
+        return (f"{self.name}, {len(self.truth)} frames: ATE {self.ate_m:.2f} m (after SE(3) alignment "
+                f"{self.ate_se3_m:.2f} m), final error {self.final_error_m:.2f} m over {self.path_length_m:.1f} m")
 
     def table(self) -> str:
         rows = [
@@ -346,47 +404,101 @@ class KittiRunResult:
             ["final error / path length, %", f"{100 * self.final_error_m / self.path_length_m:.1f}"],
             ["RANSAC inliers per frame (median)", f"{self.inliers_median:.0f}"],
         ]
-        return format_table(["quantity", "ours"], rows, title="KITTI odometry 06, frames 0-19 (real data)")
+        return format_table(["quantity", "ours"], rows,
+                            title=f"{self.name}, frames 0-{len(self.truth) - 1} (real data)")
 
 
-def run_kitti(folder=None, *, max_depth_m: float = 40.0, rng=0, **slam_kwargs) -> KittiRunResult:
-    """StereoSLAM on the 20 rectified KITTI stereo pairs of ``kitti-odometry-06-stereo`` (real data).
+#: the pipeline's settings on KITTI: ``max_depth_m = 40`` because the street scene reaches tens of
+#: metres (the arena's default, 10 m, would drop most of it); everything else as :class:`StereoParams`
+KITTI_PARAMS = StereoParams(max_depth_m=40.0)
 
-    The calibration comes from the set's ``calib.txt`` (P0, P1: fx = 707 px, baseline 0.537 m); the
-    map frame is the first left-camera frame, as in KITTI's ``poses.txt``. ATE and RPE by
-    :mod:`slamlab.evaluation` (equal to evo's).
+
+def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams | None = None, rng=0,
+              **overrides) -> KittiRunResult:
+    """StereoSLAM on a KITTI odometry sequence folder (real data); default the shared ``kitti-odometry-06-stereo``.
+
+    ``folder`` (``str`` or ``os.PathLike``) holds ``calib.txt`` (official ``P0: ...`` lines or the
+    bare rows, :func:`~slamlab.stereo.kitti.read_kitti_calib`), ``poses.txt`` (ground truth, one
+    3×4 row per frame), ``image_0/000000.png ...`` (left) and ``image_1/...`` (right). The image
+    size comes from the first left image, the run's name from the folder's name; ``n_frames``
+    keeps the first frames (default: one per pose). ``params`` (default :data:`KITTI_PARAMS`) plus
+    ``overrides``: :class:`StereoParams`. The map frame is the first left-camera frame, as in
+    ``poses.txt``. ATE and RPE by :mod:`slamlab.evaluation` (equal to evo's).
     """
-    import cv2
-
     from ..data import find_data
     from ..evaluation import Trajectory, ate, rpe
-    from ..geometry.camera import PinholeCamera
+    from .kitti import kitti_rig, read_kitti_image, read_kitti_poses
 
-    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else folder
-    P = np.loadtxt(d / "calib.txt").reshape(2, 3, 4)
-    fx, cx, cy = P[0][0, 0], P[0][0, 2], P[0][1, 2]
-    cam = PinholeCamera(1226, 370, fx, fx, cx, cy)
-    rig = StereoRig(cam, cam, np.eye(3), np.array([P[1][0, 3] / fx, 0.0, 0.0]))
-    gt34 = np.loadtxt(d / "poses.txt").reshape(-1, 3, 4)
-    slam = StereoSLAM(rig, np.eye(4), max_depth_m=max_depth_m, rng=rng, **slam_kwargs)
+    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else v.as_path(folder, "folder", kind="dir")
+    p = StereoParams.resolve(KITTI_PARAMS if params is None else params, **overrides)
+    gt34 = read_kitti_poses(d / "poses.txt")
+    n = len(gt34) if n_frames is None else min(len(gt34), v.check_int(n_frames, "n_frames", minimum=2))
+    gt34 = gt34[:n]
+    left0 = read_kitti_image(d / "image_0" / f"{0:06d}.png")
+    rig = kitti_rig(d / "calib.txt", left0.shape[1], left0.shape[0])
+    slam = StereoSLAM(rig, np.eye(4), params=p, rng=rng)
     t_slam = 0.0
-    for i in range(len(gt34)):
-        left = cv2.imread(str(d / "image_0" / f"{i:06d}.png"), cv2.IMREAD_GRAYSCALE)
-        right = cv2.imread(str(d / "image_1" / f"{i:06d}.png"), cv2.IMREAD_GRAYSCALE)
+    for i in range(n):
+        left = left0 if i == 0 else read_kitti_image(d / "image_0" / f"{i:06d}.png")
+        right = read_kitti_image(d / "image_1" / f"{i:06d}.png")
         t = time.perf_counter()
         slam.process(left, right)
         t_slam += time.perf_counter() - t
     est = slam.trajectory
-    truth = np.tile(np.eye(4), (len(gt34), 1, 1))
+    truth = np.tile(np.eye(4), (n, 1, 1))
     truth[:, :3, :] = gt34
-    ts = np.arange(len(gt34)) * 0.1  # KITTI runs at about 10 Hz
+    ts = np.arange(n) * 0.1  # KITTI runs at about 10 Hz
     ref = Trajectory(truth[:, :3, 3], truth[:, :3, :3], ts)
     ours = Trajectory(est[:, :3, 3], est[:, :3, :3], ts)
     return KittiRunResult(
-        truth=truth, estimate=est, ate_m=float(ate(ref, ours, align="none").rmse),
+        name=d.name, truth=truth, estimate=est, ate_m=float(ate(ref, ours, align="none").rmse),
         ate_se3_m=float(ate(ref, ours, align="se3").rmse), rpe_m=float(rpe(ref, ours, delta=1).rmse),
         final_error_m=float(np.linalg.norm(est[-1, :3, 3] - truth[-1, :3, 3])),
         path_length_m=float(np.sum(np.linalg.norm(np.diff(truth[:, :3, 3], axis=0), axis=1))),
         n_degenerate=len(slam.degenerate_frames), inliers_median=float(np.median(slam.counts()["n_inliers"][1:])),
-        fps=len(gt34) / t_slam,
+        fps=n / t_slam,
     )  # fmt: skip
+
+
+def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None = None,
+                   kitti: KittiRunResult | None = None) -> str:
+    """000's figures (§3.1 requirements, §3.7 results) beside ours, from the chapter's runs.
+
+    ``turn``: :func:`run_turn_in_place`; ``loops``: :func:`run_comparison` of the closed loop
+    (label -> result; the first is 000's pipeline); ``drift``: :func:`run_drift_study`;
+    ``kitti``: :func:`run_kitti`. Frame rates are timings and stay out (``timing_table``).
+    """
+    deg = np.rad2deg
+    runs = list(loops.items())
+    if not runs:
+        raise ValueError("`loops` is empty")
+    (label0, loop0), others = runs[0], runs[1:]
+
+    def per_run(fmt):
+        main = fmt(loop0)
+        return main + ("" if not others else " (" + "; ".join(f"{k}: {fmt(r)}" for k, r in others) + ")")
+
+    i180 = turn.frame_at_turn(np.pi)
+    rows = [
+        ["turn: max position error, m", "<= 0.15", f"{turn.pos_err_m.max():.2f}"],
+        ["turn: spread of positions, m", "~0.20", f"{turn.position_spread_m:.2f}"],
+        ["turn: heading error at 180 deg, deg", "<= 5", f"{deg(abs(turn.yaw_err_rad[i180])):.1f}"],
+        ["turn: heading error back at 0 deg, deg", "2-3", f"{deg(abs(turn.yaw_err_rad[-1])):.1f}"],
+        [f"loop ({label0}): max position error, m", "<= 0.5 (req.)", per_run(lambda r: f"{r.pos_err_m.max():.2f}")],
+        ["loop: max heading error / turned angle, %", "<= 10 (req.); 000: 10",
+         per_run(lambda r: f"{100 * r.heading_error_ratio:.1f}")],
+        ["loop: revisit pose change, m / deg", "same pose (req.)",
+         per_run(lambda r: f"{r.revisit_difference[0]:.2f} / {deg(abs(r.revisit_difference[1])):.1f}")],
+        ["loop: stereo matches per frame (median)", "~500 (<100 bad)",
+         per_run(lambda r: f"{np.median(r.counts['n_stereo']):.0f}")],
+    ]
+    if drift is not None:
+        levels = ", ".join(f"{1e3 * d:g}: {r.pos_err_m.max():.2f} m / {deg(np.abs(r.yaw_err_rad).max()):.1f} deg"
+                           for d, r in zip(drift.drift_std_rad, drift.runs, strict=True))
+        rows.append([f"calibration drift (mrad/frame): max error, {drift.experiment}, {drift.runs[0].n_frames} frames",
+                     "'tends to change'", levels])
+    if kitti is not None:
+        rows.append([f"real data ({kitti.name}, {len(kitti.truth)} frames): ATE / SE(3)-aligned / final, m",
+                     "— (no ground truth)", (f"{kitti.ate_m:.2f} / {kitti.ate_se3_m:.2f} / {kitti.final_error_m:.2f} "
+                                             f"over {kitti.path_length_m:.1f} m")])
+    return format_table(["quantity", "000", "ours"], rows, title="Stereo SLAM: 000 beside ours (frame rates: timing tables)")

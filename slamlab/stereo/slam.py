@@ -16,52 +16,50 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .. import _validate as v
+from ..features.detect import detect
 from ..filters.landmark import landmark_predict, landmark_update
 from ..geometry.camera import StereoRig
 from ..geometry.se3 import planar_from_se3
+from ..kdtree.stores import ExactStore, LandmarkStore, base_rule, make_store
+from .params import StereoParams
 from .stages import (
-    DETECTORS,
-    POLICIES,
-    detect,
-    estimate_pose,
-    match_to_map,
+    _check_features,
+    _estimate_pose,
+    _match_to_map,
+    _stereo_match,
+    _triangulate_local,
     pose_std,
-    stereo_match,
-    triangulate_local,
 )
-from .store import ExactStore, check_store
 
-__all__ = ["BINARY_DETECTORS", "STAGES", "FrameRecord", "StereoSLAM", "default_store"]
-
-#: detectors whose descriptors are binary (Hamming): the kd-tree stores do not apply to them
-BINARY_DETECTORS = ("orb",)
+__all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
 
 _EXECUTOR: ThreadPoolExecutor | None = None
 
 
-def _detect_pair(left, right, detector, n_features, parallel):
-    """Features of both images; in two threads when ``parallel`` (OpenCV and numpy release the GIL)."""
+def _detect_pair(left, right, method, kwargs, parallel):
+    """Features of both images by :func:`slamlab.features.detect`; in two threads when ``parallel``
+    (OpenCV and numpy release the GIL)."""
     global _EXECUTOR
     if not parallel:
-        return detect(left, detector, n_features), detect(right, detector, n_features)
+        return detect(left, method, **kwargs), detect(right, method, **kwargs)
     if _EXECUTOR is None:
         _EXECUTOR = ThreadPoolExecutor(max_workers=2, thread_name_prefix="slamlab-detect")
-    fut = _EXECUTOR.submit(detect, right, detector, n_features)
-    return detect(left, detector, n_features), fut.result()
+    fut = _EXECUTOR.submit(detect, right, method, **kwargs)
+    return detect(left, method, **kwargs), fut.result()
 
 
-def default_store(detector: str, base_seen_times: int = 3, max_non_base_time: int = 7):
+def default_store(params: StereoParams | None = None) -> LandmarkStore:
     """The landmark store the pipeline uses unless told otherwise (000 §3.4, §4).
 
     Float descriptors (SURF, SIFT): 000's multi kd-tree (n1 = 3500, q = 5.5, BBF with 200
     checks) behind the non-base buffer (:func:`slamlab.kdtree.make_store`). Binary descriptors
-    (ORB, Hamming distance): a kd-tree does not apply, so :class:`ExactStore` (brute force).
+    (ORB, Hamming distance): a kd-tree does not apply, so :class:`~slamlab.kdtree.ExactStore`
+    (brute force). Both apply the base rule with ``params``' ``base_seen_times`` / ``max_non_base_time``.
     """
-    if detector in BINARY_DETECTORS:
-        return ExactStore(base_seen_times, max_non_base_time)
-    from ..kdtree.stores import make_store
-
-    return make_store("multi", base_seen_times=base_seen_times, max_non_base_time=max_non_base_time)
+    p = StereoParams.resolve(params)
+    if p.binary:
+        return ExactStore(p.base_seen_times, p.max_non_base_time)
+    return make_store("multi", base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
 
 
 #: the per-frame stages whose times are recorded
@@ -79,120 +77,44 @@ class StereoSLAM:
 
     Parameters
     ----------
-    rig : the calibrated stereo rig.
+    rig : the calibrated stereo rig; every image must have its size (``rig.left.height_px`` ×
+        ``rig.left.width_px``).
     T_body_left : (4, 4) pose of the left camera in the body frame (the map is the first body frame).
-    detector : a name of :data:`slamlab.stereo.stages.DETECTORS`; default ``"surf"`` (000's
-        choice: the features chapter's own SURF); ``"orb"`` is the fast one.
-    n_features : at most this many keypoints per image (000: about 2000; our SURF's threshold
-        gives about 600 on the arena).
-    store : a landmark store with the interface of :mod:`slamlab.stereo.store`, or a factory
-        returning one; default :func:`default_store` (multi kd-tree for SURF/SIFT, exact
-        Hamming brute force for ORB).
-    view_margin_deg : match only the landmarks in front of the last pose's left camera, within its
-        horizontal field of view widened by this angle on each side and ``1.5 max_depth_m`` (our
-        addition, for long runs: with the exact store the query then grows with the visible part
-        of the map, not the whole map); None (default) searches the whole map, as 000 does.
-    parallel_detect : detect keypoints of the two images in two threads (our addition; same
-        result, about half the detection time on two cores).
-    policy : ``"oldest"`` (default, 000 §3.5: the pose from the landmarks first seen longest ago,
-        see :func:`~slamlab.stereo.stages.estimate_pose`; it pulls a revisited place back onto its
-        first pose) or ``"all"`` (the pose from all RANSAC inliers, to compare).
-    ransac_iters : RANSAC hypotheses per frame (000: about 200).
-    threshold_m, n_oldest, oldest_fraction, keep_fraction, min_inliers, ratio, epi_tol_px, max_depth_m : see the stage functions.
-    same_point_m : two nearest landmarks this close count as one point in the ratio rule
-        (:func:`~slamlab.stereo.stages.match_to_map`; None = plain ratio rule).
-    state_var, pixel_std : the landmark filter's process variance (m²) and the pixel error that
-        sets the observation covariance of a stereo point.
-    pose_std_m, pose_std_rad : uncertainty of the frame's pose added to the observation covariance
-        (``σ_t² + (σ_θ · range)²`` per axis; our addition: the observation in map coordinates carries
-        the pose error, and two nearly parallel stereo ellipsoids fused without it can throw a
-        landmark metres along its viewing ray).
-    max_rot_std_rad : a pose whose inliers leave a rotation standard deviation above this
-        (:func:`~slamlab.stereo.stages.pose_std` with the stereo covariances) is not trusted: the frame
-        keeps the last pose and adds nothing, like a RANSAC failure (status ``"ill_conditioned"``;
-        our addition; None = accept every converged pose). On the 80 m run the median frame shows
-        0.3 mrad, the 99th percentile 5 mrad; the pose that went 1.08 m wrong showed 14 mrad.
-    update_gate : an inlier refines its landmark only when the innovation's squared Mahalanobis
-        distance is at most this (default: χ²₃ at 99.9 %; None = always).
-    base_seen_times, max_non_base_time : 000 §3.4's base rule (3 sightings within 7 frames).
+    params : :class:`~slamlab.stereo.params.StereoParams` (default ``StereoParams()``): every
+        setting, with its source; ``overrides`` change single fields (``detector="orb"``).
+    store : a :class:`~slamlab.kdtree.LandmarkStore`, or a factory (class / callable) returning
+        one; default :func:`default_store` (multi kd-tree for SURF/SIFT, exact Hamming brute force
+        for ORB).
     rng : RANSAC's random stream.
 
     Examples
     --------
     >>> from slamlab.sim.arena import StereoArena, StereoSim
     >>> sim = StereoSim(StereoArena(2.0, 3.0, texel_m=0.01), rng=0)
-    >>> slam = StereoSLAM(sim.rig, sim.T_body_left, rng=0)
+    >>> slam = StereoSLAM(sim.rig, sim.T_body_left, params=StereoParams(), rng=0)
     >>> rec = slam.process(*sim.render_pair([1.0, 0.6, np.pi / 2]))
     >>> rec.status, bool(rec.n_stereo > 50)
     ('init', True)
     """
 
-    def __init__(
-        self,
-        rig: StereoRig,
-        T_body_left=None,
-        *,
-        detector: str = "surf",
-        n_features: int = 2000,
-        store=None,
-        view_margin_deg: float | None = None,
-        parallel_detect: bool = True,
-        policy: str = "oldest",
-        ransac_iters: int = 200,
-        threshold_m: float = 0.1,
-        n_oldest: int = 40,
-        oldest_fraction: float = 0.5,
-        keep_fraction: float = 0.5,
-        min_inliers: int = 10,
-        ratio: float = 0.8,
-        map_ratio: float = 0.8,
-        same_point_m: float | None = None,
-        epi_tol_px: float = 2.0,
-        max_depth_m: float = 10.0,
-        state_var: float = 1e-6,
-        pixel_std: float = 0.5,
-        pose_std_m: float = 0.02,
-        pose_std_rad: float = float(np.deg2rad(0.5)),
-        update_gate: float | None = 16.27,
-        max_rot_std_rad: float | None = 0.01,
-        base_seen_times: int = 3,
-        max_non_base_time: int = 7,
-        rng=None,
-    ):
+    def __init__(self, rig: StereoRig, T_body_left=None, *, params: StereoParams | None = None, store=None,
+                 rng=None, **overrides):
         if not isinstance(rig, StereoRig):
             raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
         self.rig = rig
         self.T_body_left = np.eye(4) if T_body_left is None else v.as_matrix(T_body_left, "T_body_left", (4, 4))
-        self.detector = v.check_choice(detector, "detector", DETECTORS)
-        self.n_features = v.check_int(n_features, "n_features", minimum=10)
-        self.base_seen_times = v.check_int(base_seen_times, "base_seen_times", minimum=1)
-        self.max_non_base_time = v.check_int(max_non_base_time, "max_non_base_time", minimum=1)
+        self.params = p = StereoParams.resolve(params, **overrides)
         if store is None:
-            store = default_store(self.detector, self.base_seen_times, self.max_non_base_time)
-        elif isinstance(store, type) or (callable(store) and not hasattr(store, "query")):
+            store = default_store(p)
+        elif isinstance(store, type) or (callable(store) and not isinstance(store, LandmarkStore)):
             store = store()  # a class or a factory
-        self.store = check_store(store)
-        self.policy = v.check_choice(policy, "policy", POLICIES)
-        self.ransac_iters = v.check_int(ransac_iters, "ransac_iters", minimum=1)
-        self.threshold_m = v.check_positive(threshold_m, "threshold_m")
-        self.n_oldest = v.check_int(n_oldest, "n_oldest", minimum=3)
-        self.oldest_fraction = v.check_positive(oldest_fraction, "oldest_fraction")
-        self.keep_fraction = v.check_positive(keep_fraction, "keep_fraction", allow_zero=True)
-        self.min_inliers = v.check_int(min_inliers, "min_inliers", minimum=3)
-        self.ratio = v.check_probability(ratio, "ratio")
-        self.map_ratio = v.check_probability(map_ratio, "map_ratio")
-        self.same_point_m = None if same_point_m is None else v.check_positive(same_point_m, "same_point_m")
-        self.epi_tol_px = v.check_positive(epi_tol_px, "epi_tol_px")
-        self.max_depth_m = v.check_positive(max_depth_m, "max_depth_m")
-        self.state_var = v.check_positive(state_var, "state_var", allow_zero=True)
-        self.pixel_std = v.check_positive(pixel_std, "pixel_std")
-        self.pose_std_m = v.check_positive(pose_std_m, "pose_std_m", allow_zero=True)
-        self.pose_std_rad = v.check_positive(pose_std_rad, "pose_std_rad", allow_zero=True)
-        self.update_gate = None if update_gate is None else v.check_positive(update_gate, "update_gate")
-        self.max_rot_std_rad = None if max_rot_std_rad is None else v.check_positive(max_rot_std_rad, "max_rot_std_rad")
-        self.parallel_detect = bool(parallel_detect)
-        self.view_margin_deg = None if view_margin_deg is None else v.check_positive(view_margin_deg, "view_margin_deg", allow_zero=True)
+        if not isinstance(store, LandmarkStore):
+            raise TypeError(f"`store` must be a slamlab.kdtree.LandmarkStore or a factory of one; "
+                            f"got {type(store).__name__}")
+        self.store = store
         self.rng = v.as_rng(rng)
+        self._detect_kwargs = p.detect_kwargs()
+        self._image_shape = (rig.left.height_px, rig.left.width_px)
         # landmarks (ids are row indices): position, covariance, bookkeeping
         self.X = np.empty((0, 3))
         self.P = np.empty((0, 3, 3))
@@ -208,18 +130,37 @@ class StereoSLAM:
         self.last_inlier_map = np.empty((0, 3))
 
     # -- the loop ------------------------------------------------------------------------------------
+    def _check_pair(self, left, right):
+        """The images' shapes: equal to each other and to the rig's image size (grey or colour)."""
+        sl, sr = np.shape(left), np.shape(right)
+        if len(sl) not in (2, 3) or len(sr) not in (2, 3):
+            raise ValueError(f"`left` and `right` must be (H, W) or (H, W, 3) images; got shapes {sl} and {sr}")
+        if sl != sr:
+            raise ValueError(f"`left` and `right` must have the same shape; got {sl} and {sr}")
+        if sl[:2] != self._image_shape:
+            raise ValueError(f"images must be {self._image_shape[0]}x{self._image_shape[1]} (rows x columns) like "
+                             f"the rig's cameras; got {sl[0]}x{sl[1]}")
+
     def process(self, left, right) -> FrameRecord:
-        """Run all stages on one stereo pair; returns the frame's counts (000 §3.3-3.6)."""
+        """Run all stages on one stereo pair; returns the frame's counts (000 §3.3-3.6).
+
+        ``left`` and ``right`` must have the same shape, the rig's image size; colour images are
+        converted with ``params.channel_order``.
+        """
+        self._check_pair(left, right)
+        p = self.params
         times = dict.fromkeys(STAGES, 0.0)
         clock = time.perf_counter
         t0 = clock()
-        fl, fr = _detect_pair(left, right, self.detector, self.n_features, self.parallel_detect)
+        fl, fr = _detect_pair(left, right, p.detector, self._detect_kwargs, p.parallel_detect)
+        _check_features(fl, "left features")
+        _check_features(fr, "right features")
         t1 = clock()
         times["detect"] = t1 - t0
-        sm = stereo_match(fl, fr, self.rig, ratio=self.ratio, epi_tol_px=self.epi_tol_px)
+        sm = _stereo_match(fl, fr, self.rig.F, p.ratio, p.epi_tol_px)
         t2 = clock()
         times["stereo"] = t2 - t1
-        cloud = triangulate_local(self.rig, fl, fr, sm, max_depth_m=self.max_depth_m, pixel_std=self.pixel_std)
+        cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m, p.pixel_std)
         Rb, tb = self.T_body_left[:3, :3], self.T_body_left[:3, 3]
         pts_body = cloud.points @ Rb.T + tb
         cov_body = Rb @ cloud.cov @ Rb.T
@@ -232,7 +173,7 @@ class StereoSLAM:
         )  # fmt: skip
         if len(self.X) == 0:
             # first frame (or an empty map): it defines the map frame
-            if len(pts_body) >= self.min_inliers:
+            if len(pts_body) >= p.min_inliers:
                 self._add_landmarks(pts_body, cov_body, desc, self.T)
                 rec["n_new"] = len(pts_body)
                 rec["status"] = "init"
@@ -240,21 +181,17 @@ class StereoSLAM:
                 rec["status"] = "too_few_points"
             self._finish(rec, times, t3, pts_body, np.zeros(len(pts_body), bool))
             return rec
-        cand = None if self.view_margin_deg is None else self.landmarks_in_view(self.view_margin_deg)
-        mm = match_to_map(desc, self.store, ratio=self.map_ratio, positions=self.X, same_point_m=self.same_point_m, candidates=cand)
+        cand = None if p.view_margin_deg is None else self.landmarks_in_view(p.view_margin_deg)
+        mm = _match_to_map(desc, self.store, p.map_ratio, self.X, p.same_point_m, cand)
         t4 = clock()
         times["map_match"] = t4 - t3
         rec["n_map_matches"] = len(mm.local)
-        if len(mm.local) < max(3, self.min_inliers):
+        if len(mm.local) < max(3, p.min_inliers):
             rec["status"] = "too_few_matches"
             self._finish(rec, times, t4, pts_body, np.zeros(len(pts_body), bool))
             return rec
-        est = estimate_pose(
-            pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], depth_m=cloud.points[mm.local, 2], cov=cov_body[mm.local],
-            policy=self.policy, n_oldest=self.n_oldest, oldest_fraction=self.oldest_fraction, keep_fraction=self.keep_fraction,
-            max_iters=self.ransac_iters,
-            threshold_m=self.threshold_m, min_inliers=self.min_inliers, rng=self.rng,
-        )  # fmt: skip
+        est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], cloud.points[mm.local, 2],
+                             cov_body[mm.local], p, self.rng)
         t5 = clock()
         times["pose"] = t5 - t4
         rec["n_used"] = est.n_used
@@ -262,11 +199,11 @@ class StereoSLAM:
             rec["status"] = "ransac_failed"
             self._finish(rec, times, t5, pts_body, np.zeros(len(pts_body), bool))
             return rec
-        if self.max_rot_std_rad is not None:
+        if p.max_rot_std_rad is not None:
             R = est.T[:3, :3]
             inl = mm.local[est.inliers]
             std = pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)
-            if not np.max(std[:3]) <= self.max_rot_std_rad:
+            if not np.max(std[:3]) <= p.max_rot_std_rad:
                 rec["status"] = "ill_conditioned"
                 self._finish(rec, times, t5, pts_body, np.zeros(len(pts_body), bool))
                 return rec
@@ -276,7 +213,7 @@ class StereoSLAM:
         ids = mm.ids[est.inliers]
         loc = mm.local[est.inliers]
         Z = pts_body[loc] @ R.T + t
-        pose_var = self.pose_std_m**2 + (self.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
+        pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
         Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
         rec["n_gated"] = int((~self.refine_landmarks(ids, Z, Rz)).sum())
         self.n_seen[ids] += 1
@@ -293,7 +230,8 @@ class StereoSLAM:
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
-        within its horizontal field of view widened by ``margin_deg`` per side and ``1.5 max_depth_m``."""
+        within its horizontal field of view widened by ``margin_deg`` per side and up to
+        ``params.view_depth_factor × params.max_depth_m`` (1.5 × 10 m by default) away."""
         T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
         T_wc = T @ self.T_body_left
         Xc = (self.X - T_wc[:3, 3]) @ T_wc[:3, :3]
@@ -301,7 +239,7 @@ class StereoSLAM:
         half = np.arctan2(max(cam.cx, cam.width_px - cam.cx), cam.fx) + np.deg2rad(margin_deg)
         z = Xc[:, 2]
         keep = self.alive & (z > 0) & (np.abs(np.arctan2(Xc[:, 0], z)) <= half)
-        keep &= np.einsum("ij,ij->i", Xc, Xc) <= (1.5 * self.max_depth_m) ** 2
+        keep &= np.einsum("ij,ij->i", Xc, Xc) <= (self.params.view_depth_factor * self.params.max_depth_m) ** 2
         return np.flatnonzero(keep)
 
     def refine_landmarks(self, ids, Z, Rz) -> np.ndarray:
@@ -310,11 +248,12 @@ class StereoSLAM:
         Observations whose innovation fails ``update_gate`` leave their landmark unchanged;
         returns the mask of the updated ones.
         """
-        P_pred = landmark_predict(self.P[ids], self.state_var)
+        gate = self.params.update_gate
+        P_pred = landmark_predict(self.P[ids], self.params.state_var)
         ok = np.ones(len(ids), dtype=bool)
-        if self.update_gate is not None and len(ids):
+        if gate is not None and len(ids):
             innov = Z - self.X[ids]
-            ok = np.einsum("ni,ni->n", innov, np.linalg.solve(P_pred + Rz, innov[:, :, None])[:, :, 0]) <= self.update_gate
+            ok = np.einsum("ni,ni->n", innov, np.linalg.solve(P_pred + Rz, innov[:, :, None])[:, :, 0]) <= gate
         up = ids[ok]
         self.X[up], self.P[up] = landmark_update(self.X[up], P_pred[ok], Z[ok], Rz[ok])
         return ok
@@ -332,19 +271,23 @@ class StereoSLAM:
     def _finish(self, rec, times, t_start, pts_body, inl_mask):
         t = time.perf_counter()
         self.store.end_iteration()
-        # the base rule, mirrored from the store: non-base landmarks time out
-        late = self.alive & (self.n_seen < self.base_seen_times) & (self.frame - self.first_seen >= self.max_non_base_time)
+        # the base rule (the stores' own): non-base landmarks time out
+        is_base, late = self._base_rule()
         self.alive[late] = False
         times["update"] += time.perf_counter() - t_start if rec["status"] == "ok" else time.perf_counter() - t
         R, tt = self.T[:3, :3], self.T[:3, 3]
         self.last_cloud_map = pts_body @ R.T + tt
         self.last_inlier_map = self.last_cloud_map[inl_mask]
         rec["n_landmarks"] = int(self.alive.sum())
-        rec["n_base"] = int((self.alive & (self.n_seen >= self.base_seen_times)).sum())
+        rec["n_base"] = int((self.alive & is_base).sum())
         self.poses.append(self.T.copy())
         self.records.append(rec)
         self.times.append(times)
         self.frame += 1
+
+    def _base_rule(self):
+        p = self.params
+        return base_rule(self.n_seen, self.frame - self.first_seen, p.base_seen_times, p.max_non_base_time)
 
     def run(self, frames, progress: Callable | None = None) -> StereoSLAM:
         """Process an iterable of ``(left, right)`` pairs; ``progress(i)`` is called after each."""
@@ -385,5 +328,5 @@ class StereoSLAM:
 
     def landmark_map(self, base_only: bool = True) -> np.ndarray:
         """(K, 3) landmark positions in the map frame (000's 2D map: the first two columns)."""
-        keep = self.alive & (self.n_seen >= self.base_seen_times) if base_only else self.alive
+        keep = self.alive & self._base_rule()[0] if base_only else self.alive
         return self.X[keep]

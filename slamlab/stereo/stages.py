@@ -1,8 +1,11 @@
 """The per-frame stages of the stereo SLAM pipeline (000 §3.3-3.6), callable one at a time.
 
-``detect`` → ``stereo_match`` → ``triangulate_local`` → ``match_to_map`` →
-``estimate_pose``; :class:`~slamlab.stereo.slam.StereoSLAM` runs them in a loop
-and refines / adds landmarks.
+:func:`slamlab.features.detect` (with :meth:`StereoParams.detect_kwargs`) → ``stereo_match``
+→ ``triangulate_local`` → ``match_to_map`` → ``estimate_pose``;
+:class:`~slamlab.stereo.slam.StereoSLAM` runs them in a loop and refines / adds landmarks.
+Each public stage takes ``params=`` (:class:`~slamlab.stereo.params.StereoParams`) plus
+overrides and checks its arguments once; the loop calls the unchecked cores (``_stereo_match``,
+...) with arguments it checked once.
 """
 
 from __future__ import annotations
@@ -12,20 +15,22 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import _validate as v
+from ..features.base import Features
+from ..features.detect import detect
+from ..features.matching import best_per_target, ratio_rule
 from ..geometry.camera import StereoRig
 from ..geometry.ransac import ransac
 from ..geometry.registration import RigidTransform, umeyama
 from ..geometry.triangulation import triangulate_stereo
+from ..kdtree.stores import LandmarkStore
+from .params import StereoParams
 
 __all__ = [
-    "DETECTORS",
-    "POLICIES",
-    "Features",
     "LocalCloud",
     "MapMatches",
     "PoseEstimate",
     "StereoMatches",
-    "detect",
+    "detect_features",
     "estimate_pose",
     "match_to_map",
     "pose_std",
@@ -34,57 +39,24 @@ __all__ = [
     "triangulate_local",
 ]
 
-POLICIES = ("oldest", "all")
+
+# --- stereo matching: ratio rule + epipolar check (000 §3.3) ---------------------------------------
 
 
-class Features(NamedTuple):
-    """Keypoints ``uv (N, 2)`` (column, row) and descriptors ``(N, D)`` (uint8 = binary / Hamming)."""
+def detect_features(image, *, params: StereoParams | None = None, **overrides) -> Features:
+    """Keypoints and descriptors of one image with the pipeline's settings (000 §3.3).
 
-    uv: np.ndarray
-    descriptors: np.ndarray
-
-    @property
-    def binary(self) -> bool:
-        return self.descriptors.dtype == np.uint8
-
-
-# --- detection: the features chapter's detectors with the pipeline's settings (000 §3.3) ------------
-
-#: detector -> (keyword that caps the number of keypoints, further parameters of ``slamlab.features.detect``);
-#: ORB's FAST threshold 12 (OpenCV: 20) finds 2000 points on the arena's fence
-DETECTORS = {
-    "orb": ("n_features", {"fast_threshold": 12}),
-    "sift": ("n_features", {}),
-    "surf": ("max_points", {}),
-}
-_DESCRIPTOR_SHAPE = {"orb": (32, np.uint8), "sift": (128, np.float32), "surf": (64, np.float32)}
-
-
-def detect(image, detector: str = "surf", n_features: int = 2000) -> Features:
-    """Keypoints and descriptors of one image (000 §3.3).
-
-    000 uses SURF with about 2000 points per 768×576 image; SURF is absent from
-    our OpenCV, so ``"surf"`` (the default) is the features chapter's own SURF
-    (``slamlab.features.detect``; its threshold, not ``n_features``, limits it to about 600
+    :func:`slamlab.features.detect` with :meth:`StereoParams.detect_kwargs`: 000 uses SURF with
+    about 2000 points per 768×576 image; SURF is absent from our OpenCV, so ``"surf"`` (the default)
+    is the features chapter's own SURF (its threshold, not ``n_features``, limits it to about 600
     points on the arena); ``"orb"`` and ``"sift"`` are OpenCV's (ORB is the fast one).
 
     >>> img = (np.indices((64, 64)).sum(0) % 16 < 8).astype(np.uint8) * 255
-    >>> f = detect(img, "orb", n_features=50); f.uv.shape[1], f.descriptors.dtype
+    >>> f = detect_features(img, detector="orb", n_features=50); f.uv.shape[1], f.descriptors.dtype
     (2, dtype('uint8'))
     """
-    from ..features import detect as features_detect  # the features chapter stays an optional import
-    from ..features import to_gray_uint8
-
-    v.check_choice(detector, "detector", DETECTORS)
-    n_features = v.check_int(n_features, "n_features", minimum=1)
-    cap, params = DETECTORS[detector]
-    f = features_detect(to_gray_uint8(image), detector, **{cap: n_features}, **params)
-    dim, dtype = _DESCRIPTOR_SHAPE[detector]
-    desc = np.empty((0, dim), dtype) if f.descriptors is None else np.asarray(f.descriptors, dtype)
-    return Features(np.asarray(f.uv, np.float64).reshape(-1, 2), desc)
-
-
-# --- stereo matching: ratio rule + epipolar check (000 §3.3) ---------------------------------------
+    p = StereoParams.resolve(params, **overrides)
+    return detect(image, p.detector, **p.detect_kwargs())
 
 
 class StereoMatches(NamedTuple):
@@ -97,38 +69,41 @@ class StereoMatches(NamedTuple):
 
 def _check_features(f, name):
     if not isinstance(f, Features):
-        raise TypeError(f"`{name}` must be Features (from `detect`); got {type(f).__name__}")
+        raise TypeError(f"`{name}` must be slamlab.features.Features (from `slamlab.features.detect`); "
+                        f"got {type(f).__name__}")
+    if f.descriptors is None:
+        raise ValueError(f"`{name}` must have descriptors (detect with descriptors=True)")
     return f
 
 
-def stereo_match(
-    left: Features,
-    right: Features,
-    rig: StereoRig,
-    *,
-    ratio: float = 0.8,
-    epi_tol_px: float = 2.0,
-    max_distance: float | None = None,
-) -> StereoMatches:
+def stereo_match(left: Features, right: Features, rig: StereoRig, *, params: StereoParams | None = None,
+                 max_distance: float | None = None, **overrides) -> StereoMatches:
     """Left-right correspondences by descriptor, ratio rule and epipolar check (000 §3.3).
 
     Candidates of a left keypoint are the right keypoints within ``epi_tol_px`` of its
     epipolar line (from the calibrated ``rig``); the nearest candidate is kept when its
     distance is below ``ratio`` × the second nearest (Lowe's rule; 000 does not say how it
     matched — our choice) and when no other left keypoint claims it with a smaller distance.
+    ``params`` / ``overrides``: :class:`StereoParams` (``ratio``, ``epi_tol_px``).
     """
+    p = StereoParams.resolve(params, **overrides)
     _check_features(left, "left")
     _check_features(right, "right")
     if not isinstance(rig, StereoRig):
         raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
-    ratio = v.check_probability(ratio, "ratio")
-    epi_tol_px = v.check_positive(epi_tol_px, "epi_tol_px")
+    if len(left.uv) and len(right.uv) and (left.descriptors.dtype != right.descriptors.dtype
+                                           or left.descriptors.shape[1] != right.descriptors.shape[1]):
+        raise ValueError("`left` and `right` descriptors must have the same type and length")
+    max_distance = None if max_distance is None else v.check_positive(max_distance, "max_distance")
+    return _stereo_match(left, right, rig.F, p.ratio, p.epi_tol_px, max_distance)
+
+
+def _stereo_match(left, right, F, ratio, epi_tol_px, max_distance=None) -> StereoMatches:
+    """:func:`stereo_match` on checked arguments (the per-frame core)."""
     empty = StereoMatches(np.empty(0, np.intp), np.empty(0, np.intp), np.empty(0))
     if len(left.uv) == 0 or len(right.uv) == 0:
         return empty
-    if left.descriptors.dtype != right.descriptors.dtype or left.descriptors.shape[1] != right.descriptors.shape[1]:
-        raise ValueError("`left` and `right` descriptors must have the same type and length")
-    li, ri = _epipolar_pairs(left.uv, right.uv, rig.F, epi_tol_px)
+    li, ri = _epipolar_pairs(left.uv, right.uv, F, epi_tol_px)
     if li.size == 0:
         return empty
     d = _pair_distances(left.descriptors, right.descriptors, li, ri)
@@ -143,15 +118,11 @@ def stereo_match(
     d_rest[first_min] = np.inf
     d2 = np.minimum.reduceat(d_rest, start)
     li, ri = li[first_min], ri[first_min]
-    keep = d1 < ratio * d2
+    keep = ratio_rule(d1, d2, ratio)
     if max_distance is not None:
-        keep &= d1 <= v.check_positive(max_distance, "max_distance")
+        keep &= d1 <= max_distance
     li, ri, d1 = li[keep], ri[keep], d1[keep]
-    # each right keypoint goes to its best left keypoint only
-    order = np.lexsort((d1, ri))
-    first = np.ones(order.size, dtype=bool)
-    first[1:] = ri[order][1:] != ri[order][:-1]
-    sel = np.sort(order[first])
+    sel = best_per_target(ri, d1)  # each right keypoint goes to its best left keypoint only
     return StereoMatches(li[sel], ri[sel], d1[sel])
 
 
@@ -217,30 +188,28 @@ class LocalCloud(NamedTuple):
     gap_m: np.ndarray
 
 
-def triangulate_local(
-    rig: StereoRig,
-    left: Features,
-    right: Features,
-    matches: StereoMatches,
-    *,
-    min_depth_m: float = 0.3,
-    max_depth_m: float = 10.0,
-    pixel_std: float = 0.5,
-) -> LocalCloud:
+def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: StereoMatches, *,
+                      params: StereoParams | None = None, **overrides) -> LocalCloud:
     """Midpoint triangulation of the stereo matches, with covariances (000 §3.3).
 
     Keeps points in front of both cameras with depth in ``[min_depth_m, max_depth_m]``.
     The covariance (our addition, used by the landmark filter) is that of a stereo
     point with ``pixel_std`` error per coordinate: lateral ``z σ / f``, depth
-    ``z² √2 σ / (f b)``, rotated along the viewing ray.
+    ``z² √2 σ / (f b)``, rotated along the viewing ray. ``params`` / ``overrides``:
+    :class:`StereoParams` (``min_depth_m``, ``max_depth_m``, ``pixel_std``).
     """
+    p = StereoParams.resolve(params, **overrides)
+    if not isinstance(rig, StereoRig):
+        raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
     _check_features(left, "left")
     _check_features(right, "right")
     if not isinstance(matches, StereoMatches):
         raise TypeError(f"`matches` must be StereoMatches; got {type(matches).__name__}")
-    pixel_std = v.check_positive(pixel_std, "pixel_std")
-    min_depth_m = v.check_positive(min_depth_m, "min_depth_m")
-    max_depth_m = v.check_positive(max_depth_m, "max_depth_m")
+    return _triangulate_local(rig, left, right, matches, p.min_depth_m, p.max_depth_m, p.pixel_std)
+
+
+def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixel_std) -> LocalCloud:
+    """:func:`triangulate_local` on checked arguments (the per-frame core)."""
     if len(matches.left) == 0:
         return LocalCloud(np.empty((0, 3)), np.empty((0, 3, 3)), np.empty(0, np.intp), np.empty(0))
     tri = triangulate_stereo(rig, left.uv[matches.left], right.uv[matches.right])
@@ -270,67 +239,58 @@ class MapMatches(NamedTuple):
     unmatched: np.ndarray
 
 
-def match_to_map(
-    descriptors,
-    store,
-    *,
-    ratio: float = 0.8,
-    max_distance: float | None = None,
-    positions=None,
-    same_point_m: float | None = None,
-    candidates=None,
-) -> MapMatches:
+def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | None = None, positions=None,
+                 candidates=None, max_distance: float | None = None, **overrides) -> MapMatches:
     """Match local descriptors to the stored landmarks: 2-NN query + ratio rule, one local per landmark (000 §3.4).
 
-    With ``positions`` ((n, 3) landmark positions indexed by id) and ``same_point_m``, two nearest
+    The ratio is ``map_ratio`` of ``params`` / ``overrides`` (:class:`StereoParams`). With
+    ``positions`` ((n, 3) landmark positions indexed by id) and ``same_point_m``, two nearest
     landmarks closer than ``same_point_m`` to each other count as one physical point (a duplicate
     added when a sighting was missed), so the ratio rule does not reject them (our addition:
     without it, duplicates make every later sighting of a place ambiguous and the map stops
     closing loops).
 
-    With ``candidates`` (landmark ids), only those landmarks may match: a store with a
-    ``query_among`` method (:class:`~slamlab.stereo.store.ExactStore`) searches just them; with any
-    other store the nearest neighbour must be one of them.
+    With ``candidates`` (landmark ids), only those landmarks are searched
+    (:meth:`~slamlab.kdtree.LandmarkStore.query_among`, exact for every store).
 
-    >>> from slamlab.stereo.store import ExactStore
+    >>> from slamlab.kdtree import ExactStore
     >>> s = ExactStore(); s.add(np.array([[0.0, 0.0], [5.0, 0.0]]), [7, 8])
     >>> m = match_to_map(np.array([[0.1, 0.0], [2.4, 0.0]]), s)
     >>> m.local.tolist(), m.ids.tolist(), m.unmatched.tolist()
     ([0], [7], [1])
     """
+    p = StereoParams.resolve(params, **overrides)
     D = np.asarray(descriptors)
     if D.ndim != 2:
         raise ValueError(f"`descriptors` must be 2-D (K, D); got shape {D.shape}")
-    ratio = v.check_probability(ratio, "ratio")
+    if not isinstance(store, LandmarkStore):
+        raise TypeError(f"`store` must be a slamlab.kdtree.LandmarkStore; got {type(store).__name__}")
+    X = None if positions is None else v.as_finite_array(positions, "positions", ndim=2)
+    cand = None if candidates is None else np.asarray(candidates, dtype=np.int64).ravel()
+    max_distance = None if max_distance is None else v.check_positive(max_distance, "max_distance")
+    return _match_to_map(D, store, p.map_ratio, X, p.same_point_m, cand, max_distance)
+
+
+def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates=None, max_distance=None):
+    """:func:`match_to_map` on checked arguments (the per-frame core)."""
     k = D.shape[0]
     if k == 0 or len(store) == 0:
         return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k))
-    cand = None if candidates is None else np.asarray(candidates, dtype=np.int64).ravel()
-    if cand is not None and callable(getattr(store, "query_among", None)):
-        dist, ids = store.query_among(D, cand, k=2)
+    if candidates is not None:
+        dist, ids = store.query_among(D, candidates, k=2)
     else:
         dist, ids = store.query(D, k=2)
-    dist = np.asarray(dist, dtype=float)
-    ids = np.asarray(ids)
-    ok = (ids[:, 0] >= 0) & (dist[:, 0] < ratio * dist[:, 1])
-    if cand is not None:
-        ok &= np.isin(ids[:, 0], cand)
+    ok = (ids[:, 0] >= 0) & ratio_rule(dist[:, 0], dist[:, 1], ratio)
     if positions is not None and same_point_m is not None:
-        X = v.as_finite_array(positions, "positions", ndim=2)
-        same_point_m = v.check_positive(same_point_m, "same_point_m")
         both = ~ok & (ids[:, 0] >= 0) & (ids[:, 1] >= 0)
         if both.any():
-            gap = np.linalg.norm(X[ids[both, 0]] - X[ids[both, 1]], axis=1)
+            gap = np.linalg.norm(positions[ids[both, 0]] - positions[ids[both, 1]], axis=1)
             ok[np.flatnonzero(both)[gap < same_point_m]] = True
     if max_distance is not None:
-        ok &= dist[:, 0] <= v.check_positive(max_distance, "max_distance")
+        ok &= dist[:, 0] <= max_distance
     loc = np.flatnonzero(ok)
     lid, d = ids[ok, 0], dist[ok, 0]
-    # one local point per landmark: the closest descriptor wins
-    order = np.lexsort((d, lid))
-    first = np.ones(order.size, dtype=bool)
-    first[1:] = lid[order][1:] != lid[order][:-1]
-    sel = np.sort(order[first])
+    sel = best_per_target(lid, d)  # one local point per landmark: the closest descriptor wins
     claimed = np.zeros(k, dtype=bool)
     claimed[loc] = True  # ratio-passing points that lost a duplicate are neither matches nor new
     return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed))
@@ -423,33 +383,17 @@ def _residuals(T: RigidTransform, src, dst, w):
     return np.linalg.norm(src @ T.R.T + T.t - dst, axis=1) * np.sqrt(w)
 
 
-def estimate_pose(
-    local_points,
-    map_points,
-    first_seen=None,
-    *,
-    depth_m=None,
-    cov=None,
-    policy: str = "oldest",
-    n_oldest: int = 40,
-    oldest_fraction: float = 0.5,
-    keep_fraction: float = 0.5,
-    loose_factor: float = 4.0,
-    max_std_factor: float | None = 2.0,
-    max_correction_rad: float | None = None,
-    max_correction_m: float | None = None,
-    max_iters: int = 200,
-    threshold_m: float = 0.1,
-    depth_ref_m: float = 3.0,
-    min_inliers: int = 8,
-    rng=None,
-) -> PoseEstimate:
+def estimate_pose(local_points, map_points, first_seen=None, *, depth_m=None, cov=None,
+                  params: StereoParams | None = None, rng=None, **overrides) -> PoseEstimate:
     """Rotation + translation mapping the local cloud onto the map landmarks, by RANSAC + Umeyama (000 §3.5).
 
     Parameters
     ----------
     local_points, map_points : (M, 3) matched points in the body frame and in the map frame.
     first_seen : (M,) frame at which each matched landmark was first seen (for ``policy="oldest"``).
+    params, overrides : :class:`StereoParams` (``policy``, ``ransac_iters``, ``threshold_m``,
+        ``depth_ref_m``, ``min_inliers``, ``n_oldest``, ``oldest_fraction``, ``keep_fraction``,
+        ``loose_factor``, ``still_fraction``, ``max_std_factor``, ``max_correction_*``).
     depth_m : (M,) depths of the local points: the inlier threshold grows as
         ``threshold_m · max(1, (depth / depth_ref_m)²)`` (stereo depth error ∝ depth²; our choice),
         and the final fit weights points by the inverse square of that scale.
@@ -460,7 +404,7 @@ def estimate_pose(
         nearly ambiguous) — extended by the next-oldest until, with ``cov`` given, no pose parameter is
         more than ``max_std_factor`` times as uncertain as with all candidates (:func:`pose_std`;
         "sufficiently large for computing the position") — get a RANSAC of their own, whose pose wins when at least
-        ``keep_fraction`` of them agree, it keeps 80 % of the candidates within the loose band and
+        ``keep_fraction`` of them agree, it keeps ``still_fraction`` (80 %) of the candidates within the loose band and
         it differs from the consensus pose by at most ``max_correction_rad`` / ``max_correction_m``
         (None = unbounded; a bound of 5° / 0.3 m also blocks the loop-closing correction)
         (our reading of 000 §3.5: old landmarks correct the drift of the recent ones when a place
@@ -468,7 +412,7 @@ def estimate_pose(
         ``"all"`` — the pose is the least-squares fit on all RANSAC inliers.
     cov : (M, 3, 3) covariances of the local points (body frame), for the conditioning test of
         ``policy="oldest"``; None skips the test.
-    max_iters : RANSAC hypotheses (000: about 200), minimal samples of 3, early exit at 99.9 % confidence.
+    ransac_iters : RANSAC hypotheses (000: about 200), minimal samples of 3, early exit at 99.9 % confidence.
     min_inliers : inliers needed for a valid pose.
 
     Raises
@@ -484,6 +428,7 @@ def estimate_pose(
     >>> bool(np.allclose(est.T, T)), int(est.inliers.sum())
     (True, 30)
     """
+    p = StereoParams.resolve(params, **overrides)
     src = v.as_finite_array(local_points, "local_points", ndim=2)
     dst = v.as_finite_array(map_points, "map_points", ndim=2)
     if src.shape != dst.shape or src.shape[1:] != (3,):
@@ -491,44 +436,37 @@ def estimate_pose(
     m = src.shape[0]
     if m < 3:
         raise ValueError(f"`local_points` must hold at least 3 matches for a 3-D pose; got {m}")
-    policy = v.check_choice(policy, "policy", POLICIES)
-    threshold_m = v.check_positive(threshold_m, "threshold_m")
-    depth_ref_m = v.check_positive(depth_ref_m, "depth_ref_m")
-    min_inliers = v.check_int(min_inliers, "min_inliers", minimum=3)
-    n_oldest = v.check_int(n_oldest, "n_oldest", minimum=3)
-    oldest_fraction = v.check_positive(oldest_fraction, "oldest_fraction")
-    keep_fraction = v.check_positive(keep_fraction, "keep_fraction", allow_zero=True)
-    loose_factor = v.check_positive(loose_factor, "loose_factor")
-    if max_std_factor is not None:
-        max_std_factor = v.check_positive(max_std_factor, "max_std_factor")
     if cov is not None:
         cov = np.asarray(cov, dtype=float)
         if cov.shape != (m, 3, 3) or not np.all(np.isfinite(cov)):
             raise ValueError(f"`cov` must be a finite ({m}, 3, 3) array; got shape {cov.shape}")
-    if oldest_fraction > 1:
-        raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {oldest_fraction}")
-    rng = v.as_rng(rng)
     depth = np.linalg.norm(src, axis=1) if depth_m is None else v.as_vector(depth_m, "depth_m", m)
-    scale = np.maximum(1.0, (depth / depth_ref_m) ** 2)
-    w = 1.0 / scale**2
-    if first_seen is None:
-        first_seen = np.zeros(m, dtype=np.int64)
-    first_seen = np.asarray(first_seen)
+    first_seen = np.zeros(m, dtype=np.int64) if first_seen is None else np.asarray(first_seen)
     if first_seen.shape != (m,):
         raise ValueError(f"`first_seen` must have shape ({m},); got {first_seen.shape}")
+    return _estimate_pose(src, dst, first_seen, depth, cov, p, v.as_rng(rng))
+
+
+def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> PoseEstimate:
+    """:func:`estimate_pose` on checked arguments (the per-frame core)."""
+    m = src.shape[0]
+    threshold_m, min_inliers, max_iters = p.threshold_m, p.min_inliers, p.ransac_iters
+    loose_factor, max_std_factor = p.loose_factor, p.max_std_factor
+    scale = np.maximum(1.0, (depth / p.depth_ref_m) ** 2)
+    w = 1.0 / scale**2
 
     r = ransac((src, dst, w), _fit, _residuals, 3, threshold_m, max_iters=max_iters, min_inliers=min_inliers, rng=rng)
     if not r.converged:
         return PoseEstimate(np.eye(4), np.zeros(m, dtype=bool), False, 0, r.n_iters)
     Tm = r.model
     used = np.flatnonzero(r.inliers)
-    if policy == "oldest":
+    if p.policy == "oldest":
         # 000 §3.5: the pose from the landmarks first seen longest ago and at about the same time.
         # Candidates: matches within `loose_factor` thresholds of the consensus pose (true matches to
         # old landmarks that drifted apart from the recent map stay, random false matches go);
         # then RANSAC again on the oldest of them, kept if most of them agree.
         loose = np.flatnonzero(_residuals(Tm, src, dst, w) <= loose_factor * threshold_m)
-        n_min = max(n_oldest, int(np.ceil(oldest_fraction * loose.size)))
+        n_min = max(p.n_oldest, int(np.ceil(p.oldest_fraction * loose.size)))
         old = loose[select_oldest(first_seen[loose], n_min)]
         if cov is not None and max_std_factor is not None and old.size < loose.size:
             # grow the set by first-sighting time until it determines the pose nearly as well as all candidates
@@ -547,7 +485,7 @@ def estimate_pose(
         if old.size >= 3:
             r_old = ransac((src[old], dst[old], w[old]), _fit, _residuals, 3, threshold_m, max_iters=max_iters, rng=rng)
             n_old = int(r_old.inliers.sum())
-            if r_old.converged and n_old >= max(min(min_inliers, old.size), keep_fraction * old.size):
+            if r_old.converged and n_old >= max(min(min_inliers, old.size), p.keep_fraction * old.size):
                 # and it must still explain the candidates loosely: a wedge of old landmarks at one
                 # edge of the view can otherwise trade yaw for sideways translation
                 T_old = r_old.model
@@ -555,10 +493,10 @@ def estimate_pose(
                 # the old landmarks may correct the consensus pose by a bounded amount only
                 d_rot = np.arccos(np.clip((np.trace(T_old.R @ Tm.R.T) - 1.0) / 2.0, -1.0, 1.0))
                 d_pos = np.linalg.norm(T_old.t - Tm.t)
-                bounded = (max_correction_rad is None or d_rot <= max_correction_rad) and (
-                    max_correction_m is None or d_pos <= max_correction_m
+                bounded = (p.max_correction_rad is None or d_rot <= p.max_correction_rad) and (
+                    p.max_correction_m is None or d_pos <= p.max_correction_m
                 )
-                if still.mean() >= 0.8 and bounded:
+                if still.mean() >= p.still_fraction and bounded:
                     Tm, used = T_old, old[r_old.inliers]
     inl = _residuals(Tm, src, dst, w) <= threshold_m
     T = np.eye(4)

@@ -6,7 +6,8 @@ import ipywidgets as widgets
 from IPython.display import display
 
 from ..widgets import STYLE as _STYLE
-from .experiments import run_closed_loop, run_turn_in_place
+from .experiments import experiment_poses, run_closed_loop, run_turn_in_place
+from .params import RenderParams
 from .plot import run_figure
 
 __all__ = ["explore_stereo_slam"]
@@ -17,20 +18,23 @@ def explore_stereo_slam(**defaults):
     """Run the turn in place or the closed loop (small size) with the chosen settings -> table and plots.
 
     Each change starts a run of 15-30 s; the run button (``manual``) avoids a run per slider step.
+    ``n_frames`` (a default, not a slider) keeps the first frames only (quick checks).
     A bad combination prints its message instead of failing.
     """
     d = {"experiment": "turn in place", "detector": "surf", "policy": "oldest", "ransac_iters": 200,
-         "noise_std": 0.0, "drift_mrad": 0.0, "rng": 0}  # fmt: skip
+         "noise_std": 0.0, "drift_mrad": 0.0, "rng": 0, "n_frames": None}  # fmt: skip
     d.update(defaults)
 
     def show(experiment, detector, policy, ransac_iters, noise_std, drift_mrad):
         run = run_turn_in_place if experiment == "turn in place" else run_closed_loop
-        bar = widgets.IntProgress(min=0, max=60, description="frames")
+        n = len(experiment_poses(experiment, "small")) if d["n_frames"] is None else d["n_frames"]
+        bar = widgets.IntProgress(min=0, max=n, description="frames")
         display(bar)
         try:
+            render = RenderParams(noise_std=float(noise_std), drift_std_rad=float(drift_mrad) * 1e-3)
             res = run(
-                "small", detector=detector, policy=policy, ransac_iters=int(ransac_iters), noise_std=float(noise_std),
-                drift_std_rad=float(drift_mrad) * 1e-3, rng=d["rng"], progress=lambda i: setattr(bar, "value", i + 1),
+                "small", n_frames=d["n_frames"], detector=detector, policy=policy, ransac_iters=int(ransac_iters),
+                render=render, rng=d["rng"], progress=lambda i: setattr(bar, "value", i + 1),
             )  # fmt: skip
         except (ValueError, TypeError, ImportError) as exc:
             print(f"Cannot run with these settings: {exc}")

@@ -89,13 +89,15 @@ def test_ratio_tradeoff_monotone():
 
 
 def test_experiment_bad_input():
-    with pytest.raises(ValueError, match="`sequences` must be one of"):
+    with pytest.raises(ValueError, match=r"`sequence` must be one of .* or the path of an Oxford-layout folder"):
         F.run_pair_evaluation(("leuven",), (2,))
-    with pytest.raises(ValueError, match="`steps` must be <= 6"):
+    with pytest.raises(FileNotFoundError, match="no image img7"):
         F.run_pair_evaluation(("graf",), (7,))
+    with pytest.raises(ValueError, match="`steps` must be >= 2"):
+        F.run_pair_evaluation(("graf",), (1,))
     with pytest.raises(ValueError, match="`detectors` must be one of"):
         F.run_pair_evaluation(("graf",), (2,), detectors=("AKAZE",))
-    with pytest.raises(ValueError, match="`index` must be <= 6"):
+    with pytest.raises(FileNotFoundError, match="no image img7"):
         F.load_oxford_image("graf", 7)
     with pytest.raises(ValueError, match="not both"):
         F.load_oxford_image("graf", 1, scale=0.5, size=(768, 576))

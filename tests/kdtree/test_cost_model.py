@@ -1,5 +1,6 @@
 """Cost model of 000 §4.1.2: bounds, formulas on hand-computed cases, and the readings' optima."""
 
+import numpy as np
 import pytest
 
 from slamlab.kdtree.cost_model import (
@@ -61,7 +62,13 @@ def test_calibration_reproduces_000():
 
 def test_readings_and_their_optima_match_the_close_reading():
     res = run_cost_model(n=50000, s=500, m=500, C=9.0)
-    (_, n1_up, q_up, _, e0), (_, n1_lo, q_lo, _, _), (_, n1_int, q_int, _, _), (_, n1_nb, _, _, e3) = res.readings
+    lit, *rest = res.readings
+    (_, n1_up, q_up, _, e0), (_, n1_lo, q_lo, _, _), (_, n1_int, q_int, _, _), (_, n1_nb, _, _, e3) = rest
+    # the Appendix as printed (searchKd with C inside, no factor s) -> about (1200, 2.3)
+    assert lit[1] == pytest.approx(1200, abs=100)
+    assert lit[2] == pytest.approx(2.3, abs=0.1)
+    assert res.literal is lit
+    assert res.optimum is rest[0]
     # SPEC close reading: upper -> (3430, 5.3); lower -> (3530, 4.5); integer -> (2600, 3.7-3.8); no build -> edge
     assert n1_up == pytest.approx(3430, abs=100)
     assert q_up == pytest.approx(5.3, abs=0.1)
@@ -76,9 +83,27 @@ def test_readings_and_their_optima_match_the_close_reading():
     assert res.flat_n1[0] <= 3500 <= res.flat_n1[1]
     assert res.flat_q[0] <= 5.5 <= res.flat_q[1]
     f000 = iter_time(3500, 5.5, n=50000, s=500, m=500, C=9)
-    assert f000 <= 1.01 * res.readings[0][3]
+    assert f000 <= 1.01 * res.optimum[3]
     assert "n1" in res.table()
     assert "3500" in res.table()
+
+
+def test_literal_appendix_by_hand():
+    # addKd + C searchKd at one point, every term written out (p at the upper bound, base-2 logs)
+    from slamlab.kdtree.cost_model import add_kd, p_bounds, search_kd
+
+    n1, q, n, m, C = 2000.0, 3.0, 50000.0, 500.0, 9.0
+    p = np.log(n / n1) / np.log(q) + 1.0
+    assert p == pytest.approx(p_bounds(n, n1, q)[1])
+    search = p * np.log2(n1) + C * p * (p - 1) / 2 * np.log2(q)
+    add = n1 * np.log2(n1) + m * q * p * np.log2(n1) + m * q / 2 * p * (p - 1) * np.log2(q)
+    assert search_kd(n1, q, p, C) == pytest.approx(search)
+    assert add_kd(n1, q, p, m) == pytest.approx(add)
+    # s does not enter the literal reading
+    for s in (1.0, 500.0):
+        assert iter_time(n1, q, n=n, s=s, m=m, C=C, reading="literal") == pytest.approx(add + C * search)
+    with pytest.raises(ValueError, match="`reading` must be one of"):
+        iter_time(n1, q, reading="maple")
 
 
 def test_grid_minimum_is_a_minimum():

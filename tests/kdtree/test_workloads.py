@@ -70,16 +70,3 @@ def test_bad_input():
         make_workload("table1", p_track=1.0)
     with pytest.raises(TypeError, match="`name_or_scenario` must be a scenario name"):
         make_workload(3)
-
-
-def test_recorded_stereo_stream_replays_through_the_stores():
-    """A real descriptor stream recorded from the stereo pipeline (issue 4's 'real stream')."""
-    from slamlab.kdtree.experiments import record_stereo_stream, run_store_comparison
-
-    w = record_stereo_stream(6, detector="sift", rng=0)
-    assert len(w) >= 5
-    assert all(it.queries.shape[1] == 128 for it in w.iterations if it.queries.size)
-    assert sum(it.observed.size for it in w.iterations) > 0  # landmarks were re-sighted
-    res = run_store_comparison(w, stores=("multi", "brute"), checks=10**9)  # unlimited BBF: exact
-    assert res.recall["brute"] == 1.0
-    assert res.recall["multi"] == 1.0

@@ -48,4 +48,5 @@ def test_run_kitti_matches_the_manual_loop(shared_data):
     assert res.path_length_m == pytest.approx(22.7, abs=0.1)
     assert res.ate_se3_m < 0.2
     assert res.final_error_m < 0.03 * res.path_length_m
-    assert "KITTI" in res.table()
+    assert res.name == "kitti-odometry-06-stereo"  # the folder's name
+    assert "kitti-odometry-06-stereo, frames 0-19" in res.table()

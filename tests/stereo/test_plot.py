@@ -6,7 +6,7 @@ import numpy as np
 from slamlab.geometry import StereoRig
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
-from slamlab.stereo import detect, stereo_match, triangulate_local
+from slamlab.stereo import detect_features, stereo_match, triangulate_local
 from slamlab.stereo.experiments import run_stereo_slam
 from slamlab.stereo.plot import (
     plot_frame_stages,
@@ -25,7 +25,7 @@ def test_plots():
     arena = StereoArena(seed=0)
     sim = StereoSim(arena, rig, rng=0)
     left, right = sim.render_pair([3.0, 4.0, 1.0])
-    fl, fr = detect(left, n_features=500), detect(right, n_features=500)
+    fl, fr = detect_features(left, n_features=500), detect_features(right, n_features=500)
     sm = stereo_match(fl, fr, rig)
     cloud = triangulate_local(rig, fl, fr, sm)
     axes = plot_frame_stages(left, right, fl, fr, sm, cloud, np.arange(len(cloud.points)) % 2 == 0)
@@ -41,13 +41,23 @@ def test_plots():
     plt.close(axes[0].figure)
 
 
-def test_widget_builds_without_running():
+def test_widget_runs_the_same_run_as_the_tests(capsys):
+    from slamlab.stereo import RenderParams, run_turn_in_place
     from slamlab.stereo.widgets import explore_stereo_slam
 
-    w = explore_stereo_slam(policy="oldest")
+    w = explore_stereo_slam(policy="oldest", n_frames=3)
     names = [getattr(c, "description", "") for c in w.children]
     assert "landmarks" in names
     assert "run" in names  # manual: nothing runs until the button is pressed
+    capsys.readouterr()
+    sliders = {"experiment": "turn in place", "policy": "oldest", "ransac_iters": 200}
+    w.f(**sliders, detector="orb", noise_std=1.0, drift_mrad=0.5)  # what the button calls
+    out = capsys.readouterr().out
+    ref = run_turn_in_place(n_frames=3, detector="orb", render=RenderParams(noise_std=1.0, drift_std_rad=0.5e-3))
+    assert ref.table() in out
+    plt.close("all")
+    w.f(**{**sliders, "ransac_iters": 0}, detector="orb", noise_std=0.0, drift_mrad=0.0)  # a message, not a traceback
+    assert "Cannot run with these settings: `ransac_iters` must be >= 1" in capsys.readouterr().out
 
 
 def test_plot_kitti_draws_the_paths_from_above():

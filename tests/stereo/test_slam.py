@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 
 from slamlab.geometry import StereoRig, wrap_angle
+from slamlab.kdtree import ExactStore
 from slamlab.kdtree.stores import MultiKDTree, NonBaseBuffer
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
-from slamlab.stereo import STAGES, ExactStore, StereoSLAM
+from slamlab.stereo import STAGES, StereoParams, StereoSLAM
 from slamlab.stereo.experiments import StereoRunResult, run_stereo_slam
 
 
@@ -42,7 +43,7 @@ def test_run_is_deterministic(short_turn):
 
 def test_same_frame_twice_gives_identity_and_base_landmarks():
     sim = StereoSim(StereoArena(seed=1), rng=0)
-    slam = StereoSLAM(sim.rig, sim.T_body_left, rng=0)
+    slam = StereoSLAM(sim.rig, sim.T_body_left, params=StereoParams(), rng=0)
     pair = sim.render_pair([3.0, 4.0, 0.3])
     assert slam.process(*pair).status == "init"
     for _ in range(2):
@@ -123,15 +124,25 @@ def test_bad_input():
         StereoSLAM(rig, detector="surf-xyz")
     with pytest.raises(ValueError, match="policy"):
         StereoSLAM(rig, policy="newest")
-    with pytest.raises(TypeError, match="lacks"):
+    with pytest.raises(TypeError, match="LandmarkStore"):
         StereoSLAM(rig, store=object())
+    with pytest.raises(TypeError, match="no field"):
+        StereoSLAM(rig, n_points=5)
+    with pytest.raises(TypeError, match="`params` must be a StereoParams"):
+        StereoSLAM(rig, params={"detector": "orb"})
     with pytest.raises(ValueError, match="T_body_left"):
         StereoSLAM(rig, np.eye(3))
     with pytest.raises(ValueError, match="poses"):
         run_stereo_slam(np.zeros((1, 3)))
     slam = StereoSLAM(rig)
-    with pytest.raises(ValueError, match="image"):
+    with pytest.raises(ValueError, match="images"):
         slam.process(np.zeros((4, 4, 4, 4)), np.zeros((4, 4)))
+    h, w = rig.left.height_px, rig.left.width_px
+    with pytest.raises(ValueError, match=rf"same shape; got \({h}, {w}\) and \({h}, {w - 1}\)"):
+        slam.process(np.zeros((h, w), np.uint8), np.zeros((h, w - 1), np.uint8))
+    with pytest.raises(ValueError, match=rf"must be {h}x{w} .* got 10x12"):
+        slam.process(np.zeros((10, 12), np.uint8), np.zeros((10, 12), np.uint8))
+    assert slam.frame == 0  # nothing was processed
 
 
 def test_calibration_drift_costs_stereo_matches():
@@ -221,3 +232,66 @@ def test_ill_conditioned_poses_are_not_trusted():
     assert abs(float(wrap_angle(loose.planar_trajectory[1, 2] - 0.05))) < np.deg2rad(1.0)
     with pytest.raises(ValueError, match="max_rot_std_rad"):
         StereoSLAM(rig, max_rot_std_rad=-1.0)
+
+
+def test_params_are_one_frozen_object_shared_by_the_loop_and_the_runs():
+    import dataclasses
+
+    from slamlab.stereo import run_turn_in_place
+
+    p = StereoParams()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.ratio = 0.5
+    assert set(StereoParams.sources()) == set(StereoParams.field_names())
+    assert all(src.startswith(("000 §", "ours")) for src in StereoParams.sources().values())
+    rig = StereoRig.parallel()
+    assert StereoSLAM(rig, detector="orb").params == StereoParams(detector="orb")
+    res = run_turn_in_place(n_frames=2, params=StereoParams(detector="orb"), policy="all")
+    assert res.params == StereoParams(detector="orb", policy="all")
+    # the run's default equals the pipeline's default
+    import inspect
+
+    assert inspect.signature(run_turn_in_place).parameters["params"].default is None
+
+
+def test_colour_frames_follow_the_channel_order():
+    cv2 = pytest.importorskip("cv2")
+    rig = StereoRig.parallel(0.2, 192, 144)
+    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    left, right = sim.render_pair([3.0, 4.0, 0.0])
+    rng = np.random.default_rng(0)
+    # colour frames whose OpenCV grey version is the rendered frame +- a little
+    tint = rng.integers(0, 30, (144, 192, 3)).astype(np.uint8)
+    bgr_l = cv2.merge([left, cv2.subtract(left, tint[..., 1]), cv2.add(left, tint[..., 2])])
+    bgr_r = cv2.merge([right, cv2.subtract(right, tint[..., 1]), cv2.add(right, tint[..., 2])])
+    grey = StereoSLAM(rig, sim.T_body_left, detector="orb", n_features=300, rng=0)
+    colour = StereoSLAM(rig, sim.T_body_left, detector="orb", n_features=300, channel_order="bgr", rng=0)
+    rec_g = grey.process(cv2.cvtColor(bgr_l, cv2.COLOR_BGR2GRAY), cv2.cvtColor(bgr_r, cv2.COLOR_BGR2GRAY))
+    rec_c = colour.process(bgr_l, bgr_r)
+    assert rec_c == rec_g
+
+
+def test_ours_vs_source_prints_the_runs_figures(short_turn):
+    from slamlab.stereo import ours_vs_source
+
+    _, res = short_turn
+    table = ours_vs_source(res, {"SURF, oldest": res, "again": res})
+    row = next(line for line in table.splitlines() if line.strip().startswith("turn: max position error"))
+    assert "<= 0.15" in row
+    assert row.split()[-1] == f"{res.pos_err_m.max():.2f}"
+    assert f"{res.pos_err_m.max():.2f} (again: {res.pos_err_m.max():.2f})" in table
+    assert f"{100 * res.heading_error_ratio:.1f}" in table
+    with pytest.raises(ValueError, match="`loops` is empty"):
+        ours_vs_source(res, {})
+
+
+@pytest.mark.parametrize("name", StereoParams.field_names())
+def test_every_param_is_checked(name):
+    import dataclasses
+
+    default = getattr(StereoParams(), name)
+    bad = {str: "no-such-choice", bool: "yes"}.get(type(default), -1.0)
+    with pytest.raises((ValueError, TypeError), match=f"`{name}`"):
+        StereoParams(**{name: bad})
+    assert dataclasses.fields(StereoParams)  # frozen dataclass fields, each with a source
+    assert StereoParams.sources()[name].startswith(("000 §", "ours"))

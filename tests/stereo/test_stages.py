@@ -4,14 +4,14 @@ import cv2
 import numpy as np
 import pytest
 
+from slamlab.features import Features
 from slamlab.geometry import rotation_xyz, se3_from_planar
+from slamlab.kdtree import ExactStore, LandmarkStore
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.stereo import (
-    ExactStore,
-    Features,
     StereoMatches,
-    check_store,
-    detect,
+    StereoParams,
+    detect_features,
     estimate_pose,
     match_to_map,
     select_oldest,
@@ -20,6 +20,15 @@ from slamlab.stereo import (
 )
 
 POSE = np.array([3.0, 4.0, 1.2])
+
+
+def detect(image, detector="surf", n_features=2000):
+    return detect_features(image, detector=detector, n_features=n_features)
+
+
+def _features(uv, descriptors):
+    n = len(uv)
+    return Features(np.asarray(uv, float), np.ones(n), np.zeros(n), np.ones(n), np.zeros(n, int), descriptors)
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +46,7 @@ def test_detect_orb_and_sift(frame):
     f = detect(left, "orb", 1500)
     assert 1000 < len(f.uv) <= 1500
     assert f.descriptors.shape == (len(f.uv), 32)
-    assert f.binary
+    assert f.is_binary
     ref = cv2.ORB_create(nfeatures=1500, fastThreshold=12).detect(left, None)
     np.testing.assert_allclose(f.uv, [k.pt for k in ref])
     s = detect(left, "sift", 500)
@@ -81,7 +90,7 @@ def test_stereo_match_ratio_rule_on_synthetic_descriptors():
     uv_r = np.array([[90.0, 50.0], [190.0, 80.5], [150.0, 80.0], [290.0, 300.0]])
     dl = np.array([[0] * 32, [255] * 32, [15] * 32], np.uint8)
     dr = np.array([[0] * 32, [255] * 32, [255] * 32, [15] * 32], np.uint8)
-    sm = stereo_match(Features(uv_l, dl), Features(uv_r, dr), rig)
+    sm = stereo_match(_features(uv_l, dl), _features(uv_r, dr), rig)
     # 0 <-> 0 (unique on its row); 1 has two near-equal candidates on its row -> rejected by the ratio;
     # 2's descriptor twin lies far off its epipolar line -> no match
     assert sm.left.tolist() == [0]
@@ -106,7 +115,7 @@ def test_exact_store_matches_numpy_brute_force():
     dist, ids = s.query(Qf)
     full = np.linalg.norm(Qf[:, None] - Df[None], axis=2)
     np.testing.assert_allclose(dist, np.sort(full, axis=1)[:, :2], rtol=1e-5)
-    assert check_store(s) is s
+    assert isinstance(s, LandmarkStore)
 
 
 def test_exact_store_base_rule():
@@ -187,6 +196,8 @@ def test_stage_bad_input(frame):
     sim, left, *_ = frame
     with pytest.raises(ValueError, match="detector"):
         detect(left, "surf-xyz")
+    with pytest.raises(TypeError, match="no field"):
+        detect_features(left, n_points=5)
     with pytest.raises(ValueError, match="must not be empty"):
         detect(np.zeros((0, 0)))
     with pytest.raises(ValueError, match="image"):
@@ -204,12 +215,14 @@ def test_stage_bad_input(frame):
     assert len(triangulate_local(sim.rig, f, f, empty).points) == 0
     with pytest.raises(ValueError, match="descriptors"):
         match_to_map(np.zeros(3), ExactStore())
-    with pytest.raises(TypeError, match="lacks"):
-        check_store(object())
+    with pytest.raises(TypeError, match="LandmarkStore"):
+        match_to_map(np.zeros((2, 3)), object())
     s = ExactStore()
     s.add(np.zeros((2, 4), np.uint8), [0, 1])
-    with pytest.raises(ValueError, match="columns like the stored"):
+    with pytest.raises(ValueError, match=r"must have shape \(N, 4\) to match the store"):
         s.query(np.zeros((1, 5), np.uint8))
+    with pytest.raises(TypeError, match="must be uint8"):
+        s.query(np.zeros((1, 4), np.float32))
     with pytest.raises(ValueError, match="ids"):
         s.add(np.zeros((2, 4), np.uint8), [0])
 
@@ -220,7 +233,7 @@ def test_surf_from_the_features_chapter(frame):
     f = detect(left, "surf", 300)
     assert 0 < len(f.uv) <= 300
     assert f.descriptors.shape == (len(f.uv), 64)
-    assert not f.binary
+    assert not f.is_binary
 
 
 def test_oldest_policy_follows_the_old_landmarks_when_the_map_drifted():
@@ -248,7 +261,7 @@ def _reference_stereo_match(fl, fr, rig, ratio=0.8, tol=2.0):
     lines = xl @ rig.F.T
     lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
     mask = (np.abs(lines[:, :2] @ fr.uv.T + lines[:, 2:3]) <= tol).astype(np.uint8)
-    norm = cv2.NORM_HAMMING if fl.binary else cv2.NORM_L2
+    norm = cv2.NORM_HAMMING if fl.is_binary else cv2.NORM_L2
     best = {}
     for m in cv2.BFMatcher(norm).knnMatch(fl.descriptors, fr.descriptors, k=2, mask=mask):
         if m and m[0].distance < ratio * (m[1].distance if len(m) > 1 else np.inf):
@@ -364,26 +377,26 @@ def test_exact_store_query_among_and_candidates_in_match_to_map():
     mm = match_to_map(Q, s, candidates=among)
     assert set(mm.ids.tolist()) <= set(among.tolist())
     assert sorted(mm.ids.tolist()) == list(range(100, 130, 2))  # the even twins match, the odd ones find none
-    # ... and a store without query_among has its nearest neighbours filtered
-    class Plain:
-        def __init__(self, inner):
-            self.inner = inner
+    # ... and so does every other store (query_among is part of the interface, exact for all)
+    from slamlab.kdtree import make_store
 
-        def query(self, Q, k=2):
-            return self.inner.query(Q, k)
-
-        def __len__(self):
-            return len(self.inner)
-
-    mm2 = match_to_map(Q, Plain(s), candidates=among)
-    assert sorted(mm2.ids.tolist()) == list(range(100, 130, 2))
+    Df = rng.normal(size=(400, 16)).astype(np.float32)
+    Qf = Df[:30] + np.float32(0.01)
+    for name in ("rebuild", "multi", "brute", "flann"):
+        st = make_store(name, n1=50, q=2.0)
+        st.add(Df, np.arange(100, 500))
+        st.end_iteration()
+        d_f, i_f = st.query_among(Qf, among, k=2)
+        full = np.linalg.norm(Qf[:, None] - Df[None, ::2], axis=2)
+        np.testing.assert_allclose(d_f, np.sort(full, axis=1)[:, :2], rtol=1e-5)
+        assert np.isin(i_f, among).all()
 
 
 def test_view_gate_keeps_the_landmarks_in_front():
     from slamlab.geometry import StereoRig
     from slamlab.stereo import StereoSLAM
 
-    slam = StereoSLAM(StereoRig.parallel(), np.eye(4), max_depth_m=10.0)
+    slam = StereoSLAM(StereoRig.parallel(), np.eye(4), params=StereoParams(max_depth_m=10.0))
     # camera frame: x right, z forward (T_body_left = I); 40 deg field of view -> +-20 deg
     slam.X = np.array([[0.0, 0.0, 3.0], [3.0 * np.tan(np.deg2rad(25)), 0, 3.0], [0.0, 0.0, -3.0], [0.0, 0.0, 16.0]])
     slam.alive = np.ones(4, bool)

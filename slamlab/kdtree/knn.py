@@ -1,0 +1,182 @@
+"""Exact k nearest neighbours and the k-NN list helpers: written once, used by every matcher and store.
+
+- :func:`exact_knn` — exact k-NN by brute force: Hamming distance for binary ``uint8``
+  descriptors (ORB; OpenCV's ``batchDistance``), Euclidean for float ones (BLAS on
+  query blocks, the kept distances recomputed directly in float64);
+- :func:`pad_knn` — the one "pad to k" rule: fewer than ``k`` candidates give ``inf``
+  distances and id ``-1``;
+- :func:`merge_knn` — k-NN lists of several trees merged into one (000 §4: a query
+  searches every tree);
+- :func:`hamming_distances` — pairwise Hamming distances of packed binary descriptors.
+
+The features chapter's matching (:func:`slamlab.features.knn2`), the landmark stores
+(:mod:`slamlab.kdtree.stores`) and the stereo pipeline all call these.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["exact_knn", "hamming_distances", "merge_knn", "pad_knn"]
+
+
+def pad_knn(dist, ids, k: int):
+    """``(dist (M, k), ids (M, k))`` from lists with ``k_i <= k`` columns: missing neighbours are ``inf`` / ``-1``.
+
+    >>> d, i = pad_knn(np.array([[0.5]]), np.array([[4]]), 2)
+    >>> d.tolist(), i.tolist()
+    ([[0.5, inf]], [[4, -1]])
+    """
+    dist = np.asarray(dist, dtype=np.float64)
+    ids = np.asarray(ids, dtype=np.int64)
+    m, kk = dist.shape
+    if kk >= k:
+        return dist[:, :k], ids[:, :k]
+    out_d = np.full((m, k), np.inf)
+    out_i = np.full((m, k), -1, dtype=np.int64)
+    out_d[:, :kk], out_i[:, :kk] = dist, ids
+    return out_d, out_i
+
+
+def merge_knn(dists, ids, k: int = 2):
+    """Merge per-tree k-NN lists into the k nearest overall (000 §4: a query searches every tree).
+
+    Parameters
+    ----------
+    dists, ids : lists of (M, k_i) arrays
+        Distances (``inf`` for missing) and ids (-1 for missing) from each tree.
+
+    >>> d, i = merge_knn([np.array([[1.0, 3.0]]), np.array([[2.0, np.inf]])],
+    ...                  [np.array([[10, 11]]), np.array([[20, -1]])])
+    >>> d.tolist(), i.tolist()
+    ([[1.0, 2.0]], [[10, 20]])
+    """
+    D = np.concatenate(dists, axis=1)
+    idx = np.concatenate(ids, axis=1)
+    o = np.argsort(D, axis=1, kind="stable")[:, :k]
+    return pad_knn(np.take_along_axis(D, o, axis=1), np.take_along_axis(idx, o, axis=1), k)
+
+
+def hamming_distances(A, B) -> np.ndarray:
+    """Pairwise Hamming distances between binary descriptors packed as uint8 bytes.
+
+    >>> hamming_distances(np.array([[0b1011]], np.uint8), np.array([[0], [255]], np.uint8)).tolist()
+    [[3, 5]]
+    """
+    A, B = np.asarray(A), np.asarray(B)
+    if A.dtype != np.uint8 or B.dtype != np.uint8:
+        raise TypeError(f"binary descriptors must be uint8 arrays; got {A.dtype} and {B.dtype}")
+    if A.ndim != 2 or B.ndim != 2 or A.shape[1] != B.shape[1]:
+        raise ValueError(f"descriptors must be (N, bytes) arrays of equal width; got {A.shape} and {B.shape}")
+    out = np.empty((A.shape[0], B.shape[0]), dtype=np.int64)
+    step = max(1, 4_000_000 // max(1, B.size))
+    for a in range(0, A.shape[0], step):
+        out[a:a + step] = np.bitwise_count(A[a:a + step, None, :] ^ B[None, :, :]).sum(axis=2, dtype=np.int64)
+    return out
+
+
+def exact_knn(Q, X, k: int = 2, ids=None):
+    """The ``k`` nearest rows of ``X`` to every row of ``Q``, exactly, by brute force.
+
+    Parameters
+    ----------
+    Q, X : (M, d), (N, d) arrays of one kind: ``uint8`` (binary, Hamming distance) or float
+        (Euclidean distance). The caller checks shapes and kinds (this is the inner loop).
+    k : neighbours per query.
+    ids : (N,) int, optional
+        Ids of the rows of ``X`` (default: the row indices).
+
+    Returns
+    -------
+    dist : (M, k) float, ascending; ``inf`` where ``X`` has fewer than ``k`` rows
+    ids : (M, k) int; ``-1`` where missing
+
+    >>> X = np.array([[0.0, 0.0], [3.0, 0.0], [1.0, 1.0]])
+    >>> d, i = exact_knn(np.array([[1.0, 0.0]]), X, 2, ids=np.array([10, 11, 12]))
+    >>> d.tolist(), i.tolist()
+    ([[1.0, 1.0]], [[10, 12]])
+    """
+    M, N = Q.shape[0], X.shape[0]
+    kk = min(k, N)
+    if M == 0 or kk == 0:
+        return pad_knn(np.empty((M, 0)), np.empty((M, 0), dtype=np.int64), k)
+    if Q.dtype == np.uint8:
+        import cv2  # OpenCV's popcount: several times faster than numpy's for Hamming
+
+        d, idx = cv2.batchDistance(np.ascontiguousarray(Q), np.ascontiguousarray(X), cv2.CV_32S,
+                                   normType=cv2.NORM_HAMMING, K=kk)
+        idx = idx.astype(np.int64)
+        d = np.where(idx >= 0, d, np.inf).astype(np.float64)
+    else:
+        d, idx = _exact_knn_float(Q, X, kk)
+    if ids is not None:
+        ids = np.asarray(ids, dtype=np.int64)
+        idx = np.where(idx >= 0, ids[np.maximum(idx, 0)], -1)
+    return pad_knn(d, idx, k)
+
+
+def _exact_knn_float(Q, X, k, block: int = 8192, margin: int = 1):
+    """Exact Euclidean k-NN (k <= N): float32 BLAS ranks, float64 decides.
+
+    For database blocks of ``block`` rows one GEMM gives the ranking key ``|x|²/2 - q·x`` of every
+    query against the block (the squared distance minus ``|q|²``, halved); a running list keeps the
+    best ``k + margin`` candidates per query; their distances are then recomputed directly in
+    float64 and sorted, so float32 rounding can only matter if it pushed a true neighbour behind
+    ``margin`` others. The full distance matrix is never written.
+    """
+    M, N = Q.shape[0], X.shape[0]
+    c = min(k + margin, N)
+    # augmented rows: [x, |x|²/2] · [-q, 1] = |x|²/2 - q·x, one GEMM per block writes the key directly
+    Xa = np.empty((N, X.shape[1] + 1), dtype=np.float32)
+    Xa[:, :-1] = X
+    Xa[:, -1] = 0.5 * np.einsum("ij,ij->i", Xa[:, :-1], Xa[:, :-1])
+    Qa = np.empty((M, Q.shape[1] + 1), dtype=np.float32)
+    Qa[:, :-1] = -Q
+    Qa[:, -1] = 1.0
+    buf = np.empty((M, min(block, N)), dtype=np.float32)
+    best_key = np.full((M, 0), np.inf, dtype=np.float32)
+    best_idx = np.empty((M, 0), dtype=np.int64)
+    for s0 in range(0, N, block):
+        s1 = min(s0 + block, N)
+        G = buf[:, : s1 - s0]
+        np.matmul(Qa, Xa[s0:s1].T, out=G)  # (M, b) ranking keys
+        part = _smallest(G, min(c, s1 - s0))
+        key = np.concatenate([best_key, _keys(Qa, Xa, part + s0)], axis=1)
+        idx = np.concatenate([best_idx, part + s0], axis=1)
+        if key.shape[1] > c:
+            keep = np.argpartition(key, c - 1, axis=1)[:, :c]
+            key, idx = np.take_along_axis(key, keep, axis=1), np.take_along_axis(idx, keep, axis=1)
+        best_key, best_idx = key, idx
+    # the candidates' distances recomputed directly in float64, sorted, the best k kept
+    diff = Q[:, None, :].astype(np.float64) - X[best_idx].astype(np.float64)
+    d = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    o = _order(d, best_idx)[:, :k]
+    return np.take_along_axis(d, o, axis=1), np.take_along_axis(best_idx, o, axis=1)
+
+
+def _keys(Qa, Xa, idx):
+    """Ranking keys of the selected (query, row) pairs, (M, c)."""
+    return np.einsum("ij,ikj->ik", Qa, Xa[idx])
+
+
+def _smallest(G, c):
+    """Column indices of the ``c`` smallest entries of each row (any order); overwrites ``G``'s winners."""
+    n = G.shape[1]
+    if c >= n:
+        return np.broadcast_to(np.arange(n), G.shape)
+    if c > 4:
+        return np.argpartition(G, c - 1, axis=1)[:, :c]
+    rows = np.arange(G.shape[0])
+    out = np.empty((G.shape[0], c), dtype=np.int64)
+    for j in range(c):  # a few argmin passes are much faster than argpartition
+        out[:, j] = np.argmin(G, axis=1)
+        if j < c - 1:
+            G[rows, out[:, j]] = np.inf
+    return out
+
+
+def _order(d, idx):
+    """Row-wise order by distance, ties by index (a deterministic order, whatever the candidates' order)."""
+    o = np.argsort(idx, axis=1, kind="stable")
+    o2 = np.argsort(np.take_along_axis(d, o, axis=1), axis=1, kind="stable")
+    return np.take_along_axis(o, o2, axis=1)

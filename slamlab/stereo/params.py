@@ -1,0 +1,161 @@
+"""The stereo pipeline's settings: one frozen :class:`StereoParams` (000 §3.3-3.6), and the renderer's.
+
+Every knob of :class:`~slamlab.stereo.slam.StereoSLAM` and of the stage functions is a
+field here, marked with its source section or "ours", and checked once, when the object
+is made (:meth:`StereoParams.check`). ``StereoSLAM(rig, params=...)``, the stage
+functions and every ``run_*`` take ``params=`` plus keyword overrides; the defaults
+live here only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate as v
+from .._params import Params, param
+
+__all__ = ["STEREO_DETECTORS", "RenderParams", "StereoParams"]
+
+#: detectors the pipeline accepts (names of :func:`slamlab.features.detect`); ORB's descriptors
+#: are binary (Hamming), so its landmarks go to an exact store
+STEREO_DETECTORS = ("surf", "sift", "orb")
+POLICIES = ("oldest", "all")
+
+
+def _fraction(value, name):
+    """A share in [0, 1]."""
+    value = v.check_positive(value, name, allow_zero=True)
+    if value > 1:
+        raise ValueError(f"`{name}` must be in [0, 1]; got {value}")
+    return value
+
+
+def _optional_positive(value, name, allow_zero=False):
+    return None if value is None else v.check_positive(value, name, allow_zero=allow_zero)
+
+
+@dataclass(frozen=True)
+class StereoParams(Params):
+    """Settings of the stereo SLAM pipeline (000 §3.3-3.6); ``print(p.table())`` lists them with sources.
+
+    Examples
+    --------
+    >>> p = StereoParams(detector="orb")
+    >>> p.detector, p.ransac_iters, StereoParams.sources()["ransac_iters"]
+    ('orb', 200, '000 §3.5: about 200 hypotheses')
+    >>> StereoParams(ratio=1.5)
+    Traceback (most recent call last):
+    ...
+    ValueError: `ratio` must be in (0, 1); got 1.5
+    """
+
+    # -- detection (000 §3.3) ----------------------------------------------------------------------
+    detector: str = param("surf", "000 §3.3: SURF (ours, the features chapter's; 'orb' is the fast one)")
+    n_features: int = param(2000, "000 §3.3: about 2000 points per 768x576 image")
+    orb_fast_threshold: int = param(12, "ours: ORB's FAST threshold (OpenCV: 20); 12 finds 2000 points on the arena")
+    channel_order: str = param("rgb", "ours: channel order of colour images ('bgr' for cv2.imread)")
+    parallel_detect: bool = param(True, "ours: the two images in two threads (same result)")
+    # -- stereo matching and triangulation (000 §3.3) ------------------------------------------------
+    ratio: float = param(0.8, "ours: Lowe's ratio for left-right matches (000 does not say how it matched)")
+    epi_tol_px: float = param(2.0, "ours: distance from the epipolar line")
+    min_depth_m: float = param(0.3, "ours")
+    max_depth_m: float = param(10.0, "ours: the 6x8 m arena (KITTI: 40, see run_kitti)")
+    pixel_std: float = param(0.5, "ours: pixel error behind a stereo point's covariance")
+    # -- matching to the map (000 §3.4) ----------------------------------------------------------------
+    map_ratio: float = param(0.8, "ours: ratio rule against the landmark store")
+    same_point_m: float | None = param(None, "ours: two nearest landmarks this close count as one (None: off)")
+    view_margin_deg: float | None = param(None, "ours: match only landmarks in view (None: the whole map, as 000)")
+    view_depth_factor: float = param(1.5, "ours: the view gate keeps landmarks up to this times max_depth_m away")
+    base_seen_times: int = param(3, "000 §3.4: BaseSeenTimes = 3")
+    max_non_base_time: int = param(7, "000 §3.4: MaxNonBaseTime = 7")
+    # -- pose (000 §3.5) ------------------------------------------------------------------------------
+    policy: str = param("oldest", "000 §3.5: the oldest landmarks ('all': every RANSAC inlier)")
+    ransac_iters: int = param(200, "000 §3.5: about 200 hypotheses")
+    threshold_m: float = param(0.1, "ours: RANSAC inlier distance at depth_ref_m")
+    depth_ref_m: float = param(3.0, "ours: the threshold grows as (depth / depth_ref_m)^2 beyond it")
+    min_inliers: int = param(10, "ours")
+    n_oldest: int = param(40, "ours: 000 §3.5 says 'sufficiently large'")
+    oldest_fraction: float = param(0.5, "ours")
+    keep_fraction: float = param(0.5, "ours: share of the oldest set that must agree")
+    loose_factor: float = param(4.0, "ours: candidates within this many thresholds of the consensus pose")
+    still_fraction: float = param(0.8, "ours: share of the candidates the oldest set's pose must still explain")
+    max_std_factor: float | None = param(2.0, "ours: grow the oldest set until the pose is this well determined")
+    max_correction_rad: float | None = param(None, "ours: bound on the oldest set's correction (None: none)")
+    max_correction_m: float | None = param(None, "ours: bound on the oldest set's correction (None: none)")
+    max_rot_std_rad: float | None = param(0.01, "ours: reject a pose whose rotation std exceeds this (None: off)")
+    # -- landmark filter (000 §3.6) --------------------------------------------------------------------
+    state_var: float = param(1e-6, "000 §3.6: static landmarks; ours: a small process variance, m^2")
+    pose_std_m: float = param(0.02, "ours: pose uncertainty added to an observation")
+    pose_std_rad: float = param(float(np.deg2rad(0.5)), "ours: pose uncertainty added to an observation")
+    update_gate: float | None = param(16.27, "ours: chi^2_3 at 99.9 % (None: always update)")
+
+    def check(self) -> None:
+        v.check_choice(self.detector, "detector", STEREO_DETECTORS)
+        v.check_int(self.n_features, "n_features", minimum=10)
+        v.check_int(self.orb_fast_threshold, "orb_fast_threshold", minimum=0, maximum=255)
+        v.check_choice(self.channel_order, "channel_order", ("rgb", "bgr"))
+        if not isinstance(self.parallel_detect, bool):
+            raise TypeError(f"`parallel_detect` must be a bool; got {type(self.parallel_detect).__name__}")
+        v.check_probability(self.ratio, "ratio")
+        v.check_positive(self.epi_tol_px, "epi_tol_px")
+        v.check_positive(self.min_depth_m, "min_depth_m")
+        if v.check_positive(self.max_depth_m, "max_depth_m") <= self.min_depth_m:
+            raise ValueError(f"`max_depth_m` must exceed `min_depth_m` = {self.min_depth_m}; got {self.max_depth_m}")
+        v.check_positive(self.pixel_std, "pixel_std")
+        v.check_probability(self.map_ratio, "map_ratio")
+        _optional_positive(self.same_point_m, "same_point_m")
+        _optional_positive(self.view_margin_deg, "view_margin_deg", allow_zero=True)
+        v.check_positive(self.view_depth_factor, "view_depth_factor")
+        v.check_int(self.base_seen_times, "base_seen_times", minimum=1)
+        v.check_int(self.max_non_base_time, "max_non_base_time", minimum=1)
+        v.check_choice(self.policy, "policy", POLICIES)
+        v.check_int(self.ransac_iters, "ransac_iters", minimum=1)
+        v.check_positive(self.threshold_m, "threshold_m")
+        v.check_positive(self.depth_ref_m, "depth_ref_m")
+        v.check_int(self.min_inliers, "min_inliers", minimum=3)
+        v.check_int(self.n_oldest, "n_oldest", minimum=3)
+        if v.check_positive(self.oldest_fraction, "oldest_fraction") > 1:
+            raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {self.oldest_fraction}")
+        _fraction(self.keep_fraction, "keep_fraction")
+        v.check_positive(self.loose_factor, "loose_factor")
+        _fraction(self.still_fraction, "still_fraction")
+        _optional_positive(self.max_std_factor, "max_std_factor")
+        _optional_positive(self.max_correction_rad, "max_correction_rad", allow_zero=True)
+        _optional_positive(self.max_correction_m, "max_correction_m", allow_zero=True)
+        _optional_positive(self.max_rot_std_rad, "max_rot_std_rad")
+        v.check_positive(self.state_var, "state_var", allow_zero=True)
+        v.check_positive(self.pose_std_m, "pose_std_m", allow_zero=True)
+        v.check_positive(self.pose_std_rad, "pose_std_rad", allow_zero=True)
+        _optional_positive(self.update_gate, "update_gate")
+
+    @property
+    def binary(self) -> bool:
+        """True when the detector's descriptors are binary (ORB: Hamming distance)."""
+        return self.detector == "orb"
+
+    def detect_kwargs(self) -> dict:
+        """Keyword arguments of :func:`slamlab.features.detect` for this pipeline's detector (000 §3.3)."""
+        kw = {"max_points": self.n_features, "channel_order": self.channel_order}
+        if self.detector == "orb":
+            kw.update(n_features=self.n_features, fast_threshold=self.orb_fast_threshold)
+        elif self.detector == "sift":
+            kw["n_features"] = self.n_features
+        return kw
+
+
+@dataclass(frozen=True)
+class RenderParams(Params):
+    """Settings of the rendered arena runs (the simulator's, not the pipeline's; 000 §3.7)."""
+
+    arena_seed: int = param(0, "ours: texture seed of the 6x8 m arena")
+    camera_height_m: float = param(0.4, "ours")
+    noise_std: float = param(0.0, "ours: image noise, grey levels")
+    drift_std_rad: float = param(0.0, "ours: random-walk step of the right camera per frame (000 §3.2)")
+
+    def check(self) -> None:
+        v.check_int(self.arena_seed, "arena_seed", minimum=0)
+        v.check_positive(self.camera_height_m, "camera_height_m")
+        v.check_positive(self.noise_std, "noise_std", allow_zero=True)
+        v.check_positive(self.drift_std_rad, "drift_std_rad", allow_zero=True)
