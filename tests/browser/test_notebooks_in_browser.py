@@ -1,0 +1,208 @@
+"""Every chapter and lab notebook in a real browser: JupyterLab (started as `make lab` starts it) in headless Chromium.
+
+For each notebook: open it, run all cells, and check that no cell wrote an error or to stderr,
+that every widget view rendered (no "Error displaying widget"), that every image loaded; then move
+one slider or dropdown of the notebook's first widget and check that its output area changes and
+shows no error.
+
+Marker ``browser``. Needs Playwright (PyPI) and a Chromium (Debian's ``chromium`` package;
+``playwright install`` cannot download browsers here): the suite skips, naming what is missing,
+unless ``SLAMLAB_REQUIRE_BROWSER=1`` (CI sets it), which turns the skip into a failure.
+The server runs on a free local port with a random token and with autosave off (a user-settings
+folder of its own), so the notebooks on disk are never rewritten; it is stopped by its process group.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import secrets
+import shutil
+import signal
+import socket
+import subprocess
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb")) + sorted((ROOT / "notebooks" / "labs").glob("*_lab.ipynb"))
+CHROMIUM_CANDIDATES = ("/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome")
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+RUN_TIMEOUT_S = 240
+
+pytestmark = pytest.mark.browser
+
+
+def _unavailable(reason: str):
+    if os.environ.get("SLAMLAB_REQUIRE_BROWSER", "").strip() not in ("", "0"):
+        pytest.fail(f"{reason} (SLAMLAB_REQUIRE_BROWSER=1 makes this an error)", pytrace=False)
+    pytest.skip(reason)
+
+
+def _chromium() -> str:
+    found = os.environ.get("SLAMLAB_CHROMIUM") or next((c for c in CHROMIUM_CANDIDATES if Path(c).exists()), None)
+    if found is None:
+        _unavailable(f"no Chromium found (looked for $SLAMLAB_CHROMIUM and {', '.join(CHROMIUM_CANDIDATES)}); "
+                     "install Debian's `chromium` package")
+    return found
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def lab_server(tmp_path_factory):
+    """`make lab` with options for a test: no browser, free port, token, autosave off; yields the base URL."""
+    if shutil.which("make") is None:
+        _unavailable("`make` is not installed")
+    settings = tmp_path_factory.mktemp("lab-settings")
+    plugin = settings / "@jupyterlab" / "docmanager-extension"
+    plugin.mkdir(parents=True)
+    (plugin / "plugin.jupyterlab-settings").write_text(json.dumps({"autosave": False}))
+    # every cell in the DOM (no windowing), so that every output is rendered and can be checked
+    tracker = settings / "@jupyterlab" / "notebook-extension"
+    tracker.mkdir(parents=True)
+    (tracker / "tracker.jupyterlab-settings").write_text(json.dumps({"windowingMode": "none"}))
+    workspaces = tmp_path_factory.mktemp("lab-workspaces")
+    port, token = _free_port(), secrets.token_hex(16)
+    args = (f"--no-browser --ip=127.0.0.1 --port={port} --ServerApp.token={token} "
+            f"--LabApp.user_settings_dir={settings} --LabApp.workspaces_dir={workspaces}")
+    env = {**os.environ, "MPLBACKEND": "module://matplotlib_inline.backend_inline", "SLAMLAB_PROGRESS": "0"}
+    log = (tmp_path_factory.mktemp("lab-log") / "server.log").open("w")
+    proc = subprocess.Popen(["make", "-s", "lab", f"LAB_ARGS={args}"], cwd=ROOT, env=env, stdout=log,
+                            stderr=subprocess.STDOUT, start_new_session=True)
+    base = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 90
+        while True:
+            try:
+                with urllib.request.urlopen(f"{base}/api/status?token={token}", timeout=2) as r:
+                    if r.status == 200:
+                        break
+            except OSError:
+                pass
+            if proc.poll() is not None or time.monotonic() > deadline:
+                log.flush()
+                pytest.fail(f"`make lab` did not start a server: see {log.name}", pytrace=False)
+            time.sleep(0.5)
+        yield base, token
+    finally:
+        os.killpg(proc.pid, signal.SIGTERM)
+        try:
+            proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+        log.close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        _unavailable("playwright is not installed (pip install playwright)")
+    exe = _chromium()
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=exe, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+_WATCH_BUSY = """() => {
+    window.__slamlabBusySeen = false;
+    const s = document.querySelector('.jp-Notebook-ExecutionIndicator');
+    new MutationObserver(() => { if (s.getAttribute('data-status') !== 'idle') window.__slamlabBusySeen = true; })
+        .observe(s, {attributes: true});
+}"""
+_DONE = """() => window.__slamlabBusySeen
+    && document.querySelector('.jp-Notebook-ExecutionIndicator').getAttribute('data-status') === 'idle'
+    && ![...document.querySelectorAll('.jp-CodeCell .jp-InputPrompt')].some(e => e.textContent.includes('*'))"""
+
+
+def _run_all(page) -> None:
+    """Run every cell through the Run menu; wait until the kernel has been busy and no cell is queued or running."""
+    page.wait_for_function(  # the notebook is open and its kernel is up
+        "() => { const s = document.querySelector('.jp-Notebook-ExecutionIndicator');"
+        " return s && s.getAttribute('data-status') === 'idle' && document.querySelector('.jp-CodeCell'); }",
+        timeout=120_000)
+    page.evaluate(_WATCH_BUSY)
+    page.get_by_role("menuitem", name="Run", exact=True).click()
+    page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
+    page.wait_for_function(_DONE, timeout=RUN_TIMEOUT_S * 1000)
+
+
+def _problems(page) -> list[str]:
+    return page.evaluate("""() => {
+        const out = [];
+        document.querySelectorAll('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]')
+            .forEach(e => out.push('stderr/error output: ' + e.textContent.slice(0, 300)));
+        document.querySelectorAll('.jp-OutputArea-output').forEach(e => {
+            if (e.textContent.includes('Error displaying widget')) out.push('a widget view did not render');
+        });
+        document.querySelectorAll('.jp-OutputArea-output img').forEach(img => {
+            if (!img.complete || img.naturalWidth === 0) out.push('an image did not load');
+        });
+        return out;
+    }""")
+
+
+def _move_first_control(page) -> str | None:
+    """Change the first widget's first slider or dropdown; return what was moved, or None if it has none."""
+    widget = page.locator(".widget-interact").first
+    if widget.count() == 0:
+        return None
+    output = widget.locator(".widget-output")
+    before = output.inner_text()
+    page.evaluate(_WATCH_BUSY)
+    select = widget.locator("select")
+    handle = widget.locator(".noUi-handle")
+    if select.count():
+        options = select.first.locator("option").all_inner_texts()
+        current = select.first.evaluate("s => s.options[s.selectedIndex].text")
+        target = next(o for o in options if o != current)
+        select.first.select_option(label=target)
+        moved = f"dropdown -> {target}"
+    elif handle.count():
+        handle.first.focus()
+        handle.first.press("ArrowRight")
+        moved = "slider one step right"
+    else:
+        return None
+    page.wait_for_function(_DONE, timeout=RUN_TIMEOUT_S * 1000)
+    after = output.inner_text()
+    assert after != before, f"moving the {moved} left the widget's output unchanged"
+    return moved
+
+
+@pytest.mark.parametrize("notebook", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
+def test_notebook_runs_in_jupyterlab(lab_server, browser, notebook):
+    base, token = lab_server
+    rel = notebook.relative_to(ROOT / "notebooks").as_posix()
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    try:
+        # a workspace of its own, reset: only this notebook is open (no tab restored from an earlier page)
+        page.goto(f"{base}/lab/workspaces/{notebook.stem}/tree/{rel}?reset&token={token}", timeout=60_000)
+        _run_all(page)
+        problems = _problems(page)
+        assert not problems, f"{rel}: " + "; ".join(problems)
+        has_widget = any("explore_" in c for c in _code_sources(notebook))
+        if has_widget:
+            assert page.locator(".widget-interact").count() > 0, f"{rel}: no widget view rendered"
+            moved = _move_first_control(page)
+            assert moved is not None, f"{rel}: its first widget has no slider or dropdown"
+            problems = _problems(page)
+            assert not problems, f"{rel} after moving a control ({moved}): " + "; ".join(problems)
+    finally:
+        page.close()
+
+
+def _code_sources(path: Path) -> list[str]:
+    nb = json.loads(path.read_text(encoding="utf-8"))
+    return ["".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code"]

@@ -1,0 +1,132 @@
+"""CONVENTIONS, imports: `import slamlab` stays light; the import graph has no cycle; algorithms never import sim.
+
+The graph is read from the source (every ``import`` statement, at module level and inside
+functions, since an import hidden in a function still closes a cycle when it runs).
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+PKG = Path(__file__).resolve().parent.parent / "slamlab"
+HEAVY = ("cv2", "ipywidgets", "matplotlib.pyplot")
+#: modules that may use the simulator: they run experiments, draw or build widgets (CONVENTIONS: Layout)
+SIM_USERS = ("experiments", "widgets", "plot", "__init__")
+
+
+def _module_names() -> dict[str, Path]:
+    mods = {}
+    for f in PKG.rglob("*.py"):
+        parts = f.relative_to(PKG.parent).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        mods[".".join(parts)] = f
+    return mods
+
+
+def _imports(name: str, path: Path, mods: dict[str, Path]) -> set[str]:
+    """The slamlab modules that ``name`` imports (the longest module prefix of each imported name)."""
+    package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = package[: len(package) - node.level + 1] if node.level else []
+            mod = ".".join([*base, node.module] if node.module else base)
+            targets = [f"{mod}.{a.name}" for a in node.names] + [mod]
+        else:
+            continue
+        for t in targets:
+            while t and t not in mods:
+                t = t.rpartition(".")[0]
+            # a module's own parent packages are imported by Python anyway: not an edge
+            if t and t != name and not name.startswith(t + "."):
+                found.add(t)
+    return found
+
+
+def _graph() -> dict[str, set[str]]:
+    mods = _module_names()
+    return {m: _imports(m, p, mods) for m, p in mods.items()}
+
+
+def _subpackage(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def _cycles_across_subpackages(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components (Tarjan) that span more than one subpackage."""
+    index, low, stack, on_stack, out = {}, {}, [], set(), []
+    counter = [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len({_subpackage(c) for c in comp}) > 1:
+                out.append(sorted(comp))
+
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
+    for v in graph:
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_graph_reader_sees_imports_inside_functions():
+    graph = _graph()
+    # slamlab.stereo.slam imports the landmark filter; a known edge must be found
+    assert "slamlab.filters.landmark" in graph["slamlab.stereo.slam"]
+    # and a cycle made of two modules of different subpackages is reported
+    assert _cycles_across_subpackages({"slamlab.a.x": {"slamlab.b.y"}, "slamlab.b.y": {"slamlab.a.x"}})
+
+
+def test_import_graph_has_no_cycle_across_subpackages():
+    cycles = _cycles_across_subpackages(_graph())
+    assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles)
+
+
+def test_algorithm_modules_never_import_sim():
+    bad = [f"{m} -> {t}" for m, targets in _graph().items() for t in targets
+           if _subpackage(t) == "sim" and _subpackage(m) != "sim" and m.split(".")[-1] not in SIM_USERS
+           and m != "slamlab"]
+    assert not bad, "algorithm modules import slamlab.sim: " + ", ".join(sorted(bad))
+
+
+SUBPACKAGES = ["slamlab", "slamlab.geometry", "slamlab.scans", "slamlab.io", "slamlab.sim", "slamlab.filters",
+               "slamlab.features", "slamlab.kdtree", "slamlab.stereo", "slamlab.correlation", "slamlab.hough",
+               "slamlab.evaluation", "slamlab.lab", "slamlab.sweep"]
+
+
+def test_every_subpackage_is_listed():
+    found = {f"slamlab.{p.parent.name}" for p in PKG.glob("*/__init__.py")}
+    assert found <= set(SUBPACKAGES), f"add to SUBPACKAGES: {sorted(found - set(SUBPACKAGES))}"
+
+
+@pytest.mark.parametrize("module", SUBPACKAGES)
+def test_import_loads_no_widgets_pyplot_or_cv2(module):
+    code = f"import sys, {module}; print(','.join(m for m in {HEAVY!r} if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert out == "", f"`import {module}` imported {out}"
