@@ -30,6 +30,7 @@ __all__ = [
     "check_int",
     "check_positive",
     "check_probability",
+    "parse_numbers",
 ]
 
 
@@ -232,3 +233,23 @@ def as_path(value: Any, name: str = "path", *, kind: str = "any") -> Path:
         what = {"file": "file", "dir": "folder", "any": "file or folder"}[kind]
         raise FileNotFoundError(f"`{name}`: no {what} at {p}")
     return p
+
+
+def parse_numbers(fields: Iterable[str], where: str) -> np.ndarray:
+    """Text fields of one line of a data file as floats; a field that is not a number names ``where`` and itself.
+
+    ``where`` says the file and line ("exp2.dat line 12"); "nan" and "inf" are numbers.
+
+    >>> parse_numbers(["1", "2.5", "nan"], "log.txt line 3").tolist()
+    [1.0, 2.5, nan]
+    """
+    fields = list(fields)
+    try:
+        return np.array(fields, dtype=float)
+    except ValueError:
+        for i, tok in enumerate(fields):
+            try:
+                float(tok)
+            except ValueError:
+                raise ValueError(f"{where}: field {i} is not a number: {tok!r}") from None
+        raise

@@ -333,7 +333,7 @@ def test_check_callable():
 
 def test_every_public_check_is_tested():
     tested = {
-        "as_covariance", "as_finite_array", "as_image", "as_matrix", "as_measurement", "as_path", "as_rng", "as_vector",
+        "as_covariance", "as_finite_array", "as_image", "as_matrix", "as_measurement", "as_path", "parse_numbers", "as_rng", "as_vector",
         "check_callable", "check_choice", "check_int", "check_positive", "check_probability",
     }
     assert set(v.__all__) == tested
@@ -356,3 +356,9 @@ def test_as_path_errors_name_the_argument(tmp_path):
         v.as_path(tmp_path / "missing.log", "log", kind="file")
     with pytest.raises(FileNotFoundError, match="`folder`: no folder at"):
         v.as_path(tmp_path / "a.txt", "folder", kind="dir")
+
+
+def test_parse_numbers_names_the_place_and_the_field():
+    np.testing.assert_array_equal(v.parse_numbers(["1", "-2e3", "inf"], "f"), [1.0, -2000.0, np.inf])
+    with pytest.raises(ValueError, match=r"exp2\.dat line 7: field 2 is not a number: '1,5'"):
+        v.parse_numbers(["1", "2", "1,5"], "exp2.dat line 7")

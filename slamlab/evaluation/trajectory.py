@@ -86,14 +86,6 @@ class Trajectory:
         return float(np.sum(np.linalg.norm(np.diff(self.positions_m, axis=0), axis=1)))
 
 
-def _is_number(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
-
-
 def _load_rows(path, n_cols, what: str) -> np.ndarray:
     path = os.fspath(path)
     rows = []
@@ -108,11 +100,7 @@ def _load_rows(path, n_cols, what: str) -> np.ndarray:
                 want = " or ".join(map(str, allowed))
                 raise ValueError(f"{path}:{line_no}: a {what} line needs {want} numbers (the same on every "
                                  f"line); got {len(parts)}")
-            try:
-                rows.append([float(p) for p in parts])
-            except ValueError:
-                bad = next(p for p in parts if not _is_number(p))
-                raise ValueError(f"{path}:{line_no}: {bad!r} is not a number in a {what} line") from None
+            rows.append(v.parse_numbers(parts, f"{path}:{line_no} ({what} line)"))
     if not rows:
         raise ValueError(f"{path}: no poses found")
     arr = np.asarray(rows, dtype=float)

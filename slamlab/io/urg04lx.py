@@ -137,11 +137,7 @@ def read_urg04lx_log(path, *, max_range_m: float = 4.0) -> UrgLog:
             fields = line.split()
             if len(fields) != _N_FIELDS:
                 raise ValueError(f"{p.name} line {lineno}: expected {_N_FIELDS} numbers; got {len(fields)}")
-            try:
-                rows.append(np.array(fields, dtype=float))
-            except ValueError:
-                bad = next(i for i, t in enumerate(fields) if not _is_number(t))
-                raise ValueError(f"{p.name} line {lineno}: field {bad} is not a number: {fields[bad]!r}") from None
+            rows.append(v.parse_numbers(fields, f"{p.name} line {lineno}"))
     if not rows:
         raise ValueError(f"{p.name}: no scans")
     data = np.array(rows)
@@ -150,14 +146,6 @@ def read_urg04lx_log(path, *, max_range_m: float = 4.0) -> UrgLog:
     ranges[bad] = np.nan
     t = (data[:, 0] - data[0, 0]) * 1e-6
     return UrgLog(t, data[:, 2:4].astype(np.int64), ranges, urg04lx_bearings(), str(p), float(max_range_m))
-
-
-def _is_number(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
 
 
 def urg04lx_odometry(ticks, *, wheel_radius_m: float = 0.077, half_axle_m: float = 0.165,

@@ -51,5 +51,5 @@ def test_bad_input(tmp_path):
 def test_non_numeric_token_names_file_line_and_token(tmp_path):
     f = tmp_path / "est.txt"
     f.write_text("0 0 0 0 0 0 0 1\n1 0 0 x1 0 0 0 1\n")
-    with pytest.raises(ValueError, match=r"est\.txt:2: 'x1' is not a number in a TUM line"):
+    with pytest.raises(ValueError, match=r"est\.txt:2 \(TUM line\): field 3 is not a number: 'x1'"):
         read_tum(str(f))
