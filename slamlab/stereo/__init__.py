@@ -25,7 +25,6 @@ from .experiments import (
     run_stereo_slam_variants,
     run_turn_in_place,
 )
-from .kitti import kitti_rig, read_kitti_calib, read_kitti_image, read_kitti_poses
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
 from .slam import STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
@@ -71,13 +70,9 @@ __all__ = [
     "detect_features",
     "estimate_pose",
     "experiment_poses",
-    "kitti_rig",
     "match_to_map",
     "ours_vs_source",
     "pose_std",
-    "read_kitti_calib",
-    "read_kitti_image",
-    "read_kitti_poses",
     "record_stereo_stream",
     "run_closed_loop",
     "run_comparison",

@@ -418,7 +418,7 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
     """StereoSLAM on a KITTI odometry sequence folder (real data); default the shared ``kitti-odometry-06-stereo``.
 
     ``folder`` (``str`` or ``os.PathLike``) holds ``calib.txt`` (official ``P0: ...`` lines or the
-    bare rows, :func:`~slamlab.stereo.kitti.read_kitti_calib`), ``poses.txt`` (ground truth, one
+    bare rows, :func:`~slamlab.io.read_kitti_calib`), ``poses.txt`` (ground truth, one
     3×4 row per frame), ``image_0/000000.png ...`` (left) and ``image_1/...`` (right). The image
     size comes from the first left image, the run's name from the folder's name; ``n_frames``
     keeps the first frames (default: one per pose). ``params`` (default :data:`KITTI_PARAMS`) plus
@@ -426,12 +426,12 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
     ``poses.txt``. ATE and RPE by :mod:`slamlab.evaluation` (equal to evo's).
     """
     from ..data import find_data
-    from ..evaluation import Trajectory, ate, rpe
-    from .kitti import kitti_rig, read_kitti_image, read_kitti_poses
+    from ..evaluation import Trajectory, ate, read_kitti, rpe
+    from ..io.kitti import kitti_rig, read_kitti_image
 
     d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else v.as_path(folder, "folder", kind="dir")
     p = StereoParams.resolve(KITTI_PARAMS if params is None else params, **overrides)
-    gt34 = read_kitti_poses(d / "poses.txt")
+    gt34 = read_kitti(d / "poses.txt").poses[:, :3, :]
     n = len(gt34) if n_frames is None else min(len(gt34), v.check_int(n_frames, "n_frames", minimum=2))
     gt34 = gt34[:n]
     left0 = read_kitti_image(d / "image_0" / f"{0:06d}.png")

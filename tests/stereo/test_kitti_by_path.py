@@ -5,7 +5,8 @@ import shutil
 import numpy as np
 import pytest
 
-from slamlab.stereo import read_kitti_calib, run_kitti
+from slamlab.io import read_kitti_calib
+from slamlab.stereo import run_kitti
 
 pytestmark = pytest.mark.realdata
 

@@ -55,15 +55,6 @@ def kitti_rig(calib_path, width_px: int, height_px: int) -> StereoRig:
     return StereoRig(cam, cam, np.eye(3), np.array([(P1[0, 3] - P0[0, 3]) / fx, 0.0, 0.0]))
 
 
-def read_kitti_poses(path) -> np.ndarray:
-    """(N, 3, 4) ground-truth poses of a KITTI ``poses.txt`` (one row of 12 numbers per frame)."""
-    path = v.as_path(path, "path", kind="file")
-    rows = np.loadtxt(path, ndmin=2)
-    if rows.shape[1] != 12:
-        raise ValueError(f"{path}: every line must hold 12 numbers (a 3x4 pose); got {rows.shape[1]}")
-    return rows.reshape(-1, 3, 4)
-
-
 def read_kitti_image(path) -> np.ndarray:
     """A grey uint8 KITTI image; ``FileNotFoundError`` naming the file when it is missing or unreadable."""
     import cv2
