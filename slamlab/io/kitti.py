@@ -10,7 +10,7 @@ import numpy as np
 from .. import _validate as v
 from ..geometry.camera import PinholeCamera, StereoRig
 
-__all__ = ["kitti_rig", "read_kitti_calib", "read_kitti_image", "read_kitti_poses"]
+__all__ = ["kitti_rig", "read_kitti_calib", "read_kitti_image"]
 
 
 def read_kitti_calib(path) -> dict:

@@ -190,11 +190,13 @@ def test_notebook_runs_in_jupyterlab(lab_server, browser, notebook):
         # a workspace of its own, reset: only this notebook is open (no tab restored from an earlier page)
         page.goto(f"{base}/lab/workspaces/{notebook.stem}/tree/{rel}?reset&token={token}", timeout=60_000)
         _run_all(page)
+        n_widgets = sum("explore_" in c for c in _code_sources(notebook))
+        if n_widgets:  # a widget view renders after its cell has run: wait for all of them
+            page.wait_for_function(f"() => document.querySelectorAll('.widget-interact').length >= {n_widgets}",
+                                   timeout=60_000)
         problems = _problems(page)
         assert not problems, f"{rel}: " + "; ".join(problems)
-        has_widget = any("explore_" in c for c in _code_sources(notebook))
-        if has_widget:
-            assert page.locator(".widget-interact").count() > 0, f"{rel}: no widget view rendered"
+        if n_widgets:
             moved = _move_first_control(page)
             assert moved is not None, f"{rel}: its first widget has no slider or dropdown"
             problems = _problems(page)
