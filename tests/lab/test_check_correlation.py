@@ -109,6 +109,7 @@ def test_score_mistakes():
     assert "case 1 of 4" in lab.check("06.score_map", off_by_one, quiet=True).message
 
 
+@pytest.mark.slow
 def test_exploration_answers():
     import slamlab as sl
     from slamlab.lab.tasks_correlation import EXPLORE_POSE
