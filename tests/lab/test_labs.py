@@ -102,3 +102,16 @@ def test_autograde_full_points_for_solutions_zero_for_blank(course, tmp_path):
                       if m["grade"] and c.cell_type == "code")
     assert float(rows["instructor"]["raw_score"]) == auto_points  # every autograded cell; prose is graded by hand
     assert float(rows["blank"]["raw_score"]) == 0.0
+
+
+@pytest.mark.parametrize("lab", LABS, ids=[p.name for p in LABS])
+def test_lab_checks_every_task_of_its_chapter_once(lab):
+    import re
+
+    from slamlab import lab as sl_lab
+
+    nb = nbformat.read(lab, as_version=4)
+    used = re.findall(r'sl\.lab\.(?:check|answer)\("([^"]+)"', "\n".join(c.source for c in nb.cells
+                                                                       if c.cell_type == "code"))
+    prefix = lab.name[:2] + "."
+    assert sorted(used) == list(sl_lab.tasks_of(prefix)), f"{lab.name} checks {used}"

@@ -1,0 +1,175 @@
+"""Lab 06 (correlation localisation, 004 §7): the tasks and the library functions they are checked against."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..correlation import rasterise_scan, score_maps
+from ..scans import Scan, scan_to_points
+from .core import Case, ExplorationTask, Task, allclose, register
+
+#: Exploration 1's robot pose (x, y [cells], heading [rad]) and the heading steps tried [deg].
+EXPLORE_POSE = (60.0, 40.0, float(np.radians(37.0)))
+EXPLORE_STEPS_DEG = tuple(range(1, 31))
+
+
+def _beams(rng, n, r_lo=1.0, r_hi=12.0):
+    b = np.sort(rng.uniform(-np.pi, np.pi, n))
+    return b, rng.uniform(r_lo, r_hi, n)
+
+
+def _points_cases(rng):
+    cases = []
+    for n in (5, 12):
+        b, r = _beams(rng, n)
+        valid = rng.random(n) > 0.2
+        pose = np.array([rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(-np.pi, np.pi)])
+        cases.append(Case(f"random, {n} beams", {"bearings_rad": b, "ranges": r, "valid": valid, "pose": pose}))
+    b, r = _beams(rng, 6)
+    cases.append(Case("heading just below +π, bearings beyond ±π",
+                      {"bearings_rad": b + np.pi, "ranges": r, "valid": np.ones(6, bool),
+                       "pose": np.array([3.0, -2.0, np.pi - 1e-3])}))
+    cases.append(Case("heading -3π/2 (= +π/2)", {"bearings_rad": np.array([0.0, 0.5]), "ranges": np.array([2.0, 4.0]),
+                                                 "valid": np.array([True, True]),
+                                                 "pose": np.array([1.0, 1.0, -1.5 * np.pi])}))
+    cases.append(Case("a scan with no valid beams: shape (0, 2)",
+                      {"bearings_rad": np.array([0.0, 1.0, 2.0]), "ranges": np.full(3, 30.0),
+                       "valid": np.zeros(3, bool), "pose": np.array([5.0, 5.0, 0.3])}))
+    return cases
+
+
+def _points_reference(bearings_rad, ranges, valid, pose):
+    return scan_to_points(bearings_rad, ranges, pose, valid)
+
+
+def _stamp_reference(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n):
+    T, _ = rasterise_scan(Scan(bearings_rad, ranges, valid), [heading_rad], l_max=l_max, a_c=a_c, a_p=a_p, a_n=a_n)
+    return T[0].astype(float)
+
+
+def _stamp_case(label, b, r, valid, heading, a=(-1.0, 1.0, 0.0)):
+    l_max = int(np.ceil(np.max(r[valid]) + 0.5))
+    return Case(label, {"bearings_rad": b, "ranges": r, "valid": valid, "heading_rad": heading, "l_max": l_max,
+                        "a_c": a[0], "a_p": a[1], "a_n": a[2]})
+
+
+def _stamp_cases(rng):
+    cases = []
+    for n, a in ((8, (-1.0, 1.0, 0.0)), (20, (-0.5, 2.0, 0.25))):
+        b, r = _beams(rng, n, 1.0, 9.0)
+        cases.append(_stamp_case(f"random, {n} beams, a = {a}", b, r, rng.random(n) > 0.1,
+                                 float(rng.uniform(0, 2 * np.pi)), a))
+    b, r = _beams(rng, 6, 2.0, 6.0)
+    r[[1, 4]] = 15.0  # misses at the sensor's range limit: no mark at all
+    cases.append(_stamp_case("beams without a return are skipped", b, r, np.array([1, 0, 1, 1, 0, 1], bool),
+                             float(rng.uniform(0, 2 * np.pi))))
+    cases.append(_stamp_case("heading -170° (any real heading, not only [0, 2π))", *_beams(rng, 6, 2.0, 7.0),
+                             np.ones(6, bool), float(np.radians(-170.0) + 0.013)))
+    cases.append(_stamp_case("a long beam passes the obstacle cell of a short one: a_p must win",
+                             np.array([0.0, 0.02]), np.array([3.2, 10.0]), np.array([True, True]), 0.0))
+    return cases
+
+
+def _score_at_reference(M_values, T, o, row, col):
+    return float(score_maps(M_values, T[None], o, method="direct")[0, row, col])
+
+
+def _stamp_like(rng, o):
+    S = 2 * o
+    T = np.zeros((S, S))
+    m = rng.random((S, S)) < 0.3
+    T[m] = rng.choice([-1.0, 1.0], m.sum())
+    return T
+
+
+def _score_at_cases(rng):
+    cases = []
+    M = rng.choice([-1.0, 0.0, 1.0], size=(15, 11))
+    for row, col in ((7, 5), (3, 8)):
+        cases.append(Case(f"random 15x11 map, robot at ({row}, {col})",
+                          {"M_values": M, "T": _stamp_like(rng, 3), "o": 3, "row": row, "col": col}))
+    cases.append(Case("robot at the map corner (0, 0): M = 0 outside, no wrap-around with negative indices",
+                      {"M_values": M, "T": _stamp_like(rng, 4), "o": 4, "row": 0, "col": 0}))
+    cases.append(Case("robot at the far corner (14, 10)",
+                      {"M_values": M, "T": _stamp_like(rng, 4), "o": 4, "row": 14, "col": 10}))
+    cases.append(Case("stamp larger than the map", {"M_values": M[:3, :4], "T": _stamp_like(rng, 5), "o": 5,
+                                                   "row": 1, "col": 2}))
+    return cases
+
+
+def _score_map_reference(M_values, T, o):
+    return score_maps(M_values, T[None], o, method="direct")[0]
+
+
+def _score_map_cases(rng):
+    cases = []
+    for (h, w), o in (((12, 9), 3), ((7, 16), 4)):
+        cases.append(Case(f"random {h}x{w} map, S = {2 * o}", {"M_values": rng.choice([-1.0, 0.0, 1.0], size=(h, w)),
+                                                             "T": _stamp_like(rng, o), "o": o}))
+    T = np.zeros((6, 6))
+    T[3, 4] = 1.0  # one mark, one column right of the robot at T[3, 3]
+    cases.append(Case("a single mark right of the robot: D[row, col] = M[row, col + 1]",
+                      {"M_values": np.arange(12.0).reshape(3, 4), "T": T, "o": 3}))
+    cases.append(Case("stamp larger than the map", {"M_values": rng.choice([-1.0, 1.0], size=(2, 3)),
+                                                   "T": _stamp_like(rng, 4), "o": 4}))
+    return cases
+
+
+register(Task("06.scan_points", "Task 1, scan to world points", _points_reference, _points_cases,
+              "keep the valid beams, p = l (cos α, sin α) in the robot frame, then world = t + R(θ) p with "
+              "R(θ) = [[cos θ, -sin θ], [sin θ, cos θ]]; no valid beam gives an empty (0, 2) array.",
+              compare=allclose(rtol=1e-9, atol=1e-9)))
+register(Task("06.stamp", "Task 2, the image T_n of one heading", _stamp_reference, _stamp_cases,
+              "valid beams only; absolute direction α0 + α_i; a_c at t = 0, 0.5, 1, ... while t < l, then (for "
+              "every beam, after all the free marks) a_p at t = l + 0.01 and t = l + 0.5; a point (x, y) goes to "
+              "T[o + floor(y + 0.5), o + floor(x + 0.5)] with o = l_max + 2.", compare=allclose(0.0, 0.0), points=3))
+register(Task("06.score_at", "Task 3, the score of one shift by the definition", _score_at_reference,
+              _score_at_cases,
+              "sum T[i, j] * M[row + i - o, col + j - o] only where that map index lies inside the map "
+              "(M = a_n = 0 outside); Python's M[-1] silently wraps to the last row.",
+              compare=allclose(rtol=1e-9, atol=1e-9)))
+register(Task("06.score_map", "Task 4, every shift at once: the index mapping", _score_map_reference,
+              _score_map_cases,
+              "C = scipy.signal.correlate2d(M, T, mode='full') has C[a, b] = sum T[i, j] M[i + a - (S-1), "
+              "j + b - (S-1)], so the robot cell is row = a + o - (S - 1): take the H x W block starting at "
+              "a = b = S - 1 - o.", compare=allclose(rtol=1e-9, atol=1e-9)))
+
+
+def _explore_scan():
+    from ..sim import Rangefinder, measurement_room_200
+
+    rf = Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.3, quantum_cells=0.1)
+    return rf.scan(measurement_room_200(), np.array(EXPLORE_POSE), rng=2010)
+
+
+def _first_failing_step() -> float:
+    from ..correlation import localise
+    from ..sim import test_room_200
+
+    M, scan = test_room_200(), _explore_scan()
+    for d in EXPLORE_STEPS_DEG:
+        loc = localise(M, scan, delta_alpha_rad=np.radians(d))
+        if np.hypot(loc.pose[0] - EXPLORE_POSE[0], loc.pose[1] - EXPLORE_POSE[1]) > 2.0:
+            return float(d)
+    return float("nan")
+
+
+def _monte_carlo_failures() -> float:
+    from ..correlation import run_monte_carlo
+
+    mc = run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, delta_alpha_rad=np.radians(2.0), rng=2010)
+    return float(mc.failed.sum())
+
+
+register(ExplorationTask(
+    "06.explore.heading_step",
+    "Exploration 1: the smallest whole-degree step Δα at which localisation at (60, 40, 37°) fails",
+    _first_failing_step,
+    hint="cast the scan in sl.sim.measurement_room_200() with rng=SEED, localise on sl.sim.test_room_200() with "
+         "delta_alpha_rad = radians(1), radians(2), ... and stop at the first position error > 2 cells."))
+register(ExplorationTask(
+    "06.explore.failures",
+    "Exploration 2: failures of 12 random poses with σ = 2 cells and 120 extra clutter discs",
+    _monte_carlo_failures,
+    hint="sl.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, "
+         "delta_alpha_rad=np.radians(2), rng=SEED); count res.failed."))

@@ -1,0 +1,180 @@
+"""Lab 07 (Hough SLAM, 004): the tasks and the library functions they are checked against."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..hough import HoughAccumulator, find_peaks, hough_polar, pose_from_two_lines, transform_lines
+from .core import Case, ExplorationTask, Task, allclose, register
+
+#: Exploration 1's pose index on 004's path and the line (0-based, by votes) whose loss is asked for.
+EXPLORE_POSE_INDEX = 20
+EXPLORE_LINE = 2
+
+
+def _hough_reference(bearings_rad, ranges, delta_rho, delta_theta_rad, r_max):
+    return hough_polar(bearings_rad, ranges, delta_rho=delta_rho, delta_theta_rad=delta_theta_rad, r_max=r_max).H
+
+
+def _wall_scan(rng, n, rho, theta, r_max):
+    """Points of the line (rho, theta) seen from the origin, with a little noise along the normal."""
+    t = rng.uniform(-r_max / 2, r_max / 2, n)
+    x = rho * np.cos(theta) - t * np.sin(theta)
+    y = rho * np.sin(theta) + t * np.cos(theta)
+    x, y = x + rng.normal(0, 0.05, n) * np.cos(theta), y + rng.normal(0, 0.05, n) * np.sin(theta)
+    return np.arctan2(y, x), np.hypot(x, y)
+
+
+def _hough_cases(rng):
+    cases = []
+    for n, d_rho, d_theta in ((30, 1.0, 1.0), (50, 0.5, 5.0)):
+        b1, r1 = _wall_scan(rng, n // 2, 6.0, np.radians(30.0), 16.0)
+        b2, r2 = _wall_scan(rng, n - n // 2, -4.0, np.radians(-70.0), 16.0)
+        cases.append(Case(f"two walls, {n} points, Δrho = {d_rho}, Δθ = {d_theta}°",
+                          {"bearings_rad": np.concatenate([b1, b2]), "ranges": np.concatenate([r1, r2]),
+                           "delta_rho": d_rho, "delta_theta_rad": float(np.radians(d_theta)), "r_max": 16.0}))
+    b = rng.uniform(-np.pi, np.pi, 12)
+    r = rng.uniform(1.0, 14.0, 12)
+    r[[2, 5]] = 0.0
+    r[[7, 9]] = 20.0
+    cases.append(Case("zero ranges (no return) and ranges beyond r_max do not vote",
+                      {"bearings_rad": b, "ranges": r, "delta_rho": 1.0, "delta_theta_rad": float(np.radians(45.0)),
+                       "r_max": 15.0}))
+    cases.append(Case("an empty scan: an accumulator of zeros", {"bearings_rad": np.empty(0), "ranges": np.empty(0),
+                                                                "delta_rho": 1.0,
+                                                                "delta_theta_rad": float(np.radians(10.0)),
+                                                                "r_max": 5.0}))
+    return cases
+
+
+def _peaks_reference(H, rho, theta_rad, H_min):
+    acc = HoughAccumulator(H, rho, theta_rad, float(rho[1] - rho[0]), float(theta_rad[1] - theta_rad[0]))
+    lines = find_peaks(acc, H_min, suppress_rho=0.0, suppress_theta_rad=0.0)
+    return lines.rho, lines.theta_rad, lines.votes.astype(float)
+
+
+def _accumulator(rng, n_half, n_theta):
+    n_rho = 2 * n_half + 1
+    H = rng.permutation(n_rho * n_theta).reshape(n_rho, n_theta)  # distinct counts: no flat tops
+    return {"H": H, "rho": np.arange(-n_half, n_half + 1, dtype=float),
+            "theta_rad": -np.pi / 2 + np.pi / n_theta * np.arange(n_theta)}
+
+
+def _peaks_cases(rng):
+    cases = []
+    for n_half, n_theta, frac in ((4, 12, 0.5), (6, 18, 0.7)):
+        acc = _accumulator(rng, n_half, n_theta)
+        h_min = int(frac * acc["H"].size)
+        cases.append(Case(f"random {2 * n_half + 1}x{n_theta} accumulator, H_min = {h_min}", {**acc, "H_min": h_min}))
+    # θ wraps: the column before -90° is +90° - Δθ with rho flipped
+    acc = _accumulator(rng, 3, 6)
+    H = acc["H"]
+    H[2, 0] = 100  # a peak at (rho = -1, θ = -90°) ...
+    H[4, 5] = 101  # ... beaten across the wrap by (rho = +1, θ = +60°), its neighbour (-rho, θ + 180° - Δθ)
+    H[0, 2] = 99  # a peak on the rho edge: only the cells that exist are compared
+    cases.append(Case("θ wraps at ±90° with rho flipped; a peak on the rho edge", {**acc, "H": H, "H_min": 30}))
+    acc = _accumulator(rng, 2, 4)
+    cases.append(Case("H_min above every count: no line, empty arrays", {**acc, "H_min": 1000}))
+    return cases
+
+
+def _transform_cases(rng):
+    cases = []
+    for n in (1, 5):
+        cases.append(Case(f"random, {n} lines", {"rho": rng.uniform(-10, 10, n), "theta_rad": rng.uniform(-1.5, 1.5, n),
+                                                 "pose": rng.normal(0, 2, 3)}))
+    cases.append(Case("θ leaves [-90°, 90°): keep it continuous, do not wrap",
+                      {"rho": np.array([4.0, -3.0]), "theta_rad": np.radians([-85.0, 88.0]),
+                       "pose": np.array([0.5, -1.0, np.radians(10.0)])}))
+    cases.append(Case("no lines", {"rho": np.empty(0), "theta_rad": np.empty(0), "pose": np.array([1.0, 2.0, 0.3])}))
+    return cases
+
+
+def _pose_reference(line_i1, line_i2, line_j1, line_j2):
+    try:
+        return pose_from_two_lines(line_i1, line_i2, line_j1, line_j2)
+    except ValueError:
+        return np.full(3, np.nan)
+
+
+def _pose_case(label, li, pose, tj_shift=(0.0, 0.0)):
+    rj, tj = transform_lines(li[:, 0], li[:, 1], pose)
+    tj = tj + np.asarray(tj_shift)
+    return Case(label, {"line_i1": li[0], "line_i2": li[1], "line_j1": np.array([rj[0], tj[0]]),
+                        "line_j2": np.array([rj[1], tj[1]])})
+
+
+def _pose_cases(rng):
+    cases = []
+    for k in range(2):
+        t1 = rng.uniform(-1.5, 1.5)
+        li = np.array([[rng.uniform(-10, 10), t1], [rng.uniform(-10, 10), t1 + rng.uniform(0.5, 2.6)]])
+        cases.append(_pose_case(f"random pose {k + 1}", li, np.array([*rng.normal(0, 1.5, 2), rng.normal(0, 0.2)])))
+    cases.append(_pose_case("lines near θ = ±90°, turning past -90°", np.array([[6.0, np.radians(-87.0)],
+                                                                               [2.0, np.radians(10.0)]]),
+                            np.array([0.3, 0.8, np.radians(6.0)])))
+    cases.append(_pose_case("parallel lines: no pose, (nan, nan, nan)", np.array([[6.0, 0.4], [-2.0, 0.4]]),
+                            np.array([0.5, 0.5, 0.1])))
+    cases.append(_pose_case("lines only 10° apart (< 20°): (nan, nan, nan)", np.array([[6.0, 0.4], [-2.0, 0.575]]),
+                            np.array([0.5, 0.5, 0.1])))
+    cases.append(_pose_case("the angle between the lines changed by 5° (> 2°): (nan, nan, nan)",
+                            np.array([[6.0, 0.4], [-2.0, 1.9]]), np.array([0.5, 0.5, 0.1]),
+                            (0.0, np.radians(5.0))))
+    return cases
+
+
+register(Task("07.hough_votes", "Task 1, the polar Hough accumulator", _hough_reference, _hough_cases,
+              "θ_k = -π/2 + k Δθ (k < π/Δθ); rho axis n Δrho for |n| <= n_half = ceil(r_max/Δrho); each point with "
+              "0 < r <= r_max adds 1 to H[floor(r cos(θ_k - φ)/Δrho + n_half + 0.5), k] for every k.",
+              compare=allclose(0.0, 0.0), points=3))
+register(Task("07.find_peaks", "Task 2, peaks above H_min", _peaks_reference, _peaks_cases,
+              "a cell counts when H >= H_min and H >= each of its 8 neighbours that exist in rho; across θ = ±90° "
+              "the neighbour of (i, 0) in the previous column is (n_rho - 1 - i', n_theta - 1) (rho flips sign); "
+              "return (rho, theta, votes) sorted by votes, largest first.", compare=allclose(1e-12, 1e-12),
+              points=3))
+register(Task("07.transform_lines", "Task 3, lines seen from the next pose",
+              lambda rho, theta_rad, pose: transform_lines(rho, theta_rad, pose), _transform_cases,
+              "θ_j = θ_i - Δφ and rho_j = rho_i - (Δx cos θ_i + Δy sin θ_i), with θ_i the angle before the turn; "
+              "do not wrap θ.", compare=allclose(1e-12, 1e-12)))
+register(Task("07.pose_from_two_lines", "Task 4, the pose change from two lines", _pose_reference, _pose_cases,
+              "Δφ = θ_i1 - θ_j1; d_k = rho_ik - rho_jk, D = sin(θ_i2 - θ_i1), Δx = (d_1 sin θ_i2 - d_2 sin θ_i1)/D, "
+              "Δy = (d_2 cos θ_i1 - d_1 cos θ_i2)/D; nan when |D| < sin 20° or the angle between the lines "
+              "changed by more than 2° (wrap that change to [-π, π)).", compare=allclose(1e-9, 1e-9), points=3))
+
+
+def _explore_accumulator():
+    from ..sim import Rangefinder, path_004, test_room_200
+
+    rf = Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.1)
+    scan = rf.scan(test_room_200(), path_004()[EXPLORE_POSE_INDEX], rng=2010)
+    return hough_polar(scan.bearings_rad[scan.valid], scan.ranges[scan.valid], delta_rho=1.0,
+                       delta_theta_rad=np.radians(1.0))
+
+
+def _h_min_losing_line() -> float:
+    acc = _explore_accumulator()
+    for h in range(1, int(acc.H.max()) + 2):
+        if len(find_peaks(acc, H_min=h)) <= EXPLORE_LINE:
+            return float(h)
+    return float("nan")
+
+
+def _lost_steps() -> float:
+    from ..hough import run_sim_slam
+
+    return float(run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=2010).slam.lost.sum())
+
+
+register(ExplorationTask(
+    "07.explore.h_min",
+    "Exploration 1: the smallest H_min at which the third line of the scan at pose 20 is lost",
+    _h_min_losing_line,
+    hint="the chapter's scan (sl.sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.1), "
+         "pose sl.sim.path_004()[20], rng=SEED), hough_polar with Δrho = 1, Δθ = 1°, then find_peaks for "
+         "H_min = 1, 2, ... until at most 2 lines remain."))
+register(ExplorationTask(
+    "07.explore.lost_steps",
+    "Exploration 2: lost steps of Hough SLAM on 004's path with H_min = 40",
+    _lost_steps,
+    hint="sl.hough.run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=SEED); count "
+         "res.slam.lost."))

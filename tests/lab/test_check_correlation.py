@@ -1,0 +1,134 @@
+"""Lab 06 tasks: solutions written from 004 §7 pass, typical mistakes fail at the expected case."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.signal import correlate2d
+
+from slamlab import lab
+
+# --- independent solutions (what a student should write) --------------------------------------------
+
+
+def scan_points(bearings_rad, ranges, valid, pose):
+    a, r = bearings_rad[valid], ranges[valid]
+    x, y, th = pose
+    px, py = r * np.cos(a), r * np.sin(a)
+    return np.column_stack([x + np.cos(th) * px - np.sin(th) * py, y + np.sin(th) * px + np.cos(th) * py])
+
+
+def _stamp(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n, *, per_beam=False, offsets=(0.01, 0.5)):
+    o = l_max + 2
+    T = np.full((2 * o, 2 * o), a_n)
+
+    def mark(t, ang, value):
+        x, y = t * np.cos(ang), t * np.sin(ang)
+        T[o + np.floor(y + 0.5).astype(int), o + np.floor(x + 0.5).astype(int)] = value
+
+    beams = [(heading_rad + a, r) for a, r, ok in zip(bearings_rad, ranges, valid, strict=True) if ok]
+    if per_beam:  # the mistake: a later beam's free marks overwrite an earlier beam's obstacle
+        for ang, r in beams:
+            mark(np.arange(0.0, r, 0.5), ang, a_c)
+            mark(r + np.array(offsets), ang, a_p)
+        return T
+    for ang, r in beams:
+        mark(np.arange(0.0, r, 0.5), ang, a_c)
+    for ang, r in beams:
+        mark(r + np.array(offsets), ang, a_p)
+    return T
+
+
+def stamp(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n):
+    return _stamp(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n)
+
+
+def score_at(M_values, T, o, row, col):
+    H, W = M_values.shape
+    total = 0.0
+    for i in range(T.shape[0]):
+        for j in range(T.shape[1]):
+            r, c = row + i - o, col + j - o
+            if 0 <= r < H and 0 <= c < W:
+                total += T[i, j] * M_values[r, c]
+    return total
+
+
+def score_map(M_values, T, o):
+    H, W = M_values.shape
+    a0 = T.shape[0] - 1 - o
+    return correlate2d(M_values, T, mode="full")[a0:a0 + H, a0:a0 + W]
+
+
+@pytest.mark.parametrize(("task_id", "fn"), [("06.scan_points", scan_points), ("06.stamp", stamp),
+                                             ("06.score_at", score_at), ("06.score_map", score_map)])
+def test_correct_solutions_pass(task_id, fn):
+    res = lab.check(task_id, fn, quiet=True)
+    assert res.passed, res.message
+
+
+def test_scan_points_mistakes():
+    def all_beams(bearings_rad, ranges, valid, pose):  # forgets the valid mask
+        return scan_points(bearings_rad, ranges, np.ones_like(valid), pose)
+
+    def transposed_rotation(bearings_rad, ranges, valid, pose):  # R(θ)^T instead of R(θ)
+        return scan_points(bearings_rad, ranges, valid, (pose[0], pose[1], -pose[2]))
+
+    assert "(random, 5 beams) is wrong: expected shape" in lab.check("06.scan_points", all_beams, quiet=True).message
+    assert "case 1 of 5 (random, 5 beams)" in lab.check("06.scan_points", transposed_rotation, quiet=True).message
+
+
+def test_stamp_mistakes():
+    def per_beam(**kw):
+        return _stamp(**kw, per_beam=True)
+
+    def end_only(**kw):  # only one obstacle mark, at the range itself
+        return _stamp(**kw, offsets=(0.0,))
+
+    def no_heading(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n):  # forgets the heading
+        return _stamp(bearings_rad, ranges, valid, 0.0, l_max, a_c, a_p, a_n)
+
+    assert lab.check("06.stamp", per_beam, quiet=True).status == "failed"  # beams cross near the robot already
+    assert "case 1 of 5" in lab.check("06.stamp", end_only, quiet=True).message
+    assert "case 1 of 5" in lab.check("06.stamp", no_heading, quiet=True).message
+
+
+def test_score_mistakes():
+    def wraps(M_values, T, o, row, col):  # Python's negative indices wrap around
+        H, W = M_values.shape
+        return sum(T[i, j] * M_values[(row + i - o) % H if row + i - o < H else 0, (col + j - o) % W
+                                      if col + j - o < W else 0] * (row + i - o < H and col + j - o < W)
+                   for i in range(T.shape[0]) for j in range(T.shape[1]))
+
+    def off_by_one(M_values, T, o):  # 004's 1-based "+ 1" kept in 0-based indices
+        H, W = M_values.shape
+        a0 = T.shape[0] - o
+        return np.pad(correlate2d(M_values, T, mode="full"), ((0, 1), (0, 1)))[a0:a0 + H, a0:a0 + W]
+
+    assert "(robot at the map corner (0, 0)" in lab.check("06.score_at", wraps, quiet=True).message
+    assert "case 1 of 4" in lab.check("06.score_map", off_by_one, quiet=True).message
+
+
+@pytest.mark.slow
+def test_exploration_answers():
+    import slamlab as sl
+    from slamlab.lab.tasks_correlation import EXPLORE_POSE
+
+    M, W = sl.sim.test_room_200(), sl.sim.measurement_room_200()
+    rf = sl.sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.3, quantum_cells=0.1)
+    scan = rf.scan(W, np.array(EXPLORE_POSE), rng=2010)
+    first = None
+    for d in range(1, 31):
+        loc = sl.correlation.localise(M, scan, delta_alpha_rad=np.radians(d))
+        if np.hypot(loc.col - 60, loc.row - 40) > 2:
+            first = d
+            break
+    assert first == 14
+    assert lab.answer("06.explore.heading_step", first, quiet=True).passed
+    assert lab.answer("06.explore.heading_step", first - 1, quiet=True).status == "failed"
+
+    mc = sl.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120,
+                                        delta_alpha_rad=np.radians(2.0), rng=2010)
+    n_fail = int(((mc.err_pos_cells > 2) | (np.degrees(mc.err_heading_rad) > 5)).sum())
+    assert lab.answer("06.explore.failures", n_fail, quiet=True).passed
+    assert lab.answer("06.explore.failures", n_fail + 1, quiet=True).status == "failed"
