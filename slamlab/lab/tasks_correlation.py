@@ -135,18 +135,11 @@ register(Task("06.score_map", "Task 4, every shift at once: the index mapping", 
               "a = b = S - 1 - o.", compare=allclose(rtol=1e-9, atol=1e-9)))
 
 
-def _explore_scan():
-    from ..sim import Rangefinder, measurement_room_200
-
-    rf = Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.3, quantum_cells=0.1)
-    return rf.scan(measurement_room_200(), np.array(EXPLORE_POSE), rng=2010)
-
-
 def _first_failing_step() -> float:
     from ..correlation import localise
-    from ..sim import test_room_200
+    from .experiments import localisation_scene
 
-    M, scan = test_room_200(), _explore_scan()
+    M, scan = localisation_scene(EXPLORE_POSE, rng=2010)
     for d in EXPLORE_STEPS_DEG:
         loc = localise(M, scan, delta_alpha_rad=np.radians(d))
         if np.hypot(loc.pose[0] - EXPLORE_POSE[0], loc.pose[1] - EXPLORE_POSE[1]) > 2.0:

@@ -143,10 +143,9 @@ register(Task("07.pose_from_two_lines", "Task 4, the pose change from two lines"
 
 
 def _explore_accumulator():
-    from ..sim import Rangefinder, path_004, test_room_200
+    from .experiments import hough_scene_scan
 
-    rf = Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.1)
-    scan = rf.scan(test_room_200(), path_004()[EXPLORE_POSE_INDEX], rng=2010)
+    scan = hough_scene_scan(EXPLORE_POSE_INDEX, rng=2010)
     return hough_polar(scan.bearings_rad[scan.valid], scan.ranges[scan.valid], delta_rho=1.0,
                        delta_theta_rad=np.radians(1.0))
 

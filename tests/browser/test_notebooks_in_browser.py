@@ -158,8 +158,8 @@ def _move_first_control(page) -> str | None:
     widget = page.locator(".widget-interact").first
     if widget.count() == 0:
         return None
-    output = widget.locator(".widget-output")
-    before = output.inner_text()
+    output = widget.locator(".widget-output").first
+    before = output.inner_html()  # text, tables and figures (an image's data changes with the plot)
     page.evaluate(_WATCH_BUSY)
     select = widget.locator("select")
     handle = widget.locator(".noUi-handle")
@@ -176,7 +176,7 @@ def _move_first_control(page) -> str | None:
     else:
         return None
     page.wait_for_function(_DONE, timeout=RUN_TIMEOUT_S * 1000)
-    after = output.inner_text()
+    after = output.inner_html()
     assert after != before, f"moving the {moved} left the widget's output unchanged"
     return moved
 

@@ -1,0 +1,26 @@
+"""The simulated scenes of the labs' exploration tasks (the lab's experiments: the one lab module that runs the simulator).
+
+Task modules (``tasks_*.py``) check a student's work; the scans and maps their explorations need
+come from here, so that no task module imports :mod:`slamlab.sim` (CONVENTIONS: the simulator
+produces scans and grids, everything else consumes them).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..sim import Rangefinder, measurement_room_200, path_004, test_room_200
+
+__all__ = ["hough_scene_scan", "localisation_scene"]
+
+
+def localisation_scene(pose, *, range_std_cells: float = 0.3, rng=2010):
+    """Lab 06: 004's stored test room and a 360-beam scan cast at ``pose`` in its measurement version."""
+    rf = Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=range_std_cells, quantum_cells=0.1)
+    return test_room_200(), rf.scan(measurement_room_200(), np.asarray(pose, dtype=float), rng=rng)
+
+
+def hough_scene_scan(pose_index: int, *, range_std_cells: float = 0.1, rng=2010):
+    """Lab 07: the scan at pose ``pose_index`` of 004's path in the test room (the chapter's scene)."""
+    rf = Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=range_std_cells)
+    return rf.scan(test_room_200(), path_004()[pose_index], rng=rng)
