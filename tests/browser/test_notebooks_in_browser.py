@@ -163,18 +163,22 @@ def _move_first_control(page) -> str | None:
     page.evaluate(_WATCH_BUSY)
     select = widget.locator("select")
     handle = widget.locator(".noUi-handle")
-    if select.count():
+    if handle.count():  # a slider first: one step costs least
+        handle.first.focus()
+        handle.first.press("ArrowRight")
+        moved = "slider one step right"
+    elif select.count():
         options = select.first.locator("option").all_inner_texts()
         current = select.first.evaluate("s => s.options[s.selectedIndex].text")
         target = next(o for o in options if o != current)
         select.first.select_option(label=target)
         moved = f"dropdown -> {target}"
-    elif handle.count():
-        handle.first.focus()
-        handle.first.press("ArrowRight")
-        moved = "slider one step right"
     else:
         return None
+    button = widget.locator("button")
+    if button.count():  # a manual widget (long runs) runs on its button
+        button.first.click()
+        moved += ", then its run button"
     page.wait_for_function(_DONE, timeout=RUN_TIMEOUT_S * 1000)
     after = output.inner_html()
     assert after != before, f"moving the {moved} left the widget's output unchanged"
