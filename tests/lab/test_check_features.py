@@ -1,0 +1,126 @@
+"""Labs 02 and 03 tasks: solutions written from the equations pass, typical mistakes fail at the expected case."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from slamlab import lab
+
+# --- lab 02: independent solutions (what a student should write) ------------------------------------
+
+CIRCLE = [(0, 3), (1, 3), (2, 2), (3, 1), (3, 0), (3, -1), (2, -2), (1, -3), (0, -3), (-1, -3), (-2, -2),
+          (-3, -1), (-3, 0), (-3, 1), (-2, 2), (-1, 3)]  # (du, dv)
+
+
+def integral_image(image):
+    H, W = image.shape
+    II = np.zeros((H + 1, W + 1))
+    for r in range(H):
+        for c in range(W):
+            II[r + 1, c + 1] = image[r, c] + II[r, c + 1] + II[r + 1, c] - II[r, c]
+    return II
+
+
+def box_sum(II, r0, r1, c0, c1, *, clip=True):
+    H, W = II.shape[0] - 1, II.shape[1] - 1
+    if clip:
+        r0, r1 = min(max(r0, 0), H), min(max(r1, 0), H)
+        c0, c1 = min(max(c0, 0), W), min(max(c1, 0), W)
+    return II[r1, c1] - II[r0, c1] - II[r1, c0] + II[r0, c0]
+
+
+def hessian(II, row, col, L, *, weight=0.81):
+    l, b = L // 3, (L - 1) // 2
+    h = l // 2
+
+    def box(a0, a1, b0, b1):
+        return box_sum(II, row + a0, row + a1, col + b0, col + b1)
+
+    Dxx = box(-l + 1, l, -b, b + 1) - 3 * box(-l + 1, l, -h, -h + l)
+    Dyy = box(-b, b + 1, -l + 1, l) - 3 * box(-h, -h + l, -l + 1, l)
+    Dxy = box(-l, 0, 1, l + 1) + box(1, l + 1, -l, 0) - box(-l, 0, -l, 0) - box(1, l + 1, 1, l + 1)
+    Dxx, Dyy, Dxy = Dxx / L**2, Dyy / L**2, Dxy / L**2
+    return Dxx * Dyy - weight * Dxy**2, Dxx + Dyy
+
+
+def fast_mask(image, t, n, *, dtype=int, wrap=True):
+    img = image.astype(dtype)
+    H, W = img.shape
+    out = np.zeros((H, W), dtype=bool)
+    for r in range(3, H - 3):
+        for c in range(3, W - 3):
+            p = img[r, c]
+            ring = np.array([img[r + dv, c + du] for du, dv in CIRCLE])
+            for flags in (ring > p + t, ring < p - t):
+                seq = np.concatenate([flags, flags]) if wrap else flags
+                run = best = 0
+                for f in seq:
+                    run = run + 1 if f else 0
+                    best = max(best, run)
+                out[r, c] |= best >= n
+    return out
+
+
+@pytest.mark.parametrize(("task_id", "fn"), [("02.integral_image", integral_image), ("02.box_sum", box_sum),
+                                             ("02.hessian", hessian), ("02.fast_mask", fast_mask)])
+def test_lab02_correct_solutions_pass(task_id, fn):
+    res = lab.check(task_id, fn, quiet=True)
+    assert res.passed, res.message
+
+
+def test_lab02_mistakes():
+    def no_zero_border(image):  # II[r, c] = sum of I[:r+1, :c+1], shape (H, W)
+        return np.cumsum(np.cumsum(image, axis=0), axis=1)
+
+    def no_clip(II, r0, r1, c0, c1):  # negative indices wrap around
+        return box_sum(II, r0, r1, c0, c1, clip=False)
+
+    def no_weight(II, row, col, L):  # det without 0.9²
+        return hessian(II, row, col, L, weight=1.0)
+
+    def uint8(image, t, n):  # I_p + t computed in uint8
+        return fast_mask(image, np.uint8(t), n, dtype=np.uint8)
+
+    def no_wrap(image, t, n):  # runs that cross the end of the circle list are missed
+        return fast_mask(image, t, n, wrap=False)
+
+    assert "case 1 of 5 (random 5x7 image) is wrong: expected shape" in \
+        lab.check("02.integral_image", no_zero_border, quiet=True).message
+    assert "(a box over the top-left corner" in lab.check("02.box_sum", no_clip, quiet=True).message
+    assert "case 1 of 6" in lab.check("02.hessian", no_weight, quiet=True).message
+    assert not lab.check("02.fast_mask", uint8, quiet=True).passed  # failed, or error where numpy warns
+    assert lab.check("02.fast_mask", no_wrap, quiet=True).status == "failed"  # random images have such arcs
+
+
+def test_lab02_wrapping_arc_case_alone():
+    def no_wrap_when_flat(image, t, n):  # misses wrapping arcs only on the flat test image
+        return fast_mask(image, t, n, wrap=len(np.unique(image)) > 2)
+
+    assert "wraps past the 16th" in lab.check("02.fast_mask", no_wrap_when_flat, quiet=True).message
+
+
+def test_lab02_uint8_overflow_case_alone():
+    """A solution that is right except for uint8 arithmetic fails at the overflow case, not before."""
+    def uint8_only_when_bright(image, t, n):
+        if image[4, 4] == 250:
+            return fast_mask(image, np.uint8(t), n, dtype=np.uint8)
+        return fast_mask(image, t, n)
+
+    assert "I_p + t overflows uint8" in lab.check("02.fast_mask", uint8_only_when_bright, quiet=True).message
+
+
+@pytest.mark.realdata
+@pytest.mark.slow
+def test_lab02_exploration_answers(shared_data):
+    import slamlab as sl
+
+    img = sl.features.load_oxford_image("graf", 1, size=(768, 576))
+    t = next(t for t in range(5, 105, 5) if len(sl.features.fast_detect(img, t)) <= 1000)
+    assert lab.answer("02.explore.fast_threshold", t, quiet=True).passed
+    assert lab.answer("02.explore.fast_threshold", t - 5, quiet=True).status == "failed"
+
+    ev = sl.features.run_pair_evaluation(("wall",), (2, 3, 4, 5, 6), scale=0.5, n_points=500)
+    best = max(float(np.mean(ev.rep[0, :, k])) for k in range(len(ev.detectors)))
+    assert lab.answer("02.explore.wall_repeatability", round(best, 2), quiet=True).passed
+    assert lab.answer("02.explore.wall_repeatability", best - 0.02, quiet=True).status == "failed"
