@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..features.fast import fast_corner_mask
+from ..features.matching import accept_000, accept_ratio, knn2
 from ..features.surf import _box, hessian_response, integral_image
+from ..kdtree import KDTree, bbf_trace, hamming_distances
 from .core import Case, ExplorationTask, Task, allclose, register
 
 # --- lab 02: detectors ------------------------------------------------------------------------------
@@ -149,3 +151,171 @@ register(ExplorationTask(
     _best_repeatability_wall, atol=0.005,
     hint="sl.features.run_pair_evaluation(('wall',), (2, 3, 4, 5, 6), scale=0.5, n_points=500); the last row "
          "of its table holds each detector's mean; give the largest (2 decimals are enough)."))
+
+
+# --- lab 03: matching -------------------------------------------------------------------------------
+
+#: Exploration budgets of lab 03 (BBF leaves) and the ratios tried.
+EXPLORE_BUDGETS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
+EXPLORE_RATIOS = tuple(round(0.3 + 0.05 * i, 2) for i in range(15))
+
+
+def _two_nn_cases(rng):
+    cases = [Case(f"random, {m} queries, {n} stored, d = {d}", {"query": rng.normal(size=(m, d)),
+                                                                 "train": rng.normal(size=(n, d))})
+             for m, n, d in ((4, 10, 3), (7, 30, 8))]
+    train = rng.normal(size=(6, 4))
+    cases.append(Case("a query equal to a stored point: d1 = 0", {"query": train[[2, 5]] + [[0, 0, 0, 0], [0.1, 0, 0, 0]],
+                                                                 "train": train}))
+    dup = np.vstack([train[:3], train[1:2], train[3:]])  # rows 1 and 3 are the same point
+    cases.append(Case("duplicate stored points: equal distances, the lower index first",
+                      {"query": train[1:2] + 0.05, "train": dup}))
+    cases.append(Case("one stored point: second neighbour inf, index -1",
+                      {"query": rng.normal(size=(3, 4)), "train": rng.normal(size=(1, 4))}))
+    cases.append(Case("no stored point: all inf, -1", {"query": rng.normal(size=(2, 4)), "train": np.zeros((0, 4))}))
+    return cases
+
+
+def _accept_reference(dist, factor, ratio, max_dist):
+    keep_000 = accept_000(dist, factor=factor, max_dist=max_dist)
+    keep_ratio = accept_ratio(dist, ratio) & (dist[:, 0] <= max_dist)
+    return keep_000.astype(float), keep_ratio.astype(float)
+
+
+def _accept_cases(rng):
+    d1 = rng.uniform(0.05, 0.5, 12)
+    d = np.column_stack([d1, d1 * rng.uniform(1.0, 3.0, 12)])
+    cases = [Case("random distances, factor 2, ratio 0.8, no limit", {"dist": d, "factor": 2.0, "ratio": 0.8,
+                                                                       "max_dist": np.inf}),
+             Case("random distances, factor 1.5, ratio 0.6, d1 <= 0.3", {"dist": d, "factor": 1.5, "ratio": 0.6,
+                                                                          "max_dist": 0.3}),
+             Case("d2 exactly 2 d1: 000 accepts (>=), ratio 0.5 rejects (<)",
+                  {"dist": np.array([[0.125, 0.25], [0.25, 0.5]]), "factor": 2.0, "ratio": 0.5, "max_dist": np.inf}),
+             Case("d1 exactly max_dist: accepted (<=)", {"dist": np.array([[0.25, 1.0]]), "factor": 2.0, "ratio": 0.8,
+                                                         "max_dist": 0.25}),
+             Case("duplicates d1 = d2 = 0: 000 accepts (0 >= 0), ratio rejects (0 < 0 is false)",
+                  {"dist": np.array([[0.0, 0.0], [0.0, 0.1]]), "factor": 2.0, "ratio": 0.8, "max_dist": 0.3}),
+             Case("one stored point (d2 = inf) and none (d1 = d2 = inf)",
+                  {"dist": np.array([[0.2, np.inf], [np.inf, np.inf]]), "factor": 2.0, "ratio": 0.8,
+                   "max_dist": 0.3}),
+             Case("no queries: empty results", {"dist": np.zeros((0, 2)), "factor": 2.0, "ratio": 0.8,
+                                                "max_dist": np.inf})]
+    return cases
+
+
+def _hamming_cases(rng):
+    cases = [Case(f"random {m} x {n} descriptors of {b} bytes",
+                  {"A": rng.integers(0, 256, (m, b)).astype(np.uint8), "B": rng.integers(0, 256, (n, b)).astype(np.uint8)})
+             for m, n, b in ((3, 5, 4), (6, 4, 32))]
+    cases.append(Case("0 against 255: 8 bits per byte, not 255 (uint8 arithmetic wraps)",
+                      {"A": np.zeros((1, 3), np.uint8), "B": np.array([[255, 255, 255], [1, 128, 0]], np.uint8)}))
+    cases.append(Case("bytes that differ in several bits count every bit",
+                      {"A": np.array([[0b1011, 0b11110000]], np.uint8), "B": np.array([[0b0100, 0b00001111]], np.uint8)}))
+    same = rng.integers(0, 256, (2, 8)).astype(np.uint8)
+    cases.append(Case("identical descriptors: 0", {"A": same, "B": same}))
+    return cases
+
+
+def _bbf_reference(tree, q, k, max_leaves):
+    d, ids, _ = bbf_trace(tree, q, k=k, max_leaves=max_leaves)
+    return d, ids.astype(float)
+
+
+def _bbf_compare(expected, received):
+    base = allclose(1e-9, 1e-12)
+    if not isinstance(received, (tuple, list)) or len(received) != 2:
+        return base(expected, received)
+    diff = base(expected[0], received[0])
+    if diff is not None:
+        return f"item 0 of the returned tuple (distances): {diff}"
+    e_ids = np.asarray(expected[1], dtype=float)
+    try:
+        r_ids = np.asarray(received[1], dtype=float)
+    except (TypeError, ValueError):
+        return f"expected integer ids; got {type(received[1]).__name__}"
+    if r_ids.shape != e_ids.shape:
+        return f"item 1 of the returned tuple (ids): expected shape {e_ids.shape}; got shape {r_ids.shape}"
+    d = np.asarray(expected[0])
+    unique = np.array([np.count_nonzero(d == x) == 1 for x in d])  # tied distances: any of the tied ids
+    bad = np.flatnonzero(unique & (r_ids != e_ids))
+    if bad.size:
+        i = int(bad[0])
+        return f"item 1 of the returned tuple (ids): at index {i} expected {int(e_ids[i])}, got {r_ids[i]:g}"
+    return None
+
+
+def _bbf_cases(rng):
+    cases = []
+    X = rng.random((30, 2)) * [2.0, 1.0]
+    cases.append(Case("30 points in 2-d, exact (max_leaves None)", {"tree": KDTree(X), "q": np.array([1.1, 0.45]),
+                                                                     "k": 2, "max_leaves": None}))
+    Y = rng.normal(size=(200, 4))
+    t4 = KDTree(Y)
+    q = rng.normal(size=4)
+    cases.append(Case("200 points in 4-d, one descent only (max_leaves 1)", {"tree": t4, "q": q, "k": 2,
+                                                                              "max_leaves": 1}))
+    cases.append(Case("200 points in 4-d, backtracking 6 leaves", {"tree": t4, "q": q, "k": 2, "max_leaves": 6}))
+    cases.append(Case("200 points in 4-d, k = 3, exact", {"tree": t4, "q": rng.normal(size=4), "k": 3,
+                                                           "max_leaves": None}))
+    cases.append(Case("buckets of 4 points (leaf_size 4), 3 leaves", {"tree": KDTree(Y, leaf_size=4),
+                                                                       "q": rng.normal(size=4), "k": 2,
+                                                                       "max_leaves": 3}))
+    cases.append(Case("k = 5 > 3 stored points: pad with inf and -1", {"tree": KDTree(rng.random((3, 2))),
+                                                                        "q": np.array([0.5, 0.5]), "k": 5,
+                                                                        "max_leaves": None}))
+    D = np.repeat(rng.random((4, 2)), 3, axis=0)  # every point three times
+    cases.append(Case("duplicate points: ties (any of the tied ids)", {"tree": KDTree(D), "q": D[5] + 0.01, "k": 2,
+                                                                       "max_leaves": None}))
+    return cases
+
+
+register(Task("03.two_nn", "Task 1, exact 2-NN by brute force", lambda query, train: knn2(query, train),
+              _two_nn_cases,
+              "all Euclidean distances query x train, sort each row (a stable sort keeps the lower index first "
+              "on ties), keep 2 columns; with fewer than 2 stored points pad with inf and -1 (shape (M, 2) always).",
+              compare=allclose(1e-9, 1e-12), points=2))
+register(Task("03.accept", "Task 2, 000's rule and Lowe's ratio test", _accept_reference, _accept_cases,
+              "000: d2 >= factor * d1 and d1 <= max_dist; ratio: d1 < ratio * d2 and d1 <= max_dist (write the "
+              "products, not d1 / d2: d2 may be 0 or inf); return the two boolean arrays.",
+              compare=allclose(0.0, 0.0), points=2))
+register(Task("03.hamming", "Task 3, Hamming distances of packed binary descriptors",
+              lambda A, B: hamming_distances(A, B), _hamming_cases,
+              "XOR the bytes (A[:, None, :] ^ B[None, :, :]) and count the 1 bits (np.unpackbits along the last "
+              "axis, or np.bitwise_count), summed over the bytes; subtracting uint8 values wraps around.",
+              compare=allclose(0.0, 0.0), points=2))
+register(Task("03.bbf", "Task 4, Best-Bin-First: descent and backtracking", _bbf_reference, _bbf_cases,
+              "heap of (bound, node) from (0.0, root 0); pop; stop when bound >= the k-th best squared distance or "
+              "after max_leaves leaves; descend: diff = q[split_dim] - split_val, near = left if diff <= 0 else "
+              "right, push the far child with bound max(bound, diff²); at a leaf evaluate points[perm[start:stop]].",
+              compare=_bbf_compare, points=3))
+
+
+def _smallest_budget_90() -> float:
+    from ..features import run_recall_vs_leaves
+
+    c = run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200)
+    ok = c.budgets[c.recall_bbf >= 0.9]
+    return float(ok.min()) if ok.size else float("nan")
+
+
+def _largest_precise_ratio() -> float:
+    from ..features import run_ratio_tradeoff
+
+    tr = run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
+    ok = tr.ratios[tr.precision >= 0.9]
+    return float(ok.max()) if ok.size else float("nan")
+
+
+register(ExplorationTask(
+    "03.explore.bbf_budget",
+    "Exploration 1: the smallest BBF leaf budget reaching 90 % nearest-neighbour recall with 10000 stored "
+    "descriptors",
+    _smallest_budget_90,
+    hint="sl.features.run_recall_vs_leaves((1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), n_stored=10000, "
+         "n_queries=200); the first budget whose BBF recall is >= 0.9."))
+register(ExplorationTask(
+    "03.explore.precise_ratio",
+    "Exploration 2: the largest ratio (0.30, 0.35, ..., 1.00) keeping SURF's match precision >= 0.9 on boat 1→2",
+    _largest_precise_ratio, atol=1e-6,
+    hint="sl.features.run_ratio_tradeoff(ratios, detector='SURF', sequence='boat', j=2) with ratios "
+         "0.30, 0.35, ..., 1.00; precision is not monotonic in the ratio: take the largest ratio with >= 0.9."))

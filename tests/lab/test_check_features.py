@@ -124,3 +124,109 @@ def test_lab02_exploration_answers(shared_data):
     best = max(float(np.mean(ev.rep[0, :, k])) for k in range(len(ev.detectors)))
     assert lab.answer("02.explore.wall_repeatability", round(best, 2), quiet=True).passed
     assert lab.answer("02.explore.wall_repeatability", best - 0.02, quiet=True).status == "failed"
+
+
+# --- lab 03: independent solutions ------------------------------------------------------------------
+
+
+def two_nn(query, train, *, stable=True):
+    M = query.shape[0]
+    dist, idx = np.full((M, 2), np.inf), np.full((M, 2), -1)
+    if train.shape[0] == 0:
+        return dist, idx
+    D = np.sqrt(((query[:, None, :] - train[None, :, :]) ** 2).sum(axis=2))
+    o = np.argsort(D, axis=1, kind="stable" if stable else "quicksort")[:, :2]
+    k = o.shape[1]
+    dist[:, :k], idx[:, :k] = np.take_along_axis(D, o, axis=1), o
+    return dist, idx
+
+
+def accept(dist, factor, ratio, max_dist, *, strict_000=False):
+    d1, d2 = dist[:, 0], dist[:, 1]
+    keep_000 = (d2 > factor * d1) if strict_000 else (d2 >= factor * d1)
+    return keep_000 & (d1 <= max_dist), (d1 < ratio * d2) & (d1 <= max_dist)
+
+
+def hamming(A, B):
+    x = A[:, None, :] ^ B[None, :, :]
+    return np.unpackbits(x, axis=2).sum(axis=2)
+
+
+def bbf(tree, q, k, max_leaves, *, plane_bound_only=False):
+    import heapq
+
+    t = tree.nodes
+    heap, best, leaves = [(0.0, 0)], [], 0
+    while heap:
+        bound, node = heapq.heappop(heap)
+        if len(best) >= k and bound >= best[k - 1][0]:
+            break
+        while t["left"][node] >= 0:
+            diff = q[t["split_dim"][node]] - t["split_val"][node]
+            near, far = (t["left"][node], t["right"][node]) if diff <= 0 else (t["right"][node], t["left"][node])
+            heapq.heappush(heap, (diff**2 if plane_bound_only else max(bound, diff**2), int(far)))
+            node = near
+        rows = t["perm"][t["start"][node]:t["stop"][node]]
+        d2 = ((t["points"][rows] - q) ** 2).sum(axis=1)
+        best = sorted(best + list(zip(d2.tolist(), t["ids"][rows].tolist(), strict=True)))[:k]
+        leaves += 1
+        if max_leaves is not None and leaves >= max_leaves:
+            break
+    best += [(np.inf, -1)] * (k - len(best))
+    return np.sqrt([b[0] for b in best]), np.array([b[1] for b in best])
+
+
+@pytest.mark.parametrize(("task_id", "fn"), [("03.two_nn", two_nn), ("03.accept", accept), ("03.hamming", hamming),
+                                             ("03.bbf", bbf)])
+def test_lab03_correct_solutions_pass(task_id, fn):
+    res = lab.check(task_id, fn, quiet=True)
+    assert res.passed, res.message
+
+
+def test_lab03_mistakes():
+    def no_padding(query, train):  # breaks with fewer than 2 stored points
+        D = np.linalg.norm(query[:, None, :] - train[None, :, :], axis=2)
+        o = np.argsort(D, axis=1, kind="stable")[:, :2]
+        return np.take_along_axis(D, o, axis=1), o
+
+    def strict(dist, factor, ratio, max_dist):  # 000's ">=" read as ">"
+        return accept(dist, factor, ratio, max_dist, strict_000=True)
+
+    def divides(dist, factor, ratio, max_dist):  # d1 / d2 < ratio: 0 / 0 is nan
+        d1, d2 = dist[:, 0], dist[:, 1]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r = d1 / d2
+        return (d2 >= factor * d1) & (d1 <= max_dist), (r < ratio) & (d1 <= max_dist)
+
+    def subtract(A, B):  # |a - b| in uint8 instead of differing bits
+        return np.abs(A[:, None, :].astype(int) - B[None, :, :]).sum(axis=2)
+
+    def unbounded(tree, q, k, max_leaves):  # every leaf, whatever max_leaves
+        return bbf(tree, q, k, None)
+
+    def no_backtrack(tree, q, k, max_leaves):  # one descent only
+        return bbf(tree, q, k, 1)
+
+    assert "(one stored point" in lab.check("03.two_nn", no_padding, quiet=True).message
+    assert "(d2 exactly 2 d1" in lab.check("03.accept", strict, quiet=True).message
+    assert lab.check("03.accept", divides, quiet=True).passed  # the products are safer, but d1/d2 gives the same
+    assert "case 1 of 5" in lab.check("03.hamming", subtract, quiet=True).message
+    assert "(200 points in 4-d, one descent only" in lab.check("03.bbf", unbounded, quiet=True).message
+    assert "case 1 of 7" in lab.check("03.bbf", no_backtrack, quiet=True).message
+
+
+@pytest.mark.realdata
+@pytest.mark.slow
+def test_lab03_exploration_answers(shared_data):
+    import slamlab as sl
+    from slamlab.lab.tasks_features import EXPLORE_BUDGETS, EXPLORE_RATIOS
+
+    c = sl.features.run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200)
+    budget = next(int(b) for b, r in zip(c.budgets, c.recall_bbf, strict=True) if r >= 0.9)
+    assert lab.answer("03.explore.bbf_budget", budget, quiet=True).passed
+    assert lab.answer("03.explore.bbf_budget", 200, quiet=True).status == "failed"
+
+    tr = sl.features.run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
+    best = max(r for r, p in zip(tr.ratios, tr.precision, strict=True) if p >= 0.9)
+    assert lab.answer("03.explore.precise_ratio", best, quiet=True).passed
+    assert lab.answer("03.explore.precise_ratio", best + 0.05, quiet=True).status == "failed"
