@@ -1,0 +1,321 @@
+"""Labs 02 and 03 (features, 000 §1.4; 003 §3.1): the tasks and the library functions they are checked against."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..features.fast import fast_corner_mask
+from ..features.matching import accept_000, accept_ratio, knn2
+from ..features.surf import _box, hessian_response, integral_image
+from ..kdtree import KDTree, bbf_trace, hamming_distances
+from .core import Case, ExplorationTask, Task, allclose, register
+
+# --- lab 02: detectors ------------------------------------------------------------------------------
+
+#: Exploration 1 of lab 02: FAST thresholds tried and the corner budget.
+EXPLORE_FAST_THRESHOLDS = tuple(range(5, 105, 5))
+EXPLORE_FAST_BUDGET = 1000
+
+
+def _integral_cases(rng):
+    cases = [Case(f"random {h}x{w} image", {"image": rng.random((h, w))}) for h, w in ((5, 7), (12, 9))]
+    cases.append(Case("a single pixel: shape (2, 2)", {"image": np.array([[0.25]])}))
+    cases.append(Case("one row", {"image": rng.random((1, 6))}))
+    cases.append(Case("a constant image", {"image": np.full((4, 3), 0.5)}))
+    return cases
+
+
+def _box_reference(II, r0, r1, c0, c1):
+    pad = max(II.shape) + max(abs(r0), abs(r1), abs(c0), abs(c1)) + 1
+    return float(_box(np.pad(II, pad, mode="edge"), pad, 1, 1, 1, r0, r1, c0, c1)[0, 0])
+
+
+def _box_cases(rng):
+    I = rng.random((10, 13))
+    II = integral_image(I)
+    cases = [Case("random box inside", {"II": II, "r0": 2, "r1": 7, "c0": 3, "c1": 11}),
+             Case("random box inside, one pixel", {"II": II, "r0": 4, "r1": 5, "c0": 9, "c1": 10}),
+             Case("the whole image", {"II": II, "r0": 0, "r1": 10, "c0": 0, "c1": 13}),
+             Case("an empty box (r0 = r1): 0", {"II": II, "r0": 6, "r1": 6, "c0": 2, "c1": 8}),
+             Case("a box over the top-left corner: only the part inside counts",
+                  {"II": II, "r0": -4, "r1": 3, "c0": -2, "c1": 5}),
+             Case("a box over the bottom-right corner", {"II": II, "r0": 7, "r1": 15, "c0": 10, "c1": 20}),
+             Case("a box entirely outside the image: 0", {"II": II, "r0": -9, "r1": -3, "c0": 2, "c1": 6})]
+    return cases
+
+
+def _hessian_reference(II, row, col, L):
+    det, trace = hessian_response(II, L, 1)
+    return float(det[row, col]), float(trace[row, col])
+
+
+def _hessian_cases(rng):
+    yy, xx = np.mgrid[0:40, 0:40]
+    blob = np.exp(-((xx - 20.0) ** 2 + (yy - 19.0) ** 2) / (2 * 3.0**2))
+    noise = rng.random((30, 34))
+    cases = [Case("random image, L = 9", {"II": integral_image(noise), "row": 14, "col": 17, "L": 9}),
+             Case("random image, L = 15", {"II": integral_image(noise), "row": 12, "col": 20, "L": 15}),
+             Case("a blob at its centre, L = 9: det > 0, trace < 0", {"II": integral_image(blob), "row": 19,
+                                                                      "col": 20, "L": 9}),
+             Case("a blob off centre, L = 21 (Dxy != 0)", {"II": integral_image(blob), "row": 15, "col": 24,
+                                                           "L": 21}),
+             Case("a constant image: det = 0", {"II": integral_image(np.full((20, 20), 0.7)), "row": 10, "col": 10,
+                                                "L": 15}),
+             Case("near the corner (2, 1): boxes clipped to the image", {"II": integral_image(noise), "row": 2,
+                                                                         "col": 1, "L": 9})]
+    return cases
+
+
+def _fast_reference(image, t, n):
+    return fast_corner_mask(image, t, n, high_speed=False)
+
+
+def _fast_cases(rng):
+    cases = []
+    for n, t in ((9, 20), (12, 15)):
+        img = rng.integers(0, 256, (14, 15)).astype(np.uint8)
+        img[4:10, 5:11] = rng.integers(100, 140, (6, 6))  # a flat patch with corners
+        cases.append(Case(f"random 14x15 image, n = {n}, t = {t}", {"image": img, "t": t, "n": n}))
+    sq = np.full((13, 13), 60, np.uint8)
+    sq[6:, 6:] = 200
+    cases.append(Case("a bright square's corner, n = 9", {"image": sq, "t": 30, "n": 9}))
+    hi = np.full((9, 9), 240, np.uint8)
+    hi[4, 4] = 250  # I_p + t = 270 overflows uint8 (wraps to 14): every circle pixel looks "brighter"
+    cases.append(Case("a bright centre 250 on 240, t = 20: I_p + t overflows uint8", {"image": hi, "t": 20, "n": 9}))
+    lo = np.full((9, 9), 15, np.uint8)
+    lo[4, 4] = 5  # I_p - t = -15 wraps to 241
+    cases.append(Case("a dark centre 5 on 15, t = 20: I_p - t underflows uint8", {"image": lo, "t": 20, "n": 9}))
+    eq = np.full((9, 9), 120, np.uint8)
+    eq[4, 4] = 100  # every circle pixel exactly I_p + t: not brighter (strict >)
+    cases.append(Case("circle exactly I_p + t: ties are not brighter", {"image": eq, "t": 20, "n": 9}))
+    wrap = np.full((9, 9), 100, np.uint8)
+    ring = np.array([(0, 3), (1, 3), (2, 2), (3, 1), (3, 0), (3, -1), (2, -2), (1, -3), (0, -3), (-1, -3),
+                     (-2, -2), (-3, -1), (-3, 0), (-3, 1), (-2, 2), (-1, 3)])
+    for k in (12, 13, 14, 15, 0, 1, 2, 3, 4):  # 9 contiguous across the end of the list
+        wrap[4 + ring[k, 1], 4 + ring[k, 0]] = 200
+    cases.append(Case("an arc of 9 that wraps past the 16th circle pixel", {"image": wrap, "t": 20, "n": 9}))
+    cases.append(Case("the same arc needs n <= 9: n = 10 gives no corner", {"image": wrap, "t": 20, "n": 10}))
+    cases.append(Case("an image smaller than 7x7: no corner", {"image": rng.integers(0, 256, (6, 8)).astype(np.uint8),
+                                                               "t": 10, "n": 9}))
+    return cases
+
+
+register(Task("02.integral_image", "Task 1, the integral image", lambda image: integral_image(image),
+              _integral_cases,
+              "II has shape (H + 1, W + 1) with a zero first row and column: II[r, c] = sum of I[:r, :c]; two "
+              "cumulative sums (rows, then columns) into II[1:, 1:].", compare=allclose(1e-12, 1e-12)))
+register(Task("02.box_sum", "Task 2, a box sum in four look-ups", _box_reference, _box_cases,
+              "sum of I[r0:r1, c0:c1] = II[r1, c1] - II[r0, c1] - II[r1, c0] + II[r0, c0]; clip every row index "
+              "to [0, H] and every column index to [0, W] first (zero outside the image).",
+              compare=allclose(1e-12, 1e-12), points=2))
+register(Task("02.hessian", "Task 3, the box-filter Hessian at one pixel", _hessian_reference, _hessian_cases,
+              "l = L // 3, b = (L - 1) // 2, h = l // 2, all boxes relative to (row, col) and half-open; "
+              "Dxx = box(rows -l+1..l, cols -b..b+1) - 3 box(rows -l+1..l, cols -h..-h+l), Dyy the same with rows "
+              "and columns swapped, Dxy = box(-l..0, 1..l+1) + box(1..l+1, -l..0) - box(-l..0, -l..0) - "
+              "box(1..l+1, 1..l+1); divide each by L², return (Dxx Dyy - 0.81 Dxy², Dxx + Dyy).",
+              compare=allclose(1e-9, 1e-12), points=3))
+register(Task("02.fast_mask", "Task 4, FAST's segment test on every pixel", _fast_reference, _fast_cases,
+              "work in int (image.astype(int)): uint8 wraps at 255; brighter is I_x > I_p + t, darker I_x < I_p - t "
+              "(strict); look for n contiguous on the circle including runs across its end (e.g. the 16 flags "
+              "twice); pixels closer than 3 to the border are never corners.",
+              compare=allclose(0.0, 0.0), points=3))
+
+
+def _fast_threshold_for_budget() -> float:
+    from ..features import fast_detect, load_oxford_image
+
+    img = load_oxford_image("graf", 1, size=(768, 576))
+    for t in EXPLORE_FAST_THRESHOLDS:
+        if len(fast_detect(img, t)) <= EXPLORE_FAST_BUDGET:
+            return float(t)
+    return float("nan")
+
+
+def _best_repeatability_wall() -> float:
+    from ..features import run_pair_evaluation
+
+    ev = run_pair_evaluation(("wall",), (2, 3, 4, 5, 6), scale=0.5, n_points=500)
+    return float(np.nanmax(np.nanmean(ev.rep, axis=(0, 1))))
+
+
+register(ExplorationTask(
+    "02.explore.fast_threshold",
+    "Exploration 1: the smallest FAST threshold t (5, 10, ..., 100) leaving at most 1000 FAST-9 corners on "
+    "graf/img1 at 768x576",
+    _fast_threshold_for_budget,
+    hint="img = sl.features.load_oxford_image('graf', 1, size=(768, 576)); for t = 5, 10, ... count "
+         "len(sl.features.fast_detect(img, t)) (with non-maximum suppression) and stop at the first <= 1000."))
+register(ExplorationTask(
+    "02.explore.wall_repeatability",
+    "Exploration 2: the best mean repeatability of the four detectors on wall 1→2 ... 1→6",
+    _best_repeatability_wall, atol=0.005,
+    hint="sl.features.run_pair_evaluation(('wall',), (2, 3, 4, 5, 6), scale=0.5, n_points=500); the last row "
+         "of its table holds each detector's mean; give the largest (2 decimals are enough)."))
+
+
+# --- lab 03: matching -------------------------------------------------------------------------------
+
+#: Exploration budgets of lab 03 (BBF leaves) and the ratios tried.
+EXPLORE_BUDGETS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
+EXPLORE_RATIOS = tuple(round(0.3 + 0.05 * i, 2) for i in range(15))
+
+
+def _two_nn_cases(rng):
+    cases = [Case(f"random, {m} queries, {n} stored, d = {d}", {"query": rng.normal(size=(m, d)),
+                                                                 "train": rng.normal(size=(n, d))})
+             for m, n, d in ((4, 10, 3), (7, 30, 8))]
+    train = rng.normal(size=(6, 4))
+    cases.append(Case("a query equal to a stored point: d1 = 0", {"query": train[[2, 5]] + [[0, 0, 0, 0], [0.1, 0, 0, 0]],
+                                                                 "train": train}))
+    dup = np.vstack([train[:3], train[1:2], train[3:]])  # rows 1 and 3 are the same point
+    cases.append(Case("duplicate stored points: equal distances, the lower index first",
+                      {"query": train[1:2] + 0.05, "train": dup}))
+    cases.append(Case("one stored point: second neighbour inf, index -1",
+                      {"query": rng.normal(size=(3, 4)), "train": rng.normal(size=(1, 4))}))
+    cases.append(Case("no stored point: all inf, -1", {"query": rng.normal(size=(2, 4)), "train": np.zeros((0, 4))}))
+    return cases
+
+
+def _accept_reference(dist, factor, ratio, max_dist):
+    keep_000 = accept_000(dist, factor=factor, max_dist=max_dist)
+    keep_ratio = accept_ratio(dist, ratio) & (dist[:, 0] <= max_dist)
+    return keep_000.astype(float), keep_ratio.astype(float)
+
+
+def _accept_cases(rng):
+    d1 = rng.uniform(0.05, 0.5, 12)
+    d = np.column_stack([d1, d1 * rng.uniform(1.0, 3.0, 12)])
+    cases = [Case("random distances, factor 2, ratio 0.8, no limit", {"dist": d, "factor": 2.0, "ratio": 0.8,
+                                                                       "max_dist": np.inf}),
+             Case("random distances, factor 1.5, ratio 0.6, d1 <= 0.3", {"dist": d, "factor": 1.5, "ratio": 0.6,
+                                                                          "max_dist": 0.3}),
+             Case("d2 exactly 2 d1: 000 accepts (>=), ratio 0.5 rejects (<)",
+                  {"dist": np.array([[0.125, 0.25], [0.25, 0.5]]), "factor": 2.0, "ratio": 0.5, "max_dist": np.inf}),
+             Case("d1 exactly max_dist: accepted (<=)", {"dist": np.array([[0.25, 1.0]]), "factor": 2.0, "ratio": 0.8,
+                                                         "max_dist": 0.25}),
+             Case("duplicates d1 = d2 = 0: 000 accepts (0 >= 0), ratio rejects (0 < 0 is false)",
+                  {"dist": np.array([[0.0, 0.0], [0.0, 0.1]]), "factor": 2.0, "ratio": 0.8, "max_dist": 0.3}),
+             Case("one stored point (d2 = inf) and none (d1 = d2 = inf)",
+                  {"dist": np.array([[0.2, np.inf], [np.inf, np.inf]]), "factor": 2.0, "ratio": 0.8,
+                   "max_dist": 0.3}),
+             Case("no queries: empty results", {"dist": np.zeros((0, 2)), "factor": 2.0, "ratio": 0.8,
+                                                "max_dist": np.inf})]
+    return cases
+
+
+def _hamming_cases(rng):
+    cases = [Case(f"random {m} x {n} descriptors of {b} bytes",
+                  {"A": rng.integers(0, 256, (m, b)).astype(np.uint8), "B": rng.integers(0, 256, (n, b)).astype(np.uint8)})
+             for m, n, b in ((3, 5, 4), (6, 4, 32))]
+    cases.append(Case("0 against 255: 8 bits per byte, not 255 (uint8 arithmetic wraps)",
+                      {"A": np.zeros((1, 3), np.uint8), "B": np.array([[255, 255, 255], [1, 128, 0]], np.uint8)}))
+    cases.append(Case("bytes that differ in several bits count every bit",
+                      {"A": np.array([[0b1011, 0b11110000]], np.uint8), "B": np.array([[0b0100, 0b00001111]], np.uint8)}))
+    same = rng.integers(0, 256, (2, 8)).astype(np.uint8)
+    cases.append(Case("identical descriptors: 0", {"A": same, "B": same}))
+    return cases
+
+
+def _bbf_reference(tree, q, k, max_leaves):
+    d, ids, _ = bbf_trace(tree, q, k=k, max_leaves=max_leaves)
+    return d, ids.astype(float)
+
+
+def _bbf_compare(expected, received):
+    base = allclose(1e-9, 1e-12)
+    if not isinstance(received, (tuple, list)) or len(received) != 2:
+        return base(expected, received)
+    diff = base(expected[0], received[0])
+    if diff is not None:
+        return f"item 0 of the returned tuple (distances): {diff}"
+    e_ids = np.asarray(expected[1], dtype=float)
+    try:
+        r_ids = np.asarray(received[1], dtype=float)
+    except (TypeError, ValueError):
+        return f"expected integer ids; got {type(received[1]).__name__}"
+    if r_ids.shape != e_ids.shape:
+        return f"item 1 of the returned tuple (ids): expected shape {e_ids.shape}; got shape {r_ids.shape}"
+    d = np.asarray(expected[0])
+    unique = np.array([np.count_nonzero(d == x) == 1 for x in d])  # tied distances: any of the tied ids
+    bad = np.flatnonzero(unique & (r_ids != e_ids))
+    if bad.size:
+        i = int(bad[0])
+        return f"item 1 of the returned tuple (ids): at index {i} expected {int(e_ids[i])}, got {r_ids[i]:g}"
+    return None
+
+
+def _bbf_cases(rng):
+    cases = []
+    X = rng.random((30, 2)) * [2.0, 1.0]
+    cases.append(Case("30 points in 2-d, exact (max_leaves None)", {"tree": KDTree(X), "q": np.array([1.1, 0.45]),
+                                                                     "k": 2, "max_leaves": None}))
+    Y = rng.normal(size=(200, 4))
+    t4 = KDTree(Y)
+    q = rng.normal(size=4)
+    cases.append(Case("200 points in 4-d, one descent only (max_leaves 1)", {"tree": t4, "q": q, "k": 2,
+                                                                              "max_leaves": 1}))
+    cases.append(Case("200 points in 4-d, backtracking 6 leaves", {"tree": t4, "q": q, "k": 2, "max_leaves": 6}))
+    cases.append(Case("200 points in 4-d, k = 3, exact", {"tree": t4, "q": rng.normal(size=4), "k": 3,
+                                                           "max_leaves": None}))
+    cases.append(Case("buckets of 4 points (leaf_size 4), 3 leaves", {"tree": KDTree(Y, leaf_size=4),
+                                                                       "q": rng.normal(size=4), "k": 2,
+                                                                       "max_leaves": 3}))
+    cases.append(Case("k = 5 > 3 stored points: pad with inf and -1", {"tree": KDTree(rng.random((3, 2))),
+                                                                        "q": np.array([0.5, 0.5]), "k": 5,
+                                                                        "max_leaves": None}))
+    D = np.repeat(rng.random((4, 2)), 3, axis=0)  # every point three times
+    cases.append(Case("duplicate points: ties (any of the tied ids)", {"tree": KDTree(D), "q": D[5] + 0.01, "k": 2,
+                                                                       "max_leaves": None}))
+    return cases
+
+
+register(Task("03.two_nn", "Task 1, exact 2-NN by brute force", lambda query, train: knn2(query, train),
+              _two_nn_cases,
+              "all Euclidean distances query x train, sort each row (a stable sort keeps the lower index first "
+              "on ties), keep 2 columns; with fewer than 2 stored points pad with inf and -1 (shape (M, 2) always).",
+              compare=allclose(1e-9, 1e-12), points=2))
+register(Task("03.accept", "Task 2, 000's rule and Lowe's ratio test", _accept_reference, _accept_cases,
+              "000: d2 >= factor * d1 and d1 <= max_dist; ratio: d1 < ratio * d2 and d1 <= max_dist (write the "
+              "products, not d1 / d2: d2 may be 0 or inf); return the two boolean arrays.",
+              compare=allclose(0.0, 0.0), points=2))
+register(Task("03.hamming", "Task 3, Hamming distances of packed binary descriptors",
+              lambda A, B: hamming_distances(A, B), _hamming_cases,
+              "XOR the bytes (A[:, None, :] ^ B[None, :, :]) and count the 1 bits (np.unpackbits along the last "
+              "axis, or np.bitwise_count), summed over the bytes; subtracting uint8 values wraps around.",
+              compare=allclose(0.0, 0.0), points=2))
+register(Task("03.bbf", "Task 4, Best-Bin-First: descent and backtracking", _bbf_reference, _bbf_cases,
+              "heap of (bound, node) from (0.0, root 0); pop; stop when bound >= the k-th best squared distance or "
+              "after max_leaves leaves; descend: diff = q[split_dim] - split_val, near = left if diff <= 0 else "
+              "right, push the far child with bound max(bound, diff²); at a leaf evaluate points[perm[start:stop]].",
+              compare=_bbf_compare, points=3))
+
+
+def _smallest_budget_90() -> float:
+    from ..features import run_recall_vs_leaves
+
+    c = run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200)
+    ok = c.budgets[c.recall_bbf >= 0.9]
+    return float(ok.min()) if ok.size else float("nan")
+
+
+def _largest_precise_ratio() -> float:
+    from ..features import run_ratio_tradeoff
+
+    tr = run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
+    ok = tr.ratios[tr.precision >= 0.9]
+    return float(ok.max()) if ok.size else float("nan")
+
+
+register(ExplorationTask(
+    "03.explore.bbf_budget",
+    "Exploration 1: the smallest BBF leaf budget reaching 90 % nearest-neighbour recall with 10000 stored "
+    "descriptors",
+    _smallest_budget_90,
+    hint="sl.features.run_recall_vs_leaves((1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), n_stored=10000, "
+         "n_queries=200); the first budget whose BBF recall is >= 0.9."))
+register(ExplorationTask(
+    "03.explore.precise_ratio",
+    "Exploration 2: the largest ratio (0.30, 0.35, ..., 1.00) keeping SURF's match precision >= 0.9 on boat 1→2",
+    _largest_precise_ratio, atol=1e-6,
+    hint="sl.features.run_ratio_tradeoff(ratios, detector='SURF', sequence='boat', j=2) with ratios "
+         "0.30, 0.35, ..., 1.00; precision is not monotonic in the ratio: take the largest ratio with >= 0.9."))
