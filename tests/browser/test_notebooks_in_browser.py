@@ -180,8 +180,11 @@ def _move_first_control(page) -> str | None:
         button.first.click()
         moved += ", then its run button"
     page.wait_for_function(_DONE, timeout=RUN_TIMEOUT_S * 1000)
-    after = output.inner_html()
-    assert after != before, f"moving the {moved} left the widget's output unchanged"
+    try:  # the output widget's view updates from comm messages, a moment after the kernel is idle
+        page.wait_for_function("([el, old]) => el.innerHTML !== old", arg=[output.element_handle(), before],
+                               timeout=30_000)
+    except Exception as exc:
+        raise AssertionError(f"moving the {moved} left the widget's output unchanged") from exc
     return moved
 
 
