@@ -103,7 +103,7 @@ def task(task_id: str) -> Task | ExplorationTask:
 
 
 def _load_tasks() -> None:
-    from . import tasks_correlation, tasks_filters, tasks_hough, tasks_stores  # noqa: F401  (register on import)
+    from . import tasks_correlation, tasks_filters, tasks_hough, tasks_stereo, tasks_stores  # noqa: F401  (register on import)
 
 
 def all_tasks() -> dict[str, Task | ExplorationTask]:
