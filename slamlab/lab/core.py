@@ -103,7 +103,14 @@ def task(task_id: str) -> Task | ExplorationTask:
 
 
 def _load_tasks() -> None:
-    from . import tasks_correlation, tasks_features, tasks_filters, tasks_hough  # noqa: F401  (register on import)
+    from . import (  # noqa: F401  (each registers its tasks on import)
+        tasks_correlation,
+        tasks_features,
+        tasks_filters,
+        tasks_hough,
+        tasks_stereo,
+        tasks_stores,
+    )
 
 
 def all_tasks() -> dict[str, Task | ExplorationTask]:

@@ -1,0 +1,231 @@
+"""Lab 05 (stereo SLAM, 000 §3.3-3.5): the tasks and the library functions they are checked against."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry import umeyama
+from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
+from ..geometry.triangulation import triangulate_midpoint, triangulate_stereo
+from .core import Case, ExplorationTask, Task, allclose, register
+
+#: Exploration 1: the right camera's calibration drift per frame [rad] and the frames of the turn in place.
+EXPLORE_DRIFT_RAD, EXPLORE_FRAMES = 2e-3, 5
+#: Exploration 2: depth [m] of the point and the disparity error [px].
+EXPLORE_DEPTH_M, EXPLORE_DISPARITY_ERR_PX = 8.0, 0.5
+
+
+# --- Task 1: midpoint triangulation ------------------------------------------------------------------
+
+
+def _tri_reference(c1, d1, c2, d2):
+    r = triangulate_midpoint(c1, d1, c2, d2)
+    return r.points, r.gap_m
+
+
+def _tri_cases(rng):
+    cases = []
+    for n in (1, 5):
+        P = rng.uniform([-2, -1, 2], [2, 1, 8], (n, 3))
+        c1, c2 = np.zeros(3), np.array([0.4, 0.0, 0.0])
+        d1 = (P - c1) + 0.05 * rng.normal(size=(n, 3))  # rays that miss each other: skew lines
+        d2 = (P - c2) + 0.05 * rng.normal(size=(n, 3))
+        cases.append(Case(f"random skew rays, {n} point(s)", {"c1": c1, "d1": d1, "c2": c2, "d2": d2}))
+    P = rng.uniform([-2, -1, 2], [2, 1, 8], (3, 3))
+    c2 = np.array([0.2, 0.05, -0.1])
+    cases.append(Case("rays that meet, directions of any length: gap 0",
+                      {"c1": np.zeros(3), "d1": 3.0 * P, "c2": c2, "d2": 0.2 * (P - c2)}))
+    cases.append(Case("parallel and anti-parallel rays (a c - b^2 = 0): s = t = 0, the midpoint of the centres",
+                      {"c1": np.zeros(3), "d1": np.array([[0.0, 0.0, 1.0], [0.1, 0.2, 1.0], [1.0, 1.0, 1.0]]),
+                       "c2": np.array([0.4, 0.0, 0.0]),
+                       "d2": np.array([[0.0, 0.0, 2.0], [-0.1, -0.2, -1.0], [1.0, 2.0, 1.0]])}))
+    return cases
+
+
+# --- Task 2: the epipolar check ----------------------------------------------------------------------
+
+
+def _epi_reference(uv_left, uv_right, F, tol_px):
+    from ..stereo.stages import _epipolar_pairs  # the pipeline's own check, one pair at a time
+
+    return np.array([_epipolar_pairs(uv_left[i:i + 1], uv_right[i:i + 1], F, tol_px)[0].size > 0
+                     for i in range(len(uv_left))], dtype=float)
+
+
+def _rig(rng, baseline_dir, angle_deg):
+    cam = PinholeCamera.from_hfov(768, 576, np.radians(40.0))
+    R = rotation_xyz(*np.radians(rng.uniform(-angle_deg, angle_deg, 3)))
+    return StereoRig(cam, cam, R, -R @ (0.2 * np.asarray(baseline_dir, float)))
+
+
+def _pairs(rng, rig, n, spread_px):
+    P = rng.uniform([-2, -1.5, 2], [2, 1.5, 9], (n, 3))
+    uvl, uvr = rig.project(P)
+    return uvl, uvr + rng.normal(0.0, spread_px, (n, 2))
+
+
+def _epi_cases(rng):
+    cases = []
+    for deg, n in ((0.0, 8), (3.0, 10)):
+        rig = _rig(rng, (1, 0, 0), deg)
+        uvl, uvr = _pairs(rng, rig, n, 2.0)
+        cases.append(Case(f"random, rig rotated up to {deg:g} deg, {n} pairs",
+                          {"uv_left": uvl, "uv_right": uvr, "F": rig.F, "tol_px": 2.0}))
+    rig = _rig(rng, (1, 0, 0), 2.0)
+    uvl, uvr = _pairs(rng, rig, 8, 2.0)
+    cases.append(Case("F scaled by 1000 (F is defined up to scale: normalise the line)",
+                      {"uv_left": uvl, "uv_right": uvr, "F": 1000.0 * rig.F, "tol_px": 1.5}))
+    rig = _rig(rng, (0, 1, 0), 2.0)
+    uvl, uvr = _pairs(rng, rig, 8, 2.0)
+    cases.append(Case("a vertical baseline: nearly vertical epipolar lines",
+                      {"uv_left": uvl, "uv_right": uvr, "F": rig.F, "tol_px": 2.0}))
+    return cases
+
+
+# --- Task 3: a stereo point from disparity -----------------------------------------------------------
+
+
+def _point_reference(uv_left, uv_right, fx, fy, cx, cy, baseline_m):
+    cam = PinholeCamera(768, 576, fx, fy, cx, cy)
+    rig = StereoRig(cam, cam, np.eye(3), np.array([-baseline_m, 0.0, 0.0]))
+    P = triangulate_stereo(rig, uv_left, uv_right).points
+    P[uv_left[:, 0] - uv_right[:, 0] <= 0] = np.nan
+    return P
+
+
+def _point_case(label, rng, P, fx, fy, cx, cy, B):
+    cam = PinholeCamera(768, 576, fx, fy, cx, cy)
+    uvl, uvr = StereoRig(cam, cam, np.eye(3), np.array([-B, 0.0, 0.0])).project(P)
+    return Case(label, {"uv_left": uvl, "uv_right": uvr, "fx": fx, "fy": fy, "cx": cx, "cy": cy, "baseline_m": B})
+
+
+def _point_cases(rng):
+    cases = []
+    for n, (fx, fy, B) in ((4, (1055.0, 1055.0, 0.2)), (6, (700.0, 720.0, 0.54))):
+        P = rng.uniform([-2, -1.5, 1], [2, 1.5, 30], (n, 3))
+        cases.append(_point_case(f"random, {n} points, fx={fx:g}, fy={fy:g}, B={B:g} m", rng, P, fx, fy,
+                                 float(rng.uniform(300, 400)), float(rng.uniform(250, 300)), B))
+    uvl = np.array([[400.0, 300.0], [410.5, 120.0], [100.0, 50.0]])
+    uvr = np.array([[400.0, 300.0], [412.0, 120.0], [99.75, 50.0]])
+    cases.append(Case("zero and negative disparity (a point at infinity, a bad match): NaN rows",
+                      {"uv_left": uvl, "uv_right": uvr, "fx": 1055.0, "fy": 1055.0, "cx": 383.5, "cy": 287.5,
+                       "baseline_m": 0.2}))
+    return cases
+
+
+# --- Task 4: Umeyama alignment -----------------------------------------------------------------------
+
+
+class _Fit(tuple):
+    """The reference's (R, t, c), carrying ``src`` so that the comparison can map it."""
+
+    src: np.ndarray
+
+
+def _umeyama_reference(src, dst, with_scale):
+    T = umeyama(src, dst, with_scale=with_scale)
+    out = _Fit((T.R, T.t, T.c))
+    out.src = src
+    return out
+
+
+def _umeyama_compare(expected, received) -> str | None:
+    """(R, t, c) must be a proper rotation, the same scale, and map ``src`` where the library's does.
+
+    Comparing the mapped points rather than R itself accepts any of the equally good rotations of a
+    collinear set (a rotation about the line moves none of its points).
+    """
+    if not isinstance(received, (tuple, list)) or len(received) != 3:
+        return f"expected a tuple (R, t, c); got {type(received).__name__}"
+    try:
+        R, t, c = np.asarray(received[0], float), np.asarray(received[1], float), float(received[2])
+    except (TypeError, ValueError):
+        return "expected numbers in (R, t, c)"
+    R0, t0, c0 = expected
+    if R.shape != R0.shape or t.shape != t0.shape:
+        return f"expected R of shape {R0.shape} and t of shape {t0.shape}; got {R.shape} and {t.shape}"
+    if not np.allclose(R.T @ R, np.eye(len(R)), atol=1e-8):
+        return "R is not orthonormal (R^T R != I)"
+    if np.linalg.det(R) < 0:
+        return "R is a reflection (det R = -1): flip the sign of the last singular direction"
+    if not np.isclose(c, c0, rtol=1e-8, atol=1e-10):
+        return f"scale c: expected {c0:.6g}, got {c:.6g}"
+    src = expected.src
+    mine, ref = c * src @ R.T + t, c0 * src @ R0.T + t0
+    if not np.allclose(mine, ref, rtol=1e-7, atol=1e-8):
+        k = int(np.argmax(np.abs(mine - ref).max(axis=1)))
+        return f"c R src + t differs at point {k}: expected {ref[k]}, got {mine[k]}"
+    return None
+
+
+def _umeyama_cases(rng):
+    cases = []
+    for d, n, scale in ((3, 10, False), (3, 8, True), (2, 6, False)):
+        src = rng.normal(size=(n, d)) * 2.0
+        R = rotation_xyz(*rng.uniform(-np.pi, np.pi, 3)) if d == 3 else \
+            np.array([[np.cos(a := rng.uniform(-np.pi, np.pi)), -np.sin(a)], [np.sin(a), np.cos(a)]])
+        c = float(rng.uniform(0.5, 2.0)) if scale else 1.0
+        dst = c * src @ R.T + rng.normal(size=d) + 0.01 * rng.normal(size=(n, d))
+        cases.append(Case(f"random {d}-D, {n} noisy points, with_scale={scale}",
+                          {"src": src, "dst": dst, "with_scale": scale}))
+    src = rng.normal(size=(6, 3))
+    cases.append(Case("a mirror image (dst = src with x negated): the best ROTATION, det R = +1",
+                      {"src": src, "dst": src * [-1.0, 1.0, 1.0], "with_scale": True}))
+    flat = np.column_stack([rng.normal(size=(5, 2)), np.zeros(5)])
+    R = rotation_xyz(0.3, -0.5, 1.2)
+    cases.append(Case("coplanar points (rank-2 covariance): the third axis from det = +1",
+                      {"src": flat, "dst": flat @ R.T + [1.0, 2.0, 3.0], "with_scale": False}))
+    line = np.outer(np.arange(4.0), [1.0, 2.0, 0.5])
+    cases.append(Case("collinear points: any rotation about the line fits; c R src + t is what counts",
+                      {"src": line, "dst": 1.5 * line @ R.T - [0.5, 0.0, 2.0], "with_scale": True}))
+    return cases
+
+
+register(Task("05.triangulate", "Task 1, midpoint triangulation of two rays", _tri_reference, _tri_cases,
+              "w = c1 - c2, a = d1.d1, b = d1.d2, c = d2.d2, d = d1.w, e = d2.w (row by row: np.einsum('ij,ij->i', "
+              "...) or (x * y).sum(axis=1)); s = (b e - c d)/(a c - b^2), t = (a e - b d)/(a c - b^2); when "
+              "a c - b^2 <= 1e-12 a c use s = t = 0; return ((p1 + p2)/2, |p1 - p2|).",
+              compare=allclose(rtol=1e-9, atol=1e-9)))
+register(Task("05.epipolar", "Task 2, the epipolar check", _epi_reference, _epi_cases,
+              "x_l = (u, v, 1); the line l = F x_l = (a, b, c) in the right image; the distance of (u_r, v_r) is "
+              "|a u_r + b v_r + c| / sqrt(a^2 + b^2) (dividing makes it pixels whatever the scale of F); "
+              "keep distance <= tol_px.", compare=allclose(0.0, 0.0)))
+register(Task("05.stereo_point", "Task 3, a stereo point from disparity", _point_reference, _point_cases,
+              "d = u_l - u_r; Z = fx B / d; X = (u_l - cx) Z / fx; Y = (v_l - cy) Z / fy; rows with d <= 0 are "
+              "NaN (np.nan), not inf and not an error.", compare=allclose(rtol=1e-9, atol=1e-9)))
+register(Task("05.umeyama", "Task 4, Umeyama alignment (rotation, translation, scale)", _umeyama_reference,
+              _umeyama_cases,
+              "centre both sets; Sigma = (dst - mu_d)^T (src - mu_s) / N; U, D, Vt = svd(Sigma); S = I with "
+              "S[-1, -1] = -1 when det(U) det(Vt) < 0; R = U S Vt; c = trace(D S) / var(src) (var = mean squared "
+              "norm of the centred src) or 1; t = mu_d - c R mu_s.", compare=_umeyama_compare, points=3))
+
+
+def _drift_max_error() -> float:
+    from ..stereo import RenderParams, run_turn_in_place
+
+    res = run_turn_in_place("small", n_frames=EXPLORE_FRAMES, detector="orb",
+                            render=RenderParams(drift_std_rad=EXPLORE_DRIFT_RAD), rng=2010)
+    return float(res.pos_err_m.max())
+
+
+def _depth_error() -> float:
+    from ..sim import StereoArena, StereoSim
+
+    rig = StereoSim(StereoArena(seed=0), rng=2010).rig
+    uvl, uvr = rig.project(np.array([[0.0, 0.0, EXPLORE_DEPTH_M]]))
+    uvr = uvr + np.array([EXPLORE_DISPARITY_ERR_PX, 0.0])  # the right pixel half a pixel to the right: less disparity
+    return float(triangulate_stereo(rig, uvl, uvr).points[0, 2] - EXPLORE_DEPTH_M)
+
+
+register(ExplorationTask(
+    "05.explore.drift",
+    "Exploration 1: max position error [m] of 5 turn-in-place frames (ORB) with 2 mrad calibration drift per frame",
+    _drift_max_error, atol=0.005,
+    hint="sl.stereo.run_turn_in_place('small', n_frames=5, detector='orb', "
+         "render=sl.stereo.RenderParams(drift_std_rad=2e-3), rng=SEED); read res.pos_err_m.max()."))
+register(ExplorationTask(
+    "05.explore.depth_error",
+    "Exploration 2: depth error [m] at 8 m from a 0.5 px disparity error (the simulator's rig)",
+    _depth_error, rtol=0.03,
+    hint="rig = sl.sim.StereoSim(sl.sim.StereoArena(seed=0), rng=SEED).rig; uvl, uvr = rig.project([[0, 0, 8.0]]); "
+         "add 0.5 to uvr's u; triangulate with sl.geometry.triangulate_stereo and subtract 8."))

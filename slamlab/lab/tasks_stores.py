@@ -1,0 +1,195 @@
+"""Lab 04 (landmark stores, 000 §3.4, §4, Appendix): the tasks and the library functions they are checked against."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kdtree.cost_model import iter_time, minimise_iter_time
+from ..kdtree.knn import merge_knn
+from ..kdtree.stores import SightingBook, multi_tree_sizes
+from .core import Case, ExplorationTask, Task, allclose, register
+
+#: Exploration 2's multi kd-tree and workload: n1, q, batches of new points.
+EXPLORE_N1, EXPLORE_Q, EXPLORE_BATCHES = 1000, 3.0, (500,) * 40
+
+
+# --- Task 1: the multi kd-tree's sizes -----------------------------------------------------------
+
+
+def _sizes_reference(n1, q, batches):
+    return np.array(multi_tree_sizes(n1, q, batches)[-1], dtype=float)
+
+
+def _sizes_cases(rng):
+    cases = []
+    for n1, q, nb in ((4, 2.0, 6), (10, 3.0, 12), (7, 2.5, 9)):
+        cases.append(Case(f"random batches, n1={n1}, q={q}", {"n1": n1, "q": q,
+                                                            "batches": [int(b) for b in rng.integers(1, 2 * n1, nb)]}))
+    cases.append(Case("a batch of exactly MAX_SIZE[0] = n1 stays in tree 1 (merge only when more than MAX_SIZE)",
+                      {"n1": 5, "q": 2.0, "batches": [5]}))
+    cases.append(Case("tree 2 filled to exactly MAX_SIZE[1] = floor(4 * 2.5) = 10: no further merge",
+                      {"n1": 4, "q": 2.5, "batches": [5, 5]}))
+    cases.append(Case("one huge batch cascades through every tree", {"n1": 3, "q": 2.0, "batches": [2, 40]}))
+    cases.append(Case("empty batches: one empty tree", {"n1": 4, "q": 2.0, "batches": [0, 0]}))
+    return cases
+
+
+# --- Task 2: the base rule over a sighting history -------------------------------------------------
+
+
+def _base_reference(history, base_seen_times, max_non_base_time):
+    book = SightingBook(base_seen_times, max_non_base_time)
+    known: set[int] = set()
+    base, dropped = [], []
+    for frame in history:
+        frame = np.asarray(frame, dtype=np.int64)
+        new = np.array([i for i in frame if int(i) not in known], dtype=np.int64)
+        old = np.array([i for i in frame if int(i) in known], dtype=np.int64)
+        book.observe(old)
+        book.add(new)
+        known.update(int(i) for i in new)
+        promoted, late = book.step()
+        base.extend(promoted.tolist())
+        dropped.extend(late.tolist())
+    return np.sort(np.array(base, dtype=float)), np.sort(np.array(dropped, dtype=float))
+
+
+def _history(rng, n_frames, n_ids, p):
+    """Each id appears first at a random frame and is then re-sighted with probability p per frame."""
+    first = rng.integers(0, n_frames, n_ids)
+    frames = [[] for _ in range(n_frames)]
+    for i, f in enumerate(first):
+        frames[f].append(i)
+        for t in range(f + 1, n_frames):
+            if rng.random() < p:
+                frames[t].append(i)
+    return tuple(np.array(sorted(fr), dtype=np.int64) for fr in frames)
+
+
+def _base_cases(rng):
+    cases = []
+    for n_frames, n_ids, p in ((12, 15, 0.25), (20, 30, 0.15)):
+        cases.append(Case(f"random history, {n_frames} frames, {n_ids} landmarks",
+                          {"history": _history(rng, n_frames, n_ids, p), "base_seen_times": 3,
+                           "max_non_base_time": 7}))
+    cases.append(Case("random history, BaseSeenTimes = 2, MaxNonBaseTime = 4",
+                      {"history": _history(rng, 15, 20, 0.2), "base_seen_times": 2, "max_non_base_time": 4}))
+    e = np.empty(0, dtype=np.int64)
+
+    def a(*ids):
+        return np.array(ids, dtype=np.int64)
+
+    # id 0: third sighting at age 7 (the window's last frame): base; id 1: third sighting at age 8: dropped at age 7
+    # (a later sighting of a dropped landmark changes nothing); id 2: base in frame 2; id 3: seen once, dropped at
+    # age 7; id 4: first seen in frame 5, seen twice, dropped in frame 12
+    cases.append(Case("window edge: 3rd sighting at age 7 counts, at age 8 is too late",
+                      {"history": (a(0, 1, 2, 3), a(2), a(2), a(0, 1), e, a(4), e, a(0), a(1), e, e, e, a(4)),
+                       "base_seen_times": 3, "max_non_base_time": 7}))
+    cases.append(Case("no sightings at all", {"history": (e, e, e), "base_seen_times": 3, "max_non_base_time": 7}))
+    cases.append(Case("BaseSeenTimes = 1: base in the first frame",
+                      {"history": (a(0, 1), a(2)), "base_seen_times": 1, "max_non_base_time": 7}))
+    return cases
+
+
+# --- Task 3: the Appendix's cost model, literally --------------------------------------------------
+
+
+def _iter_time_reference(n1, q, n, s, m, C):
+    return float(iter_time(n1, q, n=n, s=s, m=m, C=C, reading="literal"))
+
+
+def _iter_time_cases(rng):
+    cases = [Case("000's optimum n1 = 3500, q = 5.5 with n = 50000, s = m = 500, C = 9",
+                  {"n1": 3500.0, "q": 5.5, "n": 50000.0, "s": 500.0, "m": 500.0, "C": 9.0})]
+    for _ in range(2):
+        cases.append(Case("random", {"n1": float(rng.uniform(500, 20000)), "q": float(rng.uniform(1.5, 10)),
+                                     "n": float(rng.uniform(1e4, 1e5)), "s": float(rng.integers(100, 1000)),
+                                     "m": float(rng.integers(100, 1000)), "C": float(rng.uniform(1, 20))}))
+    cases.append(Case("n1 = n: one tree, p = 1 and the p(p-1) terms vanish",
+                      {"n1": 20000.0, "q": 3.0, "n": 20000.0, "s": 500.0, "m": 500.0, "C": 9.0}))
+    cases.append(Case("the Appendix defines s but its iterTime does not use it: s = 1",
+                      {"n1": 1200.0, "q": 2.3, "n": 50000.0, "s": 1.0, "m": 500.0, "C": 9.0}))
+    return cases
+
+
+# --- Task 4: merging per-tree k-NN lists -----------------------------------------------------------
+
+
+def _merge_reference(dists, ids, k):
+    return merge_knn(dists, ids, k)
+
+
+def _knn_of(rng, M, kk, n_found=None):
+    d = np.sort(rng.uniform(0, 10, (M, kk)), axis=1)
+    i = rng.integers(0, 1000, (M, kk))
+    if n_found is not None:
+        d[:, n_found:], i[:, n_found:] = np.inf, -1
+    return d, i
+
+
+def _merge_cases(rng):
+    cases = []
+    for n_trees, M, k in ((3, 4, 2), (4, 5, 3)):
+        lists = [_knn_of(rng, M, k) for _ in range(n_trees)]
+        cases.append(Case(f"random, {n_trees} trees, {M} queries, k={k}",
+                          {"dists": tuple(d for d, _ in lists), "ids": tuple(i for _, i in lists), "k": k}))
+    d1, i1 = _knn_of(rng, 3, 2)
+    cases.append(Case("an empty tree (all inf / -1) among full ones",
+                      {"dists": (d1, np.full((3, 2), np.inf)), "ids": (i1, np.full((3, 2), -1)), "k": 2}))
+    cases.append(Case("one tree of one point answers one column: pad to k with inf / -1",
+                      {"dists": (np.array([[1.5], [0.2]]),), "ids": (np.array([[7], [7]]),), "k": 2}))
+    cases.append(Case("a tie: equal distances keep the earlier tree's point first",
+                      {"dists": (np.array([[2.0, 5.0]]), np.array([[1.0, 2.0]]), np.array([[2.0, 3.0]])),
+                       "ids": (np.array([[30, 31]]), np.array([[10, 11]]), np.array([[20, 21]])), "k": 3}))
+    cases.append(Case("trees answering with different k_i (a one-column list)",
+                      {"dists": (np.array([[0.5], [4.0]]), np.array([[1.0, 2.0], [3.0, 3.5]])),
+                       "ids": (np.array([[1], [2]]), np.array([[3, 4], [5, 6]])), "k": 2}))
+    return cases
+
+
+register(Task("04.tree_sizes", "Task 1, multi kd-tree sizes after a sequence of inserts", _sizes_reference,
+              _sizes_cases,
+              "MAX_SIZE[i] = floor(n1 q^i) with i from 0; add the batch to tree 0; while tree i holds MORE than "
+              "MAX_SIZE[i], move all of it into tree i + 1 (creating it) and go on with i + 1; finally append "
+              "empty trees until MAX_SIZE of the last one is >= the total.", compare=allclose(0.0, 0.0)))
+register(Task("04.base_rule", "Task 2, the base rule over a sighting history", _base_reference, _base_cases,
+              "per pending landmark keep its sighting count and first frame; in each frame count the sightings, "
+              "then: seen >= BaseSeenTimes -> base; else frame - first >= MaxNonBaseTime -> dropped. The frame of "
+              "the first sighting has age 0, and a sighting in the frame of age MaxNonBaseTime still counts.",
+              compare=allclose(0.0, 0.0), points=3))
+register(Task("04.iter_time", "Task 3, the Appendix's iterTime(n1, q), literally", _iter_time_reference,
+              _iter_time_cases,
+              "p = log_q(n / n1) + 1 (the upper bound, real), log = log2; searchKd = p log n1 + C p(p-1)/2 log q; "
+              "addKd = n1 log n1 + m q p log n1 + m q/2 p(p-1) log q; iterTime = addKd + C searchKd (no s).",
+              compare=allclose(rtol=1e-9, atol=0.0)))
+register(Task("04.merge_knn", "Task 4, exact k-NN from per-tree k-NN lists", _merge_reference, _merge_cases,
+              "put the lists of all trees side by side (np.concatenate(..., axis=1)), sort each row with a STABLE "
+              "sort (np.argsort(..., kind='stable')), keep k columns and pad with inf / -1 when fewer than k.",
+              compare=allclose(0.0, 0.0)))
+
+
+def _literal_optimum_n1() -> float:
+    return minimise_iter_time(n=50000, s=500, m=500, C=9.0, reading="literal")[0]
+
+
+def _points_rebuilt() -> float:
+    from ..kdtree.stores import MultiKDTree
+
+    mt = MultiKDTree(EXPLORE_N1, EXPLORE_Q, tree="ckdtree")
+    for b, size in enumerate(EXPLORE_BATCHES):
+        mt.add(np.zeros((size, 2)) + b, np.arange(b * size, (b + 1) * size))  # the count depends on sizes only
+    return float(mt.counters.points_rebuilt)
+
+
+register(ExplorationTask(
+    "04.explore.literal_n1",
+    "Exploration 1: the optimum n1 of the Appendix's cost model as printed (n = 50000, s = m = 500, C = 9)",
+    _literal_optimum_n1, atol=50.0,
+    hint="sl.kdtree.cost_model.minimise_iter_time(n=50000, s=500, m=500, C=9.0, reading='literal') on its default "
+         "grid (n1 in steps of 50) returns (n1, q, value, ...)."))
+register(ExplorationTask(
+    "04.explore.points_rebuilt",
+    "Exploration 2: points rebuilt by MultiKDTree(1000, 3.0) over 40 batches of 500",
+    _points_rebuilt,
+    hint="add 40 batches of 500 points (any data, ids 0..19999) to sl.kdtree.MultiKDTree(1000, 3.0, "
+         "tree='ckdtree') and read store.counters.points_rebuilt."))
