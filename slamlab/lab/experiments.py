@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..sim import Rangefinder, measurement_room_200, path_004, test_room_200
+from ..sim import Rangefinder, StereoArena, StereoSim, measurement_room_200, path_004, test_room_200
 
-__all__ = ["hough_scene_scan", "localisation_scene"]
+__all__ = ["hough_scene_scan", "localisation_scene", "stereo_rig"]
 
 
 def localisation_scene(pose, *, range_std_cells: float = 0.3, rng=2010):
@@ -24,3 +24,8 @@ def hough_scene_scan(pose_index: int, *, range_std_cells: float = 0.1, rng=2010)
     """Lab 07: the scan at pose ``pose_index`` of 004's path in the test room (the chapter's scene)."""
     rf = Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=range_std_cells)
     return rf.scan(test_room_200(), path_004()[pose_index], rng=rng)
+
+
+def stereo_rig(*, arena_seed: int = 0, rng=2010):
+    """Lab 05: the stereo rig of the simulated lunar arena (the chapter's camera pair)."""
+    return StereoSim(StereoArena(seed=arena_seed), rng=rng).rig

@@ -209,9 +209,9 @@ def _drift_max_error() -> float:
 
 
 def _depth_error() -> float:
-    from ..sim import StereoArena, StereoSim
+    from .experiments import stereo_rig
 
-    rig = StereoSim(StereoArena(seed=0), rng=2010).rig
+    rig = stereo_rig(arena_seed=0, rng=2010)
     uvl, uvr = rig.project(np.array([[0.0, 0.0, EXPLORE_DEPTH_M]]))
     uvr = uvr + np.array([EXPLORE_DISPARITY_ERR_PX, 0.0])  # the right pixel half a pixel to the right: less disparity
     return float(triangulate_stereo(rig, uvl, uvr).points[0, 2] - EXPLORE_DEPTH_M)
