@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from .._progress import progress_bar
 from .._table import format_table
 from ..geometry import wrap_angle
 from ..scans import GridFrame, Scan, grid_to_values, occupancy_grid
@@ -466,7 +467,8 @@ class LogLocalisationResult:
 
 def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *,
                          cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int = 10,
-                         params: LocaliseParams | None = None, **overrides) -> LogLocalisationResult:
+                         params: LocaliseParams | None = None, progress: bool | None = None,
+                         **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on a grid built from the log's own poses (real data).
 
     The grid (``cell_m`` cells, 004's three values) is built from every scan except
@@ -485,6 +487,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         The scans to localise.
     params, **overrides
         :class:`LocaliseParams` of every localisation.
+    progress : bool, optional
+        Progress bar over the scans (default: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     p = LocaliseParams.resolve(params, **overrides)
     log = _carmen_log(path)
@@ -502,7 +506,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     Mv = grid_to_values(G, p.a_c, p.a_p, p.a_n)
     headings = heading_candidates(p.delta_alpha_rad)
     est = np.empty((idx.size, 3))
-    for k, i in enumerate(idx):
+    for k, i in enumerate(progress_bar(idx, desc="localise log scans", progress=progress)):
         est[k] = _localise(Mv, *_scan_beams(scans_c[i], f"scan {i}"), headings, p, tracking=False).pose
     est_m = frame.to_metres(est)
     true_m = log.poses[idx]

@@ -158,3 +158,13 @@ def test_localisation_table_has_one_row_per_choice_and_pose():
     assert table.columns.tolist() == ["choice", "pose_index", "x", "y", "heading_rad", "half_max_area",
                                       "heading_margin"]
     assert table[["choice", "pose_index"]].to_numpy().tolist() == [[0, 0], [0, 1], [1, 0], [1, 1]]
+
+
+@pytest.mark.realdata
+def test_log_localisation_progress_bar_only_when_asked(shared_data, capsys):
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    quiet = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0))  # SLAMLAB_PROGRESS=0 in tests
+    assert capsys.readouterr().err == ""
+    shown = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0), progress=True)
+    assert "localise log scans" in capsys.readouterr().err
+    np.testing.assert_array_equal(quiet.est_poses_m, shown.est_poses_m)
