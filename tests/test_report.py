@@ -18,11 +18,28 @@ def _outputs(nb) -> str:
     return "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
 
 
+#: Chapter notebooks with a cell tagged ``parameters`` (00, the overview, has none).
+PARAMETERISED = ("01", "06", "07")
+
+
 def test_every_chapter_notebook_has_one_parameters_cell():
-    for path in sorted((ROOT / "notebooks").glob("0[01]_*.ipynb")):
+    for number in ("00", *PARAMETERISED):
+        path = report.find_notebook(number)
         nb = nbformat.read(path, as_version=4)
-        tagged = [c for c in nb.cells if "parameters" in c.metadata.get("tags", [])]
-        assert len(tagged) == (0 if path.name.startswith("00") else 1), path.name
+        tagged = [i for i, c in enumerate(nb.cells) if "parameters" in c.metadata.get("tags", [])]
+        if number == "00":
+            assert tagged == [], path.name
+            continue
+        # right after the shared first cell (which sets SEED), so papermill's values, SEED too, override both
+        assert tagged == [1], path.name
+        assert "SEED = " in nb.cells[0].source
+        # every name it sets is used by the cells below
+        names = [line.split("=")[0].strip() for line in nb.cells[1].source.splitlines()
+                 if line and not line.startswith("#")]
+        below = "".join(c.source for c in nb.cells[2:] if c.cell_type == "code")
+        assert names, path.name
+        for name in names:
+            assert name in below, f"{path.name}: {name} unused"
 
 
 @pytest.mark.slow
@@ -43,3 +60,18 @@ def test_parse_params_reads_literals_and_words():
         "N": 3, "x": 0.5, "detector": "orb", "sizes": (1, 2)}
     with pytest.raises(SystemExit, match="NAME=value"):
         report.parse_params(["3=x"])
+
+
+@pytest.mark.slow
+@pytest.mark.realdata
+def test_report_runs_notebook_06_with_fewer_poses(tmp_path, shared_data):
+    params = report.parse_params(["TABLE1_POSES=3", "MC_SIZE=4", "CONSTANTS_POSES=2"])
+    out = report.run_report("06", params, tmp_path)
+    assert out.name == "06_correlation_localisation-TABLE1_POSES=3-MC_SIZE=4-CONSTANTS_POSES=2.ipynb"
+    text = _outputs(nbformat.read(out, as_version=4))
+    # the stored notebook says 10 / 12 / 6 poses
+    assert "Table 1, 3 poses" in text
+    assert "Monte Carlo, 4 poses" in text
+    assert "Monte Carlo (4 poses): position exact" in text
+    assert "2 poses, clutter of 004 Fig. 3b + 60 extra discs" in text
+    assert "Monte Carlo, 12 poses" not in text

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from .._progress import progress_bar
 from .._table import format_table
 from ..geometry import wrap_angle
 from ..scans import GridFrame, Scan, grid_to_values, occupancy_grid
@@ -89,15 +90,41 @@ def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int
     return [("disc", int(c), int(rw), r) for rw, c in pick]
 
 
-def _localise_many(M, W, poses, rf, rng, p: LocaliseParams):
-    """Cast and localise one scan per pose; the map and settings were checked once by the caller."""
-    Mv = grid_to_values(M, p.a_c, p.a_p, p.a_n)
-    headings = heading_candidates(p.delta_alpha_rad)
-    est = np.empty_like(poses)
-    for k, pose in enumerate(poses):
-        scan = rf.scan(W, pose, rng)
-        est[k] = _localise(Mv, *_scan_beams(scan), headings, p, tracking=False).pose
-    return est
+def _localise_one(*, beams, choice: int, Mvs, settings, headings, margins: bool = False, pose_index: int = 0) -> dict:
+    """One sweep task: localise one scan's ``beams`` on map ``Mvs[choice]`` with ``settings[choice]`` (deterministic)."""
+    loc = _localise(Mvs[choice], *beams, headings, settings[choice], tracking=False)
+    row = {"x": float(loc.pose[0]), "y": float(loc.pose[1]), "heading_rad": float(loc.pose[2])}
+    if margins:
+        row["half_max_area"], row["heading_margin"] = _margins(loc)
+    return row
+
+
+def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 1, progress: bool | None = None):
+    """Localise every scan with every setting on :func:`slamlab.sweep.sweep`: one task per (setting, scan).
+
+    The scans were drawn by the caller (the random part stays in the parent, in its order); a
+    localisation draws nothing (``rng_arg=None``), so the table is the same for any ``n_jobs``.
+    The map is turned into 004's values once per setting. Returns the table (columns ``choice``,
+    ``pose_index``, ``x``, ``y``, ``heading_rad`` and with ``margins`` ``half_max_area``,
+    ``heading_margin``), setting-major.
+    """
+    from ..sweep import sweep
+
+    beams = [_scan_beams(s) for s in scans]
+    Mvs = tuple(grid_to_values(M, q.a_c, q.a_p, q.a_n) for q in settings)
+    headings = heading_candidates(settings[0].delta_alpha_rad)
+    points = [{"choice": j, "pose_index": i, "beams": b} for j in range(len(settings)) for i, b in enumerate(beams)]
+    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress,
+                  fixed={"Mvs": Mvs, "settings": tuple(settings), "headings": headings, "margins": margins})
+    failed = table["error"].notna()
+    if failed.any():
+        raise RuntimeError(f"{int(failed.sum())} localisation(s) failed; first: {table['error'][failed].iloc[0]}")
+    return table.drop(columns=["beams", "replicate", "error"])
+
+
+def _estimates(table) -> np.ndarray:
+    """``(n, 3)`` estimated poses (x, y, heading) of a :func:`_localise_scans` table."""
+    return table[["x", "y", "heading_rad"]].to_numpy(dtype=float)
 
 
 def _errors(true, est):
@@ -158,7 +185,7 @@ class Table1Result:
 
 def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int = 360,
                max_range_cells: float = 100.0, clutter: bool = True, params: LocaliseParams | None = None,
-               rng=2010, **overrides) -> Table1Result:
+               rng=2010, n_jobs: int = 1, progress: bool | None = None, **overrides) -> Table1Result:
     """Localise the robot from no prior at ``n_poses`` random free poses of the test room (004 Table 1).
 
     The robot stands on whole cells with a uniform random heading; the scan is
@@ -166,6 +193,7 @@ def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int 
     0.1-cell quantisation, and localised on the mapped room M by the full 360°
     search. 004 does not give σ, the beam count or the range limit: ours are
     parameters. ``params`` / ``**overrides``: the :class:`LocaliseParams` of every localisation.
+    ``n_jobs`` / ``progress``: the localisations run on :func:`slamlab.sweep.sweep` (same result for any ``n_jobs``).
     """
     p = LocaliseParams.resolve(params, **overrides)
     n = v.check_int(n_poses, "n_poses", minimum=1)
@@ -173,8 +201,9 @@ def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int 
     rng = v.as_rng(rng)
     M, W = _worlds(clutter, 0, rng)
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
+    scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
-    est = _localise_many(M, W, poses, rf, rng, p)
+    est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
     ea, ex, ey = _errors(poses, est)
     return Table1Result(poses, est, ea, ex, ey, float(range_std_cells), int(n_beams), p, time.perf_counter() - t0)
 
@@ -225,11 +254,16 @@ class MonteCarloResult:
 
 def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, n_beams: int = 360,
                     max_range_cells: float = 100.0, extra_clutter: int = 0, params: LocaliseParams | None = None,
-                    rng=2011, **overrides) -> MonteCarloResult:
+                    rng=2011, n_jobs: int = 1, progress: bool | None = None, **overrides) -> MonteCarloResult:
     """Full 360° localisation at many random poses: error distribution and failure rate (our addition).
 
     ``size``: ``"small"`` (12 poses, the notebook), ``"full"`` (200) or an int.
     ``params`` / ``**overrides``: the :class:`LocaliseParams` of every localisation.
+
+    The random part (clutter, poses, then one scan per pose, in that order from ``rng``)
+    runs here; the localisations, which draw nothing, run on :func:`slamlab.sweep.sweep`
+    with ``n_jobs`` workers (one task per pose; the result is the same for any ``n_jobs``)
+    and a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
     """
     p = LocaliseParams.resolve(params, **overrides)
     n = _SIZES[v.check_choice(size, "size", _SIZES)] if isinstance(size, str) else v.check_int(size, "size",
@@ -239,8 +273,9 @@ def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, 
     rng = v.as_rng(rng)
     M, W = _worlds(True, ec, rng)
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
+    scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
-    est = _localise_many(M, W, poses, rf, rng, p)
+    est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
     ea, ex, ey = _errors(poses, est)
     ep = np.hypot(ex, ey)
     failed = (ep > FAIL_CELLS) | (np.degrees(ea) > FAIL_DEG)
@@ -296,7 +331,7 @@ def _margins(loc, heading_window=3):
 def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std_cells: float = 0.3,
                         n_beams: int = 360, max_range_cells: float = 100.0,
                         choices=((-1.0, 1.0, 0.0), (0.0, 1.0, 0.0)), params: LocaliseParams | None = None,
-                        rng=2012, **overrides) -> ConstantsResult:
+                        rng=2012, n_jobs: int = 1, progress: bool | None = None, **overrides) -> ConstantsResult:
     """Compare 004's constant choices on the same cluttered scans (004 §7).
 
     004: the peak is sharpest at ``a_p = -a_c``; with unmapped objects,
@@ -307,6 +342,10 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     heading margin (peak minus the best score ≥ 3° away, over peak minus the median
     over headings), and the failure rate. ``params`` / ``**overrides``: the other
     :class:`LocaliseParams` fields (each choice replaces ``a_c, a_p, a_n``).
+
+    The scans are drawn here; the ``len(choices) × n_poses`` localisations run on
+    :func:`slamlab.sweep.sweep` with ``n_jobs`` workers (same result for any ``n_jobs``)
+    and a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
     """
     base = LocaliseParams.resolve(params, **overrides)
     n = v.check_int(n_poses, "n_poses", minimum=1)
@@ -321,20 +360,15 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, p, rng) for p in poses]
     k = len(consts)
-    pm, hm, ep = np.empty((k, n)), np.empty((k, n)), np.empty((k, n))
-    failed = np.zeros((k, n), bool)
-    maps = []
-    headings = heading_candidates(base.delta_alpha_rad)
     t0 = time.perf_counter()
-    for j, q in enumerate(settings):
-        Mv = grid_to_values(M, q.a_c, q.a_p, q.a_n)
-        for i, (p, s) in enumerate(zip(poses, scans, strict=True)):
-            loc = _localise(Mv, *_scan_beams(s), headings, q, tracking=False)
-            pm[j, i], hm[j, i] = _margins(loc)
-            ep[j, i] = np.hypot(*(loc.pose[:2] - p[:2]))
-            failed[j, i] = ep[j, i] > FAIL_CELLS or np.degrees(heading_error(loc.pose[2], p[2])) > FAIL_DEG
-        h0 = np.radians(np.round(np.degrees(poses[0, 2])))
-        maps.append(localise(M, scans[0], params=q, prior_heading_rad=h0, window_rad=0.0).score_map)
+    table = _localise_scans(M, scans, settings, margins=True, n_jobs=n_jobs, progress=progress)
+    est = _estimates(table).reshape(k, n, 3)
+    pm = table["half_max_area"].to_numpy(dtype=float).reshape(k, n)
+    hm = table["heading_margin"].to_numpy(dtype=float).reshape(k, n)
+    ep = np.hypot(est[..., 0] - poses[:, 0], est[..., 1] - poses[:, 1])
+    failed = (ep > FAIL_CELLS) | (np.degrees(heading_error(est[..., 2], poses[:, 2])) > FAIL_DEG)
+    h0 = np.radians(np.round(np.degrees(poses[0, 2])))
+    maps = [localise(M, scans[0], params=q, prior_heading_rad=h0, window_rad=0.0).score_map for q in settings]
     labels = tuple(f"a_c={c[0]:g}, a_p={c[1]:g}, a_n={c[2]:g}" for c in consts)
     return ConstantsResult(labels, consts, pm, hm, failed.mean(axis=1), ep, ec, tuple(maps), poses[0].copy(),
                            time.perf_counter() - t0)
@@ -433,7 +467,8 @@ class LogLocalisationResult:
 
 def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *,
                          cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int = 10,
-                         params: LocaliseParams | None = None, **overrides) -> LogLocalisationResult:
+                         params: LocaliseParams | None = None, progress: bool | None = None,
+                         **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on a grid built from the log's own poses (real data).
 
     The grid (``cell_m`` cells, 004's three values) is built from every scan except
@@ -452,6 +487,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         The scans to localise.
     params, **overrides
         :class:`LocaliseParams` of every localisation.
+    progress : bool, optional
+        Progress bar over the scans (default: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     p = LocaliseParams.resolve(params, **overrides)
     log = _carmen_log(path)
@@ -469,7 +506,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     Mv = grid_to_values(G, p.a_c, p.a_p, p.a_n)
     headings = heading_candidates(p.delta_alpha_rad)
     est = np.empty((idx.size, 3))
-    for k, i in enumerate(idx):
+    for k, i in enumerate(progress_bar(idx, desc="localise log scans", progress=progress)):
         est[k] = _localise(Mv, *_scan_beams(scans_c[i], f"scan {i}"), headings, p, tracking=False).pose
     est_m = frame.to_metres(est)
     true_m = log.poses[idx]

@@ -110,3 +110,61 @@ def test_log_localisation_takes_any_path_and_labels_from_it(shared_data, tmp_pat
     assert "Intel" not in r.table()
     assert "intel" not in r.table()
     assert "my_lab_run.log.gz" in C.ours_vs_source(C.run_table1(1, rng=1), log=r)
+
+
+def _sequential_reference(n, rng, clutter=0, n_beams=360, range_std_cells=0.3):
+    """The Monte Carlo as one sequential loop (draw a scan, localise it, next pose): what sweep must reproduce."""
+    g = np.random.default_rng(rng)
+    M, W = S.test_room_200(), S.measurement_room_200()
+    if clutter:
+        W = S.add_clutter(W, C.random_clutter(W, clutter, rng=g))
+    poses = S.random_free_poses(W, n, margin_cells=2, rng=g)
+    rf = S.Rangefinder(n_beams=n_beams, fov_rad=2 * np.pi, max_range_cells=100.0, range_std_cells=range_std_cells,
+                       quantum_cells=0.1)
+    est = []
+    for pose in poses:
+        scan = rf.scan(W, pose, g)
+        est.append(C.localise(M, scan).pose)
+    return poses, np.array(est)
+
+
+def test_monte_carlo_on_sweep_equals_the_sequential_loop_for_one_and_two_workers():
+    poses, est = _sequential_reference(3, 21, clutter=5)
+    ea, ex, ey = C.experiments._errors(poses, est)
+    one = C.run_monte_carlo(3, extra_clutter=5, rng=21, n_jobs=1)
+    two = C.run_monte_carlo(3, extra_clutter=5, rng=21, n_jobs=2)
+    for r in (one, two):
+        np.testing.assert_array_equal(r.err_heading_rad, ea)
+        np.testing.assert_array_equal(r.err_pos_cells, np.hypot(ex, ey))
+    np.testing.assert_array_equal(one.failed, two.failed)
+    assert one.table() == two.table()
+
+
+def test_constants_study_identical_for_one_and_two_workers():
+    one = C.run_constants_study(2, extra_clutter=10, rng=4, n_jobs=1)
+    two = C.run_constants_study(2, extra_clutter=10, rng=4, n_jobs=2)
+    for name in ("half_max_area", "heading_margin", "failure_rate", "err_pos_cells", "example_pose"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(two, name))
+    for a, b in zip(one.example_maps, two.example_maps, strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert one.table() == two.table()
+
+
+def test_localisation_table_has_one_row_per_choice_and_pose():
+    scans = [S.Rangefinder(n_beams=90, max_range_cells=40.0).scan(S.test_room_200(), [60.0, 40.0, 0.5])] * 2
+    settings = (C.LocaliseParams(delta_alpha_rad=np.radians(10.0)),
+                C.LocaliseParams(delta_alpha_rad=np.radians(10.0), a_c=0.0))
+    table = C.experiments._localise_scans(S.test_room_200(), scans, settings, margins=True, progress=False)
+    assert table.columns.tolist() == ["choice", "pose_index", "x", "y", "heading_rad", "half_max_area",
+                                      "heading_margin"]
+    assert table[["choice", "pose_index"]].to_numpy().tolist() == [[0, 0], [0, 1], [1, 0], [1, 1]]
+
+
+@pytest.mark.realdata
+def test_log_localisation_progress_bar_only_when_asked(shared_data, capsys):
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    quiet = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0))  # SLAMLAB_PROGRESS=0 in tests
+    assert capsys.readouterr().err == ""
+    shown = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0), progress=True)
+    assert "localise log scans" in capsys.readouterr().err
+    np.testing.assert_array_equal(quiet.est_poses_m, shown.est_poses_m)
