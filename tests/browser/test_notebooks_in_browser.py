@@ -188,28 +188,54 @@ def _move_first_control(page) -> str | None:
     return moved
 
 
-@pytest.mark.parametrize("notebook", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
-def test_notebook_runs_in_jupyterlab(lab_server, browser, notebook):
-    base, token = lab_server
+def _widget_outputs(page) -> str:
+    """What the widget cells show (for a failure message): the first 200 characters of each."""
+    return " | ".join(page.evaluate(
+        "() => [...document.querySelectorAll('.jp-CodeCell')].filter(c => c.textContent.includes('explore_'))"
+        ".map(c => (c.querySelector('.jp-OutputArea') || {textContent: '(no output area)'}).textContent.slice(0, 200))"))
+
+
+def _check_notebook(page, base, token, notebook) -> None:
     rel = notebook.relative_to(ROOT / "notebooks").as_posix()
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    try:
-        # a workspace of its own, reset: only this notebook is open (no tab restored from an earlier page)
-        page.goto(f"{base}/lab/workspaces/{notebook.stem}/tree/{rel}?reset&token={token}", timeout=60_000)
-        _run_all(page)
-        n_widgets = sum("explore_" in c for c in _code_sources(notebook))
-        if n_widgets:  # a widget view renders after its cell has run: wait for all of them
+    # a workspace of its own, reset: only this notebook is open (no tab restored from an earlier page)
+    page.goto(f"{base}/lab/workspaces/{notebook.stem}/tree/{rel}?reset&token={token}", timeout=60_000)
+    _run_all(page)
+    n_widgets = sum("explore_" in c for c in _code_sources(notebook))
+    if n_widgets:  # a widget view renders after its cell has run: wait for all of them
+        try:
             page.wait_for_function(f"() => document.querySelectorAll('.widget-interact').length >= {n_widgets}",
                                    timeout=60_000)
+        except Exception as exc:
+            raise AssertionError(f"{rel}: {n_widgets} widget view(s) expected; the widget cells show: "
+                                 f"{_widget_outputs(page)}") from exc
+    problems = _problems(page)
+    assert not problems, f"{rel}: " + "; ".join(problems)
+    if n_widgets:
+        moved = _move_first_control(page)
+        assert moved is not None, f"{rel}: its first widget has no slider or dropdown"
         problems = _problems(page)
-        assert not problems, f"{rel}: " + "; ".join(problems)
-        if n_widgets:
-            moved = _move_first_control(page)
-            assert moved is not None, f"{rel}: its first widget has no slider or dropdown"
-            problems = _problems(page)
-            assert not problems, f"{rel} after moving a control ({moved}): " + "; ".join(problems)
-    finally:
-        page.close()
+        assert not problems, f"{rel} after moving a control ({moved}): " + "; ".join(problems)
+
+
+@pytest.mark.parametrize("notebook", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
+def test_notebook_runs_in_jupyterlab(lab_server, browser, notebook):
+    """One retry in a fresh page: once in a full run a widget view did not appear within 60 s (03, not
+    reproduced alone); a notebook that fails twice fails the test, with both messages."""
+    base, token = lab_server
+    first = None
+    for _attempt in range(2):
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        try:
+            _check_notebook(page, base, token, notebook)
+            if first is not None:
+                print(f"passed on the retry; first attempt: {first}")
+            return
+        except AssertionError as exc:
+            if first is not None:
+                raise AssertionError(f"failed twice.\nfirst: {first}\nsecond: {exc}") from exc
+            first = str(exc)
+        finally:
+            page.close()
 
 
 def _code_sources(path: Path) -> list[str]:
