@@ -1,5 +1,29 @@
 """Probabilistic localisation: Markov grid localisation and Monte Carlo localisation (003 §1.2.4, §2.2; Ch. 8)."""
 
+from .._lazy import lazy_exports
+from .experiments import (
+    AMCL_DEFAULTS,
+    CARMEN_LOGS,
+    FilterRun,
+    GlobalResult,
+    KidnapResult,
+    LogMCLResult,
+    MarkovVsMclResult,
+    SideBySideResult,
+    SimRun,
+    amcl_defaults_table,
+    carmen_path,
+    demo_run,
+    logs_table,
+    ours_vs_source,
+    run_correlation_side_by_side,
+    run_filter,
+    run_global_localisation,
+    run_kidnapped,
+    run_log_mcl,
+    run_markov_vs_mcl,
+    simulate_run,
+)
 from .markov import MarkovGrid, MarkovParams, markov_correct, markov_log_likelihood, markov_predict
 from .mcl import MCL, MCLParams, MCLState, StepRecord, mcl_step
 from .models import (
@@ -25,21 +49,39 @@ from .particles import (
     uniform_free_particles,
 )
 
+_PLOT = ("mcl_figure", "recorded_step_figure", "plot_averages", "plot_belief", "plot_clouds", "plot_errors", "plot_global", "plot_log_run", "plot_map",
+         "plot_particles", "plot_weights")
+_WIDGETS = ("explore_log", "explore_mcl", "explore_recorded_run")
+__getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
+
 __all__ = [
+    "AMCL_DEFAULTS",
+    "CARMEN_LOGS",
     "MCL",
     "Beams",
+    "FilterRun",
+    "GlobalResult",
+    "KidnapResult",
     "LikelihoodFieldModel",
+    "LogMCLResult",
     "MCLParams",
     "MCLState",
     "MarkovGrid",
     "MarkovParams",
+    "MarkovVsMclResult",
+    "SideBySideResult",
+    "SimRun",
     "StepRecord",
+    "amcl_defaults_table",
     "beam_model_prob",
+    "carmen_path",
     "check_particles",
+    "demo_run",
     "free_cell_centres",
     "is_localised",
     "kld_bound",
     "kld_sample_count",
+    "logs_table",
     "low_variance_resample",
     "markov_correct",
     "markov_log_likelihood",
@@ -49,9 +91,18 @@ __all__ = [
     "n_eff",
     "normalise_log_weights",
     "odometry_deltas",
+    "ours_vs_source",
     "pose_estimate",
     "ray_cast",
+    "run_correlation_side_by_side",
+    "run_filter",
+    "run_global_localisation",
+    "run_kidnapped",
+    "run_log_mcl",
+    "run_markov_vs_mcl",
     "sample_motion_odometry",
     "scan_beams",
+    "simulate_run",
     "uniform_free_particles",
 ]
+__all__ += list(_PLOT + _WIDGETS)  # loaded on first use
