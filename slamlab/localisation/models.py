@@ -115,8 +115,12 @@ def sample_motion_odometry(poses, odom_prev, odom_now, alpha, rng=None) -> np.nd
     a = _check_alpha(alpha)
     rot1, trans, rot2 = (float(d) for d in odometry_deltas(odom_prev, odom_now))
     rng = v.as_rng(rng)
-    n = P.shape[0]
-    e = rng.standard_normal((3, n))
+    return motion_from_noise(P, (rot1, trans, rot2), a, rng.standard_normal((3, P.shape[0])))
+
+
+def motion_from_noise(P, deltas, a, e) -> np.ndarray:
+    """PR Table 5.6 lines 5-10 with given standard-normal draws ``e`` (3, N): the deterministic core."""
+    rot1, trans, rot2 = deltas
     # PR Table 5.6 lines 5-7 (variances; errata form)
     r1 = rot1 - np.sqrt(a[0] * rot1**2 + a[1] * trans**2) * e[0]
     tr = trans - np.sqrt(a[2] * trans**2 + a[3] * (rot1**2 + rot2**2)) * e[1]

@@ -66,12 +66,12 @@ def n_eff(weights) -> float:
     return float(1.0 / np.sum(w * w))
 
 
-def low_variance_resample(weights, n: int | None = None, rng=None) -> np.ndarray:
+def low_variance_resample(weights, n: int | None = None, rng=None, *, offset: float | None = None) -> np.ndarray:
     """Indices of ``n`` particles drawn by the low-variance (systematic) sampler (PR Table 4.4).
 
     One random offset ``r ∈ [0, 1/n)``; particle ``i`` is drawn for every pointer
     ``r + m/n`` that falls in its slice of the cumulative weights, so a particle of
-    weight ``w`` is drawn ``⌊n·w⌋`` or ``⌈n·w⌉`` times.
+    weight ``w`` is drawn ``⌊n·w⌋`` or ``⌈n·w⌉`` times. ``offset`` fixes ``r`` (else drawn from ``rng``).
 
     >>> low_variance_resample([0.5, 0.25, 0.25], 4, rng=0).tolist()
     [0, 0, 1, 2]
@@ -86,7 +86,13 @@ def low_variance_resample(weights, n: int | None = None, rng=None) -> np.ndarray
     rng = v.as_rng(rng)
     c = np.cumsum(w / total)
     c[-1] = 1.0
-    u = (rng.uniform(0.0, 1.0 / m) + np.arange(m) / m)
+    if offset is None:
+        r = rng.uniform(0.0, 1.0 / m)
+    else:
+        r = v.check_positive(offset, "offset", allow_zero=True)
+        if r >= 1.0 / m:
+            raise ValueError(f"`offset` must be in [0, 1/n) = [0, {1.0 / m:g}); got {r}")
+    u = r + np.arange(m) / m
     return np.minimum(np.searchsorted(c, u, side="right"), w.size - 1)
 
 

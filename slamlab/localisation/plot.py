@@ -27,7 +27,8 @@ _MAP_CMAP = ListedColormap(["#dddddd", "white", "black"])  # unexplored, free, o
 
 def plot_map(grid, *, ax=None, extent=None):
     """The grid map (free white, obstacle black, unexplored grey), ``origin="lower"``."""
-    ax = new_axes(ax, equal=True)
+    ax = new_axes(ax)
+    ax.set_aspect("equal", adjustable="box")  # fixed limits are set after: keep them, shape the box
     ax.imshow(np.asarray(grid) + 1, cmap=_MAP_CMAP, vmin=0, vmax=2, origin="lower", interpolation="nearest",
               extent=extent)
     return ax
