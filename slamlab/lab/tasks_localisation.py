@@ -141,7 +141,7 @@ def _global_success() -> float:
 def _kidnap_recovery() -> float:
     from ..localisation import demo_run
 
-    run, res = demo_run(seed=2026, **EXPLORE_KIDNAP)
+    _, res = demo_run(seed=2026, **EXPLORE_KIDNAP)
     k = res.converged_at(EXPLORE_KIDNAP["kidnap_step"])
     return float("nan") if k is None else float(k - EXPLORE_KIDNAP["kidnap_step"])
 

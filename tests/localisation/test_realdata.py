@@ -43,5 +43,5 @@ def test_table_has_every_log(results):
 def test_log_by_path_and_bad_path(tmp_path):
     with pytest.raises(FileNotFoundError, match="no file"):
         L.run_log_mcl(tmp_path / "missing.log.gz")
-    with pytest.raises(TypeError, match="`path` must be a str or os.PathLike"):
+    with pytest.raises(TypeError, match=r"`path` must be a str or os\.PathLike"):
         L.run_log_mcl(3.5)
