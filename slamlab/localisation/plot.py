@@ -41,8 +41,8 @@ def plot_particles(grid, particles, weights=None, *, true_pose=None, estimate=No
     P = np.asarray(particles)
     step = max(1, P.shape[0] // max_points)
     c = None if weights is None else np.asarray(weights)[::step]
-    ax.scatter(P[::step, 0], P[::step, 1], s=2, c="tab:red" if c is None else c, cmap="viridis", alpha=0.6,
-               linewidths=0)
+    colour = {"color": "tab:red"} if c is None else {"c": c, "cmap": "viridis"}
+    ax.scatter(P[::step, 0], P[::step, 1], s=2, alpha=0.6, linewidths=0, **colour)
     for pose, style, label in ((true_pose, STYLE["truth"], "truth"), (estimate, STYLE["estimate"], "estimate")):
         if pose is not None:
             ax.plot(pose[0], pose[1], marker="o", color=style["color"], markersize=5, linestyle="none", label=label)
