@@ -167,6 +167,12 @@ def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params
 # --- global localisation vs particle count (Monte Carlo on sweep) ------------------------------------------
 
 
+def _raise_failed(df) -> None:
+    """A sweep keeps a failed run as a row with its error; here any failure is a bug: raise it."""
+    if df["error"].notna().any():
+        raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
+
+
 def _global_task(n_particles: int, rng, n_steps: int, sigma_hit: float):
     run = simulate_run(n_steps, rng=rng)
     r = run_filter(run, n_particles=n_particles, sigma_hit=sigma_hit, rng=rng)
@@ -222,8 +228,7 @@ def run_global_localisation(particle_counts=(250, 1000, 4000), *, n_runs: int = 
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     df = sweep(_global_task, {"n_particles": counts}, seeds=n_runs, seed=seed, n_jobs=n_jobs, progress=progress,
                fixed={"n_steps": n_steps, "sigma_hit": sigma_hit})
-    if df["error"].notna().any():
-        raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
+    _raise_failed(df)
     return GlobalResult(df, n_runs, n_steps)
 
 
@@ -275,8 +280,7 @@ def run_kidnapped(settings=((0.0, 0.0), (0.001, 0.1), (0.02, 0.3), (0.05, 0.5)),
     pts = [{"alpha_slow": float(s), "alpha_fast": float(f)} for s, f in settings]
     df = sweep(_kidnap_task, pts, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=seed, n_jobs=n_jobs,
                progress=progress, fixed={"n_particles": n_particles, "n_steps": n_steps, "kidnap_step": kidnap_step})
-    if df["error"].notna().any():
-        raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
+    _raise_failed(df)
     return KidnapResult(df, n_runs, kidnap_step, n_steps)
 
 
@@ -344,8 +348,7 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
     import pandas as pd
 
     df = pd.concat(frames, ignore_index=True)
-    if df["error"].notna().any():
-        raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
+    _raise_failed(df)
     return MarkovVsMclResult(df, n_runs, n_steps)
 
 
@@ -624,8 +627,7 @@ def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_parti
     df = sweep(_side_task, None, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=seed, n_jobs=n_jobs,
                progress=progress, fixed={"n_steps": n_steps, "n_particles": n_particles,
                                          "delta_alpha_deg": delta_alpha_deg})
-    if df["error"].notna().any():
-        raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
+    _raise_failed(df)
     return SideBySideResult(df, n_runs, n_steps, n_particles, float(delta_alpha_deg))
 
 

@@ -32,7 +32,7 @@ from .. import _validate as v
 from .._params import Params, param
 from ..geometry import wrap_angle
 from ..scans import FREE
-from .models import Beams, LikelihoodFieldModel, odometry_deltas, scan_beams
+from .models import Beams, LikelihoodFieldModel, check_model_settings, odometry_deltas, scan_beams
 
 __all__ = ["MarkovGrid", "MarkovParams", "markov_correct", "markov_predict"]
 
@@ -55,15 +55,7 @@ class MarkovParams(Params):
     def check(self) -> None:
         v.check_int(self.resolution, "resolution", minimum=1)
         v.check_int(self.n_headings, "n_headings", minimum=4)
-        a = np.asarray(self.alpha, dtype=float) if isinstance(self.alpha, tuple) else None
-        if a is None or a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a < 0):
-            raise ValueError(f"`alpha` must be a tuple of four numbers >= 0 (α1…α4); got {self.alpha!r}")
-        v.check_positive(self.z_hit, "z_hit", allow_zero=True)
-        v.check_positive(self.z_rand, "z_rand", allow_zero=True)
-        v.check_positive(self.sigma_hit, "sigma_hit")
-        v.check_positive(self.max_dist, "max_dist")
-        v.check_int(self.max_beams, "max_beams", minimum=1)
-        v.check_positive(self.gamma, "gamma")
+        check_model_settings(self)
         v.check_positive(self.min_blur, "min_blur", allow_zero=True)
 
 

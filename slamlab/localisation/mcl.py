@@ -32,7 +32,14 @@ import numpy as np
 
 from .. import _validate as v
 from .._params import Params, param
-from .models import Beams, LikelihoodFieldModel, check_particles, sample_motion_odometry, scan_beams
+from .models import (
+    Beams,
+    LikelihoodFieldModel,
+    check_model_settings,
+    check_particles,
+    sample_motion_odometry,
+    scan_beams,
+)
 from .particles import (
     free_cell_centres,
     is_localised,
@@ -72,17 +79,7 @@ class MCLParams(Params):
 
     def check(self) -> None:
         v.check_int(self.n_particles, "n_particles", minimum=1)
-        a = np.asarray(self.alpha, dtype=float) if isinstance(self.alpha, tuple) else None
-        if a is None or a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a < 0):
-            raise ValueError(f"`alpha` must be a tuple of four numbers >= 0 (α1…α4); got {self.alpha!r}")
-        v.check_positive(self.z_hit, "z_hit", allow_zero=True)
-        v.check_positive(self.z_rand, "z_rand", allow_zero=True)
-        if self.z_hit + self.z_rand <= 0:
-            raise ValueError("`z_hit` + `z_rand` must be > 0")
-        v.check_positive(self.sigma_hit, "sigma_hit")
-        v.check_positive(self.max_dist, "max_dist")
-        v.check_int(self.max_beams, "max_beams", minimum=1)
-        v.check_positive(self.gamma, "gamma")
+        check_model_settings(self)
         s = v.check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
         f = v.check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
         if s > 1 or f > 1:

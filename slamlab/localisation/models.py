@@ -58,10 +58,29 @@ def check_particles(poses, name: str = "particles") -> np.ndarray:
     return P
 
 
-def _check_alpha(alpha) -> np.ndarray:
-    a = np.asarray(alpha, dtype=float)
+def check_model_settings(p) -> None:
+    """Check the motion and sensor fields shared by MCLParams and MarkovParams (one place)."""
+    if not isinstance(p.alpha, tuple):
+        raise TypeError(f"`alpha` must be a tuple of four numbers >= 0 (α1…α4); got {type(p.alpha).__name__}")
+    _check_alpha(p.alpha, "alpha must be a tuple of four numbers")
+    v.check_positive(p.z_hit, "z_hit", allow_zero=True)
+    v.check_positive(p.z_rand, "z_rand", allow_zero=True)
+    if p.z_hit + p.z_rand <= 0:
+        raise ValueError("`z_hit` + `z_rand` must be > 0")
+    v.check_positive(p.sigma_hit, "sigma_hit")
+    v.check_positive(p.max_dist, "max_dist")
+    v.check_int(p.max_beams, "max_beams", minimum=1)
+    v.check_positive(p.gamma, "gamma")
+
+
+def _check_alpha(alpha, what: str = "alpha must be four finite numbers >= 0") -> np.ndarray:
+    try:
+        a = np.asarray(alpha, dtype=float)
+    except (TypeError, ValueError):
+        a = np.full(1, np.nan)
     if a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a < 0):
-        raise ValueError(f"`alpha` must be four finite numbers >= 0 (α1…α4); got {alpha!r}")
+        name, _, rest = what.partition(" ")
+        raise ValueError(f"`{name}` {rest} (α1…α4); got {alpha!r}")
     return a
 
 
