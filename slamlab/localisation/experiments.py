@@ -504,7 +504,7 @@ class LogMCLResult:
 
 
 def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1, max_range_m: float = 10.0,
-                n_particles_track: int = 1000, n_particles_global: int = 20000, odo_trans_frac: float = 0.1,
+                n_particles_track: int = 3000, n_particles_global: int = 20000, odo_trans_frac: float = 0.1,
                 odo_rot_std_deg: float = 1.0, rng=0, params: MCLParams | None = None, **overrides) -> LogMCLResult:
     """MCL on ``n_scans`` consecutive scans of a corrected CARMEN log (path: str / os.PathLike, or a log name).
 
