@@ -9,7 +9,7 @@ field of :class:`PlaneScanner`, :func:`build_plane_room` or :func:`quad_flight`:
 
 * room: 20 m × 10 m × 3 m (200 m²) with a pillar and a box (some faces parallel to
   the walls), each face a bounded rectangle carrying 1 m panels of reflectance;
-* scanner: beams at angle ``a`` from the body ``+z`` axis in the body ``x``–``z``
+* scanner: beams at angle ``a`` from the body ``+z`` axis in the body ``x``-``z``
   plane, ``a`` in [-135°, 135°] (the 90° gap points down, at the airframe); range
   noise N(0, σ_r); intensity ``I = I0 · ρ · |cos θ|`` (θ: incidence angle) plus
   N(0, σ_I); no return (NaN) beyond ``range_max_m``;
