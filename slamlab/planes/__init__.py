@@ -1,0 +1,63 @@
+"""Plane-based 3-D particle-filter SLAM from a yawing line scanner (002; Ch. 10).
+
+Its own package, not ``slamlab.localisation`` (where CONVENTIONS first placed 002): it is a
+3-D system with its own types — frames of 40 000 points, planes ``Π = {n, p, T, A}`` with
+cell grids, particles in SE(3), a plane database — and shares nothing with the 2-D
+grid localisation of Ch. 8 except the idea of a particle filter.
+"""
+
+from .description import Plane, cell_keys, describe_plane, lookup_mean_intensity, plane_frame
+from .extraction import Frame, build_frame, extract_planes, fit_plane_lsq, frame_transforms, plane_distances
+from .filter import (
+    STAGES,
+    CycleReport,
+    PlaneSLAM,
+    PlaneSLAMParams,
+    intensity_weights,
+    mean_pose,
+    pair_planes,
+    predict_particles,
+    systematic_resample,
+)
+from .mapping import PlaneMap, VoxelStore, merge_planes, planes_touch
+from .transform import (
+    LMResult,
+    lm_pose,
+    plane_pair_jacobian,
+    plane_pair_residuals,
+    planes_to_body,
+    planes_to_map,
+)
+
+__all__ = [
+    "STAGES",
+    "CycleReport",
+    "Frame",
+    "LMResult",
+    "Plane",
+    "PlaneMap",
+    "PlaneSLAM",
+    "PlaneSLAMParams",
+    "VoxelStore",
+    "build_frame",
+    "cell_keys",
+    "describe_plane",
+    "extract_planes",
+    "fit_plane_lsq",
+    "frame_transforms",
+    "intensity_weights",
+    "lm_pose",
+    "lookup_mean_intensity",
+    "mean_pose",
+    "merge_planes",
+    "pair_planes",
+    "plane_distances",
+    "plane_frame",
+    "plane_pair_jacobian",
+    "plane_pair_residuals",
+    "planes_to_body",
+    "planes_to_map",
+    "planes_touch",
+    "predict_particles",
+    "systematic_resample",
+]
