@@ -117,7 +117,8 @@ def plane_distances(points, n, p) -> np.ndarray:
 
 
 def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, min_support: int = 400,
-                   max_planes: int = 12, sample_points: int = 2000, refit_rounds: int = 2, rng=None):
+                   max_planes: int = 12, sample_points: int = 2000, refit_rounds: int = 2,
+                   min_width_m: float = 0.0, rng=None):
     """Greedy batched RANSAC plane extraction (002 "Plane extraction"; our numpy version of PCL's).
 
     Parameters
@@ -129,6 +130,9 @@ def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, 
     max_planes : planes at most.
     sample_points : hypotheses are drawn and scored on this many random remaining points.
     refit_rounds : least-squares refits on the inliers, each followed by a recount.
+    min_width_m : a plane whose inliers span less than this between their 10th and 90th percentiles along
+        either in-plane principal axis is dropped (its points go to the leftover): a narrow band (a few
+        scan lines) fixes its normal badly about its axis (ours).
     rng : Generator, int or None.
 
     Returns
@@ -152,10 +156,11 @@ def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, 
     max_planes = v.check_int(max_planes, "max_planes", minimum=0)
     sample_points = v.check_int(sample_points, "sample_points", minimum=3)
     refit_rounds = v.check_int(refit_rounds, "refit_rounds", minimum=0)
+    min_width_m = v.check_positive(min_width_m, "min_width_m", allow_zero=True)
     rng = v.as_rng(rng)
     remaining = np.arange(X.shape[0])
-    planes = []
-    while len(planes) < max_planes and remaining.size >= max(min_support, 3):
+    planes, rejected = [], []
+    while len(planes) + len(rejected) < 2 * max_planes and len(planes) < max_planes and remaining.size >= max(min_support, 3):
         sub = remaining if remaining.size <= sample_points else rng.choice(remaining, sample_points, replace=False)
         S = X[sub]
         idx = rng.integers(0, S.shape[0], (iters, 3))
@@ -190,6 +195,14 @@ def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, 
             break
         if p < 0:
             n, p = -n, -p
+        if min_width_m > 0:
+            Z = Y[mask] - Y[mask].mean(axis=0)
+            ab = Z @ np.linalg.eigh(Z.T @ Z)[1][:, 1:]              # in-plane principal coordinates
+            width = np.diff(np.percentile(ab, [10, 90], axis=0), axis=0).min()
+            if width < min_width_m:
+                remaining = remaining[~mask]
+                rejected.append(remaining.size)
+                continue
         planes.append((n, p, remaining[mask]))
         remaining = remaining[~mask]
     leftover = np.zeros(X.shape[0], dtype=bool)

@@ -58,6 +58,7 @@ class PlaneSLAMParams(Params):
     ransac_min_support: int = param(400, "ours")
     ransac_sample_points: int = param(2000, "ours")
     max_planes: int = param(10, "ours")
+    min_width_m: float = param(0.6, "ours: planes narrower than this (10-90 % spread) are dropped")
     cell_m: float = param(0.25, "ours (002: 'cells of a given size')")
     thin: int = param(3, "ours (002: 'a thinned set of parts')")
     pair_angle_deg: float = param(10.0, "ours")
@@ -201,6 +202,8 @@ class PlaneSLAM:
         self.X_predicted = self.X.copy()
         self.X_solved = self.X.copy()
         self.weights = np.full(p.n_particles, 1.0 / p.n_particles)
+        #: False freezes the map (ours: for one-cycle studies such as 002 Fig. 4)
+        self.update_map = True
 
     # --- the stages -------------------------------------------------------------------------------------------
     def detect(self, frame: Frame):
@@ -209,6 +212,7 @@ class PlaneSLAM:
         found, leftover = extract_planes(frame.points, tolerance_m=p.ransac_tolerance_m,
                                          iterations=p.ransac_iterations, min_support=p.ransac_min_support,
                                          max_planes=p.max_planes, sample_points=p.ransac_sample_points,
+                                         min_width_m=p.min_width_m,
                                          rng=self.rng)
         return found, leftover
 
@@ -276,11 +280,12 @@ class PlaneSLAM:
         t1 = clock()
         planes = self.describe(frame, found)
         t2 = clock()
-        self.X = predict_particles(self.X, U, p.sigma_xyz_m, p.sigma_rpy_deg, self.rng)
+        first = len(self.map) == 0 and bool(planes)      # the first frame with planes founds the map
+        if not first:
+            self.X = predict_particles(self.X, U, p.sigma_xyz_m, p.sigma_rpy_deg, self.rng)
         self.X_predicted = self.X.copy()
         t3 = clock()
         rank = _normal_rank([pl.n for pl in planes])
-        first = len(self.map) == 0
         use = (not first) and rank >= p.min_normal_rank
         pairs = self.solve(planes) if use else np.full((len(self.X), len(planes)), -1)
         use = use and bool((pairs >= 0).any())
@@ -294,10 +299,10 @@ class PlaneSLAM:
         t5 = clock()
         self.pose = mean_pose(self.X)
         t6 = clock()
-        if first or use:
+        if first or (use and self.update_map):
             for pl in planes:
                 self.map.add(pl.moved(self.pose))
-        if finite and leftover.any():
+        if finite and leftover.any() and self.update_map:
             pts = frame.points[leftover][:: max(1, p.thin)]
             self.map.voxels.add(pts @ self.pose[:3, :3].T + self.pose[:3, 3])
         t7 = clock()

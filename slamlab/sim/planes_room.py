@@ -31,6 +31,7 @@ __all__ = [
     "Flight",
     "PlaneRoom",
     "PlaneScanner",
+    "build_corridor",
     "build_plane_room",
     "cast_rays_planes",
     "quad_flight",
@@ -134,6 +135,24 @@ def build_plane_room(length_m: float = 20.0, width_m: float = 10.0, height_m: fl
     panels = np.where(pick, hi_r, lo_r) + rng.uniform(-0.05, 0.05, (len(faces), nu, nv))
     return PlaneRoom(np.array(c), np.array(n), np.array(u), np.array(w), hu, hv,
                      np.clip(panels, 0.0, 1.0), panel_m, tuple(names))
+
+
+def build_corridor(length_m: float = 12.0, width_m: float = 3.0, height_m: float = 3.0, *, panel_m: float = 1.0,
+                   rng=0) -> PlaneRoom:
+    """A corridor: floor, ceiling and two parallel walls, no end walls (002 Fig. 4's situation; ours).
+
+    Its planes leave the position along the corridor (``x``) free: only the panels' intensities fix it.
+
+    >>> c = build_corridor(); len(c), c.names
+    (4, ('y-', 'y+', 'z-', 'z+'))
+    """
+    L, W, H = (v.check_positive(a, n) for a, n in ((length_m, "length_m"), (width_m, "width_m"),
+                                                      (height_m, "height_m")))
+    room = build_plane_room(L, W, H, panel_m=panel_m, rng=rng)
+    keep = [i for i, n in enumerate(room.names) if n in ("room y-", "room y+", "room z-", "room z+")]
+    return PlaneRoom(room.centres[keep], room.normals[keep], room.axes_u[keep], room.axes_v[keep],
+                     room.half_u[keep], room.half_v[keep], room.panels[keep], room.panel_m,
+                     tuple(room.names[i][5:] for i in keep))
 
 
 def cast_rays_planes(room: PlaneRoom, origins, directions, range_max_m: float = np.inf):
@@ -315,8 +334,8 @@ class Flight:
 
 
 def simulate_flight(duration_s: float = 20.0, *, room: PlaneRoom | None = None, scanner: PlaneScanner | None = None,
-                    yaw_rate_deg_s: float = 45.0, speed_m_s: float = 0.6, odometry_noise: float = 1.0,
-                    rng=None) -> Flight:
+                    yaw_rate_deg_s: float = 45.0, speed_m_s: float = 0.6, waypoints_m=None,
+                    odometry_noise: float = 1.0, rng=None) -> Flight:
     """Fly :func:`quad_flight` through ``room`` and record every scan line and the odometry (002; ours).
 
     ``odometry_noise`` scales every noise and bias of :func:`simulate_odometry_3d` (0 = perfect odometry).
@@ -327,7 +346,8 @@ def simulate_flight(duration_s: float = 20.0, *, room: PlaneRoom | None = None, 
         raise TypeError(f"`room` must be a PlaneRoom; got {type(room).__name__}")
     scanner = PlaneScanner.resolve(scanner)
     k = v.check_positive(odometry_noise, "odometry_noise", allow_zero=True)
-    t, T = quad_flight(duration_s, rate_hz=scanner.lines_per_s, yaw_rate_deg_s=yaw_rate_deg_s, speed_m_s=speed_m_s)
+    t, T = quad_flight(duration_s, rate_hz=scanner.lines_per_s, yaw_rate_deg_s=yaw_rate_deg_s, speed_m_s=speed_m_s,
+                       waypoints_m=waypoints_m)
     d_body = scanner_beam_directions(scanner)
     n, b = len(t), d_body.shape[0]
     d_map = np.einsum("nij,bj->nbi", T[:, :3, :3], d_body).reshape(-1, 3)
