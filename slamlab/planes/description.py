@@ -14,7 +14,7 @@ correction (002 after [17]) divides each intensity by ``max(|cos θ|, cos_min)``
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -34,7 +34,8 @@ def cell_keys(ij) -> np.ndarray:
 @dataclass(frozen=True)
 class Plane:
     """A described plane ``Π = {n, p, T, A}`` (002): ``n (3,)``, ``p``, ``T (4, 4)`` plane frame → parent,
-    ``cell_m``, cells ``ij (M, 2)`` with ``counts (M,)`` and intensity ``sums (M,)`` (``keys`` sorted)."""
+    ``cell_m``, cells ``ij (M, 2)`` (in ascending ``keys`` order) with ``counts (M,)`` and intensity ``sums
+    (M,)``; ``mean_intensity`` ``I_k = Σ I / N_k``."""
 
     n: np.ndarray
     p: float
@@ -43,15 +44,12 @@ class Plane:
     ij: np.ndarray
     counts: np.ndarray
     sums: np.ndarray
+    keys: np.ndarray = field(init=False, repr=False, compare=False)
+    mean_intensity: np.ndarray = field(init=False, repr=False, compare=False)
 
-    @property
-    def keys(self) -> np.ndarray:
-        return cell_keys(self.ij)
-
-    @property
-    def mean_intensity(self) -> np.ndarray:
-        """``I_k = Σ I / N_k`` per cell."""
-        return self.sums / self.counts
+    def __post_init__(self):
+        object.__setattr__(self, "keys", cell_keys(self.ij))
+        object.__setattr__(self, "mean_intensity", self.sums / self.counts)   # I_k = sum I / N_k per cell
 
     @property
     def n_points(self) -> int:
@@ -110,17 +108,30 @@ def describe_plane(points, intensities, n, p: float, *, cell_m: float = 0.25, ra
     T = plane_frame(n, p, X.mean(axis=0))
     local = (X - T[:3, 3]) @ T[:3, :2]
     ij = np.floor(local / cell_m).astype(np.int64)
-    keys, inv = np.unique(cell_keys(ij), return_inverse=True)
-    counts = np.bincount(inv, minlength=len(keys))
-    sums = np.bincount(inv, weights=I, minlength=len(keys))
-    ij_u = np.c_[keys // (2 * _OFF) - _OFF, keys % (2 * _OFF) - _OFF]
-    return Plane(n, float(p), T, cell_m, ij_u, counts, sums)
+    ij_u, counts, sums = _bin_cells(ij, np.ones(len(ij)), I)
+    return Plane(n, float(p), T, cell_m, ij_u, counts.astype(np.int64), sums)
+
+
+def _bin_cells(ij, counts, sums):
+    """Sum ``counts`` and ``sums`` per cell ``ij (K, 2)`` on a dense grid (a bincount, no sort); cells come out
+    in the order of their keys (ascending), as :func:`lookup_mean_intensity` needs."""
+    lo = ij.min(axis=0)
+    w = int(ij[:, 1].max() - lo[1]) + 1
+    flat = (ij[:, 0] - lo[0]) * w + (ij[:, 1] - lo[1])
+    c = np.bincount(flat, weights=counts)
+    keep = np.flatnonzero(c)
+    s = np.bincount(flat, weights=sums)[keep]
+    return np.c_[keep // w + lo[0], keep % w + lo[1]], c[keep], s
 
 
 def lookup_mean_intensity(plane: Plane, points) -> np.ndarray:
     """Mean intensity of the cell of ``plane`` under each point ``(..., 3)`` (parent frame); NaN off the grid."""
     X = np.asarray(points, dtype=float)
-    local = (X - plane.T[:3, 3]) @ plane.T[:3, :2]
+    return lookup_local(plane, (X - plane.T[:3, 3]) @ plane.T[:3, :2])
+
+
+def lookup_local(plane: Plane, local) -> np.ndarray:
+    """Mean intensity of the cell under each in-plane point ``local (..., 2)`` (plane frame); NaN off the grid."""
     k = cell_keys(np.floor(local / plane.cell_m).astype(np.int64))
     keys = plane.keys
     pos = np.clip(np.searchsorted(keys, k), 0, len(keys) - 1)

@@ -117,7 +117,7 @@ def plane_distances(points, n, p) -> np.ndarray:
 
 
 def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, min_support: int = 400,
-                   max_planes: int = 12, sample_points: int = 2000, refit_rounds: int = 2,
+                   max_planes: int = 12, sample_points: int = 1000, refit_rounds: int = 2,
                    min_width_m: float = 0.0, rng=None):
     """Greedy batched RANSAC plane extraction (002 "Plane extraction"; our numpy version of PCL's).
 
@@ -161,7 +161,8 @@ def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, 
     remaining = np.arange(X.shape[0])
     planes, rejected = [], []
     while len(planes) + len(rejected) < 2 * max_planes and len(planes) < max_planes and remaining.size >= max(min_support, 3):
-        sub = remaining if remaining.size <= sample_points else rng.choice(remaining, sample_points, replace=False)
+        sub = remaining if remaining.size <= sample_points else remaining[rng.integers(0, remaining.size,
+                                                                                        sample_points)]
         S = X[sub]
         idx = rng.integers(0, S.shape[0], (iters, 3))
         a, b, c = S[idx[:, 0]], S[idx[:, 1]], S[idx[:, 2]]

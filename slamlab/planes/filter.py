@@ -34,7 +34,8 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate as v
 from .._params import Params, param
-from .description import Plane, describe_plane, lookup_mean_intensity
+from ..geometry import se3_inverse
+from .description import Plane, describe_plane, lookup_local
 from .extraction import Frame, extract_planes
 from .mapping import PlaneMap
 from .transform import lm_pose
@@ -56,14 +57,14 @@ class PlaneSLAMParams(Params):
     ransac_tolerance_m: float = param(0.04, "ours (002: PCL RANSAC, tolerance not given)")
     ransac_iterations: int = param(100, "ours")
     ransac_min_support: int = param(400, "ours")
-    ransac_sample_points: int = param(2000, "ours")
+    ransac_sample_points: int = param(1000, "ours")
     max_planes: int = param(10, "ours")
     min_width_m: float = param(0.6, "ours: planes narrower than this (10-90 % spread) are dropped")
     cell_m: float = param(0.25, "ours (002: 'cells of a given size')")
     thin: int = param(3, "ours (002: 'a thinned set of parts')")
     pair_angle_deg: float = param(10.0, "ours")
     pair_dist_m: float = param(0.4, "ours")
-    lm_iters: int = param(8, "ours")
+    lm_iters: int = param(6, "ours")
     sigma_normal: float = param(0.02, "ours: scale of the normal residuals")
     sigma_offset_m: float = param(0.03, "ours: scale of the offset residuals")
     lm_prior: bool = param(True, "ours: a weak prior at the prediction in the LM (False: 002's bare system)")
@@ -248,15 +249,17 @@ class PlaneSLAM:
         tot, cnt = np.zeros(P), np.zeros(P)
         for f, pl in enumerate(planes):
             sel = slice(None, None, self.params.thin)
-            c_b = pl.cell_centres()[sel]                                      # (C, 3) body
+            uv = ((pl.ij[sel] + 0.5) * pl.cell_m).T                           # (2, C) frame-plane coordinates
             I_b = pl.mean_intensity[sel]
             for m in np.unique(pairs[:, f]):
                 if m < 0:
                     continue
                 who = np.flatnonzero(pairs[:, f] == m)
-                Xw = self.X[who]
-                c_m = np.einsum("pij,cj->pci", Xw[:, :3, :3], c_b) + Xw[:, None, :3, 3]
-                I_m = lookup_mean_intensity(self.map.planes[m], c_m)          # (p, C)
+                mp = self.map.planes[m]
+                # frame plane -> body -> map (particle) -> map plane: one affine map of the cell centres
+                A = se3_inverse(mp.T) @ self.X[who] @ pl.T                    # (p, 4, 4)
+                local = np.swapaxes(A[:, :2, :2] @ uv + A[:, :2, 3:], 1, 2)   # (p, C, 2)
+                I_m = lookup_local(mp, local)                                  # (p, C)
                 d = np.abs(I_b[None] - I_m)
                 ok = np.isfinite(d)
                 tot[who] += np.where(ok, d, 0.0).sum(axis=1)

@@ -50,7 +50,8 @@ def planes_to_map(n_b, p_b, R, t):
 
 def plane_pair_residuals(R, t, n_m, p_m, n_b, p_b, mask=None) -> np.ndarray:
     """Residuals ``(P, F, 4)`` of the plane pairs at poses ``R (P, 3, 3)``, ``t (P, 3)`` (zero where masked)."""
-    nb_pred, pb_pred = planes_to_body(n_m, p_m, R[:, None], t[:, None])
+    nb_pred = n_m @ R                                          # rows: (R^T n)^T = n^T R
+    pb_pred = p_m - (n_m @ t[..., None])[..., 0]
     r = np.concatenate([nb_pred - n_b, (pb_pred - p_b)[..., None]], axis=-1)
     return r if mask is None else r * mask[..., None]
 
@@ -65,7 +66,7 @@ def _skew(a):
 
 def plane_pair_jacobian(R, n_m, mask=None) -> np.ndarray:
     """Jacobian ``(P, F, 4, 6)`` of the residuals w.r.t. ``(δ, t)`` with ``R ← R Exp(δ)`` (ours)."""
-    a = np.einsum("pji,pfj->pfi", R, n_m)
+    a = n_m @ R                                                # (P, F, 3): a_f = R^T n_f
     J = np.zeros((*a.shape[:2], 4, 6))
     J[..., :3, :3] = _skew(a)
     J[..., 3, 3:] = -n_m
@@ -123,10 +124,10 @@ def lm_pose(R0, t0, n_m, p_m, n_b, p_b, mask=None, *, sigma_n: float = 1.0, sigm
 
     def cost_of(R_, t_):
         r_ = plane_pair_residuals(R_, t_, n_m, p_m, n_b, p_b, m) * scale
-        c = 0.5 * np.einsum("pfk,pfk->p", r_, r_)
+        c = 0.5 * np.sum(r_.reshape(P, -1) ** 2, axis=1)
         if prior is not None:
             e = np.c_[Rotation.from_matrix(np.swapaxes(R0c, 1, 2) @ R_).as_rotvec(), t_ - t0c] * prior
-            c = c + 0.5 * np.einsum("pk,pk->p", e, e)
+            c = c + 0.5 * np.sum(e**2, axis=1)
             return r_, c, e
         return r_, c, None
 
@@ -138,9 +139,10 @@ def lm_pose(R0, t0, n_m, p_m, n_b, p_b, mask=None, *, sigma_n: float = 1.0, sigm
         if done.all():
             it -= 1
             break
-        J = plane_pair_jacobian(R, n_m, m) * scale[:, None]
-        H = np.einsum("pfki,pfkj->pij", J, J)
-        g = np.einsum("pfki,pfk->pi", J, r)
+        J = (plane_pair_jacobian(R, n_m, m) * scale[:, None]).reshape(P, 4 * F, 6)
+        Jt = np.swapaxes(J, 1, 2)
+        H = Jt @ J
+        g = (Jt @ r.reshape(P, 4 * F, 1))[..., 0]
         if prior is not None:
             H = H + np.diag(prior**2)
             g = g + prior * e
