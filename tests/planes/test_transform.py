@@ -119,3 +119,23 @@ def test_lm_bad_shapes():
     with pytest.raises(ValueError, match="mask"):
         lm_pose(np.eye(3)[None], np.zeros((1, 3)), np.ones((1, 1, 3)), [[1.0]], [[1.0, 0, 0]], [1.0],
                 mask=np.ones((2, 1)))
+
+
+def test_one_lm_step_is_the_damped_gauss_newton_step():
+    """One iteration equals -(J^T J + lambda I)^-1 J^T r with J by central differences (to 1e-9)."""
+    n_m, p_m = _map_planes(3)
+    n_b, p_b = planes_to_body(n_m, p_m, R_TRUE, T_TRUE)
+    R0 = R_TRUE @ Rotation.from_rotvec([0.02, -0.01, 0.03]).as_matrix()
+    t0 = T_TRUE + np.array([0.1, -0.05, 0.02])
+
+    def f(x):
+        R = R0 @ Rotation.from_rotvec(x[:3]).as_matrix()
+        return plane_pair_residuals(R[None], (t0 + x[3:])[None], n_m[None], p_m[None], n_b[None], p_b[None]).ravel()
+
+    eps = 1e-6
+    J = np.stack([(f(e * eps) - f(-e * eps)) / (2 * eps) for e in np.eye(6)], axis=1)
+    lam = 0.5
+    step = -np.linalg.solve(J.T @ J + lam * np.eye(6), J.T @ f(np.zeros(6)))
+    res = lm_pose(R0[None], t0[None], n_m[None], p_m[None], n_b, p_b, lambda0=lam, max_iters=1)
+    np.testing.assert_allclose(res.R[0], R0 @ Rotation.from_rotvec(step[:3]).as_matrix(), atol=1e-9)
+    np.testing.assert_allclose(res.t[0], t0 + step[3:], atol=1e-9)
