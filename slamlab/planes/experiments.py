@@ -168,7 +168,9 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
     tr_odo = Trajectory.from_poses(odo, ts)
     return FlightResult(ts, true, est, odo, _euler_errors(est, true), _euler_errors(odo, true),
                         ate(tr_true, tr_est, align="none").rmse, ate(tr_true, tr_odo, align="none").rmse,
-                        ate(tr_true, tr_est).rmse, ate(tr_true, tr_odo).rmse,
+                        # an SE(3) alignment needs three poses (Umeyama): NaN for shorter flights
+                        ate(tr_true, tr_est).rmse if n_frames >= 3 else float("nan"),
+                        ate(tr_true, tr_odo).rmse if n_frames >= 3 else float("nan"),
                         rpe(tr_true, tr_est).rmse, rpe(tr_true, tr_est, relation="rotation_deg").rmse,
                         n_frames, slam.n_kept_prediction, float(np.mean(nplanes)), slam.map, p, np.array(stage))
 
