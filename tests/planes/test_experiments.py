@@ -56,3 +56,11 @@ def test_bad_arguments():
         run_flight(flight="x")
     with pytest.raises(ValueError, match="n_particles"):
         run_pairs_figure(1)
+
+
+@pytest.mark.slow
+def test_a_20_s_flight_beats_the_odometry():
+    r = run_flight(20.0, rng=3)
+    assert r.n_kept_prediction == 0
+    assert r.ate_m < 0.3 * r.ate_odo_m           # the odometry drifts; the planes hold the pose
+    assert np.abs(r.errors[:, 5]).max() < 3.0    # yaw within 3 degrees all the way
