@@ -7,6 +7,7 @@ description 0.020, motion 0.003, equations 0.037, weights 0.050, pose 0.011, tot
 
     python benchmarks/bench_planes.py                 # a 30 s flight (30 cycles)
     python benchmarks/bench_planes.py --duration 120  # the full flight
+    python benchmarks/bench_planes.py --monte-carlo 10  # + 002 Fig. 4 over 10 seeds x 3 offsets (slamlab.sweep)
 
 One core: BLAS and OpenMP pools are limited to one thread before numpy is imported. Stage times are
 wall-clock means over the cycles after the first (the first only founds the map); the CPU time of a whole
@@ -29,7 +30,14 @@ import time
 import numpy as np
 
 from slamlab.planes import PlaneSLAM, PlaneSLAMParams, extract_planes
-from slamlab.planes.experiments import SOURCE_TIMES_S, STAGES, flight_frames, run_flight, timing_table
+from slamlab.planes.experiments import (
+    SOURCE_TIMES_S,
+    STAGES,
+    flight_frames,
+    run_flight,
+    run_intensity_study,
+    timing_table,
+)
 from slamlab.sim import simulate_flight
 
 
@@ -102,6 +110,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--duration", type=float, default=30.0, help="flight length in seconds (one cycle per second)")
     ap.add_argument("--seed", type=int, default=7)
+    ap.add_argument("--monte-carlo", type=int, default=0, metavar="N", help="Fig. 4 over N seeds per offset")
+    ap.add_argument("--jobs", type=int, default=1, help="workers of the Monte Carlo (slamlab.sweep)")
     args = ap.parse_args()
     print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
           f"numpy {np.__version__}; one thread; load average before: {load()}")
@@ -116,6 +126,11 @@ def main() -> None:
     print()
     print(res.table())
     bench_ransac(args.seed)
+    if args.monte_carlo:
+        study = run_intensity_study(args.monte_carlo, seed=args.seed, n_jobs=args.jobs, progress=False)
+        print()
+        print(study)
+        print(study.table())
     print(f"\nload average after: {load()}")
 
 

@@ -17,6 +17,7 @@ from .experiments import (
     ours_vs_source,
     run_flight,
     run_intensity_figure,
+    run_intensity_study,
     run_pairs_figure,
     timing_table,
 )
@@ -92,6 +93,7 @@ __all__ = [
     "predict_particles",
     "run_flight",
     "run_intensity_figure",
+    "run_intensity_study",
     "run_pairs_figure",
     "systematic_resample",
     "timing_table",

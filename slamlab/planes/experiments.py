@@ -32,6 +32,7 @@ __all__ = [
     "ours_vs_source",
     "run_flight",
     "run_intensity_figure",
+    "run_intensity_study",
     "run_pairs_figure",
     "timing_table",
 ]
@@ -295,6 +296,49 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, sigma
     spread = solved.std(axis=0)
     return IntensityResult(pred, solved, w, res, flights[1].poses[-1][:3, 3], float(err_on), float(out[False][1]),
                            spread, frames[1], slam_on.map)
+
+
+def _fig4_trial(offset_m: float, rng, n_particles: int = 400) -> dict:
+    """One Fig. 4 run with a seed drawn from ``rng``: the along-corridor errors with and without the weights."""
+    r = run_intensity_figure(offset_m, n_particles=n_particles, rng=int(rng.integers(2**31)))
+    return {"error_with_m": r.error_with_m, "error_without_m": r.error_without_m}
+
+
+@dataclass(frozen=True)
+class IntensityStudy:
+    """Fig. 4 over seeds and offsets (ours: 002 shows one cycle): one row per run in ``runs`` (a DataFrame)."""
+
+    runs: object = field(repr=False)
+
+    def __str__(self) -> str:
+        r = self.runs
+        return (f"Fig. 4 study: {len(r)} runs, median error {r.error_with_m.median():.3f} m with the intensity "
+                f"weights, {r.error_without_m.median():.3f} m without")
+
+    def table(self) -> str:
+        rows = []
+        for off, g in self.runs.groupby("offset_m"):
+            rows.append([f"{off:.2f}", str(len(g)), f"{g.error_with_m.median():.3f}",
+                         f"{g.error_with_m.quantile(0.9):.3f}", f"{g.error_without_m.median():.3f}",
+                         f"{(g.error_with_m < 0.5 * g.error_without_m).mean():.0%}"])
+        return format_table(["offset [m]", "runs", "median err, weights [m]", "90 % err, weights [m]",
+                             "median err, no weights [m]", "weights halve the error"], rows,
+                            title="002 Fig. 4 over seeds (ours)")
+
+
+def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_particles: int = 400, seed: int = 0,
+                        n_jobs: int = 1, progress: bool | None = None) -> IntensityStudy:
+    """Fig. 4 (:func:`run_intensity_figure`) repeated over ``n_seeds`` seeds for each offset, by
+    :func:`slamlab.sweep.sweep` (ours: how reliably the intensities resolve the corridor)."""
+    from ..sweep import sweep
+
+    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
+    table = sweep(_fig4_trial, {"offset_m": [float(o) for o in offsets_m]}, seeds=n_seeds, seed=seed, n_jobs=n_jobs,
+                  fixed={"n_particles": n_particles}, progress=progress, desc="Fig. 4 study")
+    bad = table["error"].notna() if "error" in table else None
+    if bad is not None and bad.any():
+        raise RuntimeError(f"{int(bad.sum())} Fig. 4 runs failed: {table.loc[bad, 'error'].iloc[0]}")
+    return IntensityStudy(table)
 
 
 def ours_vs_source(flight: FlightResult, pairs: PairsResult, fig4: IntensityResult) -> str:

@@ -64,3 +64,14 @@ def test_a_20_s_flight_beats_the_odometry():
     assert r.n_kept_prediction == 0
     assert r.ate_m < 0.3 * r.ate_odo_m           # the odometry drifts; the planes hold the pose
     assert np.abs(r.errors[:, 5]).max() < 3.0    # yaw within 3 degrees all the way
+
+
+def test_intensity_study_runs_through_sweep():
+    from slamlab.planes.experiments import run_intensity_study
+
+    s = run_intensity_study(2, (0.4,), n_particles=60, seed=1, progress=False)
+    assert len(s.runs) == 2
+    assert (s.runs.error_without_m > 0.3).all()
+    assert "0.40" in s.table()
+    with pytest.raises(ValueError, match="n_seeds"):
+        run_intensity_study(0)
