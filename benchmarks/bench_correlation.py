@@ -71,7 +71,7 @@ def peak_ours(Mv, T, o, dtype, chunk=8, workers=None, quarter_trick=True, stamps
                 best = (val, (s + k, r, c))
         return best
     tol = 1e-9 * 4e4 if np.dtype(dtype) == np.float64 else 0.5
-    val, idx, _m, _b = _peak_search(Mv, stamps, headings, T.shape[1], o, dtype=dtype, workers=workers, chunk=chunk,
+    val, idx, _m, _b, _a = _peak_search(Mv, stamps, headings, T.shape[1], o, dtype=dtype, workers=workers, chunk=chunk,
                                     tol=tol)
     return val, idx
 

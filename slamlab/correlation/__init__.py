@@ -8,6 +8,7 @@ from .algorithm import (
     heading_candidates,
     heading_error,
     localise,
+    localise_joined,
     rasterise_scan,
     score_maps,
 )
@@ -58,6 +59,7 @@ __all__ = [
     "heading_candidates",
     "heading_error",
     "localise",
+    "localise_joined",
     "log_grid",
     "ours_vs_source",
     "random_clutter",
