@@ -197,7 +197,7 @@ class SimSlamResult:
 def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: bool = False,
                  n_beams: int = 360, max_range_cells: float = 100.0, odometry_noise: float = 1.0,
                  with_icp: bool = True, start: str = "truth", params: HoughSlamParams | None = None,
-                 rng=2010, **overrides) -> SimSlamResult:
+                 rng=2010, progress: bool | None = None, **overrides) -> SimSlamResult:
     """004's experiment: Hough SLAM along the 121-pose path on the test room (004 Fig. 9-11).
 
     Δθ = 1°, Δrho = 1 cell, ranges quantised to 0.1 cell (004). Our choices (004 gives none):
@@ -216,6 +216,8 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
         Where the SLAM starts: the true first pose, or the pose that correlation localisation
         (:func:`slamlab.correlation.localise`, Δα = 1°, on the mapped room) finds from the first
         scan — 004's whole system (Fig. 2). The ICP baseline and odometry start from the truth.
+    progress : bool, optional
+        A bar over the scans of the SLAM run (None: on unless ``$SLAMLAB_PROGRESS=0``).
     params, **overrides
         :class:`HoughSlamParams` and fields to change.
     """
@@ -246,7 +248,7 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
         start_pose = localise(room, scans[0]).pose  # LocaliseParams defaults: Δα = 1° (004 §7)
         timing["correlation"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    res = hough_slam(scans, start_pose, odo.increments, params, **overrides)
+    res = hough_slam(scans, start_pose, odo.increments, params, progress=progress, **overrides)
     timing["hough_slam"] = time.perf_counter() - t0
     icp_poses = None
     if with_icp:
@@ -352,7 +354,8 @@ def _load_log(path, fmt):
 
 
 def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = None, step: int = 1,
-                 cell_m: float = 0.05, params: HoughSlamParams | None = None, **overrides) -> RealLogResult:
+                 cell_m: float = 0.05, params: HoughSlamParams | None = None, progress: bool | None = None,
+                 **overrides) -> RealLogResult:
     """Hough SLAM on a real laser log with raw odometry (a URG-04LX log of the Mines format or a CARMEN log).
 
     Parameters
@@ -372,6 +375,8 @@ def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = Non
     params, **overrides
         Defaults are our per-format settings :data:`LOG_PARAMS` (Δrho = 2 cm, H_min = 15,
         a = 0.15 m, …) with ``r_max`` = the log's range limit.
+    progress : bool, optional
+        A bar over the scans (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     if path is None:
         from ..data import find_data
@@ -394,7 +399,7 @@ def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = Non
     U = se2_relative(odo[:-1], odo[1:])
     base = HoughSlamParams(**LOG_PARAMS[fmt], r_max=float(max_range_m)) if params is None else params
     t0 = time.perf_counter()
-    res = hough_slam(scans, odo[0], U, base, **overrides)
+    res = hough_slam(scans, odo[0], U, base, progress=progress, **overrides)
     timing["hough_slam"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     pts = np.concatenate([odo[:, :2], res.poses[:, :2]])
