@@ -13,7 +13,12 @@ API summary
   ``scipy.signal.fftconvolve`` (``"fftconvolve"``) or by the definition (``"direct"``).
 - :func:`localise` ``(grid, scan, *, params=None, **overrides) -> Localisation``: the
   maximum of the 3-D stack → heading and position, streamed over heading chunks
-  (bounded memory); its settings are one :class:`LocaliseParams`.
+  (bounded memory); its settings are one :class:`LocaliseParams`. With ``ambiguity`` (default) it also
+  finds the best *rival* pose more than ``rival_radius_cells`` or ``rival_heading_rad`` away
+  (:attr:`Localisation.ambiguity`, ours).
+- :func:`localise_joined` ``(grid, scans, odom_poses, ...) -> Localisation``: two or three
+  consecutive scans placed by odometry into one T_n per heading (ours; breaks corridor and
+  half-turn ties).
 
 Scans are :class:`slamlab.scans.Scan` objects in cell units (``scan.to_cells(cell_m)``
 for a metric scan).

@@ -123,6 +123,7 @@ def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 
     from ..sweep import sweep
 
     beams = [_scan_beams(s) for s in scans]
+    settings = tuple(q.replace(ambiguity=False) for q in settings)  # these runs report no ambiguity: no rival search
     Mvs = tuple(grid_to_values(M, q.a_c, q.a_p, q.a_n) for q in settings)
     headings = heading_candidates(settings[0].delta_alpha_rad)
     points = [{"choice": j, "pose_index": i, "beams": b} for j in range(len(settings)) for i, b in enumerate(beams)]
