@@ -10,15 +10,6 @@ from slamlab.geometry import wrap_angle
 EXACT = {"dtype": "float64", "delta_alpha_rad": np.radians(10.0)}
 
 
-def _corridor() -> np.ndarray:
-    """A straight corridor (rows 20..30 free, walls at rows 19 and 31) open at the map's left edge, with a dead
-    end at column 150: symmetric under a half turn wherever a 25-cell scan sees neither end."""
-    g = np.full((52, 160), S.UNEXPLORED, dtype=np.int8)
-    g[19:32, :151] = S.OBSTACLE
-    g[20:31, :150] = S.FREE
-    return g
-
-
 def _corner() -> np.ndarray:
     """One corner: two walls meeting at (10, 10), free space inside the quadrant, the rest unexplored."""
     g = np.full((60, 60), S.UNEXPLORED, dtype=np.int8)
@@ -42,7 +33,7 @@ def _rival_by_definition(grid, scan, loc, params):
 
 
 def test_corridor_reads_as_ambiguous():
-    g = _corridor()
+    g = C.corridor_grid()
     scan = S.Rangefinder(n_beams=360, max_range_cells=25.0, quantum_cells=0.0).scan(g, [100.0, 25.0, np.pi])
     p = C.LocaliseParams(**EXACT)
     loc = C.localise(g, scan, params=p)
@@ -92,7 +83,7 @@ def test_rival_window_parameters_and_switch():
 
 
 def test_two_scans_joined_by_odometry_break_the_half_turn_tie():
-    g = _corridor()
+    g = C.corridor_grid()
     rf = S.Rangefinder(n_beams=360, max_range_cells=25.0, quantum_cells=0.0)
     # moving towards -x: the scan at (100, 25) sees a plain corridor, the one 30 cells before sees the dead end
     poses = np.array([[100.0, 25.0, np.pi], [130.0, 25.0, np.pi]])
@@ -128,3 +119,17 @@ def test_joined_bad_input():
         C.LocaliseParams(rival_heading_rad=4.0)
     with pytest.raises(TypeError, match="`ambiguity` must be a bool"):
         C.LocaliseParams(ambiguity=1)
+
+
+def test_corridor_tie_run_reports_both_modes():
+    r = C.run_corridor_tie()
+    assert np.degrees(C.heading_error(r.single.pose[2], r.true_pose[2])) == pytest.approx(180.0)
+    assert r.single.ambiguity == pytest.approx(1.0, abs=1e-12)
+    assert (r.joined.col, r.joined.row) == (100, 25)
+    assert r.joined.n_scans == 2
+    t = r.table()
+    assert "2 scans + odometry" in t
+    assert "1.000" in t
+    assert str(r).startswith("corridor: one scan 180° off")
+    with pytest.raises(ValueError, match="`step_cells` must be"):
+        C.run_corridor_tie(step_cells=-1.0)
