@@ -319,7 +319,8 @@ def run_noise_study(range_std_cells=(0.0, 0.1, 0.3, 0.5), n_runs: int = 4, *, n_
     n_poses = v.check_int(n_poses, "n_poses", minimum=5)
     bad = v.check_positive(bad_pos_cells, "bad_pos_cells")
     table = sweep(_noise_run, {"range_std_cells": sigmas}, seeds=n_runs, seed=root_seed_sequence(rng, "rng"),
-                  n_jobs=n_jobs, progress=progress, fixed={"n_poses": n_poses, "clutter": bool(clutter)})
+                  n_jobs=n_jobs, progress=progress, fixed={"n_poses": n_poses, "clutter": bool(clutter)},
+                  desc="Hough SLAM noise study")
     failed = table["error"].notna()
     if failed.any():
         raise RuntimeError(f"{int(failed.sum())} noise-study run(s) failed; first: {table['error'][failed].iloc[0]}")
