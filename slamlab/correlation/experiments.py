@@ -660,7 +660,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                        "rel": np.array(rel)})
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes}
-    table = sweep(_localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed)
+    table = sweep(_localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed,
+                  desc="localise log scans")
     failed = table["error"].notna()
     if failed.any():
         raise RuntimeError(f"{int(failed.sum())} localisation(s) failed; first: {table['error'][failed].iloc[0]}")

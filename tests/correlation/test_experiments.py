@@ -207,5 +207,5 @@ def test_log_localisation_progress_bar_only_when_asked(shared_data, capsys):
     quiet = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0))  # SLAMLAB_PROGRESS=0 in tests
     assert capsys.readouterr().err == ""
     shown = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0), progress=True)
-    assert "_localise_log_scan" in capsys.readouterr().err
+    assert "localise log scans" in capsys.readouterr().err
     np.testing.assert_array_equal(quiet.est_poses_m, shown.est_poses_m)
