@@ -295,7 +295,8 @@ def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int):
     else:
         r = run_filter(run, n_particles=size, sigma_hit=2.0, rng=rng)
         mem = size * 4 * 8  # particles (x, y, θ) and weights, float64
-    return {"success": bool(r.ok[-1]), "final_err_cells": float(r.err_pos[-1]),
+    return {"start_x": float(run.true_poses[0, 0]), "start_y": float(run.true_poses[0, 1]),
+            "success": bool(r.ok[-1]), "final_err_cells": float(r.err_pos[-1]),
             "final_err_deg": float(np.degrees(r.err_heading_rad[-1])), "memory_bytes": int(mem),
             "time_per_step_s": r.time_s / run.n_steps}
 
@@ -341,9 +342,9 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
     pts = [{"method": "markov", "size": int(s), "n_headings": int(h)} for s, h in markov]
     pts += [{"method": "mcl", "size": int(n), "n_headings": 0} for n in particle_counts]
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    root = np.random.SeedSequence(seed)
-    # one stream per run index, shared by all methods: run the sweep per method with the same seed
-    frames = [sweep(_compare_task, [p], seeds=n_runs, seed=root, n_jobs=n_jobs, progress=progress,
+    # one stream per run index, shared by all methods: one sweep per method from the same int seed (a
+    # SeedSequence object would not do: its spawn() is stateful, each sweep would get the next children)
+    frames = [sweep(_compare_task, [p], seeds=n_runs, seed=seed, n_jobs=n_jobs, progress=progress,
                     fixed={"n_steps": n_steps}) for p in pts]
     import pandas as pd
 

@@ -208,3 +208,15 @@ def test_markov_predict_conserves_mass_and_moves_the_mode():
     out = L.markov_predict(b, [0, 0, 0], [4, 0, 0], resolution=1, alpha=(0.01, 0.001, 0.01, 0.001), min_blur=0.5)
     assert out.sum() == pytest.approx(1.0)
     assert np.unravel_index(np.argmax(out), out.shape) == (2, 14, 10)
+
+
+def test_markov_vs_mcl_methods_share_the_runs():
+    from slamlab.localisation.experiments import run_markov_vs_mcl
+
+    res = run_markov_vs_mcl(markov=((8, 12),), particle_counts=(50, 60), n_runs=3, n_steps=3, seed=4)
+    df = res.table_df
+    starts = {m: g[["start_x", "start_y"]].to_numpy() for m, g in df.groupby(["method", "size"], sort=False)}
+    first = next(iter(starts.values()))
+    assert len(starts) == 3
+    assert len({tuple(map(tuple, v)) for v in starts.values()}) == 1  # every method ran the same 3 runs
+    assert len({tuple(r) for r in first}) > 1  # and the runs differ from each other
