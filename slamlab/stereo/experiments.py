@@ -333,28 +333,49 @@ class DriftStudy:
         return format_table(head, rows, title=f"calibration drift of the right camera: {self.experiment} ({self.runs[0].detector})")
 
 
+_RUNNERS = {"turn in place": "run_turn_in_place", "closed loop": "run_closed_loop"}
+
+
+def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, params: StereoParams,
+                render: RenderParams, seed) -> dict:
+    """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``seed``)."""
+    runner = globals()[_RUNNERS[experiment]]
+    return {"run": runner(size, n_frames=n_frames, params=params, render=render.replace(drift_std_rad=drift_std_rad),
+                          rng=seed)}
+
+
 def run_drift_study(
     drift_std_rad=(0.0, 0.5e-3, 1e-3, 2e-3), experiment: str = "turn in place", size: str = "small", *,
     n_frames: int | None = None, params: StereoParams | None = None, render: RenderParams | None = None, rng=0,
-    **overrides,
+    n_jobs: int = 1, progress: bool | None = None, **overrides,
 ) -> DriftStudy:
-    """The same run at several calibration-drift levels (our experiment for 000 §3.2).
+    """The same run at several calibration-drift levels (our experiment for 000 §3.2), on :func:`slamlab.sweep.sweep`.
 
     The right camera's orientation takes a random-walk step of ``drift_std_rad`` per axis and
     frame while the pipeline keeps the nominal calibration; ``params`` + ``overrides`` set the
     pipeline (``detector``, ``policy``, ...), ``render`` the rest of the renderer. Every level uses
-    the same seeds, so the level is the only change.
+    the same seed ``rng`` (common random numbers: the level is the only change), so each task is
+    deterministic and the sweep gives it no stream of its own (``rng_arg=None``); the study is
+    the same for any ``n_jobs``. ``progress``: a bar over the levels (default: on unless
+    ``$SLAMLAB_PROGRESS=0``).
     """
-    runners = {"turn in place": run_turn_in_place, "closed loop": run_closed_loop}
-    v.check_choice(experiment, "experiment", runners)
+    from ..sweep import sweep
+
+    v.check_choice(experiment, "experiment", _RUNNERS)
+    v.check_choice(size, "size", SIZES)
     levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
     if min(levels) < 0:
         raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
+    seed = v.check_int(rng, "rng", minimum=0)
     p = StereoParams.resolve(params, **overrides)
     render = RenderParams.resolve(render)
-    runs = tuple(runners[experiment](size, n_frames=n_frames, params=p, render=render.replace(drift_std_rad=d), rng=rng)
-                 for d in levels)
-    return DriftStudy(experiment, levels, runs)
+    table = sweep(drift_level, {"drift_std_rad": levels}, rng_arg=None, n_jobs=n_jobs, progress=progress,
+                  fixed={"experiment": experiment, "size": size, "n_frames": n_frames, "params": p, "render": render,
+                         "seed": seed})
+    failed = table["error"].notna()
+    if failed.any():
+        raise RuntimeError(f"{int(failed.sum())} drift level(s) failed; first: {table['error'][failed].iloc[0]}")
+    return DriftStudy(experiment, levels, tuple(table["run"]))
 
 
 def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0) -> Workload:

@@ -162,6 +162,25 @@ def test_calibration_drift_costs_stereo_matches():
         run_drift_study((-1e-3,), n_frames=2)
     with pytest.raises(ValueError, match="experiment"):
         run_drift_study((0.0,), experiment="spiral")
+    with pytest.raises(ValueError, match="size"):
+        run_drift_study((0.0,), size="huge")
+
+
+def test_drift_study_on_sweep_equals_the_sequential_loop_for_one_and_two_workers():
+    from slamlab.stereo import RenderParams, run_drift_study, run_turn_in_place
+
+    levels = (0.0, 2e-3)
+    # the study as it was: one run per level, in order, every level with the same seed
+    ref = [run_turn_in_place(n_frames=3, detector="orb", render=RenderParams(drift_std_rad=d), rng=5) for d in levels]
+    one = run_drift_study(levels, n_frames=3, detector="orb", rng=5, n_jobs=1, progress=False)
+    two = run_drift_study(levels, n_frames=3, detector="orb", rng=5, n_jobs=2, progress=False)
+    for study in (one, two):
+        assert study.drift_std_rad == levels
+        for r, s in zip(ref, study.runs, strict=True):
+            np.testing.assert_array_equal(s.estimate, r.estimate)
+            for k in r.counts:
+                np.testing.assert_array_equal(s.counts[k], r.counts[k])
+    assert one.table() == two.table()
 
 
 def test_update_gate_keeps_inconsistent_observations_from_throwing_landmarks():
