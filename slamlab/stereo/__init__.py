@@ -34,10 +34,12 @@ from .stages import (
     StereoMatches,
     detect_features,
     estimate_pose,
+    is_rectified,
     match_to_map,
     pose_std,
     select_oldest,
     stereo_match,
+    subpixel_disparity,
     triangulate_local,
 )
 
@@ -70,6 +72,7 @@ __all__ = [
     "detect_features",
     "estimate_pose",
     "experiment_poses",
+    "is_rectified",
     "match_to_map",
     "ours_vs_source",
     "pose_std",
@@ -83,6 +86,7 @@ __all__ = [
     "run_turn_in_place",
     "select_oldest",
     "stereo_match",
+    "subpixel_disparity",
     "triangulate_local",
 ]
 __all__ += list(_LAZY)

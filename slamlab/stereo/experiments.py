@@ -347,7 +347,7 @@ def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, p
     """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``seed``)."""
     runner = globals()[_RUNNERS[experiment]]
     return {"run": runner(size, n_frames=n_frames, params=params, render=render.replace(drift_std_rad=drift_std_rad),
-                          rng=seed)}
+                          progress=False, rng=seed)}
 
 
 def run_drift_study(
@@ -376,6 +376,7 @@ def run_drift_study(
     p = StereoParams.resolve(params, **overrides)
     render = RenderParams.resolve(render)
     table = sweep(drift_level, {"drift_std_rad": levels}, rng_arg=None, n_jobs=n_jobs, progress=progress,
+                  desc=f"calibration drift study ({experiment})",
                   fixed={"experiment": experiment, "size": size, "n_frames": n_frames, "params": p, "render": render,
                          "seed": seed})
     failed = table["error"].notna()
@@ -423,6 +424,17 @@ class KittiRunResult:
         return (f"{self.name}, {len(self.truth)} frames: ATE {self.ate_m:.2f} m (after SE(3) alignment "
                 f"{self.ate_se3_m:.2f} m), final error {self.final_error_m:.2f} m over {self.path_length_m:.1f} m")
 
+    @property
+    def length_ratio(self) -> float:
+        """Length of the estimated path over the true path length (1: no scale error)."""
+        return float(np.sum(np.linalg.norm(np.diff(self.estimate[:, :3, 3], axis=0), axis=1)) / self.path_length_m)
+
+    @property
+    def end_distance_ratio(self) -> float:
+        """Distance of the last estimated position from the start over the true one (1: no scale error)."""
+        return float(np.linalg.norm(self.estimate[-1, :3, 3] - self.estimate[0, :3, 3])
+                     / np.linalg.norm(self.truth[-1, :3, 3] - self.truth[0, :3, 3]))
+
     def table(self) -> str:
         rows = [
             ["frames (degenerate)", f"{len(self.truth)} ({self.n_degenerate})"],
@@ -431,6 +443,8 @@ class KittiRunResult:
             ["RPE RMSE over 1 frame, m", f"{self.rpe_m:.2f}"],
             ["final position error, m", f"{self.final_error_m:.2f}"],
             ["final error / path length, %", f"{100 * self.final_error_m / self.path_length_m:.1f}"],
+            ["path length, estimate / truth", f"{self.length_ratio:.3f}"],
+            ["start-to-end distance, estimate / truth", f"{self.end_distance_ratio:.3f}"],
             ["RANSAC inliers per frame (median)", f"{self.inliers_median:.0f}"],
         ]
         return format_table(["quantity", "ours"], rows,
