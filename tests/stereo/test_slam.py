@@ -9,7 +9,7 @@ from slamlab.kdtree.stores import MultiKDTree, NonBaseBuffer
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
 from slamlab.stereo import STAGES, StereoParams, StereoSLAM
-from slamlab.stereo.experiments import StereoRunResult, run_stereo_slam
+from slamlab.stereo.experiments import StereoRunResult, run_stereo_slam, run_stereo_slam_variants
 
 
 @pytest.fixture(scope="module")
@@ -314,3 +314,18 @@ def test_every_param_is_checked(name):
         StereoParams(**{name: bad})
     assert dataclasses.fields(StereoParams)  # frozen dataclass fields, each with a source
     assert StereoParams.sources()[name].startswith(("000 §", "ours"))
+
+
+def test_duplicate_check_keeps_re_sighted_points_out_of_the_map():
+    # a landmark whose sighting failed the ratio rule (two similar descriptors) is re-added unless the
+    # duplicate check sees that its nearest landmark by descriptor already sits where the point is
+    poses = turn_in_place(np.deg2rad(5.0))[:5]
+    runs = run_stereo_slam_variants(poses, {"off": {"detector": "orb"}, "on": {"detector": "orb", "duplicate_gap_m": 0.1}},
+                                    arena=StereoArena(seed=0), rng=0, progress=False)
+    off, on = runs["off"].counts, runs["on"].counts
+    assert off["n_duplicates"].sum() == 0
+    assert on["n_duplicates"][1:].min() > 0
+    # every point the check holds back is one landmark fewer
+    np.testing.assert_array_equal(on["n_new"][:2] + on["n_duplicates"][:2], off["n_new"][:2])
+    assert on["n_new"][1:].sum() < off["n_new"][1:].sum()
+    assert runs["on"].pos_err_m.max() < 0.1
