@@ -33,7 +33,9 @@ __all__ = [
     "KittiRunResult",
     "StereoRunResult",
     "comparison_table",
+    "disparity_errors",
     "experiment_poses",
+    "kitti_comparison",
     "ours_vs_source",
     "record_stereo_stream",
     "run_closed_loop",
@@ -546,3 +548,60 @@ def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None 
                      "— (no ground truth)", (f"{kitti.ate_m:.2f} / {kitti.ate_se3_m:.2f} / {kitti.final_error_m:.2f} "
                                              f"over {kitti.path_length_m:.1f} m")])
     return format_table(["quantity", "000", "ours"], rows, title="Stereo SLAM: 000 beside ours (frame rates: timing tables)")
+
+
+def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, params: StereoParams | None = None,
+                     rng=0, **overrides) -> str:
+    """Stereo disparity errors against the renderer's depth, per ORB pyramid level, before and after
+    :func:`~slamlab.stereo.subpixel_disparity` (our addition to 000 §3.3).
+
+    One rendered pair at ``pose`` in ``arena`` (default the 6×8 m arena): keypoints (``params`` +
+    ``overrides``, default ORB), stereo matches, and for each match the disparity minus the true one
+    ``f b / z`` (``z``: the renderer's depth at the left keypoint's pixel). Returns a table of the
+    median absolute error and the share above 1 px per level.
+    """
+    from .stages import _stereo_match, detect_features, subpixel_disparity
+
+    p = StereoParams.resolve(params, **({"detector": "orb"} | overrides))
+    arena = StereoArena(seed=0) if arena is None else arena
+    sim = StereoSim(arena, rng=rng)
+    pose = v.as_vector(pose, "pose", 3)
+    left, right = sim.render_pair(pose)
+    fl, fr = detect_features(left, params=p), detect_features(right, params=p)
+    sm = _stereo_match(fl, fr, sim.rig.F, p.ratio, p.epi_tol_px)
+    _, depth, _ = arena.cast(sim.rig.left, se3_from_planar(*pose) @ sim.T_body_left)
+    fb = sim.rig.left.fx * sim.rig.baseline_m
+
+    def errors(uvl, uvr):
+        c, r = np.rint(uvl).astype(int).T
+        return (uvl[:, 0] - uvr[:, 0]) - fb / depth[r, c]
+
+    uvl, uvr = fl.uv[sm.left], fr.uv[sm.right]
+    raw = errors(uvl, uvr)
+    ref_l, ref_r, ok = subpixel_disparity(left, right, uvl, uvr, half_px=p.subpixel_half_px, search_px=p.subpixel_search_px)
+    ref = np.full(len(raw), np.nan)
+    ref[ok] = errors(ref_l[ok], ref_r[ok])
+    level = fl.octave[sm.left]
+    rows = []
+    for lv in np.unique(level):
+        m = (level == lv) & np.isfinite(raw)
+        mr = m & ok
+        rows.append([f"{lv}", f"{m.sum()}", f"{np.median(np.abs(raw[m])):.2f}", f"{100 * np.mean(np.abs(raw[m]) > 1):.0f}",
+                     f"{np.median(np.abs(ref[mr])):.2f}", f"{100 * np.mean(np.abs(ref[mr]) > 1):.0f}", f"{100 * mr.sum() / max(m.sum(), 1):.0f}"])
+    head = ["level", "matches", "keypoints: median |err|, px", "> 1 px, %", "refined: median |err|, px", "> 1 px, %",
+            "refined, %"]
+    return format_table(head, rows, title=f"disparity error against the renderer ({p.detector.upper()}, one frame)")
+
+
+def kitti_comparison(variants: dict, folder=None, *, n_frames: int | None = None, rng=0) -> str:
+    """:func:`run_kitti` once per setting (label -> overrides of :data:`KITTI_PARAMS`), side by side:
+    ATE, final error and the scale figures (path length and start-to-end distance, estimate / truth)."""
+    if not isinstance(variants, dict) or not variants:
+        raise TypeError("`variants` must be a non-empty dict of label -> dict of overrides")
+    rows = []
+    for label, over in variants.items():
+        k = run_kitti(folder, n_frames=n_frames, rng=rng, progress=False, **over)
+        rows.append([label, f"{k.ate_m:.2f}", f"{k.ate_se3_m:.2f}", f"{k.final_error_m:.2f}", f"{k.length_ratio:.3f}",
+                     f"{k.end_distance_ratio:.3f}"])
+    head = ["setting", "ATE, m", "SE(3)-aligned, m", "final, m", "path length est./true", "start-end est./true"]
+    return format_table(head, rows, title=f"{k.name}, {len(k.truth)} frames (real data)")
