@@ -329,3 +329,28 @@ def test_duplicate_check_keeps_re_sighted_points_out_of_the_map():
     np.testing.assert_array_equal(on["n_new"][:2] + on["n_duplicates"][:2], off["n_new"][:2])
     assert on["n_new"][1:].sum() < off["n_new"][1:].sum()
     assert runs["on"].pos_err_m.max() < 0.1
+
+
+def test_disparity_errors_table_shows_the_refinement_per_level():
+    from slamlab.stereo import disparity_errors
+
+    table = disparity_errors()
+    rows = [line.split() for line in table.splitlines()[3:]]
+    assert len(rows) == 8  # ORB's 8 pyramid levels
+    for level, n, raw_med, raw_far, ref_med, ref_far, refined in rows:
+        assert int(n) > 0
+        assert float(ref_med) < float(raw_med)
+        assert float(ref_med) <= 0.05  # against the renderer's depth (see test_stages)
+        assert int(refined) >= 80
+
+
+@pytest.mark.realdata
+def test_kitti_comparison_prints_one_row_per_setting(shared_data):
+    from slamlab.stereo import kitti_comparison
+
+    table = kitti_comparison({"a": {"detector": "orb"}, "b": {"detector": "orb", "subpixel_stereo": False}},
+                             shared_data / "kitti-odometry-06-stereo", n_frames=3)
+    assert "kitti-odometry-06-stereo, 3 frames" in table
+    assert [line.split()[0] for line in table.splitlines()[3:]] == ["a", "b"]
+    with pytest.raises(TypeError, match="variants"):
+        kitti_comparison({})
