@@ -337,7 +337,7 @@ def test_disparity_errors_table_shows_the_refinement_per_level():
     table = disparity_errors()
     rows = [line.split() for line in table.splitlines()[3:]]
     assert len(rows) == 8  # ORB's 8 pyramid levels
-    for level, n, raw_med, raw_far, ref_med, ref_far, refined in rows:
+    for _level, n, raw_med, _raw_far, ref_med, _ref_far, refined in rows:
         assert int(n) > 0
         assert float(ref_med) < float(raw_med)
         assert float(ref_med) <= 0.05  # against the renderer's depth (see test_stages)
