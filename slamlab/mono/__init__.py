@@ -4,6 +4,7 @@ Uses :mod:`slamlab.features` (FAST), :mod:`slamlab.geometry` and :mod:`slamlab.e
 nothing below imports this package. cv2 loads inside the functions that need it.
 """
 
+from .align import refine_pose, se3_exp, sparse_align
 from .depth_filter import (
     Seeds,
     compute_tau,
@@ -16,6 +17,7 @@ from .depth_filter import (
     seed_points,
     update_seeds,
 )
+from .epipolar import epipolar_segments, search_epipolar
 from .initialise import (
     INIT_STATUSES,
     Initialiser,
@@ -26,23 +28,34 @@ from .initialise import (
     track_lk,
     triangulate_two_view,
 )
+from .params import MonoParams
+from .slam import STAGES, Keyframe, MonoSLAM
 
 __all__ = [
     "INIT_STATUSES",
+    "STAGES",
     "InitResult",
     "Initialiser",
+    "Keyframe",
+    "MonoParams",
+    "MonoSLAM",
     "Seeds",
     "TwoViewPose",
     "compute_tau",
     "converged_linearity",
     "converged_sigma",
     "depth_interval",
+    "epipolar_segments",
     "init_seeds",
     "inlier_ratio",
     "linearity_index",
+    "refine_pose",
     "relative_pose_essential",
     "relative_pose_homography",
+    "se3_exp",
+    "search_epipolar",
     "seed_points",
+    "sparse_align",
     "track_lk",
     "triangulate_two_view",
     "update_seeds",

@@ -138,7 +138,7 @@ def sparse_align(pyr_ref, pyr_cur, K, X_ref, T_init, *, patch_px: int = 4, max_l
     o = np.arange(patch_px) - half
     ou, ov = np.meshgrid(o, o)
     ou, ov = ou.ravel().astype(np.float64), ov.ravel().astype(np.float64)
-    front = X_ref[:, 2] > 1e-6
+    front = np.all(np.isfinite(X_ref), axis=1) & (X_ref[:, 2] > 1e-6)
     X_ref = X_ref[front]
     n_it = 0
     rms = np.inf
@@ -198,11 +198,14 @@ def sparse_align(pyr_ref, pyr_cur, K, X_ref, T_init, *, patch_px: int = 4, max_l
     return AlignResult(T, ok, int(X_ref.shape[0]), float(rms), n_it)
 
 
-def refine_pose(K, X_world, uv, T_cam_world_init, *, huber_px: float = 1.0, max_nfev: int = 50):
+def refine_pose(K, X_world, uv, T_cam_world_init, *, huber_px: float = 1.0, reject_px: float | None = 3.0,
+                max_nfev: int = 50):
     """Motion-only refinement: ``min Σ ρ(|π(T X) − uv|²)`` over the pose (003 §4.4, step 4).
 
     ``scipy.optimize.least_squares`` with a Huber loss of scale ``huber_px``, twist
-    parametrisation ``T = exp(ξ) T_init``. Returns ``(T_cam_world, residual_px (N,), ok)``.
+    parametrisation ``T = exp(ξ) T_init``; then (ours) once more on the points whose error is
+    below ``reject_px`` (the Huber loss still leans on gross outliers). Returns
+    ``(T_cam_world, residual_px (N,), ok)`` with the residuals of every point.
     """
     from scipy.optimize import least_squares
 
@@ -222,10 +225,20 @@ def refine_pose(K, X_world, uv, T_cam_world_init, *, huber_px: float = 1.0, max_
 
     sol = least_squares(resid, np.zeros(6), jac="2-point", loss="huber", f_scale=huber_px, max_nfev=max_nfev,
                         method="trf", x_scale="jac")
-    T = se3_exp(sol.x) @ T0
     r = sol.fun.reshape(2, -1)
     err = np.hypot(r[0], r[1])
-    ok = bool(np.all(np.isfinite(T))) and sol.status > 0
+    ok = sol.status > 0
+    if ok and reject_px is not None:
+        keep = err < reject_px
+        if 6 <= keep.sum() < err.size:
+            sub = np.concatenate([keep, keep])
+            sol = least_squares(lambda xi: resid(xi)[sub], sol.x, jac="2-point", loss="huber", f_scale=huber_px,
+                                max_nfev=max_nfev, method="trf", x_scale="jac")
+            r = resid(sol.x).reshape(2, -1)
+            err = np.hypot(r[0], r[1])
+            ok = sol.status > 0
+    T = se3_exp(sol.x) @ T0
+    ok = ok and bool(np.all(np.isfinite(T)))
     if not ok:
         return T0, np.full(X.shape[0], np.inf), False
     return T, err, ok

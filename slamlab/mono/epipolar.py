@@ -27,10 +27,25 @@ _FAR_DEPTH = 1e6  # depths beyond this are drawn at their vanishing point
 
 def extract_patches(img, uv, patch_px: int) -> np.ndarray:
     """``(N, patch_px²)`` bilinear patches centred at ``uv`` (N, 2)."""
+    uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+    if patch_px % 2 and np.all(uv == np.rint(uv)):  # odd patch on whole pixels: plain indexing
+        o = np.arange(patch_px) - patch_px // 2
+        ou, ov = np.meshgrid(o, o)
+        h, w = img.shape[:2]
+        r = np.clip(uv[:, 1:2].astype(np.intp) + ov.ravel(), 0, h - 1)
+        c = np.clip(uv[:, 0:1].astype(np.intp) + ou.ravel(), 0, w - 1)
+        return np.asarray(img, np.float32)[r, c]
     o = np.arange(patch_px) - (patch_px - 1) / 2.0
     ou, ov = np.meshgrid(o, o)
-    uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     return bilinear(np.asarray(img, np.float32), uv[:, 0:1] + ou.ravel(), uv[:, 1:2] + ov.ravel())
+
+
+def _normalise(P):
+    """Rows made zero-mean and unit-norm (flat rows stay zero), so that a dot product is the ZNCC."""
+    P = np.asarray(P, dtype=np.float64)
+    P = P - P.mean(axis=1, keepdims=True)
+    nrm = np.linalg.norm(P, axis=1, keepdims=True)
+    return np.where(nrm > 1e-6, P / np.maximum(nrm, 1e-12), 0.0)
 
 
 def zncc(A, B) -> np.ndarray:
@@ -86,13 +101,14 @@ class EpipolarMatch:
 
 
 def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv, *, n_sigma: float = 2.0,
-                    tol_px: float = 2.0, patch_px: int = 8, zncc_min: float = 0.8, min_parallax_rad: float = 1e-3,
-                    chunk: int = 512) -> EpipolarMatch:
+                    tol_px: float = 2.0, patch_px: int = 9, zncc_min: float = 0.8, min_parallax_rad: float = 1e-3,
+                    chunk: int = 512, cur_patches=None) -> EpipolarMatch:
     """Find each seed in the current frame among FAST corners near its epipolar segment (003 §4.2).
 
     ``ref_patches`` (N, patch_px²) the seeds' patches in their reference keyframe;
     ``corners_uv`` (C, 2) the current frame's FAST corners. Vectorised over seeds × corners
-    in chunks of ``chunk`` seeds.
+    in chunks of ``chunk`` seeds. ``cur_patches`` (C, patch_px²): the corners' patches, if
+    already cut (then ``corners_uv`` must be the same corners, all inside the margin).
     """
     K = np.asarray(K, dtype=np.float64)
     f = np.asarray(f, dtype=np.float64).reshape(-1, 3)
@@ -101,34 +117,41 @@ def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv
     corners = np.asarray(corners_uv, dtype=np.float64).reshape(-1, 2)
     h, w = img_cur.shape[:2]
     m = (patch_px + 1) / 2.0 + 1
-    corners = corners[(corners[:, 0] >= m) & (corners[:, 0] < w - m) & (corners[:, 1] >= m) & (corners[:, 1] < h - m)]
+    if cur_patches is None:
+        inside = (corners[:, 0] >= m) & (corners[:, 0] < w - m) & (corners[:, 1] >= m) & (corners[:, 1] < h - m)
+        corners = corners[inside]
     found = np.zeros(n, bool)
     uv = np.zeros((n, 2))
     score = np.full(n, -1.0)
     ncand = np.zeros(n, np.int64)
     if n == 0 or corners.shape[0] == 0:
         return EpipolarMatch(found, uv, np.zeros(n), score, ncand, a, b)
-    cur_patches = extract_patches(img_cur, corners, patch_px)
+    cur_n = _normalise(extract_patches(img_cur, corners, patch_px) if cur_patches is None else cur_patches)
+    ref_n = _normalise(ref_patches)
     for s0 in range(0, n, chunk):
         sl = slice(s0, min(n, s0 + chunk))
         A, B = a[sl], b[sl]
         d = B - A
-        L2 = np.maximum(np.sum(d * d, axis=1), 1e-12)
-        rel = corners[None, :, :] - A[:, None, :]  # (S, C, 2)
-        tpar = np.einsum("scj,sj->sc", rel, d) / L2[:, None]
-        tcl = np.clip(tpar, 0.0, 1.0)
-        closest = A[:, None, :] + tcl[..., None] * d[:, None, :]
-        dist = np.linalg.norm(corners[None, :, :] - closest, axis=2)
-        near = (dist <= tol_px) & ok[sl, None]
-        ncand[sl] = near.sum(axis=1)
-        S = zncc(ref_patches[sl], cur_patches)
-        S = np.where(near, S, -2.0)
-        j = np.argmax(S, axis=1)
-        best = S[np.arange(S.shape[0]), j]
-        hit = best >= zncc_min
-        score[sl] = np.maximum(best, -1.0)
-        found[sl] = hit
-        uv[sl] = np.where(hit[:, None], corners[j], 0.0)
+        L = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
+        e = d / L[:, None]  # unit direction; normal (-e_v, e_u)
+        nrm = np.column_stack([-e[:, 1], e[:, 0]])
+        # distance to the line and position along the segment for every (corner, seed): two products
+        c32 = corners.astype(np.float32)
+        dist = np.abs(c32 @ nrm.T.astype(np.float32) - np.sum(A * nrm, axis=1).astype(np.float32))  # (C, S)
+        along = c32 @ e.T.astype(np.float32) - np.sum(A * e, axis=1).astype(np.float32)
+        near = (dist <= tol_px) & (along >= -tol_px) & (along <= L + tol_px) & ok[sl]
+        ci, si = np.nonzero(near)
+        ncand[sl] = np.bincount(si, minlength=L.size)
+        if ci.size == 0:
+            continue
+        sc = np.einsum("ij,ij->i", ref_n[s0 + si], cur_n[ci])  # ZNCC of each candidate pair
+        order = np.lexsort((-sc, si))  # per seed, best score first
+        first = order[np.r_[True, si[order][1:] != si[order][:-1]]]
+        bs, bc, bv = si[first] + s0, ci[first], sc[first]
+        score[bs] = bv
+        hit = bv >= zncc_min
+        found[bs[hit]] = True
+        uv[bs[hit]] = corners[bc[hit]]
     # triangulate along f: ray f from the reference centre, ray through uv from the current centre
     R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
     c_cur = -R.T @ t  # current centre in the reference frame

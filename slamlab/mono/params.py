@@ -28,7 +28,7 @@ class MonoParams(Params):
     sigma_fraction: float = param(1.0 / 200.0, "SVO: sigma < rho_range / 200")
     n_sigma: float = param(2.0, "003 §4.2: search over rho +- 2 sigma")
     epi_tol_px: float = param(2.0, "ours: 003 §4.2 says the band around the epipolar line is tunable")
-    patch_px: int = param(8, "ours: patch side for the seed score (ZNCC)")
+    patch_px: int = param(9, "ours: patch side for the seed score (ZNCC; SVO scores 8x8 patches)")
     zncc_min: float = param(0.8, "ours: minimum ZNCC of a seed match")
     px_noise: float = param(1.0, "SVO: one pixel of measurement error")
     max_seed_fail: int = param(10, "ours: 003 §4.3.2 drops a seed not found 'for several frames'")

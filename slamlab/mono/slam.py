@@ -357,6 +357,10 @@ class MonoSLAM:
         from ..features.opencv import fast_cv
 
         corners = fast_cv(image, threshold=p.fast_threshold).uv
+        h, w = image.shape
+        mg = (p.patch_px + 1) / 2.0 + 1
+        corners = corners[(corners[:, 0] >= mg) & (corners[:, 0] < w - mg) & (corners[:, 1] >= mg) & (corners[:, 1] < h - mg)]
+        cur_patches = extract_patches(image, corners, p.patch_px)
         t1 = time.perf_counter()
         times["detect"] = t1 - t0
         s = self.seeds
@@ -379,7 +383,7 @@ class MonoSLAM:
                 continue
             m = search_epipolar(self.K, T_cur_ref, s.f[sel], s.mu[sel], np.sqrt(s.sigma2[sel]), self.seed_patches[sel],
                                 image, corners, n_sigma=p.n_sigma, tol_px=p.epi_tol_px, patch_px=p.patch_px,
-                                zncc_min=p.zncc_min)
+                                zncc_min=p.zncc_min, cur_patches=cur_patches)
             tried[sel] = True
             fi = sel[m.found]
             if fi.size:
