@@ -65,7 +65,7 @@ CHAPTERS: tuple[Chapter, ...] = (
     Chapter(8, "Probabilistic localisation: Markov, MCL", "08_probabilistic_localisation.ipynb",
             ("slamlab.localisation",), "003 §2.2; 002", "planned"),
     Chapter(9, "Monocular mapping", "09_monocular_mapping.ipynb",
-            ("slamlab.mono",), "003 §2.1, §4", "planned"),
+            ("slamlab.mono",), "003 §2.1, §4", "available"),
 )
 
 #: Library-only topics used by several chapters: (title, where used, subpackage, sources, status).

@@ -4,6 +4,7 @@ Uses :mod:`slamlab.features` (FAST), :mod:`slamlab.geometry` and :mod:`slamlab.e
 nothing below imports this package. cv2 loads inside the functions that need it.
 """
 
+from .._lazy import lazy_exports
 from .align import refine_pose, se3_exp, sparse_align
 from .depth_filter import (
     Seeds,
@@ -60,3 +61,12 @@ __all__ = [
     "triangulate_two_view",
     "update_seeds",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, {
+    "plot_convergence": ".plot", "plot_epipolar_pair": ".plot", "plot_map_top": ".plot",
+    "plot_seed_histograms": ".plot", "explore_mono": ".widgets",
+    "run_depth_filter_convergence": ".experiments", "run_failure_cases": ".experiments",
+    "failure_table": ".experiments", "run_kitti_mono": ".experiments", "run_mono_vs_stereo": ".experiments",
+    "run_parameter_sweep": ".experiments", "run_mono_sequence": ".experiments", "run_mono": ".experiments",
+    "ours_vs_source": ".experiments", "epipolar_demo": ".experiments", "sequence_poses": ".experiments",
+})

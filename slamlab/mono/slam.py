@@ -182,6 +182,7 @@ class MonoSLAM:
         self._prev_img = image
         self.initialised = True
         self._add_keyframe(image, idx, np.arange(len(self.points)), res.uv1)
+        self._n_at_kf = min(len(self.points), self.p.max_matches)
 
     def _add_keyframe(self, image, idx, vis_idx, vis_uv):
         p = self.p
@@ -337,10 +338,11 @@ class MonoSLAM:
         t4 = time.perf_counter()
         # keyframe rules (003 §4.3)
         self._since_kf += 1
-        n_vis = int(vis.sum())
-        lost = 1.0 - n_vis / max(self._n_at_kf, 1)
+        # points lost since the last keyframe: matched now vs matched then (003 §4.3)
+        lost = 1.0 - n_inl / max(self._n_at_kf, 1)
         if (self._since_kf >= p.kf_min_frames and lost >= p.kf_lost_ratio) or lost > p.kf_max_lost_ratio:
             self._add_keyframe(image, idx, np.flatnonzero(vis), uvp[vis])
+            self._n_at_kf = n_inl
         # drop points that keep failing (a simple outlier rejection, ours)
         bad = self.point_fail > p.max_seed_fail
         if bad.any():
