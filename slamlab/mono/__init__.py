@@ -69,4 +69,5 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "failure_table": ".experiments", "run_kitti_mono": ".experiments", "run_mono_vs_stereo": ".experiments",
     "run_parameter_sweep": ".experiments", "run_mono_sequence": ".experiments", "run_mono": ".experiments",
     "ours_vs_source": ".experiments", "epipolar_demo": ".experiments", "sequence_poses": ".experiments",
+    "compare_init_methods": ".experiments",
 })
