@@ -23,11 +23,11 @@ from .slam import STAGES, MonoSLAM
 
 __all__ = [
     "FAILURE_CASES",
-    "compare_init_methods",
     "SEQUENCES",
     "ConvergenceStudy",
     "MonoRunResult",
     "MonoVsStereo",
+    "compare_init_methods",
     "epipolar_demo",
     "failure_table",
     "mono_sim",
