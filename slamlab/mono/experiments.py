@@ -555,7 +555,8 @@ def epipolar_demo(folder=None, *, frames=(0, 1, 2), n_seeds: int = 60, depth_mea
     return out
 
 
-def ours_vs_source(failures: dict, sequence: MonoRunResult, kitti: MonoRunResult | None = None) -> str:
+def ours_vs_source(failures: dict, sequence: MonoRunResult, kitti: MonoRunResult | None = None,
+                   convergence: ConvergenceStudy | None = None) -> str:
     """003's stated figures beside ours (003 §4.3, §4.4.1, §5.1.1, §5.4, §5.5.1), from the runs' results."""
     p = MonoParams()
     n_fail_ok = sum(r.verdict == "ok" for k, r in failures.items() if k != "normal")
@@ -575,6 +576,14 @@ def ours_vs_source(failures: dict, sequence: MonoRunResult, kitti: MonoRunResult
          f"ATE {100 * sequence.ate_m:.1f} cm ({sequence.name}, rendered)"],
         ["failure cases tracked > 70 %", "6 named, no numbers", f"{n_fail_ok} of {n_cases}"],
     ]
+    if convergence is not None:
+        def half(i):
+            k = np.flatnonzero(convergence.converged[i] >= 0.5)
+            return f"{k[0]}" if k.size else "> " + str(convergence.converged.shape[1] - 1)
+
+        rows.append(["seeds converged (half, SVO test)", "'with enough parallax' (Fig. 4.5, no numbers)",
+                     "; ".join(f"{100 * r:.0f} % outliers: {half(i)} obs."
+                               for i, r in enumerate(convergence.outlier_rates))])
     if kitti is not None:
         rows.append(["real data", "ICL-NUIM OR3 (tables lost)",
                      f"KITTI 06, 20 frames: tracked {100 * kitti.fraction_tracked:.0f} %, ATE {kitti.ate_m:.2f} m"])
