@@ -109,6 +109,7 @@ def _load_tasks() -> None:
         tasks_filters,
         tasks_hough,
         tasks_localisation,
+        tasks_mono,
         tasks_planes,
         tasks_stereo,
         tasks_stores,
