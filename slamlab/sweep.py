@@ -143,7 +143,8 @@ def _dask_config(client, n_jobs: int):
 
 def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | None = None, *,
           seeds: int = 1, seed: int = 0, n_jobs: int = 1, backend: str | None = None, client=None,
-          rng_arg: str | None = "rng", progress: bool | None = None, fixed: Mapping[str, Any] | None = None):
+          rng_arg: str | None = "rng", progress: bool | None = None, fixed: Mapping[str, Any] | None = None,
+          desc: str | None = None):
     """Run ``fn(**fixed, **point, rng=Generator)`` for every grid point × ``seeds`` replicates.
 
     Parameters
@@ -168,6 +169,8 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
         Show a progress bar (default: on unless ``$SLAMLAB_PROGRESS=0``).
     fixed : mapping, optional
         Keywords passed unchanged to every run (not columns of the table).
+    desc : str, optional
+        The progress bar's label (default: the function's name).
 
     Returns
     -------
@@ -205,7 +208,7 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
 
     tasks = [(p, r) for p in points for r in range(n_rep)]
     children = root.spawn(len(tasks))
-    bar = progress_bar(total=len(tasks), desc=getattr(fn, "__name__", "sweep"), progress=progress)
+    bar = progress_bar(total=len(tasks), desc=desc or getattr(fn, "__name__", "sweep"), progress=progress)
     rows: list[dict[str, Any]] = []
     try:
         if backend == "sequential":

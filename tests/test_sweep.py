@@ -59,6 +59,8 @@ def test_progress_bar_only_when_asked(capsys, monkeypatch):
     assert capsys.readouterr().err == ""
     sweep(noisy, GRID, seed=1, progress=True)
     assert "noisy" in capsys.readouterr().err  # tqdm's text bar names the function
+    sweep(noisy, GRID, seed=1, progress=True, desc="a study")
+    assert "a study" in capsys.readouterr().err  # or says what the caller names it
 
 
 def test_result_row_forms():

@@ -114,7 +114,7 @@ def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 
     Mvs = tuple(grid_to_values(M, q.a_c, q.a_p, q.a_n) for q in settings)
     headings = heading_candidates(settings[0].delta_alpha_rad)
     points = [{"choice": j, "pose_index": i, "beams": b} for j in range(len(settings)) for i, b in enumerate(beams)]
-    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress,
+    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress, desc="correlation localisation",
                   fixed={"Mvs": Mvs, "settings": tuple(settings), "headings": headings, "margins": margins})
     failed = table["error"].notna()
     if failed.any():

@@ -17,6 +17,7 @@ from functools import lru_cache
 import numpy as np
 
 from .. import _validate as v
+from .._progress import progress_bar
 from .._table import format_table
 from .base import Features
 from .detect import detect
@@ -130,7 +131,8 @@ class PairEvaluationResult:
 
 def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
                         detectors=("SIFT", "SURF", "ORB", "FAST"), scale: float = 0.5, n_points: int = 500,
-                        tol_px: float = 2.5, rule: str = "ratio", ratio: float = 0.8) -> PairEvaluationResult:
+                        tol_px: float = 2.5, rule: str = "ratio", ratio: float = 0.8,
+                        progress: bool | None = None) -> PairEvaluationResult:
     """Repeatability and matching precision/recall on img1 → img_j of Oxford sequences (000 §1.4).
 
     ``sequences``: names of the shared sequences (:data:`OXFORD_SEQUENCES`) or ``str`` /
@@ -139,7 +141,8 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
 
     Every detector keeps its ``n_points`` strongest keypoints per image (equal
     budgets: with a fixed pixel tolerance a denser detector would look more
-    repeatable by chance). FAST corners carry upright SURF descriptors (σ = 2 px).
+    repeatable by chance). FAST corners carry upright SURF descriptors (σ = 2 px). ``progress``:
+    a bar over the image pairs (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     if isinstance(sequences, (str, os.PathLike)):
         sequences = (sequences,)
@@ -158,6 +161,7 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
     n_m, n_c = np.zeros(shape, dtype=int), np.zeros(shape, dtype=int)
     times = {d: 0.0 for d in detectors}
     n_det = {d: 0 for d in detectors}
+    bar = progress_bar(total=len(folders) * len(steps), desc="pair evaluation", progress=progress)
     for i, seq in enumerate(folders):
         first = {}
         for j, st in enumerate(steps):
@@ -178,6 +182,8 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
                 n_m[i, j, k], n_c[i, j, k] = len(m), int(c.sum())
                 prec[i, j, k] = c.mean() if len(m) else np.nan
                 rec[i, j, k] = c.sum() / r.correspondences if r.correspondences else np.nan
+            bar.update()
+    bar.close()
     rule_txt = f"ratio {ratio:g}" if rule == "ratio" else "000 (d2 >= 2 d1)"
     return PairEvaluationResult(labels, steps, detectors, scale, n_points, tol_px, rule_txt, rep, prec, rec,
                                 n_m, n_c, {d: times[d] / max(n_det[d], 1) for d in detectors})
@@ -380,13 +386,14 @@ KNN_LABELS = ("brute", "kd-tree exact (ours)", "cKDTree exact (scipy)", "BBF 200
 
 def run_knn_comparison(sizes=(2000, 13000), *, n_queries: int = 500, max_leaves: int = 200, checks: int = 200,
                        max_exact_ours: int = 2000, sequence: str = "graf", j: int = 2, scale: float = 0.5,
-                       threshold: float = 5e-5, tol_px: float = 2.5) -> KnnComparisonResult:
+                       threshold: float = 5e-5, tol_px: float = 2.5, progress: bool | None = None) -> KnnComparisonResult:
     """Exact kd-tree vs BBF vs FLANN vs brute force on real SURF descriptors (000 §1.4.3).
 
     The store holds img1's descriptors of ``sequence`` plus distractors from the
     other sequences up to each size; the queries are img_j's strongest
     ``n_queries``. Our exact tree runs only up to ``max_exact_ours`` points (in 64-d
-    it visits nearly every leaf and the lock-step numpy search is then slow).
+    it visits nearly every leaf and the lock-step numpy search is then slow). ``progress``: a bar
+    over the sizes (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     from scipy.spatial import cKDTree
 
@@ -396,7 +403,7 @@ def run_knn_comparison(sizes=(2000, 13000), *, n_queries: int = 500, max_leaves:
     n_queries = v.check_int(n_queries, "n_queries", minimum=1)
     shape = (len(sizes), len(KNN_LABELS))
     rec, prec, nm, ev, tm = (np.full(shape, np.nan) for _ in range(5))
-    for i, n in enumerate(sizes):
+    for i, n in enumerate(progress_bar(sizes, desc="kNN comparison", progress=progress)):
         f1, q, train, H = _matching_workload(n, n_queries, sequence, j, scale, threshold)
         Q = q.descriptors
         t0 = time.perf_counter()
@@ -471,8 +478,11 @@ class LeavesCurveResult:
 
 def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, n_stored: int = 5000,
                          n_queries: int = 300, sequence: str = "graf", j: int = 2, scale: float = 0.5,
-                         threshold: float = 5e-5) -> LeavesCurveResult:
-    """Recall of BBF and FLANN against the number of leaves / checks (000 §1.4.3: "about 200")."""
+                         threshold: float = 5e-5, progress: bool | None = None) -> LeavesCurveResult:
+    """Recall of BBF and FLANN against the number of leaves / checks (000 §1.4.3: "about 200").
+
+    ``progress``: a bar over the budgets (None: on unless ``$SLAMLAB_PROGRESS=0``).
+    """
     import cv2
 
     from ..kdtree import KDTree
@@ -484,7 +494,7 @@ def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, 
     tree = KDTree(train)
     fl = cv2.flann_Index(np.ascontiguousarray(train, np.float32), {"algorithm": 1, "trees": 1})
     rb, rf, eb, tm = [], [], [], []
-    for b in budgets:
+    for b in progress_bar(budgets, desc="recall vs leaves", progress=progress):
         t0 = time.perf_counter()
         _, idx = tree.query(Q, k=2, max_leaves=int(b))
         tm.append(time.perf_counter() - t0)

@@ -36,11 +36,13 @@ from .transform import (
 
 __all__ = [
     "ExampleLineResult",
+    "NoiseStudyResult",
     "RealLogResult",
     "SimSlamResult",
     "check_pose_from_two_lines",
     "pose_errors",
     "run_example_line",
+    "run_noise_study",
     "run_real_log",
     "run_sim_slam",
     "time_polar_vs_opencv",
@@ -197,7 +199,7 @@ class SimSlamResult:
 def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: bool = False,
                  n_beams: int = 360, max_range_cells: float = 100.0, odometry_noise: float = 1.0,
                  with_icp: bool = True, start: str = "truth", params: HoughSlamParams | None = None,
-                 rng=2010, **overrides) -> SimSlamResult:
+                 rng=2010, progress: bool | None = None, **overrides) -> SimSlamResult:
     """004's experiment: Hough SLAM along the 121-pose path on the test room (004 Fig. 9-11).
 
     Δθ = 1°, Δrho = 1 cell, ranges quantised to 0.1 cell (004). Our choices (004 gives none):
@@ -216,6 +218,8 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
         Where the SLAM starts: the true first pose, or the pose that correlation localisation
         (:func:`slamlab.correlation.localise`, Δα = 1°, on the mapped room) finds from the first
         scan — 004's whole system (Fig. 2). The ICP baseline and odometry start from the truth.
+    progress : bool, optional
+        A bar over the scans of the SLAM run (None: on unless ``$SLAMLAB_PROGRESS=0``).
     params, **overrides
         :class:`HoughSlamParams` and fields to change.
     """
@@ -246,7 +250,7 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
         start_pose = localise(room, scans[0]).pose  # LocaliseParams defaults: Δα = 1° (004 §7)
         timing["correlation"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    res = hough_slam(scans, start_pose, odo.increments, params, **overrides)
+    res = hough_slam(scans, start_pose, odo.increments, params, progress=progress, **overrides)
     timing["hough_slam"] = time.perf_counter() - t0
     icp_poses = None
     if with_icp:
@@ -258,6 +262,69 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
     built = occupancy_grid(scans, res.poses, room.shape, rule="count", step_cells=1.0)
     timing["build_map"] = time.perf_counter() - t0
     return SimSlamResult(truth, res, odo.poses, icp_poses, built, room, sigma, bool(clutter), timing, noise)
+
+
+# --- noise study (our addition): Monte Carlo over range noise and seeds on slamlab.sweep -------------
+
+
+def _noise_run(*, range_std_cells: float, n_poses: int, clutter: bool, rng: np.random.Generator) -> dict:
+    """One seeded Hough SLAM run of the noise study: its worst and final errors (cells, degrees)."""
+    r = run_sim_slam(n_poses, range_std_cells=range_std_cells, clutter=clutter, with_icp=False, rng=rng,
+                     progress=False)
+    e = r.errors["Hough SLAM"]
+    pos = np.hypot(e[:, 0], e[:, 1])
+    return {"max_pos_err": float(pos.max()), "final_pos_err": float(pos[-1]),
+            "max_heading_err_deg": float(np.degrees(np.abs(e[:, 2]).max())),
+            "lost_steps": int(r.slam.lost.sum()), "map_precision": map_agreement(r.built_map, r.reference_map)["precision"]}
+
+
+@dataclass(frozen=True)
+class NoiseStudyResult:
+    """Hough SLAM errors against range noise, over seeded runs (our addition; 004 gives one run)."""
+
+    runs: object = field(repr=False)  # the sweep's table (pandas DataFrame), one row per run
+    n_poses: int = 121
+    clutter: bool = False
+    bad_pos_cells: float = 2.0
+
+    def table(self) -> str:
+        rows = []
+        for sigma, g in self.runs.groupby("range_std_cells", sort=True):
+            rows.append([f"{sigma:g}", f"{len(g)}", f"{g['max_pos_err'].mean():.2f}", f"{g['max_pos_err'].max():.2f}",
+                         f"{g['max_heading_err_deg'].mean():.2f}", f"{g['final_pos_err'].mean():.2f}",
+                         f"{int(g['lost_steps'].sum())}", f"{int((g['max_pos_err'] > self.bad_pos_cells).sum())}",
+                         f"{g['map_precision'].mean():.0%}"])
+        title = (f"Hough SLAM vs range noise: {self.n_poses} poses of 004's path, clutter "
+                 f"{'on' if self.clutter else 'off'}; errors in cells (mean / worst over the runs)")
+        return format_table(["range σ [cells]", "runs", "mean max pos err", "worst max pos err",
+                             "mean max |Ea| [°]", "mean final pos err", "lost steps",
+                             f"runs > {self.bad_pos_cells:g} cells", "map precision"], rows, title=title)
+
+
+def run_noise_study(range_std_cells=(0.0, 0.1, 0.3, 0.5), n_runs: int = 4, *, n_poses: int = 61,
+                    clutter: bool = False, bad_pos_cells: float = 2.0, n_jobs: int = 1, rng=2010,
+                    progress: bool | None = None) -> NoiseStudyResult:
+    """Hough SLAM on 004's room at several range noises σ, ``n_runs`` seeded runs each (our addition).
+
+    Runs on :func:`slamlab.sweep.sweep` (run i draws from child i of ``SeedSequence(rng)``), so the
+    table is the same for any ``n_jobs``. Each run: :func:`run_sim_slam` without ICP on the first
+    ``n_poses`` poses. A run counts as bad when its largest position error passes ``bad_pos_cells``.
+    """
+    from ..sweep import root_seed_sequence, sweep
+
+    sigmas = [v.check_positive(s, "range_std_cells", allow_zero=True) for s in np.atleast_1d(range_std_cells)]
+    if not sigmas:
+        raise ValueError("`range_std_cells` must hold at least one noise level")
+    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
+    n_poses = v.check_int(n_poses, "n_poses", minimum=5)
+    bad = v.check_positive(bad_pos_cells, "bad_pos_cells")
+    table = sweep(_noise_run, {"range_std_cells": sigmas}, seeds=n_runs, seed=root_seed_sequence(rng, "rng"),
+                  n_jobs=n_jobs, progress=progress, fixed={"n_poses": n_poses, "clutter": bool(clutter)},
+                  desc="Hough SLAM noise study")
+    failed = table["error"].notna()
+    if failed.any():
+        raise RuntimeError(f"{int(failed.sum())} noise-study run(s) failed; first: {table['error'][failed].iloc[0]}")
+    return NoiseStudyResult(table, n_poses, bool(clutter), bad)
 
 
 # --- real laser logs ---------------------------------------------------------------------------
@@ -352,7 +419,8 @@ def _load_log(path, fmt):
 
 
 def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = None, step: int = 1,
-                 cell_m: float = 0.05, params: HoughSlamParams | None = None, **overrides) -> RealLogResult:
+                 cell_m: float = 0.05, params: HoughSlamParams | None = None, progress: bool | None = None,
+                 **overrides) -> RealLogResult:
     """Hough SLAM on a real laser log with raw odometry (a URG-04LX log of the Mines format or a CARMEN log).
 
     Parameters
@@ -372,6 +440,8 @@ def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = Non
     params, **overrides
         Defaults are our per-format settings :data:`LOG_PARAMS` (Δrho = 2 cm, H_min = 15,
         a = 0.15 m, …) with ``r_max`` = the log's range limit.
+    progress : bool, optional
+        A bar over the scans (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     if path is None:
         from ..data import find_data
@@ -394,7 +464,7 @@ def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = Non
     U = se2_relative(odo[:-1], odo[1:])
     base = HoughSlamParams(**LOG_PARAMS[fmt], r_max=float(max_range_m)) if params is None else params
     t0 = time.perf_counter()
-    res = hough_slam(scans, odo[0], U, base, **overrides)
+    res = hough_slam(scans, odo[0], U, base, progress=progress, **overrides)
     timing["hough_slam"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     pts = np.concatenate([odo[:, :2], res.poses[:, :2]])

@@ -25,6 +25,7 @@ import numpy as np
 
 from .. import _validate as v
 from .._params import Params, param
+from .._progress import progress_bar
 from ..geometry import wrap_angle
 from ..geometry.se2 import check_pose, se2_compose
 from ..scans import Scan
@@ -202,7 +203,8 @@ def _partial(history, n1, n2, prior, params):
 
 
 def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
-               params: HoughSlamParams | None = None, **overrides) -> HoughSlamResult:
+               params: HoughSlamParams | None = None, *, progress: bool | None = None,
+               **overrides) -> HoughSlamResult:
     """Run Hough-transform SLAM over a sequence of scans (004 Fig. 2, Fig. 4).
 
     Parameters
@@ -216,6 +218,8 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
         Body-frame increments between scans; used to predict lines for the association,
         for the gate and when a step is lost. Without it, zero motion is predicted.
     params : HoughSlamParams, optional
+    progress : bool, optional
+        A bar over the scans (None: on unless ``$SLAMLAB_PROGRESS=0``).
     **overrides
         Fields of :class:`HoughSlamParams` to change.
 
@@ -244,7 +248,7 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     n_lines = np.zeros(n, dtype=np.int64)
     history = LineHistory()
     keyframe = 0
-    for k in range(n):
+    for k in progress_bar(range(n), desc="Hough SLAM", progress=progress):
         lines = _detect(*returns[k], params, theta)
         n_lines[k] = len(lines)
         if k == 0:

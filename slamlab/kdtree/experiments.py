@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from .._progress import progress_bar
 from .._table import format_table
 from .cost_model import calibrate_C, minimise_iter_time
 from .stores import STORE_NAMES, BruteForceStore, FlannStore, make_store
@@ -177,7 +178,7 @@ def _counters(store):
 
 def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flann", "brute"), n1: int = 3500,
                          q: float = 5.5, checks: int = 200, leaf_size: int = 8, n_iterations: int | None = None,
-                         rng=2010, **scenario_changes) -> StoreComparisonResult:
+                         rng=2010, progress: bool | None = None, **scenario_changes) -> StoreComparisonResult:
     """Run 000's Table 1 (``"table1"``) or Table 2 (``"table2"``) workload through every store (000 §4.2).
 
     ``scenario`` may also be a recorded :class:`~slamlab.kdtree.workloads.Workload`
@@ -185,6 +186,7 @@ def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flan
 
     ``n_iterations`` shortens the run (the notebook's small size). The base rule
     of the scenario is applied by every store (:func:`~slamlab.kdtree.stores.make_store`).
+    ``progress``: a bar over the stores (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     stores = tuple(stores)
     if not stores:
@@ -203,7 +205,7 @@ def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flan
     kw = _store_kwargs(n1, q, checks, leaf_size)
     recall, ops, add_s, search_s = {}, {}, {}, {}
     exact = _exact_stream(w.iterations, sc.base_seen_times, sc.max_non_base_time)
-    for s in stores:
+    for s in progress_bar(stores, desc=f"{sc.name}: stores", progress=progress):
         store = make_store(s, base_seen_times=sc.base_seen_times, max_non_base_time=sc.max_non_base_time, **kw)
         a, se, o, r = _run_stream(store, w.iterations, exact)
         add_s[s], search_s[s], ops[s], recall[s] = a, se, o, r
@@ -268,7 +270,7 @@ class CrossoverResult:
 
 def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", "multi", "brute"),
                   n_queries: int = 400, n_new: int = 500, n1: int = 3500, q: float = 5.5, checks: int = 200,
-                  leaf_size: int = 8, repeats: int = 3, rng=2010) -> CrossoverResult:
+                  leaf_size: int = 8, repeats: int = 3, rng=2010, progress: bool | None = None) -> CrossoverResult:
     """Mean iteration time (``n_queries`` searches + ``n_new`` inserts) vs stored points (000 §4.3).
 
     Rebuild, FLANN and brute-force stores have no history: each is filled with
@@ -276,7 +278,8 @@ def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", 
     add cost depends on its history, so it is filled by a stream of ``n_new``-point
     adds and its add time at size ``n`` is the mean over the fill adds between
     ``n/2`` and ``n`` (the amortised cost of 000's Tables). Timed repeats give
-    their median (the machine is shared; one untimed warm-up query runs first).
+    their median (the machine is shared; one untimed warm-up query runs first). ``progress``: a
+    bar over the stores (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     sizes = np.asarray(sizes)
     if sizes.ndim != 1 or sizes.size == 0 or np.any(sizes < 1) or np.any(np.diff(sizes) <= 0):
@@ -308,7 +311,7 @@ def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", 
     warm.add(X[:n_new], ids[:n_new])
     warm.end_iteration()
     warm.query(qsets[0][0])
-    for s in stores:
+    for s in progress_bar(stores, desc="crossover: stores", progress=progress):
         rec, a_s, s_s = np.zeros(sizes.size), np.zeros(sizes.size), np.zeros(sizes.size)
         if s == "multi":
             store = make_store("multi", **kw)

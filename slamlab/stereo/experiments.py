@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from .._progress import progress_bar
 from .._table import format_table
 from ..geometry import wrap_angle
 from ..geometry.camera import StereoRig
@@ -172,8 +173,9 @@ def run_stereo_slam_variants(
     Renderer: ``render`` (:class:`RenderParams`: ``camera_height_m``, ``noise_std`` in grey levels,
     ``drift_std_rad`` = random-walk step of the right camera's orientation per frame,
     ``arena_seed``), ``arena`` (default the 6×8 m :class:`~slamlab.sim.arena.StereoArena` of
-    ``render.arena_seed``), ``rig`` (default the 768×576, 40° pair with a 0.2 m baseline) and
-    ``progress(i)``, called after each frame.
+    ``render.arena_seed``), ``rig`` (default the 768×576, 40° pair with a 0.2 m baseline).
+    ``progress``: a callable ``progress(i)`` called after each frame, or True/False/None for a
+    tqdm bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     poses = v.as_finite_array(poses, "poses", ndim=2)
     if poses.shape[1] != 3 or len(poses) < 2:
@@ -191,8 +193,8 @@ def run_stereo_slam_variants(
             raise TypeError(f"`variants[{label!r}]` must be a StereoParams or a dict of overrides; got {type(var).__name__}")
     if isinstance(store, LandmarkStore) and len(settings) > 1:
         raise ValueError("a `store` instance serves one run; give a factory for several variants")
-    if progress is not None:
-        v.check_callable(progress, "progress")
+    frame_done = progress if callable(progress) else None
+    bar = None if frame_done else progress_bar(total=len(poses), desc=f"stereo SLAM: {name}", progress=progress)
     render = RenderParams.resolve(render)
     r_sim, r_slam = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(2)
     arena = StereoArena(seed=render.arena_seed) if arena is None else arena
@@ -210,8 +212,12 @@ def run_stereo_slam_variants(
             t = time.perf_counter()
             slam.process(left, right)
             t_slam[k] += time.perf_counter() - t
-        if progress is not None:
-            progress(i)
+        if frame_done is not None:
+            frame_done(i)
+        else:
+            bar.update()
+    if bar is not None:
+        bar.close()
     out = {}
     for k, slam in slams.items():
         est = slam.planar_trajectory
@@ -357,18 +363,20 @@ def run_drift_study(
     return DriftStudy(experiment, levels, runs)
 
 
-def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0) -> Workload:
+def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0,
+                         progress: bool | None = None) -> Workload:
     """Record the landmark-store calls of the stereo pipeline on 000's closed loop (our addition).
 
     Runs the closed loop (small size: 57 frames; ``n_frames`` keeps the first frames only) with an
     :class:`~slamlab.kdtree.ExactStore` wrapped in a :class:`~slamlab.kdtree.workloads.RecordingStore`,
     and returns the recorded :class:`~slamlab.kdtree.workloads.Workload` for
     :func:`slamlab.kdtree.experiments.run_store_comparison`. ``detector="sift"`` gives 128-d float
-    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter.
+    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. ``progress``: a bar
+    over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     p = StereoParams(detector=detector)
     rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
-    run_closed_loop("small", n_frames=n_frames, params=p, store=rec, rng=rng)
+    run_closed_loop("small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
     n = len(rec.iterations)
     return rec.workload(f"stereo closed loop, {n} frames ({detector.upper()}, recorded)",
                         base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
@@ -414,7 +422,7 @@ KITTI_PARAMS = StereoParams(max_depth_m=40.0)
 
 
 def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams | None = None, rng=0,
-              **overrides) -> KittiRunResult:
+              progress: bool | None = None, **overrides) -> KittiRunResult:
     """StereoSLAM on a KITTI odometry sequence folder (real data); default the shared ``kitti-odometry-06-stereo``.
 
     ``folder`` (``str`` or ``os.PathLike``) holds ``calib.txt`` (official ``P0: ...`` lines or the
@@ -423,7 +431,8 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
     size comes from the first left image, the run's name from the folder's name; ``n_frames``
     keeps the first frames (default: one per pose). ``params`` (default :data:`KITTI_PARAMS`) plus
     ``overrides``: :class:`StereoParams`. The map frame is the first left-camera frame, as in
-    ``poses.txt``. ATE and RPE by :mod:`slamlab.evaluation` (equal to evo's).
+    ``poses.txt``. ATE and RPE by :mod:`slamlab.evaluation` (equal to evo's). ``progress``: a
+    bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
     from ..data import find_data
     from ..evaluation import Trajectory, ate, read_kitti, rpe
@@ -438,7 +447,7 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
     rig = kitti_rig(d / "calib.txt", left0.shape[1], left0.shape[0])
     slam = StereoSLAM(rig, np.eye(4), params=p, rng=rng)
     t_slam = 0.0
-    for i in range(n):
+    for i in progress_bar(range(n), desc=f"stereo SLAM: {d.name}", progress=progress):
         left = left0 if i == 0 else read_kitti_image(d / "image_0" / f"{i:06d}.png")
         right = read_kitti_image(d / "image_1" / f"{i:06d}.png")
         t = time.perf_counter()

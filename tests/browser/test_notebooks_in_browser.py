@@ -241,3 +241,43 @@ def test_notebook_runs_in_jupyterlab(lab_server, browser, notebook):
 def _code_sources(path: Path) -> list[str]:
     nb = json.loads(path.read_text(encoding="utf-8"))
     return ["".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code"]
+
+
+_PROGRESS_CELL = """import os
+os.environ.pop("SLAMLAB_PROGRESS", None)   # a student's kernel: no setting, bars on
+import slamlab as sl
+noise = sl.hough.run_noise_study((0.0, 0.1), 3, n_poses=20)
+print("rows", len(noise.runs))"""
+
+
+def test_progress_bar_is_a_widget_in_jupyterlab(lab_server, browser):
+    """A library loop shows its tqdm.auto bar as a widget in JupyterLab (not as stderr text), and the
+    bar goes away when the loop ends (``leave=False``); the notebook is a scratch file, removed after."""
+    base, token = lab_server
+    scratch = ROOT / "notebooks" / f"zz_progress_check_{secrets.token_hex(4)}.ipynb"
+    cell = {"cell_type": "code", "execution_count": None, "id": "c0", "metadata": {}, "outputs": [],
+            "source": _PROGRESS_CELL}
+    nb = {"cells": [cell], "metadata": {"kernelspec": {"name": "python3", "display_name": "Python 3",
+                                                       "language": "python"}}, "nbformat": 4, "nbformat_minor": 5}
+    scratch.write_text(json.dumps(nb), encoding="utf-8")
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    try:
+        page.goto(f"{base}/lab/workspaces/{scratch.stem}/tree/{scratch.name}?reset&token={token}", timeout=60_000)
+        page.wait_for_function(
+            "() => { const s = document.querySelector('.jp-Notebook-ExecutionIndicator');"
+            " return s && s.getAttribute('data-status') === 'idle' && document.querySelector('.jp-CodeCell'); }",
+            timeout=120_000)
+        page.wait_for_selector("text=Python 3 (ipykernel) | Idle", timeout=120_000)  # the kernel is up
+        page.evaluate(_WATCH_BUSY)
+        page.locator(".jp-CodeCell .cm-content").first.click()
+        page.keyboard.press("Shift+Enter")
+        bar = page.wait_for_selector(".jp-OutputArea-output .widget-hprogress", timeout=120_000)
+        label = page.locator(".jp-OutputArea-output").first.inner_text().replace("\u2007", " ")  # tqdm pads with figure spaces
+        assert "Hough SLAM noise study" in label  # the bar's label
+        page.wait_for_function(_DONE, timeout=RUN_TIMEOUT_S * 1000)
+        assert "rows 6" in page.locator(".jp-OutputArea-output").last.inner_text()
+        assert not bar.is_visible()
+        assert not _problems(page)
+    finally:
+        page.close()
+        scratch.unlink(missing_ok=True)
