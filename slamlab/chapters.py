@@ -66,6 +66,8 @@ CHAPTERS: tuple[Chapter, ...] = (
             ("slamlab.localisation",), "003 §2.2; 002", "planned"),
     Chapter(9, "Monocular mapping", "09_monocular_mapping.ipynb",
             ("slamlab.mono",), "003 §2.1, §4", "planned"),
+    Chapter(10, "Plane-based 3-D particle-filter SLAM", "10_plane_slam_3d.ipynb",
+            ("slamlab.planes",), "002", "available"),
 )
 
 #: Library-only topics used by several chapters: (title, where used, subpackage, sources, status).

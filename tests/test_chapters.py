@@ -18,7 +18,7 @@ def test_numbers_unique_and_in_order():
     numbers = [c.number for c in chapters.CHAPTERS]
     assert numbers == list(range(len(numbers)))
     assert numbers[0] == 0
-    assert numbers[-1] == 9
+    assert numbers[-1] == 10
 
 
 def test_notebook_names_match_numbers():
@@ -64,7 +64,7 @@ def test_subpackages_and_sources_named():
 
 def test_get_chapter():
     assert chapters.get_chapter(5).title == "Stereo SLAM"
-    with pytest.raises(ValueError, match=r"`number` must be one of \[0, 1, .*9\]; got 12"):
+    with pytest.raises(ValueError, match=r"`number` must be one of \[0, 1, .*10\]; got 12"):
         chapters.get_chapter(12)
 
 

@@ -13,7 +13,12 @@ API summary
   ``scipy.signal.fftconvolve`` (``"fftconvolve"``) or by the definition (``"direct"``).
 - :func:`localise` ``(grid, scan, *, params=None, **overrides) -> Localisation``: the
   maximum of the 3-D stack → heading and position, streamed over heading chunks
-  (bounded memory); its settings are one :class:`LocaliseParams`.
+  (bounded memory); its settings are one :class:`LocaliseParams`. With ``ambiguity`` (default) it also
+  finds the best *rival* pose more than ``rival_radius_cells`` or ``rival_heading_rad`` away
+  (:attr:`Localisation.ambiguity`, ours).
+- :func:`localise_joined` ``(grid, scans, odom_poses, ...) -> Localisation``: two or three
+  consecutive scans placed by odometry into one T_n per heading (ours; breaks corridor and
+  half-turn ties).
 
 Scans are :class:`slamlab.scans.Scan` objects in cell units (``scan.to_cells(cell_m)``
 for a metric scan).
@@ -45,6 +50,7 @@ from scipy.signal import fftconvolve
 from .. import _validate as v
 from .._params import Params, param
 from ..geometry import wrap_angle
+from ..geometry.se2 import check_poses, se2_relative, se2_transform
 from ..scans import Scan, check_grid, grid_to_values
 
 __all__ = [
@@ -54,6 +60,7 @@ __all__ = [
     "heading_candidates",
     "heading_error",
     "localise",
+    "localise_joined",
     "rasterise_scan",
     "score_maps",
 ]
@@ -295,46 +302,96 @@ class _MapSpectrum:
         return self.inverse(self.forward(T))
 
 
-def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol):
-    """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
+def _map_spectra(Mv, stamps, S, o, *, dtype, workers):
+    """Spectra of the map turned by every quarter turn the stamps use (one FFT size for all)."""
+    H, W = Mv.shape
+    side = max(H, W)
+    L = _fast_len(max(side + o, side + S - 1 - o))
+    return {q: _MapSpectrum(np.ascontiguousarray(np.rot90(Mv, q)), S, o, dtype, workers, L=(L, L))
+            for q in sorted(set(stamps.quarter.tolist()))}
+
+
+def _iter_scores(specs, stamps, sel, S, chunk):
+    """Yield ``(heads, D)``: score maps ``D[k] = D_{heads[k]}`` for the headings ``sel``, in chunks of base stamps.
 
     Quarter turns: with ``R`` the quarter turn of the stamps, ``D_{T∘R⁻¹}(M) = rot90(D_T(rot90(M)), -1)``
     (derivation in the notebook), so the spectrum of each base stamp (heading mod 90°) is computed once
     and correlated with the four rotated maps' spectra.
-    Returns ``(best_val, (n, row, col), best_map, best_per_heading)``; ties within ``tol`` go to the
-    smallest heading index, then the first row and column.
     """
-    H, W = Mv.shape
-    quarters = sorted(set(stamps.quarter.tolist()))
-    side = max(H, W)
-    L = _fast_len(max(side + o, side + S - 1 - o))
-    specs = {q: _MapSpectrum(np.ascontiguousarray(np.rot90(Mv, q)), S, o, dtype, workers, L=(L, L))
-             for q in quarters}
-    n_base = stamps.Tb.shape[0]
-    best_per = np.full(headings.size, -np.inf)
-    best_val, best_idx, best_map = -np.inf, None, None
-    for b0 in range(0, n_base, chunk):
-        b1 = min(b0 + chunk, n_base)
-        FTc = specs[quarters[0]].forward(stamps.Tb[b0:b1].reshape(b1 - b0, S, S))
+    quarters = sorted(specs)
+    bases = np.unique(stamps.inv[sel])
+    for b0 in range(0, bases.size, chunk):
+        bs = bases[b0:b0 + chunk]
+        FTc = specs[quarters[0]].forward(stamps.Tb[bs].reshape(bs.size, S, S))
+        in_chunk = sel[np.isin(stamps.inv[sel], bs)]
         for q in quarters:
-            heads = np.nonzero((stamps.quarter == q) & (stamps.inv >= b0) & (stamps.inv < b1))[0]
+            heads = in_chunk[stamps.quarter[in_chunk] == q]
             if heads.size == 0:
                 continue
-            D = specs[q].inverse(FTc[stamps.inv[heads] - b0])
+            D = specs[q].inverse(FTc[np.searchsorted(bs, stamps.inv[heads])])
             if q:
                 D = np.rot90(D, -q, axes=(1, 2))
-            per = D.reshape(D.shape[0], -1).max(axis=1)
-            best_per[heads] = per
-            m = float(per.max())
-            if m > best_val + tol or (m >= best_val - tol and best_idx is not None and heads.min() < best_idx[0]):
-                cand = np.nonzero(per >= max(m, best_val) - tol)[0]
-                k = cand[np.argmin(heads[cand])]
-                if best_idx is None or m > best_val + tol or heads[k] < best_idx[0]:
-                    flat = int(np.argmax(D[k].ravel() >= max(m, best_val) - tol))
-                    best_val = max(m, best_val)
-                    best_idx = (int(heads[k]), *np.unravel_index(flat, D.shape[1:]))
-                    best_map = np.ascontiguousarray(D[k])
-    return best_val, best_idx, best_map, best_per
+            yield heads, D
+
+
+def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None):
+    """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
+
+    Returns ``(best_val, (n, row, col), best_map, best_per_heading, argmax_per_heading)``; ties within
+    ``tol`` go to the smallest heading index, then the first row and column. ``argmax_per_heading``
+    holds the flat cell index of each heading's maximum.
+    """
+    if specs is None:
+        specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=workers)
+    best_per = np.full(headings.size, -np.inf)
+    arg_per = np.zeros(headings.size, dtype=np.int64)
+    best_val, best_idx, best_map = -np.inf, None, None
+    for heads, D in _iter_scores(specs, stamps, np.arange(headings.size), S, chunk):
+        flat_D = D.reshape(D.shape[0], -1)
+        am = flat_D.argmax(axis=1)
+        per = flat_D[np.arange(am.size), am]
+        best_per[heads], arg_per[heads] = per, am
+        m = float(per.max())
+        if m > best_val + tol or (m >= best_val - tol and best_idx is not None and heads.min() < best_idx[0]):
+            cand = np.nonzero(per >= max(m, best_val) - tol)[0]
+            k = cand[np.argmin(heads[cand])]
+            if best_idx is None or m > best_val + tol or heads[k] < best_idx[0]:
+                flat = int(np.argmax(D[k].ravel() >= max(m, best_val) - tol))
+                best_val = max(m, best_val)
+                best_idx = (int(heads[k]), *np.unravel_index(flat, D.shape[1:]))
+                best_map = np.ascontiguousarray(D[k])
+    return best_val, best_idx, best_map, best_per, arg_per
+
+
+def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, radius_cells, heading_rad, chunk):
+    """Best pose more than ``radius_cells`` or ``heading_rad`` away from the peak ``best_idx`` (ours).
+
+    Headings farther than ``heading_rad`` count with their whole map (their maxima are already known);
+    the others are scored again with the disc of radius ``radius_cells`` around the peak cell masked.
+    Returns ``(score, (n, row, col))``, ``(-inf, None)`` when no such pose exists.
+    """
+    n0, r0, c0 = best_idx
+    H, W = specs[next(iter(specs))].shape
+    dh = np.abs(wrap_angle(headings - headings[n0]))
+    far = np.nonzero(dh > heading_rad + 1e-12)[0]
+    val, idx = -np.inf, None
+    if far.size:
+        k = far[np.argmax(best_per[far])]
+        val, idx = float(best_per[k]), (int(k), *np.unravel_index(int(arg_per[k]), (H, W)))
+    near = np.nonzero(dh <= heading_rad + 1e-12)[0]
+    rows, cols = np.ogrid[:H, :W]
+    outside = ((rows - r0) ** 2 + (cols - c0) ** 2 > radius_cells ** 2).ravel()
+    if not outside.any():
+        return val, idx
+    cells = np.nonzero(outside)[0]
+    for heads, D in _iter_scores(specs, stamps, near, S, chunk):
+        Dm = D.reshape(D.shape[0], -1)[:, cells]
+        am = Dm.argmax(axis=1)
+        per = Dm[np.arange(am.size), am]
+        k = int(np.argmax(per))
+        if per[k] > val:
+            val, idx = float(per[k]), (int(heads[k]), *np.unravel_index(int(cells[am[k]]), (H, W)))
+    return val, idx
 
 
 def _direct_scores(Mv: np.ndarray, T: np.ndarray, o: int) -> np.ndarray:
@@ -419,10 +476,30 @@ class Localisation:
     headings_rad: np.ndarray = field(repr=False)  # (n,) candidates
     best_per_heading: np.ndarray = field(repr=False)  # (n,) max of each D_n
     score_map: np.ndarray = field(repr=False)  # (H, W) D at the best heading
+    rival_score: float = float("nan")  # best score of a pose > rival_radius_cells or > rival_heading_rad away
+    rival_pose: np.ndarray | None = field(default=None, repr=False)  # (3,) that pose (None: not searched)
+    n_scans: int = 1  # scans joined by odometry into the stamp (localise_joined)
+
+    @property
+    def ambiguity(self) -> float:
+        """How close the best rival comes to the peak, in [0, 1] (ours): 1 = a tie, 0 = no better than a wrong heading.
+
+        ``(rival − base) / (score − base)`` with ``base`` the median over headings of each heading's best
+        score (what a wrong heading typically reaches: with a_c < 0 every pose in open space collects the
+        free-cell matches, so the raw ratio rival/score sits near 1 even for a unique pose). NaN when the
+        rival was not searched (``ambiguity=False``); 0 when no pose lies outside the window.
+        """
+        if not np.isfinite(self.rival_score):
+            return 0.0 if self.rival_score == -np.inf else float("nan")
+        base = float(np.median(self.best_per_heading))
+        if self.score - base <= 0:
+            return 1.0
+        return float(np.clip((self.rival_score - base) / (self.score - base), 0.0, 1.0))
 
     def __str__(self) -> str:
+        amb = f", ambiguity {self.ambiguity:.3f}" if np.isfinite(self.ambiguity) else ""
         return (f"pose x={self.pose[0]:.0f}, y={self.pose[1]:.0f} cells, heading "
-                f"{np.degrees(self.pose[2]):.1f} deg (score {self.score:.1f})")
+                f"{np.degrees(self.pose[2]):.1f} deg (score {self.score:.1f}{amb})")
 
 
 @dataclass(frozen=True)
@@ -443,6 +520,9 @@ class LocaliseParams(Params):
     chunk: int = param(8, "ours: base stamps per batched FFT call (CPU caches)")
     dtype: str = param("float32", "ours: float32 FFTs find the float64 peak (test) in about half the time")
     workers: int | None = param(None, "ours: scipy.fft threads (None = scipy's default)")
+    ambiguity: bool = param(True, "ours: also find the best rival pose (re-scores the headings near the peak)")
+    rival_radius_cells: float = param(5.0, "ours: a rival is farther than this from the peak (1 m at 0.2 m)")
+    rival_heading_rad: float = param(float(np.radians(30.0)), "ours: ... or its heading is more than 30° off")
 
     def __post_init__(self) -> None:
         with contextlib.suppress(TypeError):  # accept numpy dtypes (np.float32) too; check() names a bad one
@@ -465,6 +545,12 @@ class LocaliseParams(Params):
         v.check_choice(self.dtype, "dtype", ("float32", "float64"))
         if self.workers is not None:
             v.check_int(self.workers, "workers", minimum=1)
+        if not isinstance(self.ambiguity, (bool, np.bool_)):
+            raise TypeError(f"`ambiguity` must be a bool; got {type(self.ambiguity).__name__}")
+        v.check_positive(self.rival_radius_cells, "rival_radius_cells", allow_zero=True)
+        h = v.check_positive(self.rival_heading_rad, "rival_heading_rad", allow_zero=True)
+        if h >= np.pi:
+            raise ValueError(f"`rival_heading_rad` must be < π (else no heading is far enough); got {h}")
 
 
 def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_heading_rad: float | None = None,
@@ -513,21 +599,104 @@ def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_he
 
 def _localise(Mv, a, r, h, headings, p: LocaliseParams, *, tracking: bool) -> Localisation:
     """The search itself, on checked arguments: ``Mv`` the map in 004's values (called per scan by the runs)."""
-    dtype = np.dtype(p.dtype)
     free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
                               step_cells=p.step_cells, use_misses=p.use_misses)
-    o = int(np.ceil(_reach(r, h, p))) + 2
+    return _localise_samples(Mv, free, obs, int(np.ceil(_reach(r, h, p))) + 2, headings, p, tracking=tracking)
+
+
+def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking: bool, n_scans: int = 1):
+    """Rasterise the robot-frame samples ``free`` / ``obs`` (stamp half-size ``o``), search the peak and its rival."""
+    dtype = np.dtype(p.dtype)
     S = 2 * o
     stamps = _Stamps(free, obs, headings, p.a_c, p.a_p, p.a_n, o, dtype)
     n_marks = max(1, free.shape[0] + obs.shape[0])
     amax = max(abs(p.a_c), abs(p.a_p), abs(p.a_n))
     tol = (1e-9 if dtype == np.float64 else 2e-5) * amax * amax * n_marks
-    best_val, best_idx, best_map, best = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=p.workers,
-                                                      chunk=p.chunk, tol=tol)
+    specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=p.workers)
+    best_val, best_idx, best_map, best, arg = _peak_search(Mv, stamps, headings, S, o, dtype=dtype,
+                                                           workers=p.workers, chunk=p.chunk, tol=tol, specs=specs)
     n, row, col = (int(i) for i in best_idx)
-    heading = headings[n] if tracking else float(np.mod(headings[n], 2 * np.pi))
-    return Localisation(pose=np.array([float(col), float(row), heading]), row=row, col=col, heading_index=n,
-                        score=best_val, headings_rad=headings, best_per_heading=best, score_map=best_map)
+
+    def pose_of(k, rw, cl):
+        hd = headings[k] if tracking else float(np.mod(headings[k], 2 * np.pi))
+        return np.array([float(cl), float(rw), hd])
+
+    rival_val, rival_pose = float("nan"), None
+    if p.ambiguity:
+        rival_val, ridx = _rival_search(specs, stamps, headings, S, best_idx, best, arg,
+                                        radius_cells=p.rival_radius_cells, heading_rad=p.rival_heading_rad,
+                                        chunk=p.chunk)
+        rival_pose = None if ridx is None else pose_of(*ridx)
+    return Localisation(pose=pose_of(n, row, col), row=row, col=col, heading_index=n, score=best_val,
+                        headings_rad=headings, best_per_heading=best, score_map=best_map, rival_score=rival_val,
+                        rival_pose=rival_pose, n_scans=n_scans)
+
+
+def _joined_samples(beams, rel_poses, p: LocaliseParams):
+    """Free / obstacle samples of several scans in the frame of the first one, and the stamp half-size (ours).
+
+    ``beams``: ``(bearings, ranges, valid)`` per scan; ``rel_poses`` ``(k, 3)``: each scan's pose in the
+    first scan's frame (cells, rad; the first row is the zero pose).
+    """
+    frees, obss = [], []
+    for (a, r, h), q in zip(beams, rel_poses, strict=True):
+        f, ob = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
+                              step_cells=p.step_cells, use_misses=p.use_misses)
+        frees.append(se2_transform(q, f) if f.size else f.reshape(0, 2))
+        obss.append(se2_transform(q, ob) if ob.size else ob.reshape(0, 2))
+    free, obs = np.vstack(frees), np.vstack(obss)
+    reach = float(np.sqrt(np.max(np.sum(np.vstack([free, obs]) ** 2, axis=1))))
+    return free, obs, int(np.ceil(reach)) + 2
+
+
+def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = None,
+                    prior_heading_rad: float | None = None, window_rad: float | None = None,
+                    **overrides) -> Localisation:
+    """Pose of the first of several scans joined by odometry into one stamp (ours, on 004 §7).
+
+    A single scan in a corridor or a symmetric room matches equally well turned by 180° or
+    shifted along the corridor; two or three consecutive scans, placed relative to each
+    other by odometry, see more of the room and break such ties. Every scan's free and
+    obstacle samples are moved into the first scan's frame with
+    ``odom_poses[0]⁻¹ ⊕ odom_poses[k]`` and drawn into one image T_n per heading (obstacle
+    marks over free ones, as in :func:`rasterise_scan`); the search is :func:`localise`'s.
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        The known map (cell codes).
+    scans : sequence of Scan
+        In cell units; the pose of ``scans[0]`` is estimated.
+    odom_poses : array_like, shape (len(scans), 3)
+        Odometry pose of each scan in any common frame (cells, rad); only the relative
+        poses matter.
+    params, prior_heading_rad, window_rad, **overrides
+        As in :func:`localise`.
+
+    Examples
+    --------
+    >>> from slamlab.sim import Rangefinder, test_room_200
+    >>> M = test_room_200()
+    >>> rf = Rangefinder(n_beams=180, max_range_cells=60)
+    >>> poses = np.array([[70, 30, np.radians(40)], [66, 27, np.radians(40)]])
+    >>> loc = localise_joined(M, [rf.scan(M, q) for q in poses], poses, delta_alpha_rad=np.radians(5))
+    >>> loc.col, loc.row, round(float(np.degrees(loc.pose[2]))), loc.n_scans
+    (70, 30, 40, 2)
+    """
+    p = LocaliseParams.resolve(params, **overrides)
+    g = check_grid(grid)
+    if isinstance(scans, Scan) or not isinstance(scans, (list, tuple)):
+        raise TypeError(f"`scans` must be a list or tuple of Scan; got {type(scans).__name__}")
+    if not scans:
+        raise ValueError("`scans` must hold at least one scan; got 0")
+    beams = [_scan_beams(s, f"scans[{k}]") for k, s in enumerate(scans)]
+    P = check_poses(odom_poses, "odom_poses", n=len(scans))
+    if prior_heading_rad is None and window_rad is not None:
+        raise ValueError("`window_rad` needs `prior_heading_rad` (tracking mode)")
+    headings = heading_candidates(p.delta_alpha_rad, center_rad=prior_heading_rad, window_rad=window_rad)
+    free, obs, o = _joined_samples(beams, se2_relative(P[0], P), p)
+    return _localise_samples(grid_to_values(g, p.a_c, p.a_p, p.a_n), free, obs, o, headings, p,
+                             tracking=prior_heading_rad is not None, n_scans=len(scans))
 
 
 def heading_error(est_rad, true_rad):

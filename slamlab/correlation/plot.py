@@ -169,20 +169,23 @@ def constants_figure(result, grid):
     return fig
 
 
-def plot_log_localisation(result, *, ax=None):
-    """A log's grid (metres), the logged poses of the test scans, estimates and the first scan at its estimate."""
+def plot_log_localisation(result, *, mode: int = 0, ax=None):
+    """A log's grid (metres), the logged poses of the test scans, estimates of ``result.joined[mode]`` and the
+    first scan at its single-mode estimate."""
     f = result.frame
     extent = (f.x0_m - f.cell_m / 2, f.x0_m + (f.shape[1] - 0.5) * f.cell_m,
               f.y0_m - f.cell_m / 2, f.y0_m + (f.shape[0] - 0.5) * f.cell_m)
-    ax = plot_grid(result.grid, ax=ax, extent=extent, title=f"{result.name}: grid from the logged poses, scans localised",
-                   figsize=(8, 8))
+    k = result.joined[mode]
+    what = "one scan" if k == 1 else f"{k} scans joined by odometry"
+    ax = plot_grid(result.grid, ax=ax, extent=extent, title=f"{result.name}: grid from the logged poses, "
+                   f"localised from {what}", figsize=(8, 8))
     if result.example_points_m is not None:
         pts = result.example_points_m
         ax.plot(pts[:, 0], pts[:, 1], **{**STYLE["measurement"], "markersize": 2.5},
                 label=f"scan {result.scan_indices[0]} at its estimate")
-    t, e = result.true_poses_m, result.est_poses_m
+    t, e = result.true_poses_m, result.est_poses_m[mode]
     ax.plot(t[:, 0], t[:, 1], "o", color="black", mfc="none", ms=9, label="logged pose")
-    ok = result.success
+    ok = result.success[mode]
     ax.plot(e[ok, 0], e[ok, 1], "x", color=STYLE["estimate"]["color"], ms=8, mew=2, label="estimate (ok)")
     if (~ok).any():
         ax.plot(e[~ok, 0], e[~ok, 1], "x", color="tab:red", ms=9, mew=2, label="estimate (failed)")

@@ -11,7 +11,7 @@ from ..sim.grid import add_clutter, measurement_room_200, test_room_200
 from ..sim.rangefinder import Rangefinder
 from ..widgets import STYLE as _STYLE
 from ..widgets import slider as _slider
-from .algorithm import heading_error, localise
+from .algorithm import heading_error, localise, localise_joined
 from .experiments import _carmen_log, log_grid, random_clutter
 from .plot import localisation_figure
 
@@ -70,24 +70,27 @@ def _log(path):
 
 
 def explore_log_scan(path=None, **defaults):
-    """Pick a scan of a CARMEN log (default: the corrected Intel log) and a_c/a_p; it is localised on a grid
-    built from the log's poses without its neighbours (what :func:`run_log_localisation` does)."""
-    d = {"scan": 250, "a_c": -1.0, "a_p": 1.0, "exclude": 10, "cell_m": 0.2, "max_range_m": 10.0}
+    """Pick a scan of a CARMEN log (default: the corrected Intel log), a_c/a_p and how many consecutive scans to
+    join by (logged) odometry; it is localised on a grid built from the log's poses without its neighbours
+    (what :func:`run_log_localisation` does) and its ambiguity printed."""
+    d = {"scan": 250, "a_c": -1.0, "a_p": 1.0, "exclude": 10, "joined": 1, "cell_m": 0.2, "max_range_m": 10.0}
     d.update(defaults)
     log = _log(path)
 
-    def show(scan, a_c, a_p, exclude):
+    def show(scan, a_c, a_p, exclude, joined):
         try:
-            leave = range(max(0, scan - exclude), min(log.n_scans, scan + exclude + 1))
+            js = [scan - j for j in range(joined) if scan - j >= 0]
+            ex = max(exclude, len(js) - 1)  # the joined scans never draw the map they are matched against
+            leave = range(max(0, scan - ex), min(log.n_scans, scan + ex + 1))
             G, frame, scans_c, Pc = log_grid(log, cell_m=d["cell_m"], max_range_m=d["max_range_m"], leave_out=leave)
-            loc = localise(G, scans_c[scan], a_c=a_c, a_p=a_p)
+            loc = localise_joined(G, [scans_c[j] for j in js], Pc[js], a_c=a_c, a_p=a_p)
         except (ValueError, TypeError) as exc:
             print(f"Cannot run with these settings: {exc}")
             return
         est = frame.to_metres(loc.pose[None])[0]
         err = np.hypot(*(est[:2] - log.poses[scan, :2]))
-        print(f"{log.name} scan {scan}: error {err:.2f} m, "
-              f"{np.degrees(heading_error(est[2], log.poses[scan, 2])):.1f}°")
+        print(f"{log.name} scan {scan} ({len(js)} scan(s) joined by the logged odometry): error {err:.2f} m, "
+              f"{np.degrees(heading_error(est[2], log.poses[scan, 2])):.1f}°, ambiguity {loc.ambiguity:.3f}")
         localisation_figure(G, scans_c[scan], loc, Pc[scan])
 
     return widgets.interactive(
@@ -96,4 +99,5 @@ def explore_log_scan(path=None, **defaults):
         a_c=_slider(widgets.FloatSlider, d["a_c"], -2.0, 2.0, 0.25, "a_c (free)"),
         a_p=_slider(widgets.FloatSlider, d["a_p"], -2.0, 2.0, 0.25, "a_p (obstacle)"),
         exclude=_slider(widgets.IntSlider, d["exclude"], 0, 50, 1, "scans left out of the map (±)"),
+        joined=_slider(widgets.IntSlider, d["joined"], 1, 3, 1, "scans joined by odometry"),
     )

@@ -108,6 +108,7 @@ def _load_tasks() -> None:
         tasks_features,
         tasks_filters,
         tasks_hough,
+        tasks_planes,
         tasks_stereo,
         tasks_stores,
     )

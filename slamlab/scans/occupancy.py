@@ -29,7 +29,7 @@ from ..geometry.se2 import check_poses
 from .grid import FREE, OBSTACLE, UNEXPLORED, check_grid
 from .scan import Scan
 
-__all__ = ["RULES", "OccupancyGrid", "likelihood_field", "occupancy_grid"]
+__all__ = ["RULES", "OccupancyGrid", "label_counts", "likelihood_field", "occupancy_grid"]
 
 #: Cell-labelling rules of :func:`occupancy_grid`.
 RULES = ("count", "endpoints")
@@ -139,14 +139,32 @@ def occupancy_grid(scans: Sequence[Scan], poses, shape: tuple[int, int], *, rule
             bi, ki = np.nonzero(m)
             passes += np.bincount(flat_index(x0[sl][bi] + c[sl][bi] * t[ki], y0[sl][bi] + s[sl][bi] * t[ki]),
                                   minlength=size)
-    grid = np.full(size, UNEXPLORED, dtype=np.int8)
+    hits, passes = hits.reshape(n_rows, n_cols), passes.reshape(n_rows, n_cols)
+    return OccupancyGrid(label_counts(hits, passes, rule=rule, hit_ratio=ratio, min_hits=min_hits), hits, passes,
+                         rule)
+
+
+def label_counts(hits, passes, *, rule: str = "count", hit_ratio: float = 0.25, min_hits: int = 1) -> np.ndarray:
+    """Cell codes from hit and pass counts by :func:`occupancy_grid`'s ``rule`` (counts add over scans).
+
+    Lets a caller subtract some scans' counts from a whole log's and label the rest
+    without recounting (the leave-out maps of Ch. 5).
+
+    >>> label_counts(np.array([[0, 1, 1]]), np.array([[0, 2, 8]])).tolist()
+    [[-1, 1, 0]]
+    """
+    rule = v.check_choice(rule, "rule", RULES)
+    hits = np.asarray(hits)
+    passes = np.asarray(passes)
+    if hits.shape != passes.shape:
+        raise ValueError(f"`hits` and `passes` must have the same shape; got {hits.shape} and {passes.shape}")
+    grid = np.full(hits.shape, UNEXPLORED, dtype=np.int8)
     grid[passes > 0] = FREE
     obstacle = hits >= min_hits
     if rule == "count":
-        obstacle &= hits >= ratio * passes
+        obstacle &= hits >= hit_ratio * passes
     grid[obstacle] = OBSTACLE
-    return OccupancyGrid(grid.reshape(n_rows, n_cols), hits.reshape(n_rows, n_cols),
-                         passes.reshape(n_rows, n_cols), rule)
+    return grid
 
 
 def likelihood_field(grid, *, cell_m: float = 1.0, max_dist: float | None = None) -> np.ndarray:

@@ -106,3 +106,30 @@ __all__ += [
     "turn_in_place",
     "waypoint_path",
 ]
+
+# --- a room of planes, a vertical line scanner on a yawing quadcopter, inertial odometry (002; Ch. 10) ---
+from .planes_room import (
+    Flight,
+    PlaneRoom,
+    PlaneScanner,
+    build_corridor,
+    build_plane_room,
+    cast_rays_planes,
+    quad_flight,
+    scanner_beam_directions,
+    simulate_flight,
+    simulate_odometry_3d,
+)
+
+__all__ += [
+    "Flight",
+    "PlaneRoom",
+    "PlaneScanner",
+    "build_corridor",
+    "build_plane_room",
+    "cast_rays_planes",
+    "quad_flight",
+    "scanner_beam_directions",
+    "simulate_flight",
+    "simulate_odometry_3d",
+]

@@ -25,5 +25,12 @@ def test_explore_log_scan(capsys):
     w.f(**{**w.kwargs, "a_c": 1.0, "a_p": 1.0})
     assert "Cannot run with these settings" in capsys.readouterr().out
     w.f(**{**w.kwargs, "scan": 909, "exclude": 0})
-    assert "intel-corrected.log.gz scan 909: error" in capsys.readouterr().out
+    assert "intel-corrected.log.gz scan 909 (1 scan(s) joined by the logged odometry): error" \
+        in capsys.readouterr().out
+    w.f(**{**w.kwargs, "scan": 0, "joined": 3})  # no scan before the first: it is localised alone
+    assert "scan 0 (1 scan(s) joined" in capsys.readouterr().out
+    w.f(**{**w.kwargs, "scan": 250, "joined": 3, "exclude": 0})
+    out = capsys.readouterr().out
+    assert "scan 250 (3 scan(s) joined" in out
+    assert "ambiguity" in out
     plt.close("all")

@@ -1,0 +1,211 @@
+"""Frame building and plane extraction by RANSAC (002 "Forming the range frame", "Plane extraction").
+
+Frame (002, reconstructed; the source's formula is garbled): the N lines of a buffer,
+each in the body frame at its own time, are moved into the body pose of the *last*
+line with the odometry, ``T_j = (ᵒT_N)⁻¹ ᵒT_j`` (``ᵒT_j``: body pose of line ``j`` in
+the odom frame).
+
+Planes ``n·x = p`` (002's normal form ``n·x − p = 0``) by RANSAC; 002 used PCL's, ours
+is numpy and batched: each round draws ``iterations`` minimal samples (3 points) at
+once from a random subset of ``sample_points`` points, scores all hypotheses on that
+subset at once (ours: preemptive scoring on a subset), takes the best, collects its
+inliers (``|n·x − p| <= tolerance_m``) among all remaining points, refits by least
+squares (SVD) on them and recounts; a plane needs ``min_support`` inliers. Planes
+are taken greedily until none has enough support or ``max_planes`` were found.
+Sign convention (ours): ``p >= 0``, i.e. the normal points away from the sensor.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate as v
+
+__all__ = ["Frame", "build_frame", "extract_planes", "fit_plane_lsq", "frame_transforms", "plane_distances"]
+
+
+def frame_transforms(odometry) -> np.ndarray:
+    """``T_j = (ᵒT_N)⁻¹ ᵒT_j`` for every line ``j`` of a buffer (002, reconstructed): ``(N, 4, 4)``.
+
+    >>> T = np.tile(np.eye(4), (2, 1, 1)); T[0, 0, 3] = 1.0
+    >>> frame_transforms(T)[0, :3, 3].tolist()
+    [1.0, 0.0, 0.0]
+    """
+    T = v.as_finite_array(odometry, "odometry", ndim=3)
+    if T.shape[1:] != (4, 4) or T.shape[0] < 1:
+        raise ValueError(f"`odometry` must have shape (N >= 1, 4, 4); got {T.shape}")
+    RN, tN = T[-1, :3, :3], T[-1, :3, 3]
+    out = np.zeros_like(T)
+    out[:, :3, :3] = RN.T @ T[:, :3, :3]
+    out[:, :3, 3] = (T[:, :3, 3] - tN) @ RN
+    out[:, 3, 3] = 1.0
+    return out
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A 3-D range frame in the body pose of its last line (002): ``points (K, 3)``, ``intensities (K,)``,
+    ``rays (K, 3)`` unit beam directions (for the incidence-angle correction), ``n_dropped`` points without
+    a return (NaN) left out."""
+
+    points: np.ndarray
+    intensities: np.ndarray
+    rays: np.ndarray
+    n_dropped: int
+
+    def __len__(self) -> int:
+        return self.points.shape[0]
+
+
+def build_frame(points, intensities, odometry, *, origin_m=(0.0, 0.0, 0.0)) -> Frame:
+    """Move N lines of body-frame points into the last line's body pose (002 "Forming the range frame").
+
+    Parameters
+    ----------
+    points : (N, B, 3) points of N lines (NaN: no return) in the body frame at each line's time.
+    intensities : (N, B) intensities.
+    odometry : (N, 4, 4) body poses ``ᵒT_j`` of the lines in the odom frame.
+    origin_m : (3,) scanner origin in the body frame (for the beam directions).
+    """
+    P = np.asarray(points, dtype=float)
+    if P.ndim != 3 or P.shape[2] != 3:
+        raise ValueError(f"`points` must have shape (N, B, 3); got {P.shape}")
+    I = np.asarray(intensities, dtype=float)
+    if I.shape != P.shape[:2]:
+        raise ValueError(f"`intensities` must have shape {P.shape[:2]}; got {I.shape}")
+    T = frame_transforms(odometry)
+    if T.shape[0] != P.shape[0]:
+        raise ValueError(f"`odometry` must hold one pose per line ({P.shape[0]}); got {T.shape[0]}")
+    o = v.as_vector(origin_m, "origin_m", 3)
+    ok = np.isfinite(P).all(axis=2) & np.isfinite(I)
+    line = np.nonzero(ok)[0]
+    pb = P[ok]
+    R = T[line, :3, :3]
+    pts = np.einsum("kij,kj->ki", R, pb) + T[line, :3, 3]
+    d = pb - o
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+    rays = np.einsum("kij,kj->ki", R, d)
+    return Frame(pts, I[ok], rays, int((~ok).sum()))
+
+
+def fit_plane_lsq(points) -> tuple[np.ndarray, float]:
+    """Least-squares plane through ``points (K >= 3, 3)``: ``(n, p)`` with ``n·x = p``, ``p >= 0`` (SVD; ours).
+
+    >>> n, p = fit_plane_lsq([[0, 0, 2.0], [1, 0, 2], [0, 1, 2], [1, 1, 2]])
+    >>> np.round(n, 12).tolist(), round(p, 12)
+    ([0.0, 0.0, 1.0], 2.0)
+    """
+    X = v.as_finite_array(points, "points", ndim=2)
+    if X.shape[1] != 3 or X.shape[0] < 3:
+        raise ValueError(f"`points` must have shape (K >= 3, 3); got {X.shape}")
+    c = X.mean(axis=0)
+    _, s, Vt = np.linalg.svd(X - c, full_matrices=False)
+    if s[1] <= 1e-12 * max(s[0], 1e-300):
+        raise ValueError("`points` are collinear: no unique plane")
+    n = Vt[2]
+    p = float(n @ c)
+    if p < 0:
+        n, p = -n, -p
+    return n, p
+
+
+def plane_distances(points, n, p) -> np.ndarray:
+    """Signed distances ``n·x − p`` of ``points (K, 3)`` to the plane ``(n, p)``."""
+    return np.asarray(points) @ np.asarray(n) - p
+
+
+def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, min_support: int = 400,
+                   max_planes: int = 12, sample_points: int = 1000, refit_rounds: int = 2,
+                   min_width_m: float = 0.0, rng=None):
+    """Greedy batched RANSAC plane extraction (002 "Plane extraction"; our numpy version of PCL's).
+
+    Parameters
+    ----------
+    points : (K, 3) frame points (finite).
+    tolerance_m : inlier distance.
+    iterations : minimal samples (hypotheses) per plane.
+    min_support : inliers a plane needs.
+    max_planes : planes at most.
+    sample_points : hypotheses are drawn and scored on this many random remaining points.
+    refit_rounds : least-squares refits on the inliers, each followed by a recount.
+    min_width_m : a plane whose inliers span less than this between their 10th and 90th percentiles along
+        either in-plane principal axis is dropped (its points go to the leftover): a narrow band (a few
+        scan lines) fixes its normal badly about its axis (ours).
+    rng : Generator, int or None.
+
+    Returns
+    -------
+    planes : list of ``(n (3,), p, inlier_indices)``; leftover (K,) bool mask of points on no plane.
+
+    Examples
+    --------
+    >>> g = np.random.default_rng(0); xy = g.uniform(-2, 2, (2000, 2))
+    >>> pts = np.c_[xy, np.full(2000, 1.5)]
+    >>> planes, rest = extract_planes(pts, rng=0)
+    >>> len(planes), np.round(planes[0][0], 9).tolist(), round(planes[0][1], 9), int(rest.sum())
+    (1, [0.0, 0.0, 1.0], 1.5, 0)
+    """
+    X = v.as_finite_array(points, "points", ndim=2)
+    if X.shape[1] != 3:
+        raise ValueError(f"`points` must have shape (K, 3); got {X.shape}")
+    tol = v.check_positive(tolerance_m, "tolerance_m")
+    iters = v.check_int(iterations, "iterations", minimum=1)
+    min_support = v.check_int(min_support, "min_support", minimum=3)
+    max_planes = v.check_int(max_planes, "max_planes", minimum=0)
+    sample_points = v.check_int(sample_points, "sample_points", minimum=3)
+    refit_rounds = v.check_int(refit_rounds, "refit_rounds", minimum=0)
+    min_width_m = v.check_positive(min_width_m, "min_width_m", allow_zero=True)
+    rng = v.as_rng(rng)
+    remaining = np.arange(X.shape[0])
+    planes, rejected = [], []
+    while len(planes) + len(rejected) < 2 * max_planes and len(planes) < max_planes and remaining.size >= max(min_support, 3):
+        sub = remaining if remaining.size <= sample_points else remaining[rng.integers(0, remaining.size,
+                                                                                        sample_points)]
+        S = X[sub]
+        idx = rng.integers(0, S.shape[0], (iters, 3))
+        a, b, c = S[idx[:, 0]], S[idx[:, 1]], S[idx[:, 2]]
+        nrm = np.cross(b - a, c - a)
+        norm = np.linalg.norm(nrm, axis=1)
+        good = norm > 1e-9
+        if not good.any():
+            break
+        nrm = nrm[good] / norm[good, None]
+        off = np.einsum("ij,ij->i", nrm, a[good])
+        counts = (np.abs(S @ nrm.T - off) <= tol).sum(axis=0)
+        best = int(np.argmax(counts))
+        # the subset's best count predicts the full count; stop early when even that is too small
+        if counts[best] * remaining.size / S.shape[0] < 0.5 * min_support:
+            break
+        n, p = nrm[best], float(off[best])
+        Y = X[remaining]
+        mask = np.abs(Y @ n - p) <= tol
+        for _ in range(refit_rounds):
+            if mask.sum() < 3:
+                break
+            try:
+                n, p = fit_plane_lsq(Y[mask])
+            except ValueError:
+                break
+            new = np.abs(Y @ n - p) <= tol
+            if np.array_equal(new, mask):
+                break
+            mask = new
+        if mask.sum() < min_support:
+            break
+        if p < 0:
+            n, p = -n, -p
+        if min_width_m > 0:
+            Z = Y[mask] - Y[mask].mean(axis=0)
+            ab = Z @ np.linalg.eigh(Z.T @ Z)[1][:, 1:]              # in-plane principal coordinates
+            width = np.diff(np.percentile(ab, [10, 90], axis=0), axis=0).min()
+            if width < min_width_m:
+                remaining = remaining[~mask]
+                rejected.append(remaining.size)
+                continue
+        planes.append((n, p, remaining[mask]))
+        remaining = remaining[~mask]
+    leftover = np.zeros(X.shape[0], dtype=bool)
+    leftover[remaining] = True
+    return planes, leftover

@@ -1,0 +1,319 @@
+"""The plane-based particle filter: motion, pairing + LM, intensity weights, resampling, pose, map (002 "MCL").
+
+One cycle (002; the stage names are those of 002's timing table):
+
+1. *extraction* — RANSAC planes in the frame (:func:`~slamlab.planes.extract_planes`);
+2. *description* — each plane's frame and cell grid (:func:`~slamlab.planes.describe_plane`);
+3. *motion* — every particle moved by the odometry increment ``(ΔR, Δt)`` between the
+   frames plus ``ε ~ N(0, V)``: ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t`` (002's formula is
+   garbled; ours: body-frame composition);
+4. *equations* — per particle, frame planes paired with map planes (normals within
+   ``pair_angle_deg``, offsets within ``pair_dist_m`` once moved by the particle; the
+   closest pair wins, ours) and the pose solved by :func:`~slamlab.planes.lm_pose`;
+5. *weights* — ``SAD_i = (1/N_i) Σ_planes Σ_cells |ᵇI − ᵐI|`` over a thinned set of the
+   frame planes' cells (every ``thin``-th), the map cell being the one under the frame
+   cell's centre moved by the particle; ``SAD*_i = max SAD − SAD_i``, ``w_i = SAD*_i / Σ SAD*``
+   (002); importance resampling (ours: systematic);
+6. *pose* — the mean of the particles (rotation: the chordal mean, projected on SO(3));
+   then the frame's planes enter the map (ours: timed apart as *map*, 002's table has
+   no such row).
+
+A frame whose planes' normals span fewer than ``min_normal_rank`` directions (no plane,
+one plane, parallel planes only) or that is not finite keeps the prediction and is
+counted (ours: 002 says one pair still works, :func:`lm_pose` accepts it; the filter is
+stricter by default, ``min_normal_rank=1`` follows 002).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .. import _validate as v
+from .._params import Params, param
+from ..geometry import se3_inverse
+from .description import Plane, describe_plane, lookup_local
+from .extraction import Frame, extract_planes
+from .mapping import PlaneMap
+from .transform import lm_pose
+
+__all__ = ["STAGES", "CycleReport", "PlaneSLAM", "PlaneSLAMParams", "intensity_weights", "mean_pose",
+           "pair_planes", "predict_particles", "systematic_resample"]
+
+#: the stages of 002's timing table, in order (plus our "map")
+STAGES = ("extraction", "description", "motion", "equations", "weights", "pose", "map")
+
+
+@dataclass(frozen=True)
+class PlaneSLAMParams(Params):
+    """Settings of the plane particle filter (002; "ours" where 002 gives no value)."""
+
+    n_particles: int = param(400, "002: 400 particles")
+    sigma_xyz_m: float = param(0.03, "ours: V, translation std per frame")
+    sigma_rpy_deg: float = param(0.5, "ours: V, rotation std per frame")
+    ransac_tolerance_m: float = param(0.04, "ours (002: PCL RANSAC, tolerance not given)")
+    ransac_iterations: int = param(100, "ours")
+    ransac_min_support: int = param(400, "ours")
+    ransac_sample_points: int = param(1000, "ours")
+    max_planes: int = param(10, "ours")
+    min_width_m: float = param(0.6, "ours: planes narrower than this (10-90 % spread) are dropped")
+    cell_m: float = param(0.25, "ours (002: 'cells of a given size')")
+    thin: int = param(3, "ours (002: 'a thinned set of parts')")
+    pair_angle_deg: float = param(10.0, "ours")
+    pair_dist_m: float = param(0.4, "ours")
+    lm_iters: int = param(6, "ours")
+    sigma_normal: float = param(0.02, "ours: scale of the normal residuals")
+    sigma_offset_m: float = param(0.03, "ours: scale of the offset residuals")
+    lm_prior: bool = param(True, "ours: a weak prior at the prediction in the LM (False: 002's bare system)")
+    lm_prior_scale: float = param(10.0, "ours: the prior's stds are this times V's")
+    lm_lambda: float = param(1e-3, "ours")
+    min_normal_rank: int = param(2, "ours (002: 1 pair is enough)")
+    intensity_weights: bool = param(True, "002")
+    incidence_correction: bool = param(True, "002 after [17]")
+    merge_angle_deg: float = param(8.0, "ours (002: 'some tolerance')")
+    merge_dist_m: float = param(0.15, "ours")
+    voxel_m: float = param(0.1, "ours")
+
+    def check(self) -> None:
+        v.check_int(self.n_particles, "n_particles", minimum=1)
+        for name in ("sigma_xyz_m", "sigma_rpy_deg"):
+            v.check_positive(getattr(self, name), name, allow_zero=True)
+        for name in ("ransac_tolerance_m", "cell_m", "pair_angle_deg", "pair_dist_m", "lm_lambda",
+                     "merge_angle_deg", "merge_dist_m", "voxel_m"):
+            v.check_positive(getattr(self, name), name)
+        for name, lo in (("ransac_iterations", 1), ("ransac_min_support", 3), ("ransac_sample_points", 3),
+                         ("max_planes", 1), ("thin", 1), ("lm_iters", 1), ("min_normal_rank", 1)):
+            v.check_int(getattr(self, name), name, minimum=lo)
+        if self.min_normal_rank > 3:
+            raise ValueError(f"`min_normal_rank` must be 1, 2 or 3; got {self.min_normal_rank}")
+        for name in ("intensity_weights", "incidence_correction", "lm_prior"):
+            if not isinstance(getattr(self, name), bool):
+                raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
+
+
+def _exp(rotvec):
+    return Rotation.from_rotvec(rotvec).as_matrix()
+
+
+def predict_particles(X, U, sigma_xyz_m: float, sigma_rpy_deg: float, rng) -> np.ndarray:
+    """Motion model: ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t``, ``ε ~ N(0, V)`` (002; composition ours).
+
+    ``X (P, 4, 4)`` particles ``ᵐT_b``, ``U (4, 4)`` the odometry increment between the frames.
+    """
+    P = X.shape[0]
+    out = X @ U
+    out[:, :3, :3] = out[:, :3, :3] @ _exp(rng.normal(0.0, np.deg2rad(sigma_rpy_deg), (P, 3)))
+    out[:, :3, 3] += rng.normal(0.0, sigma_xyz_m, (P, 3))
+    return out
+
+
+def pair_planes(X, n_b, p_b, n_map, p_map, *, angle_deg: float, dist_m: float) -> np.ndarray:
+    """Map plane paired with each frame plane for each particle, ``(P, F)`` (-1: none) (002; rule ours).
+
+    A frame plane moved by the particle pairs with the map plane of the smallest
+    ``(1 − cos)/(1 − cos tol) + (Δp / dist_m)²`` among those within both tolerances.
+    """
+    if len(n_map) == 0 or len(n_b) == 0:
+        return np.full((X.shape[0], len(n_b)), -1, dtype=int)
+    n_w = np.einsum("pij,fj->pfi", X[:, :3, :3], n_b)                     # (P, F, 3)
+    p_w = p_b[None] + np.einsum("pfi,pi->pf", n_w, X[:, :3, 3])
+    cos = np.einsum("pfi,mi->pfm", n_w, n_map)
+    dp = np.abs(p_w[..., None] - p_map)
+    c_tol = np.cos(np.deg2rad(angle_deg))
+    ok = (cos > c_tol) & (dp < dist_m)
+    cost = np.where(ok, (1 - cos) / (1 - c_tol) + (dp / dist_m) ** 2, np.inf)
+    k = np.argmin(cost, axis=2)
+    return np.where(np.isfinite(np.take_along_axis(cost, k[..., None], 2)[..., 0]), k, -1)
+
+
+def intensity_weights(sad) -> np.ndarray:
+    """``SAD*_i = max SAD − SAD_i``, ``w_i = SAD*_i / Σ SAD*`` (002); NaN SAD (no overlap) counts as the max;
+    all equal → uniform.
+
+    >>> intensity_weights([1.0, 3.0, 2.0]).tolist()
+    [0.6666666666666666, 0.0, 0.3333333333333333]
+    """
+    s = np.asarray(sad, dtype=float)
+    if not np.isfinite(s).any():
+        return np.full(s.shape, 1.0 / s.size)
+    top = np.nanmax(s)
+    star = top - np.where(np.isfinite(s), s, top)
+    tot = star.sum()
+    return star / tot if tot > 0 else np.full(s.shape, 1.0 / s.size)
+
+
+def systematic_resample(w, rng) -> np.ndarray:
+    """Indices of a systematic (low-variance) importance resampling of weights ``w (P,)`` (ours)."""
+    P = len(w)
+    c = np.cumsum(w)
+    c[-1] = 1.0
+    return np.searchsorted(c, (rng.random() + np.arange(P)) / P)
+
+
+def mean_pose(X, w=None) -> np.ndarray:
+    """Weighted mean pose of particles ``(P, 4, 4)``: mean position; chordal mean rotation (SVD projection)."""
+    w = np.full(X.shape[0], 1.0 / X.shape[0]) if w is None else np.asarray(w) / np.sum(w)
+    M = np.einsum("p,pij->ij", w, X[:, :3, :3])
+    U, _, Vt = np.linalg.svd(M)
+    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt))])
+    T = np.eye(4)
+    T[:3, :3] = U @ D @ Vt
+    T[:3, 3] = w @ X[:, :3, 3]
+    return T
+
+
+@dataclass(frozen=True)
+class CycleReport:
+    """What one cycle did: planes found, pairs, whether the frame was used, ``times_s`` per stage."""
+
+    n_points: int
+    n_planes: int
+    normal_rank: int
+    corrected: bool
+    mean_pairs: float
+    times_s: dict
+
+
+def _normal_rank(normals, tol_deg: float = 10.0) -> int:
+    if len(normals) == 0:
+        return 0
+    s = np.linalg.svd(np.asarray(normals), compute_uv=False)
+    return int(np.sum(s > np.sin(np.deg2rad(tol_deg)) * s[0]))
+
+
+class PlaneSLAM:
+    """The plane-based particle-filter SLAM of 002: particles ``X (P, 4, 4)`` (``ᵐT_b``), ``map``, counters.
+
+    ``step(frame, odometry_increment)`` runs one cycle; ``history`` keeps the pose estimates.
+    """
+
+    def __init__(self, initial_pose=None, *, params: PlaneSLAMParams | None = None, rng=None, **overrides):
+        self.params = p = PlaneSLAMParams.resolve(params, **overrides)
+        self.rng = v.as_rng(rng)
+        T0 = np.eye(4) if initial_pose is None else v.as_matrix(initial_pose, "initial_pose", (4, 4))
+        self.X = np.repeat(T0[None], p.n_particles, axis=0)
+        self.map = PlaneMap(angle_deg=p.merge_angle_deg, dist_m=p.merge_dist_m, voxel_m=p.voxel_m)
+        self.pose = T0.copy()
+        self.n_frames = 0
+        self.n_kept_prediction = 0
+        self.last_planes: list[Plane] = []
+        self.X_predicted = self.X.copy()
+        self.X_solved = self.X.copy()
+        self.weights = np.full(p.n_particles, 1.0 / p.n_particles)
+        #: False freezes the map (ours: for one-cycle studies such as 002 Fig. 4)
+        self.update_map = True
+
+    # --- the stages -------------------------------------------------------------------------------------------
+    def detect(self, frame: Frame):
+        """Stages 1-2: planes of ``frame`` and their descriptions (body frame), the leftover mask."""
+        p = self.params
+        found, leftover = extract_planes(frame.points, tolerance_m=p.ransac_tolerance_m,
+                                         iterations=p.ransac_iterations, min_support=p.ransac_min_support,
+                                         max_planes=p.max_planes, sample_points=p.ransac_sample_points,
+                                         min_width_m=p.min_width_m,
+                                         rng=self.rng)
+        return found, leftover
+
+    def describe(self, frame: Frame, found) -> list[Plane]:
+        p = self.params
+        return [describe_plane(frame.points[idx], frame.intensities[idx], n, off, cell_m=p.cell_m,
+                               rays=frame.rays[idx], incidence_correction=p.incidence_correction)
+                for n, off, idx in found]
+
+    def solve(self, planes: list[Plane]):
+        """Stage 4: pair and solve per particle; returns the pairs ``(P, F)``."""
+        p = self.params
+        n_b = np.array([pl.n for pl in planes])
+        p_b = np.array([pl.p for pl in planes])
+        N, Pm = self.map.arrays()
+        pairs = pair_planes(self.X, n_b, p_b, N, Pm, angle_deg=p.pair_angle_deg, dist_m=p.pair_dist_m)
+        mask = pairs >= 0
+        prior = None
+        if p.lm_prior:
+            prior = p.lm_prior_scale * np.r_[[max(np.deg2rad(p.sigma_rpy_deg), 1e-6)] * 3,
+                                             [max(p.sigma_xyz_m, 1e-6)] * 3]
+        if mask.any():
+            k = np.where(mask, pairs, 0)
+            res = lm_pose(self.X[:, :3, :3], self.X[:, :3, 3], N[k], Pm[k], n_b, p_b, mask,
+                          sigma_n=p.sigma_normal, sigma_p_m=p.sigma_offset_m, prior_sigma=prior,
+                          lambda0=p.lm_lambda, max_iters=p.lm_iters)
+            self.X[:, :3, :3], self.X[:, :3, 3] = res.R, res.t
+        return pairs
+
+    def sad(self, planes: list[Plane], pairs) -> np.ndarray:
+        """Stage 5a: ``SAD_i`` per particle (NaN where no cell overlaps) (002)."""
+        P = self.X.shape[0]
+        tot, cnt = np.zeros(P), np.zeros(P)
+        for f, pl in enumerate(planes):
+            sel = slice(None, None, self.params.thin)
+            uv = ((pl.ij[sel] + 0.5) * pl.cell_m).T                           # (2, C) frame-plane coordinates
+            I_b = pl.mean_intensity[sel]
+            for m in np.unique(pairs[:, f]):
+                if m < 0:
+                    continue
+                who = np.flatnonzero(pairs[:, f] == m)
+                mp = self.map.planes[m]
+                # frame plane -> body -> map (particle) -> map plane: one affine map of the cell centres
+                A = se3_inverse(mp.T) @ self.X[who] @ pl.T                    # (p, 4, 4)
+                local = np.swapaxes(A[:, :2, :2] @ uv + A[:, :2, 3:], 1, 2)   # (p, C, 2)
+                I_m = lookup_local(mp, local)                                  # (p, C)
+                d = np.abs(I_b[None] - I_m)
+                ok = np.isfinite(d)
+                tot[who] += np.where(ok, d, 0.0).sum(axis=1)
+                cnt[who] += ok.sum(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(cnt > 0, tot / cnt, np.nan)
+
+    # --- one cycle --------------------------------------------------------------------------------------------
+    def step(self, frame: Frame, odometry_increment) -> CycleReport:
+        """One cycle on ``frame`` (body frame of its last line) after the odometry increment ``(4, 4)``."""
+        if not isinstance(frame, Frame):
+            raise TypeError(f"`frame` must be a Frame (see build_frame); got {type(frame).__name__}")
+        U = v.as_matrix(odometry_increment, "odometry_increment", (4, 4))
+        p = self.params
+        times = dict.fromkeys(STAGES, 0.0)
+        clock = time.perf_counter
+        t0 = clock()
+        finite = bool(np.isfinite(frame.points).all() and np.isfinite(frame.intensities).all())
+        found, leftover = (self.detect(frame) if finite and len(frame) >= p.ransac_min_support
+                           else ([], np.ones(len(frame), bool)))
+        t1 = clock()
+        planes = self.describe(frame, found)
+        t2 = clock()
+        first = len(self.map) == 0 and bool(planes)      # the first frame with planes founds the map
+        if not first:
+            self.X = predict_particles(self.X, U, p.sigma_xyz_m, p.sigma_rpy_deg, self.rng)
+        self.X_predicted = self.X.copy()
+        t3 = clock()
+        rank = _normal_rank([pl.n for pl in planes])
+        use = (not first) and rank >= p.min_normal_rank
+        pairs = self.solve(planes) if use else np.full((len(self.X), len(planes)), -1)
+        use = use and bool((pairs >= 0).any())
+        self.X_solved = self.X.copy()
+        t4 = clock()
+        w = np.full(len(self.X), 1.0 / len(self.X))
+        if use and p.intensity_weights:
+            w = intensity_weights(self.sad(planes, pairs))
+            self.X = self.X[systematic_resample(w, self.rng)]
+        self.weights = w
+        t5 = clock()
+        self.pose = mean_pose(self.X)
+        t6 = clock()
+        if first or (use and self.update_map):
+            for pl in planes:
+                self.map.add(pl.moved(self.pose))
+        if finite and leftover.any() and self.update_map:
+            pts = frame.points[leftover][:: max(1, p.thin)]
+            self.map.voxels.add(pts @ self.pose[:3, :3].T + self.pose[:3, 3])
+        t7 = clock()
+        for name, a, b in zip(STAGES, (t0, t1, t2, t3, t4, t5, t6), (t1, t2, t3, t4, t5, t6, t7), strict=True):
+            times[name] = b - a
+        self.n_frames += 1
+        if not (use or first):
+            self.n_kept_prediction += 1
+        self.last_planes = planes
+        return CycleReport(len(frame), len(planes), rank, use, float((pairs >= 0).sum(axis=1).mean())
+                           if pairs.size else 0.0, times)

@@ -1,0 +1,152 @@
+"""Plots for Ch. 10 (002): scanner geometry, a frame by intensity, its planes, Fig. 2, Fig. 4, Fig. 8, Fig. 9."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ..plotting import new_axes
+from ..sim.planes_room import PlaneScanner, scanner_beam_directions
+
+__all__ = [
+    "plot_flight_errors",
+    "plot_frame_planes",
+    "plot_frame_points",
+    "plot_intensity_figure",
+    "plot_pairs_figure",
+    "plot_plane_map",
+    "scanner_geometry_figure",
+]
+
+
+def _ax3d(ax=None, figsize=(6, 5), title=None):
+    if ax is None:
+        fig = plt.figure(figsize=figsize)
+        ax = fig.add_subplot(projection="3d")
+    if title:
+        ax.set_title(title)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    return ax
+
+
+def scanner_geometry_figure(scanner: PlaneScanner | None = None, *, yaw_rate_deg_s: float = 45.0,
+                            frame_s: float = 1.0):
+    """Left: the vertical 270° fan in the body x-z plane (gap down). Right: seen from above, the fan's trace
+    swept by the yaw over one frame: two sectors of ``yaw_rate · frame_s`` degrees, 180° apart (002 Fig. 5)."""
+    s = PlaneScanner.resolve(scanner)
+    d = scanner_beam_directions(s)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4.5))
+    for k in range(0, len(d), 20):
+        a1.plot([0, d[k, 0]], [0, d[k, 2]], color="tab:orange", lw=0.6)
+    a1.plot(0, 0, "ks")
+    a1.set_aspect("equal")
+    a1.set_title(f"scan plane (body x-z): {s.fov_deg:.0f}°, {s.step_deg}° steps, {s.n_beams} beams")
+    a1.set_xlabel("body x [m]")
+    a1.set_ylabel("body z [m]")
+    sweep = np.deg2rad(yaw_rate_deg_s * frame_s)
+    for base, lab in ((0.0, "front sector"), (np.pi, "back sector")):
+        a = base + np.linspace(0, sweep, 30)
+        a2.fill(np.r_[0, np.cos(a), 0], np.r_[0, np.sin(a), 0], alpha=0.4, label=lab)
+    a2.plot(0, 0, "ks")
+    a2.set_xlim(-1.2, 1.2)
+    a2.set_ylim(-1.2, 1.2)
+    a2.set_aspect("equal")
+    a2.legend(loc="lower right")
+    a2.set_title(f"from above: {yaw_rate_deg_s:.0f}°/s × {frame_s:g} s of lines = one frame")
+    a2.set_xlabel("x [m]")
+    a2.set_ylabel("y [m]")
+    fig.tight_layout()
+    return fig
+
+
+def _thin(n, max_points, rng=0):
+    if n <= max_points:
+        return np.arange(n)
+    return np.sort(np.random.default_rng(rng).choice(n, max_points, replace=False))
+
+
+def plot_frame_points(frame, *, ax=None, max_points: int = 6000, title: str | None = None):
+    """A frame's points (body frame of its last line) coloured by intensity (002 Fig. 3)."""
+    ax = _ax3d(ax, title=title or f"one frame: {len(frame)} points, coloured by intensity")
+    k = _thin(len(frame), max_points)
+    sc = ax.scatter(*frame.points[k].T, c=frame.intensities[k], s=1, cmap="gray")
+    ax.figure.colorbar(sc, ax=ax, shrink=0.6, label="intensity")
+    return ax
+
+
+def plot_frame_planes(frame, found, *, ax=None, max_points: int = 6000, title: str | None = None):
+    """The frame's points coloured by the RANSAC plane they belong to (grey: on no plane)."""
+    ax = _ax3d(ax, title=title or f"{len(found)} planes found by RANSAC")
+    lab = np.full(len(frame), -1)
+    for i, (_, _, idx) in enumerate(found):
+        lab[idx] = i
+    k = _thin(len(frame), max_points)
+    off = k[lab[k] < 0]
+    ax.scatter(*frame.points[off].T, s=1, c="0.7")
+    for i in range(len(found)):
+        on = k[lab[k] == i]
+        ax.scatter(*frame.points[on].T, s=1, label=f"plane {i}")
+    ax.legend(markerscale=8, fontsize=8, loc="upper left")
+    return ax
+
+
+def plot_pairs_figure(result):
+    """002 Fig. 2: the predicted particles (grey) and the LM solutions for one, two, three pairs (colour)."""
+    fig = plt.figure(figsize=(13, 4.2))
+    for k in range(3):
+        ax = fig.add_subplot(1, 3, k + 1, projection="3d")
+        _ax3d(ax, title=f"{k + 1} pair{'s' if k else ''}: a {('plane', 'line', 'point')[k]}")
+        ax.scatter(*result.before[k].T, s=2, c="0.7", label="predicted")
+        ax.scatter(*result.after[k].T, s=4, c="tab:blue", label="solved")
+        ax.scatter(*result.true_t, s=40, c="tab:red", marker="*", label="truth")
+        if k == 0:
+            ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def plot_intensity_figure(result, *, ax=None):
+    """002 Fig. 4: solved particles along the corridor (x) with their intensity weights, and the particles after
+    resampling; the truth and the odometry's guess marked."""
+    ax = new_axes(ax, figsize=(8, 4), title="002 Fig. 4: weights along the line of uncertainty",
+                  xlabel="x along the corridor [m]", ylabel="weight × number of particles")
+    P = len(result.weights)
+    ax.scatter(result.solved[:, 0], result.weights * P, s=6, c="tab:blue", label="solved particles: weight")
+    ax2 = ax.twinx()
+    ax2.hist(result.resampled[:, 0], bins=30, color="tab:green", alpha=0.35, label="after resampling")
+    ax2.set_ylabel("particles after resampling")
+    ax.axvline(result.true_t[0], color="tab:red", label="truth")
+    ax.axvline(np.mean(result.predicted[:, 0]), color="0.4", ls="--", label="odometry (prediction mean)")
+    ax.legend(loc="upper left", fontsize=8)
+    return ax
+
+
+def plot_flight_errors(result):
+    """002 Fig. 8: x, y, z [m] and roll, pitch, yaw [deg] errors against time, SLAM and odometry."""
+    fig, axs = plt.subplots(2, 3, figsize=(12, 5.5), sharex=True)
+    names = ("x [m]", "y [m]", "z [m]", "roll [deg]", "pitch [deg]", "yaw [deg]")
+    for i, ax in enumerate(axs.ravel()):
+        ax.plot(result.times_s, result.errors[:, i], color="tab:blue", label="SLAM")
+        ax.plot(result.times_s, result.errors_odo[:, i], color="0.5", ls="--", label="odometry")
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_title(names[i])
+        if i >= 3:
+            ax.set_xlabel("time [s]")
+    axs[0, 0].legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def plot_plane_map(result, *, ax=None, max_cells: int = 20000):
+    """002 Fig. 9: the plane map (cell centres coloured by mean intensity) with the true and estimated paths."""
+    ax = _ax3d(ax, figsize=(8, 6), title=f"plane map: {len(result.map)} planes")
+    c = np.concatenate([pl.cell_centres() for pl in result.map.planes])
+    I = np.concatenate([pl.mean_intensity for pl in result.map.planes])
+    k = _thin(len(c), max_cells)
+    ax.scatter(*c[k].T, c=I[k], s=1, cmap="gray")
+    ax.plot(*result.poses_true[:, :3, 3].T, color="tab:red", label="truth")
+    ax.plot(*result.poses_est[:, :3, 3].T, color="tab:blue", label="SLAM")
+    ax.legend(fontsize=8)
+    return ax

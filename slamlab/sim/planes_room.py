@@ -1,0 +1,366 @@
+"""A room of planes, a UTM-30LX-like vertical scanner on a yawing quadcopter, inertial odometry (002; ours).
+
+002 flew a Gazebo quadcopter through a ~200 m² room "whose walls carry contrasting
+elements returning different intensities" with a Hokuyo UTM-30LX (40 lines/s,
+0.25°, 270°, 1081 points, intensity) mounted with a vertical scan plane; the
+vehicle yaws at 45°/s so ~1 s of lines (two 45° sectors 180° apart, > 40 000
+points) makes one frame. Everything numeric beyond those figures is ours and is a
+field of :class:`PlaneScanner`, :func:`build_plane_room` or :func:`quad_flight`:
+
+* room: 20 m × 10 m × 3 m (200 m²) with a pillar and a box (some faces parallel to
+  the walls), each face a bounded rectangle carrying 1 m panels of reflectance;
+* scanner: beams at angle ``a`` from the body ``+z`` axis in the body ``x``-``z``
+  plane, ``a`` in [-135°, 135°] (the 90° gap points down, at the airframe); range
+  noise N(0, σ_r); intensity ``I = I0 · ρ · |cos θ|`` (θ: incidence angle) plus
+  N(0, σ_I); no return (NaN) beyond ``range_max_m``;
+* odometry: the true per-line increments with Gaussian noise and a constant
+  velocity / yaw-rate bias (drift), integrated from the true start pose.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .. import _validate as v
+from .._params import Params, param
+
+__all__ = [
+    "Flight",
+    "PlaneRoom",
+    "PlaneScanner",
+    "build_corridor",
+    "build_plane_room",
+    "cast_rays_planes",
+    "quad_flight",
+    "scanner_beam_directions",
+    "simulate_flight",
+    "simulate_odometry_3d",
+]
+
+
+@dataclass(frozen=True)
+class PlaneRoom:
+    """Bounded rectangles ``n·x = p`` with in-plane axes and reflectance panels (002 Fig. 7; ours).
+
+    Attributes: ``centres (P, 3)``, ``normals (P, 3)`` (unit, pointing into the free space),
+    ``axes_u (P, 3)``, ``axes_v (P, 3)`` (unit, in-plane), ``half_u (P,)``, ``half_v (P,)`` in
+    metres, ``panels (P, Nu, Nv)`` reflectance of the panels (index from the ``-u, -v`` corner),
+    ``panel_m`` panel size, ``names`` one label per plane.
+    """
+
+    centres: np.ndarray
+    normals: np.ndarray
+    axes_u: np.ndarray
+    axes_v: np.ndarray
+    half_u: np.ndarray
+    half_v: np.ndarray
+    panels: np.ndarray
+    panel_m: float
+    names: tuple[str, ...]
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """``p`` of each plane in ``n·x = p``."""
+        return np.einsum("ij,ij->i", self.normals, self.centres)
+
+    def __len__(self) -> int:
+        return self.centres.shape[0]
+
+    def reflectance(self, plane_idx, points) -> np.ndarray:
+        """Reflectance of the panel under each point ``(K, 3)`` lying on plane ``plane_idx (K,)``."""
+        k = np.asarray(plane_idx, dtype=int)
+        d = np.asarray(points, dtype=float) - self.centres[k]
+        s = np.einsum("ij,ij->i", d, self.axes_u[k]) + self.half_u[k]
+        t = np.einsum("ij,ij->i", d, self.axes_v[k]) + self.half_v[k]
+        iu = np.clip((s // self.panel_m).astype(int), 0, self.panels.shape[1] - 1)
+        iv = np.clip((t // self.panel_m).astype(int), 0, self.panels.shape[2] - 1)
+        return self.panels[k, iu, iv]
+
+
+def _box_faces(lo, hi, inward: bool, skip=()):
+    """Six faces of an axis-aligned box (normals into the room: inward for the room, outward for objects)."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    c, h = (lo + hi) / 2, (hi - lo) / 2
+    faces = []
+    for ax, nm in ((0, "x"), (1, "y"), (2, "z")):
+        u_ax, v_ax = [a for a in range(3) if a != ax]
+        for sgn, side in ((-1, "-"), (1, "+")):
+            if f"{nm}{side}" in skip:
+                continue
+            centre = c.copy()
+            centre[ax] += sgn * h[ax]
+            n = np.zeros(3)
+            n[ax] = -sgn if inward else sgn
+            u, w = np.zeros(3), np.zeros(3)
+            u[u_ax], w[v_ax] = 1.0, 1.0
+            faces.append((f"{nm}{side}", centre, n, u, w, h[u_ax], h[v_ax]))
+    return faces
+
+
+def build_plane_room(length_m: float = 20.0, width_m: float = 10.0, height_m: float = 3.0, *,
+                     panel_m: float = 1.0, rho_low: float = 0.2, rho_high: float = 0.9, rng=0) -> PlaneRoom:
+    """The test room: walls, floor, ceiling, a pillar and a box, with random reflectance panels (002 Fig. 7; ours).
+
+    Parameters
+    ----------
+    length_m, width_m, height_m : room size (default 20 × 10 × 3 m: 002's ~200 m²).
+    panel_m : side of a reflectance panel.
+    rho_low, rho_high : reflectance range of the panels (contrasting panels: each panel draws one of the two
+        values plus a uniform ±0.05 jitter).
+    rng : seed of the panel pattern.
+
+    >>> room = build_plane_room(); len(room), float(room.half_u[0] * 2 * room.half_v[0] * 2)
+    (15, 30.0)
+    """
+    L = v.check_positive(length_m, "length_m")
+    W = v.check_positive(width_m, "width_m")
+    H = v.check_positive(height_m, "height_m")
+    panel_m = v.check_positive(panel_m, "panel_m")
+    lo_r, hi_r = v.check_probability(rho_low, "rho_low"), v.check_probability(rho_high, "rho_high")
+    rng = v.as_rng(rng)
+    faces = [("room " + f[0], *f[1:]) for f in _box_faces((0, 0, 0), (L, W, H), inward=True)]
+    # a pillar (floor to ceiling, its top and bottom hidden) and a box on the floor (its bottom hidden)
+    pil_lo, pil_hi = (0.62 * L, 0.55 * W, 0.0), (0.62 * L + 0.8, 0.55 * W + 0.8, H)
+    faces += [("pillar " + f[0], *f[1:]) for f in _box_faces(pil_lo, pil_hi, inward=False, skip=("z-", "z+"))]
+    box_lo, box_hi = (0.3 * L, 0.15 * W, 0.0), (0.3 * L + 2.0, 0.15 * W + 1.2, 1.0)
+    faces += [("box " + f[0], *f[1:]) for f in _box_faces(box_lo, box_hi, inward=False, skip=("z-",))]
+    names, c, n, u, w, hu, hv = zip(*faces, strict=True)
+    hu, hv = np.array(hu), np.array(hv)
+    nu = int(np.ceil(2 * hu.max() / panel_m))
+    nv = int(np.ceil(2 * hv.max() / panel_m))
+    pick = rng.random((len(faces), nu, nv)) < 0.5
+    panels = np.where(pick, hi_r, lo_r) + rng.uniform(-0.05, 0.05, (len(faces), nu, nv))
+    return PlaneRoom(np.array(c), np.array(n), np.array(u), np.array(w), hu, hv,
+                     np.clip(panels, 0.0, 1.0), panel_m, tuple(names))
+
+
+def build_corridor(length_m: float = 12.0, width_m: float = 3.0, height_m: float = 3.0, *, panel_m: float = 1.0,
+                   rng=0) -> PlaneRoom:
+    """A corridor: floor, ceiling and two parallel walls, no end walls (002 Fig. 4's situation; ours).
+
+    Its planes leave the position along the corridor (``x``) free: only the panels' intensities fix it.
+
+    >>> c = build_corridor(); len(c), c.names
+    (4, ('y-', 'y+', 'z-', 'z+'))
+    """
+    L, W, H = (v.check_positive(a, n) for a, n in ((length_m, "length_m"), (width_m, "width_m"),
+                                                      (height_m, "height_m")))
+    room = build_plane_room(L, W, H, panel_m=panel_m, rng=rng)
+    keep = [i for i, n in enumerate(room.names) if n in ("room y-", "room y+", "room z-", "room z+")]
+    return PlaneRoom(room.centres[keep], room.normals[keep], room.axes_u[keep], room.axes_v[keep],
+                     room.half_u[keep], room.half_v[keep], room.panels[keep], room.panel_m,
+                     tuple(room.names[i][5:] for i in keep))
+
+
+def cast_rays_planes(room: PlaneRoom, origins, directions, range_max_m: float = np.inf):
+    """Vectorised ray casting against the room's bounded planes (ours).
+
+    Parameters
+    ----------
+    origins : (K, 3) or (3,) ray origins; directions : (K, 3) unit directions.
+    range_max_m : rays hitting nothing closer return NaN.
+
+    Returns
+    -------
+    ranges (K,) (NaN: no hit), plane (K,) index of the plane hit (-1: none), cos_incidence (K,) ``|n·d|``.
+
+    >>> room = build_plane_room()
+    >>> r, k, c = cast_rays_planes(room, [[5.0, 5.0, 1.0]], [[0.0, 0.0, -1.0]])
+    >>> float(r[0]), room.names[k[0]], float(c[0])
+    (1.0, 'room z-', 1.0)
+    """
+    d = v.as_finite_array(directions, "directions", ndim=2)
+    if d.shape[1] != 3:
+        raise ValueError(f"`directions` must have shape (K, 3); got {d.shape}")
+    o = v.as_finite_array(origins, "origins")
+    o = np.broadcast_to(o, d.shape) if o.shape == (3,) else o
+    if o.shape != d.shape:
+        raise ValueError(f"`origins` must have shape (3,) or {d.shape}; got {o.shape}")
+    nd = d @ room.normals.T                                    # (K, P)
+    no = o @ room.normals.T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (room.offsets[None, :] - no) / nd
+    t = np.where(np.isfinite(t) & (t > 1e-9), t, np.inf)
+    finite = np.isfinite(t)
+    tt = np.where(finite, t, 0.0)
+    rel = o[:, None, :] + tt[..., None] * d[:, None, :] - room.centres[None]   # hit - centre, (K, P, 3)
+    su = np.einsum("kpj,pj->kp", rel, room.axes_u)
+    sv = np.einsum("kpj,pj->kp", rel, room.axes_v)
+    inside = finite & (np.abs(su) <= room.half_u + 1e-9) & (np.abs(sv) <= room.half_v + 1e-9)
+    t = np.where(inside, t, np.inf)
+    k = np.argmin(t, axis=1)
+    r = t[np.arange(len(k)), k]
+    ok = np.isfinite(r) & (r <= range_max_m)
+    cos_inc = np.abs(nd[np.arange(len(k)), k])
+    return np.where(ok, r, np.nan), np.where(ok, k, -1), np.where(ok, cos_inc, np.nan)
+
+
+@dataclass(frozen=True)
+class PlaneScanner(Params):
+    """A Hokuyo UTM-30LX-like line scanner with a vertical scan plane (002 "Experimental trial")."""
+
+    fov_deg: float = param(270.0, "002: 270°")
+    step_deg: float = param(0.25, "002: 0.25° (1081 points)")
+    lines_per_s: float = param(40.0, "002: 40 lines/s")
+    range_max_m: float = param(30.0, "ours (UTM-30LX data sheet: 30 m)")
+    sigma_range_m: float = param(0.01, "ours (data sheet: ±30 mm up to 10 m)")
+    intensity_gain: float = param(1000.0, "ours: I = I0·ρ·|cos θ|")
+    sigma_intensity: float = param(10.0, "ours")
+    mount_m: tuple = param((0.0, 0.0, 0.1), "ours: scanner origin in the body frame")
+
+    def check(self) -> None:
+        v.check_positive(self.fov_deg, "fov_deg")
+        if self.fov_deg > 360:
+            raise ValueError(f"`fov_deg` must be <= 360; got {self.fov_deg}")
+        v.check_positive(self.step_deg, "step_deg")
+        v.check_positive(self.lines_per_s, "lines_per_s")
+        v.check_positive(self.range_max_m, "range_max_m")
+        v.check_positive(self.sigma_range_m, "sigma_range_m", allow_zero=True)
+        v.check_positive(self.intensity_gain, "intensity_gain")
+        v.check_positive(self.sigma_intensity, "sigma_intensity", allow_zero=True)
+        v.as_vector(self.mount_m, "mount_m", 3)
+
+    @property
+    def n_beams(self) -> int:
+        """Beams per line: ``fov / step + 1`` (1081 for 270° / 0.25°)."""
+        return round(self.fov_deg / self.step_deg) + 1
+
+
+def scanner_beam_directions(scanner: PlaneScanner | None = None) -> np.ndarray:
+    """Unit beam directions ``(n_beams, 3)`` in the body frame: ``(sin a, 0, cos a)``, a from ``+z`` (ours).
+
+    >>> d = scanner_beam_directions(); d.shape, np.round(d[540], 12).tolist()
+    ((1081, 3), [0.0, 0.0, 1.0])
+    """
+    s = PlaneScanner.resolve(scanner)
+    a = np.deg2rad(np.linspace(-s.fov_deg / 2, s.fov_deg / 2, s.n_beams))
+    return np.stack([np.sin(a), np.zeros_like(a), np.cos(a)], axis=1)
+
+
+def quad_flight(duration_s: float = 20.0, *, rate_hz: float = 40.0, yaw_rate_deg_s: float = 45.0,
+                speed_m_s: float = 0.6, waypoints_m=None, tilt_deg: float = 2.0) -> tuple[np.ndarray, np.ndarray]:
+    """True poses ``mT_b`` of a quadcopter flying through the room while yawing (002 Fig. 5, 8; ours).
+
+    A polyline through ``waypoints_m`` at ``speed_m_s`` (height varies along it), constant yaw rate
+    (002: 45°/s), roll and pitch small sinusoids of amplitude ``tilt_deg`` (a stabilised airframe).
+
+    Returns
+    -------
+    times_s (N,), poses (N, 4, 4) at ``rate_hz`` (one per scan line).
+
+    >>> t, T = quad_flight(1.0); T.shape, float(t[-1])
+    ((40, 4, 4), 0.975)
+    """
+    duration_s = v.check_positive(duration_s, "duration_s")
+    rate_hz = v.check_positive(rate_hz, "rate_hz")
+    speed = v.check_positive(speed_m_s, "speed_m_s", allow_zero=True)
+    if waypoints_m is None:
+        waypoints_m = [[2.5, 2.5, 1.5], [9.0, 3.0, 1.6], [13.0, 3.5, 1.4], [17.5, 5.0, 1.6], [17.0, 8.0, 1.5],
+                       [10.0, 8.0, 1.7], [3.0, 7.5, 1.5]]
+    wp = v.as_finite_array(waypoints_m, "waypoints_m", ndim=2)
+    if wp.shape[1] != 3 or wp.shape[0] < 2:
+        raise ValueError(f"`waypoints_m` must have shape (N >= 2, 3); got {wp.shape}")
+    t = np.arange(round(duration_s * rate_hz)) / rate_hz
+    seg = np.linalg.norm(np.diff(wp, axis=0), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    s = np.minimum(speed * t, cum[-1])
+    pos = np.stack([np.interp(s, cum, wp[:, i]) for i in range(3)], axis=1)
+    tilt = np.deg2rad(tilt_deg)
+    yaw = np.deg2rad(yaw_rate_deg_s) * t
+    rpy = np.stack([tilt * np.sin(0.7 * t), tilt * np.sin(0.5 * t + 1.0), yaw], axis=1)
+    T = np.zeros((len(t), 4, 4))
+    T[:, :3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()
+    T[:, :3, 3] = pos
+    T[:, 3, 3] = 1.0
+    return t, T
+
+
+def simulate_odometry_3d(poses, *, sigma_trans_m: float = 0.002, sigma_rot_deg: float = 0.05,
+                         bias_m_per_step=(0.0005, -0.0003, 0.0001), bias_yaw_deg_per_step: float = 0.01,
+                         rng=None) -> np.ndarray:
+    """Inertial odometry ``oT_b``: true increments with noise and a constant bias, integrated (002; ours).
+
+    The odom frame coincides with the map frame at the first pose. The bias (per line, in the body frame) is
+    the drift; roll and pitch get noise but no bias (gravity keeps them observable to an IMU).
+    """
+    T = v.as_finite_array(poses, "poses", ndim=3)
+    if T.shape[1:] != (4, 4):
+        raise ValueError(f"`poses` must have shape (N, 4, 4); got {T.shape}")
+    rng = v.as_rng(rng)
+    n = T.shape[0]
+    inc = np.linalg.inv(T[:-1]) @ T[1:]
+    noise_rot = rng.normal(0.0, np.deg2rad(sigma_rot_deg), (n - 1, 3))
+    noise_rot[:, 2] += np.deg2rad(bias_yaw_deg_per_step)
+    dR = Rotation.from_rotvec(noise_rot).as_matrix()
+    inc[:, :3, :3] = inc[:, :3, :3] @ dR
+    inc[:, :3, 3] += rng.normal(0.0, sigma_trans_m, (n - 1, 3)) + np.asarray(bias_m_per_step, float)
+    out = np.empty_like(T)
+    out[0] = T[0]
+    for k in range(1, n):  # a running product of 4x4s: sequential by nature, cheap
+        out[k] = out[k - 1] @ inc[k - 1]
+    return out
+
+
+@dataclass(frozen=True)
+class Flight:
+    """A simulated flight: per scan line ``times_s (N,)``, true ``poses (N, 4, 4)``, ``odometry (N, 4, 4)``,
+    ``ranges_m (N, B)`` (NaN: no return), ``intensities (N, B)``, ``plane_ids (N, B)`` (ground truth, -1: none),
+    and the ``room`` and ``scanner``."""
+
+    times_s: np.ndarray
+    poses: np.ndarray
+    odometry: np.ndarray
+    ranges_m: np.ndarray
+    intensities: np.ndarray
+    plane_ids: np.ndarray
+    room: PlaneRoom
+    scanner: PlaneScanner
+
+    def __len__(self) -> int:
+        return self.times_s.shape[0]
+
+    def body_points(self, lines=slice(None)) -> np.ndarray:
+        """Points ``(n, B, 3)`` of the chosen lines in the body frame (NaN where no return)."""
+        d = scanner_beam_directions(self.scanner)
+        return self.ranges_m[lines][..., None] * d + np.asarray(self.scanner.mount_m)
+
+    def __str__(self) -> str:
+        hit = np.isfinite(self.ranges_m).mean()
+        return f"Flight: {len(self)} lines over {self.times_s[-1] + 1 / self.scanner.lines_per_s:.1f} s, " \
+               f"{self.ranges_m.shape[1]} beams, {hit:.1%} returns"
+
+
+def simulate_flight(duration_s: float = 20.0, *, room: PlaneRoom | None = None, scanner: PlaneScanner | None = None,
+                    yaw_rate_deg_s: float = 45.0, speed_m_s: float = 0.6, waypoints_m=None,
+                    odometry_noise: float = 1.0, rng=None) -> Flight:
+    """Fly :func:`quad_flight` through ``room`` and record every scan line and the odometry (002; ours).
+
+    ``odometry_noise`` scales every noise and bias of :func:`simulate_odometry_3d` (0 = perfect odometry).
+    """
+    rng = v.as_rng(rng)
+    room = build_plane_room() if room is None else room
+    if not isinstance(room, PlaneRoom):
+        raise TypeError(f"`room` must be a PlaneRoom; got {type(room).__name__}")
+    scanner = PlaneScanner.resolve(scanner)
+    k = v.check_positive(odometry_noise, "odometry_noise", allow_zero=True)
+    t, T = quad_flight(duration_s, rate_hz=scanner.lines_per_s, yaw_rate_deg_s=yaw_rate_deg_s, speed_m_s=speed_m_s,
+                       waypoints_m=waypoints_m)
+    d_body = scanner_beam_directions(scanner)
+    n, b = len(t), d_body.shape[0]
+    d_map = np.einsum("nij,bj->nbi", T[:, :3, :3], d_body).reshape(-1, 3)
+    o_map = (T[:, :3, :3] @ np.asarray(scanner.mount_m) + T[:, :3, 3])
+    o_map = np.repeat(o_map, b, axis=0)
+    r, k_plane, cos_inc = cast_rays_planes(room, o_map, d_map, scanner.range_max_m)
+    hit = k_plane >= 0
+    refl = np.zeros(n * b)
+    refl[hit] = room.reflectance(k_plane[hit], o_map[hit] + r[hit, None] * d_map[hit])
+    r = r + rng.normal(0.0, scanner.sigma_range_m, r.shape)
+    inten = scanner.intensity_gain * refl * cos_inc + rng.normal(0.0, scanner.sigma_intensity, r.shape)
+    inten = np.where(hit, np.maximum(inten, 0.0), np.nan)
+    odo = simulate_odometry_3d(T, sigma_trans_m=0.002 * k, sigma_rot_deg=0.05 * k,
+                               bias_m_per_step=(0.0005 * k, -0.0003 * k, 0.0001 * k),
+                               bias_yaw_deg_per_step=0.01 * k, rng=rng)
+    return Flight(t, T, odo, r.reshape(n, b), inten.reshape(n, b), k_plane.reshape(n, b), room, scanner)

@@ -1,0 +1,44 @@
+"""Ch. 10 plots draw what they are given; the widget gives a table or a readable message."""
+
+import matplotlib.pyplot as plt
+import pytest
+
+from slamlab import planes as PL
+from slamlab import sim as S
+
+
+@pytest.fixture(scope="module")
+def results():
+    fl = PL.run_flight(3.0, rng=1, n_particles=30)
+    return fl, PL.run_pairs_figure(20, rng=1), PL.run_intensity_figure(n_particles=30, rounds=1, rng=1)
+
+
+def test_plots_draw(results):
+    fl, pairs, fig4 = results
+    fig = PL.scanner_geometry_figure()
+    assert len(fig.axes) == 2
+    flight = S.simulate_flight(1.0, rng=2)
+    _, frame, _, _ = next(PL.flight_frames(flight))
+    ax = PL.plot_frame_points(frame, max_points=500)
+    assert len(ax.collections) == 1
+    found, _ = PL.extract_planes(frame.points, rng=0)
+    ax = PL.plot_frame_planes(frame, found, max_points=500)
+    assert len(ax.collections) == 1 + len(found)
+    assert len(PL.plot_pairs_figure(pairs).axes) == 3
+    ax = PL.plot_intensity_figure(fig4)
+    assert len(ax.collections) == 1
+    assert len(PL.plot_flight_errors(fl).axes) == 6
+    ax = PL.plot_plane_map(fl, max_cells=300)
+    assert len(ax.lines) == 2
+    plt.close("all")
+
+
+def test_explore_flight(capsys):
+    w = PL.explore_flight(duration_s=2.0, n_particles=20)
+    out = capsys.readouterr().out
+    assert "Flight: 2 frames" in out
+    w.f(**{**w.kwargs, "frame_lines": 60})                # 80 lines: one frame of 60 only
+    out = capsys.readouterr().out
+    assert "Cannot run with these settings" in out
+    assert "Traceback" not in out
+    plt.close("all")
