@@ -43,27 +43,8 @@ import itertools
 import numpy as np
 
 from .. import _validate as v
+from .._threads import run_tasks
 from .base import Features, to_gray_float
-
-_POOL = None
-
-
-def _pool():
-    """The two SURF worker threads, shared by every call (numpy releases the GIL in its loops; a
-    shared pool keeps concurrent callers, e.g. the stereo pipeline's two images, at two threads)."""
-    global _POOL
-    if _POOL is None:
-        from concurrent.futures import ThreadPoolExecutor
-
-        _POOL = ThreadPoolExecutor(max_workers=2, thread_name_prefix="slamlab-surf")
-    return _POOL
-
-
-def _run(tasks, workers):
-    """Results of the zero-argument callables ``tasks``, in order; in the shared pool when ``workers > 1``."""
-    if workers <= 1 or len(tasks) <= 1:
-        return [t() for t in tasks]
-    return [f.result() for f in [_pool().submit(t) for t in tasks]]
 
 
 def _by_parts(fn, K, chunk, workers, out):
@@ -76,7 +57,7 @@ def _by_parts(fn, K, chunk, workers, out):
             sl = slice(a, min(a + chunk, a1))
             out[sl] = fn(sl)
 
-    _run([lambda a0=a0, a1=a1: part(a0, a1) for a0, a1 in itertools.pairwise(bounds)], workers)
+    run_tasks([lambda a0=a0, a1=a1: part(a0, a1) for a0, a1 in itertools.pairwise(bounds)], workers)
     return out
 
 
@@ -166,8 +147,8 @@ def _response_stacks(II, n_octaves, init_step, workers=1):
     pad = int(L.max()) + init_step * 2 ** (n_octaves - 1) + 2
     IIp = np.pad(II, pad, mode="edge")
     jobs = [(o, int(Li)) for o in range(n_octaves) for Li in L[o]]
-    res = _run([lambda o=o, Li=Li: hessian_response(II, Li, init_step * 2**o, IIp=IIp, pad=pad) for o, Li in jobs],
-               workers)
+    res = run_tasks([lambda o=o, Li=Li: hessian_response(II, Li, init_step * 2**o, IIp=IIp, pad=pad)
+                     for o, Li in jobs], workers)
     out = []
     for o in range(n_octaves):
         dets, traces = zip(*(r for (oo, _), r in zip(jobs, res, strict=True) if oo == o), strict=True)
