@@ -134,6 +134,10 @@ def find_peaks(acc: HoughAccumulator, H_min: int, *, suppress_rho: float | None 
     return _find_peaks(acc, H_min, s_rho, s_theta, max_lines)
 
 
+_NB_DI = np.array([-1, -1, -1, 0, 0, 1, 1, 1])[:, None]
+_NB_DK = np.array([-1, 0, 1, -1, 1, -1, 0, 1])[:, None]
+
+
 def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float, max_lines: int | None) -> Lines:
     """:func:`find_peaks` on checked arguments (suppression windows resolved)."""
     H = acc.H
@@ -148,15 +152,12 @@ def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float,
     flat = np.sort(flat % n_rho * n_theta + flat // n_rho)
     i, k = flat // n_theta, flat % n_theta
     value = H[i, k]
-    is_max = np.ones(i.size, dtype=bool)
-    for di in (-1, 0, 1):
-        ii = np.clip(i + di, 0, n_rho - 1)  # rho runs off the axis into nothing: edge cells compare with themselves
-        for dk in (-1, 0, 1):
-            if di or dk:
-                kk = k + dk
-                # wrap θ: the column before -90° is +89° with rho flipped, the one after +89° is -90° flipped
-                wrap = (kk < 0) | (kk >= n_theta)
-                is_max &= value >= H[np.where(wrap, n_rho - 1 - ii, ii), kk % n_theta]
+    # the 8 neighbours of every candidate in one gather (rho runs off the axis into nothing: edge cells
+    # compare with themselves; θ wraps: the column before -90° is +89° with rho flipped, and back)
+    ii = np.clip(i + _NB_DI, 0, n_rho - 1)
+    kk = k + _NB_DK
+    wrap = (kk < 0) | (kk >= n_theta)
+    is_max = (value >= H[np.where(wrap, n_rho - 1 - ii, ii), kk % n_theta]).all(axis=0)
     i, k, value = i[is_max], k[is_max], value[is_max]
     if i.size == 0:
         return empty
