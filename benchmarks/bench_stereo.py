@@ -11,6 +11,7 @@ query vs ``cv2.BFMatcher.knnMatch``.
     python benchmarks/bench_stereo.py                    # 30 frames, ORB, SIFT and our SURF
     python benchmarks/bench_stereo.py --drift            # + calibration drift on the loop (SURF, ~2 min)
     python benchmarks/bench_stereo.py --long             # + the ~80 m run of 000 §4.2 (slow)
+    python benchmarks/bench_stereo.py --kitti            # + the 20 KITTI frames, this round's changes off/on
 
 Every run uses the pipeline's defaults (oldest-landmark policy; store: multi kd-tree for SURF/SIFT,
 exact Hamming brute force for ORB; the two images detected in two threads).
@@ -57,6 +58,7 @@ def main(argv=None):
     ap.add_argument("--detectors", default="orb,sift,surf")
     ap.add_argument("--drift", action="store_true", help="also run the calibration-drift study on the small loop")
     ap.add_argument("--long", action="store_true", help="also run the ~80 m path in the 10x12 m room")
+    ap.add_argument("--kitti", action="store_true", help="also run the 20 KITTI frames with this round's changes off and on")
     ap.add_argument("--markdown", default=None, help="write the tables to this file")
     args = ap.parse_args(argv)
 
@@ -66,6 +68,7 @@ def main(argv=None):
         print(s)
         out.append(s)
 
+    say(f"load average at start: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     say(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
         f"numpy {np.__version__}, OpenCV {cv2.__version__}")  # fmt: skip
     arena = sl.sim.StereoArena(seed=0)
@@ -116,15 +119,28 @@ def main(argv=None):
         for det in args.detectors.split(","):
             t0 = time.perf_counter()
             variants = {"oldest": {"detector": det}, "all": {"detector": det, "policy": "all"}}
-            if det == "orb":  # the exact store grows with the map: the view gate keeps it to the visible part
-                variants["oldest, view gate 20 deg"] = {"detector": det, "view_margin_deg": 20.0}
+            if det == "orb":  # before this round: no sub-pixel disparity, no duplicate check
+                variants["oldest, before (no sub-pixel disparity, no duplicate check)"] = {
+                    "detector": det, "subpixel_stereo": False, "duplicate_gap_m": None}
             runs = sl.stereo.run_stereo_slam_variants(path, variants, name="long path", arena=room, rng=0)
             for label, res in runs.items():
                 say(f"long path ({length_m:.0f} m, {len(path)} frames), {det}, policy {label}: max position error "
                     f"{res.pos_err_m.max():.2f} m, final {res.pos_err_m[-1]:.2f} m, max heading error "
                     f"{np.rad2deg(np.abs(res.yaw_err_rad).max()):.1f} deg, {len(res.degenerate)} degenerate frames; "
-                    f"SLAM {res.fps:.2f} frames/s, map query {1000 * res.stage_time_s['map_match'][1:].mean():.0f} ms/frame")  # fmt: skip
-            say(f"  ({time.perf_counter() - t0:.0f} s for these runs incl. rendering)")
+                    f"SLAM {res.fps:.2f} frames/s, map query {1000 * res.stage_time_s['map_match'][1:].mean():.0f} ms/frame, "
+                    f"{res.counts['n_landmarks'][-1]} landmarks at the end")  # fmt: skip
+            say(f"  ({time.perf_counter() - t0:.0f} s for these runs incl. rendering; load average "
+                f"{' '.join(f'{x:.2f}' for x in os.getloadavg())})")
+    if args.kitti:
+        say()
+        say("| KITTI 06, 20 frames | ATE m | SE(3)-aligned m | final m | path length est./true | start-end distance est./true |")
+        say("|---|---|---|---|---|---|")
+        for det in args.detectors.split(","):
+            for label, over in (("before", {"subpixel_stereo": False, "duplicate_gap_m": None}), ("after", {})):
+                k = sl.stereo.run_kitti(rng=0, detector=det, **over)
+                say(f"| {det}, {label} | {k.ate_m:.3f} | {k.ate_se3_m:.3f} | {k.final_error_m:.3f} | "
+                    f"{k.length_ratio:.4f} | {k.end_distance_ratio:.4f} |")
+    say(f"load average at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     if args.markdown:
         with open(args.markdown, "w") as f:
             f.write("\n".join(out) + "\n")

@@ -63,9 +63,9 @@ CHAPTERS: tuple[Chapter, ...] = (
     Chapter(7, "Hough-transform SLAM", "07_hough_slam.ipynb",
             ("slamlab.hough",), "004", "available"),
     Chapter(8, "Probabilistic localisation: Markov, MCL", "08_probabilistic_localisation.ipynb",
-            ("slamlab.localisation",), "003 §2.2; 002", "planned"),
+            ("slamlab.localisation",), "003 §1.2.4, §2.2", "available"),
     Chapter(9, "Monocular mapping", "09_monocular_mapping.ipynb",
-            ("slamlab.mono",), "003 §2.1, §4", "planned"),
+            ("slamlab.mono",), "003 §2.1, §4", "available"),
     Chapter(10, "Plane-based 3-D particle-filter SLAM", "10_plane_slam_3d.ipynb",
             ("slamlab.planes",), "002", "available"),
 )

@@ -117,7 +117,7 @@ def test_algorithm_modules_never_import_sim():
 
 SUBPACKAGES = ["slamlab", "slamlab.geometry", "slamlab.scans", "slamlab.io", "slamlab.sim", "slamlab.filters",
                "slamlab.features", "slamlab.kdtree", "slamlab.stereo", "slamlab.correlation", "slamlab.hough",
-               "slamlab.planes", "slamlab.evaluation", "slamlab.lab", "slamlab.sweep"]
+               "slamlab.planes", "slamlab.evaluation", "slamlab.lab", "slamlab.sweep", "slamlab.mono", "slamlab.localisation"]
 
 
 def test_every_subpackage_is_listed():

@@ -19,7 +19,7 @@ def _outputs(nb) -> str:
 
 
 #: Chapter notebooks with a cell tagged ``parameters`` (00, the overview, has none).
-PARAMETERISED = ("01", "02", "03", "04", "05", "06", "07", "10")
+PARAMETERISED = ("01", "02", "03", "04", "05", "06", "07", "08", "10")
 
 
 def test_every_chapter_notebook_has_one_parameters_cell():

@@ -108,6 +108,8 @@ def _load_tasks() -> None:
         tasks_features,
         tasks_filters,
         tasks_hough,
+        tasks_localisation,
+        tasks_mono,
         tasks_planes,
         tasks_stereo,
         tasks_stores,

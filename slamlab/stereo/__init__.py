@@ -14,7 +14,9 @@ from .experiments import (
     KittiRunResult,
     StereoRunResult,
     comparison_table,
+    disparity_errors,
     experiment_poses,
+    kitti_comparison,
     ours_vs_source,
     record_stereo_stream,
     run_closed_loop,
@@ -34,10 +36,12 @@ from .stages import (
     StereoMatches,
     detect_features,
     estimate_pose,
+    is_rectified,
     match_to_map,
     pose_std,
     select_oldest,
     stereo_match,
+    subpixel_disparity,
     triangulate_local,
 )
 
@@ -68,8 +72,11 @@ __all__ = [
     "comparison_table",
     "default_store",
     "detect_features",
+    "disparity_errors",
     "estimate_pose",
     "experiment_poses",
+    "is_rectified",
+    "kitti_comparison",
     "match_to_map",
     "ours_vs_source",
     "pose_std",
@@ -83,6 +90,7 @@ __all__ = [
     "run_turn_in_place",
     "select_oldest",
     "stereo_match",
+    "subpixel_disparity",
     "triangulate_local",
 ]
 __all__ += list(_LAZY)

@@ -33,7 +33,9 @@ __all__ = [
     "KittiRunResult",
     "StereoRunResult",
     "comparison_table",
+    "disparity_errors",
     "experiment_poses",
+    "kitti_comparison",
     "ours_vs_source",
     "record_stereo_stream",
     "run_closed_loop",
@@ -339,28 +341,50 @@ class DriftStudy:
         return format_table(head, rows, title=f"calibration drift of the right camera: {self.experiment} ({self.runs[0].detector})")
 
 
+_RUNNERS = {"turn in place": "run_turn_in_place", "closed loop": "run_closed_loop"}
+
+
+def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, params: StereoParams,
+                render: RenderParams, seed) -> dict:
+    """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``seed``)."""
+    runner = globals()[_RUNNERS[experiment]]
+    return {"run": runner(size, n_frames=n_frames, params=params, render=render.replace(drift_std_rad=drift_std_rad),
+                          progress=False, rng=seed)}
+
+
 def run_drift_study(
     drift_std_rad=(0.0, 0.5e-3, 1e-3, 2e-3), experiment: str = "turn in place", size: str = "small", *,
     n_frames: int | None = None, params: StereoParams | None = None, render: RenderParams | None = None, rng=0,
-    **overrides,
+    n_jobs: int = 1, progress: bool | None = None, **overrides,
 ) -> DriftStudy:
-    """The same run at several calibration-drift levels (our experiment for 000 §3.2).
+    """The same run at several calibration-drift levels (our experiment for 000 §3.2), on :func:`slamlab.sweep.sweep`.
 
     The right camera's orientation takes a random-walk step of ``drift_std_rad`` per axis and
     frame while the pipeline keeps the nominal calibration; ``params`` + ``overrides`` set the
     pipeline (``detector``, ``policy``, ...), ``render`` the rest of the renderer. Every level uses
-    the same seeds, so the level is the only change.
+    the same seed ``rng`` (common random numbers: the level is the only change), so each task is
+    deterministic and the sweep gives it no stream of its own (``rng_arg=None``); the study is
+    the same for any ``n_jobs``. ``progress``: a bar over the levels (default: on unless
+    ``$SLAMLAB_PROGRESS=0``).
     """
-    runners = {"turn in place": run_turn_in_place, "closed loop": run_closed_loop}
-    v.check_choice(experiment, "experiment", runners)
+    from ..sweep import sweep
+
+    v.check_choice(experiment, "experiment", _RUNNERS)
+    v.check_choice(size, "size", SIZES)
     levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
     if min(levels) < 0:
         raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
+    seed = v.check_int(rng, "rng", minimum=0)
     p = StereoParams.resolve(params, **overrides)
     render = RenderParams.resolve(render)
-    runs = tuple(runners[experiment](size, n_frames=n_frames, params=p, render=render.replace(drift_std_rad=d), rng=rng)
-                 for d in levels)
-    return DriftStudy(experiment, levels, runs)
+    table = sweep(drift_level, {"drift_std_rad": levels}, rng_arg=None, n_jobs=n_jobs, progress=progress,
+                  desc=f"calibration drift study ({experiment})",
+                  fixed={"experiment": experiment, "size": size, "n_frames": n_frames, "params": p, "render": render,
+                         "seed": seed})
+    failed = table["error"].notna()
+    if failed.any():
+        raise RuntimeError(f"{int(failed.sum())} drift level(s) failed; first: {table['error'][failed].iloc[0]}")
+    return DriftStudy(experiment, levels, tuple(table["run"]))
 
 
 def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0,
@@ -402,6 +426,17 @@ class KittiRunResult:
         return (f"{self.name}, {len(self.truth)} frames: ATE {self.ate_m:.2f} m (after SE(3) alignment "
                 f"{self.ate_se3_m:.2f} m), final error {self.final_error_m:.2f} m over {self.path_length_m:.1f} m")
 
+    @property
+    def length_ratio(self) -> float:
+        """Length of the estimated path over the true path length (1: no scale error)."""
+        return float(np.sum(np.linalg.norm(np.diff(self.estimate[:, :3, 3], axis=0), axis=1)) / self.path_length_m)
+
+    @property
+    def end_distance_ratio(self) -> float:
+        """Distance of the last estimated position from the start over the true one (1: no scale error)."""
+        return float(np.linalg.norm(self.estimate[-1, :3, 3] - self.estimate[0, :3, 3])
+                     / np.linalg.norm(self.truth[-1, :3, 3] - self.truth[0, :3, 3]))
+
     def table(self) -> str:
         rows = [
             ["frames (degenerate)", f"{len(self.truth)} ({self.n_degenerate})"],
@@ -410,6 +445,8 @@ class KittiRunResult:
             ["RPE RMSE over 1 frame, m", f"{self.rpe_m:.2f}"],
             ["final position error, m", f"{self.final_error_m:.2f}"],
             ["final error / path length, %", f"{100 * self.final_error_m / self.path_length_m:.1f}"],
+            ["path length, estimate / truth", f"{self.length_ratio:.3f}"],
+            ["start-to-end distance, estimate / truth", f"{self.end_distance_ratio:.3f}"],
             ["RANSAC inliers per frame (median)", f"{self.inliers_median:.0f}"],
         ]
         return format_table(["quantity", "ours"], rows,
@@ -511,3 +548,60 @@ def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None 
                      "— (no ground truth)", (f"{kitti.ate_m:.2f} / {kitti.ate_se3_m:.2f} / {kitti.final_error_m:.2f} "
                                              f"over {kitti.path_length_m:.1f} m")])
     return format_table(["quantity", "000", "ours"], rows, title="Stereo SLAM: 000 beside ours (frame rates: timing tables)")
+
+
+def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, params: StereoParams | None = None,
+                     rng=0, **overrides) -> str:
+    """Stereo disparity errors against the renderer's depth, per ORB pyramid level, before and after
+    :func:`~slamlab.stereo.subpixel_disparity` (our addition to 000 §3.3).
+
+    One rendered pair at ``pose`` in ``arena`` (default the 6×8 m arena): keypoints (``params`` +
+    ``overrides``, default ORB), stereo matches, and for each match the disparity minus the true one
+    ``f b / z`` (``z``: the renderer's depth at the left keypoint's pixel). Returns a table of the
+    median absolute error and the share above 1 px per level.
+    """
+    from .stages import _stereo_match, detect_features, subpixel_disparity
+
+    p = StereoParams.resolve(params, **({"detector": "orb"} | overrides))
+    arena = StereoArena(seed=0) if arena is None else arena
+    sim = StereoSim(arena, rng=rng)
+    pose = v.as_vector(pose, "pose", 3)
+    left, right = sim.render_pair(pose)
+    fl, fr = detect_features(left, params=p), detect_features(right, params=p)
+    sm = _stereo_match(fl, fr, sim.rig.F, p.ratio, p.epi_tol_px)
+    _, depth, _ = arena.cast(sim.rig.left, se3_from_planar(*pose) @ sim.T_body_left)
+    fb = sim.rig.left.fx * sim.rig.baseline_m
+
+    def errors(uvl, uvr):
+        c, r = np.rint(uvl).astype(int).T
+        return (uvl[:, 0] - uvr[:, 0]) - fb / depth[r, c]
+
+    uvl, uvr = fl.uv[sm.left], fr.uv[sm.right]
+    raw = errors(uvl, uvr)
+    ref_l, ref_r, ok = subpixel_disparity(left, right, uvl, uvr, half_px=p.subpixel_half_px, search_px=p.subpixel_search_px)
+    ref = np.full(len(raw), np.nan)
+    ref[ok] = errors(ref_l[ok], ref_r[ok])
+    level = fl.octave[sm.left]
+    rows = []
+    for lv in np.unique(level):
+        m = (level == lv) & np.isfinite(raw)
+        mr = m & ok
+        rows.append([f"{lv}", f"{m.sum()}", f"{np.median(np.abs(raw[m])):.2f}", f"{100 * np.mean(np.abs(raw[m]) > 1):.0f}",
+                     f"{np.median(np.abs(ref[mr])):.2f}", f"{100 * np.mean(np.abs(ref[mr]) > 1):.0f}", f"{100 * mr.sum() / max(m.sum(), 1):.0f}"])
+    head = ["level", "matches", "keypoints: median |err|, px", "> 1 px, %", "refined: median |err|, px", "> 1 px, %",
+            "refined, %"]
+    return format_table(head, rows, title=f"disparity error against the renderer ({p.detector.upper()}, one frame)")
+
+
+def kitti_comparison(variants: dict, folder=None, *, n_frames: int | None = None, rng=0) -> str:
+    """:func:`run_kitti` once per setting (label -> overrides of :data:`KITTI_PARAMS`), side by side:
+    ATE, final error and the scale figures (path length and start-to-end distance, estimate / truth)."""
+    if not isinstance(variants, dict) or not variants:
+        raise TypeError("`variants` must be a non-empty dict of label -> dict of overrides")
+    rows = []
+    for label, over in variants.items():
+        k = run_kitti(folder, n_frames=n_frames, rng=rng, progress=False, **over)
+        rows.append([label, f"{k.ate_m:.2f}", f"{k.ate_se3_m:.2f}", f"{k.final_error_m:.2f}", f"{k.length_ratio:.3f}",
+                     f"{k.end_distance_ratio:.3f}"])
+    head = ["setting", "ATE, m", "SE(3)-aligned, m", "final, m", "path length est./true", "start-end est./true"]
+    return format_table(head, rows, title=f"{k.name}, {len(k.truth)} frames (real data)")

@@ -63,9 +63,16 @@ class StereoParams(Params):
     min_depth_m: float = param(0.3, "ours")
     max_depth_m: float = param(10.0, "ours: the 6x8 m arena (KITTI: 40, see run_kitti)")
     pixel_std: float = param(0.5, "ours: pixel error behind a stereo point's covariance")
+    subpixel_stereo: bool | None = param(None, "ours: refine each match's disparity by a patch search along the row "
+                                               "(rectified rigs); None: for ORB only, whose pyramid keypoints are off by "
+                                               "up to 1.2^L / 2 px")
+    subpixel_half_px: int = param(5, "ours: half size of the patch of the disparity refinement (11x11 px)")
+    subpixel_search_px: int = param(4, "ours: columns searched on each side of the matched right keypoint")
     # -- matching to the map (000 §3.4) ----------------------------------------------------------------
     map_ratio: float = param(0.8, "ours: ratio rule against the landmark store")
     same_point_m: float | None = param(None, "ours: two nearest landmarks this close count as one (None: off)")
+    duplicate_gap_m: float | None = param(None, "ours: an unmatched point whose nearest landmark by descriptor lies this "
+                                                "close to it (after the pose) is that landmark again, not a new one (None: off)")
     view_margin_deg: float | None = param(None, "ours: match only landmarks in view (None: the whole map, as 000)")
     view_depth_factor: float = param(1.5, "ours: the view gate keeps landmarks up to this times max_depth_m away")
     base_seen_times: int = param(3, "000 §3.4: BaseSeenTimes = 3")
@@ -104,8 +111,13 @@ class StereoParams(Params):
         if v.check_positive(self.max_depth_m, "max_depth_m") <= self.min_depth_m:
             raise ValueError(f"`max_depth_m` must exceed `min_depth_m` = {self.min_depth_m}; got {self.max_depth_m}")
         v.check_positive(self.pixel_std, "pixel_std")
+        if self.subpixel_stereo is not None and not isinstance(self.subpixel_stereo, bool):
+            raise TypeError(f"`subpixel_stereo` must be a bool or None; got {type(self.subpixel_stereo).__name__}")
+        v.check_int(self.subpixel_half_px, "subpixel_half_px", minimum=1)
+        v.check_int(self.subpixel_search_px, "subpixel_search_px", minimum=1)
         v.check_probability(self.map_ratio, "map_ratio")
         _optional_positive(self.same_point_m, "same_point_m")
+        _optional_positive(self.duplicate_gap_m, "duplicate_gap_m")
         _optional_positive(self.view_margin_deg, "view_margin_deg", allow_zero=True)
         v.check_positive(self.view_depth_factor, "view_depth_factor")
         v.check_int(self.base_seen_times, "base_seen_times", minimum=1)
@@ -129,6 +141,11 @@ class StereoParams(Params):
         v.check_positive(self.pose_std_m, "pose_std_m", allow_zero=True)
         v.check_positive(self.pose_std_rad, "pose_std_rad", allow_zero=True)
         _optional_positive(self.update_gate, "update_gate")
+
+    @property
+    def refine_disparity(self) -> bool:
+        """Whether stereo matches get :func:`~slamlab.stereo.subpixel_disparity` (``subpixel_stereo``; None: ORB only)."""
+        return self.detector == "orb" if self.subpixel_stereo is None else self.subpixel_stereo
 
     @property
     def binary(self) -> bool:

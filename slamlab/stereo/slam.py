@@ -16,6 +16,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .. import _validate as v
+from ..features.base import to_gray_uint8
 from ..features.detect import detect
 from ..filters.landmark import landmark_predict, landmark_update
 from ..geometry.camera import StereoRig
@@ -28,6 +29,7 @@ from .stages import (
     _match_to_map,
     _stereo_match,
     _triangulate_local,
+    is_rectified,
     pose_std,
 )
 
@@ -115,6 +117,7 @@ class StereoSLAM:
         self.rng = v.as_rng(rng)
         self._detect_kwargs = p.detect_kwargs()
         self._image_shape = (rig.left.height_px, rig.left.width_px)
+        self._refine = p.refine_disparity and is_rectified(rig)
         # landmarks (ids are row indices): position, covariance, bookkeeping
         self.X = np.empty((0, 3))
         self.P = np.empty((0, 3, 3))
@@ -160,7 +163,11 @@ class StereoSLAM:
         sm = _stereo_match(fl, fr, self.rig.F, p.ratio, p.epi_tol_px)
         t2 = clock()
         times["stereo"] = t2 - t1
-        cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m, p.pixel_std)
+        refine = None
+        if self._refine:
+            refine = (to_gray_uint8(left, "left", channel_order=p.channel_order),
+                      to_gray_uint8(right, "right", channel_order=p.channel_order), p.subpixel_half_px, p.subpixel_search_px)
+        cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m, p.pixel_std, refine)
         Rb, tb = self.T_body_left[:3, :3], self.T_body_left[:3, 3]
         pts_body = cloud.points @ Rb.T + tb
         cov_body = Rb @ cloud.cov @ Rb.T
@@ -169,7 +176,8 @@ class StereoSLAM:
         times["triangulate"] = t3 - t2
         rec = FrameRecord(
             frame=self.frame, n_left=len(fl.uv), n_right=len(fr.uv), n_stereo=len(sm.left),
-            n_local=len(pts_body), n_map_matches=0, n_inliers=0, n_used=0, n_gated=0, n_new=0, status="ok",
+            n_local=len(pts_body), n_map_matches=0, n_inliers=0, n_used=0, n_gated=0, n_new=0, n_duplicates=0,
+            status="ok",
         )  # fmt: skip
         if len(self.X) == 0:
             # first frame (or an empty map): it defines the map frame
@@ -221,6 +229,15 @@ class StereoSLAM:
         rec["n_inliers"] = len(ids)
         # unmatched local points become new (non-base) landmarks
         new = mm.unmatched
+        if p.duplicate_gap_m is not None and new.size:
+            # a point whose nearest landmark by descriptor sits where it is, is that landmark again
+            nn = mm.nearest[new]
+            has = nn >= 0
+            gap = np.full(new.size, np.inf)
+            gap[has] = np.linalg.norm(pts_body[new[has]] @ R.T + t - self.X[nn[has]], axis=1)
+            dup = gap <= p.duplicate_gap_m
+            rec["n_duplicates"] = int(dup.sum())
+            new = new[~dup]
         self._add_landmarks(pts_body[new], cov_body[new], desc[new], est.T)
         rec["n_new"] = len(new)
         inl_mask = np.zeros(len(pts_body), bool)

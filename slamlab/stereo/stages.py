@@ -32,10 +32,12 @@ __all__ = [
     "StereoMatches",
     "detect_features",
     "estimate_pose",
+    "is_rectified",
     "match_to_map",
     "pose_std",
     "select_oldest",
     "stereo_match",
+    "subpixel_disparity",
     "triangulate_local",
 ]
 
@@ -172,6 +174,86 @@ def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
     return out
 
 
+# --- sub-pixel disparity along the rows of a rectified pair (our addition) -------------------------
+
+
+def is_rectified(rig: StereoRig, tol: float = 1e-9) -> bool:
+    """True when ``rig``'s epipolar lines are image rows: parallel axes, a baseline along ``x`` and
+    equal ``fy``, ``cy`` (then a left pixel's match lies on the same row of the right image)."""
+    return bool(np.allclose(rig.R_rl, np.eye(3), atol=tol) and abs(rig.t_rl[1]) <= tol and abs(rig.t_rl[2]) <= tol
+                and np.isclose(rig.left.fy, rig.right.fy) and np.isclose(rig.left.cy, rig.right.cy))
+
+
+def subpixel_disparity(left_image, right_image, uv_left, uv_right, *, half_px: int = 5, search_px: int = 4):
+    """Refine stereo matches of a rectified pair by patch search along the row (our addition to 000 §3.3).
+
+    The ``(2 half_px + 1)²`` patch at the left keypoint's nearest pixel ``(c, r)`` is compared (sum of absolute differences of mean-free patches) with right patches on row ``r``
+    within ``search_px`` columns of the matched right keypoint; a V (equiangular line fit, suited to
+    absolute differences) through the best cost and its two neighbours gives the sub-pixel column.
+    Returns ``(uv_left, uv_right, ok)``: the left keypoints unchanged, the right ones on the same row
+    at the refined disparity (measured at ``c``, applied at the keypoint's sub-pixel column), and the mask of matches that were refined — False near a border or when
+    the best cost lies at the end of the search window (a match the patches do not confirm).
+
+    Why: ORB finds keypoints on a scale pyramid (factor 1.2, 8 levels), so a keypoint of level L
+    sits on a grid of ``1.2^L`` pixels; the disparity of two such keypoints carries that error
+    into the depth (``z² δd / (f b)``). The patch search measures the disparity at full resolution.
+
+    >>> rng = np.random.default_rng(0); L = rng.integers(0, 256, (40, 60)).astype(np.uint8)
+    >>> R = np.roll(L, -7, axis=1)  # disparity 7 px everywhere
+    >>> _, uvr, ok = subpixel_disparity(L, R, [[30.2, 20.0]], [[21.0, 20.0]])
+    >>> bool(ok[0]), round(float(uvr[0, 0]), 1)
+    (True, 23.2)
+    """
+    from ..features.base import to_gray_uint8
+
+    h = v.check_int(half_px, "half_px", minimum=1)
+    s = v.check_int(search_px, "search_px", minimum=1)
+    IL = to_gray_uint8(left_image, "left_image")
+    IR = to_gray_uint8(right_image, "right_image")
+    if IL.shape != IR.shape:
+        raise ValueError(f"`left_image` and `right_image` must have the same shape; got {IL.shape} and {IR.shape}")
+    uvl = v.as_finite_array(uv_left, "uv_left", ndim=2)
+    uvr = v.as_finite_array(uv_right, "uv_right", ndim=2)
+    if uvl.shape != uvr.shape or uvl.shape[1:] != (2,):
+        raise ValueError(f"`uv_left` and `uv_right` must both have shape (M, 2); got {uvl.shape} and {uvr.shape}")
+    return _subpixel_disparity(IL, IR, uvl, uvr, h, s)
+
+
+def _subpixel_disparity(IL, IR, uvl, uvr, h, s):
+    """:func:`subpixel_disparity` on checked grey uint8 images (the per-frame core)."""
+    from numpy.lib.stride_tricks import sliding_window_view
+
+    H, W = IL.shape
+    c = np.rint(uvl[:, 0]).astype(np.intp)
+    r = np.rint(uvl[:, 1]).astype(np.intp)
+    cr = np.rint(c - (uvl[:, 0] - uvr[:, 0])).astype(np.intp)  # right column of pixel c at the matched disparity
+    ok = (r >= h) & (r < H - h) & (c >= h) & (c < W - h) & (cr - h - s >= 0) & (cr + h + s < W)
+    out_r = np.column_stack([uvr[:, 0], uvl[:, 1]])
+    idx = np.flatnonzero(ok)
+    if idx.size == 0:
+        return uvl.copy(), out_r, ok
+    P = 2 * h + 1
+    lp = sliding_window_view(IL, (P, P))[r[idx] - h, c[idx] - h].astype(np.float32)
+    strip = sliding_window_view(IR, (P, P + 2 * s))[r[idx] - h, cr[idx] - h - s].astype(np.float32)
+    lp -= lp.mean(axis=(1, 2), keepdims=True)
+    cost = np.empty((idx.size, 2 * s + 1), np.float32)
+    for k in range(2 * s + 1):
+        rp = strip[:, :, k:k + P]
+        cost[:, k] = np.abs(lp - (rp - rp.mean(axis=(1, 2), keepdims=True))).sum(axis=(1, 2))
+    k = np.argmin(cost, axis=1)
+    inner = (k > 0) & (k < 2 * s)
+    kk = np.clip(k, 1, 2 * s - 1)
+    rows = np.arange(idx.size)
+    cm, c0, cp = cost[rows, kk - 1], cost[rows, kk], cost[rows, kk + 1]
+    den = 2.0 * (np.maximum(cm, cp) - c0)  # equiangular (V-shaped) fit: exact for a linear SAD slope
+    delta = np.where(den > 0, (cm - cp) / np.where(den > 0, den, 1.0), 0.0)
+    # the disparity measured at pixel c, applied at the keypoint's own sub-pixel position
+    disparity = c[idx] - (cr[idx] - s + kk + np.clip(delta, -0.5, 0.5))
+    out_r[idx, 0] = uvl[idx, 0] - disparity
+    ok[idx] = inner
+    return uvl.copy(), out_r, ok
+
+
 # --- local landmark cloud (000 §3.3) ----------------------------------------------------------------
 
 
@@ -188,15 +270,19 @@ class LocalCloud(NamedTuple):
     gap_m: np.ndarray
 
 
-def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: StereoMatches, *,
+def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: StereoMatches, *, images=None,
                       params: StereoParams | None = None, **overrides) -> LocalCloud:
     """Midpoint triangulation of the stereo matches, with covariances (000 §3.3).
 
     Keeps points in front of both cameras with depth in ``[min_depth_m, max_depth_m]``.
     The covariance (our addition, used by the landmark filter) is that of a stereo
     point with ``pixel_std`` error per coordinate: lateral ``z σ / f``, depth
-    ``z² √2 σ / (f b)``, rotated along the viewing ray. ``params`` / ``overrides``:
-    :class:`StereoParams` (``min_depth_m``, ``max_depth_m``, ``pixel_std``).
+    ``z² √2 σ / (f b)``, rotated along the viewing ray. With ``images = (left_image,
+    right_image)`` and a rectified ``rig`` (:func:`is_rectified`), the disparities are first
+    refined by :func:`subpixel_disparity` when ``subpixel_stereo`` says so (default: ORB only), and
+    the matches it does not confirm are dropped (what :class:`~slamlab.stereo.StereoSLAM` does). ``params`` /
+    ``overrides``: :class:`StereoParams` (``min_depth_m``, ``max_depth_m``, ``pixel_std``,
+    ``subpixel_*``).
     """
     p = StereoParams.resolve(params, **overrides)
     if not isinstance(rig, StereoRig):
@@ -205,14 +291,27 @@ def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: 
     _check_features(right, "right")
     if not isinstance(matches, StereoMatches):
         raise TypeError(f"`matches` must be StereoMatches; got {type(matches).__name__}")
-    return _triangulate_local(rig, left, right, matches, p.min_depth_m, p.max_depth_m, p.pixel_std)
+    if images is not None and (not isinstance(images, (tuple, list)) or len(images) != 2):
+        raise TypeError("`images` must be a pair (left_image, right_image)")
+    if images is None or not (p.refine_disparity and is_rectified(rig)):
+        return _triangulate_local(rig, left, right, matches, p.min_depth_m, p.max_depth_m, p.pixel_std)
+    from ..features.base import to_gray_uint8
+
+    grey = [to_gray_uint8(im, name, channel_order=p.channel_order) for im, name in zip(images, ("left_image", "right_image"), strict=True)]
+    return _triangulate_local(rig, left, right, matches, p.min_depth_m, p.max_depth_m, p.pixel_std,
+                              refine=(*grey, p.subpixel_half_px, p.subpixel_search_px))
 
 
-def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixel_std) -> LocalCloud:
-    """:func:`triangulate_local` on checked arguments (the per-frame core)."""
+def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixel_std, refine=None) -> LocalCloud:
+    """:func:`triangulate_local` on checked arguments (the per-frame core); ``refine`` =
+    ``(grey_left, grey_right, half_px, search_px)`` refines the disparities first."""
     if len(matches.left) == 0:
         return LocalCloud(np.empty((0, 3)), np.empty((0, 3, 3)), np.empty(0, np.intp), np.empty(0))
-    tri = triangulate_stereo(rig, left.uv[matches.left], right.uv[matches.right])
+    uvl, uvr, li = left.uv[matches.left], right.uv[matches.right], matches.left
+    if refine is not None:
+        uvl, uvr, ok = _subpixel_disparity(refine[0], refine[1], uvl, uvr, refine[2], refine[3])
+        uvl, uvr, li = uvl[ok], uvr[ok], li[ok]
+    tri = triangulate_stereo(rig, uvl, uvr)
     P = tri.points
     ok = tri.valid & (P[:, 2] >= min_depth_m) & (P[:, 2] <= max_depth_m)
     P = P[ok]
@@ -223,7 +322,7 @@ def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixe
     # covariance = lat I + (dep - lat) r r^T with r the unit viewing ray
     r = P / np.linalg.norm(P, axis=1, keepdims=True)
     cov = lat[:, None, None] * np.eye(3) + (dep - lat)[:, None, None] * (r[:, :, None] * r[:, None, :])
-    return LocalCloud(P, cov, matches.left[ok], tri.gap_m[ok])
+    return LocalCloud(P, cov, li[ok], tri.gap_m[ok])
 
 
 # --- local landmarks to map landmarks through a store (000 §3.4) -----------------------------------
@@ -231,12 +330,14 @@ def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixe
 
 class MapMatches(NamedTuple):
     """``local (M,)`` indices into the local cloud, ``ids (M,)`` landmark ids, ``distance (M,)``,
-    and ``unmatched (K - M,)`` local indices that found no landmark (candidates for new landmarks)."""
+    ``unmatched (K - M,)`` local indices that found no landmark (candidates for new landmarks), and
+    ``nearest (K,)``: every local point's nearest landmark by descriptor (-1: none), matched or not."""
 
     local: np.ndarray
     ids: np.ndarray
     distance: np.ndarray
     unmatched: np.ndarray
+    nearest: np.ndarray | None = None
 
 
 def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | None = None, positions=None,
@@ -275,7 +376,7 @@ def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates
     """:func:`match_to_map` on checked arguments (the per-frame core)."""
     k = D.shape[0]
     if k == 0 or len(store) == 0:
-        return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k))
+        return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
     if candidates is not None:
         dist, ids = store.query_among(D, candidates, k=2)
     else:
@@ -293,7 +394,7 @@ def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates
     sel = best_per_target(lid, d)  # one local point per landmark: the closest descriptor wins
     claimed = np.zeros(k, dtype=bool)
     claimed[loc] = True  # ratio-passing points that lost a duplicate are neither matches nor new
-    return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed))
+    return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed), ids[:, 0])
 
 
 # --- pose: absolute orientation inside RANSAC, oldest landmarks first (000 §3.5) -----------------

@@ -9,7 +9,7 @@ from slamlab.kdtree.stores import MultiKDTree, NonBaseBuffer
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
 from slamlab.stereo import STAGES, StereoParams, StereoSLAM
-from slamlab.stereo.experiments import StereoRunResult, run_stereo_slam
+from slamlab.stereo.experiments import StereoRunResult, run_stereo_slam, run_stereo_slam_variants
 
 
 @pytest.fixture(scope="module")
@@ -162,6 +162,25 @@ def test_calibration_drift_costs_stereo_matches():
         run_drift_study((-1e-3,), n_frames=2)
     with pytest.raises(ValueError, match="experiment"):
         run_drift_study((0.0,), experiment="spiral")
+    with pytest.raises(ValueError, match="size"):
+        run_drift_study((0.0,), size="huge")
+
+
+def test_drift_study_on_sweep_equals_the_sequential_loop_for_one_and_two_workers():
+    from slamlab.stereo import RenderParams, run_drift_study, run_turn_in_place
+
+    levels = (0.0, 2e-3)
+    # the study as it was: one run per level, in order, every level with the same seed
+    ref = [run_turn_in_place(n_frames=3, detector="orb", render=RenderParams(drift_std_rad=d), rng=5) for d in levels]
+    one = run_drift_study(levels, n_frames=3, detector="orb", rng=5, n_jobs=1, progress=False)
+    two = run_drift_study(levels, n_frames=3, detector="orb", rng=5, n_jobs=2, progress=False)
+    for study in (one, two):
+        assert study.drift_std_rad == levels
+        for r, s in zip(ref, study.runs, strict=True):
+            np.testing.assert_array_equal(s.estimate, r.estimate)
+            for k in r.counts:
+                np.testing.assert_array_equal(s.counts[k], r.counts[k])
+    assert one.table() == two.table()
 
 
 def test_update_gate_keeps_inconsistent_observations_from_throwing_landmarks():
@@ -295,3 +314,43 @@ def test_every_param_is_checked(name):
         StereoParams(**{name: bad})
     assert dataclasses.fields(StereoParams)  # frozen dataclass fields, each with a source
     assert StereoParams.sources()[name].startswith(("000 §", "ours"))
+
+
+def test_duplicate_check_keeps_re_sighted_points_out_of_the_map():
+    # a landmark whose sighting failed the ratio rule (two similar descriptors) is re-added unless the
+    # duplicate check sees that its nearest landmark by descriptor already sits where the point is
+    poses = turn_in_place(np.deg2rad(5.0))[:5]
+    runs = run_stereo_slam_variants(poses, {"off": {"detector": "orb"}, "on": {"detector": "orb", "duplicate_gap_m": 0.1}},
+                                    arena=StereoArena(seed=0), rng=0, progress=False)
+    off, on = runs["off"].counts, runs["on"].counts
+    assert off["n_duplicates"].sum() == 0
+    assert on["n_duplicates"][1:].min() > 0
+    # every point the check holds back is one landmark fewer
+    np.testing.assert_array_equal(on["n_new"][:2] + on["n_duplicates"][:2], off["n_new"][:2])
+    assert on["n_new"][1:].sum() < off["n_new"][1:].sum()
+    assert runs["on"].pos_err_m.max() < 0.1
+
+
+def test_disparity_errors_table_shows_the_refinement_per_level():
+    from slamlab.stereo import disparity_errors
+
+    table = disparity_errors()
+    rows = [line.split() for line in table.splitlines()[3:]]
+    assert len(rows) == 8  # ORB's 8 pyramid levels
+    for _level, n, raw_med, _raw_far, ref_med, _ref_far, refined in rows:
+        assert int(n) > 0
+        assert float(ref_med) < float(raw_med)
+        assert float(ref_med) <= 0.05  # against the renderer's depth (see test_stages)
+        assert int(refined) >= 80
+
+
+@pytest.mark.realdata
+def test_kitti_comparison_prints_one_row_per_setting(shared_data):
+    from slamlab.stereo import kitti_comparison
+
+    table = kitti_comparison({"a": {"detector": "orb"}, "b": {"detector": "orb", "subpixel_stereo": False}},
+                             shared_data / "kitti-odometry-06-stereo", n_frames=3)
+    assert "kitti-odometry-06-stereo, 3 frames" in table
+    assert [line.split()[0] for line in table.splitlines()[3:]] == ["a", "b"]
+    with pytest.raises(TypeError, match="variants"):
+        kitti_comparison({})

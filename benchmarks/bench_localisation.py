@@ -1,0 +1,106 @@
+"""Benchmark Ch. 8: one MCL update and one Markov grid update on the 200×200 test room.
+
+Goals (issue 12): one MCL update (odometry motion + likelihood-field weights +
+low-variance resampling) of 10 000 particles × 60 beams in ≤ 15 ms, reported as
+particle-beams per second and as a ratio against the same update written with a
+per-particle Python loop (same arithmetic, identical log-likelihoods); one Markov
+grid update (motion + sensor) on 200×200 cells × 72 headings in ≤ 1 s.
+
+    python benchmarks/bench_localisation.py
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import platform
+import time
+
+import numpy as np
+
+from slamlab import localisation as L
+from slamlab import sim as S
+
+
+def best_cpu(fn, repeat=5):
+    """Best CPU time (``time.process_time``) over ``repeat`` runs and the last result (single-threaded code)."""
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.process_time()
+        out = fn()
+        times.append(time.process_time() - t0)
+    return min(times), out
+
+
+def loop_log_likelihood(model: L.LikelihoodFieldModel, X, beams: L.Beams) -> np.ndarray:
+    """The reference: the likelihood-field weight computed particle by particle, beam by beam."""
+    T = model._padded.reshape(model._padded_shape)
+    Hp, Wp = model._padded_shape
+    out = np.empty(len(X))
+    bx, by = beams.end_xy[:, 0], beams.end_xy[:, 1]
+    for i, (x, y, th) in enumerate(X):
+        c, s = math.cos(th), math.sin(th)
+        acc = 0.0
+        for k in range(beams.n):
+            col = min(max(math.floor(x + model.pad + 0.5 + c * bx[k] - s * by[k]), 0), Wp - 1)
+            row = min(max(math.floor(y + model.pad + 0.5 + s * bx[k] + c * by[k]), 0), Hp - 1)
+            acc += float(T[row, col])
+        out[i] = acc
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--particles", type=int, default=10_000)
+    ap.add_argument("--beams", type=int, default=60)
+    ap.add_argument("--loop-particles", type=int, default=1000, help="particles timed in the Python loop")
+    args = ap.parse_args(argv)
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
+          f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}")
+    M = S.test_room_200()
+    P = S.path_004(121)
+    scan = S.Rangefinder(n_beams=args.beams, max_range_cells=300, range_std_cells=0.5).scan(M, P[30], rng=0)
+    params = L.MCLParams(n_particles=args.particles, max_beams=args.beams, alpha_slow=0.0, alpha_fast=0.0,
+                         resample_threshold=1.0)
+    model = params.model(M, 300.0)
+    beams = L.scan_beams(scan, args.beams)
+    if beams.n != args.beams:
+        raise RuntimeError(f"the scan has {beams.n} returns, not {args.beams}")
+    X = L.uniform_free_particles(M, args.particles, 0)
+    state = L.MCLState(X, np.full(len(X), 1 / len(X)))
+    n, b = len(X), beams.n
+
+    t_w, ll = best_cpu(lambda: model.log_likelihood(X, beams))
+    t_step, _ = best_cpu(lambda: L.mcl_step(state, P[29], P[30], beams, model, params, np.random.default_rng(1)))
+    m = args.loop_particles
+    t_loop, ll_loop = best_cpu(lambda: loop_log_likelihood(model, X[:m], beams), repeat=2)
+    same = np.allclose(ll[:m], ll_loop, rtol=1e-5)
+    t_loop_full = t_loop * n / m
+    print(f"\nMCL update, {n} particles × {b} beams (CPU time, best of 5)")
+    print(f"  weights only (likelihood field):  {t_w * 1e3:8.2f} ms   {n * b / t_w / 1e6:7.1f} M particle-beams/s")
+    print(f"  full update (motion+weights+resample): {t_step * 1e3:8.2f} ms   goal ≤ 15 ms: "
+          f"{'met' if t_step <= 0.015 else 'NOT met'} (at this load)")
+    print(f"  per-particle loop, weights: {t_loop_full * 1e3:8.1f} ms (timed on {m} particles, scaled)   "
+          f"{n * b / t_loop_full / 1e6:7.3f} M particle-beams/s")
+    print(f"  ratio loop / ours (weights): {t_loop_full / t_w:6.0f}x   same log-likelihoods: {same}")
+
+    print("\nMarkov grid update, 200×200 cells × 72 headings, 30 beams (CPU time, best of 3)")
+    mg = L.MarkovGrid(M, 300.0, resolution=1, n_headings=72, max_beams=30)
+    bel0 = mg.belief.copy()
+
+    def markov_update():
+        mg.belief = bel0.copy()
+        mg.predict(P[29], P[30])
+        mg.correct(scan)
+
+    t_mk, _ = best_cpu(markov_update, repeat=3)
+    t_pred, _ = best_cpu(lambda: L.markov_predict(bel0, P[29], P[30], resolution=1, alpha=mg.params.alpha,
+                                                  free_mask=mg.free_mask), repeat=3)
+    print(f"  motion + sensor: {t_mk:6.3f} s (motion alone {t_pred:6.3f} s)   goal ≤ 1 s: "
+          f"{'met' if t_mk <= 1.0 else 'NOT met'} (at this load); belief {mg.nbytes / 2**20:.1f} MiB")
+    print(f"\nload average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()

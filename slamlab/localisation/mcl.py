@@ -1,0 +1,292 @@
+"""Monte Carlo localisation: MCL, augmented MCL (random injection) and KLD sampling (003 §2.2, eqs 2.8-2.11).
+
+003's Monte Carlo method: particles scored by an observation model with values in
+[0, 1] and resampled; the mean score (2.8), two running averages initialised at 0
+and updated each iteration (2.9, 2.10), and a number of particles scattered at
+random each iteration (2.11). The equations are lost images; we read them as PR's
+augmented MCL (Table 8.3; our identification)::
+
+    w_avg  = Σ_m w_prev[m]·s[m]                    (2.8)  s[m] ∈ [0, 1] the score
+    w_slow = w_slow + α_slow·(w_avg − w_slow)      (2.9)
+    w_fast = w_fast + α_fast·(w_avg − w_fast)      (2.10)
+    P_A    = M·max(0, 1 − w_fast / w_slow)         (2.11)  expected number injected
+
+Each particle of the resampled set is replaced by a uniform pose on the free cells
+with probability ``max(0, 1 − w_fast/w_slow)`` (so ``P_A`` in expectation).
+Resampling (low-variance) runs only when ``N_eff < resample_threshold·M`` or when
+particles are to be injected; otherwise weights carry over. KLD sampling (Fox 2003,
+PR Table 8.4) adapts ``M`` at each resampling: our addition, as in ROS AMCL.
+
+API summary
+-----------
+- :class:`MCLParams`: every setting with its source.
+- :func:`mcl_step` ``(state, odom_prev, odom_now, scan, model, params, rng) -> (state, StepRecord)``.
+- :class:`MCL`: the filter as an object (``step``, ``records``, particle snapshots).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as v
+from .._params import Params, param
+from .models import (
+    Beams,
+    LikelihoodFieldModel,
+    check_model_settings,
+    check_particles,
+    sample_motion_odometry,
+    scan_beams,
+)
+from .particles import (
+    free_cell_centres,
+    is_localised,
+    kld_sample_count,
+    low_variance_resample,
+    n_eff,
+    normalise_log_weights,
+    pose_estimate,
+    uniform_free_particles,
+)
+
+__all__ = ["MCL", "MCLParams", "MCLState", "StepRecord", "mcl_step"]
+
+
+@dataclass(frozen=True)
+class MCLParams(Params):
+    """Settings of Monte Carlo localisation; lengths in cells (the map's unit)."""
+
+    n_particles: int = param(2000, "ours (003: not given; ROS AMCL 100…5000, Nav2 500…2000)")
+    alpha: tuple = param((0.05, 0.002, 0.05, 0.005), "ours; PR Table 5.6 α1…α4 (ROS: 0.2 each, in metres)")
+    z_hit: float = param(0.9, "ours; PR Table 6.3 (ROS 1: 0.95, Nav2: 0.5)")
+    z_rand: float = param(0.1, "ours; PR Table 6.3 (ROS 1: 0.05, Nav2: 0.5)")
+    sigma_hit: float = param(1.5, "ours, cells; PR Table 6.3 (ROS: 0.2 m)")
+    max_dist: float = param(8.0, "ours, cells: cap of the distance table (ROS: 2 m)")
+    max_beams: int = param(30, "ours (ROS 1: 30, Nav2: 60)")
+    gamma: float = param(1.0, "ours: log-likelihood exponent (1 = PR's product over beams)")
+    alpha_slow: float = param(0.001, "003 eq 2.9 (value not given); ROS AMCL docs suggest 0.001")
+    alpha_fast: float = param(0.1, "003 eq 2.10 (value not given); ROS AMCL docs suggest 0.1")
+    resample_threshold: float = param(0.5, "ours: resample when N_eff < threshold·M (PR §4.3.4)")
+    use_kld: bool = param(False, "ours: KLD sampling, Fox 2003 / PR Table 8.4 (ROS AMCL does it)")
+    kld_epsilon: float = param(0.05, "Fox 2003 / PR Table 8.4 ε (ROS 1: 0.01, Nav2: 0.05)")
+    kld_z: float = param(0.99, "Fox 2003 / PR Table 8.4: 1 − δ (ROS: 0.99)")
+    kld_bin: tuple = param((2.0, 2.0, float(np.radians(10))), "ours: KLD bin (x, y cells, θ rad)")
+    n_min: int = param(100, "ours: KLD lower bound (ROS 1: 100, Nav2: 500)")
+    localised_pos_std: float = param(2.0, "ours: 'localised' when the position σ < this (cells)")
+    localised_heading_std_rad: float = param(float(np.radians(5)), "ours: … and the heading σ < this")
+
+    def check(self) -> None:
+        v.check_int(self.n_particles, "n_particles", minimum=1)
+        check_model_settings(self)
+        s = v.check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
+        f = v.check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
+        if s > 1 or f > 1:
+            raise ValueError(f"`alpha_slow` and `alpha_fast` must be in [0, 1]; got {s}, {f}")
+        if s > 0 and not f > s:
+            raise ValueError(f"`alpha_fast` must be > `alpha_slow` (PR: 0 ≤ α_slow ≪ α_fast); got {f} <= {s}")
+        t = v.check_positive(self.resample_threshold, "resample_threshold", allow_zero=True)
+        if t > 1:
+            raise ValueError(f"`resample_threshold` must be in [0, 1]; got {t}")
+        if not isinstance(self.use_kld, (bool, np.bool_)):
+            raise TypeError(f"`use_kld` must be a bool; got {type(self.use_kld).__name__}")
+        v.check_positive(self.kld_epsilon, "kld_epsilon")
+        v.check_probability(self.kld_z, "kld_z")
+        b = np.asarray(self.kld_bin, dtype=float)
+        if b.shape != (3,) or np.any(b <= 0):
+            raise ValueError(f"`kld_bin` must be three sizes > 0 (x, y, θ); got {self.kld_bin!r}")
+        v.check_int(self.n_min, "n_min", minimum=1)
+        v.check_positive(self.localised_pos_std, "localised_pos_std")
+        v.check_positive(self.localised_heading_std_rad, "localised_heading_std_rad")
+
+    @property
+    def injection(self) -> bool:
+        """Whether random particles are injected (α_slow > 0)."""
+        return self.alpha_slow > 0
+
+    def model(self, grid, z_max: float) -> LikelihoodFieldModel:
+        """The likelihood-field model of these settings on ``grid``."""
+        return LikelihoodFieldModel(grid, z_hit=self.z_hit, z_rand=self.z_rand, sigma_hit=self.sigma_hit,
+                                    z_max=z_max, max_dist=self.max_dist)
+
+
+@dataclass(frozen=True)
+class MCLState:
+    """The filter's state: particles, their normalised weights and the two running averages."""
+
+    particles: np.ndarray = field(repr=False)  # (M, 3)
+    weights: np.ndarray = field(repr=False)  # (M,) summing to 1
+    w_slow: float = 0.0  # 003: both start at 0
+    w_fast: float = 0.0
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    """What one MCL iteration did (for the tables and the time plots)."""
+
+    mean: np.ndarray
+    cov: np.ndarray
+    n_particles: int
+    n_eff: float
+    w_avg: float
+    w_slow: float
+    w_fast: float
+    p_inject: float
+    n_injected: int
+    resampled: bool
+    localised: bool
+    weights_vanished: bool = False
+    note: str = ""
+
+
+def _inject_probability(w_slow: float, w_fast: float) -> float:
+    """``max(0, 1 − w_fast/w_slow)`` (PR Table 8.3 line 13); 0 while ``w_slow`` is 0."""
+    if w_slow <= 0:
+        return 0.0
+    return max(0.0, 1.0 - w_fast / w_slow)
+
+
+def mcl_step(state: MCLState, odom_prev, odom_now, scan, model: LikelihoodFieldModel, params: MCLParams,
+             rng=None, *, free_xy=None) -> tuple[MCLState, StepRecord]:
+    """One iteration of (augmented) MCL (003 §2.2; PR Tables 8.2, 8.3, optionally 8.4).
+
+    Parameters
+    ----------
+    state : MCLState
+    odom_prev, odom_now : array_like, shape (3,), or None
+        The odometry reading since the last step (None: no motion).
+    scan : Scan or Beams
+        The scan in cell units (or its :func:`scan_beams`).
+    model : LikelihoodFieldModel
+    params : MCLParams
+    rng : Generator, int or None
+    free_xy : (K, 2) array, optional
+        Free cell centres for injection (computed from the model's grid when None).
+
+    Returns
+    -------
+    (MCLState, StepRecord)
+    """
+    state, rec, _ = _mcl_step(state, odom_prev, odom_now, scan, model, params, rng, free_xy=free_xy)
+    return state, rec
+
+
+def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free_xy=None):
+    """The body of :func:`mcl_step`; also returns the weighted set before resampling ``(X, w)``."""
+    if not isinstance(state, MCLState):
+        raise TypeError(f"`state` must be an MCLState; got {type(state).__name__}")
+    if not isinstance(params, MCLParams):
+        raise TypeError(f"`params` must be MCLParams; got {type(params).__name__}")
+    rng = v.as_rng(rng)
+    X = check_particles(state.particles, "state.particles")
+    beams = scan if isinstance(scan, Beams) else scan_beams(scan, params.max_beams)
+    # PR Table 8.2 line 4: x[m] ~ p(x | u, x[m])
+    if odom_prev is not None and odom_now is not None:
+        X = sample_motion_odometry(X, odom_prev, odom_now, params.alpha, rng)
+    # line 5: weights from the likelihood field (log domain: 30-60 beams underflow a product)
+    L = model.log_likelihood(X, beams)
+    s = model.score(L, beams)
+    w_prev = state.weights
+    w_avg = float(w_prev @ s)  # 2.8
+    w_slow = state.w_slow + params.alpha_slow * (w_avg - state.w_slow)  # 2.9
+    w_fast = state.w_fast + params.alpha_fast * (w_avg - state.w_fast)  # 2.10
+    log_w = np.log(np.maximum(w_prev, 1e-300)) + params.gamma * L
+    w, ok = normalise_log_weights(log_w)
+    p_inj = _inject_probability(w_slow, w_fast) if params.injection else 0.0
+    note = ""
+    if not ok:
+        if params.injection:
+            p_inj, note = 1.0, "all weights vanished: every particle re-drawn at random"
+        else:
+            note = "all weights vanished: no injection (α_slow = 0), particles kept with uniform weights"
+    weighted = (X, w)
+    mean, cov = pose_estimate(X, w)
+    neff = n_eff(w)
+    M = X.shape[0]
+    resample = neff < params.resample_threshold * M or p_inj > 0
+    n_inj = 0
+    if resample:
+        if params.use_kld:
+            n_max = params.n_particles
+            idx = rng.choice(M, size=n_max, p=w)  # PR Table 8.4 draws i.i.d.
+            m_keep = kld_sample_count(X[idx], bin_size=params.kld_bin, epsilon=params.kld_epsilon,
+                                      z_quantile=params.kld_z, n_min=min(params.n_min, n_max))
+            X = X[idx[:m_keep]]
+        else:
+            X = X[low_variance_resample(w, params.n_particles, rng)]
+        M = X.shape[0]
+        if p_inj > 0:
+            inj = rng.random(M) < p_inj  # 2.11: P_A = M·p_inj in expectation
+            n_inj = int(inj.sum())
+            if n_inj:
+                xy = free_cell_centres(model.grid) if free_xy is None else free_xy
+                X = X.copy()
+                X[inj] = uniform_free_particles(model.grid, n_inj, rng, centres=xy)
+        w = np.full(M, 1.0 / M)
+    new = MCLState(X, w, float(w_slow), float(w_fast))
+    rec = StepRecord(mean, cov, M, neff, w_avg, float(w_slow), float(w_fast), p_inj, n_inj, bool(resample),
+                     is_localised(cov, pos_std=params.localised_pos_std,
+                                  heading_std_rad=params.localised_heading_std_rad),
+                     weights_vanished=not ok, note=note)
+    return new, rec, weighted
+
+
+class MCL:
+    """Monte Carlo localisation on a grid map (003 §2.2): holds the state and the record of every step.
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        The map in cells.
+    z_max : float
+        The rangefinder's maximum range in cells.
+    params : MCLParams, optional
+    rng : Generator, int or None
+    init_pose, init_std : optional
+        Tracking: particles ~ N(init_pose, diag(init_std²)); global (default): uniform on free cells.
+    keep_particles : bool
+        Keep the weighted particles of every step, before resampling (plots, histogram, time slider).
+    **overrides
+        Fields of :class:`MCLParams`.
+
+    Examples
+    --------
+    >>> g = np.zeros((20, 20), np.int8); g[0] = g[-1] = g[:, 0] = g[:, -1] = 1
+    >>> f = MCL(g, 30.0, n_particles=50, rng=0)
+    >>> f.state.particles.shape
+    (50, 3)
+    """
+
+    def __init__(self, grid, z_max: float, *, params: MCLParams | None = None, rng=None, init_pose=None,
+                 init_std=(1.0, 1.0, 0.05), keep_particles: bool = False, **overrides):
+        self.params = MCLParams.resolve(params, **overrides)
+        self.model = self.params.model(grid, z_max)
+        self.rng = v.as_rng(rng)
+        self.free_xy = free_cell_centres(self.model.grid)
+        M = self.params.n_particles
+        if init_pose is None:
+            X = uniform_free_particles(self.model.grid, M, self.rng, centres=self.free_xy)
+        else:
+            p = check_particles(init_pose, "init_pose")[0]
+            sd = np.asarray(init_std, dtype=float)
+            if sd.shape != (3,) or np.any(sd < 0) or not np.all(np.isfinite(sd)):
+                raise ValueError(f"`init_std` must be three finite numbers >= 0; got {init_std!r}")
+            X = p + self.rng.standard_normal((M, 3)) * sd
+        self.state = MCLState(X, np.full(M, 1.0 / M))
+        self.records: list[StepRecord] = []
+        self.keep_particles = bool(keep_particles)
+        self.snapshots: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def step(self, odom_prev, odom_now, scan) -> StepRecord:
+        """One iteration; returns (and keeps) its :class:`StepRecord`."""
+        self.state, rec, weighted = _mcl_step(self.state, odom_prev, odom_now, scan, self.model, self.params,
+                                              self.rng, free_xy=self.free_xy)
+        self.records.append(rec)
+        if self.keep_particles:
+            self.snapshots.append((weighted[0].copy(), weighted[1].copy()))
+        return rec
+
+    def estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        """Mean pose and covariance of the current particles."""
+        return pose_estimate(self.state.particles, self.state.weights)

@@ -1,0 +1,162 @@
+"""Epipolar search of a seed in a new frame (003 §4.2).
+
+For a seed of reference keyframe ``r`` (bearing ``f``, inverse depth ``ρ ± σ``) the search
+covers only the depths ``[1/(ρ + 2σ), 1/max(ρ − 2σ, 1e-10)]`` (003 §4.2): their projections
+into the current frame bound a segment of the epipolar line. The candidates are the FAST
+corners of the current frame within ``tol_px`` of that segment (003 Fig. 4.3b), and the score
+is the zero-mean normalised cross-correlation (ZNCC) of ``patch_px × patch_px`` patches,
+unwarped (our choice; SVO warps the patch affinely and scores by zero-mean SSD). The best
+candidate above ``zncc_min`` is triangulated along ``f``; a failed search is an outlier
+for the Beta part (SVO: ``b += 1``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.triangulation import triangulate_midpoint
+from .align import bilinear
+from .depth_filter import depth_interval
+
+__all__ = ["EpipolarMatch", "epipolar_segments", "extract_patches", "search_epipolar", "zncc"]
+
+_FAR_DEPTH = 1e6  # depths beyond this are drawn at their vanishing point
+
+
+def extract_patches(img, uv, patch_px: int) -> np.ndarray:
+    """``(N, patch_px²)`` bilinear patches centred at ``uv`` (N, 2)."""
+    uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+    if patch_px % 2 and np.all(uv == np.rint(uv)):  # odd patch on whole pixels: plain indexing
+        o = np.arange(patch_px) - patch_px // 2
+        ou, ov = np.meshgrid(o, o)
+        h, w = img.shape[:2]
+        r = np.clip(uv[:, 1:2].astype(np.intp) + ov.ravel(), 0, h - 1)
+        c = np.clip(uv[:, 0:1].astype(np.intp) + ou.ravel(), 0, w - 1)
+        return np.asarray(img, np.float32)[r, c]
+    o = np.arange(patch_px) - (patch_px - 1) / 2.0
+    ou, ov = np.meshgrid(o, o)
+    return bilinear(np.asarray(img, np.float32), uv[:, 0:1] + ou.ravel(), uv[:, 1:2] + ov.ravel())
+
+
+def _normalise(P):
+    """Rows made zero-mean and unit-norm (flat rows stay zero), so that a dot product is the ZNCC."""
+    P = np.asarray(P, dtype=np.float64)
+    P = P - P.mean(axis=1, keepdims=True)
+    nrm = np.linalg.norm(P, axis=1, keepdims=True)
+    return np.where(nrm > 1e-6, P / np.maximum(nrm, 1e-12), 0.0)
+
+
+def zncc(A, B) -> np.ndarray:
+    """ZNCC matrix ``(N, M)`` between rows of ``A`` (N, P) and ``B`` (M, P); flat patches score 0."""
+    A = np.asarray(A, dtype=np.float64)
+    B = np.asarray(B, dtype=np.float64)
+    A = A - A.mean(axis=1, keepdims=True)
+    B = B - B.mean(axis=1, keepdims=True)
+    na = np.linalg.norm(A, axis=1)
+    nb = np.linalg.norm(B, axis=1)
+    den = np.outer(na, nb)
+    return np.where(den > 1e-6, (A @ B.T) / np.maximum(den, 1e-12), 0.0)
+
+
+def epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma: float = 2.0):
+    """End points ``(a, b)`` (N, 2) of the searched epipolar segment, ``ok`` (N,) (003 §4.2).
+
+    ``a`` is the projection of the nearest depth ``1/(ρ + nσ)``, ``b`` of the farthest
+    ``1/max(ρ − nσ, 1e-10)`` (drawn at the vanishing point beyond ``1e6`` m). ``ok`` False
+    when the near end is behind the current camera.
+    """
+    K = np.asarray(K, dtype=np.float64)
+    R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
+    z_near, z_far = depth_interval(mu, sigma, n_sigma)
+    fc = np.asarray(f, dtype=np.float64) @ R.T
+    Xa = fc * z_near[:, None] + t
+    far_inf = z_far > _FAR_DEPTH
+    Xb = np.where(far_inf[:, None], fc, fc * np.minimum(z_far, _FAR_DEPTH)[:, None] + t)
+    ok = (Xa[:, 2] > 1e-6) & (Xb[:, 2] > 1e-6)
+    Xa = np.where(ok[:, None], Xa, [0.0, 0.0, 1.0])
+    Xb = np.where(ok[:, None], Xb, [0.0, 0.0, 1.0])
+    a = np.column_stack([K[0, 0] * Xa[:, 0] / Xa[:, 2] + K[0, 2], K[1, 1] * Xa[:, 1] / Xa[:, 2] + K[1, 2]])
+    b = np.column_stack([K[0, 0] * Xb[:, 0] / Xb[:, 2] + K[0, 2], K[1, 1] * Xb[:, 1] / Xb[:, 2] + K[1, 2]])
+    return a, b, ok
+
+
+@dataclass(frozen=True)
+class EpipolarMatch:
+    """Result of :func:`search_epipolar` for N seeds.
+
+    ``found`` (N,), ``uv`` (N, 2) matched pixel (NaN-free: zeros when not found), ``depth_m``
+    (N,) triangulated depth along ``f`` in the reference frame, ``score`` (N,) best ZNCC,
+    ``n_candidates`` (N,) corners tested, ``a``/``b`` segment end points.
+    """
+
+    found: np.ndarray
+    uv: np.ndarray
+    depth_m: np.ndarray
+    score: np.ndarray
+    n_candidates: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+
+
+def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv, *, n_sigma: float = 2.0,
+                    tol_px: float = 2.0, patch_px: int = 9, zncc_min: float = 0.8, min_parallax_rad: float = 1e-3,
+                    chunk: int = 512, cur_patches=None) -> EpipolarMatch:
+    """Find each seed in the current frame among FAST corners near its epipolar segment (003 §4.2).
+
+    ``ref_patches`` (N, patch_px²) the seeds' patches in their reference keyframe;
+    ``corners_uv`` (C, 2) the current frame's FAST corners. Vectorised over seeds × corners
+    in chunks of ``chunk`` seeds. ``cur_patches`` (C, patch_px²): the corners' patches, if
+    already cut (then ``corners_uv`` must be the same corners, all inside the margin).
+    """
+    K = np.asarray(K, dtype=np.float64)
+    f = np.asarray(f, dtype=np.float64).reshape(-1, 3)
+    n = f.shape[0]
+    a, b, ok = epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma)
+    corners = np.asarray(corners_uv, dtype=np.float64).reshape(-1, 2)
+    h, w = img_cur.shape[:2]
+    m = (patch_px + 1) / 2.0 + 1
+    if cur_patches is None:
+        inside = (corners[:, 0] >= m) & (corners[:, 0] < w - m) & (corners[:, 1] >= m) & (corners[:, 1] < h - m)
+        corners = corners[inside]
+    found = np.zeros(n, bool)
+    uv = np.zeros((n, 2))
+    score = np.full(n, -1.0)
+    ncand = np.zeros(n, np.int64)
+    if n == 0 or corners.shape[0] == 0:
+        return EpipolarMatch(found, uv, np.zeros(n), score, ncand, a, b)
+    cur_n = _normalise(extract_patches(img_cur, corners, patch_px) if cur_patches is None else cur_patches)
+    ref_n = _normalise(ref_patches)
+    for s0 in range(0, n, chunk):
+        sl = slice(s0, min(n, s0 + chunk))
+        A, B = a[sl], b[sl]
+        d = B - A
+        L = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
+        e = d / L[:, None]  # unit direction; normal (-e_v, e_u)
+        nrm = np.column_stack([-e[:, 1], e[:, 0]])
+        # distance to the line and position along the segment for every (corner, seed): two products
+        c32 = corners.astype(np.float32)
+        dist = np.abs(c32 @ nrm.T.astype(np.float32) - np.sum(A * nrm, axis=1).astype(np.float32))  # (C, S)
+        along = c32 @ e.T.astype(np.float32) - np.sum(A * e, axis=1).astype(np.float32)
+        near = (dist <= tol_px) & (along >= -tol_px) & (along <= L + tol_px) & ok[sl]
+        ci, si = np.nonzero(near)
+        ncand[sl] = np.bincount(si, minlength=L.size)
+        if ci.size == 0:
+            continue
+        sc = np.einsum("ij,ij->i", ref_n[s0 + si], cur_n[ci])  # ZNCC of each candidate pair
+        order = np.lexsort((-sc, si))  # per seed, best score first
+        first = order[np.r_[True, si[order][1:] != si[order][:-1]]]
+        bs, bc, bv = si[first] + s0, ci[first], sc[first]
+        score[bs] = bv
+        hit = bv >= zncc_min
+        found[bs[hit]] = True
+        uv[bs[hit]] = corners[bc[hit]]
+    # triangulate along f: ray f from the reference centre, ray through uv from the current centre
+    R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
+    c_cur = -R.T @ t  # current centre in the reference frame
+    rays = np.column_stack([(uv[:, 0] - K[0, 2]) / K[0, 0], (uv[:, 1] - K[1, 2]) / K[1, 1], np.ones(n)]) @ R  # R^T r
+    tri = triangulate_midpoint(np.zeros(3), f, c_cur, rays, parallel_tol=min_parallax_rad**2)
+    depth = tri.s  # f is unit: the ray parameter is the depth along f
+    found &= tri.valid
+    return EpipolarMatch(found, uv, np.where(found, depth, 0.0), score, ncand, a, b)

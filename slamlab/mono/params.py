@@ -1,0 +1,90 @@
+"""Settings of the monocular pipeline (003 §4, §5.1.1): one frozen dataclass, each field sourced."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .. import _validate as v
+from .._params import Params, param
+
+__all__ = ["MonoParams"]
+
+
+@dataclass(frozen=True)
+class MonoParams(Params):
+    """Every knob of :class:`~slamlab.mono.MonoSLAM` with the source of its default."""
+
+    # initialisation (003 §4.3.1, §5.1.1)
+    fast_threshold: int = param(20, "ours: FAST threshold (003 §5.3 notes its effect on the initial map)")
+    min_corners: int = param(50, "003 §4.3.1: at least 50 FAST points")
+    init_disparity_px: float = param(15.0, "003 §5.1.1: 10-20 px ('initial displacement')")
+    init_min_tracked: float = param(0.5, "ours: restart when fewer than this share of corners is still tracked")
+    init_method: str = param("homography", "003 §4.3.1: homography + RANSAC ('essential' = the 5-point method)")
+    init_ransac_px: float = param(2.0, "ours")
+    init_min_parallax_deg: float = param(1.0, "ours: median triangulation angle needed")
+    # depth filter (003 §4.1.1, §4.2, §4.3.2; SVO)
+    convergence: str = param("linearity", "003 §4.3.2: 'linearity' (L < 0.1) or SVO's 'sigma'")
+    L_max: float = param(0.1, "003 §4.3.2")
+    sigma_fraction: float = param(1.0 / 200.0, "SVO: sigma < rho_range / 200")
+    n_sigma: float = param(2.0, "003 §4.2: search over rho +- 2 sigma")
+    epi_tol_px: float = param(2.0, "ours: 003 §4.2 says the band around the epipolar line is tunable")
+    patch_px: int = param(9, "ours: patch side for the seed score (ZNCC; SVO scores 8x8 patches)")
+    zncc_min: float = param(0.8, "ours: minimum ZNCC of a seed match")
+    px_noise: float = param(1.0, "SVO: one pixel of measurement error")
+    max_seed_fail: int = param(10, "ours: 003 §4.3.2 drops a seed not found 'for several frames'")
+    min_inlier_ratio: float = param(0.1, "SVO: drop seeds with a/(a+b) < 0.1")
+    max_seeds_per_kf: int = param(400, "ours")
+    # keyframes (003 §4.3)
+    kf_min_frames: int = param(30, "003 §4.3: 30 iterations between keyframes")
+    kf_lost_ratio: float = param(0.10, "003 §4.3: at least 10 % of points lost")
+    kf_max_lost_ratio: float = param(0.30, "003 §4.3 / §5.1.1 ('lost-point ratio'): > 30 % lost forces one")
+    max_keyframes: int = param(10, "003 §5.1.1: 'number of keyframes', value not given")
+    # tracking (003 §4.4)
+    motion_model: str = param("constant_position", "SVO; 003 §4.4 step 1 uses 'constant_velocity' (available)")
+    align_patch_px: int = param(4, "003 §4.4.1: 4x4 patches")
+    align_max_level: int = param(3, "ours: coarsest pyramid level")
+    align_min_level: int = param(1, "003 §4.4.1: the finest levels can be skipped")
+    align_iters: int = param(30, "ours")
+    align_max_points: int = param(400, "ours: map points used by the direct alignment")
+    max_matches: int = param(120, "003 §5.1.1: 'number of matches', value not given")
+    match_win_px: int = param(11, "ours: LK window refining a projected point")
+    reproj_inlier_px: float = param(2.0, "ours")
+    min_inliers: int = param(20, "ours: fewer inliers = lost")
+
+    def check(self) -> None:
+        v.check_int(self.fast_threshold, "fast_threshold", minimum=1, maximum=254)
+        v.check_int(self.min_corners, "min_corners", minimum=8)
+        v.check_positive(self.init_disparity_px, "init_disparity_px")
+        v.check_probability(self.init_min_tracked, "init_min_tracked")
+        v.check_choice(self.init_method, "init_method", ("homography", "essential"))
+        v.check_positive(self.init_ransac_px, "init_ransac_px")
+        v.check_positive(self.init_min_parallax_deg, "init_min_parallax_deg", allow_zero=True)
+        v.check_choice(self.convergence, "convergence", ("linearity", "sigma"))
+        v.check_positive(self.L_max, "L_max")
+        v.check_positive(self.sigma_fraction, "sigma_fraction")
+        v.check_positive(self.n_sigma, "n_sigma")
+        v.check_positive(self.epi_tol_px, "epi_tol_px")
+        v.check_int(self.patch_px, "patch_px", minimum=3, maximum=31)
+        if not -1.0 <= float(self.zncc_min) <= 1.0:
+            raise ValueError(f"`zncc_min` must be in [-1, 1]; got {self.zncc_min}")
+        v.check_positive(self.px_noise, "px_noise")
+        v.check_int(self.max_seed_fail, "max_seed_fail", minimum=1)
+        v.check_probability(self.min_inlier_ratio, "min_inlier_ratio")
+        v.check_int(self.max_seeds_per_kf, "max_seeds_per_kf", minimum=1)
+        v.check_int(self.kf_min_frames, "kf_min_frames", minimum=1)
+        v.check_probability(self.kf_lost_ratio, "kf_lost_ratio")
+        v.check_probability(self.kf_max_lost_ratio, "kf_max_lost_ratio")
+        v.check_int(self.max_keyframes, "max_keyframes", minimum=2)
+        v.check_choice(self.motion_model, "motion_model", ("constant_position", "constant_velocity"))
+        v.check_int(self.align_patch_px, "align_patch_px", minimum=2, maximum=16)
+        v.check_int(self.align_max_level, "align_max_level", minimum=0, maximum=6)
+        v.check_int(self.align_min_level, "align_min_level", minimum=0, maximum=6)
+        if self.align_min_level > self.align_max_level:
+            raise ValueError(f"`align_min_level` must be <= `align_max_level`; got {self.align_min_level} > "
+                             f"{self.align_max_level}")
+        v.check_int(self.align_iters, "align_iters", minimum=1)
+        v.check_int(self.align_max_points, "align_max_points", minimum=10)
+        v.check_int(self.max_matches, "max_matches", minimum=6)
+        v.check_int(self.match_win_px, "match_win_px", minimum=5, maximum=51)
+        v.check_positive(self.reproj_inlier_px, "reproj_inlier_px")
+        v.check_int(self.min_inliers, "min_inliers", minimum=6)

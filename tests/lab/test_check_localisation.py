@@ -1,0 +1,119 @@
+"""Lab 08 tasks: solutions written from PR / 003 §2.2 pass, typical mistakes fail at the expected case."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from slamlab import lab
+
+# --- independent solutions (what a student should write) --------------------------------------------
+
+
+def low_variance(weights, n, r):
+    w = np.asarray(weights, float)
+    c = np.cumsum(w / w.sum())
+    out, i = [], 0
+    for m in range(n):  # PR Table 4.4, the loop form
+        u = r + m / n
+        while u >= c[i] and i < len(c) - 1:
+            i += 1
+        out.append(i)
+    return np.array(out)
+
+
+def _wrap(a):
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def motion_sample(poses, odom_prev, odom_now, alpha, noise, *, squares=True):
+    a1, a2, a3, a4 = alpha
+    dx, dy = odom_now[0] - odom_prev[0], odom_now[1] - odom_prev[1]
+    trans = math.hypot(dx, dy)
+    rot1 = 0.0 if trans < 1e-6 else _wrap(math.atan2(dy, dx) - odom_prev[2])
+    rot2 = _wrap(odom_now[2] - odom_prev[2] - rot1)
+    p = (lambda x: x * x) if squares else abs  # the mistake: the printed PR Table 5.6 without squares
+    r1 = rot1 - math.sqrt(a1 * p(rot1) + a2 * p(trans)) * noise[0]
+    t = trans - math.sqrt(a3 * p(trans) + a4 * (p(rot1) + p(rot2))) * noise[1]
+    r2 = rot2 - math.sqrt(a1 * p(rot2) + a2 * p(trans)) * noise[2]
+    x, y, th = poses[:, 0], poses[:, 1], poses[:, 2]
+    return np.column_stack([x + t * np.cos(th + r1), y + t * np.sin(th + r1), _wrap(th + r1 + r2)])
+
+
+def likelihood_field(grid, pose, bearings_rad, ranges, z_hit, z_rand, z_max, sigma_hit, max_dist, *, skip=True,
+                     outside=True):
+    d = np.minimum(ndimage.distance_transform_edt(grid != 1), max_dist)
+    H, W = grid.shape
+    total = 0.0
+    for a, r in zip(bearings_rad, ranges, strict=True):
+        if skip and r >= z_max:
+            continue
+        ex, ey = pose[0] + r * math.cos(pose[2] + a), pose[1] + r * math.sin(pose[2] + a)
+        row, col = math.floor(ey + 0.5), math.floor(ex + 0.5)
+        if 0 <= row < H and 0 <= col < W:
+            dist = d[row, col]
+        else:
+            dist = max_dist if outside else d[min(max(row, 0), H - 1), min(max(col, 0), W - 1)]
+        g = math.exp(-0.5 * (dist / sigma_hit) ** 2) / (math.sqrt(2 * math.pi) * sigma_hit)
+        total += math.log(z_hit * g + z_rand / z_max)
+    return total
+
+
+def augmented(w_avg, w_slow, w_fast, alpha_slow, alpha_fast, *, guard=True):
+    s = w_slow + alpha_slow * (w_avg - w_slow)
+    f = w_fast + alpha_fast * (w_avg - w_fast)
+    if guard and s == 0:
+        return np.array([s, f, 0.0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.array([s, f, max(0.0, 1.0 - f / s)])
+
+
+@pytest.mark.parametrize(("task_id", "fn"), [("08.low_variance", low_variance), ("08.motion_sample", motion_sample),
+                                             ("08.likelihood_field", likelihood_field),
+                                             ("08.augmented", augmented)])
+def test_correct_solutions_pass(task_id, fn):
+    res = lab.check(task_id, fn, quiet=True)
+    assert res.passed, res.message
+
+
+def test_mistakes_fail():
+    def multinomial(weights, n, r):  # ignores r: draws i.i.d.
+        return np.random.default_rng(0).choice(len(weights), n, p=np.asarray(weights) / np.sum(weights))
+
+    def no_squares(**kw):
+        return motion_sample(**kw, squares=False)
+
+    def no_skip(**kw):
+        return likelihood_field(**kw, skip=False)
+
+    def clamp_outside(**kw):
+        return likelihood_field(**kw, outside=False)
+
+    def averages_only_after(w_avg, w_slow, w_fast, alpha_slow, alpha_fast):  # p from the old averages
+        p = 0.0 if w_slow == 0 else max(0.0, 1 - w_fast / w_slow)
+        return np.array([w_slow + alpha_slow * (w_avg - w_slow), w_fast + alpha_fast * (w_avg - w_fast), p])
+
+    assert lab.check("08.low_variance", multinomial, quiet=True).status == "failed"
+    assert "case 1 of" in lab.check("08.motion_sample", no_squares, quiet=True).message
+    assert "(a beam at z_max is skipped)" in lab.check("08.likelihood_field", no_skip, quiet=True).message
+    assert "off the map" in lab.check("08.likelihood_field", clamp_outside, quiet=True).message
+    assert lab.check("08.augmented", averages_only_after, quiet=True).status == "failed"
+    res = lab.check("08.augmented", lambda **kw: augmented(**kw, guard=False), quiet=True)
+    assert res.status in ("failed", "error")
+
+
+@pytest.mark.slow
+def test_exploration_answers():
+    import slamlab as sl
+
+    g = sl.localisation.run_global_localisation((500,), n_runs=20, n_steps=20, seed=2026)
+    rate = float(g.summary()["success"].iloc[0])
+    assert lab.answer("08.explore.global_success", rate, quiet=True).passed
+    assert lab.answer("08.explore.global_success", rate + 0.05, quiet=True).status == "failed"
+    _, res = sl.localisation.demo_run(1000, kidnap_step=25, alpha_slow=0.05, alpha_fast=0.5, seed=2026)
+    steps = res.converged_at(25) - 25
+    assert lab.answer("08.explore.kidnap_recovery", steps, quiet=True).passed
+    assert lab.answer("08.explore.kidnap_recovery", steps + 1, quiet=True).status == "failed"

@@ -1,0 +1,222 @@
+"""Resampling, N_eff, KLD, pose estimate, MCL and Markov grid localisation (003 §2.2; PR Tables 4.4, 8.1-8.4)."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from slamlab import localisation as L
+from slamlab import sim as S
+from slamlab.geometry import angle_mean, se2_integrate, se2_relative
+
+
+def test_low_variance_counts_are_floor_or_ceil_of_n_w():
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        w = rng.random(13) ** 3
+        w /= w.sum()
+        n = 97
+        counts = np.bincount(L.low_variance_resample(w, n, rng), minlength=13)
+        assert counts.sum() == n
+        assert np.all(counts >= np.floor(n * w) - 1e-9)
+        assert np.all(counts <= np.ceil(n * w) + 1e-9)
+
+
+def test_low_variance_is_unbiased():
+    w = np.array([0.1, 0.2, 0.3, 0.4])
+    rng = np.random.default_rng(1)
+    mean = np.mean([np.bincount(L.low_variance_resample(w, 10, rng), minlength=4) for _ in range(4000)], axis=0)
+    np.testing.assert_allclose(mean, 10 * w, atol=0.03)
+
+
+def test_n_eff_closed_forms():
+    assert L.n_eff(np.full(8, 1 / 8)) == pytest.approx(8)
+    assert L.n_eff([0.5, 0.5, 0, 0]) == pytest.approx(2)
+    w = np.array([0.7, 0.1, 0.1, 0.1])
+    assert L.n_eff(w) == pytest.approx(1 / (0.49 + 0.03))
+
+
+def test_normalise_log_weights_never_nan():
+    w, ok = L.normalise_log_weights([-1e308, -np.inf, np.nan])
+    assert ok
+    assert w.tolist() == [1.0, 0.0, 0.0]
+    w, ok = L.normalise_log_weights([np.nan, -np.inf])
+    assert not ok
+    assert np.allclose(w, 0.5)
+
+
+@pytest.mark.parametrize("k", [2, 10, 50, 300])
+def test_kld_bound_is_the_wilson_hilferty_chi2_quantile(k):
+    # Fox 2003: n = chi2_{k-1, 1-δ} / (2ε); the bound is the Wilson-Hilferty approximation of that quantile
+    exact = stats.chi2.ppf(0.99, k - 1) / (2 * 0.05)
+    assert float(L.kld_bound(k, 0.05, 0.99)) == pytest.approx(exact, rel=0.02 if k > 5 else 0.1)
+
+
+def test_kld_sample_count_one_bin_and_many_bins():
+    one = np.tile([[5.0, 5.0, 0.1]], (1000, 1))
+    assert L.kld_sample_count(one, n_min=50) == 50
+    rng = np.random.default_rng(0)
+    spread = np.column_stack([rng.uniform(0, 400, 3000), rng.uniform(0, 400, 3000), rng.uniform(-3, 3, 3000)])
+    m = L.kld_sample_count(spread, n_min=10)
+    k = len({tuple(r) for r in np.floor(spread[:m] / [2, 2, np.radians(10)]).astype(int)})
+    assert m >= L.kld_bound(k) - 1e-9 or m == 3000
+
+
+def test_pose_estimate_against_numpy_and_angle_mean():
+    rng = np.random.default_rng(3)
+    P = np.column_stack([rng.normal(3, 1, 500), rng.normal(-2, 0.5, 500), np.pi + rng.normal(0, 0.2, 500)])
+    P[:, 2] = np.angle(np.exp(1j * P[:, 2]))  # straddles ±π
+    w = rng.random(500)
+    m, C = L.pose_estimate(P, w)
+    wn = w / w.sum()
+    assert m[2] == pytest.approx(float(angle_mean(P[:, 2], wn)), abs=1e-12)
+    np.testing.assert_allclose(m[:2], wn @ P[:, :2], atol=1e-12)
+    d = np.column_stack([P[:, :2] - m[:2], np.angle(np.exp(1j * (P[:, 2] - m[2])))])
+    # second moments about the circular mean = covariance about the residuals' own mean + mean·meanᵀ
+    mu = wn @ d
+    np.testing.assert_allclose(C, np.cov(d.T, aweights=wn, bias=True) + np.outer(mu, mu), atol=1e-12)
+
+
+def _run(f, P, scans, odo=None, kidnap=None):
+    """Run a filter along P; odometry poses odo (default the truth)."""
+    odo = P if odo is None else odo
+    out = []
+    for k in range(len(P)):
+        prev, now = (odo[k - 1], odo[k]) if k else (None, None)
+        out.append(f.step(prev, now, scans[k]))
+    return out
+
+
+@pytest.fixture(scope="module")
+def room_run():
+    M = S.test_room_200()
+    P = S.path_004(61)
+    scans = S.simulate_scans(M, P, S.Rangefinder(n_beams=60, max_range_cells=60, range_std_cells=0.5), rng=1)
+    odo = S.simulate_odometry(P, trans_std_frac=0.05, rot_std_rad=0.01, rng=2).poses
+    return M, P, scans, odo
+
+
+def test_mcl_tracking_stays_within_a_cell(room_run):
+    M, P, scans, odo = room_run
+    f = L.MCL(M, 60.0, n_particles=500, rng=0, init_pose=P[0], init_std=(1.0, 1.0, 0.05))
+    recs = _run(f, P, scans, odo)
+    err = np.array([math.hypot(*(r.mean[:2] - p[:2])) for r, p in zip(recs, P, strict=True)])
+    herr = np.array([abs(math.remainder(r.mean[2] - p[2], 2 * math.pi)) for r, p in zip(recs, P, strict=True)])
+    assert err.max() < 1.5
+    assert np.degrees(herr).max() < 3
+    assert all(r.localised for r in recs[5:])
+
+
+def test_mcl_function_and_class_agree(room_run):
+    M, _P, scans, _ = room_run
+    f = L.MCL(M, 60.0, n_particles=200, rng=5)
+    X0 = f.state.particles.copy()
+    rec = f.step(None, None, scans[0])
+    state, rec2 = L.mcl_step(L.MCLState(X0, np.full(200, 1 / 200)), None, None, scans[0], f.model, f.params,
+                             np.random.default_rng(5).spawn(0) or _rng_after_init(200))
+    np.testing.assert_allclose(rec.mean, rec2.mean, atol=1e-12)
+    np.testing.assert_allclose(f.state.particles, state.particles, atol=1e-12)
+
+
+def _rng_after_init(n):
+    """The Generator of MCL(rng=5) after it drew the initial particles (uniform_free_particles draws 3 arrays)."""
+    rng = np.random.default_rng(5)
+    M = S.test_room_200()
+    L.uniform_free_particles(M, n, rng)
+    return rng
+
+
+def test_augmented_mcl_recovers_from_kidnapping_and_plain_mcl_does_not():
+    M = S.test_room_200()
+    P = S.path_004(121)
+    # kidnap after step 20: the robot is carried from P[20] to P[80]; odometry reports ordinary motion
+    order = list(range(21)) + list(range(80, 121))
+    true = P[order]
+    inc = se2_relative(true[:-1], true[1:])
+    inc[20] = se2_relative(P[20], P[21])
+    odo = se2_integrate(true[0], inc)
+    scans = S.simulate_scans(M, true, S.Rangefinder(n_beams=60, max_range_cells=60, range_std_cells=0.5), rng=1)
+
+    def final_error(**kw):
+        f = L.MCL(M, 60.0, n_particles=1500, rng=3, init_pose=true[0], init_std=(1.0, 1.0, 0.05), **kw)
+        recs = _run(f, true, scans, odo)
+        return math.hypot(*(recs[-1].mean[:2] - true[-1, :2])), sum(r.n_injected for r in recs)
+
+    e_aug, n_inj = final_error(alpha_slow=0.05, alpha_fast=0.5)
+    e_plain, n0 = final_error(alpha_slow=0.0, alpha_fast=0.0)
+    assert n0 == 0
+    assert n_inj > 0
+    assert e_aug < 2.0
+    assert e_plain > 10.0
+
+
+def test_all_vanishing_weights_inject_or_say_so():
+    g = np.zeros((40, 40), np.int8)
+    g[0] = g[-1] = g[:, 0] = g[:, -1] = 1
+    from slamlab.scans import Scan
+    scan = Scan(np.array([0.0]), np.array([10.0]), np.array([True]), max_range=30.0)
+    # z_rand = 0 and a tiny σ_hit: every end point that is not on a wall has probability exactly 0
+    far = np.tile([[20.0, 20.0, np.pi / 4]], (50, 1))
+    for slow, fast, injected in ((0.0, 0.0, False), (0.1, 0.5, True)):
+        f = L.MCL(g, 30.0, n_particles=50, rng=0, z_rand=0.0, sigma_hit=0.01, alpha_slow=slow, alpha_fast=fast)
+        f.state = L.MCLState(far.copy(), np.full(50, 1 / 50))
+        rec = f.step(None, None, scan)
+        assert rec.weights_vanished
+        assert np.all(np.isfinite(f.state.weights))
+        assert np.all(np.isfinite(rec.mean))
+        assert ("re-drawn" in rec.note) == injected
+        assert ("no injection" in rec.note) != injected
+        assert (rec.n_injected == 50) == injected
+
+
+def test_kld_adapts_the_particle_count(room_run):
+    M, P, scans, odo = room_run
+    f = L.MCL(M, 60.0, n_particles=4000, rng=0, use_kld=True, n_min=100, resample_threshold=1.0)
+    recs = _run(f, P[:25], scans[:25], odo[:25])
+    counts = [r.n_particles for r in recs]  # after each resampling
+    assert f.params.n_particles == 4000
+    assert min(counts) >= 100
+    assert max(counts[-5:]) < 1000
+
+
+def test_markov_likelihood_equals_the_particle_model_at_cell_poses():
+    M = S.test_room_200()
+    mg = L.MarkovGrid(M, 60.0, resolution=4, n_headings=12)
+    scan = S.Rangefinder(n_beams=24, max_range_cells=60).scan(M, [70, 30, 0.3])
+    b = L.scan_beams(scan)
+    Lg = L.markov_log_likelihood(mg.model, b, 12, 4, mg.shape)
+    poses = mg.cell_poses().reshape(-1, 3)
+    ref = mg.model.log_likelihood(poses, b).reshape(Lg.shape)
+    np.testing.assert_allclose(Lg, ref, rtol=1e-5)
+
+
+def test_markov_global_localisation_finds_the_pose(room_run):
+    M, P, scans, odo = room_run
+    mg = L.MarkovGrid(M, 60.0, resolution=2, n_headings=36)
+    for k in range(12):
+        mg.step(odo[k - 1] if k else None, odo[k] if k else None, scans[k])
+    m, _C = mg.estimate()
+    assert math.hypot(*(m[:2] - P[11, :2])) < 3.0
+    assert abs(math.remainder(m[2] - P[11, 2], 2 * math.pi)) < math.radians(10)
+    assert mg.belief.sum() == pytest.approx(1.0)
+
+
+def test_markov_predict_conserves_mass_and_moves_the_mode():
+    b = np.zeros((8, 30, 30))
+    b[2, 10, 10] = 1.0  # heading 90°: moving "forward" is +y (rows)
+    out = L.markov_predict(b, [0, 0, 0], [4, 0, 0], resolution=1, alpha=(0.01, 0.001, 0.01, 0.001), min_blur=0.5)
+    assert out.sum() == pytest.approx(1.0)
+    assert np.unravel_index(np.argmax(out), out.shape) == (2, 14, 10)
+
+
+def test_markov_vs_mcl_methods_share_the_runs():
+    from slamlab.localisation.experiments import run_markov_vs_mcl
+
+    res = run_markov_vs_mcl(markov=((8, 12),), particle_counts=(50, 60), n_runs=3, n_steps=3, seed=4)
+    df = res.table_df
+    starts = {m: g[["start_x", "start_y"]].to_numpy() for m, g in df.groupby(["method", "size"], sort=False)}
+    first = next(iter(starts.values()))
+    assert len(starts) == 3
+    assert len({tuple(map(tuple, v)) for v in starts.values()}) == 1  # every method ran the same 3 runs
+    assert len({tuple(r) for r in first}) > 1  # and the runs differ from each other
