@@ -11,8 +11,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components
 
 from .. import _validate as v
 from .transform import HoughAccumulator
@@ -136,25 +134,30 @@ def find_peaks(acc: HoughAccumulator, H_min: int, *, suppress_rho: float | None 
     return _find_peaks(acc, H_min, s_rho, s_theta, max_lines)
 
 
+_NB_DI = np.array([-1, -1, -1, 0, 0, 1, 1, 1])[:, None]
+_NB_DK = np.array([-1, 0, 1, -1, 1, -1, 0, 1])[:, None]
+
+
 def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float, max_lines: int | None) -> Lines:
     """:func:`find_peaks` on checked arguments (suppression windows resolved)."""
     H = acc.H
     n_theta = H.shape[1]
     empty = Lines(np.empty(0), np.empty(0), np.empty(0, dtype=np.int64))
-    i, k = np.nonzero(H_min <= H)
-    if i.size == 0:
-        return empty
     n_rho = H.shape[0]
+    # candidates in (rho, θ) row-major order; found on the θ-major counts, which are contiguous for
+    # hough_polar (a 2-D nonzero on the transposed view cost more than the rest of the search)
+    flat = np.flatnonzero(H_min <= H.T)
+    if flat.size == 0:
+        return empty
+    flat = np.sort(flat % n_rho * n_theta + flat // n_rho)
+    i, k = flat // n_theta, flat % n_theta
     value = H[i, k]
-    is_max = np.ones(i.size, dtype=bool)
-    for di in (-1, 0, 1):
-        ii = np.clip(i + di, 0, n_rho - 1)  # rho runs off the axis into nothing: edge cells compare with themselves
-        for dk in (-1, 0, 1):
-            if di or dk:
-                kk = k + dk
-                # wrap θ: the column before -90° is +89° with rho flipped, the one after +89° is -90° flipped
-                wrap = (kk < 0) | (kk >= n_theta)
-                is_max &= value >= H[np.where(wrap, n_rho - 1 - ii, ii), kk % n_theta]
+    # the 8 neighbours of every candidate in one gather (rho runs off the axis into nothing: edge cells
+    # compare with themselves; θ wraps: the column before -90° is +89° with rho flipped, and back)
+    ii = np.clip(i + _NB_DI, 0, n_rho - 1)
+    kk = k + _NB_DK
+    wrap = (kk < 0) | (kk >= n_theta)
+    is_max = (value >= H[np.where(wrap, n_rho - 1 - ii, ii), kk % n_theta]).all(axis=0)
     i, k, value = i[is_max], k[is_max], value[is_max]
     if i.size == 0:
         return empty
@@ -166,7 +169,7 @@ def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float,
     # ... and across the θ wrap, where (rho, -90°) continues as (-rho, 90°)
     adjacent |= ((k[:, None] == 0) & (k[None, :] == n_theta - 1)
                  & (np.abs(i[:, None] - (n_rho - 1 - i[None, :])) <= 1))
-    _, label = connected_components(csr_matrix(adjacent), directed=False)
+    label = _components(adjacent)
     count = np.bincount(label)
     wrapped = (np.bincount(label, weights=k == 0) > 0) & (np.bincount(label, weights=k == n_theta - 1) > 0)
     move = wrapped[label] & (k >= n_theta / 2)
@@ -183,6 +186,24 @@ def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float,
                                  acc.theta_rad[0] + centre[:, 1] * acc.delta_theta_rad)
     keep = _greedy_keep(rho, theta, s_rho, s_theta)[:max_lines]
     return Lines(rho[keep].astype(float), theta[keep].astype(float), votes[keep].astype(np.int64))
+
+
+def _components(adjacent):
+    """Connected-component labels ``0..K-1`` of a small adjacency matrix, edges undirected (candidates: tens).
+
+    Minimum-label propagation with pointer jumping; the same partition as
+    ``scipy.sparse.csgraph.connected_components`` without building a sparse matrix (which cost
+    more than the rest of the peak search, issue 17). Callers only use the partition.
+    """
+    m = adjacent.shape[0]
+    adjacent = adjacent | adjacent.T
+    label = np.arange(m)
+    while True:
+        new = np.minimum(label, np.where(adjacent, label[None, :], m).min(axis=1, initial=m))
+        new = new[new]
+        if np.array_equal(new, label):
+            return np.unique(label, return_inverse=True)[1]
+        label = new
 
 
 def _greedy_keep(rho, theta, s_rho, s_theta):

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["exact_knn", "hamming_distances", "merge_knn", "pad_knn"]
+__all__ = ["augment_rows", "exact_knn", "hamming_distances", "merge_knn", "pad_knn"]
 
 
 def pad_knn(dist, ids, k: int):
@@ -75,7 +75,7 @@ def hamming_distances(A, B) -> np.ndarray:
     return out
 
 
-def exact_knn(Q, X, k: int = 2, ids=None):
+def exact_knn(Q, X, k: int = 2, ids=None, *, augmented=None):
     """The ``k`` nearest rows of ``X`` to every row of ``Q``, exactly, by brute force.
 
     Parameters
@@ -85,6 +85,8 @@ def exact_knn(Q, X, k: int = 2, ids=None):
     k : neighbours per query.
     ids : (N,) int, optional
         Ids of the rows of ``X`` (default: the row indices).
+    augmented : (N, d + 1) float32, optional
+        ``augment_rows(X)`` kept by the caller (a store) between queries; float ``X`` only.
 
     Returns
     -------
@@ -108,28 +110,44 @@ def exact_knn(Q, X, k: int = 2, ids=None):
         idx = idx.astype(np.int64)
         d = np.where(idx >= 0, d, np.inf).astype(np.float64)
     else:
-        d, idx = _exact_knn_float(Q, X, kk)
+        d, idx = _exact_knn_float(Q, X, kk, Xa=augmented)
     if ids is not None:
         ids = np.asarray(ids, dtype=np.int64)
         idx = np.where(idx >= 0, ids[np.maximum(idx, 0)], -1)
     return pad_knn(d, idx, k)
 
 
-def _exact_knn_float(Q, X, k, block: int = 8192, margin: int = 1):
+def augment_rows(X, out=None) -> np.ndarray:
+    """float32 rows ``[x, |x|²/2]`` (the database side of the ranking GEMM of :func:`exact_knn`).
+
+    >>> augment_rows(np.array([[3.0, 4.0]])).tolist()
+    [[3.0, 4.0, 12.5]]
+    """
+    Xa = np.empty((X.shape[0], X.shape[1] + 1), dtype=np.float32) if out is None else out
+    Xa[:, :-1] = X
+    Xa[:, -1] = 0.5 * np.einsum("ij,ij->i", Xa[:, :-1], Xa[:, :-1])
+    return Xa
+
+
+def _exact_knn_float(Q, X, k, block: int | None = None, margin: int = 1, Xa=None):
     """Exact Euclidean k-NN (k <= N): float32 BLAS ranks, float64 decides.
 
     For database blocks of ``block`` rows one GEMM gives the ranking key ``|x|²/2 - q·x`` of every
     query against the block (the squared distance minus ``|q|²``, halved); a running list keeps the
-    best ``k + margin`` candidates per query; their distances are then recomputed directly in
+    best ``k + margin`` candidates per query (after the first block only the queries with a key
+    below their current ``k + margin``-th best take part: one ``min`` pass instead of ``k + margin``
+    ``argmin`` passes for the rest; issue 17); their distances are then recomputed directly in
     float64 and sorted, so float32 rounding can only matter if it pushed a true neighbour behind
     ``margin`` others. The full distance matrix is never written.
     """
     M, N = Q.shape[0], X.shape[0]
     c = min(k + margin, N)
     # augmented rows: [x, |x|²/2] · [-q, 1] = |x|²/2 - q·x, one GEMM per block writes the key directly
-    Xa = np.empty((N, X.shape[1] + 1), dtype=np.float32)
-    Xa[:, :-1] = X
-    Xa[:, -1] = 0.5 * np.einsum("ij,ij->i", Xa[:, :-1], Xa[:, :-1])
+    if Xa is None:
+        Xa = augment_rows(X)
+    # blocks of ~2^21 keys (8 MB): the GEMM's output and the passes over it stay in L3 with few GEMM calls
+    # (8192-row blocks of 500 queries wrote and re-read 16 MB per block three times; issue 17)
+    block = block or max(512, min(8192, (1 << 21) // max(M, 1)))
     Qa = np.empty((M, Q.shape[1] + 1), dtype=np.float32)
     Qa[:, :-1] = -Q
     Qa[:, -1] = 1.0
@@ -140,13 +158,23 @@ def _exact_knn_float(Q, X, k, block: int = 8192, margin: int = 1):
         s1 = min(s0 + block, N)
         G = buf[:, : s1 - s0]
         np.matmul(Qa, Xa[s0:s1].T, out=G)  # (M, b) ranking keys
+        if best_key.shape[1] < c:  # the first block(s): every query takes its best c
+            rows = slice(None)
+        else:  # later blocks: only queries with a key below their current c-th best (one min pass)
+            rows = np.flatnonzero(G.min(axis=1) < best_key.max(axis=1))
+            if rows.size == 0:
+                continue
+            G = G[rows]
         part = _smallest(G, min(c, s1 - s0))
-        key = np.concatenate([best_key, _keys(Qa, Xa, part + s0)], axis=1)
-        idx = np.concatenate([best_idx, part + s0], axis=1)
+        key = np.concatenate([best_key[rows], _keys(Qa[rows], Xa, part + s0)], axis=1)
+        idx = np.concatenate([best_idx[rows], part + s0], axis=1)
         if key.shape[1] > c:
             keep = np.argpartition(key, c - 1, axis=1)[:, :c]
             key, idx = np.take_along_axis(key, keep, axis=1), np.take_along_axis(idx, keep, axis=1)
-        best_key, best_idx = key, idx
+        if isinstance(rows, slice):
+            best_key, best_idx = key, idx
+        else:
+            best_key[rows], best_idx[rows] = key, idx
     # the candidates' distances recomputed directly in float64, sorted, the best k kept
     diff = Q[:, None, :].astype(np.float64) - X[best_idx].astype(np.float64)
     d = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))

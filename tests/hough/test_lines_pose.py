@@ -203,3 +203,23 @@ def test_line_history_matrix():
 def test_bad_input(call, exc, match):
     with pytest.raises(exc, match=match):
         call()
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_peak_grouping_partition_equals_scipy_connected_components(seed):
+    """The flat-top grouping of find_peaks (issue 17: no sparse matrix) = scipy's undirected components."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from slamlab.hough.lines import _components
+
+    rng = np.random.default_rng(seed)
+    m = int(rng.integers(1, 60))
+    adj = rng.random((m, m)) < 2.0 / m  # sparse and not symmetric
+    np.fill_diagonal(adj, True)
+    ours = _components(adj)
+    _, ref = connected_components(csr_matrix(adj), directed=False)
+    # the same partition: labels map one to one
+    pairs = set(zip(ours.tolist(), ref.tolist(), strict=True))
+    assert len(pairs) == len(set(ours.tolist())) == len(set(ref.tolist()))
+    assert ours.max() == len(set(ours.tolist())) - 1

@@ -148,3 +148,19 @@ def test_zero_ranges_do_not_vote():
 def test_bad_input(call, exc, match):
     with pytest.raises(exc, match=match):
         call()
+
+
+@pytest.mark.parametrize("n_points", [0, 1, 15, 20000])
+def test_polar_blocks_do_not_change_votes(n_points):
+    """Votes counted in blocks of θ rows (issue 17) equal the whole-array count of the same arithmetic."""
+    rng = np.random.default_rng(n_points)
+    phi = rng.uniform(-math.pi, math.pi, n_points)
+    r = rng.uniform(0.0, 12.0, n_points)
+    acc = h.hough_polar(phi, r, delta_rho=0.05, r_max=10.0)
+    keep = (r > 0) & (r <= 10.0)
+    x, y = r[keep] * np.cos(phi[keep]) / 0.05, r[keep] * np.sin(phi[keep]) / 0.05
+    idx = np.multiply.outer(x, np.cos(acc.theta_rad)) + np.multiply.outer(y, np.sin(acc.theta_rad))
+    idx += 200.5 + 401 * np.arange(180)
+    H = np.bincount(idx.astype(np.intp).ravel(), minlength=401 * 180).reshape(180, 401).T
+    assert np.array_equal(acc.H, H)
+    assert acc.H.sum() == keep.sum() * 180

@@ -268,3 +268,32 @@ def test_flann_seed_repeats():
         s.add(X, np.arange(3000))
         out.append(s.query(Q)[1])
     np.testing.assert_array_equal(out[0], out[1])
+
+
+def test_exact_store_keeps_its_augmented_rows_in_step_with_adds_and_drops():
+    """The cached [x, |x|²/2] rows (issue 17) follow adds, capacity growth and base-rule drops; queries
+    stay exact (cKDTree over the stored points) across many small blocks of the ranking GEMM."""
+    from slamlab.kdtree.knn import _exact_knn_float, augment_rows
+    from slamlab.kdtree.stores import ExactStore
+
+    rng = np.random.default_rng(5)
+    s = ExactStore(base_seen_times=2, max_non_base_time=2)
+    next_id = 0
+    for it in range(8):
+        n = int(rng.integers(200, 900))
+        s.add(rng.standard_normal((n, 16)).astype(np.float32), np.arange(next_id, next_id + n))
+        next_id += n
+        s.observe(s.ids[rng.random(len(s)) < 0.3])
+        Q = rng.standard_normal((40, 16)).astype(np.float32)
+        d, i = s.query(Q)
+        d_ref, i_ref = _exact(s.points, Q)
+        np.testing.assert_array_equal(i, s.ids[i_ref])
+        np.testing.assert_allclose(d, d_ref, rtol=1e-5)
+        s.end_iteration()
+        np.testing.assert_array_equal(s._pts.augmented, augment_rows(s.points))
+        assert it < 2 or s.dropped_ids.size  # the base rule drops points after the first iterations
+    # tiny blocks: most later blocks are skipped by the running bound, the result stays exact
+    X = s.points
+    _, ii = _exact_knn_float(Q, X, 2, block=64)
+    d_ref, i_ref = _exact(X, Q)
+    np.testing.assert_array_equal(ii, i_ref)
