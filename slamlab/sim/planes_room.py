@@ -179,6 +179,16 @@ def cast_rays_planes(room: PlaneRoom, origins, directions, range_max_m: float = 
     o = np.broadcast_to(o, d.shape) if o.shape == (3,) else o
     if o.shape != d.shape:
         raise ValueError(f"`origins` must have shape (3,) or {d.shape}; got {o.shape}")
+    out = [_cast_chunk(room, o[i:i + _RAY_CHUNK], d[i:i + _RAY_CHUNK], range_max_m)
+           for i in range(0, max(len(d), 1), _RAY_CHUNK)]  # chunks: the (K, P, 3) temporaries stay small
+    return tuple(np.concatenate(parts) for parts in zip(*out, strict=True))
+
+
+#: Rays per chunk of :func:`cast_rays_planes` (a (chunk, planes, 3) float64 temporary: ~6 MB for 15 planes).
+_RAY_CHUNK = 16384
+
+
+def _cast_chunk(room: PlaneRoom, o: np.ndarray, d: np.ndarray, range_max_m: float):
     nd = d @ room.normals.T                                    # (K, P)
     no = o @ room.normals.T
     with np.errstate(divide="ignore", invalid="ignore"):

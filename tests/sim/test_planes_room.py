@@ -133,3 +133,20 @@ def test_bad_arguments():
         simulate_flight(1.0, room="room")
     with pytest.raises(ValueError, match="poses"):
         simulate_odometry_3d(np.zeros((3, 3, 3)))
+
+
+def test_ray_casting_in_chunks_equals_one_pass(monkeypatch):
+    """The chunked caster (bounded temporaries, issue 16's kernel memory) gives exactly the one-pass result."""
+    import slamlab.sim.planes_room as pr
+
+    room = pr.build_plane_room()
+    rng = np.random.default_rng(4)
+    d = rng.standard_normal((5000, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    o = np.array([5.0, 5.0, 1.2]) + 0.1 * rng.standard_normal((5000, 3))
+    one = pr.cast_rays_planes(room, o, d, 30.0)
+    monkeypatch.setattr(pr, "_RAY_CHUNK", 333)
+    chunked = pr.cast_rays_planes(room, o, d, 30.0)
+    for a, b in zip(one, chunked, strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert np.isfinite(one[0]).sum() > 4000  # most rays hit a plane
