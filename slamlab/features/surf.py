@@ -142,17 +142,99 @@ def hessian_response(II, L: int, step: int, *, IIp=None, pad: int | None = None)
     return Dxx * Dyy - 0.81 * Dxy * Dxy, Dxx + Dyy
 
 
+class _Phases:
+    """The integral image on the grid ``(r, c) = step·(i, j)``, split into its step×step phases (issue 17).
+
+    Phase ``(p, q)`` holds ``II[p + step·a - P, q + step·b - P]`` (indices clipped to the image: the
+    same as edge padding, i.e. boxes clipped to the image), contiguous and flat with row length
+    ``Cq``. The corner ``II[r + dr, c + dc]`` over the whole grid is then one contiguous slice of one
+    phase, laid out as ``i·Cq + j`` (columns ``j >= nc`` are padding), so every pass of the box
+    filters runs on contiguous memory -- 2-3x faster than the strided views of :func:`_box`.
+    """
+
+    def __init__(self, II, step, reach, nr, nc):
+        self.II, self.step, self.nr, self.nc = II, step, nr, nc
+        m = -(-reach // step)  # margin in grid steps: every |dr|, |dc| <= reach
+        self.P = m * step
+        self.Cq = nc + 2 * m + 1
+        self.Rq = nr + 2 * m + 2  # one spare row: a slice may run past the last valid row's end
+        self._phase = {}
+
+    def corner(self, dr, dc):
+        """``II[r + dr, c + dc]`` for every grid point, flat ``(nr·Cq,)``."""
+        st, P, H, W = self.step, self.P, self.II.shape[0] - 1, self.II.shape[1] - 1
+        key = ((P + dr) % st, (P + dc) % st)
+        ph = self._phase.get(key)
+        if ph is None:  # two threads may build the same phase: same array, either one is kept
+            ri = np.clip(key[0] - P + st * np.arange(self.Rq), 0, H)
+            ci = np.clip(key[1] - P + st * np.arange(self.Cq), 0, W)
+            ph = self._phase[key] = np.take(self.II.ravel(), (ri * (W + 1))[:, None] + ci).ravel()
+        off = (P + dr) // st * self.Cq + (P + dc) // st
+        return ph[off:off + self.nr * self.Cq]
+
+
+def _hessian_phases(ph, L, det_out, trace_out):
+    """:func:`hessian_response` of side ``L`` on :class:`_Phases` ``ph``, written to ``det_out``/``trace_out``.
+
+    The same operations in the same order as :func:`hessian_response` (so the same values to the
+    last bit), done in place on contiguous buffers.
+    """
+    l, b = L // 3, (L - 1) // 2
+    h = l // 2
+    n = ph.nr * ph.Cq
+    c = ph.corner
+
+    def box(out, r0, r1, c0, c1):
+        np.subtract(c(r1, c1), c(r0, c1), out=out)
+        out -= c(r1, c0)
+        out += c(r0, c0)
+        return out
+
+    Dxx, Dyy, Dxy, t = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    box(Dxx, -l + 1, l, -b, b + 1)
+    Dxx -= np.multiply(box(t, -l + 1, l, -h, -h + l), 3.0, out=t)
+    box(Dyy, -b, b + 1, -l + 1, l)
+    Dyy -= np.multiply(box(t, -h, -h + l, -l + 1, l), 3.0, out=t)
+    box(Dxy, -l, 0, 1, l + 1)
+    Dxy += box(t, 1, l + 1, -l, 0)
+    Dxy -= box(t, -l, 0, -l, 0)
+    Dxy -= box(t, 1, l + 1, 1, l + 1)
+    inv = 1.0 / (L * L)
+    Dxx *= inv
+    Dyy *= inv
+    Dxy *= inv
+    np.multiply(Dxy, 0.81, out=t)
+    t *= Dxy
+    np.multiply(Dxx, Dyy, out=Dxy)
+    Dxy -= t  # det
+    Dxx += Dyy  # trace
+    det_out[...] = Dxy.reshape(ph.nr, ph.Cq)[:, :ph.nc]
+    trace_out[...] = Dxx.reshape(ph.nr, ph.Cq)[:, :ph.nc]
+
+
 def _response_stacks(II, n_octaves, init_step, workers=1):
+    """Per octave ``(det, trace, step)``, stacks ``(4, nr, nc)`` of :func:`hessian_response` (Bay 2008 §3.3).
+
+    Speed (issue 17): octave ``o > 0`` shares two filter sides with octave ``o - 1`` (15 and 27 with
+    9, 15, 21, 27; ...) on a grid twice as coarse, so its intervals 0 and 1 are the previous octave's
+    intervals 1 and 3 taken every second row and column (OpenSURF shares these layers too); only 10
+    of the 16 maps are computed, each on contiguous phases (:class:`_Phases`), split over ``workers``.
+    """
+    H, W = II.shape[0] - 1, II.shape[1] - 1
     L = filter_sizes(n_octaves)
-    pad = int(L.max()) + init_step * 2 ** (n_octaves - 1) + 2
-    IIp = np.pad(II, pad, mode="edge")
-    jobs = [(o, int(Li)) for o in range(n_octaves) for Li in L[o]]
-    res = run_tasks([lambda o=o, Li=Li: hessian_response(II, Li, init_step * 2**o, IIp=IIp, pad=pad)
-                     for o, Li in jobs], workers)
-    out = []
+    out, jobs = [], []
     for o in range(n_octaves):
-        dets, traces = zip(*(r for (oo, _), r in zip(jobs, res, strict=True) if oo == o), strict=True)
-        out.append((np.stack(dets), np.stack(traces), init_step * 2**o))
+        step = init_step * 2**o
+        nr, nc = -(-H // step), -(-W // step)
+        D, T = np.empty((4, nr, nc)), np.empty((4, nr, nc))
+        new = range(4) if o == 0 else (2, 3)
+        ph = _Phases(II, step, (int(L[o][-1]) - 1) // 2 + 1, nr, nc)
+        jobs += [lambda ph=ph, Li=int(L[o][i]), d=D[i], t=T[i]: _hessian_phases(ph, Li, d, t) for i in new]
+        out.append((D, T, step))
+    run_tasks(jobs, workers)
+    for o in range(1, n_octaves):  # L[o][0] = L[o-1][1], L[o][1] = L[o-1][3] at twice the step
+        (D0, T0, _), (D, T, _) = out[o - 1], out[o]
+        D[0], D[1], T[0], T[1] = D0[1, ::2, ::2], D0[3, ::2, ::2], T0[1, ::2, ::2], T0[3, ::2, ::2]
     return out
 
 
