@@ -47,17 +47,22 @@ from .._threads import run_tasks
 from .base import Features, to_gray_float
 
 
-def _by_parts(fn, K, chunk, workers, out):
-    """``fn(slice)`` for chunks of ``chunk`` keypoints, written into ``out[slice]``; the keypoints are
-    split into ``workers`` contiguous parts run in parallel (each chunk independent: same result)."""
-    bounds = np.linspace(0, K, max(1, min(workers, -(-K // chunk))) + 1).astype(int)
+def _by_chunks(fn, fast, chunk, workers, out):
+    """``out[idx] = fn(idx, is_fast)`` for chunks of ``chunk`` keypoints (issue 17, speed).
 
-    def part(a0, a1):
-        for a in range(a0, a1, chunk):
-            sl = slice(a, min(a + chunk, a1))
-            out[sl] = fn(sl)
+    The keypoints flagged ``fast`` (their Haar boxes lie inside the padding of :class:`_PaddedII`) and
+    the others go in separate chunks; the chunks are split into ``workers`` contiguous parts run in
+    parallel. Every keypoint is computed on its own: the result depends on neither.
+    """
+    groups = [(np.flatnonzero(fast), True), (np.flatnonzero(~fast), False)]
+    chunks = [(g[a:a + chunk], f) for g, f in groups for a in range(0, g.size, chunk)]
+    bounds = np.linspace(0, len(chunks), max(1, min(workers, len(chunks))) + 1).astype(int)
 
-    run_tasks([lambda a0=a0, a1=a1: part(a0, a1) for a0, a1 in itertools.pairwise(bounds)], workers)
+    def part(c0, c1):
+        for idx, f in chunks[c0:c1]:
+            out[idx] = fn(idx, f)
+
+    run_tasks([lambda c0=c0, c1=c1: part(c0, c1) for c0, c1 in itertools.pairwise(bounds)], workers)
     return out
 
 
@@ -330,39 +335,55 @@ def haar_xy(II, rows, cols, half):
     return right - left, lower - upper
 
 
-def _haar_keypoints(II, rows, cols, half):
-    """:func:`haar_xy` for ``(k, n)`` samples of ``k`` keypoints with one ``half`` per keypoint ``(k, 1)``.
+class _PaddedII:
+    """The integral image edge-padded by ``pad`` and flat: Haar responses without clipping (issue 17).
 
-    Same values as :func:`haar_xy`. Speed (issue 17): for the keypoints whose boxes all lie inside
-    the image the clipping is a no-op, so their eight corners are gathered at ``base + offset``
-    (one flat index per sample, offsets per keypoint) without the six clips and three row
-    products; only keypoints near the border take the clipped path.
+    Edge padding of ``II`` is the same as clipping the boxes to the image, so :meth:`haar` gives the
+    values of :func:`haar_xy` bit for bit (same corners, same operations) for every keypoint whose
+    boxes reach at most ``pad`` pixels outside the image (:meth:`fits`), with one flat index per
+    sample and per-keypoint corner offsets instead of six clips and three row products.
     """
-    H, W = II.shape[0] - 1, II.shape[1] - 1
-    Wp = W + 1
-    half = np.broadcast_to(half, (rows.shape[0], 1))
-    inside = ((rows.min(axis=1, keepdims=True) - half >= 0) & (rows.max(axis=1, keepdims=True) + half <= H)
-              & (cols.min(axis=1, keepdims=True) - half >= 0) & (cols.max(axis=1, keepdims=True) + half <= W))[:, 0]
-    if not inside.all():
-        dx = np.empty(rows.shape)
-        dy = np.empty(rows.shape)
-        out = ~inside
-        dx[out], dy[out] = haar_xy(II, rows[out], cols[out], half[out])
-        if inside.any():
-            dx[inside], dy[inside] = _haar_keypoints(II, rows[inside], cols[inside], half[inside])
-        return dx, dy
-    flat = II.ravel()
-    base = rows * Wp
-    base += cols
-    dr = half * Wp
-    A00, A01, A02 = flat[base - dr - half], flat[base - dr], flat[base - dr + half]
-    A10, A12 = flat[base - half], flat[base + half]
-    A20, A21, A22 = flat[base + dr - half], flat[base + dr], flat[base + dr + half]
-    right = A22 - A02 - A21 + A01
-    left = A21 - A01 - A20 + A00
-    lower = A22 - A12 - A20 + A10
-    upper = A12 - A02 - A10 + A00
-    return right - left, lower - upper
+
+    def __init__(self, II, pad: int = 64):
+        self.II, self.pad = II, pad
+        self.H, self.W = II.shape[0] - 1, II.shape[1] - 1
+        self.Wp = self.W + 1 + 2 * pad
+        self.flat = np.pad(II, pad, mode="edge").ravel()
+
+    def fits(self, uv, reach):
+        """Keypoints whose samples, ``reach`` pixels around ``uv``, stay inside the padding."""
+        p = self.pad
+        return ((uv[:, 0] - reach >= -p) & (uv[:, 0] + reach <= self.W + p)
+                & (uv[:, 1] - reach >= -p) & (uv[:, 1] + reach <= self.H + p))
+
+    def haar(self, rows, cols, half, fast=True):
+        """:func:`haar_xy` of ``(k, n)`` samples with one ``half`` per keypoint ``(k, 1)``."""
+        if not fast:
+            return haar_xy(self.II, rows, cols, half)
+        flat, Wp = self.flat, self.Wp
+        base = rows * Wp
+        base += cols
+        base += self.pad * (Wp + 1)
+        dr = half * Wp
+        up, down = base - dr, base + dr
+        A00, A01, A02 = flat[up - half], flat[up], flat[up + half]
+        A10, A12 = flat[base - half], flat[base + half]
+        A20, A21, A22 = flat[down - half], flat[down], flat[down + half]
+        right = A22 - A02
+        right -= A21
+        right += A01
+        left = A21 - A01
+        left -= A20
+        left += A00
+        lower = A22 - A12
+        lower -= A20
+        lower += A10
+        upper = A12 - A02
+        upper -= A10
+        upper += A00
+        right -= left
+        lower -= upper
+        return right, lower
 
 
 _ORI_I, _ORI_J = np.meshgrid(np.arange(-6, 7), np.arange(-6, 7), indexing="ij")
@@ -371,49 +392,83 @@ _ORI_I, _ORI_J = _ORI_I[_ORI_MASK], _ORI_J[_ORI_MASK]  # 109 samples
 _ORI_G = np.exp(-(_ORI_I**2 + _ORI_J**2) / (2 * 2.5**2))
 
 
+def _window_edges(window_rad, step_rad):
+    """Indices into the per-keypoint cumulative sums of :func:`_orientation_chunk` for every window.
+
+    Windows start at ``s_j = j·step`` (``j < nW``) and hold the angles in ``[s_j, s_j + w)`` and, for the
+    wrap, those below ``s_j + w - 2π``. Every edge lies at ``(j + t)·step`` with ``t`` in ``{0, f1, f2}``,
+    the fractional parts of ``w/step`` and ``(w - 2π)/step``; a sample of bin ``b = ⌊a/step⌋`` and
+    fraction ``f`` has the fine index ``3b + [f >= t0] + [f >= t1]`` (``t0 <= t1`` the sorted ``f1, f2``),
+    so the sum over ``a < (j + t)·step`` is the cumulative sum up to fine index ``3j + k(t)``.
+    """
+    nW = np.arange(0.0, 2 * np.pi, step_rad).size
+    x1, x2 = window_rad / step_rad, (window_rad - 2 * np.pi) / step_rad
+    J1, J2 = np.floor(x1), np.floor(x2)
+    f1, f2 = x1 - J1, x2 - J2
+    t = (min(f1, f2), max(f1, f2))
+    j = np.arange(nW)
+
+    def edge(jb, k):
+        return np.clip(3 * jb + k, 0, 3 * nW).astype(np.intp)
+
+    e0 = edge(j, 0)
+    e1 = edge(j + int(J1), 1 if f1 == t[0] else 2)
+    e2 = edge(j + int(J2), 1 if f2 == t[0] else 2)
+    return nW, t, e0, e1, e2
+
+
+def _orientation_chunk(P, uv, s, step_rad, edges, fast):
+    """Orientations of the keypoints ``uv`` (``s`` = rounded σ), see :func:`surf_orientation`."""
+    nW, (t0, t1), e0, e1, e2 = edges
+    k = uv.shape[0]
+    ss = s[:, None]
+    rows = np.rint(uv[:, 1]).astype(np.int64)[:, None] + _ORI_J[None, :] * ss
+    cols = np.rint(uv[:, 0]).astype(np.int64)[:, None] + _ORI_I[None, :] * ss
+    dx, dy = P.haar(rows, cols, 2 * ss, fast)
+    dx *= _ORI_G
+    dy *= _ORI_G
+    ang = np.arctan2(dy, dx)
+    np.add(ang, 2 * np.pi, out=ang, where=ang < 0)  # = ang % 2π for ang in [-π, π]
+    u = np.divide(ang, step_rad, out=ang)
+    bins = np.minimum(np.floor(u), nW - 1)
+    u -= bins  # fraction within the bin
+    fine = bins * 3
+    fine += u >= t0
+    fine += u >= t1
+    idx = fine.astype(np.intp)
+    idx += (3 * nW) * np.arange(k)[:, None]
+    # window sums: cumulative sums of the samples over (keypoint, fine index), differences at the edges
+    C = np.zeros((2, k, 3 * nW + 1))
+    C[0, :, 1:] = np.bincount(idx.ravel(), dx.ravel(), minlength=3 * nW * k).reshape(k, -1)
+    C[1, :, 1:] = np.bincount(idx.ravel(), dy.ravel(), minlength=3 * nW * k).reshape(k, -1)
+    np.cumsum(C, axis=2, out=C)
+    S = C[:, :, e1] - C[:, :, e0] + C[:, :, e2]  # (2, k, nW): Σdx, Σdy per window
+    best = np.argmax(S[0] * S[0] + S[1] * S[1], axis=1)
+    kk = np.arange(k)
+    return np.arctan2(S[1, kk, best], S[0, kk, best]) % (2 * np.pi)
+
+
 def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_rad: float = 0.15,
-                     chunk: int = 64, workers: int = 1) -> np.ndarray:
+                     chunk: int = 128, workers: int = 1, _padded=None) -> np.ndarray:
     """Dominant orientation from Haar responses in a sliding 60° window (Bay 2008 §4.1).
 
-    Returns angles in [0, 2π), image axes (u right, v down). ``chunk`` keypoints at a time,
-    split over ``workers`` threads (ours, speed; the result does not depend on either).
+    Returns angles in [0, 2π), image axes (u right, v down). The window sums are differences of
+    cumulative sums over the samples binned by angle (speed, issue 17: no per-keypoint sort; same
+    sets of samples per window as the sorted sweep). ``chunk`` keypoints at a time, split over
+    ``workers`` threads (ours, speed; the result does not depend on either).
     """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     s = np.maximum(np.rint(np.asarray(scale_px, dtype=np.float64)), 1).astype(np.int64)
-    K = uv.shape[0]
-    out = np.zeros(K)
-    starts = np.arange(0.0, 2 * np.pi, step_rad)
+    chunk = v.check_int(chunk, "chunk", minimum=1)
+    workers = v.check_int(workers, "workers", minimum=1)
+    P = _PaddedII(II) if _padded is None else _padded
+    edges = _window_edges(float(window_rad), float(step_rad))
+    fast = P.fits(uv, 7 * s + 1)  # samples at up to 5s, boxes of half-side 2s
 
-    def one(sl):
-        ss = s[sl, None]
-        rows = np.rint(uv[sl, 1]).astype(np.int64)[:, None] + _ORI_J[None, :] * ss
-        cols = np.rint(uv[sl, 0]).astype(np.int64)[:, None] + _ORI_I[None, :] * ss
-        dx, dy = _haar_keypoints(II, rows, cols, 2 * ss)
-        dx, dy = dx * _ORI_G, dy * _ORI_G
-        ang = np.arctan2(dy, dx) % (2 * np.pi)  # (k, 109)
-        # window sums from cumulative sums over the angle-sorted samples (doubled for the wrap)
-        k = ang.shape[0]
-        o = np.argsort(ang, axis=1)
-        a2 = np.take_along_axis(ang, o, axis=1)
-        a2 = np.concatenate([a2, a2 + 2 * np.pi], axis=1)  # (k, 218), sorted per row
-        n2 = a2.shape[1]
-        cx = np.zeros((k, n2 + 1))
-        cy = np.zeros((k, n2 + 1))
-        dxs, dys = np.take_along_axis(dx, o, axis=1), np.take_along_axis(dy, o, axis=1)
-        np.cumsum(np.concatenate([dxs, dxs], axis=1), axis=1, out=cx[:, 1:])
-        np.cumsum(np.concatenate([dys, dys], axis=1), axis=1, out=cy[:, 1:])
-        base = 20.0 * np.arange(k)[:, None]  # rows apart: angles < 4π < 20
-        flat = (a2 + base).ravel()
-        lo = np.searchsorted(flat, (starts[None, :] + base).ravel()).reshape(k, -1) - n2 * np.arange(k)[:, None]
-        hi = (np.searchsorted(flat, (starts[None, :] + window_rad + base).ravel()).reshape(k, -1)
-              - n2 * np.arange(k)[:, None])
-        sx = np.take_along_axis(cx, hi, axis=1) - np.take_along_axis(cx, lo, axis=1)
-        sy = np.take_along_axis(cy, hi, axis=1) - np.take_along_axis(cy, lo, axis=1)
-        best = np.argmax(sx * sx + sy * sy, axis=1)
-        kk = np.arange(best.size)
-        return np.arctan2(sy[kk, best], sx[kk, best]) % (2 * np.pi)
+    def one(idx, f):
+        return _orientation_chunk(P, uv[idx], s[idx], step_rad, edges, f)
 
-    return _by_parts(one, K, v.check_int(chunk, "chunk", minimum=1), v.check_int(workers, "workers", minimum=1), out)
+    return _by_chunks(one, fast, chunk, workers, np.zeros(uv.shape[0]))
 
 
 _D_OFF = (np.arange(20) - 9.5)  # sample centres in units of σ along each axis
@@ -425,7 +480,7 @@ _D_SUM = ((np.arange(400)[:, None] // 20 // 5 * 4 + np.arange(400)[:, None] % 20
 
 
 def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, chunk: int = 32,
-                  workers: int = 1):
+                  workers: int = 1, _padded=None):
     """64-d (or extended 128-d) SURF descriptors, unit length (Bay 2008 §4.2).
 
     Returns float32 ``(K, 64)`` or ``(K, 128)``. The Gaussian-weighted sums over the 16
@@ -441,15 +496,19 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
     K = uv.shape[0]
     dim = 128 if extended else 64
     out = np.zeros((K, dim), dtype=np.float32)
+    chunk = v.check_int(chunk, "chunk", minimum=1)
+    workers = v.check_int(workers, "workers", minimum=1)
+    P = _PaddedII(II) if _padded is None else _padded
+    fast = P.fits(uv, np.ceil(13.44 * sigma) + s_int + 1)  # samples within 9.5·√2·σ, boxes of half-side s
 
-    def one(sl):
+    def one(sl, f):
         cs, sn = np.cos(th[sl])[:, None], np.sin(th[sl])[:, None]
         sg = sigma[sl, None]
         x = (_D_X * cs - _D_Y * sn) * sg  # rotate the sample grid by θ (u right, v down)
         y = (_D_X * sn + _D_Y * cs) * sg
         cols = np.rint(uv[sl, 0:1] + x).astype(np.int64)
         rows = np.rint(uv[sl, 1:2] + y).astype(np.int64)
-        dx, dy = _haar_keypoints(II, rows, cols, s_int[sl, None])
+        dx, dy = P.haar(rows, cols, s_int[sl, None], f)
         rx = cs * dx + sn * dy  # responses in the keypoint frame (the Gaussian weight is in _D_SUM)
         ry = cs * dy - sn * dx
         if not extended:
@@ -466,7 +525,7 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
         norm = np.linalg.norm(desc, axis=1, keepdims=True)
         return desc / np.where(norm > 0, norm, 1.0)
 
-    return _by_parts(one, K, v.check_int(chunk, "chunk", minimum=1), v.check_int(workers, "workers", minimum=1), out)
+    return _by_chunks(one, fast, chunk, workers, out)
 
 
 def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_step: int = 2,
@@ -513,9 +572,10 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
     ext = _extrema(II, threshold=threshold, n_octaves=n_octaves, init_step=init_step, workers=workers)
     uv = np.column_stack([ext["u"], ext["v"]]) if ext["u"].size else np.zeros((0, 2))
     sigma = 1.2 * ext["L"] / 9.0
+    P = _PaddedII(II) if descriptors or not upright else None
     ori = (np.zeros(uv.shape[0]) if upright or uv.shape[0] == 0
-           else surf_orientation(II, uv, sigma, workers=workers))
-    desc = surf_describe(II, uv, sigma, ori, extended=extended, workers=workers) if descriptors else None
+           else surf_orientation(II, uv, sigma, workers=workers, _padded=P))
+    desc = surf_describe(II, uv, sigma, ori, extended=extended, workers=workers, _padded=P) if descriptors else None
     name = ("U-SURF" if upright else "SURF") + ("-128" if extended else "")
     return Features(uv, sigma, ori, ext["det"], ext["octave"].astype(np.int64), desc, name)
 
