@@ -1,0 +1,130 @@
+"""Benchmark Ch. 2 (issue 17): our SURF stage by stage, beside OpenCV SIFT in the same process.
+
+For graf img1 resized to 768x576 (threshold 4e-4, the ``bench_features.py`` case) the script prints,
+best of ``--repeat`` runs each, the CPU time (``time.process_time``: all threads of the process) and the
+wall time of every SURF stage with 1 and with 2 worker threads, the whole ``detect`` call (64-d
+descriptors and keypoints only), OpenCV SIFT's time, and the ratios to SIFT. CPU times are the
+figure to compare on a shared machine (other processes inflate wall times and SIFT's two threads
+most); the load average is printed before and after.
+
+``--before PATH`` also times another version of ``slamlab/features/surf.py`` (e.g. main's, from
+``git show main:slamlab/features/surf.py > /tmp/surf_before.py``) on the same image in the same
+process, and checks that it finds the same keypoints and descriptors.
+
+Usage: ``python benchmarks/bench_surf_stages.py [--repeat N] [--before PATH]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import platform
+import time
+
+import cv2
+import numpy as np
+
+import slamlab.features as F
+from slamlab.features import surf as S
+from slamlab.features.base import to_gray_float
+
+
+def _load(path):
+    spec = importlib.util.spec_from_file_location("slamlab.features._surf_other", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _stages(img, workers):
+    """(name, cpu s, wall s) of each stage of one ``surf_detect`` (the same calls, timed apart)."""
+    out = []
+    c, w = time.process_time(), time.perf_counter()
+
+    def mark(name):
+        nonlocal c, w
+        c1, w1 = time.process_time(), time.perf_counter()
+        out.append((name, c1 - c, w1 - w))
+        c, w = c1, w1
+
+    g = to_gray_float(img)
+    II = S.integral_image(g)
+    mark("grey + integral image")
+    P = S._PaddedII(II)
+    mark("padded integral image")
+    ext = S._extrema(II, threshold=4e-4, n_octaves=4, init_step=2, workers=workers, padded=P)
+    mark("response maps + NMS + interp.")
+    uv = np.column_stack([ext["u"], ext["v"]])
+    sigma = 1.2 * ext["L"] / 9.0
+    ori = S.surf_orientation(II, uv, sigma, workers=workers, _padded=P)
+    mark("orientation")
+    S.surf_describe(II, uv, sigma, ori, workers=workers, _padded=P)
+    mark("descriptors (64-d)")
+    return out
+
+
+def best(fn, repeat):
+    """(best CPU time, best wall time) over ``repeat`` calls."""
+    bc = bw = np.inf
+    for _ in range(repeat):
+        c, w = time.process_time(), time.perf_counter()
+        fn()
+        bc, bw = min(bc, time.process_time() - c), min(bw, time.perf_counter() - w)
+    return bc, bw
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--before", help="another surf.py to time beside ours")
+    args = ap.parse_args()
+    print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}, "
+          f"opencv {cv2.__version__} ({cv2.getNumThreads()} threads); load average {os.getloadavg()[0]:.2f}")
+    img = cv2.resize(F.load_oxford_image("graf", 1), (768, 576), interpolation=cv2.INTER_AREA)
+    f = F.detect(img, "surf", threshold=4e-4)
+    print(f"graf img1 768x576, threshold 4e-4: {len(f)} keypoints; best of {args.repeat}\n")
+
+    print(f"{'stage':32s} {'CPU 1 thr':>10s} {'wall 1 thr':>11s} {'CPU 2 thr':>10s} {'wall 2 thr':>11s}  [ms]")
+    per = {}
+    for workers in (1, 2):
+        for _ in range(args.repeat):
+            for name, c, w in _stages(img, workers):
+                bc, bw = per.get((name, workers), (np.inf, np.inf))
+                per[name, workers] = (min(bc, c), min(bw, w))
+    for name in dict.fromkeys(n for n, _ in per):
+        (c1, w1), (c2, w2) = per[name, 1], per[name, 2]
+        print(f"{name:32s} {1e3 * c1:10.1f} {1e3 * w1:11.1f} {1e3 * c2:10.1f} {1e3 * w2:11.1f}")
+
+    cases = {
+        "SIFT OpenCV (128-d)": lambda: F.detect(img, "sift"),
+        "SURF ours 64-d, 2 threads": lambda: F.detect(img, "surf", threshold=4e-4),
+        "SURF ours 64-d, 1 thread": lambda: F.detect(img, "surf", threshold=4e-4, workers=1),
+        "SURF ours keypoints only": lambda: F.detect(img, "surf", threshold=4e-4, descriptors=False),
+    }
+    if args.before:
+        other = _load(args.before)
+        g = to_gray_float(img)
+        fb = other.surf_detect(g, 4e-4)
+        same = len(fb) == len(f) and np.array_equal(fb.octave, f.octave)
+        dmax = float(np.abs(fb.descriptors - f.descriptors).max()) if same else float("nan")
+        print(f"\n--before {args.before}: {len(fb)} keypoints, same set: {same}, "
+              f"largest position difference {np.abs(fb.uv - f.uv).max() if same else float('nan'):.1e} px, "
+              f"largest descriptor difference {dmax:.1e}")
+        cases["SURF before 64-d (its default threads)"] = lambda: other.surf_detect(g, 4e-4)
+        cases["SURF before keypoints only"] = lambda: other.surf_detect(g, 4e-4, descriptors=False)
+    times = {}
+    for _ in range(2):  # interleaved rounds: a load change hits every case
+        for k, fn in cases.items():
+            c, w = best(fn, (args.repeat + 1) // 2)
+            bc, bw = times.get(k, (np.inf, np.inf))
+            times[k] = (min(bc, c), min(bw, w))
+    sc, sw = times["SIFT OpenCV (128-d)"]
+    print(f"\n{'detector':40s} {'CPU [ms]':>9s} {'wall [ms]':>10s} {'CPU / SIFT':>11s} {'wall / SIFT':>12s}")
+    for k, (c, w) in times.items():
+        print(f"{k:40s} {1e3 * c:9.1f} {1e3 * w:10.1f} {c / sc:11.2f} {w / sw:12.2f}")
+    print(f"\nload average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()
