@@ -183,10 +183,9 @@ class _Phases:
             view = E.E[r0::st, c0::st]
             if view.shape[0] >= self.Rq and view.shape[1] >= self.Cq:
                 return np.ascontiguousarray(view[:self.Rq, :self.Cq]).ravel()
-        H, W = E.H, E.W
-        ri = np.clip(p - P + st * np.arange(self.Rq), 0, H)
-        ci = np.clip(q - P + st * np.arange(self.Cq), 0, W)
-        return np.take(E.II.ravel(), (ri * (W + 1))[:, None] + ci).ravel()
+        ri = np.clip(p - P + st * np.arange(self.Rq), 0, E.H)
+        ci = np.clip(q - P + st * np.arange(self.Cq), 0, E.W)
+        return np.take(E.flat, E.index(ri[:, None], ci)).ravel()
 
     def corner(self, dr, dc):
         """``II[r + dr, c + dc]`` for every grid point, flat ``(nr·Cq,)``."""
@@ -366,32 +365,62 @@ def haar_xy(II, rows, cols, half):
     c0 = np.clip(cols - half, 0, W)
     cm = np.clip(cols, 0, W)
     c1 = np.clip(cols + half, 0, W)
-    A00, A01, A02 = flat[r0 + c0], flat[r0 + cm], flat[r0 + c1]
-    A10, A12 = flat[rm + c0], flat[rm + c1]
-    A20, A21, A22 = flat[r1 + c0], flat[r1 + cm], flat[r1 + c1]
-    right = A22 - A02 - A21 + A01
-    left = A21 - A01 - A20 + A00
-    lower = A22 - A12 - A20 + A10
-    upper = A12 - A02 - A10 + A00
-    return right - left, lower - upper
+    return _haar_from_corners(flat[r0 + c0], flat[r0 + cm], flat[r0 + c1], flat[rm + c0], flat[rm + c1],
+                              flat[r1 + c0], flat[r1 + cm], flat[r1 + c1])
+
+
+def _haar_from_corners(A00, A01, A02, A10, A12, A20, A21, A22):
+    """(dx, dy) from the eight corners ``A[i][j] = II[r + (i-1)·half, c + (j-1)·half]``."""
+    right = A22 - A02
+    right -= A21
+    right += A01
+    left = A21 - A01
+    left -= A20
+    left += A00
+    lower = A22 - A12
+    lower -= A20
+    lower += A10
+    upper = A12 - A02
+    upper -= A10
+    upper += A00
+    right -= left
+    lower -= upper
+    return right, lower
 
 
 class _PaddedII:
     """The integral image edge-padded, flat: Haar responses without clipping, phases by slicing (issue 17).
 
-    ``pad`` rows/columns before the image, ``pad + extra`` after it. Edge padding of ``II`` is the
-    same as clipping the boxes to the image, so :meth:`haar` gives the values of :func:`haar_xy` bit
-    for bit (same corners, same operations) for every keypoint whose boxes reach at most ``pad``
-    pixels outside the image (:meth:`fits`), with one flat index per sample and per-keypoint corner
-    offsets instead of six clips and three row products. ``extra`` lets the phases of the coarse
-    octaves (:class:`_Phases`) be slices of it: octave 3 of the default settings reaches 112 + 16
-    pixels before and 112 + 2·16 after the image.
+    ``pad`` rows/columns before the image, ``pad + extra`` after it; ``II`` is a view of its inside.
+    Edge padding of the integral image is the same as clipping the boxes to the image, so
+    :meth:`haar` gives the values of :func:`haar_xy` bit for bit (same corners, same operations) for
+    every keypoint whose boxes reach at most ``pad`` pixels outside the image (:meth:`fits`), with one
+    flat index per sample and fixed corner offsets instead of six clips and three row products.
+    ``extra`` lets the phases of the coarse octaves (:class:`_Phases`) be slices of it: octave 3 of
+    the default settings reaches 112 + 16 pixels before and 112 + 2·16 after the image.
+    ``_PaddedII(image=img)`` writes :func:`integral_image` of ``img`` straight into the padded array
+    (same values: the same two cumulative sums).
     """
 
-    def __init__(self, II, pad: int = 128, extra: int = 32):
-        self.II, self.pad = II, pad
-        self.H, self.W = II.shape[0] - 1, II.shape[1] - 1
-        self.E = np.pad(II, ((pad, pad + extra), (pad, pad + extra)), mode="edge")
+    def __init__(self, II=None, pad: int = 128, extra: int = 32, *, image=None):
+        self.pad = pad
+        if image is None:
+            self.H, self.W = II.shape[0] - 1, II.shape[1] - 1
+            self.E = np.pad(II, ((pad, pad + extra), (pad, pad + extra)), mode="edge")
+        else:
+            self.H, self.W = image.shape
+            H, W, e = self.H, self.W, pad + extra
+            self.E = E = np.empty((H + 1 + pad + e, W + 1 + pad + e))
+            inner = E[pad:pad + H + 1, pad:pad + W + 1]
+            inner[0] = 0.0
+            inner[:, 0] = 0.0
+            np.cumsum(image, axis=0, out=inner[1:, 1:])
+            np.cumsum(inner[1:, 1:], axis=1, out=inner[1:, 1:])
+            E[pad:pad + H + 1, :pad] = inner[:, :1]  # edge padding, as np.pad(mode="edge")
+            E[pad:pad + H + 1, pad + W + 1:] = inner[:, -1:]
+            E[:pad] = E[pad]
+            E[pad + H + 1:] = E[pad + H]
+        self.II = self.E[pad:pad + self.H + 1, pad:pad + self.W + 1]
         self.Wp = self.E.shape[1]
         self.flat = self.E.ravel()
 
@@ -416,25 +445,16 @@ class _PaddedII:
 
     def haar(self, idx, half):
         """:func:`haar_xy` (same operations, same values) at flat indices ``idx``, one ``half`` for all."""
-        A = self.corners(idx, half)
-        A00, A01, A02 = A[0]
-        A10, _, A12 = A[1]
-        A20, A21, A22 = A[2]
-        right = A22 - A02
-        right -= A21
-        right += A01
-        left = A21 - A01
-        left -= A20
-        left += A00
-        lower = A22 - A12
-        lower -= A20
-        lower += A10
-        upper = A12 - A02
-        upper -= A10
-        upper += A00
-        right -= left
-        lower -= upper
-        return right, lower
+        (A00, A01, A02), (A10, _, A12), (A20, A21, A22) = self.corners(idx, half)
+        return _haar_from_corners(A00, A01, A02, A10, A12, A20, A21, A22)
+
+    def haar_clipped(self, rows, cols, half):
+        """:func:`haar_xy` (boxes clipped to the image; same values) for keypoints past the padding."""
+        H, W, f = self.H, self.W, self.flat
+        r = [np.clip(rows + d, 0, H) for d in (-half, 0, half)]
+        c = [np.clip(cols + d, 0, W) for d in (-half, 0, half)]
+        return _haar_from_corners(*(f[self.index(r[i], c[j])] for i, j in
+                                    ((0, 0), (0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1), (2, 2))))
 
 
 _ORI_I, _ORI_J = np.meshgrid(np.arange(-6, 7), np.arange(-6, 7), indexing="ij")
@@ -476,7 +496,7 @@ def _orientation_chunk(P, uv, s, step_rad, edges, fast):
     if fast:
         dx, dy = P.haar(P.index(r0, c0) + P.index(_ORI_J * s, _ORI_I * s) - P.index(0, 0), 2 * s)
     else:
-        dx, dy = haar_xy(P.II, r0 + _ORI_J * s, c0 + _ORI_I * s, 2 * s)
+        dx, dy = P.haar_clipped(r0 + _ORI_J * s, c0 + _ORI_I * s, 2 * s)
     dx *= _ORI_G
     dy *= _ORI_G
     ang = np.arctan2(dy, dx)
@@ -581,7 +601,7 @@ def _describe_chunk(P, uv, sigma, s, th, extended, fast):
         t += t
         dy -= t
     else:
-        dx[...], dy[...] = haar_xy(P.II, y.astype(np.int64), x.astype(np.int64), s)
+        dx[...], dy[...] = P.haar_clipped(y.astype(np.int64), x.astype(np.int64), s)
     # responses in the keypoint frame (the Gaussian weight is applied in _subregion_sums)
     rx, ry = R[2], R[3]
     np.multiply(dx, cs, out=rx)
@@ -673,9 +693,9 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
     init_step = v.check_int(init_step, "init_step", minimum=1)
     if min(img.shape) < 16:
         raise ValueError(f"`image` must be at least 16x16 pixels for SURF; got shape {img.shape}")
-    II = integral_image(img)
     workers = v.check_int(workers, "workers", minimum=1)
-    P = _PaddedII(II)
+    P = _PaddedII(image=img)  # the integral image written into its padded array
+    II = P.II
     ext = _extrema(II, threshold=threshold, n_octaves=n_octaves, init_step=init_step, workers=workers, padded=P)
     uv = np.column_stack([ext["u"], ext["v"]]) if ext["u"].size else np.zeros((0, 2))
     sigma = 1.2 * ext["L"] / 9.0
