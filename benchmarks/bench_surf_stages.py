@@ -49,9 +49,9 @@ def _stages(img, workers):
         c, w = c1, w1
 
     g = to_gray_float(img)
-    II = S.integral_image(g)
-    mark("grey + integral image")
-    P = S._PaddedII(II)
+    mark("grey")
+    P = S._PaddedII(image=g)
+    II = P.II
     mark("padded integral image")
     ext = S._extrema(II, threshold=4e-4, n_octaves=4, init_step=2, workers=workers, padded=P)
     mark("response maps + NMS + interp.")

@@ -28,12 +28,14 @@ default and leaves only a handful of points on a real 576×768 image; the
 notebook tabulates the point count against the threshold and which scale makes
 0.05 give 000's "about 2000 points" (see :func:`threshold_sweep`).
 
-Everything is vectorised: the response maps are strided views of an
-edge-padded integral image, NMS is a separable 3×3×3 max on the interior of the
-(interval, row, column) stack, and orientation and descriptors gather Haar
-responses for chunks of a few dozen keypoints at once (issue 17: chunks whose
-temporaries stay in the 1 MiB L2 cache; 1024 keypoints × 400 samples made every
-pass go to memory and cost half of the descriptor time).
+Everything is vectorised (issue 17 for the speed; the same keypoints and descriptors as the plain
+versions, tested): the integral image is written into an edge-padded array (edge padding = boxes
+clipped to the image); the response maps of the finest octave run on contiguous copies of its
+step×step sub-grids, the coarser ones on strided views, and each octave after the first takes two
+of its four layers from the octave before (same filter side, twice the step); NMS compares the
+points above the threshold with their 26 neighbours; orientation and descriptors gather Haar
+responses for chunks of a few dozen keypoints of one rounded scale at once (temporaries that stay
+in the 1 MiB L2 cache), the orientation's sliding window from sums over angle bins.
 """
 
 from __future__ import annotations
