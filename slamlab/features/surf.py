@@ -305,51 +305,52 @@ def _interior_maxima(D, threshold):
 
 
 def _extrema(II, *, threshold, n_octaves, init_step, workers=1, padded=None):
-    """Thresholded 3×3×3 maxima, interpolated (Bay 2008 §3.4; Brown & Lowe 2002)."""
+    """Thresholded 3×3×3 maxima, interpolated (Bay 2008 §3.4; Brown & Lowe 2002); octaves in parallel."""
     H, W = II.shape[0] - 1, II.shape[1] - 1
     L = filter_sizes(n_octaves)
-    res = {k: [] for k in ("u", "v", "L", "det", "octave")}
-    for o, (D, step) in enumerate(_response_stacks(II, n_octaves, init_step, workers, padded)):
-        nI, nr, nc = D.shape
-        if nr < 3 or nc < 3:
-            continue
-        if nI < 3:
-            continue
-        i, r, c = _interior_maxima(D, threshold)
-        # the largest filter of the 3x3x3 neighbourhood must lie inside the image
-        b_top = (L[o][np.minimum(i + 1, nI - 1)] - 1) // 2 + 1
-        rr, cc = r * step, c * step
-        ok = (rr - b_top >= 0) & (rr + b_top < H) & (cc - b_top >= 0) & (cc + b_top < W)
-        i, r, c = i[ok], r[ok], c[ok]
-        if i.size == 0:
-            continue
-        v0 = D[i, r, c]
-        dx = (D[i, r, c + 1] - D[i, r, c - 1]) / 2
-        dy = (D[i, r + 1, c] - D[i, r - 1, c]) / 2
-        ds = (D[i + 1, r, c] - D[i - 1, r, c]) / 2
-        dxx = D[i, r, c + 1] + D[i, r, c - 1] - 2 * v0
-        dyy = D[i, r + 1, c] + D[i, r - 1, c] - 2 * v0
-        dss = D[i + 1, r, c] + D[i - 1, r, c] - 2 * v0
-        dxy = (D[i, r + 1, c + 1] - D[i, r + 1, c - 1] - D[i, r - 1, c + 1] + D[i, r - 1, c - 1]) / 4
-        dxs = (D[i + 1, r, c + 1] - D[i + 1, r, c - 1] - D[i - 1, r, c + 1] + D[i - 1, r, c - 1]) / 4
-        dys = (D[i + 1, r + 1, c] - D[i + 1, r - 1, c] - D[i - 1, r + 1, c] + D[i - 1, r - 1, c]) / 4
-        Hm = np.stack([np.stack([dxx, dxy, dxs], -1), np.stack([dxy, dyy, dys], -1),
-                       np.stack([dxs, dys, dss], -1)], -2)
-        g = np.stack([dx, dy, ds], -1)
-        det = np.linalg.det(Hm)
-        good = np.abs(det) > 1e-300
-        off = np.zeros_like(g)
-        off[good] = -np.linalg.solve(Hm[good], g[good][..., None])[..., 0]
-        good &= np.all(np.abs(off) < 0.5, axis=1)
-        i, r, c, off, v0 = i[good], r[good], c[good], off[good], v0[good]
-        res["u"].append((c + off[:, 0]) * step)
-        res["v"].append((r + off[:, 1]) * step)
-        res["L"].append(L[o][i] + off[:, 2] * (L[o][1] - L[o][0]))
-        res["det"].append(v0)
-        res["octave"].append(np.full(i.size, o))
-    if not res["u"]:
-        return {k: np.zeros(0) for k in res}
-    return {k: np.concatenate(val) for k, val in res.items()}
+    stacks = _response_stacks(II, n_octaves, init_step, workers, padded)
+    found = run_tasks([lambda o=o, D=D, step=step: _octave_extrema(D, step, L[o], o, threshold, H, W)
+                       for o, (D, step) in enumerate(stacks)], workers)
+    found = [f for f in found if f is not None]
+    if not found:
+        return {k: np.zeros(0) for k in ("u", "v", "L", "det", "octave")}
+    return {k: np.concatenate([f[k] for f in found]) for k in found[0]}
+
+
+def _octave_extrema(D, step, Lo, o, threshold, H, W):
+    """The interpolated maxima of one octave's stack ``D`` (filter sides ``Lo``), or None if none."""
+    nI, nr, nc = D.shape
+    if nr < 3 or nc < 3 or nI < 3:
+        return None
+    i, r, c = _interior_maxima(D, threshold)
+    # the largest filter of the 3x3x3 neighbourhood must lie inside the image
+    b_top = (Lo[np.minimum(i + 1, nI - 1)] - 1) // 2 + 1
+    rr, cc = r * step, c * step
+    ok = (rr - b_top >= 0) & (rr + b_top < H) & (cc - b_top >= 0) & (cc + b_top < W)
+    i, r, c = i[ok], r[ok], c[ok]
+    if i.size == 0:
+        return None
+    v0 = D[i, r, c]
+    dx = (D[i, r, c + 1] - D[i, r, c - 1]) / 2
+    dy = (D[i, r + 1, c] - D[i, r - 1, c]) / 2
+    ds = (D[i + 1, r, c] - D[i - 1, r, c]) / 2
+    dxx = D[i, r, c + 1] + D[i, r, c - 1] - 2 * v0
+    dyy = D[i, r + 1, c] + D[i, r - 1, c] - 2 * v0
+    dss = D[i + 1, r, c] + D[i - 1, r, c] - 2 * v0
+    dxy = (D[i, r + 1, c + 1] - D[i, r + 1, c - 1] - D[i, r - 1, c + 1] + D[i, r - 1, c - 1]) / 4
+    dxs = (D[i + 1, r, c + 1] - D[i + 1, r, c - 1] - D[i - 1, r, c + 1] + D[i - 1, r, c - 1]) / 4
+    dys = (D[i + 1, r + 1, c] - D[i + 1, r - 1, c] - D[i - 1, r + 1, c] + D[i - 1, r - 1, c]) / 4
+    Hm = np.stack([np.stack([dxx, dxy, dxs], -1), np.stack([dxy, dyy, dys], -1),
+                   np.stack([dxs, dys, dss], -1)], -2)
+    g = np.stack([dx, dy, ds], -1)
+    det = np.linalg.det(Hm)
+    good = np.abs(det) > 1e-300
+    off = np.zeros_like(g)
+    off[good] = -np.linalg.solve(Hm[good], g[good][..., None])[..., 0]
+    good &= np.all(np.abs(off) < 0.5, axis=1)
+    i, r, c, off, v0 = i[good], r[good], c[good], off[good], v0[good]
+    return {"u": (c + off[:, 0]) * step, "v": (r + off[:, 1]) * step, "L": Lo[i] + off[:, 2] * (Lo[1] - Lo[0]),
+            "det": v0, "octave": np.full(i.size, o)}
 
 
 def haar_xy(II, rows, cols, half):
