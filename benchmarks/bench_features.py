@@ -1,12 +1,15 @@
 """Benchmark Ch. 2: detection time on 768x576 (ours vs OpenCV) and 2-NN matching cost (ours vs references).
 
-Usage: ``python benchmarks/bench_features.py [--quick]``. Prints, for each case, ours and the
-reference measured in the same process and their ratio. ``--quick`` uses smaller stores.
+Usage: ``python benchmarks/bench_features.py [--quick] [--detection-only]``. Prints, for each case, ours
+and the reference measured in the same process and their ratio, and the load average before and
+after. ``--quick`` uses smaller stores; ``--detection-only`` skips the matching cases. The SURF stages
+one by one (CPU and wall time, 1 and 2 threads): ``benchmarks/bench_surf_stages.py``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import platform
 import time
 
@@ -95,11 +98,14 @@ def bench_matching(sizes, n_queries=500, repeats=3):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--detection-only", action="store_true")
     args = ap.parse_args()
     print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, python {platform.python_version()}, "
-          f"numpy {np.__version__}, opencv {cv2.__version__}")
+          f"numpy {np.__version__}, opencv {cv2.__version__}; load average {os.getloadavg()[0]:.2f}")
     bench_detection(3 if args.quick else 5)
-    bench_matching((2000, 13000) if args.quick else (2000, 13000, 65000))
+    if not args.detection_only:
+        bench_matching((2000, 13000) if args.quick else (2000, 13000, 65000))
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
