@@ -634,10 +634,11 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
     """64-d (or extended 128-d) SURF descriptors, unit length (Bay 2008 §4.2).
 
     Returns float32 ``(K, 64)`` or ``(K, 128)``. The Gaussian-weighted sums over the 16
-    sub-regions are one matrix product per feature; the signed sums of the rotated responses
-    are the rotated sums (Σ(c·dx + s·dy)·g = c·Σdx·g + s·Σdy·g), so only the absolute values
-    need the rotated responses per sample (speed, issue 17; same values to rounding). ``chunk``
-    keypoints at a time, split over ``workers`` threads (the result does not depend on either).
+    sub-regions are taken for all features of a chunk together (:func:`_subregion_sums`); the
+    signed sums of the rotated responses are the rotated sums (Σ(c·dx + s·dy)·g = c·Σdx·g +
+    s·Σdy·g), so only the absolute values need the rotated responses per sample (speed, issue 17;
+    same values to rounding). ``chunk`` keypoints at a time, split over ``workers`` threads (the
+    result does not depend on either).
     """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     sigma = np.asarray(scale_px, dtype=np.float64)
