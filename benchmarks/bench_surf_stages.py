@@ -50,7 +50,7 @@ def _stages(img, workers):
 
     g = to_gray_float(img)
     mark("grey")
-    P = S._PaddedII(image=g)
+    P = S._PaddedII(image=g, workers=workers)
     II = P.II
     mark("padded integral image")
     ext = S._extrema(II, threshold=4e-4, n_octaves=4, init_step=2, workers=workers, padded=P)

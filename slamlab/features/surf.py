@@ -405,7 +405,7 @@ class _PaddedII:
     (same values: the same two cumulative sums).
     """
 
-    def __init__(self, II=None, pad: int = 128, extra: int = 32, *, image=None):
+    def __init__(self, II=None, pad: int = 128, extra: int = 32, *, image=None, workers: int = 1):
         self.pad = pad
         if image is None:
             self.H, self.W = II.shape[0] - 1, II.shape[1] - 1
@@ -417,8 +417,10 @@ class _PaddedII:
             inner = E[pad:pad + H + 1, pad:pad + W + 1]
             inner[0] = 0.0
             inner[:, 0] = 0.0
-            np.cumsum(image, axis=0, out=inner[1:, 1:])
-            np.cumsum(inner[1:, 1:], axis=1, out=inner[1:, 1:])
+            body = inner[1:, 1:]  # columns, then rows, in two halves (independent: same sums)
+            halves = (slice(None, W // 2), slice(W // 2, None)), (slice(None, H // 2), slice(H // 2, None))
+            run_tasks([lambda c=c: np.cumsum(image[:, c], axis=0, out=body[:, c]) for c in halves[0]], workers)
+            run_tasks([lambda r=r: np.cumsum(body[r], axis=1, out=body[r]) for r in halves[1]], workers)
             E[pad:pad + H + 1, :pad] = inner[:, :1]  # edge padding, as np.pad(mode="edge")
             E[pad:pad + H + 1, pad + W + 1:] = inner[:, -1:]
             E[:pad] = E[pad]
@@ -698,7 +700,7 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
     if min(img.shape) < 16:
         raise ValueError(f"`image` must be at least 16x16 pixels for SURF; got shape {img.shape}")
     workers = v.check_int(workers, "workers", minimum=1)
-    P = _PaddedII(image=img)  # the integral image written into its padded array
+    P = _PaddedII(image=img, workers=workers)  # the integral image written into its padded array
     II = P.II
     ext = _extrema(II, threshold=threshold, n_octaves=n_octaves, init_step=init_step, workers=workers, padded=P)
     uv = np.column_stack([ext["u"], ext["v"]]) if ext["u"].size else np.zeros((0, 2))

@@ -142,7 +142,7 @@ def test_interior_maxima_equal_maximum_filter(levels):
 def test_padded_integral_image_from_the_image_equals_padded_integral_image(shape):
     img = np.random.default_rng(9).random(shape)
     II = integral_image(img)
-    P = _PaddedII(image=img, pad=20, extra=7)
+    P = _PaddedII(image=img, pad=20, extra=7, workers=2)
     np.testing.assert_array_equal(P.E, np.pad(II, ((20, 27), (20, 27)), mode="edge"))
     np.testing.assert_array_equal(P.II, II)
 
