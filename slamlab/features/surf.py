@@ -578,13 +578,12 @@ def _describe_chunk(P, uv, sigma, s, th, extended, fast):
     k = uv.shape[0]
     cs, sn = np.cos(th)[:, None], np.sin(th)[:, None]
     sg = sigma[:, None]
-    # sample positions: the 20×20 grid rotated by θ (u right, v down), rounded to pixels
-    x = _D_X * cs
-    x -= _D_Y * sn
+    # sample positions: the 20×20 grid rotated by θ (u right, v down), rounded to pixels;
+    # x = (X·c - Y·s)·σ + u with the products taken on the 20 grid values (the same numbers)
+    x = np.subtract((_D_OFF * cs)[:, None, :], (_D_OFF * sn)[:, :, None]).reshape(k, -1)
     x *= sg
     x += uv[:, 0:1]
-    y = _D_X * sn
-    y += _D_Y * cs
+    y = np.add((_D_OFF * sn)[:, None, :], (_D_OFF * cs)[:, :, None]).reshape(k, -1)
     y *= sg
     y += uv[:, 1:2]
     np.rint(x, out=x)
