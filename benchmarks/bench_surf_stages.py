@@ -9,9 +9,12 @@ most); the load average is printed before and after.
 
 ``--before PATH`` also times another version of ``slamlab/features/surf.py`` (e.g. main's, from
 ``git show main:slamlab/features/surf.py > /tmp/surf_before.py``) on the same image in the same
-process, and checks that it finds the same keypoints and descriptors.
+process, and checks that it finds the same keypoints and descriptors; with ``--compare-all`` it
+compares the two versions on images 1, 3 and 6 of every Oxford sequence at hand (full size) with
+five settings (default, 128-d, upright, 5 octaves from step 1, threshold 1e-4) and prints the largest
+differences.
 
-Usage: ``python benchmarks/bench_surf_stages.py [--repeat N] [--before PATH]``.
+Usage: ``python benchmarks/bench_surf_stages.py [--repeat N] [--before PATH [--compare-all]]``.
 """
 
 from __future__ import annotations
@@ -64,6 +67,32 @@ def _stages(img, workers):
     return out
 
 
+def compare_all(other):
+    """Largest differences between our SURF and ``other``'s on the Oxford images at hand."""
+    settings = [({}, 4e-4), ({"extended": True}, 4e-4), ({"upright": True}, 4e-4),
+                ({"n_octaves": 5, "init_step": 1}, 4e-4), ({}, 1e-4)]
+    worst, n_sets, n_points = {"uv": 0.0, "orientation": 0.0, "response (rel.)": 0.0, "descriptor": 0.0}, 0, 0
+    for seq in F.OXFORD_SEQUENCES:
+        for i in (1, 3, 6):
+            try:
+                img = to_gray_float(F.load_oxford_image(seq, i))
+            except (ValueError, FileNotFoundError):
+                break
+            for kw, thr in settings:
+                a, b = F.surf_detect(img, thr, **kw), other.surf_detect(img, thr, **kw)
+                n_sets += 1
+                if len(a) != len(b) or not np.array_equal(a.octave, b.octave):
+                    print(f"  {seq} img{i} {kw} {thr}: keypoint sets differ ({len(a)} vs {len(b)})")
+                    continue
+                n_points += len(a)
+                d_ori = np.angle(np.exp(1j * (a.orientation_rad - b.orientation_rad)))
+                for k, d in (("uv", a.uv - b.uv), ("orientation", d_ori), ("response (rel.)", a.response / b.response - 1),
+                             ("descriptor", a.descriptors - b.descriptors)):
+                    worst[k] = max(worst[k], float(np.abs(d).max(initial=0.0)))
+    print(f"compared on {n_sets} (image, setting) pairs, {n_points} keypoints; largest differences: "
+          + ", ".join(f"{k} {val:.1e}" for k, val in worst.items()) + "\n")
+
+
 def best(fn, repeat):
     """(best CPU time, best wall time) over ``repeat`` calls."""
     bc = bw = np.inf
@@ -78,7 +107,10 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--before", help="another surf.py to time beside ours")
+    ap.add_argument("--compare-all", action="store_true", help="with --before: same results on every sequence?")
     args = ap.parse_args()
+    if args.before and args.compare_all:
+        compare_all(_load(args.before))
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}, "
           f"opencv {cv2.__version__} ({cv2.getNumThreads()} threads); load average {os.getloadavg()[0]:.2f}")
     img = cv2.resize(F.load_oxford_image("graf", 1), (768, 576), interpolation=cv2.INTER_AREA)

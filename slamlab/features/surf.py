@@ -520,7 +520,10 @@ def _orientation_chunk(P, uv, s, step_rad, edges, fast):
     C[1, :, 1:] = np.bincount(idx.ravel(), dy.ravel(), minlength=3 * nW * k).reshape(k, -1)
     np.cumsum(C, axis=2, out=C)
     S = C[:, :, e1] - C[:, :, e0] + C[:, :, e2]  # (2, k, nW): Σdx, Σdy per window
-    best = np.argmax(S[0] * S[0] + S[1] * S[1], axis=1)
+    # the longest sum; among windows within 1e-12 of it (ties, e.g. windows that differ only by
+    # zero responses of a flat patch) the first, whatever the rounding of the sums (ours)
+    n2 = S[0] * S[0] + S[1] * S[1]
+    best = np.argmax(n2 >= (1 - 1e-12) * n2.max(axis=1, keepdims=True), axis=1)
     kk = np.arange(k)
     return np.arctan2(S[1, kk, best], S[0, kk, best]) % (2 * np.pi)
 
