@@ -534,8 +534,10 @@ def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_ra
 
     Returns angles in [0, 2π), image axes (u right, v down). The window sums are differences of
     cumulative sums over the samples binned by angle (speed, issue 17: no per-keypoint sort; same
-    sets of samples per window as the sorted sweep). ``chunk`` keypoints at a time, split over
-    ``workers`` threads (ours, speed; the result does not depend on either).
+    sets of samples per window as the sorted sweep). Windows whose sums are within 1e-12 of the
+    longest count as tied and the first wins (ours: the choice does not depend on rounding).
+    ``chunk`` keypoints at a time, split over ``workers`` threads (ours, speed; the result does not
+    depend on either).
     """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     s = np.maximum(np.rint(np.asarray(scale_px, dtype=np.float64)), 1).astype(np.int64)
