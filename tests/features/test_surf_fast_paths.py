@@ -155,3 +155,29 @@ def test_clipped_haar_on_the_padded_image_equals_haar_xy():
     half = rng.integers(1, 30, (6, 1))
     for got, ref in zip(P.haar_clipped(rows, cols, half), haar_xy(II, rows, cols, half), strict=True):
         np.testing.assert_array_equal(got, ref)
+
+
+def test_orientation_ties_go_to_the_first_window():
+    """A bright quadrant, symmetric about the diagonal: windows holding the 0 and π/4 samples and the
+    π/4 and π/2 samples have the same sum length; the first of the tied windows wins (not rounding)."""
+    img = np.zeros((60, 60))
+    img[30:, 30:] = 1.0
+    assert np.array_equal(img, img.T)
+    II = integral_image(img)
+    uv, sigma = np.array([[30.0, 30.0]]), np.array([2.0])
+    s, I, J = 2, *np.meshgrid(np.arange(-6, 7), np.arange(-6, 7), indexing="ij")
+    m = I**2 + J**2 < 36
+    g = np.exp(-(I[m] ** 2 + J[m] ** 2) / (2 * 2.5**2))
+    dx, dy = haar_xy(II, 30 + J[m] * s, 30 + I[m] * s, 2 * s)
+    dx, dy = dx * g, dy * g
+    a = np.arctan2(dy, dx) % (2 * np.pi)
+    starts = np.arange(0.0, 2 * np.pi, 0.15)
+    inside = ((starts[:, None] <= a) & (a < starts[:, None] + np.pi / 3)) | (a + 2 * np.pi < starts[:, None] + np.pi / 3)
+    sx, sy = inside @ dx, inside @ dy
+    n2 = sx**2 + sy**2
+    tied = np.flatnonzero(n2 >= (1 - 1e-12) * n2.max())
+    assert tied.size >= 2  # tied windows ...
+    assert np.ptp(np.arctan2(sy[tied], sx[tied])) > 0.1  # ... with different angles
+    expected = np.arctan2(sy[tied[0]], sx[tied[0]]) % (2 * np.pi)
+    got = surf_orientation(II, uv, sigma)
+    np.testing.assert_allclose(got, [expected], atol=1e-12)
