@@ -11,7 +11,8 @@ most); the load average is printed before and after.
 ``git show main:slamlab/features/surf.py > /tmp/surf_before.py``) on the same image in the same
 process, and checks that it finds the same keypoints and descriptors; with ``--compare-all`` it
 compares the two versions on images 1, 3 and 6 of every Oxford sequence at hand (full size) with
-five settings (default, 128-d, upright, 5 octaves from step 1, threshold 1e-4) and prints the largest
+five settings (default, 128-d, upright, 5 octaves from step 1, threshold 1e-4) and on 20 renders of
+the stereo arena (5 poses, left and right, with and without noise; 3 settings) and prints the largest
 differences.
 
 Usage: ``python benchmarks/bench_surf_stages.py [--repeat N] [--before PATH [--compare-all]]``.
@@ -68,27 +69,36 @@ def _stages(img, workers):
 
 
 def compare_all(other):
-    """Largest differences between our SURF and ``other``'s on the Oxford images at hand."""
+    """Largest differences between our SURF and ``other``'s on the Oxford images at hand and arena renders."""
     settings = [({}, 4e-4), ({"extended": True}, 4e-4), ({"upright": True}, 4e-4),
                 ({"n_octaves": 5, "init_step": 1}, 4e-4), ({}, 1e-4)]
     worst, n_sets, n_points = {"uv": 0.0, "orientation": 0.0, "response (rel.)": 0.0, "descriptor": 0.0}, 0, 0
+    images = []
     for seq in F.OXFORD_SEQUENCES:
         for i in (1, 3, 6):
             try:
-                img = to_gray_float(F.load_oxford_image(seq, i))
+                images.append((f"{seq} img{i}", to_gray_float(F.load_oxford_image(seq, i)), settings))
             except (ValueError, FileNotFoundError):
                 break
-            for kw, thr in settings:
-                a, b = F.surf_detect(img, thr, **kw), other.surf_detect(img, thr, **kw)
-                n_sets += 1
-                if len(a) != len(b) or not np.array_equal(a.octave, b.octave):
-                    print(f"  {seq} img{i} {kw} {thr}: keypoint sets differ ({len(a)} vs {len(b)})")
-                    continue
-                n_points += len(a)
-                d_ori = np.angle(np.exp(1j * (a.orientation_rad - b.orientation_rad)))
-                for k, d in (("uv", a.uv - b.uv), ("orientation", d_ori), ("response (rel.)", a.response / b.response - 1),
-                             ("descriptor", a.descriptors - b.descriptors)):
-                    worst[k] = max(worst[k], float(np.abs(d).max(initial=0.0)))
+    from slamlab import sim  # the stereo arena's renders (flat fences and floor: ties in the orientation)
+
+    for noise in (0.0, 2.0):
+        rig = sim.StereoSim(sim.StereoArena(seed=0), noise_std=noise, rng=0)
+        for pose in ([2.0, 2.0, 0.3], [4.0, 3.0, 1.2], [3.0, 5.0, -2.0], [1.0, 1.0, 0.0], [4.5, 4.5, 2.5]):
+            for side, im in zip("LR", rig.render_pair(pose), strict=True):
+                images.append((f"arena {pose} {side}", to_gray_float(im), settings[2:3] + settings[0:1] + settings[4:]))
+    for name, img, sets in images:
+        for kw, thr in sets:
+            a, b = F.surf_detect(img, thr, **kw), other.surf_detect(img, thr, **kw)
+            n_sets += 1
+            if len(a) != len(b) or not np.array_equal(a.octave, b.octave):
+                print(f"  {name} {kw} {thr}: keypoint sets differ ({len(a)} vs {len(b)})")
+                continue
+            n_points += len(a)
+            d_ori = np.angle(np.exp(1j * (a.orientation_rad - b.orientation_rad)))
+            for k, d in (("uv", a.uv - b.uv), ("orientation", d_ori), ("response (rel.)", a.response / b.response - 1),
+                         ("descriptor", a.descriptors - b.descriptors)):
+                worst[k] = max(worst[k], float(np.abs(d).max(initial=0.0)))
     print(f"compared on {n_sets} (image, setting) pairs, {n_points} keypoints; largest differences: "
           + ", ".join(f"{k} {val:.1e}" for k, val in worst.items()) + "\n")
 
