@@ -399,8 +399,9 @@ class _PaddedII:
     :meth:`haar` gives the values of :func:`haar_xy` bit for bit (same corners, same operations) for
     every keypoint whose boxes reach at most ``pad`` pixels outside the image (:meth:`fits`), with one
     flat index per sample and fixed corner offsets instead of six clips and three row products.
-    ``extra`` lets the phases of the coarse octaves (:class:`_Phases`) be slices of it: octave 3 of
-    the default settings reaches 112 + 16 pixels before and 112 + 2·16 after the image.
+    ``extra`` lets the coarse octaves read it directly too (phases or strided views,
+    :func:`_response_stacks`): octave 3 of the default settings reaches 112 + 16 pixels before and
+    112 + 2·16 after the image.
     ``_PaddedII(image=img)`` writes :func:`integral_image` of ``img`` straight into the padded array
     (same values: the same two cumulative sums).
     """
