@@ -61,9 +61,9 @@ def _stages(img, workers):
     mark("response maps + NMS + interp.")
     uv = np.column_stack([ext["u"], ext["v"]])
     sigma = 1.2 * ext["L"] / 9.0
-    ori = S.surf_orientation(II, uv, sigma, workers=workers, _padded=P)
+    ori = S.surf_orientation(II, uv, sigma, _padded=P)
     mark("orientation")
-    S.surf_describe(II, uv, sigma, ori, workers=workers, _padded=P)
+    S.surf_describe(II, uv, sigma, ori, _padded=P)
     mark("descriptors (64-d)")
     return out
 

@@ -687,8 +687,9 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
     descriptors : bool
         Compute descriptors (False: keypoints only).
     workers : int
-        Threads for the response maps, orientations and descriptors (ours, speed; 2 = this
+        Threads for the integral image, the response maps and their maxima (ours, speed; 2 = this
         project's machines; the same result for any value). Concurrent calls share two threads.
+        Orientations and descriptors run in the calling thread (two gained nothing, issue 17).
 
     Examples
     --------
@@ -710,9 +711,11 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
     ext = _extrema(II, threshold=threshold, n_octaves=n_octaves, init_step=init_step, workers=workers, padded=P)
     uv = np.column_stack([ext["u"], ext["v"]]) if ext["u"].size else np.zeros((0, 2))
     sigma = 1.2 * ext["L"] / 9.0
+    # orientations and descriptors in one thread: their numpy calls on chunks of a few dozen keypoints
+    # are too short for two threads to gain (quiet machine: 22.1 ms with one, 27.2 with two; issue 17)
     ori = (np.zeros(uv.shape[0]) if upright or uv.shape[0] == 0
-           else surf_orientation(II, uv, sigma, workers=workers, _padded=P))
-    desc = surf_describe(II, uv, sigma, ori, extended=extended, workers=workers, _padded=P) if descriptors else None
+           else surf_orientation(II, uv, sigma, _padded=P))
+    desc = surf_describe(II, uv, sigma, ori, extended=extended, _padded=P) if descriptors else None
     name = ("U-SURF" if upright else "SURF") + ("-128" if extended else "")
     return Features(uv, sigma, ori, ext["det"], ext["octave"].astype(np.int64), desc, name)
 
