@@ -200,6 +200,7 @@ class StereoSLAM:
             # first frame (or an empty map): it defines the map frame
             if len(pts_body) >= p.min_inliers:
                 self._add_landmarks(pts_body, cov_body, desc, self.T)
+                self._last_ids = np.arange(len(pts_body))
                 rec["n_new"] = len(pts_body)
                 rec["status"] = "init"
             else:
