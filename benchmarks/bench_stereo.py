@@ -136,13 +136,19 @@ def main(argv=None):
                 f"{' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     if args.kitti:
         say()
-        say("| KITTI 06, 20 frames | ATE m | SE(3)-aligned m | final m | path length est./true | start-end distance est./true |")
-        say("|---|---|---|---|---|---|")
+        say("| KITTI 06, 20 frames | ATE m | SE(3)-aligned m | final m | path length est./true | start-end distance est./true "
+            "| step est./true mean ± s.e. | sd |")
+        say("|---|---|---|---|---|---|---|---|")
         for det in args.detectors.split(","):
-            for label, over in (("before", {"subpixel_stereo": False, "duplicate_gap_m": None}), ("after", {})):
-                k = sl.stereo.run_kitti(rng=0, detector=det, **over)
+            variants = [("before (keypoint disparities, 8 ORB levels)", {"subpixel_stereo": False, "duplicate_gap_m": None,
+                                                                          "orb_levels": 8}),
+                        ("refined disparities, 8 ORB levels", {"orb_levels": 8}), ("after (KITTI_PARAMS)", {})]
+            for label, over in variants if det == "orb" else [("before", {"subpixel_stereo": False}), ("after", {})]:
+                k = sl.stereo.run_kitti(rng=0, detector=det, progress=False, **over)
+                st = k.step_ratios
                 say(f"| {det}, {label} | {k.ate_m:.3f} | {k.ate_se3_m:.3f} | {k.final_error_m:.3f} | "
-                    f"{k.length_ratio:.4f} | {k.end_distance_ratio:.4f} |")
+                    f"{k.length_ratio:.4f} | {k.end_distance_ratio:.4f} | {st.mean():.4f} ± "
+                    f"{st.std(ddof=1) / np.sqrt(st.size):.4f} | {st.std(ddof=1):.4f} |")
     say(f"load average at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     if args.markdown:
         with open(args.markdown, "w") as f:

@@ -56,6 +56,7 @@ class StereoParams(Params):
     detector: str = param("surf", "000 §3.3: SURF (ours, the features chapter's; 'orb' is the fast one)")
     n_features: int = param(2000, "000 §3.3: about 2000 points per 768x576 image")
     orb_fast_threshold: int = param(12, "ours: ORB's FAST threshold (OpenCV: 20); 12 finds 2000 points on the arena")
+    orb_levels: int = param(8, "ours: ORB's pyramid levels, 1.2x apart (OpenCV's 8; KITTI: 1, see run_kitti)")
     channel_order: str = param("rgb", "ours: channel order of colour images ('bgr' for cv2.imread)")
     parallel_detect: bool = param(True, "ours: the two images in two threads (same result)")
     # -- stereo matching and triangulation (000 §3.3) ------------------------------------------------
@@ -109,6 +110,7 @@ class StereoParams(Params):
         v.check_choice(self.detector, "detector", STEREO_DETECTORS)
         v.check_int(self.n_features, "n_features", minimum=10)
         v.check_int(self.orb_fast_threshold, "orb_fast_threshold", minimum=0, maximum=255)
+        v.check_int(self.orb_levels, "orb_levels", minimum=1)
         v.check_choice(self.channel_order, "channel_order", ("rgb", "bgr"))
         if not isinstance(self.parallel_detect, bool):
             raise TypeError(f"`parallel_detect` must be a bool; got {type(self.parallel_detect).__name__}")
@@ -179,7 +181,7 @@ class StereoParams(Params):
         """Keyword arguments of :func:`slamlab.features.detect` for this pipeline's detector (000 §3.3)."""
         kw = {"max_points": self.n_features, "channel_order": self.channel_order}
         if self.detector == "orb":
-            kw.update(n_features=self.n_features, fast_threshold=self.orb_fast_threshold)
+            kw.update(n_features=self.n_features, fast_threshold=self.orb_fast_threshold, n_levels=self.orb_levels)
         elif self.detector == "sift":
             kw["n_features"] = self.n_features
         return kw

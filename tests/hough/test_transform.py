@@ -152,7 +152,7 @@ def test_bad_input(call, exc, match):
 
 @pytest.mark.parametrize("n_points", [0, 1, 15, 20000])
 def test_polar_blocks_do_not_change_votes(n_points):
-    """Votes counted in blocks of θ rows (issue 17) equal the whole-array count of the same arithmetic."""
+    """Votes from blocked matrix products over θ rows (issue 17) equal the whole-array elementwise count."""
     rng = np.random.default_rng(n_points)
     phi = rng.uniform(-math.pi, math.pi, n_points)
     r = rng.uniform(0.0, 12.0, n_points)

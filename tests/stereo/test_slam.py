@@ -128,6 +128,8 @@ def test_bad_input():
         StereoSLAM(rig, store=object())
     with pytest.raises(TypeError, match="no field"):
         StereoSLAM(rig, n_points=5)
+    with pytest.raises(ValueError, match="orb_levels"):
+        StereoSLAM(rig, detector="orb", orb_levels=0)
     with pytest.raises(TypeError, match="`params` must be a StereoParams"):
         StereoSLAM(rig, params={"detector": "orb"})
     with pytest.raises(ValueError, match="T_body_left"):
