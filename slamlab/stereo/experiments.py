@@ -464,9 +464,11 @@ class KittiRunResult:
 #: the pipeline's settings on KITTI: ``max_depth_m = 40`` because the street scene reaches tens of
 #: metres (the arena's default, 10 m, would drop most of it); ``orb_levels = 1`` (ORB only): at 10 Hz a
 #: feature's scale changes by a few per cent per frame, and ORB's coarse levels doubled the spread of its
-#: per-frame step lengths (sd 5.2 % -> 2.8 % of the true step over frames 0-19, issue 17); everything else
+#: per-frame step lengths (sd 5.2 % -> 2.8 % of the true step over frames 0-19, issue 17);
+#: ``map_search = "global"``: 20 frames leave a small map, so ORB keeps 000's search over every landmark
+#: (the window search is for long runs; on these frames it gave ATE 0.19 against 0.18 m); everything else
 #: as :class:`StereoParams`
-KITTI_PARAMS = StereoParams(max_depth_m=40.0, orb_levels=1)
+KITTI_PARAMS = StereoParams(max_depth_m=40.0, orb_levels=1, map_search="global")
 
 
 def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams | None = None, rng=0,
