@@ -81,6 +81,8 @@ class StereoParams(Params):
                                          "point); None: 'window' for ORB, 'global' otherwise")
     window_px: float = param(15.0, "ours: radius of the window search around each keypoint, px")
     window_max_hamming: int = param(64, "ours: largest Hamming distance (of 256 bits) a window match may have; binary only")
+    window_min_share: float = param(0.1, "ours: fewer window matches than this share of the points: search globally "
+                                         "(a first pose from repeated texture is confirmed by few windows)")
     view_margin_deg: float | None = param(None, "ours: match only landmarks in view (None: the whole map, as 000)")
     view_depth_factor: float = param(1.5, "ours: the view gate keeps landmarks up to this times max_depth_m away")
     base_seen_times: int = param(3, "000 §3.4: BaseSeenTimes = 3")
@@ -131,6 +133,7 @@ class StereoParams(Params):
             v.check_choice(self.map_search, "map_search", MAP_SEARCHES)
         v.check_positive(self.window_px, "window_px")
         v.check_int(self.window_max_hamming, "window_max_hamming", minimum=0)
+        _fraction(self.window_min_share, "window_min_share")
         _optional_positive(self.view_margin_deg, "view_margin_deg", allow_zero=True)
         v.check_positive(self.view_depth_factor, "view_depth_factor")
         v.check_int(self.base_seen_times, "base_seen_times", minimum=1)

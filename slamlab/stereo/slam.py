@@ -285,6 +285,9 @@ class StereoSLAM:
                                     p.twin_gap_m)
         clock.lap("map_match")
         rec["n_compared"] += n_pairs
+        if len(mm.local) < p.window_min_share * len(desc):
+            rec["status"] = "too_few_matches"
+            return mm, None
         return self._pose(rec, clock, mm, pts_body, cov_body, depth)
 
     def _locate(self, rec, clock, desc, pts_body, cov_body, depth, cand):

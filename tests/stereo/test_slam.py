@@ -439,3 +439,14 @@ def test_stage_times_in_wall_and_cpu_time(short_turn):
     assert set(wall) == set(cpu) == set(STAGES)
     assert all(len(wall[s]) == 3 and np.all(cpu[s] >= 0) and np.all(wall[s] >= 0) for s in STAGES)
     assert sum(cpu[s].sum() for s in STAGES) > 0
+
+
+def test_window_search_confirmed_by_too_few_windows_searches_globally(orb_frames):
+    # window_min_share = 1: no frame has every point matched in its window, so every frame falls back
+    sim, _poses, pairs = orb_frames
+    slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", window_min_share=1.0, rng=0)
+    slam.run(pairs[:3])
+    c = slam.counts()
+    assert c["window_fallback"][1:].all()
+    assert len(slam.degenerate_frames) == 0
+    np.testing.assert_array_less(c["n_map_matches"][1:], c["n_local"][1:])
