@@ -395,10 +395,11 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
     :class:`~slamlab.kdtree.ExactStore` wrapped in a :class:`~slamlab.kdtree.workloads.RecordingStore`,
     and returns the recorded :class:`~slamlab.kdtree.workloads.Workload` for
     :func:`slamlab.kdtree.experiments.run_store_comparison`. ``detector="sift"`` gives 128-d float
-    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. ``progress``: a bar
-    over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
+    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. The map search is 000's
+    global one for every detector (ORB's window search would leave the store almost no queries).
+    ``progress``: a bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
-    p = StereoParams(detector=detector)
+    p = StereoParams(detector=detector, map_search="global")
     rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
     run_closed_loop("small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
     n = len(rec.iterations)
