@@ -104,7 +104,9 @@ class StereoSLAM:
         setting, with its source; ``overrides`` change single fields (``detector="orb"``).
     store : a :class:`~slamlab.kdtree.LandmarkStore`, or a factory (class / callable) returning
         one; default :func:`default_store` (multi kd-tree for SURF/SIFT, exact Hamming brute force
-        for ORB).
+        for ORB). ORB matches to the map by the window search by default (``params.map_search``, our
+        addition): a first pose from the last frame's landmarks, then each point only against the
+        landmarks projected near it; the store serves the global search when that gives no pose.
     rng : RANSAC's random stream.
 
     Examples
