@@ -23,7 +23,7 @@ import numpy as np
 import slamlab as sl
 from slamlab.geometry import wrap_angle
 from slamlab.geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
-from slamlab.stereo import RenderParams, StereoParams, StereoSLAM
+from slamlab.stereo import STAGES, RenderParams, StereoParams, StereoSLAM
 
 
 def load(n_frames, cache: Path):
@@ -69,13 +69,18 @@ def main(argv=None):
         est = slam.planar_trajectory
         err = np.hypot(*(est[:, :2] - truth[:, :2]).T)
         yaw = np.rad2deg(np.abs(wrap_angle(est[:, 2] - truth[:, 2])))
-        c, st = slam.counts(), slam.stage_times()
+        c, st, sc = slam.counts(), slam.stage_times(), slam.stage_times(cpu=True)
         print(f"long path ({length_m:.0f} m, {len(path)} frames), {label} ({p.detector}, policy {p.policy}): max position "
               f"error {err.max():.2f} m (frame {int(err.argmax())}), final {err[-1]:.2f} m, mean {err.mean():.3f} m, max "
               f"heading error {yaw.max():.1f} deg, {len(slam.degenerate_frames)} degenerate frames; SLAM {len(path) / wall:.2f} "
               f"frames/s wall, {len(path) / cpu:.2f} frames/s CPU, map query {1000 * st['map_match'][1:].mean():.0f} ms/frame; "
               f"{c['n_landmarks'][-1]} landmarks at the end ({len(slam.X)} ever added, {np.median(c['n_new'][1:]):.0f} new "
               f"per frame (median)); load average {load0:.2f} -> {os.getloadavg()[0]:.2f}", flush=True)
+        print(f"  {label}: ms/frame wall (CPU): " + ", ".join(
+            f"{s} {1000 * st[s][1:].mean():.1f} ({1000 * sc[s][1:].mean():.1f})" for s in STAGES)
+            + f"; landmarks searched {c['n_searched'][1:].mean():.0f} per frame (mean), "
+              f"{int(c['gate_fallback'].sum())} whole-map fallbacks, {int(c['window_fallback'].sum())} window "
+              f"fallbacks, {c['n_compared'][1:].mean() / 1e6:.2f} M descriptor distances per frame (mean)", flush=True)
 
 
 if __name__ == "__main__":

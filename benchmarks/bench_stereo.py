@@ -119,16 +119,19 @@ def main(argv=None):
         for det in args.detectors.split(","):
             t0 = time.perf_counter()
             variants = {"oldest": {"detector": det}, "all": {"detector": det, "policy": "all"}}
-            if det == "orb":  # before this round: no sub-pixel disparity, no duplicate check
-                variants["oldest, before (no sub-pixel disparity, no duplicate check)"] = {
-                    "detector": det, "subpixel_stereo": False, "duplicate_gap_m": None}
+            if det == "orb":  # before issue 17: the global search, and before it also no sub-pixel disparity
+                variants["oldest, global search (before the window search)"] = {"detector": det, "map_search": "global"}
+                variants["oldest, before (global search, no sub-pixel disparity, no duplicate check)"] = {
+                    "detector": det, "map_search": "global", "subpixel_stereo": False, "duplicate_gap_m": None}
             runs = sl.stereo.run_stereo_slam_variants(path, variants, name="long path", arena=room, rng=0)
             for label, res in runs.items():
                 say(f"long path ({length_m:.0f} m, {len(path)} frames), {det}, policy {label}: max position error "
-                    f"{res.pos_err_m.max():.2f} m, final {res.pos_err_m[-1]:.2f} m, max heading error "
-                    f"{np.rad2deg(np.abs(res.yaw_err_rad).max()):.1f} deg, {len(res.degenerate)} degenerate frames; "
-                    f"SLAM {res.fps:.2f} frames/s, map query {1000 * res.stage_time_s['map_match'][1:].mean():.0f} ms/frame, "
-                    f"{res.counts['n_landmarks'][-1]} landmarks at the end")  # fmt: skip
+                    f"{res.pos_err_m.max():.2f} m, final {res.pos_err_m[-1]:.2f} m, mean {res.pos_err_m.mean():.3f} m, "
+                    f"max heading error {np.rad2deg(np.abs(res.yaw_err_rad).max()):.1f} deg, {len(res.degenerate)} "
+                    f"degenerate frames; SLAM {res.fps:.2f} frames/s, map query "
+                    f"{1000 * res.stage_time_s['map_match'][1:].mean():.0f} ms/frame, {res.counts['n_landmarks'][-1]} "
+                    f"landmarks at the end ({np.median(res.counts['n_new'][1:]):.0f} new per frame, median)")  # fmt: skip
+                say("    ms/frame: " + ", ".join(f"{s} {1000 * res.stage_time_s[s][1:].mean():.1f}" for s in STAGES))
             say(f"  ({time.perf_counter() - t0:.0f} s for these runs incl. rendering; load average "
                 f"{' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     if args.kitti:

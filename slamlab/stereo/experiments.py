@@ -395,10 +395,11 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
     :class:`~slamlab.kdtree.ExactStore` wrapped in a :class:`~slamlab.kdtree.workloads.RecordingStore`,
     and returns the recorded :class:`~slamlab.kdtree.workloads.Workload` for
     :func:`slamlab.kdtree.experiments.run_store_comparison`. ``detector="sift"`` gives 128-d float
-    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. ``progress``: a bar
-    over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
+    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. The map search is 000's
+    global one for every detector (ORB's window search would leave the store almost no queries).
+    ``progress``: a bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
-    p = StereoParams(detector=detector)
+    p = StereoParams(detector=detector, map_search="global")
     rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
     run_closed_loop("small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
     n = len(rec.iterations)
@@ -464,9 +465,11 @@ class KittiRunResult:
 #: the pipeline's settings on KITTI: ``max_depth_m = 40`` because the street scene reaches tens of
 #: metres (the arena's default, 10 m, would drop most of it); ``orb_levels = 1`` (ORB only): at 10 Hz a
 #: feature's scale changes by a few per cent per frame, and ORB's coarse levels doubled the spread of its
-#: per-frame step lengths (sd 5.2 % -> 2.8 % of the true step over frames 0-19, issue 17); everything else
+#: per-frame step lengths (sd 5.2 % -> 2.8 % of the true step over frames 0-19, issue 17);
+#: ``map_search = "global"``: 20 frames leave a small map, so ORB keeps 000's search over every landmark
+#: (the window search is for long runs; on these frames it gave ATE 0.19 against 0.18 m); everything else
 #: as :class:`StereoParams`
-KITTI_PARAMS = StereoParams(max_depth_m=40.0, orb_levels=1)
+KITTI_PARAMS = StereoParams(max_depth_m=40.0, orb_levels=1, map_search="global")
 
 
 def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams | None = None, rng=0,

@@ -22,6 +22,7 @@ __all__ = ["STEREO_DETECTORS", "RenderParams", "StereoParams"]
 #: are binary (Hamming), so its landmarks go to an exact store
 STEREO_DETECTORS = ("surf", "sift", "orb")
 POLICIES = ("oldest", "all")
+MAP_SEARCHES = ("global", "window")
 
 
 def _fraction(value, name):
@@ -71,9 +72,17 @@ class StereoParams(Params):
     subpixel_search_px: int = param(4, "ours: columns searched on each side of the matched right keypoint")
     # -- matching to the map (000 §3.4) ----------------------------------------------------------------
     map_ratio: float = param(0.8, "ours: ratio rule against the landmark store")
-    same_point_m: float | None = param(None, "ours: two nearest landmarks this close count as one (None: off)")
+    same_point_m: float | None = param(None, "ours: two nearest landmarks this close count as one for the ratio rule "
+                                             "(0: off; None: 0.03 m with the window search, off with the global one)")
     duplicate_gap_m: float | None = param(None, "ours: an unmatched point whose nearest landmark by descriptor lies this "
                                                 "close to it (after the pose) is that landmark again, not a new one (None: off)")
+    map_search: str | None = param(None, "ours: 'global' (000: every stored landmark by descriptor) or 'window' (a pose "
+                                         "from the last frame's landmarks, then the landmarks it projects near each "
+                                         "point); None: 'window' for ORB, 'global' otherwise")
+    window_px: float = param(15.0, "ours: radius of the window search around each keypoint, px")
+    window_max_hamming: int = param(64, "ours: largest Hamming distance (of 256 bits) a window match may have; binary only")
+    window_min_share: float = param(0.1, "ours: fewer window matches than this share of the points: search globally "
+                                         "(a first pose from repeated texture is confirmed by few windows)")
     view_margin_deg: float | None = param(None, "ours: match only landmarks in view (None: the whole map, as 000)")
     view_depth_factor: float = param(1.5, "ours: the view gate keeps landmarks up to this times max_depth_m away")
     base_seen_times: int = param(3, "000 §3.4: BaseSeenTimes = 3")
@@ -118,8 +127,13 @@ class StereoParams(Params):
         v.check_int(self.subpixel_half_px, "subpixel_half_px", minimum=1)
         v.check_int(self.subpixel_search_px, "subpixel_search_px", minimum=1)
         v.check_probability(self.map_ratio, "map_ratio")
-        _optional_positive(self.same_point_m, "same_point_m")
+        _optional_positive(self.same_point_m, "same_point_m", allow_zero=True)
         _optional_positive(self.duplicate_gap_m, "duplicate_gap_m")
+        if self.map_search is not None:
+            v.check_choice(self.map_search, "map_search", MAP_SEARCHES)
+        v.check_positive(self.window_px, "window_px")
+        v.check_int(self.window_max_hamming, "window_max_hamming", minimum=0)
+        _fraction(self.window_min_share, "window_min_share")
         _optional_positive(self.view_margin_deg, "view_margin_deg", allow_zero=True)
         v.check_positive(self.view_depth_factor, "view_depth_factor")
         v.check_int(self.base_seen_times, "base_seen_times", minimum=1)
@@ -148,6 +162,18 @@ class StereoParams(Params):
     def refine_disparity(self) -> bool:
         """Whether stereo matches get :func:`~slamlab.stereo.subpixel_disparity` (``subpixel_stereo``; None: ORB only)."""
         return self.detector == "orb" if self.subpixel_stereo is None else self.subpixel_stereo
+
+    @property
+    def search(self) -> str:
+        """The map search in use (``map_search``; None: 'window' for ORB, 'global' otherwise)."""
+        return ("window" if self.binary else "global") if self.map_search is None else self.map_search
+
+    @property
+    def twin_gap_m(self) -> float | None:
+        """The ``same_point_m`` in use (None: off)."""
+        if self.same_point_m is None:
+            return 0.03 if self.search == "window" else None
+        return self.same_point_m or None
 
     @property
     def binary(self) -> bool:

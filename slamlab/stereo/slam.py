@@ -21,14 +21,17 @@ from ..features.detect import detect
 from ..filters.landmark import landmark_predict, landmark_update
 from ..geometry.camera import StereoRig
 from ..geometry.se3 import planar_from_se3
+from ..kdtree.knn import exact_knn
 from ..kdtree.stores import ExactStore, LandmarkStore, base_rule, make_store
 from .params import StereoParams
 from .stages import (
     _check_features,
     _estimate_pose,
     _match_to_map,
+    _matches_from_knn,
     _stereo_match,
     _triangulate_local,
+    _window_match,
     is_rectified,
     pose_std,
 )
@@ -68,6 +71,21 @@ def default_store(params: StereoParams | None = None) -> LandmarkStore:
 STAGES = ("detect", "stereo", "triangulate", "map_match", "pose", "update")
 
 
+class _StageClock:
+    """Wall-clock and process CPU time per stage: ``lap(stage)`` adds the time since the last lap."""
+
+    def __init__(self):
+        self.wall = dict.fromkeys(STAGES, 0.0)
+        self.cpu = dict.fromkeys(STAGES, 0.0)
+        self._w, self._c = time.perf_counter(), time.process_time()
+
+    def lap(self, stage):
+        w, c = time.perf_counter(), time.process_time()
+        self.wall[stage] += w - self._w
+        self.cpu[stage] += c - self._c
+        self._w, self._c = w, c
+
+
 class FrameRecord(dict):
     """Counts of one frame (a plain dict with attribute access)."""
 
@@ -86,7 +104,9 @@ class StereoSLAM:
         setting, with its source; ``overrides`` change single fields (``detector="orb"``).
     store : a :class:`~slamlab.kdtree.LandmarkStore`, or a factory (class / callable) returning
         one; default :func:`default_store` (multi kd-tree for SURF/SIFT, exact Hamming brute force
-        for ORB).
+        for ORB). ORB matches to the map by the window search by default (``params.map_search``, our
+        addition): a first pose from the last frame's landmarks, then each point only against the
+        landmarks projected near it; the store serves the global search when that gives no pose.
     rng : RANSAC's random stream.
 
     Examples
@@ -124,10 +144,13 @@ class StereoSLAM:
         self.first_seen = np.empty(0, dtype=np.int64)
         self.n_seen = np.empty(0, dtype=np.int64)
         self.alive = np.empty(0, dtype=bool)
+        self.desc: np.ndarray | None = None  # descriptor of each landmark (the window search's copy)
+        self._last_ids = np.empty(0, dtype=np.int64)  # landmarks matched or added by the last located frame
         self.T = np.eye(4)  # current pose of the body in the map
         self.poses: list[np.ndarray] = []
         self.records: list[FrameRecord] = []
-        self.times: list[dict] = []
+        self.times: list[dict] = []  # wall-clock seconds per stage and frame
+        self.cpu_times: list[dict] = []  # CPU seconds of this process (all threads) per stage and frame
         self.frame = 0
         self.last_cloud_map = np.empty((0, 3))
         self.last_inlier_map = np.empty((0, 3))
@@ -152,17 +175,13 @@ class StereoSLAM:
         """
         self._check_pair(left, right)
         p = self.params
-        times = dict.fromkeys(STAGES, 0.0)
-        clock = time.perf_counter
-        t0 = clock()
+        clock = _StageClock()
         fl, fr = _detect_pair(left, right, p.detector, self._detect_kwargs, p.parallel_detect)
         _check_features(fl, "left features")
         _check_features(fr, "right features")
-        t1 = clock()
-        times["detect"] = t1 - t0
+        clock.lap("detect")
         sm = _stereo_match(fl, fr, self.rig.F, p.ratio, p.epi_tol_px)
-        t2 = clock()
-        times["stereo"] = t2 - t1
+        clock.lap("stereo")
         refine = None
         if self._refine:
             refine = (to_gray_uint8(left, "left", channel_order=p.channel_order),
@@ -172,49 +191,43 @@ class StereoSLAM:
         pts_body = cloud.points @ Rb.T + tb
         cov_body = Rb @ cloud.cov @ Rb.T
         desc = fl.descriptors[cloud.left]
-        t3 = clock()
-        times["triangulate"] = t3 - t2
+        clock.lap("triangulate")
         rec = FrameRecord(
             frame=self.frame, n_left=len(fl.uv), n_right=len(fr.uv), n_stereo=len(sm.left),
-            n_local=len(pts_body), n_map_matches=0, n_inliers=0, n_used=0, n_gated=0, n_new=0, n_duplicates=0,
-            status="ok",
+            n_local=len(pts_body), n_searched=0, n_map_matches=0, n_inliers=0, n_used=0, n_gated=0, n_new=0,
+            n_compared=0, n_duplicates=0, window_fallback=False, gate_fallback=False, status="ok",
         )  # fmt: skip
+        no_inliers = np.zeros(len(pts_body), bool)
         if len(self.X) == 0:
             # first frame (or an empty map): it defines the map frame
             if len(pts_body) >= p.min_inliers:
                 self._add_landmarks(pts_body, cov_body, desc, self.T)
+                self._last_ids = np.arange(len(pts_body))
                 rec["n_new"] = len(pts_body)
                 rec["status"] = "init"
             else:
                 rec["status"] = "too_few_points"
-            self._finish(rec, times, t3, pts_body, np.zeros(len(pts_body), bool))
+            self._finish(rec, clock, pts_body, no_inliers)
             return rec
-        cand = None if p.view_margin_deg is None else self.landmarks_in_view(p.view_margin_deg)
-        mm = _match_to_map(desc, self.store, p.map_ratio, self.X, p.same_point_m, cand)
-        t4 = clock()
-        times["map_match"] = t4 - t3
-        rec["n_map_matches"] = len(mm.local)
-        if len(mm.local) < max(3, p.min_inliers):
-            rec["status"] = "too_few_matches"
-            self._finish(rec, times, t4, pts_body, np.zeros(len(pts_body), bool))
+        mm = est = None
+        if p.search == "window" and self._last_ids.size:
+            mm, est = self._locate_window(rec, clock, desc, fl.uv[cloud.left], pts_body, cov_body, cloud.points[:, 2])
+            rec["window_fallback"] = est is None
+        cand = None
+        if est is None and p.view_margin_deg is not None:
+            cand = self.landmarks_in_view(p.view_margin_deg)
+            mm, est = self._locate(rec, clock, desc, pts_body, cov_body, cloud.points[:, 2], cand)
+        elif est is None:
+            mm, est = self._locate(rec, clock, desc, pts_body, cov_body, cloud.points[:, 2], None)
+        if est is None and cand is not None:
+            # the view gate rests on the last pose: when the landmarks in view do not give a pose, search the
+            # whole map (our addition; it keeps tracking after frames that kept the last pose while the robot turned)
+            rec["gate_fallback"] = True
+            mm, est = self._locate(rec, clock, desc, pts_body, cov_body, cloud.points[:, 2], None)
+        if est is None:
+            self._finish(rec, clock, pts_body, no_inliers)
             return rec
-        est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], cloud.points[mm.local, 2],
-                             cov_body[mm.local], p, self.rng)
-        t5 = clock()
-        times["pose"] = t5 - t4
-        rec["n_used"] = est.n_used
-        if not est.converged:
-            rec["status"] = "ransac_failed"
-            self._finish(rec, times, t5, pts_body, np.zeros(len(pts_body), bool))
-            return rec
-        if p.max_rot_std_rad is not None:
-            R = est.T[:3, :3]
-            inl = mm.local[est.inliers]
-            std = pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)
-            if not np.max(std[:3]) <= p.max_rot_std_rad:
-                rec["status"] = "ill_conditioned"
-                self._finish(rec, times, t5, pts_body, np.zeros(len(pts_body), bool))
-                return rec
+        rec["status"] = "ok"
         self.T = est.T
         R, t = est.T[:3, :3], est.T[:3, 3]
         # refine re-seen landmarks with the static Kalman filter (000 §3.6)
@@ -238,12 +251,82 @@ class StereoSLAM:
             dup = gap <= p.duplicate_gap_m
             rec["n_duplicates"] = int(dup.sum())
             new = new[~dup]
+        first_new = len(self.X)
         self._add_landmarks(pts_body[new], cov_body[new], desc[new], est.T)
         rec["n_new"] = len(new)
+        self._last_ids = np.concatenate([ids, np.arange(first_new, len(self.X))])
         inl_mask = np.zeros(len(pts_body), bool)
         inl_mask[loc] = True
-        self._finish(rec, times, t5, pts_body, inl_mask)
+        self._finish(rec, clock, pts_body, inl_mask)
         return rec
+
+    def _locate_window(self, rec, clock, desc, uv, pts_body, cov_body, depth):
+        """The window search (``map_search='window'``, our addition): a first pose from the landmarks of the
+        last located frame (000 §3.4-3.5 on that small set), then every landmark in view of that pose
+        projected into the left image and matched only to the keypoints within ``window_px`` of it;
+        the pose of those matches is the frame's. ``(matches, estimate)`` as :meth:`_locate`."""
+        p = self.params
+        last = self._last_ids[self.alive[self._last_ids]]
+        dist, ids = exact_knn(desc, self.desc[last], 2, last)
+        mm = _matches_from_knn(dist, ids, p.map_ratio, self.X, p.twin_gap_m)
+        clock.lap("map_match")
+        rec["n_searched"] += len(last)
+        rec["n_compared"] += len(last) * len(desc)
+        mm, est = self._pose(rec, clock, mm, pts_body, cov_body, depth)
+        if est is None:
+            return mm, None
+        T_wc = est.T @ self.T_body_left
+        cam = self.rig.left
+        cand = self.landmarks_in_view(np.rad2deg(p.window_px / cam.fx), T_body=est.T)
+        Xc = (self.X[cand] - T_wc[:3, 3]) @ T_wc[:3, :3]
+        uv_lm = np.column_stack([cam.fx * Xc[:, 0] / Xc[:, 2] + cam.cx, cam.fy * Xc[:, 1] / Xc[:, 2] + cam.cy])
+        inside = (uv_lm[:, 1] >= -p.window_px) & (uv_lm[:, 1] <= cam.height_px + p.window_px)
+        cand, uv_lm = cand[inside], uv_lm[inside]
+        max_d = p.window_max_hamming if p.binary else np.inf
+        mm, n_pairs = _window_match(desc, uv, self.desc[cand], uv_lm, cand, p.window_px, p.map_ratio, max_d, self.X,
+                                    p.twin_gap_m)
+        clock.lap("map_match")
+        rec["n_compared"] += n_pairs
+        if len(mm.local) < p.window_min_share * len(desc):
+            rec["status"] = "too_few_matches"
+            return mm, None
+        return self._pose(rec, clock, mm, pts_body, cov_body, depth)
+
+    def _locate(self, rec, clock, desc, pts_body, cov_body, depth, cand):
+        """Match to the map (the landmarks ``cand``, or all) and estimate the pose (000 §3.4-3.5);
+        ``(matches, estimate)``, the estimate None (and ``rec.status`` saying why) when the frame gives no pose."""
+        p = self.params
+        mm = _match_to_map(desc, self.store, p.map_ratio, self.X, p.twin_gap_m, cand)
+        clock.lap("map_match")
+        n = len(self.store) if cand is None else len(cand)
+        rec["n_searched"] += n
+        rec["n_compared"] += n * len(desc)
+        return self._pose(rec, clock, mm, pts_body, cov_body, depth)
+
+    def _pose(self, rec, clock, mm, pts_body, cov_body, depth):
+        """The pose of map matches ``mm`` (000 §3.5) with our checks; ``(mm, estimate or None)``."""
+        p = self.params
+        rec["n_map_matches"] = len(mm.local)
+        if len(mm.local) < max(3, p.min_inliers):
+            rec["status"] = "too_few_matches"
+            return mm, None
+        est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], depth[mm.local],
+                             cov_body[mm.local], p, self.rng)
+        rec["n_used"] = est.n_used
+        if not est.converged:
+            clock.lap("pose")
+            rec["status"] = "ransac_failed"
+            return mm, None
+        if p.max_rot_std_rad is not None:
+            R = est.T[:3, :3]
+            inl = mm.local[est.inliers]
+            std = pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)
+            if not np.max(std[:3]) <= p.max_rot_std_rad:
+                clock.lap("pose")
+                rec["status"] = "ill_conditioned"
+                return mm, None
+        clock.lap("pose")
+        return mm, est
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
@@ -251,13 +334,14 @@ class StereoSLAM:
         ``params.view_depth_factor × params.max_depth_m`` (1.5 × 10 m by default) away."""
         T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
         T_wc = T @ self.T_body_left
-        Xc = (self.X - T_wc[:3, 3]) @ T_wc[:3, :3]
+        live = np.flatnonzero(self.alive)
+        Xc = (self.X[live] - T_wc[:3, 3]) @ T_wc[:3, :3]
         cam = self.rig.left
         half = np.arctan2(max(cam.cx, cam.width_px - cam.cx), cam.fx) + np.deg2rad(margin_deg)
         z = Xc[:, 2]
-        keep = self.alive & (z > 0) & (np.abs(np.arctan2(Xc[:, 0], z)) <= half)
+        keep = (z > 0) & (np.abs(np.arctan2(Xc[:, 0], z)) <= half)
         keep &= np.einsum("ij,ij->i", Xc, Xc) <= (self.params.view_depth_factor * self.params.max_depth_m) ** 2
-        return np.flatnonzero(keep)
+        return live[keep]
 
     def refine_landmarks(self, ids, Z, Rz) -> np.ndarray:
         """Kalman-update landmarks ``ids`` with map-frame observations ``Z`` (covariances ``Rz``) (000 §3.6).
@@ -283,15 +367,15 @@ class StereoSLAM:
         self.first_seen = np.concatenate([self.first_seen, np.full(len(ids), self.frame)])
         self.n_seen = np.concatenate([self.n_seen, np.ones(len(ids), dtype=np.int64)])
         self.alive = np.concatenate([self.alive, np.ones(len(ids), dtype=bool)])
+        self.desc = desc.copy() if self.desc is None else np.concatenate([self.desc, desc])
         self.store.add(desc, ids)
 
-    def _finish(self, rec, times, t_start, pts_body, inl_mask):
-        t = time.perf_counter()
+    def _finish(self, rec, clock, pts_body, inl_mask):
         self.store.end_iteration()
         # the base rule (the stores' own): non-base landmarks time out
         is_base, late = self._base_rule()
         self.alive[late] = False
-        times["update"] += time.perf_counter() - t_start if rec["status"] == "ok" else time.perf_counter() - t
+        clock.lap("update")
         R, tt = self.T[:3, :3], self.T[:3, 3]
         self.last_cloud_map = pts_body @ R.T + tt
         self.last_inlier_map = self.last_cloud_map[inl_mask]
@@ -299,7 +383,8 @@ class StereoSLAM:
         rec["n_base"] = int((self.alive & is_base).sum())
         self.poses.append(self.T.copy())
         self.records.append(rec)
-        self.times.append(times)
+        self.times.append(clock.wall)
+        self.cpu_times.append(clock.cpu)
         self.frame += 1
 
     def _base_rule(self):
@@ -334,9 +419,11 @@ class StereoSLAM:
         keys = [k for k in self.records[0] if k != "status"] if self.records else []
         return {k: np.array([r[k] for r in self.records]) for k in keys}
 
-    def stage_times(self) -> dict:
-        """Per-frame time of each stage in seconds, as arrays."""
-        return {s: np.array([t[s] for t in self.times]) for s in STAGES}
+    def stage_times(self, cpu: bool = False) -> dict:
+        """Per-frame time of each stage in seconds, as arrays: wall clock, or with ``cpu`` the process's
+        CPU time (all its threads: detection runs the two images in two threads)."""
+        times = self.cpu_times if cpu else self.times
+        return {s: np.array([t[s] for t in times]) for s in STAGES}
 
     @property
     def degenerate_frames(self) -> np.ndarray:

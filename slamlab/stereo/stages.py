@@ -109,23 +109,32 @@ def _stereo_match(left, right, F, ratio, epi_tol_px, max_distance=None) -> Stere
     if li.size == 0:
         return empty
     d = _pair_distances(left.descriptors, right.descriptors, li, ri)
-    # pairs come grouped by left keypoint: nearest and second-nearest right keypoint per group
-    start = np.flatnonzero(np.r_[True, li[1:] != li[:-1]])
-    size = np.diff(np.r_[start, li.size])
-    d1 = np.minimum.reduceat(d, start)
-    at_min = np.flatnonzero(d == np.repeat(d1, size))
-    # one nearest per group (with a tie, d2 = d1 and the ratio rule rejects the keypoint anyway)
-    first_min = at_min[np.r_[True, li[at_min][1:] != li[at_min][:-1]]]
-    d_rest = d.copy()
-    d_rest[first_min] = np.inf
-    d2 = np.minimum.reduceat(d_rest, start)
-    li, ri = li[first_min], ri[first_min]
+    li, ri, d1, d2, _ = _two_nearest(li, ri, d)
     keep = ratio_rule(d1, d2, ratio)
     if max_distance is not None:
         keep &= d1 <= max_distance
     li, ri, d1 = li[keep], ri[keep], d1[keep]
     sel = best_per_target(ri, d1)  # each right keypoint goes to its best left keypoint only
     return StereoMatches(li[sel], ri[sel], d1[sel])
+
+
+def _two_nearest(qi, ti, d):
+    """Nearest and second-nearest target of each query from candidate pairs ``(qi, ti)`` with distances
+    ``d``, the pairs grouped by ascending query index: ``(query, nearest, d1, d2, second)``, one row per
+    query with candidates (``d2 = inf`` and ``second = -1`` for a single candidate; with a tie, d2 = d1)."""
+    start = np.flatnonzero(np.r_[True, qi[1:] != qi[:-1]])
+    size = np.diff(np.r_[start, qi.size])
+    d1 = np.minimum.reduceat(d, start)
+    at_min = np.flatnonzero(d == np.repeat(d1, size))
+    first_min = at_min[np.r_[True, qi[at_min][1:] != qi[at_min][:-1]]]
+    d_rest = d.copy()
+    d_rest[first_min] = np.inf
+    d2 = np.minimum.reduceat(d_rest, start)
+    at2 = np.flatnonzero((d_rest == np.repeat(d2, size)) & np.isfinite(d_rest))
+    second = np.full(start.size, -1, dtype=np.int64)
+    g2 = np.searchsorted(start, at2, side="right") - 1
+    second[g2[::-1]] = ti[at2[::-1]]  # the first second-nearest of each group wins
+    return qi[first_min], ti[first_min], d1, d2, second
 
 
 def _epipolar_pairs(uv_left, uv_right, F, tol_px):
@@ -167,7 +176,11 @@ def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
         if A.dtype == np.uint8:
             if A.shape[1] % 8 == 0:  # 8 bytes at a time
                 x, y = x.view(np.uint64), y.view(np.uint64)
-            out[s0:s0 + block] = np.bitwise_count(x ^ y).sum(axis=1)
+            bits = np.bitwise_count(x ^ y)
+            acc = bits[:, 0].astype(np.uint16)
+            for j in range(1, bits.shape[1]):  # column adds: ~2x faster than .sum(axis=1) on 4 columns
+                acc += bits[:, j]
+            out[s0:s0 + block] = acc
         else:
             dxy = x.astype(np.float32) - y
             out[s0:s0 + block] = np.sqrt(np.einsum("ij,ij->i", dxy, dxy))
@@ -369,7 +382,7 @@ def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | No
     X = None if positions is None else v.as_finite_array(positions, "positions", ndim=2)
     cand = None if candidates is None else np.asarray(candidates, dtype=np.int64).ravel()
     max_distance = None if max_distance is None else v.check_positive(max_distance, "max_distance")
-    return _match_to_map(D, store, p.map_ratio, X, p.same_point_m, cand, max_distance)
+    return _match_to_map(D, store, p.map_ratio, X, p.same_point_m or None, cand, max_distance)
 
 
 def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates=None, max_distance=None):
@@ -381,12 +394,25 @@ def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates
         dist, ids = store.query_among(D, candidates, k=2)
     else:
         dist, ids = store.query(D, k=2)
+    return _matches_from_knn(dist, ids, ratio, positions, same_point_m, max_distance)
+
+
+def _accept_twins(ok, first, second, positions, same_point_m):
+    """Set ``ok`` (in place) where the ratio rule failed only because the nearest and second-nearest
+    landmarks (ids ``first``, ``second``; -1: none) lie within ``same_point_m`` of each other: one point."""
+    if positions is None or same_point_m is None:
+        return
+    both = ~ok & (first >= 0) & (second >= 0)
+    if both.any():
+        gap = np.linalg.norm(positions[first[both]] - positions[second[both]], axis=1)
+        ok[np.flatnonzero(both)[gap < same_point_m]] = True
+
+
+def _matches_from_knn(dist, ids, ratio, positions=None, same_point_m=None, max_distance=None) -> MapMatches:
+    """:class:`MapMatches` from the 2-NN ``(dist, ids)`` of every local point (the rules of :func:`match_to_map`)."""
+    k = dist.shape[0]
     ok = (ids[:, 0] >= 0) & ratio_rule(dist[:, 0], dist[:, 1], ratio)
-    if positions is not None and same_point_m is not None:
-        both = ~ok & (ids[:, 0] >= 0) & (ids[:, 1] >= 0)
-        if both.any():
-            gap = np.linalg.norm(positions[ids[both, 0]] - positions[ids[both, 1]], axis=1)
-            ok[np.flatnonzero(both)[gap < same_point_m]] = True
+    _accept_twins(ok, ids[:, 0], ids[:, 1], positions, same_point_m)
     if max_distance is not None:
         ok &= dist[:, 0] <= max_distance
     loc = np.flatnonzero(ok)
@@ -395,6 +421,58 @@ def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates
     claimed = np.zeros(k, dtype=bool)
     claimed[loc] = True  # ratio-passing points that lost a duplicate are neither matches nor new
     return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed), ids[:, 0])
+
+
+def _radius_pairs(uv_q, uv_t, radius):
+    """All pairs ``(query, target)`` of 2-D points at most ``radius`` apart, grouped by ascending query
+    index: targets bucketed in a grid of ``radius`` cells, each query looks in its 3 x 3 cells."""
+    lo_xy = np.minimum(uv_q.min(axis=0), uv_t.min(axis=0))
+    cq = np.floor((uv_q - lo_xy) / radius).astype(np.int64)
+    ct = np.floor((uv_t - lo_xy) / radius).astype(np.int64)
+    ny = int(max(cq[:, 1].max(), ct[:, 1].max())) + 3
+    key_t = (ct[:, 0] + 1) * ny + ct[:, 1] + 1
+    order = np.argsort(key_t, kind="stable")
+    keys = key_t[order]
+    # the 3 cells of a column are consecutive keys: one range per column offset
+    base = (cq[:, 0:1] + 1 + np.arange(-1, 2)) * ny + cq[:, 1:2] + 1  # (k, 3) middle cell of each column
+    lo = np.searchsorted(keys, base - 1, side="left")
+    hi = np.searchsorted(keys, base + 1, side="right")
+    cnt = (hi - lo).ravel()
+    qi = np.repeat(np.arange(len(uv_q)), 3)
+    qi = np.repeat(qi, cnt)
+    ti = order[np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt - lo.ravel(), cnt)]
+    d = uv_q[qi] - uv_t[ti]
+    keep = np.einsum("ij,ij->i", d, d) <= radius * radius
+    return qi[keep], ti[keep]
+
+
+def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance, positions=None,
+                  same_point_m=None) -> tuple[MapMatches, int]:
+    """Map matching by projection (our addition to 000 §3.4): each local point (left keypoint ``uv``,
+    descriptor ``D``) is compared only with the landmarks ``ids_lm`` that a predicted pose projects within
+    ``radius_px`` of it (pixels ``uv_lm``, descriptors ``desc_lm``); nearest and second nearest of those
+    decide by the ratio rule (two neighbours closer than ``same_point_m`` count as one), the nearest
+    must be within ``max_distance``, one local point per landmark. Returns the matches and the number of
+    descriptor distances computed."""
+    k = D.shape[0]
+    none = MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
+    if k == 0 or len(ids_lm) == 0:
+        return none, 0
+    qi, rows = _radius_pairs(uv, uv_lm, radius_px)
+    if qi.size == 0:
+        return none, 0
+    d = _pair_distances(D, desc_lm, qi, rows)
+    q, r1, d1, d2, r2 = _two_nearest(qi, rows, d)
+    ok = ratio_rule(d1, d2, ratio)
+    _accept_twins(ok, ids_lm[r1], np.where(r2 >= 0, ids_lm[r2], -1), positions, same_point_m)
+    ok &= d1 <= max_distance
+    nearest = np.full(k, -1, dtype=np.int64)
+    nearest[q] = ids_lm[r1]
+    loc, lid, dd = q[ok], ids_lm[r1[ok]], d1[ok]
+    sel = best_per_target(lid, dd)
+    claimed = np.zeros(k, dtype=bool)
+    claimed[loc] = True
+    return MapMatches(loc[sel], lid[sel], dd[sel], np.flatnonzero(~claimed), nearest), int(qi.size)
 
 
 # --- pose: absolute orientation inside RANSAC, oldest landmarks first (000 §3.5) -----------------

@@ -356,3 +356,97 @@ def test_kitti_comparison_prints_one_row_per_setting(shared_data):
     assert [line.split()[0] for line in table.splitlines()[3:]] == ["a", "b"]
     with pytest.raises(TypeError, match="variants"):
         kitti_comparison({})
+
+
+@pytest.fixture(scope="module")
+def orb_frames():
+    sim = StereoSim(StereoArena(seed=0), rng=0)
+    poses = turn_in_place(np.deg2rad(5.0))[:6]
+    return sim, poses, [sim.render_pair(p) for p in poses]
+
+
+def test_window_search_tracks_with_a_fraction_of_the_descriptor_distances(orb_frames):
+    sim, poses, pairs = orb_frames
+    runs = {}
+    for search in ("window", "global"):
+        slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", map_search=search, rng=0)
+        slam.run(pairs)
+        runs[search] = slam
+    assert StereoParams(detector="orb").search == "window"
+    assert StereoParams().search == "global"
+    for slam in runs.values():
+        est = slam.planar_trajectory
+        truth = poses - poses[0]
+        assert np.abs(wrap_angle(est[:, 2] - truth[:, 2])).max() < np.deg2rad(0.5)
+        assert np.hypot(*est[:, :2].T).max() < 0.05  # a turn in place
+        assert len(slam.degenerate_frames) == 0
+    cw, cg = runs["window"].counts(), runs["global"].counts()
+    assert not cw["window_fallback"].any()
+    # global: every query against every stored landmark; window: the last frame's landmarks + the windows
+    np.testing.assert_array_equal(cg["n_compared"][1:], cg["n_local"][1:] * cg["n_searched"][1:])
+    # window search: the last frame's landmarks for every point, then a few landmarks per window
+    per_window = (cw["n_compared"][1:] - cw["n_local"][1:] * cw["n_searched"][1:]) / cw["n_local"][1:]
+    assert np.all(per_window < 0.03 * cw["n_landmarks"][:-1])  # a 15-px disc is 0.16 % of the image
+    assert cw["n_compared"][-1] < 0.5 * cg["n_compared"][-1]
+    assert cw["n_inliers"][1:].min() > 300
+
+
+def test_map_does_not_grow_on_a_revisit(orb_frames):
+    # the frames of a turn, back and forth three times: the window search with the twin rule finds the
+    # landmarks of the first pass again instead of adding copies (000 §3.4: copies that are seen become base)
+    sim, _, pairs = orb_frames
+    frames = pairs + pairs[::-1] + pairs
+    new = {}
+    for label, over in (("window", {}), ("global", {"map_search": "global", "same_point_m": 0})):
+        slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", rng=0, **over)
+        slam.run(frames)
+        c = slam.counts()
+        new[label] = c["n_new"][len(pairs):].sum()
+        if label == "window":
+            assert c["n_landmarks"][-1] <= c["n_landmarks"][len(pairs) - 1]
+            # the same images right after they were mapped: (almost) every point is a landmark again
+            assert c["n_new"][len(pairs)] < 0.01 * c["n_local"][len(pairs)]
+    assert new["window"] < 0.8 * new["global"]
+
+
+def test_a_search_that_gives_no_pose_falls_back_to_the_whole_map(orb_frames):
+    sim, _, pairs = orb_frames
+    # the view gate at a wrong last pose (turned around) finds nothing in view: the whole map is searched
+    slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", map_search="global", view_margin_deg=0.0, rng=0)
+    slam.process(*pairs[0])
+    slam.T = np.diag([-1.0, -1.0, 1.0, 1.0])
+    rec = slam.process(*pairs[0])
+    assert rec.gate_fallback
+    assert rec.status == "ok"
+    np.testing.assert_allclose(slam.T, np.eye(4), atol=1e-6)
+    # the window search whose first pose fails (too few landmarks of the last frame) falls back the same way
+    slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", rng=0)
+    slam.process(*pairs[0])
+    slam._last_ids = np.arange(3)
+    rec = slam.process(*pairs[0])
+    assert rec.window_fallback
+    assert rec.status == "ok"
+    assert rec.n_searched == 3 + len(slam.store) - rec.n_new
+    np.testing.assert_allclose(slam.T, np.eye(4), atol=1e-6)
+
+
+def test_stage_times_in_wall_and_cpu_time(short_turn):
+    poses, _ = short_turn
+    sim = StereoSim(StereoArena(seed=0), rng=0)
+    slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", rng=0)
+    slam.run(sim.render_pair(p) for p in poses[:3])
+    wall, cpu = slam.stage_times(), slam.stage_times(cpu=True)
+    assert set(wall) == set(cpu) == set(STAGES)
+    assert all(len(wall[s]) == 3 and np.all(cpu[s] >= 0) and np.all(wall[s] >= 0) for s in STAGES)
+    assert sum(cpu[s].sum() for s in STAGES) > 0
+
+
+def test_window_search_confirmed_by_too_few_windows_searches_globally(orb_frames):
+    # window_min_share = 1: no frame has every point matched in its window, so every frame falls back
+    sim, _poses, pairs = orb_frames
+    slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", window_min_share=1.0, rng=0)
+    slam.run(pairs[:3])
+    c = slam.counts()
+    assert c["window_fallback"][1:].all()
+    assert len(slam.degenerate_frames) == 0
+    np.testing.assert_array_less(c["n_map_matches"][1:], c["n_local"][1:])

@@ -483,3 +483,68 @@ def test_subpixel_disparity_bad_input():
     rig = StereoRig.parallel()
     assert is_rectified(rig)
     assert not is_rectified(StereoRig(rig.left, rig.right, rotation_xyz(0.0, 0.01, 0.0), rig.t_rl))
+
+
+def test_radius_pairs_are_every_pair_within_the_radius():
+    from slamlab.stereo.stages import _radius_pairs
+
+    rng = np.random.default_rng(3)
+    uq = rng.uniform(-30, 800, (300, 2))
+    ut = rng.uniform(0, 780, (900, 2))
+    for radius in (4.0, 15.0, 60.0):
+        qi, ti = _radius_pairs(uq, ut, radius)
+        d = np.linalg.norm(uq[:, None] - ut[None], axis=2)
+        expected = set(zip(*np.nonzero(d <= radius), strict=True))
+        assert set(zip(qi.tolist(), ti.tolist(), strict=True)) == {(int(a), int(b)) for a, b in expected}
+        assert np.all(np.diff(qi) >= 0)  # grouped by query
+    qi, ti = _radius_pairs(np.array([[0.0, 0.0]]), np.array([[100.0, 100.0]]), 5.0)
+    assert qi.size == ti.size == 0
+
+
+def test_two_nearest_per_query():
+    from slamlab.stereo.stages import _two_nearest
+
+    q, t1, d1, d2, t2 = _two_nearest(np.array([0, 0, 0, 2, 3, 3]), np.array([5, 6, 7, 8, 9, 10]),
+                                     np.array([3.0, 1.0, 2.0, 4.0, 1.0, 1.0]))
+    assert q.tolist() == [0, 2, 3]
+    assert t1.tolist() == [6, 8, 9]
+    assert t2.tolist() == [7, -1, 10]
+    assert d1.tolist() == [1.0, 4.0, 1.0]
+    assert d2.tolist() == [2.0, np.inf, 1.0]
+
+
+def test_window_match_searches_only_near_the_projections():
+    from slamlab.stereo.stages import _window_match
+
+    rng = np.random.default_rng(5)
+    n = 60
+    desc = rng.integers(0, 256, (n, 32), dtype=np.uint8)
+    ids = np.arange(1000, 1000 + n)
+    uv_lm = np.column_stack([np.arange(n) * 12.0, np.full(n, 100.0)])  # 12 px apart on one row
+    X = np.zeros((1000 + n, 3))
+    X[ids, 0] = np.arange(n) * 0.1  # landmarks 10 cm apart
+    flip = np.zeros(32, np.uint8)
+    flip[:3] = 1  # 3 bits
+    D = desc[[3, 10, 20]] ^ flip
+    uv = uv_lm[[3, 10, 20]] + [2.0, 1.0]
+    uv[2] += [200.0, 0.0]  # the third point's landmark projects 200 px away: outside its window
+    mm, n_pairs = _window_match(D, uv, desc, uv_lm, ids, 15.0, 0.8, 64)
+    assert dict(zip(mm.local.tolist(), mm.ids.tolist(), strict=True)) == {0: 1003, 1: 1010}
+    assert mm.unmatched.tolist() == [2]
+    # pairs: every landmark within 15 px of each point (brute force)
+    assert n_pairs == int((np.linalg.norm(uv[:, None] - uv_lm[None], axis=2) <= 15.0).sum())
+    # a window candidate farther than the Hamming bound is no match
+    mm, _ = _window_match(D[:1] ^ np.uint8(0x0F), uv[:1], desc, uv_lm, ids, 15.0, 0.8, 64)  # 4 x 32 bits more
+    assert mm.local.size == 0
+    # twins: two landmarks with the same descriptor in one window fail the ratio rule unless they are one place
+    desc2 = desc.copy()
+    desc2[4] = desc2[3]
+    mm, _ = _window_match(D[:1], uv[:1], desc2, uv_lm, ids, 15.0, 0.8, 64, X, None)
+    assert mm.local.size == 0
+    assert mm.unmatched.tolist() == [0]
+    X2 = X.copy()
+    X2[1004] = X2[1003] + [0.01, 0.0, 0.0]  # 1 cm apart: the same point added twice
+    mm, _ = _window_match(D[:1], uv[:1], desc2, uv_lm, ids, 15.0, 0.8, 64, X2, 0.03)
+    assert mm.ids.tolist() == [1003]
+    mm, _ = _window_match(D[:1], uv[:1], desc2, uv_lm, ids, 15.0, 0.8, 64, X, 0.03)  # 10 cm apart: two points
+    assert mm.local.size == 0
