@@ -29,6 +29,7 @@ from .mcl import MCL, MCLParams, MCLState, StepRecord, mcl_step
 from .models import (
     Beams,
     LikelihoodFieldModel,
+    ModelParams,
     beam_model_prob,
     check_particles,
     motion_density_odometry,
@@ -69,6 +70,7 @@ __all__ = [
     "MarkovGrid",
     "MarkovParams",
     "MarkovVsMclResult",
+    "ModelParams",
     "SideBySideResult",
     "SimRun",
     "StepRecord",

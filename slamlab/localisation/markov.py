@@ -29,33 +29,27 @@ import numpy as np
 from scipy import ndimage
 
 from .. import _validate as v
-from .._params import Params, param
+from .._params import param
 from ..geometry import wrap_angle
 from ..scans import FREE
-from .models import Beams, LikelihoodFieldModel, check_model_settings, odometry_deltas, scan_beams
+from .models import Beams, LikelihoodFieldModel, ModelParams, odometry_deltas, scan_beams
 
 __all__ = ["MarkovGrid", "MarkovParams", "markov_correct", "markov_predict"]
 
 
 @dataclass(frozen=True)
-class MarkovParams(Params):
-    """Settings of Markov grid localisation; lengths in map cells."""
+class MarkovParams(ModelParams):
+    """Settings of Markov grid localisation; lengths in map cells. The motion and sensor model's
+    fields (the same as MCL's) come first (:class:`~slamlab.localisation.models.ModelParams`)."""
 
     resolution: int = param(2, "ours: map cells per belief cell (003: not given)")
     n_headings: int = param(72, "ours: 5° heading bins (003: not given)")
-    alpha: tuple = param((0.05, 0.002, 0.05, 0.005), "ours; same as MCLParams (PR Table 5.5)")
-    z_hit: float = param(0.9, "ours; PR Table 6.3")
-    z_rand: float = param(0.1, "ours; PR Table 6.3")
-    sigma_hit: float = param(1.5, "ours, cells; PR Table 6.3")
-    max_dist: float = param(8.0, "ours, cells")
-    max_beams: int = param(30, "ours")
-    gamma: float = param(1.0, "ours: log-likelihood exponent")
     min_blur: float = param(0.5, "ours: Gaussian σ (belief cells and heading bins) added at each motion step")
 
     def check(self) -> None:
+        super().check()
         v.check_int(self.resolution, "resolution", minimum=1)
         v.check_int(self.n_headings, "n_headings", minimum=4)
-        check_model_settings(self)
         v.check_positive(self.min_blur, "min_blur", allow_zero=True)
 
 

@@ -31,11 +31,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
-from .._params import Params, param
+from .._params import param
 from .models import (
     Beams,
     LikelihoodFieldModel,
-    check_model_settings,
+    ModelParams,
     check_particles,
     sample_motion_odometry,
     scan_beams,
@@ -55,17 +55,11 @@ __all__ = ["MCL", "MCLParams", "MCLState", "StepRecord", "mcl_step"]
 
 
 @dataclass(frozen=True)
-class MCLParams(Params):
-    """Settings of Monte Carlo localisation; lengths in cells (the map's unit)."""
+class MCLParams(ModelParams):
+    """Settings of Monte Carlo localisation; lengths in cells (the map's unit). The motion and sensor
+    model's fields come first (:class:`~slamlab.localisation.models.ModelParams`)."""
 
     n_particles: int = param(2000, "ours (003: not given; ROS AMCL 100…5000, Nav2 500…2000)")
-    alpha: tuple = param((0.05, 0.002, 0.05, 0.005), "ours; PR Table 5.6 α1…α4 (ROS: 0.2 each, in metres)")
-    z_hit: float = param(0.9, "ours; PR Table 6.3 (ROS 1: 0.95, Nav2: 0.5)")
-    z_rand: float = param(0.1, "ours; PR Table 6.3 (ROS 1: 0.05, Nav2: 0.5)")
-    sigma_hit: float = param(1.5, "ours, cells; PR Table 6.3 (ROS: 0.2 m)")
-    max_dist: float = param(8.0, "ours, cells: cap of the distance table (ROS: 2 m)")
-    max_beams: int = param(30, "ours (ROS 1: 30, Nav2: 60)")
-    gamma: float = param(1.0, "ours: log-likelihood exponent (1 = PR's product over beams)")
     alpha_slow: float = param(0.001, "003 eq 2.9 (value not given); ROS AMCL docs suggest 0.001")
     alpha_fast: float = param(0.1, "003 eq 2.10 (value not given); ROS AMCL docs suggest 0.1")
     resample_threshold: float = param(0.5, "ours: resample when N_eff < threshold·M (PR §4.3.4)")
@@ -78,8 +72,8 @@ class MCLParams(Params):
     localised_heading_std_rad: float = param(float(np.radians(5)), "ours: … and the heading σ < this")
 
     def check(self) -> None:
+        super().check()
         v.check_int(self.n_particles, "n_particles", minimum=1)
-        check_model_settings(self)
         s = v.check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
         f = v.check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
         if s > 1 or f > 1:

@@ -27,12 +27,14 @@ import numpy as np
 from scipy.special import erf
 
 from .. import _validate as v
+from .._params import Params, param
 from ..geometry import wrap_angle
 from ..scans import OBSTACLE, Scan, check_grid, likelihood_field
 
 __all__ = [
     "Beams",
     "LikelihoodFieldModel",
+    "ModelParams",
     "beam_model_prob",
     "check_particles",
     "motion_density_odometry",
@@ -58,19 +60,31 @@ def check_particles(poses, name: str = "particles") -> np.ndarray:
     return P
 
 
-def check_model_settings(p) -> None:
-    """Check the motion and sensor fields shared by MCLParams and MarkovParams (one place)."""
-    if not isinstance(p.alpha, tuple):
-        raise TypeError(f"`alpha` must be a tuple of four numbers >= 0 (α1…α4); got {type(p.alpha).__name__}")
-    _check_alpha(p.alpha, "alpha must be a tuple of four numbers")
-    v.check_positive(p.z_hit, "z_hit", allow_zero=True)
-    v.check_positive(p.z_rand, "z_rand", allow_zero=True)
-    if p.z_hit + p.z_rand <= 0:
-        raise ValueError("`z_hit` + `z_rand` must be > 0")
-    v.check_positive(p.sigma_hit, "sigma_hit")
-    v.check_positive(p.max_dist, "max_dist")
-    v.check_int(p.max_beams, "max_beams", minimum=1)
-    v.check_positive(p.gamma, "gamma")
+@dataclass(frozen=True)
+class ModelParams(Params):
+    """The odometry motion model and likelihood-field sensor model settings shared by :class:`MCLParams`
+    and :class:`MarkovParams` (PR Tables 5.5-5.6, 6.3); lengths in cells (the map's unit)."""
+
+    alpha: tuple = param((0.05, 0.002, 0.05, 0.005), "ours; PR Tables 5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
+    z_hit: float = param(0.9, "ours; PR Table 6.3 (ROS 1: 0.95, Nav2: 0.5)")
+    z_rand: float = param(0.1, "ours; PR Table 6.3 (ROS 1: 0.05, Nav2: 0.5)")
+    sigma_hit: float = param(1.5, "ours, cells; PR Table 6.3 (ROS: 0.2 m)")
+    max_dist: float = param(8.0, "ours, cells: cap of the distance table (ROS: 2 m)")
+    max_beams: int = param(30, "ours (ROS 1: 30, Nav2: 60)")
+    gamma: float = param(1.0, "ours: log-likelihood exponent (1 = PR's product over beams)")
+
+    def check(self) -> None:
+        if not isinstance(self.alpha, tuple):
+            raise TypeError(f"`alpha` must be a tuple of four numbers >= 0 (α1…α4); got {type(self.alpha).__name__}")
+        _check_alpha(self.alpha, "alpha must be a tuple of four numbers")
+        v.check_positive(self.z_hit, "z_hit", allow_zero=True)
+        v.check_positive(self.z_rand, "z_rand", allow_zero=True)
+        if self.z_hit + self.z_rand <= 0:
+            raise ValueError("`z_hit` + `z_rand` must be > 0")
+        v.check_positive(self.sigma_hit, "sigma_hit")
+        v.check_positive(self.max_dist, "max_dist")
+        v.check_int(self.max_beams, "max_beams", minimum=1)
+        v.check_positive(self.gamma, "gamma")
 
 
 def _check_alpha(alpha, what: str = "alpha must be four finite numbers >= 0") -> np.ndarray:
