@@ -19,6 +19,7 @@ import numpy as np
 from .. import _validate as v
 from .._progress import progress_bar
 from .._table import format_table
+from ..kdtree.knn import flann_index
 from .base import Features
 from .detect import detect
 from .evaluation import (
@@ -426,9 +427,7 @@ def run_knn_comparison(sizes=(2000, 13000), *, n_queries: int = 500, max_leaves:
         d, idx = tree.query(Q, k=2, max_leaves=max_leaves)
         tm[i, 3] = time.perf_counter() - t0
         results[3] = (d, idx, tree.last_stats.mean_distance_evals)
-        import cv2
-
-        fl = cv2.flann_Index(np.ascontiguousarray(train, np.float32), {"algorithm": 1, "trees": 1})
+        fl = flann_index(train, trees=1)
         t0 = time.perf_counter()
         d, idx = knn2(Q, train, method="flann", checks=checks, tree=fl)
         tm[i, 4] = time.perf_counter() - t0
@@ -483,7 +482,6 @@ def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, 
 
     ``progress``: a bar over the budgets (None: on unless ``$SLAMLAB_PROGRESS=0``).
     """
-    import cv2
 
     from ..kdtree import KDTree
 
@@ -492,7 +490,7 @@ def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, 
     Q = q.descriptors
     _, i_ref = knn2(Q, train, method="brute")
     tree = KDTree(train)
-    fl = cv2.flann_Index(np.ascontiguousarray(train, np.float32), {"algorithm": 1, "trees": 1})
+    fl = flann_index(train, trees=1)
     rb, rf, eb, tm = [], [], [], []
     for b in progress_bar(budgets, desc="recall vs leaves", progress=progress):
         t0 = time.perf_counter()

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
-from ..kdtree.knn import exact_knn, hamming_distances, pad_knn
+from ..kdtree.knn import exact_knn, flann_index, hamming_distances, pad_knn
 from ..kdtree.tree import KDTree
 
 __all__ = [
@@ -98,11 +98,8 @@ def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: 
             tree = KDTree(T, leaf_size=leaf_size)
         return tree.query(Q, k=2, max_leaves=None if method == "kdtree" else v.check_int(max_leaves, "max_leaves",
                                                                                           minimum=1))
-    import cv2
-
     checks = v.check_int(checks, "checks", minimum=1)
-    T32 = np.ascontiguousarray(T, dtype=np.float32)
-    index = tree if tree is not None else cv2.flann_Index(T32, {"algorithm": 1, "trees": 1})
+    index = tree if tree is not None else flann_index(T, trees=1)
     k = min(2, T.shape[0])
     idx, d2 = index.knnSearch(np.ascontiguousarray(Q, dtype=np.float32), k, params={"checks": checks})
     return pad_knn(np.sqrt(np.maximum(d2, 0)), idx, 2)

@@ -11,7 +11,16 @@ __all__ = ["RigidTransform", "angle_mean", "apply_transform", "check_pose", "che
 # --- pinhole camera, stereo rig, midpoint triangulation, RANSAC, SE(3) helpers (000 §3) ---
 from .camera import PinholeCamera, StereoRig, focal_from_hfov, fundamental_matrix, rotation_xyz
 from .ransac import RansacResult, ransac
-from .se3 import planar_from_se3, se3, se3_from_planar, se3_inverse, yaw_from_R
+from .se3 import (
+    planar_from_se3,
+    rotate_points,
+    se3,
+    se3_compose,
+    se3_from_planar,
+    se3_inverse,
+    transform_points,
+    yaw_from_R,
+)
 from .triangulation import Triangulation, triangulate_midpoint, triangulate_stereo
 
 __all__ += [
@@ -23,10 +32,13 @@ __all__ += [
     "fundamental_matrix",
     "planar_from_se3",
     "ransac",
+    "rotate_points",
     "rotation_xyz",
     "se3",
+    "se3_compose",
     "se3_from_planar",
     "se3_inverse",
+    "transform_points",
     "triangulate_midpoint",
     "triangulate_stereo",
     "yaw_from_R",

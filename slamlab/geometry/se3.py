@@ -11,7 +11,8 @@ import numpy as np
 
 from .. import _validate as v
 
-__all__ = ["planar_from_se3", "se3", "se3_from_planar", "se3_inverse", "yaw_from_R"]
+__all__ = ["planar_from_se3", "rotate_points", "se3", "se3_compose", "se3_from_planar", "se3_inverse", "transform_points",
+           "yaw_from_R"]
 
 
 def se3(R, t) -> np.ndarray:
@@ -45,6 +46,59 @@ def se3_inverse(T) -> np.ndarray:
     out[..., :3, 3] = -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3])
     out[..., 3, 3] = 1.0
     return out
+
+
+def rotate_points(R, points) -> np.ndarray:
+    """``points @ R.T`` for ``points (N, 3)``, as three sums of products in a fixed order (our helper).
+
+    The same bits on every machine: a matrix product goes to BLAS, whose rounding depends on its
+    kernel (FMA or not, blocking) and thread count, and a renderer that quantises to grey levels
+    turns that last-bit difference into a different pixel. ``R`` is cast to the points' dtype
+    (float32 rays stay float32).
+
+    >>> rotate_points(se3_from_planar(0, 0, np.pi / 2)[:3, :3], [[1.0, 0.0, 0.0]]).round(12)
+    array([[0., 1., 0.]])
+    """
+    P = np.asarray(points)
+    if P.ndim != 2 or P.shape[1] != 3:
+        raise ValueError(f"`points` must have shape (N, 3); got {P.shape}")
+    if not np.issubdtype(P.dtype, np.floating):
+        P = P.astype(np.float64)
+    R = v.as_matrix(R, "R", (3, 3)).astype(P.dtype)
+    x, y, z = P[:, 0], P[:, 1], P[:, 2]
+    out = np.empty_like(P)
+    for k in range(3):
+        out[:, k] = x * R[k, 0] + y * R[k, 1] + z * R[k, 2]
+    return out
+
+
+def transform_points(T, points) -> np.ndarray:
+    """``points @ R.T + t`` for a 4×4 ``T`` and ``points (N, 3)``, without BLAS (see :func:`rotate_points`).
+
+    >>> transform_points(se3_from_planar(1.0, 0.0, 0.0), [[0.0, 2.0, 0.0]])
+    array([[1., 2., 0.]])
+    """
+    T = v.as_matrix(T, "T", (4, 4))
+    out = rotate_points(T[:3, :3], points)
+    out += T[:3, 3].astype(out.dtype)
+    return out
+
+
+def se3_compose(A, B) -> np.ndarray:
+    """``A @ B`` for 4×4 transforms (batched over leading axes), as sums in a fixed order (no BLAS).
+
+    ``np.einsum`` without ``optimize`` never calls BLAS, so the product has the same bits under
+    every BLAS kernel and thread count (``A @ B`` does not: a 1-ulp difference in a pose is
+    enough to change a later inlier decision of a tracker).
+
+    >>> T = se3_from_planar(1.0, 2.0, 0.5); np.allclose(se3_compose(T, se3_inverse(T)), np.eye(4))
+    True
+    """
+    A = np.asarray(A, dtype=np.float64)
+    B = np.asarray(B, dtype=np.float64)
+    if A.shape[-2:] != (4, 4) or B.shape[-2:] != (4, 4):
+        raise ValueError(f"`A` and `B` must have shape (..., 4, 4); got {A.shape} and {B.shape}")
+    return np.einsum("...ij,...jk->...ik", A, B)
 
 
 def se3_from_planar(x_m: float, y_m: float, yaw_rad: float, z_m: float = 0.0) -> np.ndarray:

@@ -7,7 +7,8 @@
   distances and id ``-1``;
 - :func:`merge_knn` — k-NN lists of several trees merged into one (000 §4: a query
   searches every tree);
-- :func:`hamming_distances` — pairwise Hamming distances of packed binary descriptors.
+- :func:`hamming_distances` — pairwise Hamming distances of packed binary descriptors;
+- :func:`flann_index` — OpenCV's FLANN randomised kd-trees, built from a seeded RNG.
 
 The features chapter's matching (:func:`slamlab.features.knn2`), the landmark stores
 (:mod:`slamlab.kdtree.stores`) and the stereo pipeline all call these.
@@ -17,7 +18,22 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["augment_rows", "exact_knn", "hamming_distances", "merge_knn", "pad_knn"]
+__all__ = ["augment_rows", "exact_knn", "flann_index", "hamming_distances", "merge_knn", "pad_knn"]
+
+
+def flann_index(data, *, trees: int = 1, seed: int | None = 0):
+    """OpenCV's FLANN randomised kd-trees (``cv2.flann_Index``, ``trees`` of them) over ``data (N, D)``.
+
+    FLANN draws its split dimensions from OpenCV's global RNG, so an unseeded build depends on
+    whatever drew from that RNG before (in a notebook: any earlier cell). ``seed`` (not None)
+    reseeds it with ``cv2.setRNGSeed`` first, so the same data give the same trees in any kernel
+    (a side effect on OpenCV's global RNG).
+    """
+    import cv2
+
+    if seed is not None:
+        cv2.setRNGSeed(int(seed))
+    return cv2.flann_Index(np.ascontiguousarray(data, dtype=np.float32), {"algorithm": 1, "trees": int(trees)})
 
 
 def pad_knn(dist, ids, k: int):

@@ -44,7 +44,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import _validate as v
-from .knn import augment_rows, exact_knn, merge_knn, pad_knn
+from .knn import augment_rows, exact_knn, flann_index, merge_knn, pad_knn
 from .tree import KDTree
 
 __all__ = [
@@ -682,12 +682,8 @@ class FlannStore(LandmarkStore):
             self._build()
 
     def _build(self):
-        import cv2
-
         self._data = np.ascontiguousarray(self._pts.points)
-        if self.seed is not None:
-            cv2.setRNGSeed(self.seed)
-        self._index = cv2.flann_Index(self._data, {"algorithm": 1, "trees": self.trees})
+        self._index = flann_index(self._data, trees=self.trees, seed=self.seed)
         self._id_map = self._pts.point_ids.copy()
         self.counters.points_rebuilt += self._pts.n
         self.counters.trees_built += self.trees

@@ -5,16 +5,23 @@
   patches (003: 4×4) around points of known depth, by inverse compositional Gauss-Newton
   (Baker & Matthews 2004) on SE(3), coarse to fine over an image pyramid.
 * :func:`refine_pose` - 003 §4.4 step 4: the reprojection error of matched map points,
-  minimised over the 6 pose parameters by ``scipy.optimize.least_squares`` (Huber loss).
+  minimised over the 6 pose parameters by Levenberg-Marquardt with Huber weights.
+
+Every product, norm and solve here is written without BLAS/LAPACK (``np.einsum``, element-wise
+sums, a 6×6 Cholesky in Python floats): a tracker turns a last-bit difference into a different
+inlier set a few frames later, and BLAS rounds differently by kernel, machine and thread count,
+so with BLAS the same notebook printed different results on different machines (our choice).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _validate as v
+from ..geometry.se3 import se3_compose, se3_inverse, transform_points
 
 __all__ = [
     "AlignResult",
@@ -23,12 +30,17 @@ __all__ = [
     "project",
     "refine_pose",
     "se3_exp",
+    "solve_spd",
     "sparse_align",
 ]
 
 
 def _hat(w):
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+def _mat3(A, B):
+    return np.einsum("ij,jk->ik", A, B)
 
 
 def se3_exp(xi) -> np.ndarray:
@@ -39,21 +51,61 @@ def se3_exp(xi) -> np.ndarray:
     """
     xi = np.asarray(xi, dtype=np.float64)
     vv, w = xi[:3], xi[3:]
-    th = float(np.linalg.norm(w))
+    th = math.sqrt(float(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]))
     W = _hat(w)
     if th < 1e-10:
         R = np.eye(3) + W
         V = np.eye(3) + 0.5 * W
     else:
-        A = np.sin(th) / th
-        B = (1 - np.cos(th)) / th**2
+        A = math.sin(th) / th
+        B = (1 - math.cos(th)) / th**2
         C = (1 - A) / th**2
-        R = np.eye(3) + A * W + B * W @ W
-        V = np.eye(3) + B * W + C * W @ W
+        WW = _mat3(W, W)
+        R = np.eye(3) + A * W + B * WW
+        V = np.eye(3) + B * W + C * WW
     T = np.eye(4)
     T[:3, :3] = R
-    T[:3, 3] = V @ vv
+    T[:3, 3] = np.einsum("ij,j->i", V, vv)
     return T
+
+
+def solve_spd(H, g) -> np.ndarray:
+    """``H⁻¹ g`` for a small symmetric positive definite ``H`` by Cholesky in Python floats (ours).
+
+    The same bits on every machine (LAPACK's solvers call BLAS kernels that round by CPU).
+    Returns NaNs when ``H`` is not positive definite.
+
+    >>> solve_spd(np.array([[4.0, 2.0], [2.0, 3.0]]), np.array([2.0, 1.0])).tolist()
+    [0.5, 0.0]
+    """
+    A = np.asarray(H, dtype=np.float64).tolist()
+    b = np.asarray(g, dtype=np.float64).tolist()
+    n = len(b)
+    L = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        for j in range(i + 1):
+            acc = A[i][j]
+            for k in range(j):
+                acc -= L[i][k] * L[j][k]
+            if i == j:
+                if not acc > 0.0:
+                    return np.full(n, np.nan)
+                L[i][i] = math.sqrt(acc)
+            else:
+                L[i][j] = acc / L[j][j]
+    y = [0.0] * n
+    for i in range(n):
+        acc = b[i]
+        for k in range(i):
+            acc -= L[i][k] * y[k]
+        y[i] = acc / L[i][i]
+    x = [0.0] * n
+    for i in range(n - 1, -1, -1):
+        acc = y[i]
+        for k in range(i + 1, n):
+            acc -= L[k][i] * x[k]
+        x[i] = acc / L[i][i]
+    return np.array(x)
 
 
 def build_pyramid(image, levels: int) -> list[np.ndarray]:
@@ -162,12 +214,12 @@ def sparse_align(pyr_ref, pyr_cur, K, X_ref, T_init, *, patch_px: int = 4, max_l
         Jp = _d_proj(K, Xl, s)  # (M, 2, 6)
         J = gx[..., None] * Jp[:, None, 0, :] + gy[..., None] * Jp[:, None, 1, :]  # (M, P, 6)
         J = J.reshape(-1, 6)
-        H = J.T @ J + 1e-9 * np.eye(6)
+        H = np.einsum("ni,nj->ij", J, J) + 1e-9 * np.eye(6)
         chi_prev = np.inf
         T_prev = T
         for _ in range(max_iter):
             n_it += 1
-            Xc = Xl @ T[:3, :3].T + T[:3, 3]
+            Xc = transform_points(T, Xl)
             ok_z = Xc[:, 2] > 1e-6
             uvc = project(K, np.where(ok_z[:, None], Xc, 1.0)) * s
             vis = ok_z & (uvc[:, 0] >= half + 1) & (uvc[:, 0] < w - half - 2) & (uvc[:, 1] >= half + 1) & (uvc[:, 1] < h - half - 2)
@@ -182,15 +234,16 @@ def sparse_align(pyr_ref, pyr_cur, K, X_ref, T_init, *, patch_px: int = 4, max_l
                 T = T_prev
                 break
             rms = np.sqrt(chi)
-            g = Jm.reshape(-1, 6).T @ r.ravel()
-            Hm = Jm.reshape(-1, 6).T @ Jm.reshape(-1, 6) + 1e-9 * np.eye(6) if not vis.all() else H
-            delta = np.linalg.solve(Hm, g)
+            Jf = Jm.reshape(-1, 6)
+            g = np.einsum("ni,n->i", Jf, r.ravel())
+            Hm = np.einsum("ni,nj->ij", Jf, Jf) + 1e-9 * np.eye(6) if not vis.all() else H
+            delta = solve_spd(Hm, g)
             if not np.all(np.isfinite(delta)):
                 break
             T_prev = T
-            T = T @ np.linalg.inv(se3_exp(delta))
+            T = se3_compose(T, se3_inverse(se3_exp(delta)))
             chi_prev = chi
-            if np.linalg.norm(delta) < eps:
+            if math.sqrt(float(np.sum(delta * delta))) < eps:
                 break
     ok = bool(np.isfinite(rms)) and np.all(np.isfinite(T))
     if not np.all(np.isfinite(T)):
@@ -199,46 +252,81 @@ def sparse_align(pyr_ref, pyr_cur, K, X_ref, T_init, *, patch_px: int = 4, max_l
 
 
 def refine_pose(K, X_world, uv, T_cam_world_init, *, huber_px: float = 1.0, reject_px: float | None = 3.0,
-                max_nfev: int = 50):
-    """Motion-only refinement: ``min Σ ρ(|π(T X) − uv|²)`` over the pose (003 §4.4, step 4).
+                max_iter: int = 50, tol: float = 1e-8):
+    """Motion-only refinement: ``min Σ ρ(r)`` over the pose, ``r`` = π(T X) − uv per coordinate (003 §4.4, step 4).
 
-    ``scipy.optimize.least_squares`` with a Huber loss of scale ``huber_px``, twist
-    parametrisation ``T = exp(ξ) T_init``; then (ours) once more on the points whose error is
-    below ``reject_px`` (the Huber loss still leans on gross outliers). Returns
-    ``(T_cam_world, residual_px (N,), ok)`` with the residuals of every point.
+    Levenberg-Marquardt on the twist of a left update ``T ← exp(ξ) T`` with the analytic
+    Jacobian of :func:`_d_proj` and Huber weights of scale ``huber_px`` (iteratively reweighted),
+    until the step's norm or the cost's relative decrease is below ``tol`` (scipy's ``xtol`` and
+    ``ftol`` defaults), or ``max_iter`` steps; then (ours) once more on the points
+    whose error is below ``reject_px`` (the Huber loss still leans on gross outliers). Returns
+    ``(T_cam_world, residual_px (N,), ok)`` with the residuals of every point; ``ok`` is False
+    (and the initial pose returned) when a run does not converge in ``max_iter`` steps or ends
+    non-finite. Written without BLAS (see the module docstring): the same bits on any machine.
     """
-    from scipy.optimize import least_squares
-
     K = np.asarray(K, dtype=np.float64)
     X = np.asarray(X_world, dtype=np.float64).reshape(-1, 3)
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     T0 = np.asarray(T_cam_world_init, dtype=np.float64)
     if X.shape[0] < 3:
         return T0, np.full(X.shape[0], np.inf), False
-    Xc0 = X @ T0[:3, :3].T + T0[:3, 3]
-
-    def resid(xi):
-        Tx = se3_exp(xi)
-        Xc = Xc0 @ Tx[:3, :3].T + Tx[:3, 3]
-        z = np.maximum(Xc[:, 2], 1e-6)
-        return np.concatenate([(K[0, 0] * Xc[:, 0] / z + K[0, 2]) - uv[:, 0], (K[1, 1] * Xc[:, 1] / z + K[1, 2]) - uv[:, 1]])
-
-    sol = least_squares(resid, np.zeros(6), jac="2-point", loss="huber", f_scale=huber_px, max_nfev=max_nfev,
-                        method="trf", x_scale="jac")
-    r = sol.fun.reshape(2, -1)
-    err = np.hypot(r[0], r[1])
-    ok = sol.status > 0
+    T, ok = _lm_huber(K, X, uv, T0, huber_px, max_iter, tol)
+    err = _reproj_err(K, X, uv, T)
     if ok and reject_px is not None:
         keep = err < reject_px
         if 6 <= keep.sum() < err.size:
-            sub = np.concatenate([keep, keep])
-            sol = least_squares(lambda xi: resid(xi)[sub], sol.x, jac="2-point", loss="huber", f_scale=huber_px,
-                                max_nfev=max_nfev, method="trf", x_scale="jac")
-            r = resid(sol.x).reshape(2, -1)
-            err = np.hypot(r[0], r[1])
-            ok = sol.status > 0
-    T = se3_exp(sol.x) @ T0
+            T, ok = _lm_huber(K, X[keep], uv[keep], T, huber_px, max_iter, tol)
+            err = _reproj_err(K, X, uv, T)
     ok = ok and bool(np.all(np.isfinite(T)))
     if not ok:
         return T0, np.full(X.shape[0], np.inf), False
     return T, err, ok
+
+
+def _residuals(K, Xc, uv):
+    z = np.maximum(Xc[:, 2], 1e-6)
+    return np.column_stack([K[0, 0] * Xc[:, 0] / z + K[0, 2] - uv[:, 0], K[1, 1] * Xc[:, 1] / z + K[1, 2] - uv[:, 1]])
+
+
+def _reproj_err(K, X, uv, T):
+    r = _residuals(K, transform_points(T, X), uv)
+    return np.hypot(r[:, 0], r[:, 1])
+
+
+def _huber_cost(r, delta):
+    a = np.abs(r)
+    return float(np.sum(np.where(a <= delta, 0.5 * r * r, delta * (a - 0.5 * delta))))
+
+
+def _lm_huber(K, X, uv, T, huber_px, max_iter, tol):
+    """Levenberg-Marquardt with Huber (IRLS) weights on ``T ← exp(ξ) T``; ``(T, converged)``."""
+    lam = 1e-4
+    Xc = transform_points(T, X)
+    r = _residuals(K, Xc, uv)
+    cost = _huber_cost(r, huber_px)
+    for _ in range(max_iter):
+        a = np.abs(r)
+        w = np.where(a <= huber_px, 1.0, huber_px / np.maximum(a, 1e-300))  # (N, 2)
+        J = _d_proj(K, Xc, 1.0)  # (N, 2, 6)
+        H = np.einsum("nk,nki,nkj->ij", w, J, J)
+        g = np.einsum("nk,nki,nk->i", w, J, r)
+        while True:
+            Hd = H + lam * np.diag(np.diag(H))
+            step = -solve_spd(Hd, g)
+            if not np.all(np.isfinite(step)):
+                return T, False
+            T_new = se3_compose(se3_exp(step), T)
+            Xc_new = transform_points(T_new, X)
+            r_new = _residuals(K, Xc_new, uv)
+            cost_new = _huber_cost(r_new, huber_px)
+            if cost_new <= cost:
+                decrease = cost - cost_new
+                T, Xc, r, cost = T_new, Xc_new, r_new, cost_new
+                lam = max(lam / 10.0, 1e-12)
+                break
+            lam *= 10.0
+            if lam > 1e8:  # no step lowers the cost: at a minimum
+                return T, True
+        if math.sqrt(float(np.sum(step * step))) < tol or decrease <= tol * cost:
+            return T, True
+    return T, False

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry.se3 import rotate_points
 from ..geometry.triangulation import triangulate_midpoint
 from .align import bilinear
 from .depth_filter import depth_interval
@@ -57,7 +58,7 @@ def zncc(A, B) -> np.ndarray:
     na = np.linalg.norm(A, axis=1)
     nb = np.linalg.norm(B, axis=1)
     den = np.outer(na, nb)
-    return np.where(den > 1e-6, (A @ B.T) / np.maximum(den, 1e-12), 0.0)
+    return np.where(den > 1e-6, np.einsum("ip,jp->ij", A, B) / np.maximum(den, 1e-12), 0.0)  # no BLAS: same bits anywhere
 
 
 def epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma: float = 2.0):
@@ -70,7 +71,7 @@ def epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma: float = 2.0):
     K = np.asarray(K, dtype=np.float64)
     R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
     z_near, z_far = depth_interval(mu, sigma, n_sigma)
-    fc = np.asarray(f, dtype=np.float64) @ R.T
+    fc = rotate_points(R, np.asarray(f, dtype=np.float64))
     Xa = fc * z_near[:, None] + t
     far_inf = z_far > _FAR_DEPTH
     Xb = np.where(far_inf[:, None], fc, fc * np.minimum(z_far, _FAR_DEPTH)[:, None] + t)
@@ -135,10 +136,13 @@ def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv
         L = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
         e = d / L[:, None]  # unit direction; normal (-e_v, e_u)
         nrm = np.column_stack([-e[:, 1], e[:, 0]])
-        # distance to the line and position along the segment for every (corner, seed): two products
-        c32 = corners.astype(np.float32)
-        dist = np.abs(c32 @ nrm.T.astype(np.float32) - np.sum(A * nrm, axis=1).astype(np.float32))  # (C, S)
-        along = c32 @ e.T.astype(np.float32) - np.sum(A * e, axis=1).astype(np.float32)
+        # distance to the line and position along the segment for every (corner, seed): element-wise
+        # (C, S) products, not a BLAS matrix product, whose rounding (and so which corner is within
+        # tol_px) would depend on the machine
+        cu, cv = (corners[:, k:k + 1].astype(np.float32) for k in (0, 1))
+        n32, e32 = nrm.astype(np.float32), e.astype(np.float32)
+        dist = np.abs(cu * n32[:, 0] + cv * n32[:, 1] - np.sum(A * nrm, axis=1).astype(np.float32))  # (C, S)
+        along = cu * e32[:, 0] + cv * e32[:, 1] - np.sum(A * e, axis=1).astype(np.float32)
         near = (dist <= tol_px) & (along >= -tol_px) & (along <= L + tol_px) & ok[sl]
         ci, si = np.nonzero(near)
         ncand[sl] = np.bincount(si, minlength=L.size)
@@ -154,8 +158,9 @@ def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv
         uv[bs[hit]] = corners[bc[hit]]
     # triangulate along f: ray f from the reference centre, ray through uv from the current centre
     R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
-    c_cur = -R.T @ t  # current centre in the reference frame
-    rays = np.column_stack([(uv[:, 0] - K[0, 2]) / K[0, 0], (uv[:, 1] - K[1, 2]) / K[1, 1], np.ones(n)]) @ R  # R^T r
+    c_cur = -np.einsum("ji,j->i", R, t)  # current centre in the reference frame
+    rays = rotate_points(R.T, np.column_stack([(uv[:, 0] - K[0, 2]) / K[0, 0], (uv[:, 1] - K[1, 2]) / K[1, 1],
+                                               np.ones(n)]))  # R^T r
     tri = triangulate_midpoint(np.zeros(3), f, c_cur, rays, parallel_tol=min_parallax_rad**2)
     depth = tri.s  # f is unit: the ray parameter is the depth along f
     found &= tri.valid

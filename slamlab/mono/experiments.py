@@ -16,7 +16,7 @@ from .. import _validate as v
 from .._progress import progress_bar
 from .._table import format_table
 from ..geometry.camera import StereoRig
-from ..geometry.se3 import se3_from_planar, se3_inverse
+from ..geometry.se3 import se3_compose, se3_from_planar, se3_inverse
 from ..sim.arena import StereoArena, StereoSim
 from .params import MonoParams
 from .slam import STAGES, MonoSLAM
@@ -106,7 +106,7 @@ def render_sequence(sim: StereoSim, poses, *, blur_px: float = 0.0, contrast: fl
     tilt[1:3, 1:3] = [[c, s_], [-s_, c]]  # about the camera x axis: the optical axis dips (y is down)
     imgs, Ts = [], []
     for pose in progress_bar(poses, desc="render", progress=progress):
-        T = se3_from_planar(*pose) @ sim.T_body_left @ tilt
+        T = se3_compose(se3_compose(se3_from_planar(*pose), sim.T_body_left), tilt)
         img = sim.arena.render(cam, T) * 255.0
         if blur_px > 0:
             img = cv2.GaussianBlur(img.astype(np.float32), (0, 0), blur_px)

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
-from ..geometry.se3 import se3_inverse
+from ..geometry.se3 import se3_compose, se3_inverse, transform_points
 from .align import build_pyramid, project, refine_pose, sparse_align
 from .depth_filter import (
     Seeds,
@@ -52,7 +52,7 @@ class Keyframe:
 
     @property
     def center(self) -> np.ndarray:
-        return -self.T_cw[:3, :3].T @ self.T_cw[:3, 3]
+        return -np.einsum("ji,j->i", self.T_cw[:3, :3], self.T_cw[:3, 3])
 
 
 class MonoSLAM:
@@ -206,7 +206,7 @@ class MonoSLAM:
         uv, resp = uv[keep], resp[keep]
         order = np.argsort(-resp, kind="stable")[: p.max_seeds_per_kf]
         uv = uv[order]
-        Xc = self.points[vis_idx] @ kf.T_cw[:3, :3].T + kf.T_cw[:3, 3] if len(vis_idx) else np.zeros((0, 3))
+        Xc = transform_points(kf.T_cw, self.points[vis_idx]) if len(vis_idx) else np.zeros((0, 3))
         z = Xc[:, 2][Xc[:, 2] > 0] if len(Xc) else np.zeros(0)
         depth_mean = float(np.median(z)) if z.size else 1.0
         depth_min = float(np.min(z)) if z.size else 0.5
@@ -261,11 +261,11 @@ class MonoSLAM:
         if self._T_cw_prev is None or p.motion_model == "constant_position":
             vel = np.eye(4)
         else:
-            vel = T_prev @ se3_inverse(self._T_cw_prev)
-        T_pred = vel @ T_prev
+            vel = se3_compose(T_prev, se3_inverse(self._T_cw_prev))
+        T_pred = se3_compose(vel, T_prev)
         # 2. sparse direct alignment to the previous frame
         # every map point in view of the previous frame (at most align_max_points, spread; ours)
-        X_prev = self.points @ T_prev[:3, :3].T + T_prev[:3, 3]
+        X_prev = transform_points(T_prev, self.points)
         uv_prev = project(self.K, np.where(X_prev[:, 2:3] > 1e-6, X_prev, 1.0))
         in_prev = np.flatnonzero((X_prev[:, 2] > 1e-6) & (uv_prev[:, 0] >= 0) & (uv_prev[:, 0] < w)
                                  & (uv_prev[:, 1] >= 0) & (uv_prev[:, 1] < h))
@@ -274,13 +274,13 @@ class MonoSLAM:
         X_prev = X_prev[in_prev]
         al = sparse_align(self._prev_pyr, pyr, self.K, X_prev, vel, patch_px=p.align_patch_px,
                           max_level=p.align_max_level, min_level=p.align_min_level, max_iter=p.align_iters)
-        T_est = al.T_cur_ref @ T_prev if al.ok else T_pred
+        T_est = se3_compose(al.T_cur_ref, T_prev) if al.ok else T_pred
         if not al.ok:
             self._count("align_failed")
         t1 = time.perf_counter()
         times["align"] = t1 - t0
         # 3. project the map, refine each projection by LK from its keyframe
-        Xc = self.points @ T_est[:3, :3].T + T_est[:3, 3]
+        Xc = transform_points(T_est, self.points)
         front = Xc[:, 2] > 1e-6
         uvp = project(self.K, np.where(front[:, None], Xc, 1.0))
         mrg = p.match_win_px
@@ -367,16 +367,16 @@ class MonoSLAM:
         times["detect"] = t1 - t0
         s = self.seeds
         T_cw = self._T_cw
-        c_w = -T_cw[:3, :3].T @ T_cw[:3, 3]
+        c_w = -np.einsum("ji,j->i", T_cw[:3, :3], T_cw[:3, 3])
         found_all = np.zeros(len(s), bool)
         tried = np.zeros(len(s), bool)
         for kf in self.keyframes:
             sel = np.flatnonzero(s.ref == kf.id)
             if sel.size == 0:
                 continue
-            T_cur_ref = T_cw @ se3_inverse(kf.T_cw)
+            T_cur_ref = se3_compose(T_cw, se3_inverse(kf.T_cw))
             # visible: the mean-depth point projects into the image
-            Xm = s.f[sel] / np.maximum(s.mu[sel], 1e-6)[:, None] @ T_cur_ref[:3, :3].T + T_cur_ref[:3, 3]
+            Xm = transform_points(T_cur_ref, s.f[sel] / np.maximum(s.mu[sel], 1e-6)[:, None])
             uvm = project(self.K, np.where(Xm[:, 2:3] > 1e-6, Xm, 1.0))
             h, w = image.shape
             visible = (Xm[:, 2] > 1e-6) & (uvm[:, 0] >= 0) & (uvm[:, 0] < w) & (uvm[:, 1] >= 0) & (uvm[:, 1] < h)

@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import _validate as v
 from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
-from ..geometry.se3 import se3, se3_from_planar
+from ..geometry.se3 import rotate_points, se3, se3_from_planar
 from .textures import lunar_texture
 
 __all__ = ["R_BODY_CAM", "StereoArena", "StereoSim"]
@@ -47,7 +47,9 @@ def _mip_levels(tex, n):
 
 def _sample_mip(levels, r, c, footprint_texels, wrap_cols):
     """Bilinear sample of the pyramid level whose texel matches the pixel footprint (anti-aliasing)."""
-    lvl = np.clip(np.floor(np.log2(np.maximum(footprint_texels, 1.0))), 0, len(levels) - 1).astype(np.intp)
+    # floor(log2(x)) from the binary exponent: exact on every machine (np.log2's last bit is not)
+    _, exponent = np.frexp(np.maximum(footprint_texels, 1.0))
+    lvl = np.clip(exponent - 1, 0, len(levels) - 1).astype(np.intp)
     out = np.empty(r.shape, dtype=np.float32)
     for k, tex in enumerate(levels):
         m = lvl == k
@@ -176,7 +178,8 @@ class StereoArena:
         o = T[:3, 3]
         if not (0 < o[0] < self.width_m and 0 < o[1] < self.length_m and o[2] > 0):
             raise ValueError(f"the camera must be inside the arena above the floor; got position {np.round(o, 3).tolist()}")
-        d = self._rays(camera) @ T[:3, :3].T.astype(np.float32)
+        # not `rays @ R.T`: BLAS rounds by kernel and machine, and a last-bit change moves a grey level
+        d = rotate_points(T[:3, :3], self._rays(camera))
         dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
         W, L, H = self.width_m, self.length_m, self.fence_height_m
         # ray parameters of the exits through the x-walls, the y-walls and the floor (camera inside
@@ -216,7 +219,7 @@ class StereoArena:
         img = np.full(surface.shape, self.sky, dtype=np.float32)
         f = surface == FLOOR
         # pixel footprint on the surface (m): t |d|^2 / (f |d . n|) along the steepest direction
-        dn2 = np.einsum("ij,ij->i", d, d)
+        dn2 = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]
         pix = 1.0 / min(camera.fx, camera.fy)
         if f.any():
             df = d[f]
