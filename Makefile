@@ -9,7 +9,7 @@ PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
 	-p no:cacheprovider
 
-.PHONY: venv lab test notebooks report student autograde lint bench lock clean distclean
+.PHONY: venv lab test reproducible notebooks report student autograde lint bench lock clean distclean
 
 ## venv: create .venv if missing and install slamlab[test] from constraints.txt (again only when those change)
 venv: $(STAMP)
@@ -29,6 +29,12 @@ lab: venv
 ## test: the whole suite in one pytest run: unit tests, doctests, every notebook under nbval
 test: venv
 	MPLBACKEND=Agg $(BIN)/python -m pytest $(PYTEST_ARGS)
+
+## reproducible: re-run every notebook and lab under another BLAS kernel, 1 thread, OpenCV 1 thread, no AVX-512,
+## with OpenCV's and numpy's global RNGs moved first; compare every output with the stored one (VARIANT=alt|nosimd)
+VARIANT ?= alt
+reproducible: venv
+	MPLBACKEND=Agg $(BIN)/python tools/check_reproducible.py --variant $(VARIANT)
 
 ## notebooks: re-execute every notebook in place (refreshes nbval's stored reference outputs)
 notebooks: venv
