@@ -15,6 +15,7 @@ check only prints and returns its :class:`CheckResult`.
 
 from __future__ import annotations
 
+import math
 import os
 import traceback
 from collections.abc import Callable, Iterable
@@ -243,9 +244,19 @@ def answer(task_id: str, value, *, quiet: bool = False) -> CheckResult:
     except (TypeError, ValueError):
         return _finish(CheckResult(task_id, "failed", f"{t.question} — expected a number; got {value!r}"), quiet)
     exp = float(t.expected())
-    if abs(x - exp) <= t.atol + t.rtol * abs(exp):
-        return _finish(CheckResult(task_id, "passed", f"{t.question} — {x:g}: passed."), quiet)
-    return _finish(CheckResult(task_id, "failed", f"{t.question} — {x:g} is not it. Hint: {t.hint}"), quiet)
+    tol = t.atol + t.rtol * abs(exp)
+    shown = _shown(x, tol)
+    if abs(x - exp) <= tol:
+        return _finish(CheckResult(task_id, "passed", f"{t.question} — {shown}: passed."), quiet)
+    return _finish(CheckResult(task_id, "failed", f"{t.question} — {shown} is not it. Hint: {t.hint}"), quiet)
+
+
+def _shown(x: float, tol: float) -> str:
+    """``x`` to the decimals that the tolerance resolves (a number found by experiment on another machine
+    can differ in its last digits; what the check can tell apart is what is printed)."""
+    if not tol > 0 or not math.isfinite(x):
+        return f"{x:g}"
+    return f"{round(x, max(0, math.ceil(-math.log10(tol)))):g}"
 
 
 def tasks_of(prefix: str) -> Iterable[str]:

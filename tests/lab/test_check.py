@@ -140,3 +140,14 @@ def test_exploration_answer_given_as_a_function():
     res = lab.answer("01.explore.q_scale", broken, quiet=True)
     assert res.status == "error"
     assert "return 1 / 0" in res.message
+
+
+def test_answer_prints_the_number_to_the_decimals_its_tolerance_resolves():
+    from slamlab.lab.core import _shown
+
+    # a pipeline's 6th digit differs between machines; a check within 0.005 shows 3 decimals
+    assert _shown(0.912438, 0.005) == "0.912"
+    assert _shown(0.912439, 0.005) == "0.912"
+    assert _shown(0.3456, 0.027) == "0.35"
+    assert _shown(7.0, 0.0) == "7"  # exact answers (counts) as they are
+    assert _shown(0.35, 1e-9) == "0.35"
