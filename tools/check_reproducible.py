@@ -55,6 +55,7 @@ from run_notebooks import (
     _kernel_manager,
     default_notebooks,
     output_problems,
+    shutdown,
 )
 
 SANITIZE_CFG = NOTEBOOK_DIR / "nbval_sanitize.cfg"
@@ -151,7 +152,10 @@ def execute(path: Path, env: dict[str, str]):
     client = NotebookClient(nb, km=km, timeout=CELL_TIMEOUT_S, allow_errors=True, record_timing=False,
                             store_widget_state=True, resources={"metadata": {"path": str(NOTEBOOK_DIR)}})
     full_env = {**os.environ, "MPLBACKEND": "Agg", "SLAMLAB_PROGRESS": "0", **env}
-    client.execute(env=full_env)
+    try:
+        client.execute(env=full_env)
+    finally:
+        shutdown(km)
     nb.cells.pop(0)
     return nb
 
