@@ -14,6 +14,8 @@ folder of its own), so the notebooks on disk are never rewritten; it is stopped 
 
 from __future__ import annotations
 
+import fcntl
+import hashlib
 import json
 import os
 import re
@@ -22,6 +24,7 @@ import shutil
 import signal
 import socket
 import subprocess
+import tempfile
 import time
 import urllib.request
 from pathlib import Path
@@ -34,6 +37,7 @@ CHROMIUM_CANDIDATES = ("/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/b
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 RUN_TIMEOUT_S = 240
+SERVER_TIMEOUT_S = 90  # `make lab` until the server answers
 KERNEL_TIMEOUT_S = 120  # notebook shown and its kernel started, connected and idle
 
 pytestmark = pytest.mark.browser
@@ -59,9 +63,56 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
+def _make_venv_locked() -> None:
+    """``make venv`` while holding a lock: pytest-xdist workers never install into one ``.venv`` at once.
+
+    `make lab` depends on the venv target, which reinstalls when ``pyproject.toml`` or ``constraints.txt``
+    is newer than the stamp; done here first under a lock, the venv is up to date when `make lab` checks it.
+    """
+    digest = hashlib.sha1(str(ROOT).encode()).hexdigest()[:12]
+    lock_path = Path(tempfile.gettempdir()) / f"slamlab-make-venv-{digest}.lock"
+    with lock_path.open("w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        done = subprocess.run(["make", "-s", "venv"], check=False, cwd=ROOT, capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.fail(f"`make venv` failed:\n{done.stdout}\n{done.stderr}", pytrace=False)
+
+
+def _wait_for_server(proc, base: str, token: str, deadline: float) -> bool:
+    """Poll the server's status until it answers (True) or its process has exited (False)."""
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(f"{base}/api/status?token={token}", timeout=2) as r:
+                if r.status == 200:
+                    return True
+        except OSError:
+            pass
+        if proc.poll() is not None:
+            return False
+        time.sleep(0.5)
+    return False
+
+
+def _stop(proc) -> None:
+    """Stop `make lab` and the server and kernels under it (its own process group)."""
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGTERM)
+    try:
+        proc.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+
+
 @pytest.fixture(scope="module")
 def lab_server(tmp_path_factory):
-    """`make lab` with options for a test: no browser, free port, token, autosave off; yields the base URL."""
+    """`make lab` with options for a test: no browser, free port, token, autosave off; yields the base URL.
+
+    Safe under pytest-xdist (each worker starts its own server): the venv is brought up to date under a
+    lock, folders come from the worker's own temporary directory, and the server does not move to another
+    port when its port was taken in the meantime (``port_retries=0``) but exits, and is started again on
+    another free port.
+    """
     if shutil.which("make") is None:
         _unavailable("`make` is not installed")
     settings = tmp_path_factory.mktemp("lab-settings")
@@ -73,36 +124,35 @@ def lab_server(tmp_path_factory):
     tracker.mkdir(parents=True)
     (tracker / "tracker.jupyterlab-settings").write_text(json.dumps({"windowingMode": "none"}))
     workspaces = tmp_path_factory.mktemp("lab-workspaces")
-    port, token = _free_port(), secrets.token_hex(16)
-    args = (f"--no-browser --ip=127.0.0.1 --port={port} --ServerApp.token={token} "
-            f"--LabApp.user_settings_dir={settings} --LabApp.workspaces_dir={workspaces} "
-            "--LabApp.expose_app_in_browser=True")  # window.jupyterapp: the test reads the notebook's kernel state
+    token = secrets.token_hex(16)
     env = {**os.environ, "MPLBACKEND": "module://matplotlib_inline.backend_inline", "SLAMLAB_PROGRESS": "0"}
-    log = (tmp_path_factory.mktemp("lab-log") / "server.log").open("w")
-    proc = subprocess.Popen(["make", "-s", "lab", f"LAB_ARGS={args}"], cwd=ROOT, env=env, stdout=log,
-                            stderr=subprocess.STDOUT, start_new_session=True)
-    base = f"http://127.0.0.1:{port}"
-    try:
-        deadline = time.monotonic() + 90
-        while True:
-            try:
-                with urllib.request.urlopen(f"{base}/api/status?token={token}", timeout=2) as r:
-                    if r.status == 200:
-                        break
-            except OSError:
-                pass
-            if proc.poll() is not None or time.monotonic() > deadline:
-                log.flush()
-                pytest.fail(f"`make lab` did not start a server: see {log.name}", pytrace=False)
-            time.sleep(0.5)
-        yield base, token
-    finally:
-        os.killpg(proc.pid, signal.SIGTERM)
+    log_path = tmp_path_factory.mktemp("lab-log") / "server.log"
+    _make_venv_locked()
+    deadline = time.monotonic() + SERVER_TIMEOUT_S
+    proc = None
+    with log_path.open("w") as log:
         try:
-            proc.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-        log.close()
+            for _attempt in range(3):
+                port = _free_port()
+                args = (f"--no-browser --ip=127.0.0.1 --port={port} --ServerApp.port_retries=0 "
+                        f"--ServerApp.token={token} --LabApp.user_settings_dir={settings} "
+                        f"--LabApp.workspaces_dir={workspaces} "
+                        "--LabApp.expose_app_in_browser=True")  # window.jupyterapp: the tests read the kernel state
+                proc = subprocess.Popen(["make", "-s", "lab", f"LAB_ARGS={args}"], cwd=ROOT, env=env, stdout=log,
+                                        stderr=subprocess.STDOUT, start_new_session=True)
+                base = f"http://127.0.0.1:{port}"
+                if _wait_for_server(proc, base, token, deadline):
+                    break
+                _stop(proc)
+                log.flush()
+                if f"port {port} is already in use" not in log_path.read_text():
+                    pytest.fail(f"`make lab` did not start a server: see {log_path}", pytrace=False)
+            else:
+                pytest.fail(f"`make lab` found its port taken three times: see {log_path}", pytrace=False)
+            yield base, token
+        finally:
+            if proc is not None:
+                _stop(proc)
 
 
 @pytest.fixture(scope="module")
