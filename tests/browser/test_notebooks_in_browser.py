@@ -197,9 +197,17 @@ def _wait_for_kernel(page, path: str) -> None:
     page.wait_for_function(_KERNEL_READY, arg=path, timeout=KERNEL_TIMEOUT_S * 1000)
 
 
+_CLEARED = """() => !document.querySelector('.jp-CodeCell .jp-OutputArea-output')
+    && ![...document.querySelectorAll('.jp-CodeCell .jp-InputPrompt')].some(e => /\\d/.test(e.textContent))"""
+
+
 def _run_all(page, path: str) -> None:
-    """Run every cell through the Run menu; wait until the kernel has been busy and no cell is queued or running."""
+    """Clear the stored outputs, run every cell through the Run menu; wait until the kernel has been busy and no
+    cell is queued or running. Cleared first, so that every output and execution count checked comes from this run."""
     _wait_for_kernel(page, path)
+    page.get_by_role("menuitem", name="Edit", exact=True).click()
+    page.get_by_role("menuitem", name="Clear Outputs of All Cells", exact=True).click()
+    page.wait_for_function(_CLEARED, timeout=30_000)
     page.evaluate(_WATCH_BUSY)
     page.get_by_role("menuitem", name="Run", exact=True).click()
     page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
@@ -287,7 +295,7 @@ def _check_notebook(page, base, token, notebook) -> None:
 
 
 def _assert_every_cell_ran(page, notebook: Path, rel: str) -> None:
-    """Every code cell of the notebook shows an execution count: Run All ran all of them, in this kernel."""
+    """Every code cell of the notebook shows an execution count: Run All ran all of them (the counts were cleared)."""
     expected = sum(bool(source.strip()) for source in _code_sources(notebook))  # JupyterLab skips empty cells
     counts = page.evaluate("() => [...document.querySelectorAll('.jp-CodeCell .jp-InputPrompt')]"
                            ".map(e => e.textContent.trim())")
