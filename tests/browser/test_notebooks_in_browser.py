@@ -184,7 +184,9 @@ _DONE = """() => window.__slamlabBusySeen
 # server has started a kernel; JupyterLab runs a cell only if the session has a kernel, and clears it
 # otherwise, so a Run All in that window ran nothing (issue 22: under load the kernel came 2-3 s later).
 _KERNEL_READY = """(path) => {
-    const panel = [...window.jupyterapp.shell.widgets('main')].find(w => w.context && w.context.path === path);
+    const app = window.jupyterapp;  // set once JupyterLab has started (the page may still be loading)
+    if (!app || !app.shell) return false;
+    const panel = [...app.shell.widgets('main')].find(w => w.context && w.context.path === path);
     const session = panel && panel.sessionContext;
     const kernel = session && session.isReady && session.session && session.session.kernel;
     return !!kernel && kernel.connectionStatus === 'connected' && kernel.status === 'idle'
