@@ -56,6 +56,10 @@ def test_lab_has_implementation_exploration_and_prose_tasks(lab):
 def course(tmp_path_factory):
     pytest.importorskip("nbgrader")
     root = tmp_path_factory.mktemp("course")
+    # nbgrader stops a cell after 30 s by default (a CellTimeoutError, and a lost point): on a loaded machine,
+    # and with make test's two workers sharing the cores, a lab's exploration cell can take longer than that
+    # (03's did, under load 7). Same limit as _run's below; nbgrader reads this file from the course folder.
+    (root / "nbgrader_config.py").write_text("c = get_config()  # noqa: F821\nc.Execute.timeout = 600\n")
     students = labs_tool.make_student(root / "student", root)
     return root, students
 
