@@ -22,7 +22,7 @@ from pathlib import Path
 import nbformat
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from run_notebooks import NOTEBOOK_DIR, _kernel_manager
+from run_notebooks import NOTEBOOK_DIR, _kernel_manager, shutdown
 
 PROBE = ("import resource as _r\n"
          "print('PEAK_RSS_KIB', _r.getrusage(_r.RUSAGE_SELF).ru_maxrss, _r.getrusage(_r.RUSAGE_CHILDREN).ru_maxrss)")
@@ -34,10 +34,14 @@ def peak_rss_mib(path: Path) -> tuple[float, float, float]:
 
     nb = nbformat.read(path, as_version=4)
     nb.cells.append(nbformat.v4.new_code_cell(PROBE))
-    client = NotebookClient(nb, km=_kernel_manager(), timeout=600, allow_errors=False, record_timing=False,
+    km = _kernel_manager()
+    client = NotebookClient(nb, km=km, timeout=600, allow_errors=False, record_timing=False,
                             resources={"metadata": {"path": str(NOTEBOOK_DIR)}})
     t0 = time.perf_counter()
-    client.execute()
+    try:
+        client.execute()
+    finally:
+        shutdown(km)
     wall = time.perf_counter() - t0
     text = "".join(o.get("text", "") for o in nb.cells[-1].outputs)
     _, own, children = text.split()

@@ -130,15 +130,24 @@ def _kernel_manager():
     return AsyncKernelManager(kernel_name="python3", kernel_spec_manager=CurrentEnvKernelSpecManager())
 
 
+def shutdown(km) -> None:
+    """Stop a kernel that nbclient was handed (it only shuts down kernels it started itself)."""
+    from jupyter_core.utils import run_sync
+
+    if run_sync(km.is_alive)():
+        run_sync(km.shutdown_kernel)(now=True)
+
+
 def execute_notebook(path: Path) -> list[str]:
     """Run ``path`` in place; return problems (the file is only written when there are none)."""
     from nbclient import NotebookClient
     from nbclient.exceptions import CellExecutionError
 
     nb = nbformat.read(path, as_version=4)
+    km = _kernel_manager()
     client = NotebookClient(
         nb,
-        km=_kernel_manager(),
+        km=km,
         timeout=CELL_TIMEOUT_S,
         allow_errors=True,  # collect every error, report them all with cell numbers below
         record_timing=False,
@@ -149,6 +158,8 @@ def execute_notebook(path: Path) -> list[str]:
         client.execute()
     except CellExecutionError as err:  # pragma: no cover - allow_errors=True reports in outputs
         return [f"{path.name}: {err}"]
+    finally:
+        shutdown(km)
     problems = output_problems(nb, path.name)
     if problems:
         return problems

@@ -559,7 +559,7 @@ def ours_vs_source(sim: SimSlamResult, *, example: ExampleLineResult | None = No
                   f"({example.polar_line[0]:.1f}, {example.polar_line[1]:.1f})"]]
     if two_lines_error is not None:
         rows.append(["pose from two lines, exact synthetic cases: largest error", "formula (lost, reconstructed)",
-                     f"{two_lines_error:.1e}"])
+                     "< 1e-12 (rounding)" if two_lines_error < 1e-12 else f"{two_lines_error:.1e}"])
     if exact is not None:
         rows.append([f"max |Ex| / |Ey|, |Ea|, range σ = {exact.range_std_cells:g} (Fig. 10)",
                      "orders of magnitude below 1 cell, 1°", maxima(exact)])

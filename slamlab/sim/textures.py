@@ -5,6 +5,11 @@ cannot ship those photographs, so we synthesise look-alikes: a height field of
 fractal (1/f^beta) noise plus bowl-shaped craters with raised rims, lit from a
 low sun (Lambert shading) and multiplied by a slowly varying albedo. Every
 texture is periodic along both axes and deterministic from the seed.
+
+Memory: the element-wise steps run on blocks of about :data:`BLOCK_ELEMENTS` texels, so that a
+long fence (the 60×60 m arena's 240 m at 4 mm: 125 × 60 000 texels, 57 MiB per float64 array)
+needs about three full-size arrays at a time instead of eight (our change; the values are the
+same bit for bit as those of the whole-array expressions, see ``tests/sim/test_arena.py``).
 """
 
 from __future__ import annotations
@@ -15,6 +20,9 @@ from .. import _validate as v
 
 __all__ = ["crater_heightfield", "fractal_noise", "lunar_texture"]
 
+#: texels per block of the element-wise and 1-D FFT passes (2 MiB of float64; our choice)
+BLOCK_ELEMENTS = 1 << 18
+
 
 def _shape(shape, name="shape"):
     if not isinstance(shape, tuple | list) or len(shape) != 2:
@@ -22,8 +30,17 @@ def _shape(shape, name="shape"):
     return tuple(v.check_int(s, name, minimum=2) for s in shape)
 
 
+def _blocks(n: int, other: int) -> list[slice]:
+    """Slices of ``range(n)`` whose blocks of ``other`` elements each hold about BLOCK_ELEMENTS."""
+    step = max(1, BLOCK_ELEMENTS // max(other, 1))
+    return [slice(i, min(i + step, n)) for i in range(0, n, step)]
+
+
 def fractal_noise(shape, beta: float = 2.0, rng=None) -> np.ndarray:
     """Periodic fractal noise with power spectrum ``1 / f^beta``, zero mean, unit std (our texture).
+
+    Peak memory: about twice the float64 result (the half spectrum and the result; the 2-D inverse
+    FFT runs as its two 1-D passes on blocks).
 
     >>> z = fractal_noise((32, 64), rng=0)
     >>> z.shape, round(float(z.mean()), 12), round(float(z.std()), 12)
@@ -34,14 +51,33 @@ def fractal_noise(shape, beta: float = 2.0, rng=None) -> np.ndarray:
     rng = v.as_rng(rng)
     fy = np.fft.fftfreq(rows)[:, None]
     fx = np.fft.rfftfreq(cols)[None, :]
-    f = np.hypot(fx, fy)
-    f[0, 0] = 1.0
-    amp = f ** (-beta / 2.0)
-    amp[0, 0] = 0.0
-    spec = amp * (rng.standard_normal(amp.shape) + 1j * rng.standard_normal(amp.shape))
-    z = np.fft.irfft2(spec, s=(rows, cols))
+    n_freq = fx.shape[1]
+    # spectrum = amplitude × (N(0,1) + i N(0,1)): all real parts are drawn first, then all
+    # imaginary parts, in row-major order -- the stream of one draw of the whole array each
+    spec = np.empty((rows, n_freq), dtype=np.complex128)
+    row_blocks = _blocks(rows, n_freq)
+    for part in ("real", "imag"):
+        for b in row_blocks:
+            getattr(spec, part)[b] = rng.standard_normal((b.stop - b.start, n_freq))
+    for b in row_blocks:
+        f = np.hypot(fx, fy[b])
+        if b.start == 0:
+            f[0, 0] = 1.0
+        amp = f ** (-beta / 2.0)
+        if b.start == 0:
+            amp[0, 0] = 0.0  # zero mean
+        spec[b] = amp * spec[b]
+    # irfft2 = ifft along the columns, then irfft along the rows: each pass is 1-D, so it runs
+    # on blocks (in place for the first, into the output for the second)
+    for b in _blocks(n_freq, rows):
+        spec[:, b] = np.fft.ifft(spec[:, b], axis=0)
+    z = np.empty((rows, cols))
+    for b in row_blocks:
+        np.fft.irfft(spec[b], n=cols, axis=1, out=z[b])
+    del spec
     z -= z.mean()
-    return z / z.std()
+    z /= z.std()
+    return z
 
 
 def crater_heightfield(shape, n_craters: int = 300, radius_px=(3.0, 40.0), slope: float = 2.2, rng=None) -> np.ndarray:
@@ -110,17 +146,32 @@ def lunar_texture(
     contrast = v.check_positive(contrast, "contrast")
     rng = v.as_rng(rng)
     r_noise, r_crater, r_albedo = rng.spawn(3)
-    h = noise_amp_px * fractal_noise((rows, cols), noise_beta, r_noise)
+    h = fractal_noise((rows, cols), noise_beta, r_noise)
+    h *= noise_amp_px
     h += crater_heightfield((rows, cols), n_craters, radius_px, rng=r_crater)
-    # periodic central differences -> surface normal (-hx, -hy, 1)
-    hx = 0.5 * (np.roll(h, -1, axis=1) - np.roll(h, 1, axis=1))
-    hy = 0.5 * (np.roll(h, -1, axis=0) - np.roll(h, 1, axis=0))
     sun = np.array(
         [np.cos(sun_elevation_rad) * np.cos(sun_azimuth_rad), np.cos(sun_elevation_rad) * np.sin(sun_azimuth_rad), np.sin(sun_elevation_rad)]
     )
-    shade = (-hx * sun[0] - hy * sun[1] + sun[2]) / np.sqrt(hx**2 + hy**2 + 1.0)
-    shade = np.clip(shade, 0.0, None)
-    albedo = 0.75 + 0.2 * np.tanh(fractal_noise((rows, cols), 3.0, r_albedo))
-    img = albedo * shade
-    img = 0.5 + contrast * (img - img.mean()) / (4.0 * img.std() + 1e-12)
-    return np.clip(img, 0.0, 1.0)
+    # Lambert shading from periodic central differences, surface normal (-hx, -hy, 1), on blocks
+    # of columns with one wrapped neighbour column on either side
+    img = np.empty((rows, cols))
+    for b in _blocks(cols, rows):
+        hb = h[:, np.arange(b.start - 1, b.stop + 1) % cols]
+        hx = 0.5 * (hb[:, 2:] - hb[:, :-2])
+        hc = hb[:, 1:-1]
+        hy = 0.5 * (np.roll(hc, -1, axis=0) - np.roll(hc, 1, axis=0))
+        shade = (-hx * sun[0] - hy * sun[1] + sun[2]) / np.sqrt(hx**2 + hy**2 + 1.0)
+        img[:, b] = np.clip(shade, 0.0, None)
+    del h
+    albedo = fractal_noise((rows, cols), 3.0, r_albedo)
+    np.tanh(albedo, out=albedo)
+    albedo *= 0.2
+    albedo += 0.75
+    img *= albedo  # brightness = albedo × shading
+    del albedo
+    mean, std = img.mean(), img.std()
+    img -= mean
+    img *= contrast
+    img /= 4.0 * std + 1e-12
+    img += 0.5
+    return np.clip(img, 0.0, 1.0, out=img)
