@@ -5,9 +5,10 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
+# -n 2 --dist loadfile: two pytest-xdist workers (both cores); each file, so each notebook's cells, stays in one
 PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
-	-p no:cacheprovider
+	-p no:cacheprovider -n 2 --dist loadfile
 
 .PHONY: venv lab test reproducible notebooks report student autograde lint bench lock clean distclean
 

@@ -32,9 +32,15 @@ def _load_runner():
 runner = _load_runner()
 
 
+#: The browser suite's scratch notebook (tests/browser), which lives in notebooks/ for a few seconds while
+#: that suite runs; under ``make test`` (pytest-xdist) it may run at the same time as this file.
+BROWSER_SCRATCH = "zz_progress_check_"
+
+
 def test_there_are_notebooks():
     assert NOTEBOOKS, "no notebooks/*.ipynb"
-    assert runner.default_notebooks() == NOTEBOOKS + LABS
+    found = [p for p in runner.default_notebooks() if not p.name.startswith(BROWSER_SCRATCH)]
+    assert found == NOTEBOOKS + LABS
 
 
 def test_filenames_numbered_uniquely():
