@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _validate as v
+from .._threads import run_tasks
 from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
 from ..geometry.se3 import rotate_points, se3, se3_from_planar
 from .textures import lunar_texture
@@ -301,9 +302,12 @@ class StereoSim:
         T_wb = se3_from_planar(*pose)
         if self.drift_std_rad > 0:
             self.drift_rad = self.drift_rad + self.rng.normal(0.0, self.drift_std_rad, 3)
+        views = ((self.rig.left, T_wb @ self.T_body_left), (self.rig.right, T_wb @ self.T_body_right(self.drift_rad)))
+        # the two renders in two threads (numpy releases the GIL); the noise is drawn in order afterwards
+        images = run_tasks([lambda cam=cam, T=T: self.arena.render(cam, T) for cam, T in views], 2)
         out = []
-        for cam, T_bc in ((self.rig.left, self.T_body_left), (self.rig.right, self.T_body_right(self.drift_rad))):
-            img = self.arena.render(cam, T_wb @ T_bc) * 255.0
+        for img in images:
+            img *= 255.0
             if self.noise_std > 0:
                 img += self.rng.normal(0.0, self.noise_std, img.shape).astype(np.float32)
             out.append(np.clip(np.rint(img), 0, 255).astype(np.uint8))
