@@ -22,7 +22,7 @@ import numpy as np
 from .. import _validate as v
 from .._threads import run_tasks
 from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
-from ..geometry.se3 import rotate_points, se3, se3_from_planar
+from ..geometry.se3 import rotate_components, se3, se3_from_planar
 from .textures import lunar_texture
 
 __all__ = ["R_BODY_CAM", "StereoArena", "StereoSim"]
@@ -76,8 +76,12 @@ def _bilinear(tex, r, c, wrap_cols: bool):
         c0 = c.astype(np.intp)
         c1 = c0 + 1
     fc = c - c0
-    top = tex[r0, c0] * (1 - fc) + tex[r0, c1] * fc
-    bot = tex[r0 + 1, c0] * (1 - fc) + tex[r0 + 1, c1] * fc
+    # flat indices into the texture: the same texels as tex[r0, c0] etc., gathered faster
+    flat = tex.ravel()
+    i00 = r0 * cols
+    i10 = i00 + cols
+    top = flat.take(i00 + c0) * (1 - fc) + flat.take(i00 + c1) * fc
+    bot = flat.take(i10 + c0) * (1 - fc) + flat.take(i10 + c1) * fc
     return top * (1 - fr) + bot * fr
 
 
@@ -153,10 +157,12 @@ class StereoArena:
         xy = v.as_finite_array(xy_m, "xy_m", ndim=2)
         return (xy[:, 0] > 0) & (xy[:, 0] < self.width_m) & (xy[:, 1] > 0) & (xy[:, 1] < self.length_m)
 
-    def _rays(self, camera: PinholeCamera) -> np.ndarray:
+    def _rays(self, camera: PinholeCamera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The camera's pixel rays (z = 1) as three contiguous float32 coordinate arrays (cached)."""
         rays = self._ray_cache.get(camera)
         if rays is None:
-            rays = camera.pixel_rays().reshape(-1, 3).astype(np.float32)
+            r = camera.pixel_rays().reshape(-1, 3).astype(np.float32)
+            rays = tuple(np.ascontiguousarray(r[:, k]) for k in range(3))
             self._ray_cache = {camera: rays}
         return rays
 
@@ -167,12 +173,13 @@ class StereoArena:
         (depth ``z`` in the camera frame, rays have ``z = 1``); ``points`` world hits (NaN on the background).
         """
         surface, t, d, o = self._cast(camera, T_world_cam)
-        pts = o + t[:, None].astype(np.float64) * d
+        pts = o + t[:, None].astype(np.float64) * np.stack(d, axis=1)
         pts[surface == SKY] = np.nan
         shape = (camera.height_px, camera.width_px)
         return surface.reshape(shape), t.reshape(shape), pts.reshape((*shape, 3))
 
     def _cast(self, camera, T_world_cam):
+        """``surface``, ``t``, the world ray directions ``(dx, dy, dz)`` (float32) and the camera centre ``o``."""
         if not isinstance(camera, PinholeCamera):
             raise TypeError(f"`camera` must be a PinholeCamera; got {type(camera).__name__}")
         T = v.as_matrix(T_world_cam, "T_world_cam", (4, 4))
@@ -180,8 +187,7 @@ class StereoArena:
         if not (0 < o[0] < self.width_m and 0 < o[1] < self.length_m and o[2] > 0):
             raise ValueError(f"the camera must be inside the arena above the floor; got position {np.round(o, 3).tolist()}")
         # not `rays @ R.T`: BLAS rounds by kernel and machine, and a last-bit change moves a grey level
-        d = rotate_points(T[:3, :3], self._rays(camera))
-        dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
+        dx, dy, dz = rotate_components(T[:3, :3], *self._rays(camera))
         W, L, H = self.width_m, self.length_m, self.fence_height_m
         # ray parameters of the exits through the x-walls, the y-walls and the floor (camera inside
         # the box, so every distance is positive; a zero direction component gives +inf)
@@ -195,17 +201,27 @@ class StereoArena:
         surface = floor.view(np.uint8) + 2 * wall.view(np.uint8)
         t = np.where(floor, tf, tw)
         t[surface == SKY] = np.inf
-        return surface, t, d, o
+        return surface, t, (dx, dy, dz), o
 
     def wall_coordinate(self, points_m) -> np.ndarray:
         """Arc length ``s`` along the fence (y=0 wall, then x=W, y=L, x=0) of points on it."""
         P = v.as_finite_array(points_m, "points_m", ndim=2)
-        x, y = P[:, 0], P[:, 1]
+        return self._wall_coordinate(P[:, 0], P[:, 1])[0]
+
+    def _wall_coordinate(self, x, y):
+        """:meth:`wall_coordinate` of the points ``(x, y)``, and whether each lies on an x = const wall."""
         W, L = self.width_m, self.length_m
-        dist = np.column_stack([np.abs(y), np.abs(x - W), np.abs(y - L), np.abs(x)])
-        side = np.argmin(dist, axis=1)
+        dist = (np.abs(y), np.abs(x - W), np.abs(y - L), np.abs(x))
+        # argmin over the four distances: the first smallest (a later side wins only when strictly nearer)
+        side = np.zeros(x.shape, dtype=np.intp)
+        best = dist[0]
+        for k in (1, 2, 3):
+            nearer = dist[k] < best
+            side[nearer] = k
+            best = np.where(nearer, dist[k], best)
         s = np.choose(side, [x, W + y, W + L + (W - x), 2 * W + L + (L - y)])
-        return s
+        on_x_wall = np.minimum(dist[3], dist[1]) < np.minimum(dist[0], dist[2])
+        return s, on_x_wall
 
     def render(self, camera: PinholeCamera, T_world_cam) -> np.ndarray:
         """Noise-free float32 image ``(H, W)`` in ``[0, 1]`` seen by ``camera`` at pose ``T_world_cam``.
@@ -216,26 +232,25 @@ class StereoArena:
         >>> img = arena.render(cam, T); img.shape, img.dtype
         ((48, 64), dtype('float32'))
         """
-        surface, t, d, o = self._cast(camera, T_world_cam)
+        surface, t, (dx, dy, dz), o = self._cast(camera, T_world_cam)
         img = np.full(surface.shape, self.sky, dtype=np.float32)
         f = surface == FLOOR
         # pixel footprint on the surface (m): t |d|^2 / (f |d . n|) along the steepest direction
-        dn2 = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]
+        dn2 = dx * dx + dy * dy + dz * dz
         pix = 1.0 / min(camera.fx, camera.fy)
         if f.any():
-            df = d[f]
-            p = o + t[f, None] * df
-            fp = t[f] * dn2[f] * pix / (np.abs(df[:, 2]) * self.floor_texel_m)
-            img[f] = _sample_mip(self._floor_mips, p[:, 1] / self.floor_texel_m, p[:, 0] / self.floor_texel_m, fp, False)
+            tf = t[f]
+            px, py = o[0] + tf * dx[f], o[1] + tf * dy[f]
+            fp = tf * dn2[f] * pix / (np.abs(dz[f]) * self.floor_texel_m)
+            img[f] = _sample_mip(self._floor_mips, py / self.floor_texel_m, px / self.floor_texel_m, fp, False)
         w = surface == WALL
         if w.any():
-            dw = d[w]
-            p = o + t[w, None] * dw
-            s = self.wall_coordinate(p)
-            hit_x = np.minimum(np.abs(p[:, 0]), np.abs(p[:, 0] - self.width_m)) < np.minimum(np.abs(p[:, 1]), np.abs(p[:, 1] - self.length_m))
-            dnorm = np.where(hit_x, np.abs(dw[:, 0]), np.abs(dw[:, 1]))
-            fp = t[w] * dn2[w] * pix / (np.maximum(dnorm, 1e-6) * self.texel_m)
-            img[w] = _sample_mip(self._wall_mips, (self.fence_height_m - p[:, 2]) / self.texel_m, s / self.texel_m, fp, True)
+            tw, dwx, dwy = t[w], dx[w], dy[w]
+            px, py, pz = o[0] + tw * dwx, o[1] + tw * dwy, o[2] + tw * dz[w]
+            s, hit_x = self._wall_coordinate(px, py)
+            dnorm = np.where(hit_x, np.abs(dwx), np.abs(dwy))
+            fp = tw * dn2[w] * pix / (np.maximum(dnorm, 1e-6) * self.texel_m)
+            img[w] = _sample_mip(self._wall_mips, (self.fence_height_m - pz) / self.texel_m, s / self.texel_m, fp, True)
         return img.reshape(camera.height_px, camera.width_px)
 
 
