@@ -5,6 +5,14 @@ that no cell wrote an error or to stderr, that every widget view rendered (no "E
 that every image loaded; then move one slider or dropdown of the notebook's first widget and check that
 its output area changes and shows no error. The notebook's kernel is shut down after its test.
 
+The same run is also the reproducibility check (issue 22): the server, and so every kernel, runs under
+``tools/check_reproducible.py``'s variant ``alt`` (another OpenBLAS kernel than the machine's, one BLAS,
+OpenMP and OpenCV thread, no AVX-512), and every kernel starts with that tool's prelude (OpenCV's, numpy's
+and Python's global random states moved: an IPython startup file). After Run All, the notebook's outputs
+are read from JupyterLab's model and compared with the stored ones exactly as that tool and nbval compare
+them (the same sanitiser; images and widget views skipped): a number that moves with the machine fails here,
+while nbval checks the machine as it is. ``make reproducible`` runs the same check outside the browser.
+
 Marker ``browser``. Needs Playwright (PyPI) and a Chromium (Debian's ``chromium`` package;
 ``playwright install`` cannot download browsers here): the suite skips, naming what is missing,
 unless ``SLAMLAB_REQUIRE_BROWSER=1`` (CI sets it), which turns the skip into a failure.
@@ -16,6 +24,7 @@ from __future__ import annotations
 
 import fcntl
 import hashlib
+import importlib.util
 import json
 import os
 import re
@@ -32,6 +41,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent.parent
+_spec = importlib.util.spec_from_file_location("_check_reproducible", ROOT / "tools" / "check_reproducible.py")
+reproducible = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(reproducible)
+#: the machine set-up the browser's kernels run under (the main nbval run uses the machine as it is)
+VARIANT = "alt"
 #: The chapters here; the labs in test_labs_in_browser.py, so that `pytest -n 2 --dist loadfile` runs the two
 #: halves on two workers at once (a file stays on one worker), each with a server of its own.
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
@@ -128,7 +142,14 @@ def lab_server(tmp_path_factory):
     (tracker / "tracker.jupyterlab-settings").write_text(json.dumps({"windowingMode": "none"}))
     workspaces = tmp_path_factory.mktemp("lab-workspaces")
     token = secrets.token_hex(16)
-    env = {**os.environ, "MPLBACKEND": "module://matplotlib_inline.backend_inline", "SLAMLAB_PROGRESS": "0"}
+    # the kernels' IPython profile: a startup file runs the reproducibility prelude before the first cell
+    ipython_dir = tmp_path_factory.mktemp("ipython")
+    startup = ipython_dir / "profile_default" / "startup"
+    startup.mkdir(parents=True)
+    (startup / "00-slamlab-prelude.py").write_text(
+        reproducible.PRELUDE + "\nimport os as _os; _os.environ['SLAMLAB_PRELUDE_RAN'] = '1'; del _os\n")
+    env = {**os.environ, "MPLBACKEND": "module://matplotlib_inline.backend_inline", "SLAMLAB_PROGRESS": "0",
+           "IPYTHONDIR": str(ipython_dir), **reproducible.variant_env(VARIANT)}
     log_path = tmp_path_factory.mktemp("lab-log") / "server.log"
     _make_venv_locked()
     deadline = time.monotonic() + SERVER_TIMEOUT_S
@@ -223,7 +244,8 @@ def _problems(page) -> list[str]:
     return page.evaluate("""() => {
         const out = [];
         document.querySelectorAll('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]')
-            .forEach(e => out.push('stderr/error output: ' + e.textContent.slice(0, 300)));
+            .forEach(e => out.push('stderr/error output: ' + (e.textContent.length <= 1500 ? e.textContent
+                : e.textContent.slice(0, 300) + ' [...] ' + e.textContent.slice(-1200))));  // the end names the error
         document.querySelectorAll('.jp-OutputArea-output').forEach(e => {
             if (e.textContent.includes('Error displaying widget')) out.push('a widget view did not render');
         });
@@ -282,6 +304,7 @@ def _check_notebook(page, base, token, notebook) -> None:
     page.goto(f"{base}/lab/workspaces/{notebook.stem}/tree/{rel}?reset&token={token}", timeout=60_000)
     _run_all(page, rel)
     _assert_every_cell_ran(page, notebook, rel)
+    _assert_outputs_reproduce(page, notebook, rel)
     n_widgets = sum("explore_" in c for c in _code_sources(notebook))
     if n_widgets:  # a widget view renders after its cell has run: wait for all of them
         try:
@@ -309,6 +332,23 @@ def _assert_every_cell_ran(page, notebook: Path, rel: str) -> None:
         problems = _problems(page)
         raise AssertionError(f"{rel}: {ran} of {expected} code cells ran (prompts: {' '.join(counts)})"
                              + (f"; {'; '.join(problems)}" if problems else ""))
+
+
+_NOTEBOOK_JSON = """(path) => {
+    const panel = [...window.jupyterapp.shell.widgets('main')].find(w => w.context && w.context.path === path);
+    return panel.context.model.toJSON();
+}"""
+
+
+def _assert_outputs_reproduce(page, notebook: Path, rel: str) -> None:
+    """The outputs of this run (variant ``VARIANT``, prelude first) are the stored ones, as nbval compares them."""
+    import nbformat
+
+    fresh = nbformat.from_dict(page.evaluate(_NOTEBOOK_JSON, rel))
+    stored = nbformat.read(notebook, as_version=4)
+    diffs = reproducible.compare(stored, fresh, reproducible.sanitize_patterns())
+    assert not diffs, (f"{rel}: outputs differ from the stored ones under variant {VARIANT!r} "
+                       f"({reproducible.variant_env(VARIANT)}):\n" + "\n".join(diffs))
 
 
 def _shut_down_sessions(base: str, token: str, path: str) -> None:
@@ -342,12 +382,13 @@ _PROGRESS_CELL = """import os
 os.environ.pop("SLAMLAB_PROGRESS", None)   # a student's kernel: no setting, bars on
 import slamlab as sl
 noise = sl.hough.run_noise_study((0.0, 0.1), 3, n_poses=20)
-print("rows", len(noise.runs))"""
+print("rows", len(noise.runs), "coretype", os.environ.get("OPENBLAS_CORETYPE"), "prelude", os.environ.get("SLAMLAB_PRELUDE_RAN"))"""
 
 
 def test_progress_bar_is_a_widget_in_jupyterlab(lab_server, browser):
     """A library loop shows its tqdm.auto bar as a widget in JupyterLab (not as stderr text), and the
-    bar goes away when the loop ends (``leave=False``); the notebook is a scratch file, removed after."""
+    bar goes away when the loop ends (``leave=False``); the notebook is a scratch file, removed after.
+    The same kernel shows that the server's kernels run under the variant and started with the prelude."""
     base, token = lab_server
     scratch = ROOT / "notebooks" / f"zz_progress_check_{secrets.token_hex(4)}.ipynb"
     cell = {"cell_type": "code", "execution_count": None, "id": "c0", "metadata": {}, "outputs": [],
@@ -366,7 +407,10 @@ def test_progress_bar_is_a_widget_in_jupyterlab(lab_server, browser):
         label = page.locator(".jp-OutputArea-output").first.inner_text().replace("\u2007", " ")  # tqdm pads with figure spaces
         assert "Hough SLAM noise study" in label  # the bar's label
         page.wait_for_function(_DONE, timeout=RUN_TIMEOUT_S * 1000)
-        assert "rows 6" in page.locator(".jp-OutputArea-output").last.inner_text()
+        text = page.locator(".jp-OutputArea-output").last.inner_text()
+        assert "rows 6" in text
+        # the kernel runs under the reproducibility variant, its prelude first (see the module docstring)
+        assert f"coretype {reproducible.variant_env(VARIANT)['OPENBLAS_CORETYPE']} prelude 1" in text, text
         assert not bar.is_visible()
         assert not _problems(page)
     finally:
