@@ -7,21 +7,43 @@ grid localisation of Ch. 8 except the idea of a particle filter.
 """
 
 from .._lazy import lazy_exports
+from .ablations import (
+    PAIR_VARIANTS,
+    FlightComparison,
+    IncidenceResult,
+    map_normal_error_deg,
+    run_frame_source_ablation,
+    run_incidence_ablation,
+    run_pairs_ablation,
+)
 from .description import Plane, cell_keys, describe_plane, lookup_mean_intensity, plane_frame
 from .experiments import (
+    GOAL_S,
+    POSE_SOURCES,
     SOURCE_TIMES_S,
     FlightResult,
-    IntensityResult,
-    PairsResult,
+    euler_errors,
     flight_frames,
+    flight_head,
+    in_frame_rotation_error_deg,
     ours_vs_source,
     run_flight,
-    run_intensity_figure,
-    run_intensity_study,
-    run_pairs_figure,
+    setup_table,
+    three_plane_room,
+    timing_goal,
     timing_table,
 )
 from .extraction import Frame, build_frame, extract_planes, fit_plane_lsq, frame_transforms, plane_distances
+from .figures import (
+    IntensityResult,
+    IntensitySpread,
+    IntensityStudy,
+    PairsResult,
+    run_intensity_figure,
+    run_intensity_spread,
+    run_intensity_study,
+    run_pairs_figure,
+)
 from .filter import (
     STAGES,
     CycleReport,
@@ -45,6 +67,8 @@ from .transform import (
 
 _PLOT = (
     "plot_flight_errors",
+    "plot_plane_description",
+    "plot_room",
     "plot_frame_planes",
     "plot_frame_points",
     "plot_intensity_figure",
@@ -52,16 +76,23 @@ _PLOT = (
     "plot_plane_map",
     "scanner_geometry_figure",
 )
-_WIDGETS = ("explore_flight",)
+_WIDGETS = ("explore_flight", "explore_intensity_figure")
 __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
 
 __all__ = [
+    "GOAL_S",
+    "PAIR_VARIANTS",
+    "POSE_SOURCES",
     "SOURCE_TIMES_S",
     "STAGES",
     "CycleReport",
+    "FlightComparison",
     "FlightResult",
     "Frame",
+    "IncidenceResult",
     "IntensityResult",
+    "IntensitySpread",
+    "IntensityStudy",
     "LMResult",
     "PairsResult",
     "Plane",
@@ -72,13 +103,17 @@ __all__ = [
     "build_frame",
     "cell_keys",
     "describe_plane",
+    "euler_errors",
     "extract_planes",
     "fit_plane_lsq",
     "flight_frames",
+    "flight_head",
     "frame_transforms",
+    "in_frame_rotation_error_deg",
     "intensity_weights",
     "lm_pose",
     "lookup_mean_intensity",
+    "map_normal_error_deg",
     "mean_pose",
     "merge_planes",
     "ours_vs_source",
@@ -92,10 +127,17 @@ __all__ = [
     "planes_touch",
     "predict_particles",
     "run_flight",
+    "run_frame_source_ablation",
+    "run_incidence_ablation",
     "run_intensity_figure",
+    "run_intensity_spread",
     "run_intensity_study",
+    "run_pairs_ablation",
     "run_pairs_figure",
+    "setup_table",
     "systematic_resample",
+    "three_plane_room",
+    "timing_goal",
     "timing_table",
 ]
 __all__ += list(_PLOT + _WIDGETS)  # loaded on first use

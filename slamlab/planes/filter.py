@@ -5,8 +5,10 @@ One cycle (002; the stage names are those of 002's timing table):
 1. *extraction* — RANSAC planes in the frame (:func:`~slamlab.planes.extract_planes`);
 2. *description* — each plane's frame and cell grid (:func:`~slamlab.planes.describe_plane`);
 3. *motion* — every particle moved by the odometry increment ``(ΔR, Δt)`` between the
-   frames plus ``ε ~ N(0, V)``: ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t`` (002's formula is
-   garbled; ours: body-frame composition);
+   frames plus ``ε ~ N(0, V)``, "ε a normally distributed random variable with zero mean and
+   variance V" (002: V is a *variance*): ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t`` (002's
+   formula is garbled; ours: body-frame composition; ours: one V per translation axis
+   ``V_xyz_m2`` [m²] and one per rotation axis ``V_rpy_deg2`` [deg²]);
 4. *equations* — per particle, frame planes paired with map planes (normals within
    ``pair_angle_deg``, offsets within ``pair_dist_m`` once moved by the particle; the
    closest pair wins, ours) and the pose solved by :func:`~slamlab.planes.lm_pose`;
@@ -52,8 +54,8 @@ class PlaneSLAMParams(Params):
     """Settings of the plane particle filter (002; "ours" where 002 gives no value)."""
 
     n_particles: int = param(400, "002: 400 particles")
-    sigma_xyz_m: float = param(0.03, "ours: V, translation std per frame")
-    sigma_rpy_deg: float = param(0.5, "ours: V, rotation std per frame")
+    V_xyz_m2: float = param(9e-4, "002: ε ~ N(0, V), V a variance; value ours: (3 cm)² per axis per frame")
+    V_rpy_deg2: float = param(0.25, "002: ε ~ N(0, V), V a variance; value ours: (0.5°)² per axis per frame")
     ransac_tolerance_m: float = param(0.04, "ours (002: PCL RANSAC, tolerance not given)")
     ransac_iterations: int = param(100, "ours")
     ransac_min_support: int = param(400, "ours")
@@ -68,7 +70,7 @@ class PlaneSLAMParams(Params):
     sigma_normal: float = param(0.02, "ours: scale of the normal residuals")
     sigma_offset_m: float = param(0.03, "ours: scale of the offset residuals")
     lm_prior: bool = param(True, "ours: a weak prior at the prediction in the LM (False: 002's bare system)")
-    lm_prior_scale: float = param(10.0, "ours: the prior's stds are this times V's")
+    lm_prior_scale: float = param(10.0, "ours: the prior's stds are this times √V")
     lm_lambda: float = param(1e-3, "ours")
     min_normal_rank: int = param(2, "ours (002: 1 pair is enough)")
     intensity_weights: bool = param(True, "002")
@@ -79,7 +81,7 @@ class PlaneSLAMParams(Params):
 
     def check(self) -> None:
         v.check_int(self.n_particles, "n_particles", minimum=1)
-        for name in ("sigma_xyz_m", "sigma_rpy_deg"):
+        for name in ("V_xyz_m2", "V_rpy_deg2"):
             v.check_positive(getattr(self, name), name, allow_zero=True)
         for name in ("ransac_tolerance_m", "cell_m", "pair_angle_deg", "pair_dist_m", "lm_lambda",
                      "merge_angle_deg", "merge_dist_m", "voxel_m"):
@@ -98,15 +100,17 @@ def _exp(rotvec):
     return Rotation.from_rotvec(rotvec).as_matrix()
 
 
-def predict_particles(X, U, sigma_xyz_m: float, sigma_rpy_deg: float, rng) -> np.ndarray:
-    """Motion model: ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t``, ``ε ~ N(0, V)`` (002; composition ours).
+def predict_particles(X, U, V_xyz_m2: float, V_rpy_deg2: float, rng) -> np.ndarray:
+    """Motion model: ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t``, ``ε ~ N(0, V)`` (002 "MCL"; composition ours).
 
-    ``X (P, 4, 4)`` particles ``ᵐT_b``, ``U (4, 4)`` the odometry increment between the frames.
+    ``X (P, 4, 4)`` particles ``ᵐT_b``, ``U (4, 4)`` the odometry increment between the frames;
+    ``V_xyz_m2`` [m²] and ``V_rpy_deg2`` [deg²] the *variances* of ε per axis (002: "with a variance
+    equal to V"), so the draws have standard deviations ``√V``.
     """
     P = X.shape[0]
     out = X @ U
-    out[:, :3, :3] = out[:, :3, :3] @ _exp(rng.normal(0.0, np.deg2rad(sigma_rpy_deg), (P, 3)))
-    out[:, :3, 3] += rng.normal(0.0, sigma_xyz_m, (P, 3))
+    out[:, :3, :3] = out[:, :3, :3] @ _exp(rng.normal(0.0, np.deg2rad(np.sqrt(V_rpy_deg2)), (P, 3)))
+    out[:, :3, 3] += rng.normal(0.0, np.sqrt(V_xyz_m2), (P, 3))
     return out
 
 
@@ -203,6 +207,8 @@ class PlaneSLAM:
         self.X_predicted = self.X.copy()
         self.X_solved = self.X.copy()
         self.weights = np.full(p.n_particles, 1.0 / p.n_particles)
+        #: the last cycle's ``SAD_i`` (NaN where not computed: weights off, frame not used)
+        self.last_sad = np.full(p.n_particles, np.nan)
         #: False freezes the map (ours: for one-cycle studies such as 002 Fig. 4)
         self.update_map = True
 
@@ -233,8 +239,8 @@ class PlaneSLAM:
         mask = pairs >= 0
         prior = None
         if p.lm_prior:
-            prior = p.lm_prior_scale * np.r_[[max(np.deg2rad(p.sigma_rpy_deg), 1e-6)] * 3,
-                                             [max(p.sigma_xyz_m, 1e-6)] * 3]
+            prior = p.lm_prior_scale * np.r_[[max(np.deg2rad(np.sqrt(p.V_rpy_deg2)), 1e-6)] * 3,
+                                             [max(np.sqrt(p.V_xyz_m2), 1e-6)] * 3]
         if mask.any():
             k = np.where(mask, pairs, 0)
             res = lm_pose(self.X[:, :3, :3], self.X[:, :3, 3], N[k], Pm[k], n_b, p_b, mask,
@@ -285,7 +291,7 @@ class PlaneSLAM:
         t2 = clock()
         first = len(self.map) == 0 and bool(planes)      # the first frame with planes founds the map
         if not first:
-            self.X = predict_particles(self.X, U, p.sigma_xyz_m, p.sigma_rpy_deg, self.rng)
+            self.X = predict_particles(self.X, U, p.V_xyz_m2, p.V_rpy_deg2, self.rng)
         self.X_predicted = self.X.copy()
         t3 = clock()
         rank = _normal_rank([pl.n for pl in planes])
@@ -295,8 +301,10 @@ class PlaneSLAM:
         self.X_solved = self.X.copy()
         t4 = clock()
         w = np.full(len(self.X), 1.0 / len(self.X))
+        self.last_sad = np.full(len(self.X), np.nan)
         if use and p.intensity_weights:
-            w = intensity_weights(self.sad(planes, pairs))
+            self.last_sad = self.sad(planes, pairs)
+            w = intensity_weights(self.last_sad)
             self.X = self.X[systematic_resample(w, self.rng)]
         self.weights = w
         t5 = clock()

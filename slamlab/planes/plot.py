@@ -1,4 +1,5 @@
-"""Plots for Ch. 10 (002): scanner geometry, a frame by intensity, its planes, Fig. 2, Fig. 4, Fig. 8, Fig. 9."""
+"""Plots for Ch. 10 (002): scanner geometry, a frame by intensity, its planes, Fig. 2, Fig. 4, Fig. 6, Fig. 7, Fig. 8,
+Fig. 9."""
 
 from __future__ import annotations
 
@@ -14,7 +15,9 @@ __all__ = [
     "plot_frame_points",
     "plot_intensity_figure",
     "plot_pairs_figure",
+    "plot_plane_description",
     "plot_plane_map",
+    "plot_room",
     "scanner_geometry_figure",
 ]
 
@@ -110,7 +113,7 @@ def plot_pairs_figure(result):
 def plot_intensity_figure(result, *, ax=None):
     """002 Fig. 4: solved particles along the corridor (x) with their intensity weights, and the particles after
     resampling; the truth and the odometry's guess marked."""
-    ax = new_axes(ax, figsize=(8, 4), title="002 Fig. 4: weights along the line of uncertainty",
+    ax = new_axes(ax, figsize=(8, 4), title="002 Fig. 4: weights along the line of uncertainty (first cycle)",
                   xlabel="x along the corridor [m]", ylabel="weight × number of particles")
     P = len(result.weights)
     ax.scatter(result.solved[:, 0], result.weights * P, s=6, c="tab:blue", label="solved particles: weight")
@@ -149,4 +152,76 @@ def plot_plane_map(result, *, ax=None, max_cells: int = 20000):
     ax.plot(*result.poses_true[:, :3, 3].T, color="tab:red", label="truth")
     ax.plot(*result.poses_est[:, :3, 3].T, color="tab:blue", label="SLAM")
     ax.legend(fontsize=8)
+    return ax
+
+
+def plot_plane_description(plane, points=None, *, axs=None, max_points: int = 4000):
+    """002 Fig. 6: a plane's points in its own frame ``Π`` (left: projected on its ``OXY`` plane) and its cells
+    (right: the parts ``A``, coloured by the mean intensity ``I_k = Σ I / N_k``, a cell outlined per part).
+
+    ``plane`` a :class:`~slamlab.planes.Plane`; ``points (K, 3)`` its points in the plane's parent frame
+    (optional: without them only the cells are drawn).
+    """
+    if axs is None:
+        _fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
+    a1, a2 = axs
+    T = plane.T
+    if points is not None:
+        X = np.asarray(points, dtype=float)
+        local = (X - T[:3, 3]) @ T[:3, :3]                   # ᴾp = (ᵇ_ΠT)⁻¹ ᵇp
+        k = _thin(len(local), max_points)
+        a1.scatter(local[k, 0], local[k, 1], s=1, c="tab:blue")
+        a1.set_title(f"{len(X)} points in the plane's frame, on OXY\n(dropped z: |z| <= "
+                     f"{np.abs(local[:, 2]).max():.3f} m)", fontsize=9)
+    c = plane.cell_m
+    lo, hi = plane.ij.min(axis=0), plane.ij.max(axis=0)
+    grid = np.full((hi[1] - lo[1] + 1, hi[0] - lo[0] + 1), np.nan)
+    grid[plane.ij[:, 1] - lo[1], plane.ij[:, 0] - lo[0]] = plane.mean_intensity
+    im = a2.imshow(grid, origin="lower", cmap="gray", interpolation="nearest",
+                   extent=(lo[0] * c, (hi[0] + 1) * c, lo[1] * c, (hi[1] + 1) * c))
+    a2.figure.colorbar(im, ax=a2, shrink=0.8, label="mean intensity of the part")
+    a2.set_title(f"{len(plane.ij)} parts of {c} m\n(cells with at least one point)", fontsize=9)
+    for ax in (a1, a2):
+        ax.set_xlabel("plane x [m]")
+        ax.set_ylabel("plane y [m]")
+        ax.set_aspect("equal")
+    if points is not None:
+        a1.set_xlim(a2.get_xlim())
+        a1.set_ylim(a2.get_ylim())
+    return axs
+
+
+def plot_room(room, *, ax=None, path=None, hide=("room z+",)):
+    """002 Fig. 7: the model of the room — every bounded plane drawn with its reflectance panels (grey levels);
+    ``path (N, 3)`` optional, e.g. a flight's true positions; ``hide`` names of planes left out (the ceiling, so
+    that the inside shows)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    ax = _ax3d(ax, figsize=(8, 6), title=f"the room: {len(room)} planes, {room.panel_m} m reflectance panels")
+    polys, shades = [], []
+    for i in range(len(room)):
+        if room.names[i] in hide:
+            continue
+        nu = int(np.ceil(2 * room.half_u[i] / room.panel_m - 1e-9))
+        nv = int(np.ceil(2 * room.half_v[i] / room.panel_m - 1e-9))
+        corner = room.centres[i] - room.half_u[i] * room.axes_u[i] - room.half_v[i] * room.axes_v[i]
+        su = np.minimum(np.arange(nu + 1) * room.panel_m, 2 * room.half_u[i])
+        sv = np.minimum(np.arange(nv + 1) * room.panel_m, 2 * room.half_v[i])
+        for a in range(nu):
+            for b in range(nv):   # a few hundred panels in all: drawing, not a hot path
+                q = [corner + su[x] * room.axes_u[i] + sv[y] * room.axes_v[i]
+                     for x, y in ((a, b), (a + 1, b), (a + 1, b + 1), (a, b + 1))]
+                polys.append(q)
+                shades.append(room.panels[i, a, b])
+    coll = Poly3DCollection(polys, facecolors=plt.cm.gray(np.asarray(shades)), edgecolors="none", alpha=0.55)
+    ax.add_collection3d(coll)
+    lo = (room.centres - np.abs(room.axes_u) * room.half_u[:, None] - np.abs(room.axes_v) * room.half_v[:, None]).min(0)
+    hi = (room.centres + np.abs(room.axes_u) * room.half_u[:, None] + np.abs(room.axes_v) * room.half_v[:, None]).max(0)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(tuple(np.maximum(hi - lo, 1e-9)))
+    if path is not None:
+        ax.plot(*np.asarray(path, dtype=float).T, color="tab:red", label="flight path")
+        ax.legend(fontsize=8)
     return ax

@@ -164,3 +164,19 @@ def test_plane_frame_is_orthonormal_on_the_plane():
     T = plane_frame([0.0, 0.6, 0.8], 2.0, [1.0, 1.0, 1.0])
     np.testing.assert_allclose(T[:3, :3].T @ T[:3, :3], np.eye(3), atol=1e-12)
     assert T[:3, 2] @ T[:3, 3] == pytest.approx(2.0)
+
+
+def test_V_is_a_variance():
+    # 002: "ε normally distributed with zero mean and a variance equal to V": the draws' std is sqrt(V)
+    X = np.repeat(np.eye(4)[None], 20000, 0)
+    out = predict_particles(X, np.eye(4), 0.04, 4.0, np.random.default_rng(1))
+    assert np.std(out[:, :3, 3]) == pytest.approx(0.2, rel=0.02)
+    from scipy.spatial.transform import Rotation
+
+    rv = np.rad2deg(Rotation.from_matrix(out[:, :3, :3]).as_rotvec())
+    assert np.std(rv) == pytest.approx(2.0, rel=0.02)
+    assert PlaneSLAMParams().V_xyz_m2 == pytest.approx(0.03**2)
+    with pytest.raises(ValueError, match="V_xyz_m2"):
+        PlaneSLAMParams(V_xyz_m2=-1.0)
+    with pytest.raises(TypeError, match="sigma_xyz_m"):
+        PlaneSLAMParams.resolve(None, sigma_xyz_m=0.03)

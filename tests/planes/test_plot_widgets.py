@@ -1,6 +1,7 @@
 """Ch. 10 plots draw what they are given; the widget gives a table or a readable message."""
 
 import matplotlib.pyplot as plt
+import numpy as np
 import pytest
 
 from slamlab import planes as PL
@@ -30,6 +31,18 @@ def test_plots_draw(results):
     assert len(PL.plot_flight_errors(fl).axes) == 6
     ax = PL.plot_plane_map(fl, max_cells=300)
     assert len(ax.lines) == 2
+    n, p, idx = found[0]
+    pl = PL.describe_plane(frame.points[idx], frame.intensities[idx], n, p, rays=frame.rays[idx])
+    a1, a2 = PL.plot_plane_description(pl, frame.points[idx], max_points=300)
+    assert len(a1.collections) == 1
+    assert len(a2.images) == 1
+    room = S.build_plane_room(rng=0)
+    ax = PL.plot_room(room, path=fl.poses_true[:, :3, 3])          # Fig. 7: the panels, the ceiling hidden
+    assert len(ax.collections) == 1
+    assert len(ax.lines) == 1
+    shown = sum(int(np.ceil(2 * room.half_u[i] - 1e-9)) * int(np.ceil(2 * room.half_v[i] - 1e-9))
+                for i in range(len(room)) if room.names[i] != "room z+")
+    assert len(ax.collections[0].get_facecolors()) == shown
     plt.close("all")
 
 
@@ -40,5 +53,16 @@ def test_explore_flight(capsys):
     w.f(**{**w.kwargs, "frame_lines": 60})                # 80 lines: one frame of 60 only
     out = capsys.readouterr().out
     assert "Cannot run with these settings" in out
+    assert "Traceback" not in out
+    plt.close("all")
+
+
+def test_explore_intensity_figure(capsys):
+    w = PL.explore_intensity_figure(n_particles=40)
+    out = capsys.readouterr().out
+    assert "one cycle" in out
+    assert "V of the prediction" in out
+    w.f(**{**w.kwargs, "V_xyz_m2": 0.0})                 # no spread: a readable result, not a traceback
+    out = capsys.readouterr().out
     assert "Traceback" not in out
     plt.close("all")
