@@ -5,8 +5,6 @@ from .experiments import (
     AMCL_DEFAULTS,
     CARMEN_LOGS,
     FilterRun,
-    GlobalResult,
-    KidnapResult,
     LogMCLResult,
     MarkovVsMclResult,
     SideBySideResult,
@@ -18,15 +16,15 @@ from .experiments import (
     ours_vs_source,
     run_correlation_side_by_side,
     run_filter,
-    run_global_localisation,
-    run_kidnapped,
     run_log_mcl,
     run_markov_vs_mcl,
     simulate_run,
 )
 from .markov import MarkovGrid, MarkovParams, markov_correct, markov_log_likelihood, markov_predict
-from .mcl import MCL, MCLParams, MCLState, StepRecord, mcl_step
+from .markov_study import MARKOV_PRIORS, MarkovStudyResult, run_markov_kidnap, run_markov_prior
+from .mcl import AVERAGES, MCL, MCLParams, MCLState, StepRecord, mcl_step
 from .models import (
+    SCORES,
     Beams,
     LikelihoodFieldModel,
     ModelParams,
@@ -39,6 +37,7 @@ from .models import (
     scan_beams,
 )
 from .particles import (
+    amcl_converged,
     free_cell_centres,
     is_localised,
     kld_bound,
@@ -49,16 +48,38 @@ from .particles import (
     pose_estimate,
     uniform_free_particles,
 )
+from .studies import (
+    ABLATION,
+    CHAPTER_BEFORE,
+    KIDNAP_VARIANTS,
+    SCORE_VARIANTS,
+    AblationResult,
+    GlobalResult,
+    KidnapResult,
+    ScoreComparison,
+    run_global_ablation,
+    run_global_localisation,
+    run_kidnapped,
+    run_score_comparison,
+)
 
 _PLOT = ("mcl_figure", "recorded_step_figure", "plot_averages", "plot_belief", "plot_clouds", "plot_errors", "plot_global", "plot_log_run", "plot_map",
          "plot_particles", "plot_weights")
-_WIDGETS = ("explore_log", "explore_mcl", "explore_recorded_run")
+_WIDGETS = ("explore_log", "explore_markov", "explore_mcl", "explore_recorded_run")
 __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
 
 __all__ = [
+    "ABLATION",
     "AMCL_DEFAULTS",
+    "AVERAGES",
     "CARMEN_LOGS",
+    "CHAPTER_BEFORE",
+    "KIDNAP_VARIANTS",
+    "MARKOV_PRIORS",
     "MCL",
+    "SCORES",
+    "SCORE_VARIANTS",
+    "AblationResult",
     "Beams",
     "FilterRun",
     "GlobalResult",
@@ -69,11 +90,14 @@ __all__ = [
     "MCLState",
     "MarkovGrid",
     "MarkovParams",
+    "MarkovStudyResult",
     "MarkovVsMclResult",
     "ModelParams",
+    "ScoreComparison",
     "SideBySideResult",
     "SimRun",
     "StepRecord",
+    "amcl_converged",
     "amcl_defaults_table",
     "beam_model_prob",
     "carmen_path",
@@ -98,10 +122,14 @@ __all__ = [
     "ray_cast",
     "run_correlation_side_by_side",
     "run_filter",
+    "run_global_ablation",
     "run_global_localisation",
     "run_kidnapped",
     "run_log_mcl",
+    "run_markov_kidnap",
+    "run_markov_prior",
     "run_markov_vs_mcl",
+    "run_score_comparison",
     "sample_motion_odometry",
     "scan_beams",
     "simulate_run",

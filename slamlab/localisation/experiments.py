@@ -31,15 +31,11 @@ __all__ = [
     "FAIL_DEG",
     "FAIL_POS_CELLS",
     "FilterRun",
-    "GlobalResult",
-    "KidnapResult",
     "MarkovVsMclResult",
     "SimRun",
     "amcl_defaults_table",
     "ours_vs_source",
     "run_filter",
-    "run_global_localisation",
-    "run_kidnapped",
     "run_markov_vs_mcl",
     "simulate_run",
 ]
@@ -62,6 +58,7 @@ class SimRun:
     scans: list = field(repr=False)
     kidnap_step: int | None = None
     max_range: float = MAX_RANGE
+    start: int = 0  # index of the first pose on 004's path
 
     @property
     def n_steps(self) -> int:
@@ -105,7 +102,7 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
     M = test_room_200()
     rf = Rangefinder(n_beams=n_beams, max_range_cells=MAX_RANGE, range_std_cells=range_std_cells)
     scans = [rf.scan(M, p, rng) for p in true]
-    return SimRun(M, true, odo, scans, kidnap_step)
+    return SimRun(M, true, odo, scans, kidnap_step, start=s0)
 
 
 @dataclass(frozen=True)
@@ -164,124 +161,10 @@ def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params
     return FilterRun(est, e, eh, records, snaps, dt)
 
 
-# --- global localisation vs particle count (Monte Carlo on sweep) ------------------------------------------
-
-
 def _raise_failed(df) -> None:
     """A sweep keeps a failed run as a row with its error; here any failure is a bug: raise it."""
     if df["error"].notna().any():
         raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
-
-
-def _global_task(n_particles: int, rng, n_steps: int, sigma_hit: float):
-    run = simulate_run(n_steps, rng=rng)
-    r = run_filter(run, n_particles=n_particles, sigma_hit=sigma_hit, rng=rng)
-    k = r.converged_at()
-    return {"success": bool(r.ok[-1]), "converged_step": -1 if k is None else k,
-            "final_err_cells": float(r.err_pos[-1]), "time_per_step_s": r.time_s / run.n_steps}
-
-
-@dataclass(frozen=True)
-class GlobalResult:
-    """Global localisation from no prior: success and convergence against the particle count."""
-
-    table_df: object = field(repr=False)  # the sweep's tidy table
-    n_runs: int = 0
-    n_steps: int = 0
-
-    def summary(self):
-        """Per particle count: success rate, median converged step, median final error, time per step."""
-        df = self.table_df
-        g = df.groupby("n_particles")
-        out = g.agg(success=("success", "mean"), time_per_step_s=("time_per_step_s", "median"))
-        conv = df[df["converged_step"] >= 0].groupby("n_particles")["converged_step"]
-        out["median_converged_step"] = conv.median()
-        out["median_final_err_cells"] = g["final_err_cells"].median()
-        return out
-
-    def table(self) -> str:
-        s = self.summary()
-        rows = [[int(n), f"{r.success:.2f}", "-" if np.isnan(r.median_converged_step) else
-                 f"{r.median_converged_step:.0f}", f"{r.median_final_err_cells:.2f}"] for n, r in s.iterrows()]
-        return format_table(["particles", "success", "median step localised", "median final err [cells]"], rows,
-                            title=f"Global localisation, {self.n_runs} runs per count, {self.n_steps} steps each "
-                                  f"(success: < {FAIL_POS_CELLS:g} cells and < {FAIL_DEG:g}° at the end)")
-
-    def timing_table(self) -> str:
-        s = self.summary()
-        rows = [[int(n), f"{1e3 * r.time_per_step_s:.2f}"] for n, r in s.iterrows()]
-        return format_table(["particles", "median ms per step"], rows, title="Time per MCL step (wall clock)")
-
-    def __str__(self) -> str:
-        s = self.summary()
-        return "Global localisation: success " + ", ".join(f"{r.success:.2f} at {int(n)}" for n, r in s.iterrows())
-
-
-def run_global_localisation(particle_counts=(250, 1000, 4000), *, n_runs: int = 50, n_steps: int = 40,
-                            sigma_hit: float = 2.0, seed: int = 0, n_jobs: int = 1,
-                            progress: bool | None = None) -> GlobalResult:
-    """Global localisation in the test room from no prior: ``n_runs`` seeded runs per particle count, each
-    from a random place on 004's path, on :func:`slamlab.sweep.sweep`."""
-    from ..sweep import sweep
-
-    counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    df = sweep(_global_task, {"n_particles": counts}, seeds=n_runs, seed=seed, n_jobs=n_jobs, progress=progress,
-               fixed={"n_steps": n_steps, "sigma_hit": sigma_hit})
-    _raise_failed(df)
-    return GlobalResult(df, n_runs, n_steps)
-
-
-# --- kidnapped robot ---------------------------------------------------------------------------------
-
-
-def _kidnap_task(alpha_slow: float, alpha_fast: float, rng, n_particles: int, n_steps: int, kidnap_step: int):
-    run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
-    r = run_filter(run, init="tracking", n_particles=n_particles, alpha_slow=alpha_slow, alpha_fast=alpha_fast,
-                   rng=rng)
-    k = r.converged_at(kidnap_step)
-    return {"recovered": bool(r.ok[-1]), "recovery_steps": -1 if k is None else k - kidnap_step,
-            "injected": int(sum(x.n_injected for x in r.records)),
-            "tracked_before": bool(r.ok[kidnap_step - 1])}
-
-
-@dataclass(frozen=True)
-class KidnapResult:
-    """Kidnapped robot: recovery with and without random injection, per (α_slow, α_fast)."""
-
-    table_df: object = field(repr=False)
-    n_runs: int = 0
-    kidnap_step: int = 0
-    n_steps: int = 0
-
-    def table(self) -> str:
-        df = self.table_df
-        rows = []
-        for (s, f), g in df.groupby(["alpha_slow", "alpha_fast"], sort=False):
-            rec = g[g["recovery_steps"] >= 0]["recovery_steps"]
-            rows.append([f"{s:g}", f"{f:g}", "no" if s == 0 else "yes", f"{g['tracked_before'].mean():.2f}",
-                         f"{g['recovered'].mean():.2f}", "-" if rec.empty else f"{rec.median():.0f}",
-                         f"{g['injected'].mean():.0f}"])
-        return format_table(["α_slow", "α_fast", "injection", "tracked before", "recovered",
-                             "median steps to recover", "mean injected"], rows,
-                            title=f"Kidnapped robot: {self.n_runs} runs per setting, kidnapped at step "
-                                  f"{self.kidnap_step} of {self.n_steps}")
-
-    def __str__(self) -> str:
-        return f"Kidnapped robot, {self.n_runs} runs per setting"
-
-
-def run_kidnapped(settings=((0.0, 0.0), (0.001, 0.1), (0.02, 0.3), (0.05, 0.5)), *, n_runs: int = 10,
-                  n_particles: int = 1500, n_steps: int = 60, kidnap_step: int = 20, seed: int = 1,
-                  n_jobs: int = 1, progress: bool | None = None) -> KidnapResult:
-    """Track from the known start, kidnap at ``kidnap_step``; recovery per (α_slow, α_fast) (on sweep)."""
-    from ..sweep import sweep
-
-    pts = [{"alpha_slow": float(s), "alpha_fast": float(f)} for s, f in settings]
-    df = sweep(_kidnap_task, pts, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=seed, n_jobs=n_jobs,
-               progress=progress, fixed={"n_particles": n_particles, "n_steps": n_steps, "kidnap_step": kidnap_step})
-    _raise_failed(df)
-    return KidnapResult(df, n_runs, kidnap_step, n_steps)
 
 
 # --- Markov grid vs MCL -------------------------------------------------------------------------------
@@ -293,7 +176,7 @@ def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int):
         r = run_filter(run, method="markov", resolution=size, n_headings=n_headings)
         mem = r.records[0]
     else:
-        r = run_filter(run, n_particles=size, sigma_hit=2.0, rng=rng)
+        r = run_filter(run, n_particles=size, rng=rng)
         mem = size * 4 * 8  # particles (x, y, θ) and weights, float64
     return {"start_x": float(run.true_poses[0, 0]), "start_y": float(run.true_poses[0, 1]),
             "success": bool(r.ok[-1]), "final_err_cells": float(r.err_pos[-1]),
@@ -355,35 +238,42 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
 
 # --- AMCL defaults and "Ours vs the source" ------------------------------------------------------------
 
-#: AMCL's defaults as declared in the node sources (read 2026-11-23): ROS 1 ``ros-planning/navigation``
-#: ``amcl/src/amcl_node.cpp`` (``private_nh_.param(...)``) and the ROS wiki page ``wiki.ros.org/amcl``;
-#: ROS 2 ``ros-navigation/navigation2`` ``nav2_amcl/src/amcl_node.cpp`` (``add_parameter(...)``) and
-#: ``docs.nav2.org/configuration/packages/configuring-amcl.html``. Lengths in metres.
+#: AMCL's defaults as declared in the node sources (read 2026-11-26 from the snapshots): ROS 1
+#: ``ros-planning/navigation`` ``amcl/src/amcl_node.cpp`` (``private_nh_.param(...)``), ``amcl/cfg/AMCL.cfg`` and
+#: ``amcl/src/amcl/pf/pf.c``, ``amcl/src/amcl/sensors/amcl_laser.cpp``; ROS 2 ``ros-navigation/navigation2``
+#: ``nav2_amcl/src/amcl_node.cpp`` (``declare_or_get_parameter``) and its ``pf/pf.c``. Lengths in metres.
 AMCL_DEFAULTS = {
     "particles (min … max)": ("100 … 5000", "500 … 2000"),
     "KLD ε (kld_err / pf_err)": ("0.01", "0.05"),
     "KLD 1 − δ (kld_z / pf_z)": ("0.99", "0.99"),
     "sensor model": ("likelihood_field", "likelihood_field"),
+    "observation weight": ("1 + Σ p³ (likelihood_field)", "1 + Σ p³ (likelihood_field)"),
     "z_hit": ("0.95", "0.5"),
     "z_rand": ("0.05", "0.5"),
     "σ_hit [m]": ("0.2", "0.2"),
     "likelihood max dist [m]": ("2.0", "2.0"),
     "beams used": ("30", "60"),
     "α1 … α4": ("0.2 each", "0.2 each"),
-    "α_slow / α_fast": ("0.0 / 0.0 (off)", "0.0 / 0.0 (off)"),
-    "resample interval": ("2", "1"),
+    "α_slow / α_fast": ("0.001 / 0.1 (node; AMCL.cfg: 0 / 0)", "0.0 / 0.0 (off)"),
+    "w_slow, w_fast start": ("first w_avg; 0 again after injecting", "first w_avg; 0 again after injecting"),
+    "resampling": ("every 2nd update; selective_resampling off", "every update"),
+    "beam skipping": ("off (do_beamskip; _prob model only)", "off (do_beamskip; _prob model only)"),
+    "convergence test": ("all particles within 0.5 m of the mean", "all particles within 0.5 m of the mean"),
 }
 
 
 def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) -> str:
     """ROS 1 AMCL, ROS 2 Nav2 AMCL and ours side by side (ours in cells, and in metres at ``cell_m``)."""
     p = MCLParams() if params is None else params
+    score = {"likelihood": "Π q_k (PR Table 6.3), log space", "geometric_mean": "(Π q_k/q_max)^(1/B) (ours)",
+             "amcl_cubes": "1 + Σ p³ (as amcl)"}[p.score]
     ours = {
         "particles (min … max)": f"{p.n_particles} fixed" + (f" (KLD: {p.n_min} … {p.n_particles})"
                                                              if p.use_kld else ""),
         "KLD ε (kld_err / pf_err)": f"{p.kld_epsilon:g} (when use_kld)",
         "KLD 1 − δ (kld_z / pf_z)": f"{p.kld_z:g} (when use_kld)",
         "sensor model": "likelihood_field",
+        "observation weight": score + ("" if p.gamma == 1 else f", ^{p.gamma:g}"),
         "z_hit": f"{p.z_hit:g}",
         "z_rand": f"{p.z_rand:g}",
         "σ_hit [m]": f"{p.sigma_hit:g} cells = {p.sigma_hit * cell_m:g} m at {cell_m:g} m cells",
@@ -391,49 +281,60 @@ def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) ->
         "beams used": f"{p.max_beams}",
         "α1 … α4": ", ".join(f"{a:g}" for a in p.alpha),
         "α_slow / α_fast": f"{p.alpha_slow:g} / {p.alpha_fast:g} (on)" if p.injection else "0 / 0 (off)",
-        "resample interval": f"when N_eff < {p.resample_threshold:g}·M",
+        "w_slow, w_fast start": {"003": "0 (003), never restarted", "amcl": "first w_avg; 0 after injecting",
+                                 "first": "first w_avg, never restarted",
+                                 "debiased": "0 (003), divided by 1 − (1 − α)^t"}[p.averages],
+        "resampling": "every step" if p.resample_threshold >= 1 else
+                      f"when N_eff < {p.resample_threshold:g}·M or injecting",
+        "beam skipping": "on, once converged" if p.beam_skip else "off",
+        "convergence test": f"all particles within {p.converged_dist:g} cells = {p.converged_dist * cell_m:g} m",
     }
     rows = [[k, a, b, ours[k]] for k, (a, b) in AMCL_DEFAULTS.items()]
     return format_table(["setting", "ROS 1 amcl", "ROS 2 Nav2 amcl", "ours"], rows,
                         title="AMCL defaults (node sources) beside ours")
 
 
-def ours_vs_source(global_result: GlobalResult | None = None, kidnap: KidnapResult | None = None) -> str:
-    """003 §2.2 / §1.2.4 beside what this chapter does, with our figures where a run is given."""
+def ours_vs_source(global_result=None, kidnap=None, ablation=None) -> str:
+    """003 §2.2 / §1.2.4 beside what this chapter does, with our figures where a run is given
+    (a :class:`~slamlab.localisation.studies.GlobalResult`, ``KidnapResult``, ``AblationResult``)."""
+    p = MCLParams()
     rows = [
         ["three cases", "tracking, global localisation, SLAM (§1.2.4)", "tracking and global here; SLAM: Ch. 6"],
         ["Markov grid", "cells summing to 1, uniform without prior", "(x, y, θ) grid, uniform on free cells"],
         ["Markov motion", "odometry (no formula)", "shift + Gaussian blur from α1…α4 (ours)"],
-        ["Markov cost", "grows with the number of cells", "see the Markov vs MCL table"],
-        ["MCL weight", "observation model in [0, 1]", "likelihood field; score = per-beam geom. mean"],
+        ["Markov cost", "grows with the number of cells", "see the Markov tables"],
+        ["MCL weight", "observation model in [0, 1]", f"likelihood field; score '{p.score}' (a parameter)"],
         ["eq 2.7", "Markov property (lost image)", "p(x_t+1 | x_0..t) = p(x_t+1 | x_t) (PR)"],
-        ["eqs 2.8-2.10", "mean weight, w_slow, w_fast from 0 (lost)", "PR Table 8.3 averages, start at 0"],
+        ["eq 2.8", "mean weight (lost image)", "w_avg = Σ w_prev·ω, ω the score (PR Table 8.3 l. 6)"],
+        ["eqs 2.9-2.10", "w_slow, w_fast, 'initially 0' (lost)", f"PR Table 8.3, averages '{p.averages}'"],
         ["eq 2.11", "particles scattered at random (lost)", "M·max(0, 1 − w_fast/w_slow) expected"],
-        ["resampling", "by probability", "low-variance, when N_eff < M/2 (ours)"],
+        ["resampling", "by probability", "low-variance (PR Table 4.4), selective: N_eff < M/2 (ours)"],
         ["particle count", "not given", "fixed, or KLD sampling (our addition)"],
         ["results", "none survive (003's tables are lost)", "tables of this notebook"],
     ]
     if global_result is not None:
         s = global_result.summary()
         best = s["success"].idxmax()
-        rows.append(["global success", "—", f"{s.loc[best, 'success']:.2f} with {int(best)} particles"])
+        rows.append(["global success", "—", (f"{s.loc[best, 'success']:.2f} with {int(best)} particles at step "
+                                            f"{global_result.n_steps} ({global_result.n_runs} runs)")])
     if kidnap is not None:
-        df = kidnap.table_df
-        on = df[df["alpha_slow"] > 0].groupby(["alpha_slow", "alpha_fast"])["recovered"].mean()
-        off = df[df["alpha_slow"] == 0]["recovered"].mean()
-        (s_best, f_best), best = on.idxmax(), on.max()
-        text = f"{best:.2f} with (α_slow, α_fast) = ({s_best:g}, {f_best:g}), {off:.2f} without injection"
-        rows.append(["kidnap recovery", "—", text])
+        rows.append(["kidnap recovery", "—", (f"{kidnap.recovered():.2f} with the defaults ({kidnap.n_runs} runs), "
+                                             f"{kidnap.recovered(kidnap.labels[0]):.2f} without injection")])
+    if ablation is not None and "defaults" in ablation.labels:
+        s = ablation.summary()
+        k = f"success@{ablation.n_steps}"
+        rows.append(["cause of issue 12's figures", "—", (f"{s[k].iloc[0]:.2f} before → {s.loc['defaults', k]:.2f} "
+                                                         f"with the defaults ({ablation.n_particles} particles)")])
     return format_table(["item", "003", "ours"], rows, title="Ours vs the source (003 §1.2.4, §2.2)")
 
 
-def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, alpha_slow: float = 0.05,
-             alpha_fast: float = 0.5, n_steps: int = 60, seed: int = 7, **overrides):
-    """One recorded global run (with an optional kidnap) for the plots and the time slider."""
+def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: int = 60, seed: int = 7,
+             **overrides):
+    """One recorded global run (with an optional kidnap) for the plots and the time slider; ``overrides``:
+    fields of :class:`MCLParams` (default: its defaults)."""
     rng = np.random.default_rng(seed)
     run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
-    return run, run_filter(run, n_particles=n_particles, alpha_slow=alpha_slow, alpha_fast=alpha_fast, rng=rng,
-                           keep_particles=True, **overrides)
+    return run, run_filter(run, n_particles=n_particles, rng=rng, keep_particles=True, **overrides)
 
 
 __all__ += ["demo_run", "uniform_free_particles"]
@@ -520,7 +421,8 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     the odometry is the corrected path with Gaussian noise, ``odo_trans_frac`` of each step's
     length and ``odo_rot_std_deg`` per step (ours: the corrected logs carry no raw odometry).
     Tracking starts from the corrected first pose (σ 0.1 m, 2°), global from particles uniform on
-    the free cells. Sensor settings: σ_hit 0.2 m, distance cap 1 m (ROS's σ_hit; ours otherwise).
+    the free cells. Sensor settings: σ_hit 0.2 m, distance cap 1 m (ROS's σ_hit; ours otherwise); the motion
+    noise α = (0.05, 0.002, 0.05, 0.005) in cells and the averages from 0 (003: no injection while tracking).
     ``global_overrides``: MCLParams fields for the global run only; default (ours) σ_hit 0.4 m and random
     injection with (α_slow, α_fast) = (0.05, 0.5): a wider likelihood keeps more hypotheses in the first
     weightings and injection re-seeds a wrong convergence. Tracking, global and the odometry noise draw from
@@ -534,7 +436,12 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     log = path if isinstance(path, CarmenLog) else read_carmen(v.as_path(path, "path", kind="file"))
     cell = v.check_positive(cell_m, "cell_m")
     n = v.check_int(n_scans, "n_scans", minimum=2)
-    s0 = v.check_int(start, "start", minimum=0, maximum=log.n_scans - n)
+    if n > log.n_scans:
+        raise ValueError(f"`n_scans` must be <= the {log.n_scans} scans of log {log.name!r}; got {n}")
+    s0 = v.check_int(start, "start", minimum=0)
+    if s0 + n > log.n_scans:
+        raise ValueError(f"`start` + `n_scans` must be <= the {log.n_scans} scans of log {log.name!r}; got "
+                         f"{s0} + {n} = {s0 + n}")
     rng_odo, rng_track, rng_global = v.as_rng(rng).spawn(3)
     t0 = time.perf_counter()
     G, frame, scans_c, Pc = log_grid(log, cell_m=cell, max_range_m=max_range_m)
@@ -542,7 +449,8 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     true_c = Pc[idx]
     odo = simulate_odometry(true_c, trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
                             rng=rng_odo).poses
-    base = {"sigma_hit": 0.2 / cell, "max_dist": 1.0 / cell, "kld_bin": (0.5 / cell, 0.5 / cell, 0.174533)}
+    base = {"sigma_hit": 0.2 / cell, "max_dist": 1.0 / cell, "kld_bin": (0.5 / cell, 0.5 / cell, 0.174533),
+            "alpha": (0.05, 0.002, 0.05, 0.005), "averages": "003"}
     base.update(overrides)
     zmax = max_range_m / cell
     est = {}
@@ -588,7 +496,7 @@ def _side_task(rng, n_steps: int, n_particles: int, delta_alpha_deg: float):
     from ..correlation import localise
 
     run = simulate_run(n_steps, rng=rng)
-    r = run_filter(run, n_particles=n_particles, sigma_hit=2.0, rng=rng)
+    r = run_filter(run, n_particles=n_particles, rng=rng)
     t0 = time.perf_counter()
     loc = localise(run.grid, run.scans[-1], delta_alpha_rad=float(np.radians(delta_alpha_deg)))
     t_corr = time.perf_counter() - t0
