@@ -3,22 +3,26 @@
 from .._lazy import lazy_exports
 from .experiments import (
     AMCL_DEFAULTS,
-    CARMEN_LOGS,
     FilterRun,
-    LogMCLResult,
     MarkovVsMclResult,
     SideBySideResult,
     SimRun,
     amcl_defaults_table,
-    carmen_path,
     demo_run,
-    logs_table,
     ours_vs_source,
     run_correlation_side_by_side,
     run_filter,
-    run_log_mcl,
     run_markov_vs_mcl,
     simulate_run,
+)
+from .logs import (
+    CARMEN_LOGS,
+    LogMCLResult,
+    LogProtocolResult,
+    carmen_path,
+    logs_table,
+    run_log_mcl,
+    run_log_protocol,
 )
 from .markov import MarkovGrid, MarkovParams, markov_correct, markov_log_likelihood, markov_predict
 from .markov_study import MARKOV_PRIORS, MarkovStudyResult, run_markov_kidnap, run_markov_prior
@@ -86,6 +90,7 @@ __all__ = [
     "KidnapResult",
     "LikelihoodFieldModel",
     "LogMCLResult",
+    "LogProtocolResult",
     "MCLParams",
     "MCLState",
     "MarkovGrid",
@@ -126,6 +131,7 @@ __all__ = [
     "run_global_localisation",
     "run_kidnapped",
     "run_log_mcl",
+    "run_log_protocol",
     "run_markov_kidnap",
     "run_markov_prior",
     "run_markov_vs_mcl",

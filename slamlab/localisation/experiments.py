@@ -1,11 +1,12 @@
-"""The experiments of Ch. 8 (003 §2.2): global localisation, kidnapped robot, Markov grid vs MCL, the
-correlation method side by side, the CARMEN logs, AMCL's defaults, and "Ours vs the source".
+"""The simulated runs of Ch. 8 (003 §2.2) and the experiments on them that are not studies of MCL's settings:
+Markov grid vs MCL, the correlation method side by side, AMCL's defaults, "Ours vs the source", the recorded demo.
+The MCL studies are in :mod:`~slamlab.localisation.studies`, the Markov studies in
+:mod:`~slamlab.localisation.markov_study`, the real logs in :mod:`~slamlab.localisation.logs`.
 
 Simulation: 004's test room (the Ch. 5/6 simulator), a rangefinder of 60 beams over
 360° (range limit 100 cells, σ = 0.5 cell, 0.1-cell quantisation), 004's path, and
 odometry with 5 % translation noise and 0.01 rad heading noise per step (ours: 003
-gives none). Success: position error < 3 cells and heading error < 5° at the end of
-a run (ours). Every Monte Carlo study runs on :func:`slamlab.sweep.sweep` with one
+gives none). Success at a step: position error < 3 cells and heading error < 5° (ours). Every Monte Carlo study runs on :func:`slamlab.sweep.sweep` with one
 seeded stream per run.
 """
 
@@ -19,7 +20,7 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import se2_integrate, se2_relative, wrap_angle
-from ..sim.grid import test_room_200
+from ..sim.grid import measurement_room_200, test_room_200
 from ..sim.paths import path_004
 from ..sim.rangefinder import Rangefinder, simulate_odometry
 from .markov import MarkovGrid
@@ -68,13 +69,17 @@ class SimRun:
 
 def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: int | None = None,
                  kidnap_to: int | None = None, n_beams: int = 60, range_std_cells: float = 0.5,
-                 odo_trans_frac: float = 0.05, odo_rot_std_rad: float = 0.01, rng=None) -> SimRun:
+                 odo_trans_frac: float = 0.05, odo_rot_std_rad: float = 0.01, world: str = "map",
+                 rng=None) -> SimRun:
     """A run along 004's path in the test room: ``n_steps`` poses from pose ``start`` (random when None).
 
     With ``kidnap_step = k`` the robot is carried, between steps ``k−1`` and ``k``, to pose
     ``kidnap_to`` of the path (random, at least 40 poses away, when None); the odometry
-    reports an ordinary step there. Noise: Gaussian range noise, odometry noise per step.
+    reports an ordinary step there. Noise: Gaussian range noise, odometry noise per step. ``world``:
+    "map" (the scans see the map itself) or "cluttered" (they see 004's room with its unmapped clutter,
+    :func:`slamlab.sim.measurement_room_200`, while the filter keeps the map).
     """
+    v.check_choice(world, "world", ("map", "cluttered"))
     rng = v.as_rng(rng)
     n = v.check_int(n_steps, "n_steps", minimum=2)
     P = path_004(121)
@@ -101,7 +106,8 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
     odo = simulate_odometry(believed, trans_std_frac=odo_trans_frac, rot_std_rad=odo_rot_std_rad, rng=rng).poses
     M = test_room_200()
     rf = Rangefinder(n_beams=n_beams, max_range_cells=MAX_RANGE, range_std_cells=range_std_cells)
-    scans = [rf.scan(M, p, rng) for p in true]
+    W = M if world == "map" else measurement_room_200()
+    scans = [rf.scan(W, p, rng) for p in true]
     return SimRun(M, true, odo, scans, kidnap_step, start=s0)
 
 
@@ -338,155 +344,6 @@ def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: 
 
 
 __all__ += ["demo_run", "uniform_free_particles"]
-
-
-# --- real data: the corrected CARMEN logs ----------------------------------------------------------------
-
-#: The five corrected Radish logs of ``../shared/data/carmen-radish-corrected``.
-CARMEN_LOGS = ("intel", "csail", "fhw", "orebro", "seattle")
-#: Tracking and global success on a real log: within this distance [m] ...
-REAL_POS_M = 0.2
-#: ... and this heading error [deg] of the corrected pose.
-REAL_DEG = 2.0
-
-
-def global_log_settings(cell_m: float) -> dict:
-    """The global run's MCLParams overrides on a real log (ours): σ_hit 0.4 m, injection (0.05, 0.5)."""
-    return {"sigma_hit": 0.4 / cell_m, "alpha_slow": 0.05, "alpha_fast": 0.5}
-
-
-def carmen_path(name: str):
-    """Path of ``<name>-corrected.log.gz`` in the shared data (via :func:`slamlab.data.find_data`)."""
-    from ..data import find_data
-
-    v.check_choice(name, "name", CARMEN_LOGS)
-    return find_data(f"carmen-radish-corrected/{name}-corrected.log.gz")
-
-
-@dataclass(frozen=True)
-class LogMCLResult:
-    """MCL on a stretch of a corrected CARMEN log: tracking and global localisation against the corrected poses."""
-
-    name: str
-    scan_indices: np.ndarray = field(repr=False)
-    true_m: np.ndarray = field(repr=False)  # (n, 3) corrected poses
-    track_m: np.ndarray = field(repr=False)  # (n, 3) tracking estimates
-    global_m: np.ndarray = field(repr=False)  # (n, 3) global estimates
-    odo_m: np.ndarray = field(repr=False)  # (n, 3) the noisy odometry we made
-    cell_m: float = 0.1
-    grid_shape: tuple = (0, 0)
-    n_particles_track: int = 0
-    n_particles_global: int = 0
-    odo_trans_frac: float = 0.0
-    odo_rot_std_deg: float = 0.0
-    grid: np.ndarray = field(default=None, repr=False)
-    frame: object = field(default=None, repr=False)
-    time_s: float = field(default=0.0, compare=False)
-
-    @staticmethod
-    def _errors(est, true):
-        return np.hypot(*(est[:, :2] - true[:, :2]).T), np.degrees(np.abs(wrap_angle(est[:, 2] - true[:, 2])))
-
-    def within(self, which: str = "track") -> np.ndarray:
-        """Per step: within 0.2 m and 2° of the corrected pose."""
-        e, h = self._errors(self.track_m if which == "track" else self.global_m, self.true_m)
-        return (e < REAL_POS_M) & (h < REAL_DEG)
-
-    def row(self) -> dict:
-        """The numbers of the table (also for tests)."""
-        et, ht = self._errors(self.track_m, self.true_m)
-        eg, _ = self._errors(self.global_m, self.true_m)
-        eo, _ = self._errors(self.odo_m, self.true_m)
-        wg = self.within("global")
-        first = int(np.argmax(wg)) if wg.any() else -1
-        return {"log": self.name, "steps": int(self.scan_indices.size), "odo_final_err_m": float(eo[-1]),
-                "track_median_err_m": float(np.median(et)), "track_median_err_deg": float(np.median(ht)),
-                "track_within": float(self.within("track").mean()), "global_within": float(wg.mean()),
-                "global_first_step": first, "global_final_err_m": float(eg[-1])}
-
-    def __str__(self) -> str:
-        r = self.row()
-        return (f"{self.name}: tracking within {REAL_POS_M:g} m / {REAL_DEG:g}° at {r['track_within']:.2f} of "
-                f"{r['steps']} steps; global {r['global_within']:.2f}")
-
-
-def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1, max_range_m: float = 10.0,
-                n_particles_track: int = 3000, n_particles_global: int = 20000, odo_trans_frac: float = 0.1,
-                odo_rot_std_deg: float = 1.0, rng=0, params: MCLParams | None = None, global_overrides=None,
-                **overrides) -> LogMCLResult:
-    """MCL on ``n_scans`` consecutive scans of a corrected CARMEN log (path: str / os.PathLike, or a log name).
-
-    The map is the occupancy grid of all the log's scans at their corrected poses
-    (:func:`slamlab.correlation.log_grid`, ``cell_m`` cells, ranges below ``max_range_m``);
-    the odometry is the corrected path with Gaussian noise, ``odo_trans_frac`` of each step's
-    length and ``odo_rot_std_deg`` per step (ours: the corrected logs carry no raw odometry).
-    Tracking starts from the corrected first pose (σ 0.1 m, 2°), global from particles uniform on
-    the free cells. Sensor settings: σ_hit 0.2 m, distance cap 1 m (ROS's σ_hit; ours otherwise); the motion
-    noise α = (0.05, 0.002, 0.05, 0.005) in cells and the averages from 0 (003: no injection while tracking).
-    ``global_overrides``: MCLParams fields for the global run only; default (ours) σ_hit 0.4 m and random
-    injection with (α_slow, α_fast) = (0.05, 0.5): a wider likelihood keeps more hypotheses in the first
-    weightings and injection re-seeds a wrong convergence. Tracking, global and the odometry noise draw from
-    three independent streams spawned from ``rng``.
-    """
-    from ..correlation.experiments import log_grid
-    from ..io import CarmenLog, read_carmen
-
-    if isinstance(path, str) and path in CARMEN_LOGS:
-        path = carmen_path(path)
-    log = path if isinstance(path, CarmenLog) else read_carmen(v.as_path(path, "path", kind="file"))
-    cell = v.check_positive(cell_m, "cell_m")
-    n = v.check_int(n_scans, "n_scans", minimum=2)
-    if n > log.n_scans:
-        raise ValueError(f"`n_scans` must be <= the {log.n_scans} scans of log {log.name!r}; got {n}")
-    s0 = v.check_int(start, "start", minimum=0)
-    if s0 + n > log.n_scans:
-        raise ValueError(f"`start` + `n_scans` must be <= the {log.n_scans} scans of log {log.name!r}; got "
-                         f"{s0} + {n} = {s0 + n}")
-    rng_odo, rng_track, rng_global = v.as_rng(rng).spawn(3)
-    t0 = time.perf_counter()
-    G, frame, scans_c, Pc = log_grid(log, cell_m=cell, max_range_m=max_range_m)
-    idx = np.arange(s0, s0 + n)
-    true_c = Pc[idx]
-    odo = simulate_odometry(true_c, trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
-                            rng=rng_odo).poses
-    base = {"sigma_hit": 0.2 / cell, "max_dist": 1.0 / cell, "kld_bin": (0.5 / cell, 0.5 / cell, 0.174533),
-            "alpha": (0.05, 0.002, 0.05, 0.005), "averages": "003"}
-    base.update(overrides)
-    zmax = max_range_m / cell
-    est = {}
-    for mode, count, r in (("track", n_particles_track, rng_track), ("global", n_particles_global, rng_global)):
-        kw = {"init_pose": true_c[0], "init_std": (0.1 / cell, 0.1 / cell, float(np.radians(2)))} \
-            if mode == "track" else dict(global_log_settings(cell) if global_overrides is None else global_overrides)
-        f = MCL(G, zmax, params=params, rng=r, n_particles=count, **{**base, **kw})
-        out = np.empty((n, 3))
-        for k, i in enumerate(idx):
-            prev, now = (odo[k - 1], odo[k]) if k else (None, None)
-            out[k] = f.step(prev, now, scans_c[i]).mean
-        est[mode] = frame.to_metres(out)
-    return LogMCLResult(log.name, idx, log.poses[idx].copy(), est["track"], est["global"], frame.to_metres(odo), cell,
-                        G.shape, int(n_particles_track), int(n_particles_global), float(odo_trans_frac),
-                        float(odo_rot_std_deg), G, frame, time.perf_counter() - t0)
-
-
-def logs_table(results) -> str:
-    """One row per log: odometry drift, tracking and global errors, the fractions within 0.2 m / 2°."""
-    rows = []
-    for r in results:
-        d = r.row()
-        rows.append([d["log"], d["steps"], f"{d['odo_final_err_m']:.2f}", f"{d['track_median_err_m']:.3f}",
-                     f"{d['track_median_err_deg']:.2f}", f"{d['track_within']:.2f}", f"{d['global_within']:.2f}",
-                     "never" if d["global_first_step"] < 0 else d["global_first_step"],
-                     f"{d['global_final_err_m']:.2f}"])
-    r0 = results[0]
-    return format_table(["log", "steps", "odometry drift [m]", "track med err [m]", "track med err [°]",
-                         "track within", "global within", "global first ok step", "global final err [m]"], rows,
-                        title=f"MCL on the corrected CARMEN logs: {r0.cell_m:g} m cells, odometry noise "
-                              f"{100 * r0.odo_trans_frac:g} % of each step + {r0.odo_rot_std_deg:g}°/step; "
-                              f"{r0.n_particles_track} particles tracking, {r0.n_particles_global} global; "
-                              f"'within' = fraction of steps within {REAL_POS_M:g} m and {REAL_DEG:g}°")
-
-
-__all__ += ["CARMEN_LOGS", "REAL_DEG", "REAL_POS_M", "LogMCLResult", "carmen_path", "logs_table", "run_log_mcl"]
 
 
 # --- Ch. 5's correlation method on the same scans -----------------------------------------------------

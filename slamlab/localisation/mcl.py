@@ -4,18 +4,28 @@
 [0, 1] and resampled; the mean score (2.8), two running averages initialised at 0
 and updated each iteration (2.9, 2.10), and a number of particles scattered at
 random each iteration (2.11). The equations are lost images; we read them as PR's
-augmented MCL (Table 8.3; our identification)::
+augmented MCL (Table 8.3; our identification). What the code does::
 
-    w_avg  = Σ_m w_prev[m]·s[m]                    (2.8)  s[m] ∈ [0, 1] the score
-    w_slow = w_slow + α_slow·(w_avg − w_slow)      (2.9)
-    w_fast = w_fast + α_fast·(w_avg − w_fast)      (2.10)
-    P_A    = M·max(0, 1 − w_fast / w_slow)         (2.11)  expected number injected
+    w[m]   ∝ w_prev[m]·p(z | x[m])^γ                (PR Table 8.2 line 5; γ = 1)
+    w_avg  = Σ_m w_prev[m]·ω[m]                     (2.8)  ω the score (``score``)
+    w_slow = w_slow + α_slow·(w_avg − w_slow)       (2.9)
+    w_fast = w_fast + α_fast·(w_avg − w_fast)       (2.10)
+    P_A    = M·max(0, 1 − w_fast / w_slow)          (2.11) expected number injected
+
+``score`` (what 2.8 averages): ``"likelihood"`` ω = p(z | x) (PR Table 8.3), ``"geometric_mean"``
+(ours, default) the per-beam geometric mean of q_k/q_max in [0, 1], ``"amcl_cubes"`` ROS 1 amcl's
+1 + Σ p³. ``averages`` (how 2.9-2.10 start): ``"003"`` at 0; ``"debiased"`` (default) at 0 and divided
+by 1 − (1 − α)^t; ``"amcl"`` at the first w_avg and again after every injection (ROS 1 amcl, Beluga);
+``"first"`` at the first w_avg. Averages are kept in log space.
 
 Each particle of the resampled set is replaced by a uniform pose on the free cells
 with probability ``max(0, 1 − w_fast/w_slow)`` (so ``P_A`` in expectation).
 Resampling (low-variance) runs only when ``N_eff < resample_threshold·M`` or when
-particles are to be injected; otherwise weights carry over. KLD sampling (Fox 2003,
-PR Table 8.4) adapts ``M`` at each resampling: our addition, as in ROS AMCL.
+particles are to be injected (ROS 1 amcl's selective resampling; ``resample_threshold = 1``:
+every step, as 003 and PR Table 8.2); otherwise weights carry over. Beam skipping (Nav2's
+``likelihood_field_prob``) and KLD sampling (Fox 2003, PR Table 8.4) are our additions, off by default.
+After resampling the set is tested for convergence as ROS 1 amcl does (every particle within
+``converged_dist`` of the mean in x and y).
 
 API summary
 -----------

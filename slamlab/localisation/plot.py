@@ -121,11 +121,19 @@ def plot_belief(markov, *, true_pose=None, ax=None):
 
 
 def plot_global(result, *, ax=None):
-    """Success rate against the particle count."""
-    s = result.summary()
-    ax = new_axes(ax, xlabel="particles", ylabel="success rate", title="Global localisation")
-    ax.semilogx(s.index, s["success"], "o-")
+    """Success (solid) and amcl's convergence test (dotted) against the step, one line per particle count."""
+    from .studies import _per_step
+
+    ax = new_axes(ax, xlabel="step", ylabel="share of runs", title="Global localisation")
+    df = result.table_df
+    for i, n in enumerate(sorted(df["n_particles"].unique())):
+        g = df[df["n_particles"] == n]
+        k = np.arange(1, result.n_steps + 1)
+        c = f"C{i}"
+        ax.plot(k, _per_step(g, "ok").mean(axis=0), "-", color=c, label=f"{n} particles: within 3 cells, 5°")
+        ax.plot(k, _per_step(g, "conv").mean(axis=0), ":", color=c, label=f"{n}: amcl converged")
     ax.set_ylim(-0.05, 1.05)
+    ax.legend(fontsize=7, loc="lower right")
     return ax
 
 

@@ -78,8 +78,8 @@ def _on_turn(run) -> bool:
     return bool(np.hypot(*(run.true_poses[1, :2] - run.true_poses[0, :2])) < 1e-9)
 
 
-def _global_task(rng, n_particles: int, n_steps: int, overrides: dict, variant: str = ""):
-    run = simulate_run(n_steps, rng=rng)
+def _global_task(rng, n_particles: int, n_steps: int, overrides: dict, variant: str = "", world: str = "map"):
+    run = simulate_run(n_steps, world=world, rng=rng)
     r = run_filter(run, n_particles=n_particles, rng=rng, **overrides)
     return {"ok": _bits(r.ok), "conv": _bits(x.converged for x in r.records), "on_turn": _on_turn(run),
             "time_per_step_s": r.time_s / run.n_steps}
@@ -234,6 +234,7 @@ class AblationResult:
     n_runs: int = 0
     n_steps: int = 0
     n_particles: int = 0
+    world: str = "map"
 
     @property
     def mid_step(self) -> int:
@@ -256,7 +257,8 @@ class AblationResult:
                  _fmt(r.success_leg_start)] for lab, r in s.iterrows()]
         return format_table(["variant", f"success @{self.mid_step}", f"success @{self.n_steps}", "amcl converged",
                              "converged but wrong", "success, turn start (runs)", "success, leg start"], rows,
-                            title=f"Ablation of global localisation: {self.n_particles} particles, the same "
+                            title=f"Global localisation{' among unmapped clutter' if self.world != 'map' else ''}: "
+                                  f"{self.n_particles} particles, the same "
                                   f"{self.n_runs} runs for every variant, {self.n_steps} steps; columns after "
                                   f"the second at step {self.n_steps}\ndefaults: {_params_line()}")
 
@@ -268,11 +270,12 @@ _SIZES = {"small": {"n_runs": 12, "n_particles": 1000}, "full": {"n_runs": 50, "
 
 
 def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int | None = None,
-                        n_particles: int | None = None, n_steps: int = 30, seed: int = 0, n_jobs: int = 1,
-                        progress: bool | None = None) -> AblationResult:
+                        n_particles: int | None = None, n_steps: int = 30, world: str = "map", seed: int = 0,
+                        n_jobs: int = 1, progress: bool | None = None) -> AblationResult:
     """Global localisation with one factor changed at a time (``variants``: (label, MCLParams overrides)).
 
-    ``size``: "small" (12 runs of 1000 particles per variant, the notebook) or "full" (50 runs).
+    ``size``: "small" (12 runs of 1000 particles per variant, the notebook) or "full" (50 runs). ``world``: see
+    :func:`~slamlab.localisation.experiments.simulate_run` ("cluttered": scans with unmapped objects).
     """
     v.check_choice(size, "size", tuple(_SIZES))
     n_runs = v.check_int(_SIZES[size]["n_runs"] if n_runs is None else n_runs, "n_runs", minimum=1)
@@ -287,8 +290,10 @@ def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int |
     if len(set(labels)) != len(labels):
         raise ValueError("`variants` labels must be distinct")
     df = _paired_sweep([{"variant": lab, "overrides": dict(ov)} for lab, ov in variants], n_runs=n_runs, seed=seed,
-                       n_jobs=n_jobs, progress=progress, fixed={"n_steps": n_steps, "n_particles": n_part})
-    return AblationResult(df, tuple(labels), n_runs, n_steps, n_part)
+                       n_jobs=n_jobs, progress=progress,
+                       fixed={"n_steps": n_steps, "n_particles": n_part, "world": v.check_choice(world, "world",
+                                                                                                ("map", "cluttered"))})
+    return AblationResult(df, tuple(labels), n_runs, n_steps, n_part, world)
 
 
 # --- the kidnapped robot --------------------------------------------------------------------------------------
@@ -303,8 +308,9 @@ KIDNAP_VARIANTS = (
 )
 
 
-def _kidnap_task(rng, overrides: dict, n_particles: int, n_steps: int, kidnap_step: int, variant: str = ""):
-    run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
+def _kidnap_task(rng, overrides: dict, n_particles: int, n_steps: int, kidnap_step: int, variant: str = "",
+                 world: str = "map"):
+    run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, world=world, rng=rng)
     r = run_filter(run, init="tracking", n_particles=n_particles, rng=rng, **overrides)
     k = r.converged_at(kidnap_step)
     inj = np.array([x.n_injected for x in r.records])
@@ -325,6 +331,7 @@ class KidnapResult:
     kidnap_step: int = 0
     n_steps: int = 0
     n_particles: int = 0
+    world: str = "map"
 
     def recovered(self, label: str | None = None) -> float:
         """Share of runs that recover (within the bounds from some step after the kidnap to the end)."""
@@ -344,7 +351,8 @@ class KidnapResult:
     def table(self) -> str:
         return format_table(["variant", "tracked before", "recovered", "median steps to recover",
                              "% injected per step before", "% after", "median err before [cells]"], self.rows(),
-                            title=f"Kidnapped robot: {self.n_particles} particles, the same {self.n_runs} runs per "
+                            title=f"Kidnapped robot{' among unmapped clutter' if self.world != 'map' else ''}: "
+                                  f"{self.n_particles} particles, the same {self.n_runs} runs per "
                                   f"variant, kidnapped at step {self.kidnap_step} of {self.n_steps}; recovered: "
                                   f"within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}° from some step to the end\n"
                                   f"defaults: {_params_line()}")
@@ -354,7 +362,8 @@ class KidnapResult:
 
 
 def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000, n_steps: int = 50,
-                  kidnap_step: int = 20, seed: int = 1, n_jobs: int = 1, progress: bool | None = None) -> KidnapResult:
+                  kidnap_step: int = 20, world: str = "map", seed: int = 1, n_jobs: int = 1,
+                  progress: bool | None = None) -> KidnapResult:
     """Track from the known start, kidnap at ``kidnap_step``; recovery per variant ((label, overrides) pairs, the
     same runs for every variant; on sweep)."""
     import pandas as pd
@@ -373,11 +382,12 @@ def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: in
         labels.append(item[0])
         df = sweep(_kidnap_task, [{"variant": item[0], "overrides": dict(item[1])}], seeds=n_runs, seed=seed,
                    n_jobs=n_jobs, progress=progress,
-                   fixed={"n_particles": n_particles, "n_steps": n_steps, "kidnap_step": kidnap_step})
+                   fixed={"n_particles": n_particles, "n_steps": n_steps, "kidnap_step": kidnap_step,
+                          "world": v.check_choice(world, "world", ("map", "cluttered"))})
         _raise_failed(df)
         frames.append(df)
     return KidnapResult(pd.concat(frames, ignore_index=True), tuple(labels), n_runs, kidnap_step, n_steps,
-                        int(n_particles))
+                        int(n_particles), world)
 
 
 # --- the observation score on both -------------------------------------------------------------------------------

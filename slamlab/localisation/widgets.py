@@ -8,7 +8,8 @@ import ipywidgets as widgets
 import numpy as np
 
 from ..widgets import slider as _slider
-from .experiments import CARMEN_LOGS, demo_run, run_log_mcl
+from .experiments import demo_run
+from .logs import CARMEN_LOGS, run_log_mcl
 from .plot import mcl_figure, plot_belief, plot_log_run, recorded_step_figure
 
 __all__ = ["explore_log", "explore_markov", "explore_mcl", "explore_recorded_run"]

@@ -47,3 +47,13 @@ def test_log_by_path_and_bad_path(tmp_path):
         L.run_log_mcl(tmp_path / "missing.log.gz")
     with pytest.raises(TypeError, match=r"`path` must be a str or os\.PathLike"):
         L.run_log_mcl(3.5)
+
+
+@pytest.mark.slow
+def test_protocol_success_rate_over_the_five_logs(shared_data):
+    """Issue 27's goal: global localisation from no prior succeeds in >= 0.8 of 10 stretches of 30 scans per log,
+    over the five shared logs (20 000 particles; the bound is the goal's)."""
+    paths = [shared_data / "carmen-radish-corrected" / f"{name}-corrected.log.gz" for name in L.CARMEN_LOGS]
+    res = L.run_log_protocol(paths, (20000,), n_runs=10, n_scans=30, seed=0, progress=False)
+    assert res.table_df.groupby("name").size().tolist() == [10] * 5
+    assert res.success(20000) >= 0.8, res.table()
