@@ -6,7 +6,7 @@ and updated each iteration (2.9, 2.10), and a number of particles scattered at
 random each iteration (2.11). The equations are lost images; we read them as PR's
 augmented MCL (Table 8.3; our identification). What the code does::
 
-    w[m]   ∝ w_prev[m]·p(z | x[m])^γ                (PR Table 8.2 line 5; γ = 1)
+    w[m]   ∝ w_prev[m]·p(z | x[m])^gamma            (PR Table 8.2 line 5; gamma = 1)
     w_avg  = Σ_m w_prev[m]·ω[m]                     (2.8)  ω the score (``score``)
     w_slow = w_slow + α_slow·(w_avg − w_slow)       (2.9)
     w_fast = w_fast + α_fast·(w_avg − w_fast)       (2.10)
