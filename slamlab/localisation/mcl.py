@@ -36,12 +36,13 @@ API summary
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .. import _validate as v
 from .._params import param
+from ..geometry import wrap_angle
 from .models import (
     SCORES,
     Beams,
@@ -78,6 +79,8 @@ class MCLParams(ModelParams):
                                                   "5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
     sigma_hit: float = param(4.0, "ours, cells (the ablation); PR Table 6.3 (ROS: 0.2 m)")
     max_dist: float = param(12.0, "ours, cells: 3 σ_hit, cap of the distance table (ROS: 2 m)")
+    gamma: float = param(0.5, "ours (the ablation): weights p(z | x)^gamma, a tempered likelihood (1 = PR's "
+                              "product of the beams as if independent)")
     n_particles: int = param(2000, "ours (003: not given; ROS AMCL 100…5000, Nav2 500…2000)")
     score: str = param("geometric_mean", "ours: the score ω that eq 2.8 averages (SCORES; 003: 'a probability "
                                          "between 0 and 1'); 'likelihood' = PR Table 8.3. Weights: p(z | x)^gamma")
@@ -94,6 +97,12 @@ class MCLParams(ModelParams):
     beam_skip_threshold: float = param(0.3, "ROS/Nav2 beam_skip_threshold: keep a beam when > this share of "
                                             "the particles put its end point near an obstacle")
     beam_skip_error_threshold: float = param(0.9, "ROS/Nav2: if this share of the beams is skipped, use all")
+    jitter: tuple = param((0.6, 0.04), "ours (the ablation): σ of a Gaussian jitter (cells, rad) added to every "
+                                       "particle at every step, moving or not (cf. the roughening of Gordon et al. "
+                                       "1993, after resampling); (0, 0) = none")
+    update_min_d: float = param(0.0, "cells; ROS amcl update_min_d (0.2 m; Nav2 0.25 m): update only after "
+                                     "moving this far (0 = every step, 003)")
+    update_min_a: float = param(0.0, "rad; ROS amcl update_min_a (π/6; Nav2 0.2): … or turning this far")
     converged_dist: float = param(5.0, "cells; ROS 1 amcl's convergence test: every particle within 0.5 m "
                                        "(= 5 cells of 0.1 m) of the mean in x and y")
     use_kld: bool = param(False, "ours: KLD sampling, Fox 2003 / PR Table 8.4 (ROS AMCL does it)")
@@ -125,6 +134,11 @@ class MCLParams(ModelParams):
         v.check_probability(self.beam_skip_threshold, "beam_skip_threshold")
         v.check_probability(self.beam_skip_error_threshold, "beam_skip_error_threshold")
         v.check_positive(self.converged_dist, "converged_dist")
+        j = np.asarray(self.jitter, dtype=float) if isinstance(self.jitter, tuple) else np.full(1, np.nan)
+        if j.shape != (2,) or not np.all(np.isfinite(j)) or np.any(j < 0):
+            raise ValueError(f"`jitter` must be a tuple of two numbers >= 0 (cells, rad); got {self.jitter!r}")
+        v.check_positive(self.update_min_d, "update_min_d", allow_zero=True)
+        v.check_positive(self.update_min_a, "update_min_a", allow_zero=True)
         v.check_positive(self.kld_epsilon, "kld_epsilon")
         v.check_probability(self.kld_z, "kld_z")
         b = np.asarray(self.kld_bin, dtype=float)
@@ -265,6 +279,9 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     # PR Table 8.2 line 4: x[m] ~ p(x | u, x[m])
     if odom_prev is not None and odom_now is not None:
         X = sample_motion_odometry(X, odom_prev, odom_now, params.alpha, rng)
+    if params.jitter[0] > 0 or params.jitter[1] > 0:
+        X = X + rng.standard_normal(X.shape) * np.array([params.jitter[0], params.jitter[0], params.jitter[1]])
+        X[:, 2] = wrap_angle(X[:, 2])
     # line 5: the likelihood of every particle and the score ω of eq 2.8, in log space (30-60 beams underflow)
     mask = _beam_mask(model, X, beams, params) if params.beam_skip and state.converged else None
     n_beams = model.n_used(beams) if mask is None else int(np.count_nonzero(mask))
@@ -382,11 +399,32 @@ class MCL:
             X = p + self.rng.standard_normal((M, 3)) * sd
         self.state = MCLState(X, np.full(M, 1.0 / M))
         self.records: list[StepRecord] = []
+        self._odom_ref = None  # odometry at the last update (update_min_d / update_min_a)
         self.keep_particles = bool(keep_particles)
         self.snapshots: list[tuple[np.ndarray, np.ndarray]] = []
 
     def step(self, odom_prev, odom_now, scan) -> StepRecord:
-        """One iteration; returns (and keeps) its :class:`StepRecord`."""
+        """One iteration; returns (and keeps) its :class:`StepRecord`.
+
+        With ``update_min_d`` / ``update_min_a`` (ROS amcl's thresholds) the filter is updated only once the
+        odometry has moved that far since the last update (the motion of all the skipped steps is applied
+        then); a skipped step repeats the last record (``note = "no update: moved too little"``).
+        """
+        p = self.params
+        if odom_prev is not None and odom_now is not None and (p.update_min_d > 0 or p.update_min_a > 0):
+            ref = odom_prev if self._odom_ref is None else self._odom_ref
+            a = np.asarray(ref, dtype=float)
+            b = np.asarray(odom_now, dtype=float)
+            moved_d = float(np.hypot(b[0] - a[0], b[1] - a[1]))
+            moved_a = abs(float(wrap_angle(b[2] - a[2])))
+            if self.records and moved_d < p.update_min_d and moved_a < p.update_min_a:
+                self._odom_ref = a
+                rec = replace(self.records[-1], note="no update: moved too little", n_injected=0, resampled=False)
+                self.records.append(rec)
+                if self.keep_particles:
+                    self.snapshots.append(self.snapshots[-1])
+                return rec
+            odom_prev, self._odom_ref = a, b
         self.state, rec, weighted = _mcl_step(self.state, odom_prev, odom_now, scan, self.model, self.params,
                                               self.rng, free_xy=self.free_xy)
         self.records.append(rec)

@@ -35,11 +35,11 @@ __all__ = [
     "run_score_comparison",
 ]
 
-#: The chapter's global-localisation set-up before issue 27 (what gave 0.10 / 0.30 / 0.52): PR's product weights,
-#: the geometric-mean score in eq 2.8, 003's averages from 0 (so no injection with α_slow = 0.001), σ_hit 2 cells,
-#: the old motion noise; the old study judged at step 20.
+#: The chapter's global-localisation set-up before issue 27 (what gave 0.10 / 0.30 / 0.52): PR's product weights
+#: (gamma = 1), the geometric-mean score in eq 2.8, 003's averages from 0 (so no injection with α_slow = 0.001),
+#: σ_hit 2 cells, the old motion noise, no jitter; the old study judged at step 20.
 CHAPTER_BEFORE = {"score": "geometric_mean", "averages": "003", "sigma_hit": 2.0, "max_dist": 8.0,
-                  "alpha": (0.05, 0.002, 0.05, 0.005)}
+                  "alpha": (0.05, 0.002, 0.05, 0.005), "gamma": 1.0, "jitter": (0.0, 0.0)}
 
 #: The ablation: (label, overrides of the defaults). The first block starts from :data:`CHAPTER_BEFORE` and
 #: changes one factor; the second starts from the defaults and takes one factor back.
@@ -47,18 +47,21 @@ ABLATION = (
     ("before (issue 12 set-up)", CHAPTER_BEFORE),
     ("before + σ_hit 4 cells", {**CHAPTER_BEFORE, "sigma_hit": 4.0, "max_dist": 12.0}),
     ("before + motion noise ×4", {**CHAPTER_BEFORE, "alpha": (0.2, 0.008, 0.2, 0.02)}),
+    ("before + jitter (0.6 cell, 0.04 rad)", {**CHAPTER_BEFORE, "jitter": (0.6, 0.04)}),
+    ("before + weights p^0.5", {**CHAPTER_BEFORE, "gamma": 0.5}),
     ("before + injection (debiased averages)", {**CHAPTER_BEFORE, "averages": "debiased"}),
     ("before + 60 beams", {**CHAPTER_BEFORE, "max_beams": 60}),
     ("before + resample every step", {**CHAPTER_BEFORE, "resample_threshold": 1.0}),
-    ("before + weights p^(1/30) (tempered)", {**CHAPTER_BEFORE, "gamma": 1 / 30}),
     ("defaults", {}),
     ("defaults, σ_hit 2 cells", {"sigma_hit": 2.0, "max_dist": 8.0}),
     ("defaults, old motion noise", {"alpha": (0.05, 0.002, 0.05, 0.005)}),
+    ("defaults, no jitter", {"jitter": (0.0, 0.0)}),
+    ("defaults, weights p^1", {"gamma": 1.0}),
     ("defaults, no injection", {"alpha_slow": 0.0, "alpha_fast": 0.0}),
     ("defaults, eq 2.8 on p(z | x)", {"score": "likelihood"}),
-    ("defaults, weights p^(1/30) (tempered)", {"gamma": 1 / 30}),
     ("defaults, resample every step", {"resample_threshold": 1.0}),
     ("defaults, 15 beams", {"max_beams": 15}),
+    ("defaults, amcl update thresholds", {"update_min_d": 2.0, "update_min_a": float(np.pi / 6)}),
 )
 
 #: The observation scores compared (label, overrides): eq 2.8 averages ω; the weights are p(z | x) in every case.
@@ -121,7 +124,8 @@ def _fmt(x, p=2):
 def _params_line(overrides: dict | None = None) -> str:
     p = MCLParams(**(overrides or {}))
     return (f"score {p.score}, σ_hit {p.sigma_hit:g} cells, max_dist {p.max_dist:g}, {p.max_beams} beams, "
-            f"α1…α4 = ({', '.join(f'{a:g}' for a in p.alpha)}), averages {p.averages}, "
+            f"α1…α4 = ({', '.join(f'{a:g}' for a in p.alpha)}), jitter ({p.jitter[0]:g}, {p.jitter[1]:g}), "
+            f"weights p^{p.gamma:g}, averages {p.averages}, "
             f"(α_slow, α_fast) = ({p.alpha_slow:g}, {p.alpha_fast:g}), resample when N_eff < "
             f"{p.resample_threshold:g}·M{' (every step)' if p.resample_threshold >= 1 else ''}")
 
@@ -266,7 +270,7 @@ class AblationResult:
         return f"Ablation of global localisation, {len(self.labels)} variants × {self.n_runs} runs"
 
 
-_SIZES = {"small": {"n_runs": 12, "n_particles": 1000}, "full": {"n_runs": 50, "n_particles": 1000}}
+_SIZES = {"small": {"n_runs": 12, "n_particles": 1000}, "full": {"n_runs": 50, "n_particles": 2500}}
 
 
 def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int | None = None,
@@ -274,7 +278,7 @@ def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int |
                         n_jobs: int = 1, progress: bool | None = None) -> AblationResult:
     """Global localisation with one factor changed at a time (``variants``: (label, MCLParams overrides)).
 
-    ``size``: "small" (12 runs of 1000 particles per variant, the notebook) or "full" (50 runs). ``world``: see
+    ``size``: "small" (12 runs of 1000 particles per variant, the notebook) or "full" (50 runs of 2500). ``world``: see
     :func:`~slamlab.localisation.experiments.simulate_run` ("cluttered": scans with unmapped objects).
     """
     v.check_choice(size, "size", tuple(_SIZES))
