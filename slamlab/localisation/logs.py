@@ -32,6 +32,15 @@ REAL_POS_M = 0.2
 REAL_DEG = 2.0
 
 
+def log_settings(cell_m: float) -> dict:
+    """The MCLParams overrides of every run on a real log (ours, set before issue 27 and kept): σ_hit 0.2 m,
+    distance cap 1 m, KLD bins 0.5 m, the motion noise (0.05, 0.002, 0.05, 0.005) in cells, weights p^1, no
+    jitter, 003's averages from 0 (so no injection while tracking with (0.001, 0.1))."""
+    return {"sigma_hit": 0.2 / cell_m, "max_dist": 1.0 / cell_m, "kld_bin": (0.5 / cell_m, 0.5 / cell_m, 0.174533),
+            "alpha": (0.05, 0.002, 0.05, 0.005), "gamma": 1.0, "jitter": (0.0, 0.0), "averages": "003",
+            "score": "geometric_mean"}
+
+
 def global_log_settings(cell_m: float) -> dict:
     """The global run's MCLParams overrides on a real log (ours): σ_hit 0.4 m, injection (0.05, 0.5)."""
     return {"sigma_hit": 0.4 / cell_m, "alpha_slow": 0.05, "alpha_fast": 0.5}
@@ -121,7 +130,8 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     length and ``odo_rot_std_deg`` per step (ours: the corrected logs carry no raw odometry).
     Tracking starts from the corrected first pose (σ 0.1 m, 2°), global from particles uniform on
     the free cells. Sensor settings: σ_hit 0.2 m, distance cap 1 m (ROS's σ_hit; ours otherwise); the motion
-    noise α = (0.05, 0.002, 0.05, 0.005) in cells and the averages from 0 (003: no injection while tracking).
+    noise α = (0.05, 0.002, 0.05, 0.005) in cells, weights p^1, no jitter and the averages from 0 (003: no injection
+    while tracking): :func:`log_settings`.
     ``global_overrides``: MCLParams fields for the global run only; default (ours) σ_hit 0.4 m and random
     injection with (α_slow, α_fast) = (0.05, 0.5): a wider likelihood keeps more hypotheses in the first
     weightings and injection re-seeds a wrong convergence. Tracking, global and the odometry noise draw from
@@ -149,9 +159,7 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     true_c = Pc[idx]
     odo = simulate_odometry(true_c, trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
                             rng=rng_odo).poses
-    base = {"sigma_hit": 0.2 / cell, "max_dist": 1.0 / cell, "kld_bin": (0.5 / cell, 0.5 / cell, 0.174533),
-            "alpha": (0.05, 0.002, 0.05, 0.005), "averages": "003"}
-    base.update(overrides)
+    base = {**log_settings(cell), **overrides}
     zmax = max_range_m / cell
     est = {}
     for mode, count, r in (("track", n_particles_track, rng_track), ("global", n_particles_global, rng_global)):
@@ -207,8 +215,7 @@ def _protocol_task(rng, log: str, log_index: int, run: int, n_particles: int, n_
     odo = simulate_odometry(Pc[idx], trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
                             rng=rng_odo).poses
     cell = cell_m
-    kw = {"sigma_hit": 0.2 / cell, "max_dist": 1.0 / cell, "kld_bin": (0.5 / cell, 0.5 / cell, 0.174533),
-          "alpha": (0.05, 0.002, 0.05, 0.005), "averages": "003", **global_log_settings(cell), **overrides}
+    kw = {**log_settings(cell), **global_log_settings(cell), **overrides}
     f = MCL(G, max_range_m / cell, rng=rng, n_particles=n_particles, **kw)
     t0 = time.perf_counter()
     out = np.empty((n_scans, 3))
