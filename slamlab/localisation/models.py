@@ -329,11 +329,17 @@ class LikelihoodFieldModel:
         by = beams.end_xy[keep, 1].astype(np.float32)[None, :]
         x = (P[:, 0] + off).astype(np.float32)[:, None]
         y = (P[:, 1] + off).astype(np.float32)[:, None]
-        col = np.clip(np.floor(x + c * bx - s * by), 0, Wp - 1).astype(np.int32)
-        row = np.clip(np.floor(y + s * bx + c * by), 0, Hp - 1).astype(np.int32)
-        row *= Wp
-        row += col
-        return table[row], keep
+        col = np.floor(x + c * bx - s * by)
+        row = np.floor(y + s * bx + c * by)
+        H, W = self.shape
+        if not (P[:, 0].min() >= -1 and P[:, 0].max() <= W and P[:, 1].min() >= -1 and P[:, 1].max() <= H):
+            # a pose off the map: its end points may leave the padding (inside it, z_max cells each side, they cannot)
+            np.clip(col, 0, Wp - 1, out=col)
+            np.clip(row, 0, Hp - 1, out=row)
+        idx = row.astype(np.int32)
+        idx *= Wp
+        idx += col.astype(np.int32)
+        return table[idx], keep
 
     def used(self, beams: Beams) -> np.ndarray:
         """Mask of the beams that enter the likelihood: ranges below ``z_max`` (PR Table 6.3 line 3)."""
