@@ -207,7 +207,7 @@ class StepRecord:
 
 
 def _inject_probability(w_slow: float, w_fast: float) -> float:
-    """``max(0, 1 − w_fast/w_slow)`` (PR Table 8.3 line 13); 0 while ``w_slow`` is 0."""
+    """``max(0, 1 − w_fast/w_slow)`` (PR Table 8.3); 0 while ``w_slow`` is 0."""
     if w_slow <= 0:
         return 0.0
     return max(0.0, 1.0 - w_fast / w_slow)
@@ -294,7 +294,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
         log_s = model.log_score(X, beams, params.score, mask)
     w_prev = state.weights
     log_wp = np.log(np.maximum(w_prev, 1e-300))
-    # 2.8: w_avg = Σ_m w_prev[m]·ω[m], the weighted mean of the score (PR Table 8.3 line 6 with ω = p(z | x))
+    # 2.8: w_avg = Σ_m w_prev[m]·ω[m], the weighted mean of the score (PR Table 8.3 with ω = p(z | x))
     fin = np.isfinite(log_s)
     log_w_avg = float(np.logaddexp.reduce(log_wp[fin] + log_s[fin])) if fin.any() else -np.inf
     ls, lf = state.log_w_slow, state.log_w_fast
