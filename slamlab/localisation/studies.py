@@ -416,10 +416,12 @@ class ScoreComparison:
         return f"Observation scores compared: {len(self.global_.labels)} scores"
 
 
-def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000, seed: int = 0,
-                         n_jobs: int = 1, progress: bool | None = None) -> ScoreComparison:
-    """Each score variant on the global study and the kidnap study (``n_runs`` runs each)."""
-    g = run_global_ablation(variants, n_runs=n_runs, n_particles=n_particles, seed=seed, n_jobs=n_jobs,
+def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000,
+                         global_particles: int = 2500, seed: int = 0, n_jobs: int = 1,
+                         progress: bool | None = None) -> ScoreComparison:
+    """Each score variant on the global study (``global_particles``) and the kidnap study (``n_particles``),
+    ``n_runs`` runs each."""
+    g = run_global_ablation(variants, n_runs=n_runs, n_particles=global_particles, seed=seed, n_jobs=n_jobs,
                             progress=progress)
     k = run_kidnapped(variants, n_runs=n_runs, n_particles=n_particles, seed=seed + 1, n_jobs=n_jobs,
                       progress=progress)
