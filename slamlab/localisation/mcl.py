@@ -20,9 +20,9 @@ by 1 − (1 − α)^t; ``"amcl"`` at the first w_avg and again after every injec
 
 Each particle of the resampled set is replaced by a uniform pose on the free cells
 with probability ``max(0, 1 − w_fast/w_slow)`` (so ``P_A`` in expectation).
-Resampling (low-variance) runs only when ``N_eff < resample_threshold·M`` or when
-particles are to be injected (ROS 1 amcl's selective resampling; ``resample_threshold = 1``:
-every step, as 003 and PR Table 8.2); otherwise weights carry over. Beam skipping (Nav2's
+Resampling (low-variance) runs only when ``N_eff < resample_threshold·M`` (ROS 1 amcl's selective
+resampling; ``resample_threshold = 1``: every step, as 003 and PR Table 8.2); otherwise weights carry
+over, and nothing is injected (as in ROS 1 amcl, injection happens in the resampling). Beam skipping (Nav2's
 ``likelihood_field_prob``) and KLD sampling (Fox 2003, PR Table 8.4) are our additions, off by default.
 After resampling the set is tested for convergence as ROS 1 amcl does (every particle within
 ``converged_dist`` of the mean in x and y).
@@ -322,7 +322,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     mean, cov = pose_estimate(X, w)
     neff = n_eff(w)
     M = X.shape[0]
-    resample = params.resample_threshold >= 1 or neff < params.resample_threshold * M or p_inj > 0
+    resample = params.resample_threshold >= 1 or neff < params.resample_threshold * M or not ok
     n_inj = 0
     if resample:
         if params.use_kld:

@@ -81,7 +81,7 @@ def _global_task(rng, n_particles: int, n_steps: int, overrides: dict, variant: 
     run = simulate_run(n_steps, world=world, rng=rng)
     r = run_filter(run, n_particles=n_particles, rng=rng, **overrides)
     return {"ok": _bits(r.ok), "conv": _bits(x.converged for x in r.records), "on_turn": _on_turn(run),
-            "time_per_step_s": r.time_s / run.n_steps}
+            "resampled": float(np.mean([x.resampled for x in r.records])), "time_per_step_s": r.time_s / run.n_steps}
 
 
 def _per_step(df, col: str) -> np.ndarray:
@@ -110,6 +110,7 @@ def _group_stats(g, steps) -> dict:
             "success_turn_start": float(ok[turn, -1].mean()) if turn.any() else float("nan"),
             "n_turn_start": int(turn.sum()),
             "success_leg_start": float(ok[~turn, -1].mean()) if (~turn).any() else float("nan"),
+            "resampled": float(g["resampled"].mean()),
             "time_per_step_s": float(g["time_per_step_s"].median())}
 
 
@@ -254,9 +255,10 @@ class AblationResult:
         s = self.summary()
         rows = [[lab, _fmt(r[f"success@{self.mid_step}"]), _fmt(r[f"success@{self.n_steps}"]), _fmt(r.amcl_converged),
                  _fmt(r.converged_wrong), f"{_fmt(r.success_turn_start)} ({int(r.n_turn_start)})",
-                 _fmt(r.success_leg_start)] for lab, r in s.iterrows()]
+                 _fmt(r.success_leg_start), _fmt(r.resampled)] for lab, r in s.iterrows()]
         return format_table(["variant", f"success @{self.mid_step}", f"success @{self.n_steps}", "amcl converged",
-                             "converged but wrong", "success, turn start (runs)", "success, leg start"], rows,
+                             "converged but wrong", "success, turn start (runs)", "success, leg start",
+                             "steps resampled"], rows,
                             title=f"Global localisation{' among unmapped clutter' if self.world != 'map' else ''}: "
                                   f"{self.n_particles} particles, the same "
                                   f"{self.n_runs} runs for every variant, {self.n_steps} steps; columns after "
