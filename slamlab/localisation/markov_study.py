@@ -40,13 +40,15 @@ def _ok_bits(est, true) -> str:
 
 
 def _markov_task(rng, kind: str, offset: float, floor: float, n_steps: int, resolution: int, n_headings: int,
-                 kidnap_step: int | None, variant: str = ""):
+                 kidnap_step: int | None, variant: str = "", overrides: dict | None = None):
     run = simulate_run(n_steps, start=None if kidnap_step is None else 0, kidnap_step=kidnap_step, rng=rng)
-    g = MarkovGrid(run.grid, run.max_range, resolution=resolution, n_headings=n_headings, uniform_floor=floor)
+    g = MarkovGrid(run.grid, run.max_range, resolution=resolution, n_headings=n_headings, uniform_floor=floor,
+                   **(overrides or {}))
     if kind == "gaussian":
         t = run.true_poses[0]
         a = float(rng.uniform(-np.pi, np.pi))  # the direction of the offset
-        g.belief = g.gaussian_prior([*t, offset * np.cos(a), offset * np.sin(a), 0.0], 10.0, np.radians(20))
+        centre = t + np.array([offset * np.cos(a), offset * np.sin(a), 0.0])
+        g.belief = g.gaussian_prior(centre, 10.0, np.radians(20))
     est = np.empty((run.n_steps, 3))
     for k in range(run.n_steps):
         prev, now = (run.odom_poses[k - 1], run.odom_poses[k]) if k else (None, None)
@@ -104,10 +106,14 @@ def _run(points, fixed, *, n_runs, seed, n_jobs, progress):
 
 
 def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10, resolution: int = 4,
-                     n_headings: int = 36, seed: int = 5, n_jobs: int = 1,
-                     progress: bool | None = None) -> MarkovStudyResult:
+                     n_headings: int = 36, seed: int = 5, n_jobs: int = 1, progress: bool | None = None,
+                     **overrides) -> MarkovStudyResult:
     """The Markov grid from a uniform prior and from Gaussian priors (``priors``: (label, "uniform"|"gaussian",
-    offset of the prior's centre from the true start [cells])); the same runs for every prior."""
+    offset of the prior's centre from the true start [cells])); the same runs for every prior. ``overrides``:
+    fields of :class:`~slamlab.localisation.markov.MarkovParams` (e.g. fewer beams, ``max_beams=4``)."""
+    from .markov import MarkovParams
+
+    MarkovParams.resolve(None, **overrides)
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=2)
     pts = []
@@ -116,9 +122,11 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
             raise ValueError(f"`priors` must hold (label, 'uniform' or 'gaussian', offset) triples; got {item!r}")
         pts.append({"variant": item[0], "kind": item[1], "offset": float(item[2])})
     df = _run(pts, {"floor": 0.0, "n_steps": n_steps, "resolution": resolution, "n_headings": n_headings,
-                    "kidnap_step": None}, n_runs=n_runs, seed=seed, n_jobs=n_jobs, progress=progress)
+                    "kidnap_step": None, "overrides": dict(overrides)}, n_runs=n_runs, seed=seed, n_jobs=n_jobs,
+              progress=progress)
+    extra = ", ".join(f"{k} {val}" for k, val in overrides.items())
     return MarkovStudyResult(df, tuple(p["variant"] for p in pts), n_runs, n_steps, resolution, n_headings, None,
-                             "Markov grid, priors")
+                             "Markov grid, priors" + (f" ({extra})" if extra else ""))
 
 
 def run_markov_kidnap(floors=(0.0, 1e-6, 1e-3), *, n_runs: int = 5, n_steps: int = 24, kidnap_step: int = 8,
