@@ -285,3 +285,16 @@ def test_beam_skipping_keeps_the_beams_most_particles_agree_with():
     mask = _beam_mask(m, X, b2, p)
     assert not mask[:5].any()
     assert mask[5:][m.used(b2)[5:]].all()
+
+
+@pytest.mark.slow
+def test_markov_prior_and_uniform_floor_studies():
+    """003's two claims as runs: with a weak sensor (3 beams) a prior at the truth localises where the uniform
+    belief does not; after a kidnap a grid with a uniform floor is back within the bounds."""
+    mp = L.run_markov_prior(L.MARKOV_PRIORS[:2], n_runs=2, n_steps=8, seed=2026, progress=False, max_beams=3)
+    assert mp.success(L.MARKOV_PRIORS[1][0]) > mp.success(L.MARKOV_PRIORS[0][0])
+    mk = L.run_markov_kidnap((1e-3,), n_runs=1, n_steps=12, kidnap_step=6, seed=1, progress=False)
+    assert mk.success(mk.labels[0], 5) == 1.0  # tracking before the kidnap
+    assert mk.success(mk.labels[0]) == 1.0  # and back after it
+    with pytest.raises(ValueError, match="`priors` must hold"):
+        L.run_markov_prior([("x", "flat", 0.0)])
