@@ -268,7 +268,7 @@ class AblationResult:
         return f"Ablation of global localisation, {len(self.labels)} variants × {self.n_runs} runs"
 
 
-_SIZES = {"small": {"n_runs": 12, "n_particles": 2500}, "full": {"n_runs": 50, "n_particles": 2500}}
+_SIZES = {"small": {"n_runs": 8, "n_particles": 2500}, "full": {"n_runs": 50, "n_particles": 2500}}
 
 
 def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int | None = None,
@@ -276,7 +276,7 @@ def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int |
                         n_jobs: int = 1, progress: bool | None = None) -> AblationResult:
     """Global localisation with one factor changed at a time (``variants``: (label, MCLParams overrides)).
 
-    ``size``: "small" (12 runs of 2500 particles per variant, the notebook) or "full" (50 runs). ``world``: see
+    ``size``: "small" (8 runs of 2500 particles per variant, the notebook) or "full" (50 runs). ``world``: see
     :func:`~slamlab.localisation.experiments.simulate_run` ("cluttered": scans with unmapped objects).
     """
     v.check_choice(size, "size", tuple(_SIZES))
