@@ -20,6 +20,8 @@ from .logs import (
     LogMCLResult,
     LogProtocolResult,
     carmen_path,
+    global_log_settings,
+    log_settings,
     logs_table,
     run_log_mcl,
     run_log_protocol,
@@ -54,6 +56,7 @@ from .particles import (
 )
 from .studies import (
     ABLATION,
+    ABLATION_MORE,
     CHAPTER_BEFORE,
     KIDNAP_VARIANTS,
     SCORE_VARIANTS,
@@ -74,6 +77,7 @@ __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), 
 
 __all__ = [
     "ABLATION",
+    "ABLATION_MORE",
     "AMCL_DEFAULTS",
     "AVERAGES",
     "CARMEN_LOGS",
@@ -109,9 +113,11 @@ __all__ = [
     "check_particles",
     "demo_run",
     "free_cell_centres",
+    "global_log_settings",
     "is_localised",
     "kld_bound",
     "kld_sample_count",
+    "log_settings",
     "logs_table",
     "low_variance_resample",
     "markov_correct",

@@ -280,15 +280,14 @@ AMCL_DEFAULTS = {
 def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) -> str:
     """ROS 1 AMCL, ROS 2 Nav2 AMCL and ours side by side (ours in cells, and in metres at ``cell_m``)."""
     p = MCLParams() if params is None else params
-    score = {"likelihood": "Π q_k (PR Table 6.3), log space", "geometric_mean": "(Π q_k/q_max)^(1/B) (ours)",
-             "amcl_cubes": "1 + Σ p³ (as amcl)"}[p.score]
+    score = {"likelihood": "p(z | x)", "geometric_mean": "geometric mean (ours)", "amcl_cubes": "1 + Σ p³"}[p.score]
     ours = {
         "particles (min … max)": f"{p.n_particles} fixed" + (f" (KLD: {p.n_min} … {p.n_particles})"
                                                              if p.use_kld else ""),
         "KLD ε (kld_err / pf_err)": f"{p.kld_epsilon:g} (when use_kld)",
         "KLD 1 − δ (kld_z / pf_z)": f"{p.kld_z:g} (when use_kld)",
         "sensor model": "likelihood_field",
-        "observation weight": score + ("" if p.gamma == 1 else f", ^{p.gamma:g}"),
+        "observation weight": f"p(z | x)^{p.gamma:g} = (Π q_k)^{p.gamma:g}; eq 2.8: {score}",
         "z_hit": f"{p.z_hit:g}",
         "z_rand": f"{p.z_rand:g}",
         "σ_hit [m]": f"{p.sigma_hit:g} cells = {p.sigma_hit * cell_m:g} m at {cell_m:g} m cells",
@@ -335,7 +334,7 @@ def ours_vs_source(global_result=None, kidnap=None, ablation=None) -> str:
                                             f"{global_result.n_steps} ({global_result.n_runs} runs)")])
     if kidnap is not None:
         rows.append(["kidnap recovery", "—", (f"{kidnap.recovered():.2f} with the defaults ({kidnap.n_runs} runs), "
-                                             f"{kidnap.recovered(kidnap.labels[0]):.2f} without injection")])
+                                             f"{kidnap.recovered(kidnap.labels[0]):.2f} with 003's averages from 0")])
     if ablation is not None and "defaults" in ablation.labels:
         s = ablation.summary()
         k = f"success@{ablation.n_steps}"

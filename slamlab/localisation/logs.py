@@ -194,7 +194,8 @@ def logs_table(results) -> str:
                               f"'within' = fraction of steps within {REAL_POS_M:g} m and {REAL_DEG:g}°")
 
 
-__all__ += ["CARMEN_LOGS", "REAL_DEG", "REAL_POS_M", "LogMCLResult", "carmen_path", "logs_table", "run_log_mcl"]
+__all__ += ["CARMEN_LOGS", "REAL_DEG", "REAL_POS_M", "LogMCLResult", "carmen_path", "global_log_settings",
+            "log_settings", "logs_table", "run_log_mcl"]
 
 
 
