@@ -1,11 +1,12 @@
-"""The experiments of Ch. 8 (003 §2.2): global localisation, kidnapped robot, Markov grid vs MCL, the
-correlation method side by side, the CARMEN logs, AMCL's defaults, and "Ours vs the source".
+"""The simulated runs of Ch. 8 (003 §2.2) and the experiments on them that are not studies of MCL's settings:
+Markov grid vs MCL, the correlation method side by side, AMCL's defaults, "Ours vs the source", the recorded demo.
+The MCL studies are in :mod:`~slamlab.localisation.studies`, the Markov studies in
+:mod:`~slamlab.localisation.markov_study`, the real logs in :mod:`~slamlab.localisation.logs`.
 
 Simulation: 004's test room (the Ch. 5/6 simulator), a rangefinder of 60 beams over
 360° (range limit 100 cells, σ = 0.5 cell, 0.1-cell quantisation), 004's path, and
 odometry with 5 % translation noise and 0.01 rad heading noise per step (ours: 003
-gives none). Success: position error < 3 cells and heading error < 5° at the end of
-a run (ours). Every Monte Carlo study runs on :func:`slamlab.sweep.sweep` with one
+gives none). Success at a step: position error < 3 cells and heading error < 5° (ours). Every Monte Carlo study runs on :func:`slamlab.sweep.sweep` with one
 seeded stream per run.
 """
 
@@ -19,11 +20,13 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import se2_integrate, se2_relative, wrap_angle
-from ..sim.grid import test_room_200
+from ..scans import Scan
+from ..sim.grid import measurement_room_200, test_room_200
 from ..sim.paths import path_004
 from ..sim.rangefinder import Rangefinder, simulate_odometry
 from .markov import MarkovGrid
 from .mcl import MCL, MCLParams
+from .models import ray_cast
 from .particles import uniform_free_particles
 
 __all__ = [
@@ -31,15 +34,11 @@ __all__ = [
     "FAIL_DEG",
     "FAIL_POS_CELLS",
     "FilterRun",
-    "GlobalResult",
-    "KidnapResult",
     "MarkovVsMclResult",
     "SimRun",
     "amcl_defaults_table",
     "ours_vs_source",
     "run_filter",
-    "run_global_localisation",
-    "run_kidnapped",
     "run_markov_vs_mcl",
     "simulate_run",
 ]
@@ -62,6 +61,7 @@ class SimRun:
     scans: list = field(repr=False)
     kidnap_step: int | None = None
     max_range: float = MAX_RANGE
+    start: int = 0  # index of the first pose on 004's path
 
     @property
     def n_steps(self) -> int:
@@ -71,13 +71,17 @@ class SimRun:
 
 def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: int | None = None,
                  kidnap_to: int | None = None, n_beams: int = 60, range_std_cells: float = 0.5,
-                 odo_trans_frac: float = 0.05, odo_rot_std_rad: float = 0.01, rng=None) -> SimRun:
+                 odo_trans_frac: float = 0.05, odo_rot_std_rad: float = 0.01, world: str = "map",
+                 rng=None) -> SimRun:
     """A run along 004's path in the test room: ``n_steps`` poses from pose ``start`` (random when None).
 
     With ``kidnap_step = k`` the robot is carried, between steps ``k−1`` and ``k``, to pose
     ``kidnap_to`` of the path (random, at least 40 poses away, when None); the odometry
-    reports an ordinary step there. Noise: Gaussian range noise, odometry noise per step.
+    reports an ordinary step there. Noise: Gaussian range noise, odometry noise per step. ``world``:
+    "map" (the scans see the map itself) or "cluttered" (they see 004's room with its unmapped clutter,
+    :func:`slamlab.sim.measurement_room_200`, while the filter keeps the map).
     """
+    v.check_choice(world, "world", ("map", "cluttered"))
     rng = v.as_rng(rng)
     n = v.check_int(n_steps, "n_steps", minimum=2)
     P = path_004(121)
@@ -104,8 +108,16 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
     odo = simulate_odometry(believed, trans_std_frac=odo_trans_frac, rot_std_rad=odo_rot_std_rad, rng=rng).poses
     M = test_room_200()
     rf = Rangefinder(n_beams=n_beams, max_range_cells=MAX_RANGE, range_std_cells=range_std_cells)
-    scans = [rf.scan(M, p, rng) for p in true]
-    return SimRun(M, true, odo, scans, kidnap_step)
+    W = M if world == "map" else measurement_room_200()
+    # the rangefinder's exact traversal for every pose at once (ray_cast = slamlab.sim.cast_rays, tested), then
+    # its noise pose by pose in order (the same draws as Rangefinder.scan)
+    ang = rf.angles_rad
+    Z = ray_cast(W, true, ang, MAX_RANGE)
+    scans = []
+    for z, p in zip(Z, true, strict=True):
+        hit = z < MAX_RANGE
+        scans.append(Scan(ang, rf.measure(z, hit, rng), hit, unit="cell", max_range=MAX_RANGE, pose=p))
+    return SimRun(M, true, odo, scans, kidnap_step, start=s0)
 
 
 @dataclass(frozen=True)
@@ -164,124 +176,10 @@ def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params
     return FilterRun(est, e, eh, records, snaps, dt)
 
 
-# --- global localisation vs particle count (Monte Carlo on sweep) ------------------------------------------
-
-
 def _raise_failed(df) -> None:
     """A sweep keeps a failed run as a row with its error; here any failure is a bug: raise it."""
     if df["error"].notna().any():
         raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
-
-
-def _global_task(n_particles: int, rng, n_steps: int, sigma_hit: float):
-    run = simulate_run(n_steps, rng=rng)
-    r = run_filter(run, n_particles=n_particles, sigma_hit=sigma_hit, rng=rng)
-    k = r.converged_at()
-    return {"success": bool(r.ok[-1]), "converged_step": -1 if k is None else k,
-            "final_err_cells": float(r.err_pos[-1]), "time_per_step_s": r.time_s / run.n_steps}
-
-
-@dataclass(frozen=True)
-class GlobalResult:
-    """Global localisation from no prior: success and convergence against the particle count."""
-
-    table_df: object = field(repr=False)  # the sweep's tidy table
-    n_runs: int = 0
-    n_steps: int = 0
-
-    def summary(self):
-        """Per particle count: success rate, median converged step, median final error, time per step."""
-        df = self.table_df
-        g = df.groupby("n_particles")
-        out = g.agg(success=("success", "mean"), time_per_step_s=("time_per_step_s", "median"))
-        conv = df[df["converged_step"] >= 0].groupby("n_particles")["converged_step"]
-        out["median_converged_step"] = conv.median()
-        out["median_final_err_cells"] = g["final_err_cells"].median()
-        return out
-
-    def table(self) -> str:
-        s = self.summary()
-        rows = [[int(n), f"{r.success:.2f}", "-" if np.isnan(r.median_converged_step) else
-                 f"{r.median_converged_step:.0f}", f"{r.median_final_err_cells:.2f}"] for n, r in s.iterrows()]
-        return format_table(["particles", "success", "median step localised", "median final err [cells]"], rows,
-                            title=f"Global localisation, {self.n_runs} runs per count, {self.n_steps} steps each "
-                                  f"(success: < {FAIL_POS_CELLS:g} cells and < {FAIL_DEG:g}° at the end)")
-
-    def timing_table(self) -> str:
-        s = self.summary()
-        rows = [[int(n), f"{1e3 * r.time_per_step_s:.2f}"] for n, r in s.iterrows()]
-        return format_table(["particles", "median ms per step"], rows, title="Time per MCL step (wall clock)")
-
-    def __str__(self) -> str:
-        s = self.summary()
-        return "Global localisation: success " + ", ".join(f"{r.success:.2f} at {int(n)}" for n, r in s.iterrows())
-
-
-def run_global_localisation(particle_counts=(250, 1000, 4000), *, n_runs: int = 50, n_steps: int = 40,
-                            sigma_hit: float = 2.0, seed: int = 0, n_jobs: int = 1,
-                            progress: bool | None = None) -> GlobalResult:
-    """Global localisation in the test room from no prior: ``n_runs`` seeded runs per particle count, each
-    from a random place on 004's path, on :func:`slamlab.sweep.sweep`."""
-    from ..sweep import sweep
-
-    counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    df = sweep(_global_task, {"n_particles": counts}, seeds=n_runs, seed=seed, n_jobs=n_jobs, progress=progress,
-               fixed={"n_steps": n_steps, "sigma_hit": sigma_hit})
-    _raise_failed(df)
-    return GlobalResult(df, n_runs, n_steps)
-
-
-# --- kidnapped robot ---------------------------------------------------------------------------------
-
-
-def _kidnap_task(alpha_slow: float, alpha_fast: float, rng, n_particles: int, n_steps: int, kidnap_step: int):
-    run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
-    r = run_filter(run, init="tracking", n_particles=n_particles, alpha_slow=alpha_slow, alpha_fast=alpha_fast,
-                   rng=rng)
-    k = r.converged_at(kidnap_step)
-    return {"recovered": bool(r.ok[-1]), "recovery_steps": -1 if k is None else k - kidnap_step,
-            "injected": int(sum(x.n_injected for x in r.records)),
-            "tracked_before": bool(r.ok[kidnap_step - 1])}
-
-
-@dataclass(frozen=True)
-class KidnapResult:
-    """Kidnapped robot: recovery with and without random injection, per (α_slow, α_fast)."""
-
-    table_df: object = field(repr=False)
-    n_runs: int = 0
-    kidnap_step: int = 0
-    n_steps: int = 0
-
-    def table(self) -> str:
-        df = self.table_df
-        rows = []
-        for (s, f), g in df.groupby(["alpha_slow", "alpha_fast"], sort=False):
-            rec = g[g["recovery_steps"] >= 0]["recovery_steps"]
-            rows.append([f"{s:g}", f"{f:g}", "no" if s == 0 else "yes", f"{g['tracked_before'].mean():.2f}",
-                         f"{g['recovered'].mean():.2f}", "-" if rec.empty else f"{rec.median():.0f}",
-                         f"{g['injected'].mean():.0f}"])
-        return format_table(["α_slow", "α_fast", "injection", "tracked before", "recovered",
-                             "median steps to recover", "mean injected"], rows,
-                            title=f"Kidnapped robot: {self.n_runs} runs per setting, kidnapped at step "
-                                  f"{self.kidnap_step} of {self.n_steps}")
-
-    def __str__(self) -> str:
-        return f"Kidnapped robot, {self.n_runs} runs per setting"
-
-
-def run_kidnapped(settings=((0.0, 0.0), (0.001, 0.1), (0.02, 0.3), (0.05, 0.5)), *, n_runs: int = 10,
-                  n_particles: int = 1500, n_steps: int = 60, kidnap_step: int = 20, seed: int = 1,
-                  n_jobs: int = 1, progress: bool | None = None) -> KidnapResult:
-    """Track from the known start, kidnap at ``kidnap_step``; recovery per (α_slow, α_fast) (on sweep)."""
-    from ..sweep import sweep
-
-    pts = [{"alpha_slow": float(s), "alpha_fast": float(f)} for s, f in settings]
-    df = sweep(_kidnap_task, pts, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=seed, n_jobs=n_jobs,
-               progress=progress, fixed={"n_particles": n_particles, "n_steps": n_steps, "kidnap_step": kidnap_step})
-    _raise_failed(df)
-    return KidnapResult(df, n_runs, kidnap_step, n_steps)
 
 
 # --- Markov grid vs MCL -------------------------------------------------------------------------------
@@ -293,7 +191,7 @@ def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int):
         r = run_filter(run, method="markov", resolution=size, n_headings=n_headings)
         mem = r.records[0]
     else:
-        r = run_filter(run, n_particles=size, sigma_hit=2.0, rng=rng)
+        r = run_filter(run, n_particles=size, rng=rng)
         mem = size * 4 * 8  # particles (x, y, θ) and weights, float64
     return {"start_x": float(run.true_poses[0, 0]), "start_y": float(run.true_poses[0, 1]),
             "success": bool(r.ok[-1]), "final_err_cells": float(r.err_pos[-1]),
@@ -355,35 +253,41 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
 
 # --- AMCL defaults and "Ours vs the source" ------------------------------------------------------------
 
-#: AMCL's defaults as declared in the node sources (read 2026-11-23): ROS 1 ``ros-planning/navigation``
-#: ``amcl/src/amcl_node.cpp`` (``private_nh_.param(...)``) and the ROS wiki page ``wiki.ros.org/amcl``;
-#: ROS 2 ``ros-navigation/navigation2`` ``nav2_amcl/src/amcl_node.cpp`` (``add_parameter(...)``) and
-#: ``docs.nav2.org/configuration/packages/configuring-amcl.html``. Lengths in metres.
+#: AMCL's defaults as declared in the node sources (read 2026-11-26 from the snapshots): ROS 1
+#: ``ros-planning/navigation`` ``amcl/src/amcl_node.cpp`` (``private_nh_.param(...)``), ``amcl/cfg/AMCL.cfg`` and
+#: ``amcl/src/amcl/pf/pf.c``, ``amcl/src/amcl/sensors/amcl_laser.cpp``; ROS 2 ``ros-navigation/navigation2``
+#: ``nav2_amcl/src/amcl_node.cpp`` (``declare_or_get_parameter``) and its ``pf/pf.c``. Lengths in metres.
 AMCL_DEFAULTS = {
     "particles (min … max)": ("100 … 5000", "500 … 2000"),
     "KLD ε (kld_err / pf_err)": ("0.01", "0.05"),
     "KLD 1 − δ (kld_z / pf_z)": ("0.99", "0.99"),
     "sensor model": ("likelihood_field", "likelihood_field"),
+    "observation weight": ("1 + Σ p³ (likelihood_field)", "1 + Σ p³ (likelihood_field)"),
     "z_hit": ("0.95", "0.5"),
     "z_rand": ("0.05", "0.5"),
     "σ_hit [m]": ("0.2", "0.2"),
     "likelihood max dist [m]": ("2.0", "2.0"),
     "beams used": ("30", "60"),
     "α1 … α4": ("0.2 each", "0.2 each"),
-    "α_slow / α_fast": ("0.0 / 0.0 (off)", "0.0 / 0.0 (off)"),
-    "resample interval": ("2", "1"),
+    "α_slow / α_fast": ("0.001 / 0.1 (node; AMCL.cfg: 0 / 0)", "0.0 / 0.0 (off)"),
+    "w_slow, w_fast start": ("first w_avg; 0 again after injecting", "first w_avg; 0 again after injecting"),
+    "resampling": ("every 2nd update; selective_resampling off", "every update"),
+    "beam skipping": ("off (do_beamskip; _prob model only)", "off (do_beamskip; _prob model only)"),
+    "convergence test": ("all particles within 0.5 m of the mean", "all particles within 0.5 m of the mean"),
 }
 
 
 def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) -> str:
     """ROS 1 AMCL, ROS 2 Nav2 AMCL and ours side by side (ours in cells, and in metres at ``cell_m``)."""
     p = MCLParams() if params is None else params
+    score = {"likelihood": "p(z | x)", "geometric_mean": "geometric mean (ours)", "amcl_cubes": "1 + Σ p³"}[p.score]
     ours = {
         "particles (min … max)": f"{p.n_particles} fixed" + (f" (KLD: {p.n_min} … {p.n_particles})"
                                                              if p.use_kld else ""),
         "KLD ε (kld_err / pf_err)": f"{p.kld_epsilon:g} (when use_kld)",
         "KLD 1 − δ (kld_z / pf_z)": f"{p.kld_z:g} (when use_kld)",
         "sensor model": "likelihood_field",
+        "observation weight": f"p(z | x)^{p.gamma:g} = (Π q_k)^{p.gamma:g}; eq 2.8: {score}",
         "z_hit": f"{p.z_hit:g}",
         "z_rand": f"{p.z_rand:g}",
         "σ_hit [m]": f"{p.sigma_hit:g} cells = {p.sigma_hit * cell_m:g} m at {cell_m:g} m cells",
@@ -391,194 +295,64 @@ def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) ->
         "beams used": f"{p.max_beams}",
         "α1 … α4": ", ".join(f"{a:g}" for a in p.alpha),
         "α_slow / α_fast": f"{p.alpha_slow:g} / {p.alpha_fast:g} (on)" if p.injection else "0 / 0 (off)",
-        "resample interval": f"when N_eff < {p.resample_threshold:g}·M",
+        "w_slow, w_fast start": {"003": "0 (003), never restarted", "amcl": "first w_avg; 0 after injecting",
+                                 "first": "first w_avg, never restarted",
+                                 "debiased": "0 (003), divided by 1 − (1 − α)^t"}[p.averages],
+        "resampling": "every step" if p.resample_threshold >= 1 else
+                      f"when N_eff < {p.resample_threshold:g}·M or injecting",
+        "beam skipping": "on, once converged" if p.beam_skip else "off",
+        "convergence test": f"all particles within {p.converged_dist:g} cells = {p.converged_dist * cell_m:g} m",
     }
     rows = [[k, a, b, ours[k]] for k, (a, b) in AMCL_DEFAULTS.items()]
     return format_table(["setting", "ROS 1 amcl", "ROS 2 Nav2 amcl", "ours"], rows,
                         title="AMCL defaults (node sources) beside ours")
 
 
-def ours_vs_source(global_result: GlobalResult | None = None, kidnap: KidnapResult | None = None) -> str:
-    """003 §2.2 / §1.2.4 beside what this chapter does, with our figures where a run is given."""
+def ours_vs_source(global_result=None, kidnap=None, ablation=None) -> str:
+    """003 §2.2 / §1.2.4 beside what this chapter does, with our figures where a run is given
+    (a :class:`~slamlab.localisation.studies.GlobalResult`, ``KidnapResult``, ``AblationResult``)."""
+    p = MCLParams()
     rows = [
         ["three cases", "tracking, global localisation, SLAM (§1.2.4)", "tracking and global here; SLAM: Ch. 6"],
         ["Markov grid", "cells summing to 1, uniform without prior", "(x, y, θ) grid, uniform on free cells"],
         ["Markov motion", "odometry (no formula)", "shift + Gaussian blur from α1…α4 (ours)"],
-        ["Markov cost", "grows with the number of cells", "see the Markov vs MCL table"],
-        ["MCL weight", "observation model in [0, 1]", "likelihood field; score = per-beam geom. mean"],
+        ["Markov cost", "grows with the number of cells", "see the Markov tables"],
+        ["MCL motion", "odometry (no formula)", f"PR Table 5.6 + jitter ({p.jitter[0]:g} cell, {p.jitter[1]:g} rad; ours)"],
+        ["MCL weight", "observation model in [0, 1]", f"likelihood field p(z | x)^{p.gamma:g}; 2.8 score '{p.score}'"],
         ["eq 2.7", "Markov property (lost image)", "p(x_t+1 | x_0..t) = p(x_t+1 | x_t) (PR)"],
-        ["eqs 2.8-2.10", "mean weight, w_slow, w_fast from 0 (lost)", "PR Table 8.3 averages, start at 0"],
+        ["eq 2.8", "mean weight (lost image)", "w_avg = Σ w_prev·ω, ω the score (PR Table 8.3)"],
+        ["eqs 2.9-2.10", "w_slow, w_fast, 'initially 0' (lost)", f"PR Table 8.3, averages '{p.averages}'"],
         ["eq 2.11", "particles scattered at random (lost)", "M·max(0, 1 − w_fast/w_slow) expected"],
-        ["resampling", "by probability", "low-variance, when N_eff < M/2 (ours)"],
+        ["resampling", "by probability", "low-variance (PR Table 4.4), selective: N_eff < M/2 (ours)"],
         ["particle count", "not given", "fixed, or KLD sampling (our addition)"],
         ["results", "none survive (003's tables are lost)", "tables of this notebook"],
     ]
     if global_result is not None:
         s = global_result.summary()
         best = s["success"].idxmax()
-        rows.append(["global success", "—", f"{s.loc[best, 'success']:.2f} with {int(best)} particles"])
+        rows.append(["global success", "—", (f"{s.loc[best, 'success']:.2f} with {int(best)} particles at step "
+                                            f"{global_result.n_steps} ({global_result.n_runs} runs)")])
     if kidnap is not None:
-        df = kidnap.table_df
-        on = df[df["alpha_slow"] > 0].groupby(["alpha_slow", "alpha_fast"])["recovered"].mean()
-        off = df[df["alpha_slow"] == 0]["recovered"].mean()
-        (s_best, f_best), best = on.idxmax(), on.max()
-        text = f"{best:.2f} with (α_slow, α_fast) = ({s_best:g}, {f_best:g}), {off:.2f} without injection"
-        rows.append(["kidnap recovery", "—", text])
+        rows.append(["kidnap recovery", "—", (f"{kidnap.recovered():.2f} with the defaults ({kidnap.n_runs} runs), "
+                                             f"{kidnap.recovered(kidnap.labels[0]):.2f} with 003's averages from 0")])
+    if ablation is not None and "defaults" in ablation.labels:
+        s = ablation.summary()
+        k = f"success@{ablation.n_steps}"
+        rows.append(["cause of issue 12's figures", "—", (f"{s[k].iloc[0]:.2f} before → {s.loc['defaults', k]:.2f} "
+                                                         f"with the defaults ({ablation.n_particles} particles)")])
     return format_table(["item", "003", "ours"], rows, title="Ours vs the source (003 §1.2.4, §2.2)")
 
 
-def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, alpha_slow: float = 0.05,
-             alpha_fast: float = 0.5, n_steps: int = 60, seed: int = 7, **overrides):
-    """One recorded global run (with an optional kidnap) for the plots and the time slider."""
+def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: int = 60, seed: int = 7,
+             **overrides):
+    """One recorded global run (with an optional kidnap) for the plots and the time slider; ``overrides``:
+    fields of :class:`MCLParams` (default: its defaults)."""
     rng = np.random.default_rng(seed)
     run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
-    return run, run_filter(run, n_particles=n_particles, alpha_slow=alpha_slow, alpha_fast=alpha_fast, rng=rng,
-                           keep_particles=True, **overrides)
+    return run, run_filter(run, n_particles=n_particles, rng=rng, keep_particles=True, **overrides)
 
 
 __all__ += ["demo_run", "uniform_free_particles"]
-
-
-# --- real data: the corrected CARMEN logs ----------------------------------------------------------------
-
-#: The five corrected Radish logs of ``../shared/data/carmen-radish-corrected``.
-CARMEN_LOGS = ("intel", "csail", "fhw", "orebro", "seattle")
-#: Tracking and global success on a real log: within this distance [m] ...
-REAL_POS_M = 0.2
-#: ... and this heading error [deg] of the corrected pose.
-REAL_DEG = 2.0
-
-
-def global_log_settings(cell_m: float) -> dict:
-    """The global run's MCLParams overrides on a real log (ours): σ_hit 0.4 m, injection (0.05, 0.5)."""
-    return {"sigma_hit": 0.4 / cell_m, "alpha_slow": 0.05, "alpha_fast": 0.5}
-
-
-def carmen_path(name: str):
-    """Path of ``<name>-corrected.log.gz`` in the shared data (via :func:`slamlab.data.find_data`)."""
-    from ..data import find_data
-
-    v.check_choice(name, "name", CARMEN_LOGS)
-    return find_data(f"carmen-radish-corrected/{name}-corrected.log.gz")
-
-
-@dataclass(frozen=True)
-class LogMCLResult:
-    """MCL on a stretch of a corrected CARMEN log: tracking and global localisation against the corrected poses."""
-
-    name: str
-    scan_indices: np.ndarray = field(repr=False)
-    true_m: np.ndarray = field(repr=False)  # (n, 3) corrected poses
-    track_m: np.ndarray = field(repr=False)  # (n, 3) tracking estimates
-    global_m: np.ndarray = field(repr=False)  # (n, 3) global estimates
-    odo_m: np.ndarray = field(repr=False)  # (n, 3) the noisy odometry we made
-    cell_m: float = 0.1
-    grid_shape: tuple = (0, 0)
-    n_particles_track: int = 0
-    n_particles_global: int = 0
-    odo_trans_frac: float = 0.0
-    odo_rot_std_deg: float = 0.0
-    grid: np.ndarray = field(default=None, repr=False)
-    frame: object = field(default=None, repr=False)
-    time_s: float = field(default=0.0, compare=False)
-
-    @staticmethod
-    def _errors(est, true):
-        return np.hypot(*(est[:, :2] - true[:, :2]).T), np.degrees(np.abs(wrap_angle(est[:, 2] - true[:, 2])))
-
-    def within(self, which: str = "track") -> np.ndarray:
-        """Per step: within 0.2 m and 2° of the corrected pose."""
-        e, h = self._errors(self.track_m if which == "track" else self.global_m, self.true_m)
-        return (e < REAL_POS_M) & (h < REAL_DEG)
-
-    def row(self) -> dict:
-        """The numbers of the table (also for tests)."""
-        et, ht = self._errors(self.track_m, self.true_m)
-        eg, _ = self._errors(self.global_m, self.true_m)
-        eo, _ = self._errors(self.odo_m, self.true_m)
-        wg = self.within("global")
-        first = int(np.argmax(wg)) if wg.any() else -1
-        return {"log": self.name, "steps": int(self.scan_indices.size), "odo_final_err_m": float(eo[-1]),
-                "track_median_err_m": float(np.median(et)), "track_median_err_deg": float(np.median(ht)),
-                "track_within": float(self.within("track").mean()), "global_within": float(wg.mean()),
-                "global_first_step": first, "global_final_err_m": float(eg[-1])}
-
-    def __str__(self) -> str:
-        r = self.row()
-        return (f"{self.name}: tracking within {REAL_POS_M:g} m / {REAL_DEG:g}° at {r['track_within']:.2f} of "
-                f"{r['steps']} steps; global {r['global_within']:.2f}")
-
-
-def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1, max_range_m: float = 10.0,
-                n_particles_track: int = 3000, n_particles_global: int = 20000, odo_trans_frac: float = 0.1,
-                odo_rot_std_deg: float = 1.0, rng=0, params: MCLParams | None = None, global_overrides=None,
-                **overrides) -> LogMCLResult:
-    """MCL on ``n_scans`` consecutive scans of a corrected CARMEN log (path: str / os.PathLike, or a log name).
-
-    The map is the occupancy grid of all the log's scans at their corrected poses
-    (:func:`slamlab.correlation.log_grid`, ``cell_m`` cells, ranges below ``max_range_m``);
-    the odometry is the corrected path with Gaussian noise, ``odo_trans_frac`` of each step's
-    length and ``odo_rot_std_deg`` per step (ours: the corrected logs carry no raw odometry).
-    Tracking starts from the corrected first pose (σ 0.1 m, 2°), global from particles uniform on
-    the free cells. Sensor settings: σ_hit 0.2 m, distance cap 1 m (ROS's σ_hit; ours otherwise).
-    ``global_overrides``: MCLParams fields for the global run only; default (ours) σ_hit 0.4 m and random
-    injection with (α_slow, α_fast) = (0.05, 0.5): a wider likelihood keeps more hypotheses in the first
-    weightings and injection re-seeds a wrong convergence. Tracking, global and the odometry noise draw from
-    three independent streams spawned from ``rng``.
-    """
-    from ..correlation.experiments import log_grid
-    from ..io import CarmenLog, read_carmen
-
-    if isinstance(path, str) and path in CARMEN_LOGS:
-        path = carmen_path(path)
-    log = path if isinstance(path, CarmenLog) else read_carmen(v.as_path(path, "path", kind="file"))
-    cell = v.check_positive(cell_m, "cell_m")
-    n = v.check_int(n_scans, "n_scans", minimum=2)
-    s0 = v.check_int(start, "start", minimum=0, maximum=log.n_scans - n)
-    rng_odo, rng_track, rng_global = v.as_rng(rng).spawn(3)
-    t0 = time.perf_counter()
-    G, frame, scans_c, Pc = log_grid(log, cell_m=cell, max_range_m=max_range_m)
-    idx = np.arange(s0, s0 + n)
-    true_c = Pc[idx]
-    odo = simulate_odometry(true_c, trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
-                            rng=rng_odo).poses
-    base = {"sigma_hit": 0.2 / cell, "max_dist": 1.0 / cell, "kld_bin": (0.5 / cell, 0.5 / cell, 0.174533)}
-    base.update(overrides)
-    zmax = max_range_m / cell
-    est = {}
-    for mode, count, r in (("track", n_particles_track, rng_track), ("global", n_particles_global, rng_global)):
-        kw = {"init_pose": true_c[0], "init_std": (0.1 / cell, 0.1 / cell, float(np.radians(2)))} \
-            if mode == "track" else dict(global_log_settings(cell) if global_overrides is None else global_overrides)
-        f = MCL(G, zmax, params=params, rng=r, n_particles=count, **{**base, **kw})
-        out = np.empty((n, 3))
-        for k, i in enumerate(idx):
-            prev, now = (odo[k - 1], odo[k]) if k else (None, None)
-            out[k] = f.step(prev, now, scans_c[i]).mean
-        est[mode] = frame.to_metres(out)
-    return LogMCLResult(log.name, idx, log.poses[idx].copy(), est["track"], est["global"], frame.to_metres(odo), cell,
-                        G.shape, int(n_particles_track), int(n_particles_global), float(odo_trans_frac),
-                        float(odo_rot_std_deg), G, frame, time.perf_counter() - t0)
-
-
-def logs_table(results) -> str:
-    """One row per log: odometry drift, tracking and global errors, the fractions within 0.2 m / 2°."""
-    rows = []
-    for r in results:
-        d = r.row()
-        rows.append([d["log"], d["steps"], f"{d['odo_final_err_m']:.2f}", f"{d['track_median_err_m']:.3f}",
-                     f"{d['track_median_err_deg']:.2f}", f"{d['track_within']:.2f}", f"{d['global_within']:.2f}",
-                     "never" if d["global_first_step"] < 0 else d["global_first_step"],
-                     f"{d['global_final_err_m']:.2f}"])
-    r0 = results[0]
-    return format_table(["log", "steps", "odometry drift [m]", "track med err [m]", "track med err [°]",
-                         "track within", "global within", "global first ok step", "global final err [m]"], rows,
-                        title=f"MCL on the corrected CARMEN logs: {r0.cell_m:g} m cells, odometry noise "
-                              f"{100 * r0.odo_trans_frac:g} % of each step + {r0.odo_rot_std_deg:g}°/step; "
-                              f"{r0.n_particles_track} particles tracking, {r0.n_particles_global} global; "
-                              f"'within' = fraction of steps within {REAL_POS_M:g} m and {REAL_DEG:g}°")
-
-
-__all__ += ["CARMEN_LOGS", "REAL_DEG", "REAL_POS_M", "LogMCLResult", "carmen_path", "logs_table", "run_log_mcl"]
 
 
 # --- Ch. 5's correlation method on the same scans -----------------------------------------------------
@@ -588,7 +362,7 @@ def _side_task(rng, n_steps: int, n_particles: int, delta_alpha_deg: float):
     from ..correlation import localise
 
     run = simulate_run(n_steps, rng=rng)
-    r = run_filter(run, n_particles=n_particles, sigma_hit=2.0, rng=rng)
+    r = run_filter(run, n_particles=n_particles, rng=rng)
     t0 = time.perf_counter()
     loc = localise(run.grid, run.scans[-1], delta_alpha_rad=float(np.radians(delta_alpha_deg)))
     t_corr = time.perf_counter() - t0

@@ -45,12 +45,17 @@ class MarkovParams(ModelParams):
     resolution: int = param(2, "ours: map cells per belief cell (003: not given)")
     n_headings: int = param(72, "ours: 5° heading bins (003: not given)")
     min_blur: float = param(0.5, "ours: Gaussian σ (belief cells and heading bins) added at each motion step")
+    uniform_floor: float = param(0.0, "ours: share ε of a uniform belief mixed in after each motion step (the "
+                                      "grid's random injection; 0 = PR Table 8.1)")
 
     def check(self) -> None:
         super().check()
         v.check_int(self.resolution, "resolution", minimum=1)
         v.check_int(self.n_headings, "n_headings", minimum=4)
         v.check_positive(self.min_blur, "min_blur", allow_zero=True)
+        e = v.check_positive(self.uniform_floor, "uniform_floor", allow_zero=True)
+        if e >= 1:
+            raise ValueError(f"`uniform_floor` must be in [0, 1); got {e}")
 
 
 def markov_predict(bel, odom_prev, odom_now, *, resolution: int, alpha, min_blur: float = 0.5,
@@ -185,6 +190,9 @@ class MarkovGrid:
         p = self.params
         self.belief = markov_predict(self.belief, odom_prev, odom_now, resolution=p.resolution, alpha=p.alpha,
                                      min_blur=p.min_blur, free_mask=self.free_mask)
+        if p.uniform_floor > 0:
+            u = np.broadcast_to(self.free_mask, self.belief.shape)
+            self.belief = (1 - p.uniform_floor) * self.belief + p.uniform_floor * u / u.sum()
 
     def correct(self, scan) -> bool:
         """Sensor update from a scan (cell units) or its beams; False when the scan ruled out every cell."""
@@ -239,6 +247,21 @@ class MarkovGrid:
         k, i, j = np.unravel_index(int(np.argmax(self.belief)), self.belief.shape)
         s = self.params.resolution
         return np.array([j * s, i * s, self.headings_rad[k]], dtype=float)
+
+    def gaussian_prior(self, pose, pos_std: float, heading_std_rad: float) -> np.ndarray:
+        """A belief ``∝ exp(−½(Δx² + Δy²)/σ_pos² − ½Δθ²/σ_θ²)`` around ``pose`` (map cells, rad), on the free
+        cells: a prior for :class:`MarkovGrid` (003 §2.2.1: priors are easy on a grid)."""
+        p = np.asarray(pose, dtype=float)
+        if p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise ValueError(f"`pose` must be three finite numbers (x, y, heading); got {pose!r}")
+        sp = v.check_positive(pos_std, "pos_std")
+        st = v.check_positive(heading_std_rad, "heading_std_rad")
+        P = self.cell_poses()
+        d2 = ((P[..., 0] - p[0]) ** 2 + (P[..., 1] - p[1]) ** 2) / sp**2 + wrap_angle(P[..., 2] - p[2]) ** 2 / st**2
+        b = np.exp(-0.5 * (d2 - d2.min())) * self.free_mask
+        if b.sum() <= 0:
+            raise ValueError("the prior puts no probability on a free cell")
+        return b / b.sum()
 
     @property
     def nbytes(self) -> int:

@@ -4,18 +4,28 @@
 [0, 1] and resampled; the mean score (2.8), two running averages initialised at 0
 and updated each iteration (2.9, 2.10), and a number of particles scattered at
 random each iteration (2.11). The equations are lost images; we read them as PR's
-augmented MCL (Table 8.3; our identification)::
+augmented MCL (Table 8.3; our identification). What the code does::
 
-    w_avg  = Σ_m w_prev[m]·s[m]                    (2.8)  s[m] ∈ [0, 1] the score
-    w_slow = w_slow + α_slow·(w_avg − w_slow)      (2.9)
-    w_fast = w_fast + α_fast·(w_avg − w_fast)      (2.10)
-    P_A    = M·max(0, 1 − w_fast / w_slow)         (2.11)  expected number injected
+    w[m]   ∝ w_prev[m]·p(z | x[m])^gamma            (PR Table 8.2 line 5; gamma = 1)
+    w_avg  = Σ_m w_prev[m]·ω[m]                     (2.8)  ω the score (``score``)
+    w_slow = w_slow + α_slow·(w_avg − w_slow)       (2.9)
+    w_fast = w_fast + α_fast·(w_avg − w_fast)       (2.10)
+    P_A    = M·max(0, 1 − w_fast / w_slow)          (2.11) expected number injected
+
+``score`` (what 2.8 averages): ``"likelihood"`` ω = p(z | x) (PR Table 8.3), ``"geometric_mean"``
+(ours, default) the per-beam geometric mean of q_k/q_max in [0, 1], ``"amcl_cubes"`` ROS 1 amcl's
+1 + Σ p³. ``averages`` (how 2.9-2.10 start): ``"003"`` at 0; ``"debiased"`` (default) at 0 and divided
+by 1 − (1 − α)^t; ``"amcl"`` at the first w_avg and again after every injection (ROS 1 amcl, Beluga);
+``"first"`` at the first w_avg. Averages are kept in log space.
 
 Each particle of the resampled set is replaced by a uniform pose on the free cells
 with probability ``max(0, 1 − w_fast/w_slow)`` (so ``P_A`` in expectation).
-Resampling (low-variance) runs only when ``N_eff < resample_threshold·M`` or when
-particles are to be injected; otherwise weights carry over. KLD sampling (Fox 2003,
-PR Table 8.4) adapts ``M`` at each resampling: our addition, as in ROS AMCL.
+Resampling (low-variance) runs only when ``N_eff < resample_threshold·M`` (ROS 1 amcl's selective
+resampling; ``resample_threshold = 1``: every step, as 003 and PR Table 8.2); otherwise weights carry
+over, and nothing is injected (as in ROS 1 amcl, injection happens in the resampling). Beam skipping (Nav2's
+``likelihood_field_prob``) and KLD sampling (Fox 2003, PR Table 8.4) are our additions, off by default.
+After resampling the set is tested for convergence as ROS 1 amcl does (every particle within
+``converged_dist`` of the mean in x and y).
 
 API summary
 -----------
@@ -26,13 +36,15 @@ API summary
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .. import _validate as v
 from .._params import param
+from ..geometry import wrap_angle
 from .models import (
+    SCORES,
     Beams,
     LikelihoodFieldModel,
     ModelParams,
@@ -41,6 +53,7 @@ from .models import (
     scan_beams,
 )
 from .particles import (
+    amcl_converged,
     free_cell_centres,
     is_localised,
     kld_sample_count,
@@ -51,7 +64,10 @@ from .particles import (
     uniform_free_particles,
 )
 
-__all__ = ["MCL", "MCLParams", "MCLState", "StepRecord", "mcl_step"]
+__all__ = ["AVERAGES", "MCL", "MCLParams", "MCLState", "StepRecord", "mcl_step"]
+
+#: How w_slow and w_fast start (and restart): see :class:`MCLParams`.
+AVERAGES = ("003", "amcl", "first", "debiased")
 
 
 @dataclass(frozen=True)
@@ -59,10 +75,36 @@ class MCLParams(ModelParams):
     """Settings of Monte Carlo localisation; lengths in cells (the map's unit). The motion and sensor
     model's fields come first (:class:`~slamlab.localisation.models.ModelParams`)."""
 
+    alpha: tuple = param((0.2, 0.008, 0.2, 0.02), "ours: 4 × the Markov grid's, in cells (the ablation); PR Tables "
+                                                  "5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
+    sigma_hit: float = param(4.0, "ours, cells (the ablation); PR Table 6.3 (ROS: 0.2 m)")
+    max_dist: float = param(12.0, "ours, cells: 3 σ_hit, cap of the distance table (ROS: 2 m)")
+    gamma: float = param(0.5, "ours (the ablation): weights p(z | x)^gamma, a tempered likelihood (1 = PR's "
+                              "product of the beams as if independent)")
     n_particles: int = param(2000, "ours (003: not given; ROS AMCL 100…5000, Nav2 500…2000)")
+    score: str = param("geometric_mean", "ours: the score ω that eq 2.8 averages (SCORES; 003: 'a probability "
+                                         "between 0 and 1'); 'likelihood' = PR Table 8.3. Weights: p(z | x)^gamma")
     alpha_slow: float = param(0.001, "003 eq 2.9 (value not given); ROS AMCL docs suggest 0.001")
     alpha_fast: float = param(0.1, "003 eq 2.10 (value not given); ROS AMCL docs suggest 0.1")
-    resample_threshold: float = param(0.5, "ours: resample when N_eff < threshold·M (PR §4.3.4)")
+    averages: str = param("debiased", "'003': w_slow, w_fast start at 0 ('initially 0'); 'debiased' (ours): from "
+                                      "0, divided by 1 − (1 − α)^t; 'amcl': at the first w_avg, and again after "
+                                      "every injection (ROS 1 amcl pf.c, Beluga); 'first' (ours): at the first "
+                                      "w_avg, never restarted")
+    resample_threshold: float = param(0.5, "ours: resample when N_eff < threshold·M (ROS 1 amcl's selective "
+                                           "resampling: 0.5); 1 = every step (003, PR Table 8.2)")
+    beam_skip: bool = param(False, "ours: Nav2/ROS 1 likelihood_field_prob's beam skipping, once converged")
+    beam_skip_distance: float = param(5.0, "cells; ROS/Nav2 beam_skip_distance 0.5 m (= 5 cells of 0.1 m)")
+    beam_skip_threshold: float = param(0.3, "ROS/Nav2 beam_skip_threshold: keep a beam when > this share of "
+                                            "the particles put its end point near an obstacle")
+    beam_skip_error_threshold: float = param(0.9, "ROS/Nav2: if this share of the beams is skipped, use all")
+    jitter: tuple = param((0.6, 0.04), "ours (the ablation): σ of a Gaussian jitter (cells, rad) added to every "
+                                       "particle at every step, moving or not (cf. the roughening of Gordon et al. "
+                                       "1993, after resampling); (0, 0) = none")
+    update_min_d: float = param(0.0, "cells; ROS amcl update_min_d (0.2 m; Nav2 0.25 m): update only after "
+                                     "moving this far (0 = every step, 003)")
+    update_min_a: float = param(0.0, "rad; ROS amcl update_min_a (π/6; Nav2 0.2): … or turning this far")
+    converged_dist: float = param(5.0, "cells; ROS 1 amcl's convergence test: every particle within 0.5 m "
+                                       "(= 5 cells of 0.1 m) of the mean in x and y")
     use_kld: bool = param(False, "ours: KLD sampling, Fox 2003 / PR Table 8.4 (ROS AMCL does it)")
     kld_epsilon: float = param(0.05, "Fox 2003 / PR Table 8.4 ε (ROS 1: 0.01, Nav2: 0.05)")
     kld_z: float = param(0.99, "Fox 2003 / PR Table 8.4: 1 − δ (ROS: 0.99)")
@@ -74,6 +116,8 @@ class MCLParams(ModelParams):
     def check(self) -> None:
         super().check()
         v.check_int(self.n_particles, "n_particles", minimum=1)
+        v.check_choice(self.score, "score", SCORES)
+        v.check_choice(self.averages, "averages", AVERAGES)
         s = v.check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
         f = v.check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
         if s > 1 or f > 1:
@@ -83,8 +127,18 @@ class MCLParams(ModelParams):
         t = v.check_positive(self.resample_threshold, "resample_threshold", allow_zero=True)
         if t > 1:
             raise ValueError(f"`resample_threshold` must be in [0, 1]; got {t}")
-        if not isinstance(self.use_kld, (bool, np.bool_)):
-            raise TypeError(f"`use_kld` must be a bool; got {type(self.use_kld).__name__}")
+        for name in ("use_kld", "beam_skip"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
+        v.check_positive(self.beam_skip_distance, "beam_skip_distance")
+        v.check_probability(self.beam_skip_threshold, "beam_skip_threshold")
+        v.check_probability(self.beam_skip_error_threshold, "beam_skip_error_threshold")
+        v.check_positive(self.converged_dist, "converged_dist")
+        j = np.asarray(self.jitter, dtype=float) if isinstance(self.jitter, tuple) else np.full(1, np.nan)
+        if j.shape != (2,) or not np.all(np.isfinite(j)) or np.any(j < 0):
+            raise ValueError(f"`jitter` must be a tuple of two numbers >= 0 (cells, rad); got {self.jitter!r}")
+        v.check_positive(self.update_min_d, "update_min_d", allow_zero=True)
+        v.check_positive(self.update_min_a, "update_min_a", allow_zero=True)
         v.check_positive(self.kld_epsilon, "kld_epsilon")
         v.check_probability(self.kld_z, "kld_z")
         b = np.asarray(self.kld_bin, dtype=float)
@@ -107,12 +161,25 @@ class MCLParams(ModelParams):
 
 @dataclass(frozen=True)
 class MCLState:
-    """The filter's state: particles, their normalised weights and the two running averages."""
+    """The filter's state: particles, their normalised weights, the logs of the two running averages
+    (``-inf`` = 0, 003's start) and whether the last resampled set passed amcl's convergence test."""
 
     particles: np.ndarray = field(repr=False)  # (M, 3)
     weights: np.ndarray = field(repr=False)  # (M,) summing to 1
-    w_slow: float = 0.0  # 003: both start at 0
-    w_fast: float = 0.0
+    log_w_slow: float = -np.inf
+    log_w_fast: float = -np.inf
+    converged: bool = False
+    n_updates: int = 0  # updates of the averages since they last started at 0
+
+    @property
+    def w_slow(self) -> float:
+        """w_slow (eq 2.9) on the score's scale."""
+        return float(np.exp(self.log_w_slow))
+
+    @property
+    def w_fast(self) -> float:
+        """w_fast (eq 2.10) on the score's scale."""
+        return float(np.exp(self.log_w_fast))
 
 
 @dataclass(frozen=True)
@@ -132,13 +199,47 @@ class StepRecord:
     localised: bool
     weights_vanished: bool = False
     note: str = ""
+    converged: bool = False  # amcl's test on the set after this step
+    n_beams: int = 0  # beams that weighed the particles (after beam skipping)
+    log_w_avg: float = -np.inf
+    log_w_slow: float = -np.inf  # the averages that set p_inject (debiased when averages = "debiased")
+    log_w_fast: float = -np.inf
 
 
 def _inject_probability(w_slow: float, w_fast: float) -> float:
-    """``max(0, 1 − w_fast/w_slow)`` (PR Table 8.3 line 13); 0 while ``w_slow`` is 0."""
+    """``max(0, 1 − w_fast/w_slow)`` (PR Table 8.3); 0 while ``w_slow`` is 0."""
     if w_slow <= 0:
         return 0.0
     return max(0.0, 1.0 - w_fast / w_slow)
+
+
+def _log_average(log_w: float, log_x: float, alpha: float) -> float:
+    """``log(w + α·(x − w))`` from ``log w`` and ``log x`` (eqs 2.9, 2.10 in log space)."""
+    if alpha <= 0:
+        return log_w
+    if alpha >= 1:
+        return log_x
+    return float(np.logaddexp(np.log1p(-alpha) + log_w, np.log(alpha) + log_x))
+
+
+def _log_bias(alpha: float, t: int) -> float:
+    """``log(1 − (1 − α)^t)``: the weight an average started at 0 has put on the data after ``t`` updates."""
+    if alpha <= 0:
+        return 0.0
+    return float(np.log(-np.expm1(t * np.log1p(-alpha)))) if alpha < 1 else 0.0
+
+
+def _beam_mask(model, X, beams, params) -> np.ndarray:
+    """Nav2 / ROS 1 ``likelihood_field_prob`` beam skipping: keep a beam when more than
+    ``beam_skip_threshold`` of the particles put its end point within ``beam_skip_distance`` of an
+    obstacle; all beams when ``beam_skip_error_threshold`` of them would be skipped."""
+    d, keep = model.beam_distances(X, beams)
+    agree = (d < params.beam_skip_distance).mean(axis=0) > params.beam_skip_threshold
+    mask = np.zeros(beams.n, bool)
+    mask[keep] = agree
+    if np.count_nonzero(~agree) >= params.beam_skip_error_threshold * agree.size:
+        mask[keep] = True
+    return mask
 
 
 def mcl_step(state: MCLState, odom_prev, odom_now, scan, model: LikelihoodFieldModel, params: MCLParams,
@@ -178,16 +279,39 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     # PR Table 8.2 line 4: x[m] ~ p(x | u, x[m])
     if odom_prev is not None and odom_now is not None:
         X = sample_motion_odometry(X, odom_prev, odom_now, params.alpha, rng)
-    # line 5: weights from the likelihood field (log domain: 30-60 beams underflow a product)
-    L = model.log_likelihood(X, beams)
-    s = model.score(L, beams)
+    if params.jitter[0] > 0 or params.jitter[1] > 0:
+        X = X + rng.standard_normal(X.shape) * np.array([params.jitter[0], params.jitter[0], params.jitter[1]])
+        X[:, 2] = wrap_angle(X[:, 2])
+    # line 5: the likelihood of every particle and the score ω of eq 2.8, in log space (30-60 beams underflow)
+    mask = _beam_mask(model, X, beams, params) if params.beam_skip and state.converged else None
+    n_beams = model.n_used(beams) if mask is None else int(np.count_nonzero(mask))
+    L = model.log_score(X, beams, "likelihood", mask)  # log p(z | x), PR Table 6.3
+    if params.score == "likelihood":
+        log_s = L
+    elif params.score == "geometric_mean":
+        log_s = L / max(1, n_beams) - model.log_q_max
+    else:
+        log_s = model.log_score(X, beams, params.score, mask)
     w_prev = state.weights
-    w_avg = float(w_prev @ s)  # 2.8
-    w_slow = state.w_slow + params.alpha_slow * (w_avg - state.w_slow)  # 2.9
-    w_fast = state.w_fast + params.alpha_fast * (w_avg - state.w_fast)  # 2.10
-    log_w = np.log(np.maximum(w_prev, 1e-300)) + params.gamma * L
+    log_wp = np.log(np.maximum(w_prev, 1e-300))
+    # 2.8: w_avg = Σ_m w_prev[m]·ω[m], the weighted mean of the score (PR Table 8.3 with ω = p(z | x))
+    fin = np.isfinite(log_s)
+    log_w_avg = float(np.logaddexp.reduce(log_wp[fin] + log_s[fin])) if fin.any() else -np.inf
+    ls, lf = state.log_w_slow, state.log_w_fast
+    if params.averages in ("amcl", "first") and ls == -np.inf:  # amcl / Beluga: an average at 0 starts at w_avg
+        ls = lf = log_w_avg
+    else:
+        ls = _log_average(ls, log_w_avg, params.alpha_slow)  # 2.9
+        lf = _log_average(lf, log_w_avg, params.alpha_fast)  # 2.10
+    n_up = state.n_updates + 1
+    ls_used, lf_used = ls, lf
+    if params.averages == "debiased":  # an average started at 0, divided by 1 − (1 − α)^t (Adam's bias correction)
+        ls_used = ls - _log_bias(params.alpha_slow, n_up)
+        lf_used = lf - _log_bias(params.alpha_fast, n_up)
+    log_w = log_wp + params.gamma * L  # PR Table 8.2 line 5: w = p(z | x) (tempered by gamma)
     w, ok = normalise_log_weights(log_w)
-    p_inj = _inject_probability(w_slow, w_fast) if params.injection else 0.0
+    p_inj = (max(0.0, 1.0 - float(np.exp(lf_used - ls_used))) if ls_used > -np.inf else 0.0) \
+        if params.injection else 0.0
     note = ""
     if not ok:
         if params.injection:
@@ -198,7 +322,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     mean, cov = pose_estimate(X, w)
     neff = n_eff(w)
     M = X.shape[0]
-    resample = neff < params.resample_threshold * M or p_inj > 0
+    resample = params.resample_threshold >= 1 or neff < params.resample_threshold * M or not ok
     n_inj = 0
     if resample:
         if params.use_kld:
@@ -217,12 +341,18 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
                 xy = free_cell_centres(model.grid) if free_xy is None else free_xy
                 X = X.copy()
                 X[inj] = uniform_free_particles(model.grid, n_inj, rng, centres=xy)
+            if params.averages == "amcl":  # pf.c: "reset averages, to avoid spiraling off into complete randomness"
+                ls = lf = -np.inf
+                n_up = 0
         w = np.full(M, 1.0 / M)
-    new = MCLState(X, w, float(w_slow), float(w_fast))
-    rec = StepRecord(mean, cov, M, neff, w_avg, float(w_slow), float(w_fast), p_inj, n_inj, bool(resample),
-                     is_localised(cov, pos_std=params.localised_pos_std,
-                                  heading_std_rad=params.localised_heading_std_rad),
-                     weights_vanished=not ok, note=note)
+    conv = amcl_converged(X, params.converged_dist)
+    new = MCLState(X, w, float(ls), float(lf), conv, n_up)
+    rec = StepRecord(mean, cov, M, neff, float(np.exp(log_w_avg)), float(np.exp(ls_used)), float(np.exp(lf_used)),
+                     p_inj, n_inj,
+                     bool(resample), is_localised(cov, pos_std=params.localised_pos_std,
+                                                  heading_std_rad=params.localised_heading_std_rad),
+                     weights_vanished=not ok, note=note, converged=conv, n_beams=n_beams, log_w_avg=log_w_avg,
+                     log_w_slow=float(ls_used), log_w_fast=float(lf_used))
     return new, rec, weighted
 
 
@@ -269,11 +399,32 @@ class MCL:
             X = p + self.rng.standard_normal((M, 3)) * sd
         self.state = MCLState(X, np.full(M, 1.0 / M))
         self.records: list[StepRecord] = []
+        self._odom_ref = None  # odometry at the last update (update_min_d / update_min_a)
         self.keep_particles = bool(keep_particles)
         self.snapshots: list[tuple[np.ndarray, np.ndarray]] = []
 
     def step(self, odom_prev, odom_now, scan) -> StepRecord:
-        """One iteration; returns (and keeps) its :class:`StepRecord`."""
+        """One iteration; returns (and keeps) its :class:`StepRecord`.
+
+        With ``update_min_d`` / ``update_min_a`` (ROS amcl's thresholds) the filter is updated only once the
+        odometry has moved that far since the last update (the motion of all the skipped steps is applied
+        then); a skipped step repeats the last record (``note = "no update: moved too little"``).
+        """
+        p = self.params
+        if odom_prev is not None and odom_now is not None and (p.update_min_d > 0 or p.update_min_a > 0):
+            ref = odom_prev if self._odom_ref is None else self._odom_ref
+            a = np.asarray(ref, dtype=float)
+            b = np.asarray(odom_now, dtype=float)
+            moved_d = float(np.hypot(b[0] - a[0], b[1] - a[1]))
+            moved_a = abs(float(wrap_angle(b[2] - a[2])))
+            if self.records and moved_d < p.update_min_d and moved_a < p.update_min_a:
+                self._odom_ref = a
+                rec = replace(self.records[-1], note="no update: moved too little", n_injected=0, resampled=False)
+                self.records.append(rec)
+                if self.keep_particles:
+                    self.snapshots.append(self.snapshots[-1])
+                return rec
+            odom_prev, self._odom_ref = a, b
         self.state, rec, weighted = _mcl_step(self.state, odom_prev, odom_now, scan, self.model, self.params,
                                               self.rng, free_xy=self.free_xy)
         self.records.append(rec)

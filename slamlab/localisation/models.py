@@ -32,6 +32,7 @@ from ..geometry import wrap_angle
 from ..scans import OBSTACLE, Scan, check_grid, likelihood_field
 
 __all__ = [
+    "SCORES",
     "Beams",
     "LikelihoodFieldModel",
     "ModelParams",
@@ -43,6 +44,10 @@ __all__ = [
     "sample_motion_odometry",
     "scan_beams",
 ]
+
+
+#: The observation scores a filter can weigh with (see :meth:`LikelihoodFieldModel.log_score`).
+SCORES = ("likelihood", "geometric_mean", "amcl_cubes")
 
 
 def check_particles(poses, name: str = "particles") -> np.ndarray:
@@ -291,6 +296,9 @@ class LikelihoodFieldModel:
         self.log_table = self.log_q(self.dist).ravel()
         self._padded = T.ravel()
         self._padded_shape = T.shape
+        D = np.full(T.shape, self.max_dist, dtype=np.float32)
+        D[self.pad:self.pad + H, self.pad:self.pad + W] = self.dist
+        self._padded_dist = D.ravel()
 
     def log_q(self, d) -> np.ndarray:
         """``log(z_hit·N(d; 0, σ_hit²) + z_rand/z_max)`` for distances ``d`` [cells]."""
@@ -306,12 +314,13 @@ class LikelihoodFieldModel:
         bx, by = beams.end_xy[:, 0][None, :], beams.end_xy[:, 1][None, :]
         return P[:, :1] + c * bx - s * by, P[:, 1:2] + s * bx + c * by
 
-    def beam_log_q(self, poses, beams: Beams) -> np.ndarray:
-        """``log q_k`` for every pose × beam, shape ``(N, B)``, float32 (beams at ``z_max`` give 0)."""
+    def _gather(self, table, poses, beams: Beams) -> tuple[np.ndarray, np.ndarray]:
+        """``table`` (a padded, raveled per-cell table) at every end point of the beams below ``z_max``:
+        values ``(N, B_used)`` and the mask of those beams ``(B,)``."""
         P = check_particles(poses, "poses")
         if not isinstance(beams, Beams):
             raise TypeError(f"`beams` must be Beams (from scan_beams); got {type(beams).__name__}")
-        keep = beams.ranges < min(beams.max_range, self.z_max)
+        keep = self.used(beams)
         Hp, Wp = self._padded_shape
         off = self.pad + 0.5  # floor(x + 0.5) of the cell, shifted into the padded table
         c = np.cos(P[:, 2]).astype(np.float32)[:, None]
@@ -320,16 +329,35 @@ class LikelihoodFieldModel:
         by = beams.end_xy[keep, 1].astype(np.float32)[None, :]
         x = (P[:, 0] + off).astype(np.float32)[:, None]
         y = (P[:, 1] + off).astype(np.float32)[:, None]
-        col = np.clip(np.floor(x + c * bx - s * by), 0, Wp - 1).astype(np.int32)
-        row = np.clip(np.floor(y + s * bx + c * by), 0, Hp - 1).astype(np.int32)
-        row *= Wp
-        row += col
-        vals = self._padded[row]
+        col = np.floor(x + c * bx - s * by)
+        row = np.floor(y + s * bx + c * by)
+        H, W = self.shape
+        if not (P[:, 0].min() >= -1 and P[:, 0].max() <= W and P[:, 1].min() >= -1 and P[:, 1].max() <= H):
+            # a pose off the map: its end points may leave the padding (inside it, z_max cells each side, they cannot)
+            np.clip(col, 0, Wp - 1, out=col)
+            np.clip(row, 0, Hp - 1, out=row)
+        idx = row.astype(np.int32)
+        idx *= Wp
+        idx += col.astype(np.int32)
+        return table[idx], keep
+
+    def used(self, beams: Beams) -> np.ndarray:
+        """Mask of the beams that enter the likelihood: ranges below ``z_max`` (PR Table 6.3 line 3)."""
+        return beams.ranges < min(beams.max_range, self.z_max)
+
+    def beam_log_q(self, poses, beams: Beams) -> np.ndarray:
+        """``log q_k`` for every pose × beam, shape ``(N, B)``, float32 (beams at ``z_max`` give 0)."""
+        vals, keep = self._gather(self._padded, poses, beams)
         if keep.all():
             return vals
-        out = np.zeros((P.shape[0], beams.n), dtype=np.float32)
+        out = np.zeros((vals.shape[0], beams.n), dtype=np.float32)
         out[:, keep] = vals
         return out
+
+    def beam_distances(self, poses, beams: Beams) -> tuple[np.ndarray, np.ndarray]:
+        """Distance ``d`` [cells] from every end point to the nearest obstacle (capped at ``max_dist``; off
+        the map ``max_dist``), shape ``(N, B_used)``, and the mask ``(B,)`` of the beams below ``z_max``."""
+        return self._gather(self._padded_dist, poses, beams)
 
     def log_likelihood(self, poses, beams: Beams) -> np.ndarray:
         """``log p(z | x) = Σ_k log q_k`` for every pose, shape ``(N,)``."""
@@ -337,13 +365,42 @@ class LikelihoodFieldModel:
 
     def n_used(self, beams: Beams) -> int:
         """Number of beams that enter the product (ranges below ``z_max``)."""
-        return int(np.count_nonzero(beams.ranges < min(beams.max_range, self.z_max)))
+        return int(np.count_nonzero(self.used(beams)))
 
     def score(self, log_lik, beams: Beams) -> np.ndarray:
-        """The observation score in [0, 1] of 003 §2.2 (our choice): the per-beam geometric mean of
-        ``q_k / q_max``, ``exp(log p / B − log q_max)``; it feeds w_avg, w_slow, w_fast."""
+        """The per-beam geometric mean of ``q_k / q_max``, ``exp(log p / B − log q_max)`` in [0, 1] (ours):
+        one reading of 003 §2.2's "probability between 0 and 1" per particle."""
         n = max(1, self.n_used(beams))
         return np.exp(np.asarray(log_lik, dtype=float) / n - self.log_q_max)
+
+    def log_score(self, poses, beams: Beams, score: str = "likelihood", beam_mask=None) -> np.ndarray:
+        """``log`` of the per-particle observation score ``ω`` that weighs the particles, shape ``(N,)``.
+
+        - ``"likelihood"``: ``log p(z | x) = Σ_k log q_k`` (PR Table 6.3; ROS 1 / Nav2 amcl's
+          ``likelihood_field_prob`` takes the same product, in log space, with an unnormalised Gaussian);
+        - ``"geometric_mean"`` (ours): ``(1/B)·Σ_k log(q_k / q_max)`` ≤ 0, the log of a score in [0, 1];
+        - ``"amcl_cubes"``: ``log(1 + Σ_k p_k³)`` with ``p_k = z_hit·exp(−d_k²/(2σ_hit²)) + z_rand/z_max``,
+          the ad-hoc sum of ROS 1 amcl's default ``likelihood_field`` model and Beluga's
+          ``LikelihoodFieldModel`` (both say it "works well" without a derivation).
+
+        ``beam_mask`` (B,) keeps only some beams (beam skipping); beams at ``z_max`` never count.
+        """
+        v.check_choice(score, "score", SCORES)
+        if score == "amcl_cubes":
+            d, keep = self.beam_distances(poses, beams)
+            p = self.z_hit * np.exp(-0.5 * (d.astype(np.float64) / self.sigma_hit) ** 2) + self.z_rand / self.z_max
+            if beam_mask is not None:
+                p = p[:, np.asarray(beam_mask, bool)[keep]]
+            return np.log1p((p * p * p).sum(axis=1))
+        lq = self.beam_log_q(poses, beams)
+        if beam_mask is not None:
+            m = np.asarray(beam_mask, bool)
+            lq = lq[:, m]
+            n = max(1, int(np.count_nonzero(m & self.used(beams))))
+        else:
+            n = max(1, self.n_used(beams))
+        L = lq.sum(axis=1, dtype=np.float64)
+        return L if score == "likelihood" else L / n - self.log_q_max
 
 
 # --- beam model (PR Table 6.1) ------------------------------------------------------------------------

@@ -23,6 +23,7 @@ from ..geometry import wrap_angle
 from ..scans import FREE, check_grid
 
 __all__ = [
+    "amcl_converged",
     "free_cell_centres",
     "is_localised",
     "kld_bound",
@@ -178,6 +179,20 @@ def is_localised(cov, *, pos_std: float = 2.0, heading_std_rad: float = 0.087266
         raise ValueError(f"`cov` must be a finite 3×3 matrix; got shape {C.shape}")
     lam = float(np.linalg.eigvalsh(C[:2, :2]).max())
     return bool(np.sqrt(max(lam, 0.0)) < pos_std and np.sqrt(max(C[2, 2], 0.0)) < heading_std_rad)
+
+
+def amcl_converged(particles, dist: float) -> bool:
+    """ROS 1 amcl's convergence test (``pf_update_converged``): every particle within ``dist`` of the
+    particles' (unweighted) mean in x and in y (amcl: 0.5 m).
+
+    >>> amcl_converged([[0, 0, 0], [1, 0, 3]], 0.6), amcl_converged([[0, 0, 0], [1, 0, 3]], 0.4)
+    (True, False)
+    """
+    P = np.asarray(particles, dtype=float)
+    if P.ndim != 2 or P.shape[1] < 2 or P.shape[0] == 0:
+        raise ValueError(f"`particles` must have shape (N, 3) with N >= 1; got {P.shape}")
+    d = v.check_positive(dist, "dist")
+    return bool(np.all(np.abs(P[:, :2] - P[:, :2].mean(axis=0)) <= d))
 
 
 def free_cell_centres(grid) -> np.ndarray:

@@ -77,13 +77,14 @@ def plot_weights(weights, *, ax=None, bins: int = 50, title=None):
 
 
 def plot_averages(result, *, ax=None, kidnap_step=None):
-    """w_avg, w_slow, w_fast and the injected count against the step (003 eqs 2.8-2.11)."""
-    ax = new_axes(ax, xlabel="step", ylabel="score", title="w_avg, w_slow, w_fast and injected particles")
+    """log w_avg, log w_slow, log w_fast and the injected count against the step (003 eqs 2.8-2.11)."""
+    ax = new_axes(ax, xlabel="step", ylabel="log of the average score",
+                  title="w_avg, w_slow, w_fast (log) and injected particles")
     r = result.records
     k = np.arange(len(r))
-    ax.plot(k, [x.w_avg for x in r], color="0.6", label="w_avg (2.8)")
-    ax.plot(k, [x.w_slow for x in r], color="tab:blue", label="w_slow (2.9)")
-    ax.plot(k, [x.w_fast for x in r], color="tab:orange", label="w_fast (2.10)")
+    ax.plot(k, [x.log_w_avg for x in r], color="0.6", label="log w_avg (2.8)")
+    ax.plot(k, [x.log_w_slow for x in r], color="tab:blue", label="log w_slow (2.9)")
+    ax.plot(k, [x.log_w_fast for x in r], color="tab:orange", label="log w_fast (2.10)")
     ax2 = ax.twinx()
     ax2.bar(k, [x.n_injected for x in r], color="tab:red", alpha=0.35, label="injected (2.11)")
     ax2.set_ylabel("injected particles")
@@ -91,7 +92,7 @@ def plot_averages(result, *, ax=None, kidnap_step=None):
         ax.axvline(kidnap_step, color="k", linestyle=":", label="kidnap")
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, loc="upper right", fontsize=8)
+    ax.legend(h1 + h2, l1 + l2, loc="lower left", fontsize=8)
     return ax
 
 
@@ -120,11 +121,19 @@ def plot_belief(markov, *, true_pose=None, ax=None):
 
 
 def plot_global(result, *, ax=None):
-    """Success rate against the particle count."""
-    s = result.summary()
-    ax = new_axes(ax, xlabel="particles", ylabel="success rate", title="Global localisation")
-    ax.semilogx(s.index, s["success"], "o-")
+    """Success (solid) and amcl's convergence test (dotted) against the step, one line per particle count."""
+    from .studies import _per_step
+
+    ax = new_axes(ax, xlabel="step", ylabel="share of runs", title="Global localisation")
+    df = result.table_df
+    for i, n in enumerate(sorted(df["n_particles"].unique())):
+        g = df[df["n_particles"] == n]
+        k = np.arange(1, result.n_steps + 1)
+        c = f"C{i}"
+        ax.plot(k, _per_step(g, "ok").mean(axis=0), "-", color=c, label=f"{n} particles: within 3 cells, 5°")
+        ax.plot(k, _per_step(g, "conv").mean(axis=0), ":", color=c, label=f"{n}: amcl converged")
     ax.set_ylim(-0.05, 1.05)
+    ax.legend(fontsize=7, loc="lower right")
     return ax
 
 

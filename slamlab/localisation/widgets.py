@@ -8,25 +8,29 @@ import ipywidgets as widgets
 import numpy as np
 
 from ..widgets import slider as _slider
-from .experiments import CARMEN_LOGS, demo_run, run_log_mcl
-from .plot import mcl_figure, plot_log_run, recorded_step_figure
+from .experiments import demo_run
+from .logs import CARMEN_LOGS, run_log_mcl
+from .plot import mcl_figure, plot_belief, plot_log_run, recorded_step_figure
 
-__all__ = ["explore_log", "explore_mcl", "explore_recorded_run"]
+__all__ = ["explore_log", "explore_markov", "explore_mcl", "explore_recorded_run"]
 
 
 def explore_mcl(**defaults):
     """Particle count, α_slow/α_fast, z_hit/σ_hit, odometry noise, kidnap step → a recorded global run
     (cloud at the end, error and w_slow/w_fast against the step). Any setting gives a result or a message."""
-    d = {"n_particles": 2000, "alpha_slow": 0.05, "alpha_fast": 0.5, "z_hit": 0.9, "sigma_hit": 2.0,
-         "odo_noise": 1.0, "kidnap_step": 25, "seed": 7}
+    from .mcl import MCLParams
+
+    p0 = MCLParams()
+    d = {"n_particles": 2000, "alpha_slow": p0.alpha_slow, "alpha_fast": p0.alpha_fast, "z_hit": p0.z_hit,
+         "sigma_hit": p0.sigma_hit, "odo_noise": 1.0, "kidnap_step": 25, "seed": 7}
     d.update(defaults)
 
     def show(n_particles, alpha_slow, alpha_fast, z_hit, sigma_hit, odo_noise, kidnap_step):
         try:
-            alpha = tuple(float(a * odo_noise) for a in (0.05, 0.002, 0.05, 0.005))
+            alpha = tuple(float(a * odo_noise) for a in p0.alpha)
             run, res = demo_run(int(n_particles), kidnap_step=int(kidnap_step) or None, alpha_slow=alpha_slow,
                                 alpha_fast=alpha_fast, seed=d["seed"], z_hit=z_hit, z_rand=1.0 - z_hit,
-                                sigma_hit=sigma_hit, alpha=alpha)
+                                sigma_hit=sigma_hit, max_dist=3 * sigma_hit, alpha=alpha)
         except (ValueError, TypeError) as exc:
             print(f"Cannot run with these settings: {exc}")
             return
@@ -85,4 +89,50 @@ def explore_log(**defaults):
         start=_slider(widgets.IntSlider, d["start"], 0, 150, 10, "first scan"),
         n_scans=_slider(widgets.IntSlider, d["n_scans"], 10, 80, 5, "scans"),
         n_global=_slider(widgets.IntSlider, d["n_global"], 1000, 40000, 1000, "global particles"),
+    )
+
+
+def explore_markov(**defaults):
+    """The Markov grid (003 §2.2.1): belief-cell size, headings, steps, the prior and an optional kidnap → the
+    belief over the map after the last step, and the error at each step."""
+    from .experiments import simulate_run
+    from .markov import MarkovGrid
+
+    d = {"resolution": 4, "n_headings": 36, "n_steps": 8, "prior": "uniform", "kidnap_step": 0,
+         "uniform_floor": 0.0, "seed": 7}
+    d.update(defaults)
+
+    def show(resolution, n_headings, n_steps, prior, kidnap_step, uniform_floor):
+        try:
+            k = int(kidnap_step) or None
+            if k is not None and k >= n_steps:
+                raise ValueError(f"the kidnap step ({k}) must come before the last step ({n_steps - 1})")
+            rng = np.random.default_rng(d["seed"])
+            run = simulate_run(int(n_steps), start=0, kidnap_step=k, rng=rng)
+            g = MarkovGrid(run.grid, run.max_range, resolution=int(resolution), n_headings=int(n_headings),
+                           uniform_floor=float(uniform_floor))
+            if prior != "uniform":
+                off = 0.0 if prior == "Gaussian at the start" else 30.0
+                g.belief = g.gaussian_prior(run.true_poses[0] + [off, 0.0, 0.0], 10.0, np.radians(20))
+            errs = []
+            for i in range(run.n_steps):
+                prev, now = (run.odom_poses[i - 1], run.odom_poses[i]) if i else (None, None)
+                m = g.step(prev, now, run.scans[i])
+                errs.append(float(np.hypot(*(m[:2] - run.true_poses[i, :2]))))
+        except (ValueError, TypeError) as exc:
+            print(f"Cannot run with these settings: {exc}")
+            return
+        print(f"belief {g.belief.shape} ({g.nbytes / 2**20:.2f} MiB); position error per step [cells]: "
+              + ", ".join(f"{e:.1f}" for e in errs))
+        plot_belief(g, true_pose=run.true_poses[-1])
+
+    return widgets.interactive(
+        show,
+        resolution=_slider(widgets.IntSlider, d["resolution"], 2, 10, 1, "cell size [map cells]"),
+        n_headings=_slider(widgets.IntSlider, d["n_headings"], 8, 72, 4, "headings"),
+        n_steps=_slider(widgets.IntSlider, d["n_steps"], 2, 30, 1, "steps"),
+        prior=widgets.Dropdown(options=["uniform", "Gaussian at the start", "Gaussian 30 cells off"],
+                               value=d["prior"], description="prior"),
+        kidnap_step=_slider(widgets.IntSlider, d["kidnap_step"], 0, 29, 1, "kidnap step (0 = none)"),
+        uniform_floor=widgets.Dropdown(options=[0.0, 1e-6, 1e-3], value=d["uniform_floor"], description="floor ε"),
     )

@@ -82,3 +82,38 @@ def test_weights_errors():
         L.is_localised(np.eye(2))
     with pytest.raises(ValueError, match="`alpha` must be four"):
         L.motion_density_odometry([[0, 0, 0]], [[0, 0, 0]], [0, 0, 0], [1, 0, 0], (1, 2, 3))
+
+
+def test_new_params_checks():
+    with pytest.raises(ValueError, match="`score` must be one of"):
+        L.MCLParams(score="product")
+    with pytest.raises(ValueError, match="`averages` must be one of"):
+        L.MCLParams(averages="zero")
+    with pytest.raises(TypeError, match="`beam_skip` must be a bool"):
+        L.MCLParams(beam_skip=1)
+    with pytest.raises(ValueError, match="`converged_dist` must be > 0"):
+        L.MCLParams(converged_dist=0.0)
+    with pytest.raises(ValueError, match="`uniform_floor` must be in"):
+        L.MarkovParams(uniform_floor=1.0)
+    with pytest.raises(TypeError, match="`variants` must hold"):
+        L.run_global_ablation([("a", 3)], n_runs=1)
+    with pytest.raises(ValueError, match="`size` must be one of"):
+        L.run_global_ablation(size="huge")
+    with pytest.raises(TypeError, match="has no field"):
+        L.run_global_localisation((10,), n_runs=1, sigma=3)
+    mg = L.MarkovGrid(_room(), 30.0, resolution=2, n_headings=8)
+    with pytest.raises(ValueError, match="`pose` must be three finite"):
+        mg.gaussian_prior([np.nan, 1, 0], 2.0, 0.3)
+
+
+def test_log_with_too_few_scans_names_the_length(tmp_path):
+    from slamlab.io import CarmenLog
+
+    n = 5
+    log = CarmenLog(path=str(tmp_path / "tiny.log"), ranges_m=np.ones((n, 4)), valid=np.ones((n, 4), bool),
+                    poses=np.zeros((n, 3)), odom_poses=np.zeros((n, 3)), timestamps_s=np.arange(n, dtype=float),
+                    odom=np.zeros((0, 4)), max_range_m=10.0)
+    with pytest.raises(ValueError, match=r"`n_scans` must be <= the 5 scans of log 'tiny.log'; got 40"):
+        L.run_log_mcl(log, n_scans=40)
+    with pytest.raises(ValueError, match=r"`start` \+ `n_scans` must be <= the 5 scans of log 'tiny.log'; got 4 \+ 3"):
+        L.run_log_mcl(log, start=4, n_scans=3)

@@ -161,3 +161,29 @@ def test_odometry_deltas_tiny_translation_has_no_first_rotation():
     r1, _t, r2 = L.odometry_deltas([0, 0, 0.2], [1e-9, 0, 0.5])
     assert float(r1) == 0.0
     assert float(r2) == pytest.approx(0.3)
+
+
+def test_the_three_scores_against_per_beam_loops():
+    """log_score: 'likelihood' = Σ log q_k, 'geometric_mean' = mean log(q_k/q_max), 'amcl_cubes' = log(1 + Σ p_k³)
+    with amcl's unnormalised p_k (amcl_laser.cpp LikelihoodFieldModel), from the distance table by a loop."""
+    M = S.test_room_200()
+    m = L.LikelihoodFieldModel(M, z_hit=0.8, z_rand=0.2, sigma_hit=3.0, z_max=60.0, max_dist=9.0)
+    X = L.uniform_free_particles(M, 30, np.random.default_rng(8))
+    scan = S.Rangefinder(n_beams=40, max_range_cells=60, range_std_cells=0.3).scan(M, [100, 60, 1.0], 3)
+    b = L.scan_beams(scan)
+    d, keep = m.beam_distances(X, b)
+    assert keep.sum() == d.shape[1] == m.n_used(b)
+    lq = m.beam_log_q(X, b)[:, keep].astype(float)
+    np.testing.assert_allclose(np.log(0.8 * stats.norm(0, 3.0).pdf(d) + 0.2 / 60), lq, rtol=1e-5)
+    cubes = np.array([math.log(1 + sum((0.8 * math.exp(-dk * dk / 18.0) + 0.2 / 60) ** 3 for dk in row))
+                      for row in d.astype(float)])
+    np.testing.assert_allclose(m.log_score(X, b, "likelihood"), lq.sum(axis=1), rtol=1e-6)
+    np.testing.assert_allclose(m.log_score(X, b, "geometric_mean"), lq.mean(axis=1) - m.log_q_max, rtol=1e-6)
+    np.testing.assert_allclose(m.log_score(X, b, "amcl_cubes"), cubes, rtol=1e-9)
+    np.testing.assert_allclose(np.exp(m.log_score(X, b, "geometric_mean")), m.score(m.log_likelihood(X, b), b),
+                               rtol=1e-6)
+    mask = np.zeros(b.n, bool)
+    mask[np.flatnonzero(keep)[:5]] = True
+    np.testing.assert_allclose(m.log_score(X, b, "likelihood", mask), lq[:, :5].sum(axis=1), rtol=1e-6)
+    with pytest.raises(ValueError, match="`score` must be one of"):
+        m.log_score(X, b, "beam")

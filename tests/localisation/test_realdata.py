@@ -47,3 +47,16 @@ def test_log_by_path_and_bad_path(tmp_path):
         L.run_log_mcl(tmp_path / "missing.log.gz")
     with pytest.raises(TypeError, match=r"`path` must be a str or os\.PathLike"):
         L.run_log_mcl(3.5)
+
+
+
+def test_protocol_runs_on_a_log_by_path(shared_data):
+    """The protocol on any CARMEN log by path: one row per stretch and count, the same stretches for every count.
+    (Issue 27's goal, success >= 0.8 over 10 stretches of 30 scans per log with 20 000 particles, does not hold:
+    0.68 measured on 2026-11-26, so it is not pinned.)"""
+    path = shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz"
+    res = L.run_log_protocol(path, (300, 600), n_runs=2, n_scans=4, seed=0, progress=False)
+    df = res.table_df
+    assert len(df) == 4
+    assert df.groupby("n_particles")["start"].apply(list).tolist() == [[0, df["start"].max()]] * 2
+    assert "seattle-corrected" in res.table()
