@@ -184,12 +184,46 @@ class MonoRunResult:
         return format_table(["quantity", "value"], rows, title=self.name)
 
 
+def _check_frames(images) -> list:
+    """``images`` as a list of grey frames of one size, or a ValueError/TypeError naming ``images``."""
+    if isinstance(images, np.ndarray) and images.ndim == 3:
+        images = list(images)
+    try:
+        images = list(images)
+    except TypeError:
+        raise TypeError(f"`images` must be a sequence of grey images; got {type(images).__name__}") from None
+    if not images:
+        raise ValueError("`images` must hold at least one frame; got none")
+    out = [v.as_image(img, f"images[{i}]") for i, img in enumerate(images)]
+    shape0 = out[0].shape
+    for i, img in enumerate(out):
+        if img.shape != shape0:
+            raise ValueError(f"`images` must all have one size; images[0] is {shape0} (H, W) but images[{i}] is "
+                             f"{img.shape}")
+    return out
+
+
+def _check_truth(truth_T_wc, n: int) -> np.ndarray:
+    """``truth_T_wc`` as an (n, 4, 4) array, or a ValueError naming ``truth_T_wc``."""
+    T = v.as_finite_array(truth_T_wc, "truth_T_wc", ndim=3)
+    if T.shape[1:] != (4, 4):
+        raise ValueError(f"`truth_T_wc` must have shape (N, 4, 4); got {T.shape}")
+    if T.shape[0] != n:
+        raise ValueError(f"`truth_T_wc` must hold one pose per frame: {n} frames in `images`, {T.shape[0]} poses "
+                         "in `truth_T_wc`")
+    return T
+
+
 def run_mono(images, truth_T_wc, K, *, name: str = "run", params: MonoParams | None = None, progress=None,
              snapshot_frames=(), **overrides) -> MonoRunResult:
     """Run :class:`MonoSLAM` on images with ground truth ``(N, 4, 4)`` and score it (003 §5.2).
 
     ``snapshot_frames``: frames after which the seeds' ``σ_ρ / ρ_range`` are kept (for histograms).
+    Raises ``ValueError`` naming the argument when the frames differ in size or ``truth_T_wc``
+    does not hold one pose per frame.
     """
+    images = _check_frames(images)
+    truth_T_wc = _check_truth(truth_T_wc, len(images))
     p = MonoParams.resolve(params, **overrides)
     slam = MonoSLAM(K, params=p)
     snaps = {}

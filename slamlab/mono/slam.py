@@ -95,6 +95,7 @@ class MonoSLAM:
         self._prev_img = None
         self._n_at_kf = 0
         self._since_kf = 0
+        self._shape = None  # (H, W) of the first frame: every frame must have it
         self._px_angle = 2.0 * np.arctan(p.px_noise / (2.0 * self.K[0, 0]))
 
     # -- helpers ---------------------------------------------------------------------------
@@ -118,6 +119,9 @@ class MonoSLAM:
         image = v.as_image(image, "image")
         if image.ndim == 3:
             raise ValueError(f"`image` must be a grey image (H, W); got shape {image.shape}")
+        if self.records and image.shape != self._shape:
+            raise ValueError(f"`image` must have the size of the first frame {self._shape} (H, W); got {image.shape}")
+        self._shape = image.shape
         times = dict.fromkeys(STAGES, 0.0)
         idx = len(self.records)
         if not self.initialised:

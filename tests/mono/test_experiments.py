@@ -73,3 +73,32 @@ def test_both_convergence_criteria_run(strafe_frames):
     # at a wall 2.5 m away and 2 cm steps, SVO's sigma < range/200 is the stricter test
     assert n["linearity"] > 0
     assert n["sigma"] <= n["linearity"]
+
+
+def test_run_mono_rejects_frames_of_different_sizes(strafe_frames):
+    from slamlab.mono.experiments import run_mono
+
+    imgs, Ts, K = strafe_frames
+    frames = [*imgs[:3], imgs[3][:-2]]
+    with pytest.raises(ValueError, match=r"`images` must all have one size.*images\[3\]"):
+        run_mono(frames, Ts[:4], K, progress=False)
+    with pytest.raises(ValueError, match=r"`images\[1\]` must have shape \(H, W\)"):
+        run_mono([imgs[0], np.zeros((4, 4, 4, 4))], Ts[:2], K, progress=False)
+    with pytest.raises(ValueError, match="`images` must hold at least one frame"):
+        run_mono([], Ts[:0], K, progress=False)
+    slam = MonoSLAM(K)
+    slam.process(imgs[0])
+    with pytest.raises(ValueError, match="`image` must have the size of the first frame"):
+        slam.process(imgs[1][:, :-1])
+
+
+def test_run_mono_rejects_truth_of_another_length(strafe_frames):
+    from slamlab.mono.experiments import run_mono
+
+    imgs, Ts, K = strafe_frames
+    with pytest.raises(ValueError, match=r"`truth_T_wc` must hold one pose per frame: 6 frames in `images`, 5 poses"):
+        run_mono(imgs[:6], Ts[:5], K, progress=False)
+    with pytest.raises(ValueError, match=r"`truth_T_wc` must have shape \(N, 4, 4\)"):
+        run_mono(imgs[:2], Ts[:2, :3], K, progress=False)
+    with pytest.raises(ValueError, match="`truth_T_wc` must be 3-dimensional"):
+        run_mono(imgs[:2], Ts[0], K, progress=False)
