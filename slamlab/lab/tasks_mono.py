@@ -96,7 +96,7 @@ def _observations_to_half() -> float:
 
 
 def _kitti_tracked() -> float:
-    from ..mono.experiments import run_kitti_mono
+    from ..mono.kitti import run_kitti_mono
 
     return float(run_kitti_mono().tracked.sum())
 

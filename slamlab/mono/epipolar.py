@@ -21,7 +21,7 @@ from ..geometry.triangulation import triangulate_midpoint
 from .align import bilinear
 from .depth_filter import depth_interval
 
-__all__ = ["EpipolarMatch", "epipolar_segments", "extract_patches", "search_epipolar", "zncc"]
+__all__ = ["EpipolarMatch", "affine_warp", "epipolar_segments", "extract_patches", "search_epipolar", "warped_patches", "zncc"]
 
 _FAR_DEPTH = 1e6  # depths beyond this are drawn at their vanishing point
 
@@ -101,19 +101,64 @@ class EpipolarMatch:
     b: np.ndarray
 
 
+def affine_warp(K, T_cur_ref, f, depth_m, uv_ref, *, h_px: float = 5.0) -> np.ndarray:
+    """``(N, 2, 2)`` affine warp ``∂uv_cur / ∂uv_ref`` of each point at ``depth_m`` along ``f`` (SVO's
+    ``getWarpMatrixAffine``): the pixel ``uv_ref`` shifted by ``h_px`` in u and in v, back-projected to the
+    same depth and projected into the current camera. Written without BLAS (einsum)."""
+    K = np.asarray(K, dtype=np.float64)
+    R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
+    uv_ref = np.asarray(uv_ref, dtype=np.float64).reshape(-1, 2)
+    z = np.asarray(depth_m, dtype=np.float64).reshape(-1)
+
+    def cur_px(uv):
+        r = np.column_stack([(uv[:, 0] - K[0, 2]) / K[0, 0], (uv[:, 1] - K[1, 2]) / K[1, 1], np.ones(len(uv))])
+        r /= np.sqrt(np.einsum("ni,ni->n", r, r))[:, None]
+        X = np.einsum("ij,nj->ni", R, r * z[:, None]) + t
+        Z = np.maximum(X[:, 2], 1e-6)
+        return np.column_stack([K[0, 0] * X[:, 0] / Z + K[0, 2], K[1, 1] * X[:, 1] / Z + K[1, 2]])
+
+    del f  # the ray of uv_ref is f; the shifted rays are rebuilt from the pixels
+    c = cur_px(uv_ref)
+    du = (cur_px(uv_ref + np.array([h_px, 0.0])) - c) / h_px
+    dv = (cur_px(uv_ref + np.array([0.0, h_px])) - c) / h_px
+    return np.stack([du, dv], axis=2)  # columns: d/du, d/dv
+
+
+def warped_patches(img_ref, uv_ref, A, patch_px: int) -> np.ndarray:
+    """``(N, patch_px²)`` reference patches resampled as the current camera sees them: pixel ``o`` of the
+    current patch is ``uv_ref + A⁻¹ o`` in the reference image (SVO's ``warpAffine``)."""
+    A = np.asarray(A, dtype=np.float64)
+    det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+    det = np.where(np.abs(det) > 1e-9, det, 1.0)
+    Ai = np.stack([np.stack([A[:, 1, 1], -A[:, 0, 1]], 1), np.stack([-A[:, 1, 0], A[:, 0, 0]], 1)], 1) / det[:, None, None]
+    o = np.arange(patch_px) - (patch_px - 1) / 2.0
+    ou, ov = (g.ravel() for g in np.meshgrid(o, o))
+    uu = uv_ref[:, 0:1] + Ai[:, 0, 0:1] * ou + Ai[:, 0, 1:2] * ov
+    vv = uv_ref[:, 1:2] + Ai[:, 1, 0:1] * ou + Ai[:, 1, 1:2] * ov
+    h, w = img_ref.shape[:2]
+    uu, vv = np.clip(uu, 0, w - 2), np.clip(vv, 0, h - 2)
+    return bilinear(np.asarray(img_ref, np.float32), uu, vv)
+
+
 def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv, *, n_sigma: float = 2.0,
                     tol_px: float = 2.0, patch_px: int = 9, zncc_min: float = 0.8, min_parallax_rad: float = 1e-3,
-                    chunk: int = 512, cur_patches=None) -> EpipolarMatch:
+                    chunk: int = 512, cur_patches=None, img_ref=None, uv_ref=None) -> EpipolarMatch:
     """Find each seed in the current frame among FAST corners near its epipolar segment (003 §4.2).
 
     ``ref_patches`` (N, patch_px²) the seeds' patches in their reference keyframe;
     ``corners_uv`` (C, 2) the current frame's FAST corners. Vectorised over seeds × corners
     in chunks of ``chunk`` seeds. ``cur_patches`` (C, patch_px²): the corners' patches, if
     already cut (then ``corners_uv`` must be the same corners, all inside the margin).
+    ``img_ref`` and ``uv_ref`` (N, 2) given: the reference patches are warped affinely to the
+    current view at the seed's mean depth (SVO's remedy for scale change, e.g. forward motion)
+    instead of ``ref_patches``.
     """
     K = np.asarray(K, dtype=np.float64)
     f = np.asarray(f, dtype=np.float64).reshape(-1, 3)
     n = f.shape[0]
+    if img_ref is not None and uv_ref is not None and n:
+        A = affine_warp(K, T_cur_ref, f, 1.0 / np.maximum(np.asarray(mu, dtype=np.float64), 1e-6), uv_ref)
+        ref_patches = warped_patches(img_ref, np.asarray(uv_ref, dtype=np.float64).reshape(-1, 2), A, patch_px)
     a, b, ok = epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma)
     corners = np.asarray(corners_uv, dtype=np.float64).reshape(-1, 2)
     h, w = img_cur.shape[:2]

@@ -314,6 +314,8 @@ class Initialiser:
     method: str = "homography"
     ransac_px: float = 2.0
     min_parallax_deg: float = 1.0
+    min_point_parallax_deg: float = 0.0  # ours: points of the first map need at least this triangulation angle
+    plane_share: float = 0.9  # "auto": the homography when its inliers are at least this share of the 5-point's
     median_depth_m: float = 1.0
     lk_win_px: int = 21
     fb_max_px: float = 1.0
@@ -330,8 +332,10 @@ class Initialiser:
         v.check_int(self.min_corners, "min_corners", minimum=5)
         v.check_positive(self.min_disparity_px, "min_disparity_px", allow_zero=True)
         v.check_probability(self.min_tracked_ratio, "min_tracked_ratio")
-        v.check_choice(self.method, "method", ("homography", "essential"))
+        v.check_choice(self.method, "method", ("homography", "essential", "auto"))
+        v.check_probability(self.plane_share, "plane_share")
         v.check_positive(self.min_parallax_deg, "min_parallax_deg", allow_zero=True)
+        v.check_positive(self.min_point_parallax_deg, "min_point_parallax_deg", allow_zero=True)
 
     def _count(self, status):
         self.counts[status] = self.counts.get(status, 0) + 1
@@ -363,8 +367,16 @@ class Initialiser:
             return self._count("tracking")
         if self.method == "homography":
             pose = relative_pose_homography(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
-        else:
+        elif self.method == "essential":
             pose = relative_pose_essential(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
+        else:  # "auto" (ours): 003's homography when a dominant plane explains the matches, else the 5-point
+            pose_h = relative_pose_homography(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
+            pose_e = relative_pose_essential(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
+            n_h = int(np.count_nonzero(pose_h.inliers)) if pose_h.ok else 0
+            n_e = int(np.count_nonzero(pose_e.inliers)) if pose_e.ok else 0
+            pose = pose_h if pose_h.ok and n_h >= self.plane_share * n_e else pose_e
+            self.counts["auto_homography" if pose is pose_h else "auto_essential"] = \
+                self.counts.get("auto_homography" if pose is pose_h else "auto_essential", 0) + 1
         if not pose.ok:
             status = "degenerate_homography" if "homography" in pose.reason or pose.reason == "cheirality" else "no_parallax"
             self.reset(image, self.frame_index)
@@ -378,7 +390,12 @@ class Initialiser:
         r1 /= np.maximum(np.linalg.norm(r1, axis=1, keepdims=True), 1e-12)
         parallax = np.degrees(np.arccos(np.clip(np.sum(r0 * r1, axis=1), -1, 1)))
         if front.sum() < 8 or np.median(parallax[front]) < self.min_parallax_deg:
-            # pure rotation or too little baseline: 003 §5.3 — no usable depth
+            # pure rotation or too little baseline: 003 §5.3 — no usable depth yet; keep the first
+            # frame and wait for more baseline (ours; 003 restarts only when the tracks are lost)
+            self.counts["no_parallax"] = self.counts.get("no_parallax", 0) + 1
+            return "no_parallax"
+        front &= parallax >= self.min_point_parallax_deg  # ours: a point with too little parallax has no depth
+        if front.sum() < 8:
             self.reset(image, self.frame_index)
             self.counts["no_parallax"] = self.counts.get("no_parallax", 0) + 1
             return "no_parallax"

@@ -19,9 +19,13 @@ class MonoParams(Params):
     min_corners: int = param(50, "003 §4.3.1: at least 50 FAST points")
     init_disparity_px: float = param(15.0, "003 §5.1.1: 10-20 px ('initial displacement')")
     init_min_tracked: float = param(0.5, "ours: restart when fewer than this share of corners is still tracked")
-    init_method: str = param("homography", "003 §4.3.1: homography + RANSAC ('essential' = the 5-point method)")
+    init_method: str = param("auto", "ours: 003 §4.3.1's homography when a dominant plane explains the matches, "
+                                     "else the 5-point method it also names ('homography', 'essential')")
+    init_plane_share: float = param(0.9, "ours ('auto'): the homography when its RANSAC inliers are at least this "
+                                         "share of the 5-point method's")
     init_ransac_px: float = param(2.0, "ours")
     init_min_parallax_deg: float = param(1.0, "ours: median triangulation angle needed")
+    init_min_point_parallax_deg: float = param(0.0, "ours: triangulation angle each point of the first map needs")
     # depth filter (003 §4.1.1, §4.2, §4.3.2; SVO)
     convergence: str = param("linearity", "003 §4.3.2: 'linearity' (L < 0.1) or SVO's 'sigma'")
     L_max: float = param(0.1, "003 §4.3.2")
@@ -30,6 +34,7 @@ class MonoParams(Params):
     epi_tol_px: float = param(2.0, "ours: 003 §4.2 says the band around the epipolar line is tunable")
     patch_px: int = param(9, "ours: patch side for the seed score (ZNCC; SVO scores 8x8 patches)")
     zncc_min: float = param(0.8, "ours: minimum ZNCC of a seed match")
+    warp_patches: bool = param(True, "SVO: the seed's patch warped affinely to the current view at its mean depth")
     px_noise: float = param(1.0, "SVO: one pixel of measurement error")
     max_seed_fail: int = param(10, "ours: 003 §4.3.2 drops a seed not found 'for several frames'")
     min_inlier_ratio: float = param(0.1, "SVO: drop seeds with a/(a+b) < 0.1")
@@ -40,7 +45,7 @@ class MonoParams(Params):
     kf_max_lost_ratio: float = param(0.30, "003 §4.3 / §5.1.1 ('lost-point ratio'): > 30 % lost forces one")
     max_keyframes: int = param(10, "003 §5.1.1: 'number of keyframes', value not given")
     # tracking (003 §4.4)
-    motion_model: str = param("constant_position", "SVO; 003 §4.4 step 1 uses 'constant_velocity' (available)")
+    motion_model: str = param("constant_velocity", "003 §4.4 step 1 ('constant_position': SVO's)")
     align_patch_px: int = param(4, "003 §4.4.1: 4x4 patches")
     align_max_level: int = param(3, "ours: coarsest pyramid level")
     align_min_level: int = param(1, "003 §4.4.1: the finest levels can be skipped")
@@ -48,17 +53,33 @@ class MonoParams(Params):
     align_max_points: int = param(400, "ours: map points used by the direct alignment")
     max_matches: int = param(120, "003 §5.1.1: 'number of matches', value not given")
     match_win_px: int = param(11, "ours: LK window refining a projected point")
-    reproj_inlier_px: float = param(2.0, "ours")
+    refine_iters: int = param(200, "ours: Levenberg-Marquardt steps of the motion-only refinement")
+    reproj_inlier_deg: float = param(0.33, "ours: inlier angle of a reprojection (4 px at KITTI's 707 px focal "
+                                           "length, 1.5 px at the rendered 264 px)")
     min_inliers: int = param(20, "ours: fewer inliers = lost")
+    max_coast: int = param(0, "ours: lost frames over which the constant-velocity prior keeps moving the pose "
+                                  "before a re-initialisation (0: re-initialise at once)")
+    reinit_when_lost: bool = param(True, "ours: after coasting, a new two-view map placed at the predicted pose, "
+                                         "scaled by the velocity (constant-velocity prior only)")
+    prefer_seen: bool = param(True, "ours: among the map points in view, those matched in the previous frame first")
+    # failure detection and the switches of 003 §5.1.1 / §5.4 (ours unless stated)
+    min_inlier_share: float = param(0.35, "ours: lost when fewer than this share of the matched points are inliers")
+    max_align_rms: float = param(40.0, "ours: lost when the alignment's photometric RMS (grey levels) exceeds this")
+    outlier_rejection: bool = param(True, "003 §5.1.1 item 5 (RdE); our form: a second refinement without points "
+                                          "over 3 px and dropping points that keep failing")
+    refine: bool = param(True, "003 §4.4 step 4: motion-only refinement of the reprojection error (off: the "
+                               "alignment's pose is final)")
 
     def check(self) -> None:
         v.check_int(self.fast_threshold, "fast_threshold", minimum=1, maximum=254)
         v.check_int(self.min_corners, "min_corners", minimum=8)
         v.check_positive(self.init_disparity_px, "init_disparity_px")
         v.check_probability(self.init_min_tracked, "init_min_tracked")
-        v.check_choice(self.init_method, "init_method", ("homography", "essential"))
+        v.check_choice(self.init_method, "init_method", ("homography", "essential", "auto"))
+        v.check_probability(self.init_plane_share, "init_plane_share")
         v.check_positive(self.init_ransac_px, "init_ransac_px")
         v.check_positive(self.init_min_parallax_deg, "init_min_parallax_deg", allow_zero=True)
+        v.check_positive(self.init_min_point_parallax_deg, "init_min_point_parallax_deg", allow_zero=True)
         v.check_choice(self.convergence, "convergence", ("linearity", "sigma"))
         v.check_positive(self.L_max, "L_max")
         v.check_positive(self.sigma_fraction, "sigma_fraction")
@@ -86,5 +107,13 @@ class MonoParams(Params):
         v.check_int(self.align_max_points, "align_max_points", minimum=10)
         v.check_int(self.max_matches, "max_matches", minimum=6)
         v.check_int(self.match_win_px, "match_win_px", minimum=5, maximum=51)
-        v.check_positive(self.reproj_inlier_px, "reproj_inlier_px")
+        v.check_positive(self.reproj_inlier_deg, "reproj_inlier_deg")
         v.check_int(self.min_inliers, "min_inliers", minimum=6)
+        v.check_int(self.max_coast, "max_coast", minimum=0)
+        v.check_int(self.refine_iters, "refine_iters", minimum=1)
+        if not 0.0 <= v.check_positive(self.min_inlier_share, "min_inlier_share", allow_zero=True) <= 1.0:
+            raise ValueError(f"`min_inlier_share` must be in [0, 1]; got {self.min_inlier_share}")
+        v.check_positive(self.max_align_rms, "max_align_rms")
+        for name in ("outlier_rejection", "refine", "prefer_seen", "warp_patches", "reinit_when_lost"):
+            if not isinstance(getattr(self, name), bool):
+                raise TypeError(f"`{name}` must be True or False; got {getattr(self, name)!r}")

@@ -5,9 +5,15 @@ Per frame: initialisation until two keyframes exist (003 §4.3.1); then tracking
 points projected and refined by Lucas-Kanade from their keyframe → motion-only
 refinement), the depth filter of every seed (003 §4.2, §4.3.2) and the keyframe rules
 (003 §4.3). SDVL runs tracking and mapping in two threads; we run them in turn (our
-simplification: the results do not depend on thread timing). Bad input is counted in
-:attr:`MonoSLAM.counts` and never raises or gives a NaN pose; a lost frame keeps the last
-tracked pose and is marked ``tracked = False``.
+simplification: the results do not depend on thread timing).
+
+Failure (ours): a frame is *lost* when too few points, or too small a share of the matched
+points, reproject within ``reproj_inlier_deg``, or when the alignment's photometric RMS is
+too large. A lost frame reports the pose the motion prior predicts (``max_coast`` frames of
+coasting), then a new two-view map is started from the last tracked frame, placed at its
+pose and scaled by the recent per-frame steps, and accepted only if its motion agrees with
+the prior (``reinit_when_lost``; SDVL stays lost until it sees a known place, 003 §5.3).
+Bad input never gives a NaN pose; a frame of another size is a ``ValueError``.
 """
 
 from __future__ import annotations
@@ -41,6 +47,18 @@ __all__ = ["STAGES", "Keyframe", "MonoSLAM"]
 STAGES = ("detect", "align", "match", "refine", "mapping", "keyframe")
 
 
+def orthonormalise(T) -> np.ndarray:
+    """``T`` with its rotation pulled back onto SO(3) by two Newton-Schulz steps ``R ← R (3I − RᵀR) / 2``
+    (ours; einsum, no BLAS). A constant-velocity prior composes a pose with the inverse (the transpose)
+    of the last one every frame: without this, a 1e-16 departure from orthonormality grows ~2.4× per frame."""
+    T = np.array(T, dtype=np.float64)
+    R = T[:3, :3]
+    for _ in range(2):
+        R = 0.5 * np.einsum("ij,jk->ik", R, 3.0 * np.eye(3) - np.einsum("ji,jk->ik", R, R))
+    T[:3, :3] = R
+    return T
+
+
 @dataclass
 class Keyframe:
     """A keyframe (003 §4.3): its id, frame index, pose ``T_cw`` (world → camera) and image."""
@@ -72,10 +90,10 @@ class MonoSLAM:
         self.K = v.as_matrix(K, "K", (3, 3))
         self.p = MonoParams.resolve(params, **overrides)
         p = self.p
-        self.init = Initialiser(self.K, self._corners, min_corners=p.min_corners,
-                                min_disparity_px=p.init_disparity_px, min_tracked_ratio=p.init_min_tracked,
-                                method=p.init_method, ransac_px=p.init_ransac_px,
-                                min_parallax_deg=p.init_min_parallax_deg)
+        self.init = self._new_initialiser()
+        self._last_idx = -1  # index of the last tracked (or initialised) frame
+        self._steps: list[float] = []  # recent per-frame steps (map units) of tracked frames
+        self._reinit = None  # while re-initialising after a loss (ours): velocity, predicted poses, frame offset
         self.initialised = False
         self.keyframes: list[Keyframe] = []
         self._next_kf = 0
@@ -95,9 +113,22 @@ class MonoSLAM:
         self._prev_img = None
         self._n_at_kf = 0
         self._since_kf = 0
+        self._n_coast = 0  # frames lost since the last tracked one, coasting on the velocity
+        self._T_show = None  # the pose reported for a lost frame when coasting
+        self._diag: dict = {}  # the last frame's matched count and alignment residual
+        self._shape = None  # (H, W) of the first frame: every frame must have it
+        self._inlier_px = float(self.K[0, 0] * np.tan(np.deg2rad(p.reproj_inlier_deg)))
         self._px_angle = 2.0 * np.arctan(p.px_noise / (2.0 * self.K[0, 0]))
 
     # -- helpers ---------------------------------------------------------------------------
+    def _new_initialiser(self) -> Initialiser:
+        p = self.p
+        return Initialiser(self.K, self._corners, min_corners=p.min_corners,
+                           min_disparity_px=p.init_disparity_px, min_tracked_ratio=p.init_min_tracked,
+                           method=p.init_method, ransac_px=p.init_ransac_px,
+                           min_parallax_deg=p.init_min_parallax_deg,
+                           min_point_parallax_deg=p.init_min_point_parallax_deg, plane_share=p.init_plane_share)
+
     def _corners(self, image):
         from ..features.opencv import fast_cv
 
@@ -118,22 +149,34 @@ class MonoSLAM:
         image = v.as_image(image, "image")
         if image.ndim == 3:
             raise ValueError(f"`image` must be a grey image (H, W); got shape {image.shape}")
+        if self.records and image.shape != self._shape:
+            raise ValueError(f"`image` must have the size of the first frame {self._shape} (H, W); got {image.shape}")
+        self._shape = image.shape
         times = dict.fromkeys(STAGES, 0.0)
+        self._diag = {}
         idx = len(self.records)
         if not self.initialised:
+            if self._reinit is not None:  # the pose predicted for this frame, and its place in the initialiser
+                r = self._reinit
+                r["T_pred"][idx] = orthonormalise(se3_compose(r["vel"], r["T_pred"][max(r["T_pred"])]))
+                r["frames"].append(idx)
             status = self.init.add_frame(image)
             self._count(f"init_{status}")
             tracked = False
-            n_inl = 0
-            if status == "done":
-                self._start_map(image, idx)
+            n_inl = self._start_map(image, idx) if status == "done" else None
+            if n_inl is not None:
                 tracked = True
-                n_inl = len(self.points)
                 status = "initialised"
+            elif status == "done":
+                status, n_inl = "reinit_rejected", 0
+            elif self._reinit is not None:  # re-initialising: the pose moves on with the velocity
+                self._T_show = self._reinit["T_pred"][idx]
+            n_inl = n_inl or 0
         else:
             status, tracked, n_inl = self._track(image, idx, times)
-        T_wc = se3_inverse(self._T_cw)
+        T_wc = se3_inverse(self._T_cw if self._T_show is None else self._T_show)
         rec = {"frame": idx, "status": status, "tracked": tracked, "T_wc": T_wc, "n_inliers": int(n_inl),
+               "n_matched": self._diag.get("n_matched", 0), "align_rms": self._diag.get("align_rms", float("nan")),
                "n_points": len(self.points), "n_seeds": len(self.seeds), "n_keyframes": len(self.keyframes),
                "times": times}
         self.records.append(rec)
@@ -165,24 +208,64 @@ class MonoSLAM:
     def _start_map(self, image, idx):
         res = self.init.result
         R, t = res.pose.R, res.pose.t * res.scale
-        kf0 = Keyframe(self._next_kf, res.frame0, np.eye(4), self.init.ref_image)
+        X0 = res.X0
+        T0 = np.eye(4)
+        vel = None
+        f0 = -1
+        if self._reinit is not None:
+            # ours: the new two-view map is placed at the pose predicted for its first frame and scaled
+            # so that its baseline is the velocity's step times the frames between its two keyframes
+            r = self._reinit
+            f0, f1 = r["frames"][res.frame0], r["frames"][res.frame1]
+            T0 = r["T_pred"][f0]
+            vel = r["vel"]
+            step = r["step"]
+            # accept the new map only if its motion agrees with the prior (ours): translation direction
+            # within 30° of the velocity's, rotation within 5° of the velocity's over the same frames
+            pred = np.eye(4)
+            for _ in range(f1 - f0):
+                pred = se3_compose(vel, pred)
+            tp, tn = pred[:3, 3], res.pose.t
+            cos_t = float(np.sum(tp * tn)) / max(float(np.sqrt(np.sum(tp**2) * np.sum(tn**2))), 1e-12)
+            dR = np.einsum("ij,kj->ik", R, pred[:3, :3])
+            ang = float(np.degrees(np.arccos(np.clip((np.trace(dR) - 1.0) / 2.0, -1.0, 1.0))))
+            if cos_t < np.cos(np.deg2rad(30.0)) or ang > 5.0:
+                self._count("reinit_rejected")
+                self.init = self._new_initialiser()
+                self.init.add_frame(image)
+                r["frames"] = [idx]
+                self._T_show = r["T_pred"][idx]
+                return None
+            s = step * (f1 - f0) / max(float(np.sqrt(np.sum(t**2))), 1e-12)
+            t, X0 = t * s, X0 * s
+            self._count("reinitialised")
+            self._reinit = None
+            self._T_show = None
+        kf0 = Keyframe(self._next_kf, f0 if vel is not None else idx - (res.frame1 - res.frame0), T0,
+                       self.init.ref_image)
         T1 = np.eye(4)
         T1[:3, :3], T1[:3, 3] = R, t
+        T1 = se3_compose(T1, T0)
         self.keyframes.append(kf0)
         self._next_kf += 1
-        self.points = res.X0.copy()
-        self.point_kf = np.full(len(res.X0), kf0.id, np.int64)
-        self.point_uv = res.uv0.copy()
-        self.point_fail = np.zeros(len(res.X0), np.int64)
-        self._T_cw = T1
-        self._T_cw_prev = None
+        n_old = len(self.points)
+        Xw = transform_points(se3_inverse(T0), X0)
+        self.points = np.vstack([self.points, Xw])
+        self.point_kf = np.concatenate([self.point_kf, np.full(len(X0), kf0.id, np.int64)])
+        self.point_uv = np.vstack([self.point_uv, res.uv0])
+        self.point_fail = np.concatenate([self.point_fail, np.zeros(len(X0), np.int64)])
+        self._T_cw = T1 = orthonormalise(T1)
+        self._last_idx = idx
+        self._T_cw_prev = None if vel is None else se3_compose(se3_inverse(vel), T1)
+        self._n_coast = 0
         self._prev_pyr = build_pyramid(image, self.p.align_max_level)
-        self._prev_vis = np.arange(len(self.points))
+        self._prev_vis = np.arange(n_old, len(self.points))
         self._prev_uv = res.uv1.copy()
         self._prev_img = image
         self.initialised = True
-        self._add_keyframe(image, idx, np.arange(len(self.points)), res.uv1)
-        self._n_at_kf = min(len(self.points), self.p.max_matches)
+        self._add_keyframe(image, idx, np.arange(n_old, len(self.points)), res.uv1)
+        self._n_at_kf = min(len(X0), self.p.max_matches)
+        return len(X0)
 
     def _add_keyframe(self, image, idx, vis_idx, vis_uv):
         p = self.p
@@ -219,7 +302,7 @@ class MonoSLAM:
         self._n_at_kf = len(vis_idx)
         self._since_kf = 0
         # cap: drop the keyframe farthest from the current position (003 §4.3)
-        if len(self.keyframes) > p.max_keyframes:
+        while len(self.keyframes) > p.max_keyframes:
             c = kf.center
             far = max(self.keyframes[:-1], key=lambda k: float(np.linalg.norm(k.center - c)))
             self.keyframes.remove(far)
@@ -234,7 +317,12 @@ class MonoSLAM:
         """``n`` of the candidate points spread over an 8×6 grid, round robin over the cells; in a
         cell the fewest recent failures first, then the oldest keyframe (ours)."""
         cell = (np.clip((uv[:, 1] * 6 / h).astype(int), 0, 5) * 8 + np.clip((uv[:, 0] * 8 / w).astype(int), 0, 7))
-        order = np.lexsort((cand, self.point_kf[cand], self.point_fail[cand], cell))
+        keys = (cand, self.point_kf[cand], self.point_fail[cand])
+        if self.p.prefer_seen:  # points matched in the previous frame first (ours)
+            seen = np.zeros(len(self.points), bool)
+            seen[self._prev_vis] = True
+            keys = (*keys, ~seen[cand])
+        order = np.lexsort((*keys, cell))
         c_sorted = cell[order]
         first = np.searchsorted(c_sorted, c_sorted, side="left")
         rank = np.arange(order.size) - first
@@ -259,9 +347,12 @@ class MonoSLAM:
         # 1. motion prior: 003's constant velocity or SVO's constant position (our default, see MonoParams)
         T_prev = self._T_cw
         if self._T_cw_prev is None or p.motion_model == "constant_position":
-            vel = np.eye(4)
+            vel1 = np.eye(4)
         else:
-            vel = se3_compose(T_prev, se3_inverse(self._T_cw_prev))
+            vel1 = se3_compose(T_prev, se3_inverse(self._T_cw_prev))
+        vel = vel1  # motion from the last tracked frame: one velocity step per frame since (ours: coasting)
+        for _ in range(self._n_coast):
+            vel = se3_compose(vel1, vel)
         T_pred = se3_compose(vel, T_prev)
         # 2. sparse direct alignment to the previous frame
         # every map point in view of the previous frame (at most align_max_points, spread; ours)
@@ -277,6 +368,8 @@ class MonoSLAM:
         T_est = se3_compose(al.T_cur_ref, T_prev) if al.ok else T_pred
         if not al.ok:
             self._count("align_failed")
+        # failure detection (ours): a photometric residual too large for the patches to be the same
+        align_bad = al.ok and al.rms > p.max_align_rms
         t1 = time.perf_counter()
         times["align"] = t1 - t0
         # 3. project the map, refine each projection by LK from its keyframe
@@ -311,9 +404,16 @@ class MonoSLAM:
         mi = cand[ok_m]
         n_inl = 0
         T_new = T_est
-        if mi.size >= p.min_inliers:
-            T_new, err, ok = refine_pose(self.K, self.points[mi], uv_m[ok_m], T_est, huber_px=1.0)
-            inl = ok & (err < p.reproj_inlier_px) if ok else np.zeros(mi.size, bool)
+        if mi.size >= p.min_inliers and p.refine:
+            T_new, err, ok = refine_pose(self.K, self.points[mi], uv_m[ok_m], T_est, huber_px=1.0, max_iter=p.refine_iters,
+                                         reject_px=3.0 if p.outlier_rejection else None)
+            inl = ok & (err < self._inlier_px) if ok else np.zeros(mi.size, bool)
+            n_inl = int(inl.sum())
+        elif mi.size >= p.min_inliers:  # no refinement: the alignment's pose, inliers counted there
+            Xm = transform_points(T_est, self.points[mi])
+            Xm[:, 2] = np.maximum(Xm[:, 2], 1e-6)
+            err = np.linalg.norm(project(self.K, Xm) - uv_m[ok_m], axis=1)
+            inl = err < self._inlier_px
             n_inl = int(inl.sum())
         else:
             inl = np.zeros(mi.size, bool)
@@ -321,14 +421,54 @@ class MonoSLAM:
         times["refine"] = t3 - t2
         self.point_fail[cand] += 1
         self.point_fail[mi[inl]] = 0
-        if n_inl < p.min_inliers or not np.all(np.isfinite(T_new)):
+        self._diag = {"n_matched": int(mi.size), "align_rms": float(al.rms)}
+        share_bad = n_inl < p.min_inlier_share * max(mi.size, 1)
+        if n_inl < p.min_inliers or share_bad or align_bad or not np.all(np.isfinite(T_new)):
             self._count("lost")
-            # keep the last pose; the next frame tries again from it (no motion prior)
-            self._T_cw_prev = None
+            if n_inl >= p.min_inliers:
+                self._count("lost_by_share" if share_bad else ("lost_by_photometric" if align_bad else "lost_nonfinite"))
+            if self._T_cw_prev is not None and p.motion_model == "constant_velocity" and self._n_coast < p.max_coast:
+                # coast (ours): report the predicted pose and keep the velocity for the next attempt
+                self._n_coast += 1
+                self._T_show = T_pred = orthonormalise(T_pred)
+                self._count("coasted")
+            elif p.reinit_when_lost and self._T_cw_prev is not None and p.motion_model == "constant_velocity":
+                # ours: a new two-view map, anchored at the predicted pose with the velocity's scale
+                # the step: median of the last tracked frames' steps (one velocity can be off)
+                steps = self._steps[-5:] or [float(np.sqrt(np.sum(vel1[:3, 3] ** 2)))]
+                # the new initialiser starts from the last tracked frame (its pose is known), so that this
+                # frame can already complete it
+                self._reinit = {"vel": vel1, "T_pred": {self._last_idx: T_prev, idx: T_pred},
+                                "frames": [self._last_idx, idx], "step": float(np.median(steps))}
+                self.init = self._new_initialiser()
+                self.init.add_frame(self._prev_img)
+                st = self.init.add_frame(image)
+                self.initialised = False
+                self._T_show = T_pred
+                self._count("reinit_started")
+                if st == "done":
+                    n_new = self._start_map(image, idx)
+                    if n_new is not None:
+                        return "initialised", True, n_new
+            else:
+                # keep the last pose; the next frame tries again from it (no motion prior)
+                self._T_cw_prev = None
+                self._n_coast = 0
+                self._T_show = None
             return "lost", False, n_inl
-        # a one-frame velocity needs two consecutive tracked frames
-        self._T_cw_prev = self._T_cw if self.records and self.records[-1]["tracked"] else None
-        self._T_cw = T_new
+        if self._n_coast and self._T_cw_prev is not None:
+            # back after coasting: keep the velocity of before (ours)
+            self._T_cw_prev = se3_compose(se3_inverse(vel1), T_new)
+        else:
+            # a one-frame velocity needs two consecutive tracked frames
+            self._T_cw_prev = self._T_cw if self.records and self.records[-1]["tracked"] else None
+        self._n_coast = 0
+        self._T_show = None
+        if self.records and self.records[-1]["tracked"]:  # a step between two consecutive tracked frames
+            d = se3_compose(T_new, se3_inverse(self._T_cw))[:3, 3]
+            self._steps = [*self._steps[-9:], float(np.sqrt(np.sum(d**2)))]
+        self._T_cw = orthonormalise(T_new)
+        self._last_idx = idx
         self._prev_pyr = pyr
         self._prev_vis = mi[inl]
         self._prev_uv = uv_m[ok_m][inl]
@@ -345,7 +485,7 @@ class MonoSLAM:
             self._n_at_kf = n_inl
         # drop points that keep failing (a simple outlier rejection, ours)
         bad = self.point_fail > p.max_seed_fail
-        if bad.any():
+        if bad.any() and p.outlier_rejection:
             self._count("points_dropped", int(bad.sum()))
             self._keep_points(~bad)
         times["keyframe"] = time.perf_counter() - t4
@@ -385,7 +525,8 @@ class MonoSLAM:
                 continue
             m = search_epipolar(self.K, T_cur_ref, s.f[sel], s.mu[sel], np.sqrt(s.sigma2[sel]), self.seed_patches[sel],
                                 image, corners, n_sigma=p.n_sigma, tol_px=p.epi_tol_px, patch_px=p.patch_px,
-                                zncc_min=p.zncc_min, cur_patches=cur_patches)
+                                zncc_min=p.zncc_min, cur_patches=cur_patches,
+                                img_ref=kf.image if p.warp_patches else None, uv_ref=s.uv[sel])
             tried[sel] = True
             fi = sel[m.found]
             if fi.size:

@@ -35,7 +35,7 @@ def strafe_frames():
 
 def test_lost_tracking_is_reported_with_a_finite_pose(strafe_frames):
     imgs, _, K = strafe_frames
-    slam = MonoSLAM(K)
+    slam = MonoSLAM(K, motion_model="constant_position")
     for img in imgs[:12]:
         slam.process(img)
     assert slam.initialised
@@ -51,7 +51,8 @@ def test_lost_tracking_is_reported_with_a_finite_pose(strafe_frames):
 
 def test_keyframe_cap_drops_the_farthest(strafe_frames):
     imgs, _, K = strafe_frames
-    slam = MonoSLAM(K, max_keyframes=2, kf_min_frames=1, kf_lost_ratio=0.01, kf_max_lost_ratio=0.02)
+    slam = MonoSLAM(K, max_keyframes=2, kf_min_frames=1, kf_lost_ratio=0.01, kf_max_lost_ratio=0.02,
+                    reproj_inlier_deg=0.1)
     for img in imgs:
         slam.process(img)
     assert len(slam.keyframes) <= 2
@@ -73,3 +74,92 @@ def test_both_convergence_criteria_run(strafe_frames):
     # at a wall 2.5 m away and 2 cm steps, SVO's sigma < range/200 is the stricter test
     assert n["linearity"] > 0
     assert n["sigma"] <= n["linearity"]
+
+
+def test_run_mono_rejects_frames_of_different_sizes(strafe_frames):
+    from slamlab.mono.experiments import run_mono
+
+    imgs, Ts, K = strafe_frames
+    frames = [*imgs[:3], imgs[3][:-2]]
+    with pytest.raises(ValueError, match=r"`images` must all have one size.*images\[3\]"):
+        run_mono(frames, Ts[:4], K, progress=False)
+    with pytest.raises(ValueError, match=r"`images\[1\]` must have shape \(H, W\)"):
+        run_mono([imgs[0], np.zeros((4, 4, 4, 4))], Ts[:2], K, progress=False)
+    with pytest.raises(ValueError, match="`images` must hold at least one frame"):
+        run_mono([], Ts[:0], K, progress=False)
+    slam = MonoSLAM(K)
+    slam.process(imgs[0])
+    with pytest.raises(ValueError, match="`image` must have the size of the first frame"):
+        slam.process(imgs[1][:, :-1])
+
+
+def test_run_mono_rejects_truth_of_another_length(strafe_frames):
+    from slamlab.mono.experiments import run_mono
+
+    imgs, Ts, K = strafe_frames
+    with pytest.raises(ValueError, match=r"`truth_T_wc` must hold one pose per frame: 6 frames in `images`, 5 poses"):
+        run_mono(imgs[:6], Ts[:5], K, progress=False)
+    with pytest.raises(ValueError, match=r"`truth_T_wc` must have shape \(N, 4, 4\)"):
+        run_mono(imgs[:2], Ts[:2, :3], K, progress=False)
+    with pytest.raises(ValueError, match="`truth_T_wc` must be 3-dimensional"):
+        run_mono(imgs[:2], Ts[0], K, progress=False)
+
+
+def test_lost_frames_coast_on_the_velocity_then_track_again(strafe_frames):
+    from slamlab.geometry.se3 import se3_compose, se3_inverse
+
+    imgs, _, K = strafe_frames
+    slam = MonoSLAM(K, motion_model="constant_velocity", max_coast=2, reinit_when_lost=False)
+    for img in imgs[:12]:
+        slam.process(img)
+    assert slam.records[-1]["tracked"]
+    assert slam.records[-2]["tracked"]
+    T1, T2 = (se3_inverse(r["T_wc"]) for r in slam.records[-2:])  # world -> camera
+    vel = se3_compose(T2, se3_inverse(T1))
+    blank = np.full_like(imgs[0], 90)
+    rec = slam.process(blank)
+    assert rec["status"] == "lost"
+    np.testing.assert_allclose(se3_inverse(rec["T_wc"]), se3_compose(vel, T2), atol=1e-12)
+    rec = slam.process(blank)
+    np.testing.assert_allclose(se3_inverse(rec["T_wc"]), se3_compose(vel, se3_compose(vel, T2)), atol=1e-12)
+    rec = slam.process(blank)  # beyond max_coast: the last tracked pose is kept
+    np.testing.assert_allclose(se3_inverse(rec["T_wc"]), T2, atol=1e-12)
+    assert slam.counts["coasted"] == 2
+
+
+def test_after_coasting_a_new_map_is_started_at_the_predicted_pose(strafe_frames):
+    from slamlab.geometry.se3 import se3_compose, se3_inverse
+
+    imgs, _, K = strafe_frames
+    slam = MonoSLAM(K, motion_model="constant_velocity", max_coast=0)
+    for img in imgs[:10]:
+        slam.process(img)
+    T1, T2 = (se3_inverse(r["T_wc"]) for r in slam.records[-2:])
+    vel = se3_compose(T2, se3_inverse(T1))
+    rec = slam.process(np.full_like(imgs[0], 90))  # lost, no coasting: re-initialise from here
+    assert rec["status"] == "lost"
+    assert not slam.initialised
+    np.testing.assert_allclose(se3_inverse(rec["T_wc"]), se3_compose(vel, T2), atol=1e-12)
+    n_kf = slam.counts["keyframes"]
+    for img in imgs[10:]:
+        rec = slam.process(img)
+    assert slam.counts["reinit_started"] == 1
+    assert slam.counts.get("reinitialised", 0) == 1  # the blank frame had no corners: the next frame starts it
+    assert slam.counts["keyframes"] > n_kf
+    assert rec["tracked"]
+    assert np.all(np.isfinite(slam.trajectory))
+
+
+def test_poses_stay_rotations_under_the_constant_velocity_prior(strafe_frames):
+    from slamlab.mono.slam import orthonormalise
+
+    imgs, _, K = strafe_frames
+    slam = MonoSLAM(K, motion_model="constant_velocity")
+    for img in imgs:
+        slam.process(img)
+    R = slam.trajectory[:, :3, :3]
+    assert np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max() < 1e-12
+    bad = np.eye(4)
+    bad[:3, :3] = [[1.01, 0.02, 0.0], [-0.02, 0.99, 0.0], [0.0, 0.0, 1.0]]
+    Rb = orthonormalise(bad)[:3, :3]
+    assert np.abs(Rb.T @ Rb - np.eye(3)).max() < 1e-6
