@@ -34,7 +34,8 @@ def test_old_signature_and_tolerance_still_work(tasks):
     assert core.answer("t.old", 10.4, quiet=True).passed
     assert core.answer("t.old", lambda: 9.6, quiet=True).passed
     r = core.answer("t.old", 10.6, quiet=True)
-    assert r.status == "failed" and r.message.endswith("Hint: think about X.")
+    assert r.status == "failed"
+    assert r.message.endswith("Hint: think about X.")
     assert core.answer("t.old", None, quiet=True).status == "not done yet"
 
 
@@ -50,9 +51,11 @@ def test_accepted_range_is_closed_and_does_not_run_the_library(tasks):
 def test_typical_wrong_answer_gets_its_misconception_and_more_on_the_second_attempt(tasks):
     first = core.answer("t.new", 8.0, quiet=True)
     assert first.status == "failed"
-    assert "last value that fails" in first.message and "first value that succeeds" not in first.message
+    assert "last value that fails" in first.message
+    assert "first value that succeeds" not in first.message
     second = core.answer("t.new", 8.0, quiet=True)
-    assert "last value that fails" in second.message and "first value that succeeds" in second.message
+    assert "last value that fails" in second.message
+    assert "first value that succeeds" in second.message
     unit = core.answer("t.new", 1030.0, quiet=True)  # within the wrong answer's own 5 %
     assert "check the unit" in unit.message
 
@@ -69,13 +72,16 @@ def test_hint_never_contains_the_answer(tasks):
     for x in (8.0, 50.0, 1000.0):
         msg = core.answer("t.new", x, quiet=True).message
         hint = msg.split("Hint:", 1)[1]
-        assert "10" not in hint and "9" not in hint and "11" not in hint
+        assert "10" not in hint
+        assert "9" not in hint
+        assert "11" not in hint
 
 
 def test_nan_and_inf_are_wrong_not_errors(tasks):
     for x in (float("nan"), float("inf")):
         r = core.answer("t.new", x, quiet=True)
-        assert r.status == "failed" and "think about Y" in r.message
+        assert r.status == "failed"
+        assert "think about Y" in r.message
 
 
 def test_bad_accepted_range_is_a_clear_error(monkeypatch):
