@@ -116,23 +116,24 @@ def _score_map_cases(rng):
 
 
 register(Task("06.scan_points", "Task 1, scan to world points", _points_reference, _points_cases,
-              "keep the valid beams, p = l (cos α, sin α) in the robot frame, then world = t + R(θ) p with "
-              "R(θ) = [[cos θ, -sin θ], [sin θ, cos θ]]; no valid beam gives an empty (0, 2) array.",
+              "Invalid beams give no point; each beam's angle is relative to the robot, so rotate"
+              " by the heading before adding the position. No valid beam still gives an array of "
+              "two columns.",
               compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("06.stamp", "Task 2, the image T_n of one heading", _stamp_reference, _stamp_cases,
-              "valid beams only; absolute direction α0 + α_i; a_c at t = 0, 0.5, 1, ... while t < l, then (for "
-              "every beam, after all the free marks) a_p at t = l + 0.01 and t = l + 0.5; a point (x, y) goes to "
-              "T[o + floor(y + 0.5), o + floor(x + 0.5)] with o = l_max + 2.", compare=allclose(0.0, 0.0), points=3))
+              "Each beam's absolute direction adds the robot's heading; free cells are marked "
+              "along the beam up to the hit and the occupied marks go just beyond it, after all "
+              "free marks; a point goes to the nearest cell, measured from the template's centre "
+              "offset.", compare=allclose(0.0, 0.0), points=3))
 register(Task("06.score_at", "Task 3, the score of one shift by the definition", _score_at_reference,
               _score_at_cases,
-              "sum T[i, j] * M[row + i - o, col + j - o] only where that map index lies inside the map "
-              "(M = a_n = 0 outside); Python's M[-1] silently wraps to the last row.",
+              "Map cells outside the map count zero; a negative index in Python does not fail but"
+              " wraps to the other end of the map.",
               compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("06.score_map", "Task 4, every shift at once: the index mapping", _score_map_reference,
               _score_map_cases,
-              "C = scipy.signal.correlate2d(M, T, mode='full') has C[a, b] = sum T[i, j] M[i + a - (S-1), "
-              "j + b - (S-1)], so the robot cell is row = a + o - (S - 1): take the H x W block starting at "
-              "a = b = S - 1 - o.", compare=allclose(rtol=1e-9, atol=1e-9)))
+              "The correlation's output is larger than the map: think about which of its cells "
+              "corresponds to the robot at map cell (0, 0), given the template's centre offset.", compare=allclose(rtol=1e-9, atol=1e-9)))
 
 
 def _first_failing_step() -> float:

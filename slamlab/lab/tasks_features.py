@@ -102,22 +102,24 @@ def _fast_cases(rng):
 
 register(Task("02.integral_image", "Task 1, the integral image", lambda image: integral_image(image),
               _integral_cases,
-              "II has shape (H + 1, W + 1) with a zero first row and column: II[r, c] = sum of I[:r, :c]; two "
-              "cumulative sums (rows, then columns) into II[1:, 1:].", compare=allclose(1e-12, 1e-12)))
+              "The integral image is one row and one column larger than the image: its first row "
+              "and column are zero, and each entry sums everything above and to the left of it, "
+              "excluding its own row and column.", compare=allclose(1e-12, 1e-12)))
 register(Task("02.box_sum", "Task 2, a box sum in four look-ups", _box_reference, _box_cases,
-              "sum of I[r0:r1, c0:c1] = II[r1, c1] - II[r0, c1] - II[r1, c0] + II[r0, c0]; clip every row index "
-              "to [0, H] and every column index to [0, W] first (zero outside the image).",
+              "A box sum needs four entries of the integral image; boxes reaching outside the "
+              "image count zero there, so think about what an index below 0 or beyond the size "
+              "should become (Python's negative indices wrap around).",
               compare=allclose(1e-12, 1e-12), points=2))
 register(Task("02.hessian", "Task 3, the box-filter Hessian at one pixel", _hessian_reference, _hessian_cases,
-              "l = L // 3, b = (L - 1) // 2, h = l // 2, all boxes relative to (row, col) and half-open; "
-              "Dxx = box(rows -l+1..l, cols -b..b+1) - 3 box(rows -l+1..l, cols -h..-h+l), Dyy the same with rows "
-              "and columns swapped, Dxy = box(-l..0, 1..l+1) + box(1..l+1, -l..0) - box(-l..0, -l..0) - "
-              "box(1..l+1, 1..l+1); divide each by L², return (Dxx Dyy - 0.81 Dxy², Dxx + Dyy).",
+              "Each second derivative is a sum of boxes scaled by the filter area; check the box "
+              "sizes against 000's figure for the given L, that the boxes are half-open, and the "
+              "0.81 weight on the mixed term in the determinant.",
               compare=allclose(1e-9, 1e-12), points=3))
 register(Task("02.fast_mask", "Task 4, FAST's segment test on every pixel", _fast_reference, _fast_cases,
-              "work in int (image.astype(int)): uint8 wraps at 255; brighter is I_x > I_p + t, darker I_x < I_p - t "
-              "(strict); look for n contiguous on the circle including runs across its end (e.g. the 16 flags "
-              "twice); pixels closer than 3 to the border are never corners.",
+              "Three things to reason about: the image's integer type overflows when you add the "
+              "threshold; 'brighter' and 'darker' are strict comparisons; the circle is closed, "
+              "so a run of pixels may wrap past its start. Pixels too close to the border have no"
+              " full circle.",
               compare=allclose(0.0, 0.0), points=3))
 
 
@@ -271,22 +273,24 @@ def _bbf_cases(rng):
 
 register(Task("03.two_nn", "Task 1, exact 2-NN by brute force", lambda query, train: knn2(query, train),
               _two_nn_cases,
-              "all Euclidean distances query x train, sort each row (a stable sort keeps the lower index first "
-              "on ties), keep 2 columns; with fewer than 2 stored points pad with inf and -1 (shape (M, 2) always).",
+              "Each query needs its two nearest stored descriptors in order; when two distances "
+              "are equal the lower index comes first, and when fewer than two are stored the "
+              "result still has two columns (with a marker for 'none').",
               compare=allclose(1e-9, 1e-12), points=2))
 register(Task("03.accept", "Task 2, 000's rule and Lowe's ratio test", _accept_reference, _accept_cases,
-              "000: d2 >= factor * d1 and d1 <= max_dist; ratio: d1 < ratio * d2 and d1 <= max_dist (write the "
-              "products, not d1 / d2: d2 may be 0 or inf); return the two boolean arrays.",
+              "Each criterion is a comparison of the two distances; a distance can be 0 or "
+              "infinite, so think about which form of the comparison stays defined then. Both "
+              "criteria also need the absolute distance limit.",
               compare=allclose(0.0, 0.0), points=2))
 register(Task("03.hamming", "Task 3, Hamming distances of packed binary descriptors",
               lambda A, B: hamming_distances(A, B), _hamming_cases,
-              "XOR the bytes (A[:, None, :] ^ B[None, :, :]) and count the 1 bits (np.unpackbits along the last "
-              "axis, or np.bitwise_count), summed over the bytes; subtracting uint8 values wraps around.",
+              "The distance counts differing bits, not differing bytes; subtracting unsigned "
+              "bytes wraps around instead of giving a difference.",
               compare=allclose(0.0, 0.0), points=2))
 register(Task("03.bbf", "Task 4, Best-Bin-First: descent and backtracking", _bbf_reference, _bbf_cases,
-              "heap of (bound, node) from (0.0, root 0); pop; stop when bound >= the k-th best squared distance or "
-              "after max_leaves leaves; descend: diff = q[split_dim] - split_val, near = left if diff <= 0 else "
-              "right, push the far child with bound max(bound, diff²); at a leaf evaluate points[perm[start:stop]].",
+              "Check the stopping rule (the bound against the k-th best distance so far, and the "
+              "leaf budget), which child is the near one when the query lies exactly on the "
+              "split, and the bound you store with the far child.",
               compare=_bbf_compare, points=3))
 
 

@@ -74,21 +74,27 @@ def _joseph_reference(P, K, H, R):
 
 
 register(Task("01.kf_predict", "Task 1, KF predict", lambda x, P, F, Q: kf_predict(x, P, F, Q), _predict_cases,
-              "x = F x and P = F P F^T + Q: mind the transpose and use @ (matrix product), not *."))
+              "The predicted covariance must stay symmetric and must grow by Q: check which "
+              "products are matrix products and where a transpose belongs."))
 register(Task("01.kf_update", "Task 2, KF update (short form)", _update_reference, _update_cases,
-              "y = z - H x, S = H P H^T + R, K = P H^T S^-1, x + K y, (I - K H) P; solve with S rather than "
-              "inverting it, and return (x, P)."))
+              "Check the shapes of the innovation, its covariance and the gain against the "
+              "measurement's size, and that the posterior covariance is no larger than the prior;"
+              " the function returns the state and the covariance."))
 register(Task("01.joseph", "Task 3, Joseph covariance update", _joseph_reference, _joseph_cases,
-              "(I - K H) P (I - K H)^T + K R K^T holds for any gain K, not only the optimal one."))
+              "The form must hold for any gain, not only the optimal one: with a non-optimal gain"
+              " the two terms of the equation must both appear, and the result must stay "
+              "symmetric."))
 register(Task("01.sigma_weights", "Task 4, sigma-point weights", lambda L, alpha, beta, kappa:
               sigma_weights(L, alpha, beta, kappa), _weights_cases,
-              "lambda = alpha^2 (L + kappa) - L; W_c^0 adds (1 - alpha^2 + beta). Compute L + lambda as "
-              "alpha^2 (L + kappa): with alpha = 1e-3 the difference L + lambda loses digits.",
+              "The mean weights must sum to 1. With 000's tiny alpha the value L + lambda is the "
+              "difference of two nearly equal numbers: think about computing it without that "
+              "cancellation.",
               compare=allclose(rtol=1e-12, atol=0.0)))
 register(Task("01.sigma_points", "Task 5, sigma points", lambda x, P, alpha, kappa: sigma_points(x, P, alpha, kappa),
               _points_cases,
-              "Rows x, x + A_i, x - A_i with A_i the columns of the lower Cholesky factor of (L + lambda) P "
-              "(np.linalg.cholesky gives it); L + lambda = alpha^2 (L + kappa).",
+              "The points must be symmetric about the mean, and their weighted covariance must "
+              "give back (L + lambda) P's scale: check which factor of the matrix you take and "
+              "whether you use its rows or its columns.",
               compare=allclose(rtol=1e-9, atol=1e-12)))
 
 

@@ -124,22 +124,23 @@ def _pose_cases(rng):
 
 
 register(Task("07.hough_votes", "Task 1, the polar Hough accumulator", _hough_reference, _hough_cases,
-              "θ_k = -π/2 + k Δθ (k < π/Δθ); rho axis n Δrho for |n| <= n_half = ceil(r_max/Δrho); each point with "
-              "0 < r <= r_max adds 1 to H[floor(r cos(θ_k - φ)/Δrho + n_half + 0.5), k] for every k.",
+              "Check the θ range (half a turn), the number of rho cells on each side of zero, "
+              "rounding to the nearest cell, and which points vote (the range must be positive "
+              "and within the maximum).",
               compare=allclose(0.0, 0.0), points=3))
 register(Task("07.find_peaks", "Task 2, peaks above H_min", _peaks_reference, _peaks_cases,
-              "a cell counts when H >= H_min and H >= each of its 8 neighbours that exist in rho; across θ = ±90° "
-              "the neighbour of (i, 0) in the previous column is (n_rho - 1 - i', n_theta - 1) (rho flips sign); "
-              "return (rho, theta, votes) sorted by votes, largest first.", compare=allclose(1e-12, 1e-12),
+              "A peak needs at least H_min votes and no more-voted neighbour; at the θ = ±90° "
+              "seam the neighbouring column has rho of opposite sign. Return the peaks strongest "
+              "first.", compare=allclose(1e-12, 1e-12),
               points=3))
 register(Task("07.transform_lines", "Task 3, lines seen from the next pose",
               lambda rho, theta_rad, pose: transform_lines(rho, theta_rad, pose), _transform_cases,
-              "θ_j = θ_i - Δφ and rho_j = rho_i - (Δx cos θ_i + Δy sin θ_i), with θ_i the angle before the turn; "
-              "do not wrap θ.", compare=allclose(1e-12, 1e-12)))
+              "A line's angle shifts by the rotation, and its distance by the translation's "
+              "component along the line's normal before the turn; do not wrap the angle.", compare=allclose(1e-12, 1e-12)))
 register(Task("07.pose_from_two_lines", "Task 4, the pose change from two lines", _pose_reference, _pose_cases,
-              "Δφ = θ_i1 - θ_j1; d_k = rho_ik - rho_jk, D = sin(θ_i2 - θ_i1), Δx = (d_1 sin θ_i2 - d_2 sin θ_i1)/D, "
-              "Δy = (d_2 cos θ_i1 - d_1 cos θ_i2)/D; nan when |D| < sin 20° or the angle between the lines "
-              "changed by more than 2° (wrap that change to [-π, π)).", compare=allclose(1e-9, 1e-9), points=3))
+              "The rotation comes from one line's angle change and the translation from the two "
+              "lines' distance changes; when the lines are nearly parallel, or the angle between "
+              "them changed, no reliable pose exists, so say so rather than return a number.", compare=allclose(1e-9, 1e-9), points=3))
 
 
 def _explore_accumulator():

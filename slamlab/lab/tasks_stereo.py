@@ -182,22 +182,22 @@ def _umeyama_cases(rng):
 
 
 register(Task("05.triangulate", "Task 1, midpoint triangulation of two rays", _tri_reference, _tri_cases,
-              "w = c1 - c2, a = d1.d1, b = d1.d2, c = d2.d2, d = d1.w, e = d2.w (row by row: np.einsum('ij,ij->i', "
-              "...) or (x * y).sum(axis=1)); s = (b e - c d)/(a c - b^2), t = (a e - b d)/(a c - b^2); when "
-              "a c - b^2 <= 1e-12 a c use s = t = 0; return ((p1 + p2)/2, |p1 - p2|).",
+              "The midpoint lies between the two closest points of the rays, and the gap is their"
+              " distance; near-parallel rays make the system singular, so think about what the "
+              "function should return then. Check that you do it per row.",
               compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("05.epipolar", "Task 2, the epipolar check", _epi_reference, _epi_cases,
-              "x_l = (u, v, 1); the line l = F x_l = (a, b, c) in the right image; the distance of (u_r, v_r) is "
-              "|a u_r + b v_r + c| / sqrt(a^2 + b^2) (dividing makes it pixels whatever the scale of F); "
-              "keep distance <= tol_px.", compare=allclose(0.0, 0.0)))
+              "The distance to the epipolar line must be in pixels whatever the scale of F: a "
+              "line's coefficients need normalising before they give a distance. Check which "
+              "image's point the line lives in.", compare=allclose(0.0, 0.0)))
 register(Task("05.stereo_point", "Task 3, a stereo point from disparity", _point_reference, _point_cases,
-              "d = u_l - u_r; Z = fx B / d; X = (u_l - cx) Z / fx; Y = (v_l - cy) Z / fy; rows with d <= 0 are "
-              "NaN (np.nan), not inf and not an error.", compare=allclose(rtol=1e-9, atol=1e-9)))
+              "Depth comes from the disparity; think about the sign of the disparity and what a "
+              "zero or negative one should give (not an infinity and not an error).", compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("05.umeyama", "Task 4, Umeyama alignment (rotation, translation, scale)", _umeyama_reference,
               _umeyama_cases,
-              "centre both sets; Sigma = (dst - mu_d)^T (src - mu_s) / N; U, D, Vt = svd(Sigma); S = I with "
-              "S[-1, -1] = -1 when det(U) det(Vt) < 0; R = U S Vt; c = trace(D S) / var(src) (var = mean squared "
-              "norm of the centred src) or 1; t = mu_d - c R mu_s.", compare=_umeyama_compare, points=3))
+              "Check the order of source and destination in the cross-covariance, the reflection "
+              "case (a determinant of -1), and that the scale uses the source's spread; without "
+              "scale estimation the scale is 1.", compare=_umeyama_compare, points=3))
 
 
 def _drift_max_error() -> float:

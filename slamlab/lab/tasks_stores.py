@@ -149,22 +149,24 @@ def _merge_cases(rng):
 
 register(Task("04.tree_sizes", "Task 1, multi kd-tree sizes after a sequence of inserts", _sizes_reference,
               _sizes_cases,
-              "MAX_SIZE[i] = floor(n1 q^i) with i from 0; add the batch to tree 0; while tree i holds MORE than "
-              "MAX_SIZE[i], move all of it into tree i + 1 (creating it) and go on with i + 1; finally append "
-              "empty trees until MAX_SIZE of the last one is >= the total.", compare=allclose(0.0, 0.0)))
+              "Trees are numbered from 0; a tree overflows when it holds more than its capacity "
+              "(not when it is full), and a merge can cascade. After the batch, the last tree "
+              "must be able to hold the total.", compare=allclose(0.0, 0.0)))
 register(Task("04.base_rule", "Task 2, the base rule over a sighting history", _base_reference, _base_cases,
-              "per pending landmark keep its sighting count and first frame; in each frame count the sightings, "
-              "then: seen >= BaseSeenTimes -> base; else frame - first >= MaxNonBaseTime -> dropped. The frame of "
-              "the first sighting has age 0, and a sighting in the frame of age MaxNonBaseTime still counts.",
+              "Count the ages in frames from the first sighting (that frame has age 0); a "
+              "landmark seen often enough becomes a base one before its age is checked, and the "
+              "age limit itself still allows the landmark to count.",
               compare=allclose(0.0, 0.0), points=3))
 register(Task("04.iter_time", "Task 3, the Appendix's iterTime(n1, q), literally", _iter_time_reference,
               _iter_time_cases,
-              "p = log_q(n / n1) + 1 (the upper bound, real), log = log2; searchKd = p log n1 + C p(p-1)/2 log q; "
-              "addKd = n1 log n1 + m q p log n1 + m q/2 p(p-1) log q; iterTime = addKd + C searchKd (no s).",
+              "Follow the Appendix exactly as printed: the number of trees is the upper bound (a "
+              "real number, not rounded), logarithms are base 2, and s does not appear in this "
+              "reading.",
               compare=allclose(rtol=1e-9, atol=0.0)))
 register(Task("04.merge_knn", "Task 4, exact k-NN from per-tree k-NN lists", _merge_reference, _merge_cases,
-              "put the lists of all trees side by side (np.concatenate(..., axis=1)), sort each row with a STABLE "
-              "sort (np.argsort(..., kind='stable')), keep k columns and pad with inf / -1 when fewer than k.",
+              "The merged list must be exactly the k nearest over all trees, in order; on equal "
+              "distances the order of the trees' lists decides, and when fewer than k neighbours "
+              "exist the remaining entries are the 'none' markers.",
               compare=allclose(0.0, 0.0)))
 
 
