@@ -6,7 +6,7 @@ import numpy as np
 
 from ..correlation import rasterise_scan, score_maps
 from ..scans import Scan, scan_to_points
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 #: Exploration 1's robot pose (x, y [cells], heading [rad]) and the heading steps tried [deg].
 EXPLORE_POSE = (60.0, 40.0, float(np.radians(37.0)))
@@ -159,11 +159,22 @@ register(ExplorationTask(
     "06.explore.heading_step",
     "Exploration 1: the smallest whole-degree step Δα at which localisation at (60, 40, 37°) fails",
     _first_failing_step,
-    hint="cast the scan in sl.sim.measurement_room_200() with rng=SEED, localise on sl.sim.test_room_200() with "
-         "delta_alpha_rad = radians(1), radians(2), ... and stop at the first position error > 2 cells."))
+    why="exactly the library's value: one seeded scan (rng=SEED) localised with whole-degree steps; the search is "
+        "deterministic given the scan; no independent localiser yet.",
+    hint="failure means a position error above 2 cells against the true pose; the question asks for the first "
+         "step size at which that happens, with the scan and map the question names.",
+    more="The coarser the heading search, the further its best heading can be from the true one.",
+    wrong=(WrongAnswer("the last step that succeeds", lambda: _first_failing_step() - 1.0,
+                       hint="at that step the localisation still succeeds: the question asks for the first step "
+                            "that fails."),)))
 register(ExplorationTask(
     "06.explore.failures",
     "Exploration 2: failures of 12 random poses with σ = 2 cells and 120 extra clutter discs",
     _monte_carlo_failures,
-    hint="sl.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, "
-         "delta_alpha_rad=np.radians(2), rng=SEED); count res.failed."))
+    why="exactly the library's seeded Monte Carlo (rng=SEED): the poses, noise and clutter are random, so the "
+        "question fixes the seed; no independent localiser yet.",
+    hint="a localisation fails when its position error is above 2 cells or its heading error above 5°; count "
+         "failures, with the noise, clutter and heading step the question names.",
+    more="Both error criteria count: a pose can be close in position and still wrong in heading.",
+    wrong=(WrongAnswer("successes", lambda: 12.0 - _monte_carlo_failures(),
+                       hint="that is the number of successes: the question asks how many fail."),)))

@@ -8,7 +8,7 @@ from ..features.fast import fast_corner_mask
 from ..features.matching import accept_000, accept_ratio, knn2
 from ..features.surf import _box, hessian_response, integral_image
 from ..kdtree import KDTree, bbf_trace, hamming_distances
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 # --- lab 02: detectors ------------------------------------------------------------------------------
 
@@ -123,6 +123,10 @@ register(Task("02.fast_mask", "Task 4, FAST's segment test on every pixel", _fas
               compare=allclose(0.0, 0.0), points=3))
 
 
+_GRID_NEXT = ("The question asks for the first value that meets the criterion: check where it changes from failing "
+              "to holding.")
+
+
 def _fast_threshold_for_budget() -> float:
     from ..features import fast_detect, load_oxford_image
 
@@ -145,14 +149,25 @@ register(ExplorationTask(
     "Exploration 1: the smallest FAST threshold t (5, 10, ..., 100) leaving at most 1000 FAST-9 corners on "
     "graf/img1 at 768x576",
     _fast_threshold_for_budget,
-    hint="img = sl.features.load_oxford_image('graf', 1, size=(768, 576)); for t = 5, 10, ... count "
-         "len(sl.features.fast_detect(img, t)) (with non-maximum suppression) and stop at the first <= 1000."))
+    why="exactly the library's value on the grid 5, 10, ..., 100: the corner count falls monotonically with t, so "
+        "any search over that grid (a loop, a sweep, a bisection) finds the same t; no independent detector yet.",
+    hint="the corner count falls as the threshold rises; the budget is met by every threshold from some value on, "
+         "and the question asks for the smallest of them, on the image and size the question names.",
+    more="Count corners after non-maximum suppression, as a tracker would use them.",
+    wrong=(WrongAnswer("the last threshold over budget", lambda: _fast_threshold_for_budget() - 5.0,
+                       hint="at that threshold there are still more than 1000 corners: it is the last one over the "
+                            "budget.", more=_GRID_NEXT),)))
 register(ExplorationTask(
     "02.explore.wall_repeatability",
     "Exploration 2: the best mean repeatability of the four detectors on wall 1→2 ... 1→6",
     _best_repeatability_wall, atol=0.005,
-    hint="sl.features.run_pair_evaluation(('wall',), (2, 3, 4, 5, 6), scale=0.5, n_points=500); the last row "
-         "of its table holds each detector's mean; give the largest (2 decimals are enough)."))
+    why="the library's evaluation ± 0.005 (two decimals): the images, points and tolerance are fixed by the "
+        "question, so the number is deterministic; no independent evaluation yet.",
+    hint="repeatability is a fraction between 0 and 1 per image pair; average each detector over the five pairs and "
+         "give the best detector's average.",
+    more="The best detector is the one with the largest mean, not the largest single pair.",
+    wrong=(WrongAnswer("percent", lambda: 100.0 * _best_repeatability_wall(), rtol=0.02,
+                       hint="check the unit: repeatability is asked as a fraction, not in percent."),)))
 
 
 # --- lab 03: matching -------------------------------------------------------------------------------
@@ -315,11 +330,24 @@ register(ExplorationTask(
     "Exploration 1: the smallest BBF leaf budget reaching 90 % nearest-neighbour recall with 10000 stored "
     "descriptors",
     _smallest_budget_90,
-    hint="sl.features.run_recall_vs_leaves((1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), n_stored=10000, "
-         "n_queries=200); the first budget whose BBF recall is >= 0.9."))
+    why="exactly the library's value on the budgets 1, 2, 5, ..., 1000 (the question's grid; the descriptors and "
+        "queries are fixed, so the recall curve is deterministic); no independent search yet.",
+    hint="recall is the share of queries whose true nearest neighbour BBF finds; it grows with the leaf budget. "
+         "The question asks for the smallest budget of the grid at which it reaches 90 %.",
+    more="Compare BBF's result with the exact nearest neighbour, not with the ratio-test matches.",
+    wrong=(WrongAnswer("the last budget below 90 %",
+                       lambda: float(EXPLORE_BUDGETS[EXPLORE_BUDGETS.index(int(_smallest_budget_90())) - 1]),
+                       hint="at that budget the recall is still below 90 %: it is the last budget that fails.",
+                       more=_GRID_NEXT),)))
 register(ExplorationTask(
     "03.explore.precise_ratio",
     "Exploration 2: the largest ratio (0.30, 0.35, ..., 1.00) keeping SURF's match precision >= 0.9 on boat 1→2",
     _largest_precise_ratio, atol=1e-6,
-    hint="sl.features.run_ratio_tradeoff(ratios, detector='SURF', sequence='boat', j=2) with ratios "
-         "0.30, 0.35, ..., 1.00; precision is not monotonic in the ratio: take the largest ratio with >= 0.9."))
+    why="exactly the library's value on the grid 0.30, 0.35, ..., 1.00 (deterministic matches on fixed images); no "
+        "independent matcher yet.",
+    hint="precision is the share of kept matches that are correct; a looser ratio keeps more matches. Precision "
+         "need not fall monotonically: check every ratio of the grid, not only until the first failure.",
+    more="The largest qualifying ratio can lie beyond a ratio that fails.",
+    wrong=(WrongAnswer("the first ratio that fails", lambda: round(_largest_precise_ratio() + 0.05, 2), atol=1e-6,
+                       hint="at that ratio the precision is already below 0.9: it is the first ratio that fails, "
+                            "not the last that holds."),)))

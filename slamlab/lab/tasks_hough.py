@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..hough import HoughAccumulator, find_peaks, hough_polar, pose_from_two_lines, transform_lines
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 #: Exploration 1's pose index on 004's path and the line (0-based, by votes) whose loss is asked for.
 EXPLORE_POSE_INDEX = 20
@@ -169,12 +169,24 @@ register(ExplorationTask(
     "07.explore.h_min",
     "Exploration 1: the smallest H_min at which the third line of the scan at pose 20 is lost",
     _h_min_losing_line,
-    hint="the chapter's scan (sl.sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.1), "
-         "pose sl.sim.path_004()[20], rng=SEED), hough_polar with Δrho = 1, Δθ = 1°, then find_peaks for "
-         "H_min = 1, 2, ... until at most 2 lines remain."))
+    why="exactly the library's value: the scan is seeded and the accumulator's votes are integers, so the H_min "
+        "where the third line drops out is one number; no independent peak finder yet.",
+    hint="H_min is the least number of votes a peak needs; the third line (by votes) disappears once H_min exceeds "
+         "what it got. The question asks for the first H_min with at most two lines left.",
+    more="Look at the votes of the strongest peaks and at how the peak finder compares them with H_min.",
+    wrong=(WrongAnswer("the last H_min keeping three lines", lambda: _h_min_losing_line() - 1.0,
+                       hint="at that H_min the third line is still found: it is the last value that keeps it, not "
+                            "the first that loses it."),)))
 register(ExplorationTask(
     "07.explore.lost_steps",
     "Exploration 2: lost steps of Hough SLAM on 004's path with H_min = 40",
     _lost_steps,
-    hint="sl.hough.run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=SEED); count "
-         "res.slam.lost."))
+    why="exactly the library's seeded run (rng=SEED) of 120 steps; no independent SLAM run yet.",
+    hint="a step is lost when no pose can be computed from lines and the step falls back on odometry; count the "
+         "lost steps of the whole run with only H_min changed.",
+    more="Count steps, not lines or a fraction of the run.",
+    wrong=(WrongAnswer("tracked steps", lambda: 120.0 - _lost_steps(),
+                       hint="that is the number of steps with a pose from lines: the question asks for the lost "
+                            "ones."),
+           WrongAnswer("a fraction", lambda: _lost_steps() / 120.0, atol=0.01,
+                       hint="that looks like a fraction of the run: the question asks for a count of steps."))))
