@@ -137,6 +137,24 @@ def _fast_threshold_for_budget() -> float:
     return float("nan")
 
 
+def fast_threshold_opencv(*, nonmax: bool = True) -> float:
+    """Exploration 1 answered with OpenCV's FAST-9 (an independent detector): the smallest grid threshold within budget.
+
+    ``nonmax=False`` counts the corners before non-maximum suppression (a typical wrong reading).
+    """
+    import cv2
+
+    from ..features import load_oxford_image
+
+    img = np.ascontiguousarray(load_oxford_image("graf", 1, size=(768, 576)), dtype=np.uint8)
+    for t in EXPLORE_FAST_THRESHOLDS:
+        fd = cv2.FastFeatureDetector_create(threshold=int(t), nonmaxSuppression=nonmax,
+                                            type=cv2.FAST_FEATURE_DETECTOR_TYPE_9_16)
+        if len(fd.detect(img)) <= EXPLORE_FAST_BUDGET:
+            return float(t)
+    return float("nan")
+
+
 def _best_repeatability_wall() -> float:
     from ..features import run_pair_evaluation
 
@@ -148,15 +166,19 @@ register(ExplorationTask(
     "02.explore.fast_threshold",
     "Exploration 1: the smallest FAST threshold t (5, 10, ..., 100) leaving at most 1000 FAST-9 corners on "
     "graf/img1 at 768x576",
-    _fast_threshold_for_budget,
-    why="exactly the library's value on the grid 5, 10, ..., 100: the corner count falls monotonically with t, so "
-        "any search over that grid (a loop, a sweep, a bisection) finds the same t; no independent detector yet.",
+    _fast_threshold_for_budget, accepted=lambda: (fast_threshold_opencv(),) * 2,
+    why="exactly the grid value OpenCV's FAST-9 with non-maximum suppression gives (an independent detector; its "
+        "counts equal the library's at every threshold of the grid): the count falls monotonically with t, so any "
+        "search over the grid 5, 10, ..., 100 (a loop, a sweep, a bisection) finds the same t.",
     hint="the corner count falls as the threshold rises; the budget is met by every threshold from some value on, "
          "and the question asks for the smallest of them, on the image and size the question names.",
     more="Count corners after non-maximum suppression, as a tracker would use them.",
-    wrong=(WrongAnswer("the last threshold over budget", lambda: _fast_threshold_for_budget() - 5.0,
+    wrong=(WrongAnswer("the last threshold over budget", lambda: fast_threshold_opencv() - 5.0,
                        hint="at that threshold there are still more than 1000 corners: it is the last one over the "
-                            "budget.", more=_GRID_NEXT),)))
+                            "budget.", more=_GRID_NEXT),
+           WrongAnswer("no non-maximum suppression", lambda: fast_threshold_opencv(nonmax=False),
+                       hint="that threshold fits the budget only if clusters of neighbouring corners are counted "
+                            "one by one: count the corners left after non-maximum suppression."))))
 register(ExplorationTask(
     "02.explore.wall_repeatability",
     "Exploration 2: the best mean repeatability of the four detectors on wall 1→2 ... 1→6",

@@ -216,3 +216,21 @@ def test_typical_wrong_answers_are_rejected_with_their_hint_and_never_the_answer
             assert w.more in core.answer(task_id, v, quiet=True).message
         for shown in {f"{lo:g}", f"{hi:g}", f"{(lo + hi) / 2:g}"} - {"0"}:
             assert shown not in first.message.split("Hint:", 1)[1], f"{task_id}: the hint gives {shown}"
+
+
+@pytest.mark.realdata
+def test_fast_threshold_range_is_opencvs_answer_and_opencv_counts_as_the_library():
+    import cv2
+
+    from slamlab.features import fast_detect, load_oxford_image
+    from slamlab.lab import tasks_features as tfe
+
+    t = core.task("02.explore.fast_threshold")
+    lo, hi = t.accepted_range()
+    assert lo == hi == t.expected()
+    img = np.ascontiguousarray(load_oxford_image("graf", 1, size=(768, 576)), dtype=np.uint8)
+    for thr in (20, 30, 35, 40):  # around the answer: the two detectors agree corner count for corner count
+        fd = cv2.FastFeatureDetector_create(threshold=thr, nonmaxSuppression=True,
+                                            type=cv2.FAST_FEATURE_DETECTOR_TYPE_9_16)
+        assert len(fd.detect(img)) == len(fast_detect(img, thr))
+    assert tfe.fast_threshold_opencv(nonmax=False) > hi
