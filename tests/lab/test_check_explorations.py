@@ -234,3 +234,22 @@ def test_fast_threshold_range_is_opencvs_answer_and_opencv_counts_as_the_library
                                             type=cv2.FAST_FEATURE_DETECTOR_TYPE_9_16)
         assert len(fd.detect(img)) == len(fast_detect(img, thr))
     assert tfe.fast_threshold_opencv(nonmax=False) > hi
+
+
+@pytest.mark.parametrize("lab", LABS_01_07, ids=[p.name for p in LABS_01_07])
+def test_lab_has_an_open_investigation_with_a_rubric_and_a_time_plan(lab):
+    nb = json.loads(lab.read_text(encoding="utf-8"))
+    by_id = {c["metadata"].get("nbgrader", {}).get("grade_id"): c for c in nb["cells"]}
+    n = lab.name[:2]
+    text, answer = by_id[f"lab{n}_inv_text"], by_id[f"lab{n}_inv_answer"]
+    meta = answer["metadata"]["nbgrader"]
+    assert answer["cell_type"] == "markdown"
+    assert meta["grade"]
+    assert meta["solution"]
+    assert meta["points"] == 4
+    rubric = "".join(answer["source"])
+    assert "Rubric" in rubric
+    assert rubric.count("1 point") == 4  # what earns each point
+    assert "?" in "".join(text["source"])
+    assert not _CALL.search("".join(text["source"]))
+    assert "Time plan" in "".join(by_id[f"lab{n}_intro"]["source"])
