@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Case", "CheckResult", "ExplorationTask", "Task", "answer", "check", "register", "task"]
+__all__ = ["Case", "CheckResult", "ExplorationTask", "Task", "WrongAnswer", "answer", "check", "register", "task"]
 
 _PKG_DIR = str(Path(__file__).resolve().parent.parent)
 _REGISTRY: dict[str, Task | ExplorationTask] = {}
@@ -57,8 +57,35 @@ class Task:
 
 
 @dataclass(frozen=True)
+class WrongAnswer:
+    """A typical wrong answer to an exploration and the misconception that leads to it.
+
+    ``value()`` computes the wrong number the misconception gives (from the same independent
+    computation as the accepted range); a received value within ``atol + rtol·|value|`` of it gets
+    ``hint`` (which names the misconception, never the answer or code) and, from the second failed
+    attempt on, ``more`` as well (still no code).
+    """
+
+    label: str
+    value: Callable[[], float]
+    hint: str
+    more: str = ""
+    rtol: float = 0.0
+    atol: float = 1e-9
+
+
+@dataclass(frozen=True)
 class ExplorationTask:
-    """A question answered with a number found by running an experiment; ``accept(value)`` says if it is right."""
+    """A question answered with a number found by running an experiment; ``accept(value)`` says if it is right.
+
+    Without ``accepted`` a value passes within ``atol + rtol·|expected()|`` of ``expected()`` (the
+    library's own run). With ``accepted`` it passes inside the closed range ``accepted()`` returns,
+    a range derived from an independent computation and wide enough for every correct method
+    (other seeds, grids or run counts where the question allows); ``why`` states, for the
+    instructor, what the range is and why. ``wrong`` lists the typical wrong answers, each mapped to
+    a hint naming its misconception; ``hint`` is for any other wrong value and ``more`` is added to
+    it from the second failed attempt on.
+    """
 
     task_id: str
     question: str
@@ -67,6 +94,29 @@ class ExplorationTask:
     atol: float = 0.0
     hint: str = ""
     points: int = 1
+    accepted: Callable[[], tuple[float, float]] | None = None
+    why: str = ""
+    wrong: tuple[WrongAnswer, ...] = ()
+    more: str = ""
+
+    def accepted_range(self) -> tuple[float, float]:
+        """The closed range of values that pass."""
+        if self.accepted is not None:
+            lo, hi = (float(v) for v in self.accepted())
+            if not lo <= hi:
+                raise ValueError(f"{self.task_id}: `accepted` must return (lo, hi) with lo <= hi; got ({lo}, {hi})")
+            return lo, hi
+        exp = float(self.expected())
+        tol = self.atol + self.rtol * abs(exp)
+        return exp - tol, exp + tol
+
+    def misconception(self, x: float) -> WrongAnswer | None:
+        """The typical wrong answer ``x`` matches, if any (the first in ``wrong``)."""
+        for w in self.wrong:
+            v = float(w.value())
+            if abs(x - v) <= w.atol + w.rtol * abs(v):
+                return w
+        return None
 
 
 @dataclass(frozen=True)
@@ -221,10 +271,13 @@ def _copy(value):
 
 
 def answer(task_id: str, value, *, quiet: bool = False) -> CheckResult:
-    """Check a number found by experiment against the library's own run (within the task's tolerance).
+    """Check a number found by experiment: inside the task's accepted range, or else which misconception it shows.
 
     ``value`` is the number, or a function returning it (called here; ``NotImplementedError``
-    from it means "not done yet", as in nbgrader's student version).
+    from it means "not done yet", as in nbgrader's student version). The accepted range is the
+    task's ``accepted()`` (an independent computation), or the library's own run within the task's
+    tolerance. A wrong value that matches one of the task's typical wrong answers gets the hint
+    naming that misconception; from the second failed attempt at a task on, the hint says more.
     """
     t = task(task_id)
     if not isinstance(t, ExplorationTask):
@@ -243,12 +296,22 @@ def answer(task_id: str, value, *, quiet: bool = False) -> CheckResult:
         x = float(value)
     except (TypeError, ValueError):
         return _finish(CheckResult(task_id, "failed", f"{t.question} — expected a number; got {value!r}"), quiet)
-    exp = float(t.expected())
-    tol = t.atol + t.rtol * abs(exp)
-    shown = _shown(x, tol)
-    if abs(x - exp) <= tol:
+    lo, hi = t.accepted_range()
+    centre = float(t.expected()) if t.accepted is None else (lo + hi) / 2
+    shown = _shown(x, t.atol + t.rtol * abs(centre))  # as many decimals as the task's tolerance resolves
+    if lo <= x <= hi:
+        _ATTEMPTS.pop(task_id, None)
         return _finish(CheckResult(task_id, "passed", f"{t.question} — {shown}: passed."), quiet)
-    return _finish(CheckResult(task_id, "failed", f"{t.question} — {shown} is not it. Hint: {t.hint}"), quiet)
+    _ATTEMPTS[task_id] = n_failed = _ATTEMPTS.get(task_id, 0) + 1
+    w = t.misconception(x) if math.isfinite(x) else None
+    hint, more = (w.hint, w.more) if w is not None else (t.hint, t.more)
+    if n_failed >= 2 and more:
+        hint = f"{hint} {more}"
+    return _finish(CheckResult(task_id, "failed", f"{t.question} — {shown} is not it. Hint: {hint}"), quiet)
+
+
+#: Failed ``answer`` attempts per task in this kernel (a second failed attempt may get a fuller hint).
+_ATTEMPTS: dict[str, int] = {}
 
 
 def _shown(x: float, tol: float) -> str:

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..correlation import rasterise_scan, score_maps
 from ..scans import Scan, scan_to_points
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 #: Exploration 1's robot pose (x, y [cells], heading [rad]) and the heading steps tried [deg].
 EXPLORE_POSE = (60.0, 40.0, float(np.radians(37.0)))
@@ -116,23 +116,24 @@ def _score_map_cases(rng):
 
 
 register(Task("06.scan_points", "Task 1, scan to world points", _points_reference, _points_cases,
-              "keep the valid beams, p = l (cos α, sin α) in the robot frame, then world = t + R(θ) p with "
-              "R(θ) = [[cos θ, -sin θ], [sin θ, cos θ]]; no valid beam gives an empty (0, 2) array.",
+              "Invalid beams give no point; each beam's angle is relative to the robot, so rotate"
+              " by the heading before adding the position. No valid beam still gives an array of "
+              "two columns.",
               compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("06.stamp", "Task 2, the image T_n of one heading", _stamp_reference, _stamp_cases,
-              "valid beams only; absolute direction α0 + α_i; a_c at t = 0, 0.5, 1, ... while t < l, then (for "
-              "every beam, after all the free marks) a_p at t = l + 0.01 and t = l + 0.5; a point (x, y) goes to "
-              "T[o + floor(y + 0.5), o + floor(x + 0.5)] with o = l_max + 2.", compare=allclose(0.0, 0.0), points=3))
+              "Each beam's absolute direction adds the robot's heading; free cells are marked "
+              "along the beam up to the hit and the occupied marks go just beyond it, after all "
+              "free marks; a point goes to the nearest cell, measured from the template's centre "
+              "offset.", compare=allclose(0.0, 0.0), points=3))
 register(Task("06.score_at", "Task 3, the score of one shift by the definition", _score_at_reference,
               _score_at_cases,
-              "sum T[i, j] * M[row + i - o, col + j - o] only where that map index lies inside the map "
-              "(M = a_n = 0 outside); Python's M[-1] silently wraps to the last row.",
+              "Map cells outside the map count zero; a negative index in Python does not fail but"
+              " wraps to the other end of the map.",
               compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("06.score_map", "Task 4, every shift at once: the index mapping", _score_map_reference,
               _score_map_cases,
-              "C = scipy.signal.correlate2d(M, T, mode='full') has C[a, b] = sum T[i, j] M[i + a - (S-1), "
-              "j + b - (S-1)], so the robot cell is row = a + o - (S - 1): take the H x W block starting at "
-              "a = b = S - 1 - o.", compare=allclose(rtol=1e-9, atol=1e-9)))
+              "The correlation's output is larger than the map: think about which of its cells "
+              "corresponds to the robot at map cell (0, 0), given the template's centre offset.", compare=allclose(rtol=1e-9, atol=1e-9)))
 
 
 def _first_failing_step() -> float:
@@ -158,11 +159,22 @@ register(ExplorationTask(
     "06.explore.heading_step",
     "Exploration 1: the smallest whole-degree step Δα at which localisation at (60, 40, 37°) fails",
     _first_failing_step,
-    hint="cast the scan in sl.sim.measurement_room_200() with rng=SEED, localise on sl.sim.test_room_200() with "
-         "delta_alpha_rad = radians(1), radians(2), ... and stop at the first position error > 2 cells."))
+    why="exactly the library's value: one seeded scan (rng=SEED) localised with whole-degree steps; the search is "
+        "deterministic given the scan; no independent localiser yet.",
+    hint="failure means a position error above 2 cells against the true pose; the question asks for the first "
+         "step size at which that happens, with the scan and map the question names.",
+    more="The coarser the heading search, the further its best heading can be from the true one.",
+    wrong=(WrongAnswer("the last step that succeeds", lambda: _first_failing_step() - 1.0,
+                       hint="at that step the localisation still succeeds: the question asks for the first step "
+                            "that fails."),)))
 register(ExplorationTask(
     "06.explore.failures",
     "Exploration 2: failures of 12 random poses with σ = 2 cells and 120 extra clutter discs",
     _monte_carlo_failures,
-    hint="sl.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, "
-         "delta_alpha_rad=np.radians(2), rng=SEED); count res.failed."))
+    why="exactly the library's seeded Monte Carlo (rng=SEED): the poses, noise and clutter are random, so the "
+        "question fixes the seed; no independent localiser yet.",
+    hint="a localisation fails when its position error is above 2 cells or its heading error above 5°; count "
+         "failures, with the noise, clutter and heading step the question names.",
+    more="Both error criteria count: a pose can be close in position and still wrong in heading.",
+    wrong=(WrongAnswer("successes", lambda: 12.0 - _monte_carlo_failures(),
+                       hint="that is the number of successes: the question asks how many fail."),)))

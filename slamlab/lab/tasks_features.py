@@ -8,7 +8,7 @@ from ..features.fast import fast_corner_mask
 from ..features.matching import accept_000, accept_ratio, knn2
 from ..features.surf import _box, hessian_response, integral_image
 from ..kdtree import KDTree, bbf_trace, hamming_distances
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 # --- lab 02: detectors ------------------------------------------------------------------------------
 
@@ -102,23 +102,29 @@ def _fast_cases(rng):
 
 register(Task("02.integral_image", "Task 1, the integral image", lambda image: integral_image(image),
               _integral_cases,
-              "II has shape (H + 1, W + 1) with a zero first row and column: II[r, c] = sum of I[:r, :c]; two "
-              "cumulative sums (rows, then columns) into II[1:, 1:].", compare=allclose(1e-12, 1e-12)))
+              "The integral image is one row and one column larger than the image: its first row "
+              "and column are zero, and each entry sums everything above and to the left of it, "
+              "excluding its own row and column.", compare=allclose(1e-12, 1e-12)))
 register(Task("02.box_sum", "Task 2, a box sum in four look-ups", _box_reference, _box_cases,
-              "sum of I[r0:r1, c0:c1] = II[r1, c1] - II[r0, c1] - II[r1, c0] + II[r0, c0]; clip every row index "
-              "to [0, H] and every column index to [0, W] first (zero outside the image).",
+              "A box sum needs four entries of the integral image; boxes reaching outside the "
+              "image count zero there, so think about what an index below 0 or beyond the size "
+              "should become (Python's negative indices wrap around).",
               compare=allclose(1e-12, 1e-12), points=2))
 register(Task("02.hessian", "Task 3, the box-filter Hessian at one pixel", _hessian_reference, _hessian_cases,
-              "l = L // 3, b = (L - 1) // 2, h = l // 2, all boxes relative to (row, col) and half-open; "
-              "Dxx = box(rows -l+1..l, cols -b..b+1) - 3 box(rows -l+1..l, cols -h..-h+l), Dyy the same with rows "
-              "and columns swapped, Dxy = box(-l..0, 1..l+1) + box(1..l+1, -l..0) - box(-l..0, -l..0) - "
-              "box(1..l+1, 1..l+1); divide each by L², return (Dxx Dyy - 0.81 Dxy², Dxx + Dyy).",
+              "Each second derivative is a sum of boxes scaled by the filter area; check the box "
+              "sizes against 000's figure for the given L, that the boxes are half-open, and the "
+              "0.81 weight on the mixed term in the determinant.",
               compare=allclose(1e-9, 1e-12), points=3))
 register(Task("02.fast_mask", "Task 4, FAST's segment test on every pixel", _fast_reference, _fast_cases,
-              "work in int (image.astype(int)): uint8 wraps at 255; brighter is I_x > I_p + t, darker I_x < I_p - t "
-              "(strict); look for n contiguous on the circle including runs across its end (e.g. the 16 flags "
-              "twice); pixels closer than 3 to the border are never corners.",
+              "Three things to reason about: the image's integer type overflows when you add the "
+              "threshold; 'brighter' and 'darker' are strict comparisons; the circle is closed, "
+              "so a run of pixels may wrap past its start. Pixels too close to the border have no"
+              " full circle.",
               compare=allclose(0.0, 0.0), points=3))
+
+
+_GRID_NEXT = ("The question asks for the first value that meets the criterion: check where it changes from failing "
+              "to holding.")
 
 
 def _fast_threshold_for_budget() -> float:
@@ -127,6 +133,24 @@ def _fast_threshold_for_budget() -> float:
     img = load_oxford_image("graf", 1, size=(768, 576))
     for t in EXPLORE_FAST_THRESHOLDS:
         if len(fast_detect(img, t)) <= EXPLORE_FAST_BUDGET:
+            return float(t)
+    return float("nan")
+
+
+def fast_threshold_opencv(*, nonmax: bool = True) -> float:
+    """Exploration 1 answered with OpenCV's FAST-9 (an independent detector): the smallest grid threshold within budget.
+
+    ``nonmax=False`` counts the corners before non-maximum suppression (a typical wrong reading).
+    """
+    import cv2
+
+    from ..features import load_oxford_image
+
+    img = np.ascontiguousarray(load_oxford_image("graf", 1, size=(768, 576)), dtype=np.uint8)
+    for t in EXPLORE_FAST_THRESHOLDS:
+        fd = cv2.FastFeatureDetector_create(threshold=int(t), nonmaxSuppression=nonmax,
+                                            type=cv2.FAST_FEATURE_DETECTOR_TYPE_9_16)
+        if len(fd.detect(img)) <= EXPLORE_FAST_BUDGET:
             return float(t)
     return float("nan")
 
@@ -142,15 +166,30 @@ register(ExplorationTask(
     "02.explore.fast_threshold",
     "Exploration 1: the smallest FAST threshold t (5, 10, ..., 100) leaving at most 1000 FAST-9 corners on "
     "graf/img1 at 768x576",
-    _fast_threshold_for_budget,
-    hint="img = sl.features.load_oxford_image('graf', 1, size=(768, 576)); for t = 5, 10, ... count "
-         "len(sl.features.fast_detect(img, t)) (with non-maximum suppression) and stop at the first <= 1000."))
+    _fast_threshold_for_budget, accepted=lambda: (fast_threshold_opencv(),) * 2,
+    why="exactly the grid value OpenCV's FAST-9 with non-maximum suppression gives (an independent detector; its "
+        "counts equal the library's at every threshold of the grid): the count falls monotonically with t, so any "
+        "search over the grid 5, 10, ..., 100 (a loop, a sweep, a bisection) finds the same t.",
+    hint="the corner count falls as the threshold rises; the budget is met by every threshold from some value on, "
+         "and the question asks for the smallest of them, on the image and size the question names.",
+    more="Count corners after non-maximum suppression, as a tracker would use them.",
+    wrong=(WrongAnswer("the last threshold over budget", lambda: fast_threshold_opencv() - 5.0,
+                       hint="at that threshold there are still more than 1000 corners: it is the last one over the "
+                            "budget.", more=_GRID_NEXT),
+           WrongAnswer("no non-maximum suppression", lambda: fast_threshold_opencv(nonmax=False),
+                       hint="that threshold fits the budget only if clusters of neighbouring corners are counted "
+                            "one by one: count the corners left after non-maximum suppression."))))
 register(ExplorationTask(
     "02.explore.wall_repeatability",
     "Exploration 2: the best mean repeatability of the four detectors on wall 1→2 ... 1→6",
     _best_repeatability_wall, atol=0.005,
-    hint="sl.features.run_pair_evaluation(('wall',), (2, 3, 4, 5, 6), scale=0.5, n_points=500); the last row "
-         "of its table holds each detector's mean; give the largest (2 decimals are enough)."))
+    why="the library's evaluation ± 0.005 (two decimals): the images, points and tolerance are fixed by the "
+        "question, so the number is deterministic; no independent evaluation yet.",
+    hint="repeatability is a fraction between 0 and 1 per image pair; average each detector over the five pairs and "
+         "give the best detector's average.",
+    more="The best detector is the one with the largest mean, not the largest single pair.",
+    wrong=(WrongAnswer("percent", lambda: 100.0 * _best_repeatability_wall(), rtol=0.02,
+                       hint="check the unit: repeatability is asked as a fraction, not in percent."),)))
 
 
 # --- lab 03: matching -------------------------------------------------------------------------------
@@ -271,22 +310,24 @@ def _bbf_cases(rng):
 
 register(Task("03.two_nn", "Task 1, exact 2-NN by brute force", lambda query, train: knn2(query, train),
               _two_nn_cases,
-              "all Euclidean distances query x train, sort each row (a stable sort keeps the lower index first "
-              "on ties), keep 2 columns; with fewer than 2 stored points pad with inf and -1 (shape (M, 2) always).",
+              "Each query needs its two nearest stored descriptors in order; when two distances "
+              "are equal the lower index comes first, and when fewer than two are stored the "
+              "result still has two columns (with a marker for 'none').",
               compare=allclose(1e-9, 1e-12), points=2))
 register(Task("03.accept", "Task 2, 000's rule and Lowe's ratio test", _accept_reference, _accept_cases,
-              "000: d2 >= factor * d1 and d1 <= max_dist; ratio: d1 < ratio * d2 and d1 <= max_dist (write the "
-              "products, not d1 / d2: d2 may be 0 or inf); return the two boolean arrays.",
+              "Each criterion is a comparison of the two distances; a distance can be 0 or "
+              "infinite, so think about which form of the comparison stays defined then. Both "
+              "criteria also need the absolute distance limit.",
               compare=allclose(0.0, 0.0), points=2))
 register(Task("03.hamming", "Task 3, Hamming distances of packed binary descriptors",
               lambda A, B: hamming_distances(A, B), _hamming_cases,
-              "XOR the bytes (A[:, None, :] ^ B[None, :, :]) and count the 1 bits (np.unpackbits along the last "
-              "axis, or np.bitwise_count), summed over the bytes; subtracting uint8 values wraps around.",
+              "The distance counts differing bits, not differing bytes; subtracting unsigned "
+              "bytes wraps around instead of giving a difference.",
               compare=allclose(0.0, 0.0), points=2))
 register(Task("03.bbf", "Task 4, Best-Bin-First: descent and backtracking", _bbf_reference, _bbf_cases,
-              "heap of (bound, node) from (0.0, root 0); pop; stop when bound >= the k-th best squared distance or "
-              "after max_leaves leaves; descend: diff = q[split_dim] - split_val, near = left if diff <= 0 else "
-              "right, push the far child with bound max(bound, diff²); at a leaf evaluate points[perm[start:stop]].",
+              "Check the stopping rule (the bound against the k-th best distance so far, and the "
+              "leaf budget), which child is the near one when the query lies exactly on the "
+              "split, and the bound you store with the far child.",
               compare=_bbf_compare, points=3))
 
 
@@ -311,11 +352,24 @@ register(ExplorationTask(
     "Exploration 1: the smallest BBF leaf budget reaching 90 % nearest-neighbour recall with 10000 stored "
     "descriptors",
     _smallest_budget_90,
-    hint="sl.features.run_recall_vs_leaves((1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), n_stored=10000, "
-         "n_queries=200); the first budget whose BBF recall is >= 0.9."))
+    why="exactly the library's value on the budgets 1, 2, 5, ..., 1000 (the question's grid; the descriptors and "
+        "queries are fixed, so the recall curve is deterministic); no independent search yet.",
+    hint="recall is the share of queries whose true nearest neighbour BBF finds; it grows with the leaf budget. "
+         "The question asks for the smallest budget of the grid at which it reaches 90 %.",
+    more="Compare BBF's result with the exact nearest neighbour, not with the ratio-test matches.",
+    wrong=(WrongAnswer("the last budget below 90 %",
+                       lambda: float(EXPLORE_BUDGETS[EXPLORE_BUDGETS.index(int(_smallest_budget_90())) - 1]),
+                       hint="at that budget the recall is still below 90 %: it is the last budget that fails.",
+                       more=_GRID_NEXT),)))
 register(ExplorationTask(
     "03.explore.precise_ratio",
     "Exploration 2: the largest ratio (0.30, 0.35, ..., 1.00) keeping SURF's match precision >= 0.9 on boat 1→2",
     _largest_precise_ratio, atol=1e-6,
-    hint="sl.features.run_ratio_tradeoff(ratios, detector='SURF', sequence='boat', j=2) with ratios "
-         "0.30, 0.35, ..., 1.00; precision is not monotonic in the ratio: take the largest ratio with >= 0.9."))
+    why="exactly the library's value on the grid 0.30, 0.35, ..., 1.00 (deterministic matches on fixed images); no "
+        "independent matcher yet.",
+    hint="precision is the share of kept matches that are correct; a looser ratio keeps more matches. Precision "
+         "need not fall monotonically: check every ratio of the grid, not only until the first failure.",
+    more="The largest qualifying ratio can lie beyond a ratio that fails.",
+    wrong=(WrongAnswer("the first ratio that fails", lambda: round(_largest_precise_ratio() + 0.05, 2), atol=1e-6,
+                       hint="at that ratio the precision is already below 0.9: it is the first ratio that fails, "
+                            "not the last that holds."),)))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..filters import kf_predict, kf_update, sigma_points, sigma_weights
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 
 def _spd(rng, n, scale=1.0):
@@ -74,21 +74,27 @@ def _joseph_reference(P, K, H, R):
 
 
 register(Task("01.kf_predict", "Task 1, KF predict", lambda x, P, F, Q: kf_predict(x, P, F, Q), _predict_cases,
-              "x = F x and P = F P F^T + Q: mind the transpose and use @ (matrix product), not *."))
+              "The predicted covariance must stay symmetric and must grow by Q: check which "
+              "products are matrix products and where a transpose belongs."))
 register(Task("01.kf_update", "Task 2, KF update (short form)", _update_reference, _update_cases,
-              "y = z - H x, S = H P H^T + R, K = P H^T S^-1, x + K y, (I - K H) P; solve with S rather than "
-              "inverting it, and return (x, P)."))
+              "Check the shapes of the innovation, its covariance and the gain against the "
+              "measurement's size, and that the posterior covariance is no larger than the prior;"
+              " the function returns the state and the covariance."))
 register(Task("01.joseph", "Task 3, Joseph covariance update", _joseph_reference, _joseph_cases,
-              "(I - K H) P (I - K H)^T + K R K^T holds for any gain K, not only the optimal one."))
+              "The form must hold for any gain, not only the optimal one: with a non-optimal gain"
+              " the two terms of the equation must both appear, and the result must stay "
+              "symmetric."))
 register(Task("01.sigma_weights", "Task 4, sigma-point weights", lambda L, alpha, beta, kappa:
               sigma_weights(L, alpha, beta, kappa), _weights_cases,
-              "lambda = alpha^2 (L + kappa) - L; W_c^0 adds (1 - alpha^2 + beta). Compute L + lambda as "
-              "alpha^2 (L + kappa): with alpha = 1e-3 the difference L + lambda loses digits.",
+              "The mean weights must sum to 1. With 000's tiny alpha the value L + lambda is the "
+              "difference of two nearly equal numbers: think about computing it without that "
+              "cancellation.",
               compare=allclose(rtol=1e-12, atol=0.0)))
 register(Task("01.sigma_points", "Task 5, sigma points", lambda x, P, alpha, kappa: sigma_points(x, P, alpha, kappa),
               _points_cases,
-              "Rows x, x + A_i, x - A_i with A_i the columns of the lower Cholesky factor of (L + lambda) P "
-              "(np.linalg.cholesky gives it); L + lambda = alpha^2 (L + kappa).",
+              "The points must be symmetric about the mean, and their weighted covariance must "
+              "give back (L + lambda) P's scale: check which factor of the matrix you take and "
+              "whether you use its rows or its columns.",
               compare=allclose(rtol=1e-9, atol=1e-12)))
 
 
@@ -109,11 +115,66 @@ def _rmse_quarter_metre() -> float:
                          progress=False).rmse_pos_m
 
 
+def cv_position_rmse_analytic(pos_std_m: float, *, n_steps: int | None = 50, accel_std: float = 0.2,
+                              dt_s: float = 1.0) -> float:
+    """The KF's expected 2-D position RMSE on the chapter's constant-velocity target, from the Riccati recursion.
+
+    Independent of the Monte Carlo (:func:`slamlab.filters.run_cv_target`): with a matched linear
+    model the posterior covariance ``P_k`` is the error covariance, so the expected mean squared
+    2-D position error over steps ``1..n_steps`` is the mean of ``P_k[x,x] + P_k[y,y]`` (per axis
+    ``[p, v]``, ``Q = σ_a² [[dt³/3, dt²/2], [dt²/2, dt]]``, ``P_0 = diag(σ_z², 1)``, 000 §1.2.1's
+    predict and update). ``n_steps=None`` gives the steady state (many steps).
+    """
+    F = np.array([[1.0, dt_s], [0.0, 1.0]])
+    Q = accel_std**2 * np.array([[dt_s**3 / 3, dt_s**2 / 2], [dt_s**2 / 2, dt_s]])
+    P = np.diag([pos_std_m**2, 1.0])
+    var = []
+    for _ in range(n_steps or 2000):
+        P = F @ P @ F.T + Q
+        k = P[:, 0] / (P[0, 0] + pos_std_m**2)
+        P = P - np.outer(k, P[0, :])
+        var.append(2.0 * P[0, 0])  # x and y axes alike
+    return float(np.sqrt(var[-1] if n_steps is None else np.mean(var)))
+
+
+def _rmse_accepted() -> tuple[float, float]:
+    # 50-step mean (transient included) or the steady state (many steps), ±5 % for the Monte Carlo spread
+    return 0.95 * cv_position_rmse_analytic(0.25, n_steps=None), 1.05 * cv_position_rmse_analytic(0.25)
+
+
+_GRID_NEXT = ("The question asks for the first value that meets the criterion: check where it changes from failing "
+              "to holding.")
+
 register(ExplorationTask(
     "01.explore.q_scale",
     "Exploration 1: the smallest Q scale of (1, 2, 4, 8, 16) that makes the EKF consistent",
-    _smallest_q_scale, hint="run sl.filters.run_stabilising_noise with those scales and read the last column."))
+    _smallest_q_scale,
+    hint="a consistent filter's mean NEES lies inside the chi-square interval for its state dimension and run "
+         "count; check each scale against both ends of that interval.",
+    more="Too small a Q gives a NEES above the interval; an excessive Q one below it.",
+    why="exactly the library's scale on (1, 2, 4, 8, 16) with 30 runs of 60 steps, rng=SEED: the answer is a grid "
+        "value and the seeded runs make it reproducible; no independent computation yet.",
+    wrong=(WrongAnswer("the last inconsistent scale", lambda: _smallest_q_scale() / 2,
+                       "that scale still gives a NEES outside the interval: it is the last one that fails.",
+                       more=_GRID_NEXT),)))
 register(ExplorationTask(
     "01.explore.rmse_quarter_metre",
     "Exploration 2: the KF's position RMSE [m] with a 0.25 m measurement sigma", _rmse_quarter_metre, rtol=0.02,
-    hint="run sl.filters.run_cv_target(pos_std_m=0.25, rng=2010) with 50 runs of 50 steps; give 3 decimals."))
+    accepted=_rmse_accepted,
+    why="from the Riccati recursion (independent of the Monte Carlo): 0.95 × the steady-state 2-D RMSE to "
+        "1.05 × the mean over 50 steps with the initial transient; any seed, 50 runs or more, 50 steps or more pass.",
+    hint="the RMSE asked for is of the filter's position estimate against the true position, as a 2-D distance, "
+         "averaged over runs and steps, with the measurement noise changed and nothing else.",
+    more="Compare your number with the measurement σ and with the chapter's result for σ = 1 m: which way should "
+         "a better sensor move it?",
+    wrong=(WrongAnswer("the chapter's sensor", lambda: cv_position_rmse_analytic(1.0), rtol=0.05,
+                       hint="that is the error with the chapter's 1 m sensor: the measurement noise was not changed."),
+           WrongAnswer("the measurement sigma", lambda: 0.25, atol=1e-3,
+                       hint="that is the sensor's σ, not the filter's error: the filter's error is measured against "
+                            "the true trajectory."),
+           WrongAnswer("mean squared error", lambda: cv_position_rmse_analytic(0.25) ** 2, rtol=0.1,
+                       hint="that looks like a squared error (m²): the RMSE takes the square root of the mean."),
+           WrongAnswer("one axis only", lambda: cv_position_rmse_analytic(0.25) / np.sqrt(2.0), rtol=0.05,
+                       hint="that looks like the error of one coordinate: the position error is the 2-D distance."),
+           WrongAnswer("centimetres", lambda: 100.0 * cv_position_rmse_analytic(0.25), rtol=0.1,
+                       hint="check the unit: the answer is in metres."))))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..hough import HoughAccumulator, find_peaks, hough_polar, pose_from_two_lines, transform_lines
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 #: Exploration 1's pose index on 004's path and the line (0-based, by votes) whose loss is asked for.
 EXPLORE_POSE_INDEX = 20
@@ -124,22 +124,23 @@ def _pose_cases(rng):
 
 
 register(Task("07.hough_votes", "Task 1, the polar Hough accumulator", _hough_reference, _hough_cases,
-              "θ_k = -π/2 + k Δθ (k < π/Δθ); rho axis n Δrho for |n| <= n_half = ceil(r_max/Δrho); each point with "
-              "0 < r <= r_max adds 1 to H[floor(r cos(θ_k - φ)/Δrho + n_half + 0.5), k] for every k.",
+              "Check the θ range (half a turn), the number of rho cells on each side of zero, "
+              "rounding to the nearest cell, and which points vote (the range must be positive "
+              "and within the maximum).",
               compare=allclose(0.0, 0.0), points=3))
 register(Task("07.find_peaks", "Task 2, peaks above H_min", _peaks_reference, _peaks_cases,
-              "a cell counts when H >= H_min and H >= each of its 8 neighbours that exist in rho; across θ = ±90° "
-              "the neighbour of (i, 0) in the previous column is (n_rho - 1 - i', n_theta - 1) (rho flips sign); "
-              "return (rho, theta, votes) sorted by votes, largest first.", compare=allclose(1e-12, 1e-12),
+              "A peak needs at least H_min votes and no more-voted neighbour; at the θ = ±90° "
+              "seam the neighbouring column has rho of opposite sign. Return the peaks strongest "
+              "first.", compare=allclose(1e-12, 1e-12),
               points=3))
 register(Task("07.transform_lines", "Task 3, lines seen from the next pose",
               lambda rho, theta_rad, pose: transform_lines(rho, theta_rad, pose), _transform_cases,
-              "θ_j = θ_i - Δφ and rho_j = rho_i - (Δx cos θ_i + Δy sin θ_i), with θ_i the angle before the turn; "
-              "do not wrap θ.", compare=allclose(1e-12, 1e-12)))
+              "A line's angle shifts by the rotation, and its distance by the translation's "
+              "component along the line's normal before the turn; do not wrap the angle.", compare=allclose(1e-12, 1e-12)))
 register(Task("07.pose_from_two_lines", "Task 4, the pose change from two lines", _pose_reference, _pose_cases,
-              "Δφ = θ_i1 - θ_j1; d_k = rho_ik - rho_jk, D = sin(θ_i2 - θ_i1), Δx = (d_1 sin θ_i2 - d_2 sin θ_i1)/D, "
-              "Δy = (d_2 cos θ_i1 - d_1 cos θ_i2)/D; nan when |D| < sin 20° or the angle between the lines "
-              "changed by more than 2° (wrap that change to [-π, π)).", compare=allclose(1e-9, 1e-9), points=3))
+              "The rotation comes from one line's angle change and the translation from the two "
+              "lines' distance changes; when the lines are nearly parallel, or the angle between "
+              "them changed, no reliable pose exists, so say so rather than return a number.", compare=allclose(1e-9, 1e-9), points=3))
 
 
 def _explore_accumulator():
@@ -168,12 +169,24 @@ register(ExplorationTask(
     "07.explore.h_min",
     "Exploration 1: the smallest H_min at which the third line of the scan at pose 20 is lost",
     _h_min_losing_line,
-    hint="the chapter's scan (sl.sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.1), "
-         "pose sl.sim.path_004()[20], rng=SEED), hough_polar with Δrho = 1, Δθ = 1°, then find_peaks for "
-         "H_min = 1, 2, ... until at most 2 lines remain."))
+    why="exactly the library's value: the scan is seeded and the accumulator's votes are integers, so the H_min "
+        "where the third line drops out is one number; no independent peak finder yet.",
+    hint="H_min is the least number of votes a peak needs; the third line (by votes) disappears once H_min exceeds "
+         "what it got. The question asks for the first H_min with at most two lines left.",
+    more="Look at the votes of the strongest peaks and at how the peak finder compares them with H_min.",
+    wrong=(WrongAnswer("the last H_min keeping three lines", lambda: _h_min_losing_line() - 1.0,
+                       hint="at that H_min the third line is still found: it is the last value that keeps it, not "
+                            "the first that loses it."),)))
 register(ExplorationTask(
     "07.explore.lost_steps",
     "Exploration 2: lost steps of Hough SLAM on 004's path with H_min = 40",
     _lost_steps,
-    hint="sl.hough.run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=SEED); count "
-         "res.slam.lost."))
+    why="exactly the library's seeded run (rng=SEED) of 120 steps; no independent SLAM run yet.",
+    hint="a step is lost when no pose can be computed from lines and the step falls back on odometry; count the "
+         "lost steps of the whole run with only H_min changed.",
+    more="Count steps, not lines or a fraction of the run.",
+    wrong=(WrongAnswer("tracked steps", lambda: 120.0 - _lost_steps(),
+                       hint="that is the number of steps with a pose from lines: the question asks for the lost "
+                            "ones."),
+           WrongAnswer("a fraction", lambda: _lost_steps() / 120.0, atol=0.01,
+                       hint="that looks like a fraction of the run: the question asks for a count of steps."))))

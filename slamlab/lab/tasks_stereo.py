@@ -7,7 +7,7 @@ import numpy as np
 from ..geometry import umeyama
 from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
 from ..geometry.triangulation import triangulate_midpoint, triangulate_stereo
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 #: Exploration 1: the right camera's calibration drift per frame [rad] and the frames of the turn in place.
 EXPLORE_DRIFT_RAD, EXPLORE_FRAMES = 2e-3, 5
@@ -182,22 +182,22 @@ def _umeyama_cases(rng):
 
 
 register(Task("05.triangulate", "Task 1, midpoint triangulation of two rays", _tri_reference, _tri_cases,
-              "w = c1 - c2, a = d1.d1, b = d1.d2, c = d2.d2, d = d1.w, e = d2.w (row by row: np.einsum('ij,ij->i', "
-              "...) or (x * y).sum(axis=1)); s = (b e - c d)/(a c - b^2), t = (a e - b d)/(a c - b^2); when "
-              "a c - b^2 <= 1e-12 a c use s = t = 0; return ((p1 + p2)/2, |p1 - p2|).",
+              "The midpoint lies between the two closest points of the rays, and the gap is their"
+              " distance; near-parallel rays make the system singular, so think about what the "
+              "function should return then. Check that you do it per row.",
               compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("05.epipolar", "Task 2, the epipolar check", _epi_reference, _epi_cases,
-              "x_l = (u, v, 1); the line l = F x_l = (a, b, c) in the right image; the distance of (u_r, v_r) is "
-              "|a u_r + b v_r + c| / sqrt(a^2 + b^2) (dividing makes it pixels whatever the scale of F); "
-              "keep distance <= tol_px.", compare=allclose(0.0, 0.0)))
+              "The distance to the epipolar line must be in pixels whatever the scale of F: a "
+              "line's coefficients need normalising before they give a distance. Check which "
+              "image's point the line lives in.", compare=allclose(0.0, 0.0)))
 register(Task("05.stereo_point", "Task 3, a stereo point from disparity", _point_reference, _point_cases,
-              "d = u_l - u_r; Z = fx B / d; X = (u_l - cx) Z / fx; Y = (v_l - cy) Z / fy; rows with d <= 0 are "
-              "NaN (np.nan), not inf and not an error.", compare=allclose(rtol=1e-9, atol=1e-9)))
+              "Depth comes from the disparity; think about the sign of the disparity and what a "
+              "zero or negative one should give (not an infinity and not an error).", compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("05.umeyama", "Task 4, Umeyama alignment (rotation, translation, scale)", _umeyama_reference,
               _umeyama_cases,
-              "centre both sets; Sigma = (dst - mu_d)^T (src - mu_s) / N; U, D, Vt = svd(Sigma); S = I with "
-              "S[-1, -1] = -1 when det(U) det(Vt) < 0; R = U S Vt; c = trace(D S) / var(src) (var = mean squared "
-              "norm of the centred src) or 1; t = mu_d - c R mu_s.", compare=_umeyama_compare, points=3))
+              "Check the order of source and destination in the cross-covariance, the reflection "
+              "case (a determinant of -1), and that the scale uses the source's spread; without "
+              "scale estimation the scale is 1.", compare=_umeyama_compare, points=3))
 
 
 def _drift_max_error() -> float:
@@ -217,15 +217,54 @@ def _depth_error() -> float:
     return float(triangulate_stereo(rig, uvl, uvr).points[0, 2] - EXPLORE_DEPTH_M)
 
 
+def depth_error_formulas() -> tuple[float, float]:
+    """``(first order, exact)`` depth error at 8 m from a 0.5 px disparity error, from the rig's f and B alone.
+
+    ``Z = f B / d``: first order ``δZ = Z² δd / (f B)`` (000 §3.3), exact ``f B / (d - δd) - Z``; no
+    triangulation code involved (the independent check of Exploration 2).
+    """
+    from .experiments import stereo_rig
+
+    rig = stereo_rig(arena_seed=0, rng=2010)
+    fb = rig.left.fx * rig.baseline_m
+    Z, dd = EXPLORE_DEPTH_M, EXPLORE_DISPARITY_ERR_PX
+    return Z**2 * dd / fb, fb / (fb / Z - dd) - Z
+
+
+def _depth_accepted() -> tuple[float, float]:
+    first, exact = depth_error_formulas()
+    return 0.97 * first, 1.03 * exact
+
+
+def _depth_mid() -> float:
+    return float(np.mean(depth_error_formulas()))
+
+
 register(ExplorationTask(
     "05.explore.drift",
     "Exploration 1: max position error [m] of 5 turn-in-place frames (ORB) with 2 mrad calibration drift per frame",
     _drift_max_error, atol=0.005,
-    hint="sl.stereo.run_turn_in_place('small', n_frames=5, detector='orb', "
-         "render=sl.stereo.RenderParams(drift_std_rad=2e-3), rng=SEED); read res.pos_err_m.max()."))
+    why="the library's seeded run (rng=SEED) ± 5 mm: the drift is a random walk, so other seeds give other numbers "
+        "and the question fixes the seed; no independent computation yet.",
+    hint="the drift perturbs the right camera's calibration while the pipeline still assumes the nominal rig; the "
+         "question asks for the worst position error over the frames, in metres, with everything else as in the "
+         "chapter.",
+    more="The worst error is the maximum over frames, not the last frame's or the mean."))
 register(ExplorationTask(
     "05.explore.depth_error",
     "Exploration 2: depth error [m] at 8 m from a 0.5 px disparity error (the simulator's rig)",
-    _depth_error, rtol=0.03,
-    hint="rig = sl.sim.StereoSim(sl.sim.StereoArena(seed=0), rng=SEED).rig; uvl, uvr = rig.project([[0, 0, 8.0]]); "
-         "add 0.5 to uvr's u; triangulate with sl.geometry.triangulate_stereo and subtract 8."))
+    _depth_error, rtol=0.03, accepted=_depth_accepted,
+    why="from the rig's focal length and baseline alone (Z = f B / d): 0.97 × the first-order δZ = Z² δd / (f B) "
+        "to 1.03 × the exact f B / (d − δd) − Z, so triangulating and the first-order formula both pass.",
+    hint="the error asked for is the triangulated depth minus the true 8 m, in metres, for a disparity that is half "
+         "a pixel too small.",
+    more="Depth is inversely proportional to disparity: a smaller disparity puts the point further away.",
+    wrong=(WrongAnswer("a larger disparity", lambda: -_depth_mid(), rtol=0.06,
+                       hint="the sign says the point came out closer: the disparity error makes the disparity "
+                            "smaller, which puts the point further away."),
+           WrongAnswer("millimetres", lambda: 1000.0 * _depth_mid(), rtol=0.06,
+                       hint="check the unit: the answer is in metres."),
+           WrongAnswer("relative error", lambda: _depth_mid() / EXPLORE_DEPTH_M, rtol=0.06,
+                       hint="that looks like the error divided by the depth: the question asks for metres."),
+           WrongAnswer("the depth itself", lambda: EXPLORE_DEPTH_M + _depth_mid(), rtol=0.01,
+                       hint="that is the depth itself: the error is its difference from the true 8 m."))))

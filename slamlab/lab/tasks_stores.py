@@ -7,7 +7,7 @@ import numpy as np
 from ..kdtree.cost_model import iter_time, minimise_iter_time
 from ..kdtree.knn import merge_knn
 from ..kdtree.stores import SightingBook, multi_tree_sizes
-from .core import Case, ExplorationTask, Task, allclose, register
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 #: Exploration 2's multi kd-tree and workload: n1, q, batches of new points.
 EXPLORE_N1, EXPLORE_Q, EXPLORE_BATCHES = 1000, 3.0, (500,) * 40
@@ -149,22 +149,24 @@ def _merge_cases(rng):
 
 register(Task("04.tree_sizes", "Task 1, multi kd-tree sizes after a sequence of inserts", _sizes_reference,
               _sizes_cases,
-              "MAX_SIZE[i] = floor(n1 q^i) with i from 0; add the batch to tree 0; while tree i holds MORE than "
-              "MAX_SIZE[i], move all of it into tree i + 1 (creating it) and go on with i + 1; finally append "
-              "empty trees until MAX_SIZE of the last one is >= the total.", compare=allclose(0.0, 0.0)))
+              "Trees are numbered from 0; a tree overflows when it holds more than its capacity "
+              "(not when it is full), and a merge can cascade. After the batch, the last tree "
+              "must be able to hold the total.", compare=allclose(0.0, 0.0)))
 register(Task("04.base_rule", "Task 2, the base rule over a sighting history", _base_reference, _base_cases,
-              "per pending landmark keep its sighting count and first frame; in each frame count the sightings, "
-              "then: seen >= BaseSeenTimes -> base; else frame - first >= MaxNonBaseTime -> dropped. The frame of "
-              "the first sighting has age 0, and a sighting in the frame of age MaxNonBaseTime still counts.",
+              "Count the ages in frames from the first sighting (that frame has age 0); a "
+              "landmark seen often enough becomes a base one before its age is checked, and the "
+              "age limit itself still allows the landmark to count.",
               compare=allclose(0.0, 0.0), points=3))
 register(Task("04.iter_time", "Task 3, the Appendix's iterTime(n1, q), literally", _iter_time_reference,
               _iter_time_cases,
-              "p = log_q(n / n1) + 1 (the upper bound, real), log = log2; searchKd = p log n1 + C p(p-1)/2 log q; "
-              "addKd = n1 log n1 + m q p log n1 + m q/2 p(p-1) log q; iterTime = addKd + C searchKd (no s).",
+              "Follow the Appendix exactly as printed: the number of trees is the upper bound (a "
+              "real number, not rounded), logarithms are base 2, and s does not appear in this "
+              "reading.",
               compare=allclose(rtol=1e-9, atol=0.0)))
 register(Task("04.merge_knn", "Task 4, exact k-NN from per-tree k-NN lists", _merge_reference, _merge_cases,
-              "put the lists of all trees side by side (np.concatenate(..., axis=1)), sort each row with a STABLE "
-              "sort (np.argsort(..., kind='stable')), keep k columns and pad with inf / -1 when fewer than k.",
+              "The merged list must be exactly the k nearest over all trees, in order; on equal "
+              "distances the order of the trees' lists decides, and when fewer than k neighbours "
+              "exist the remaining entries are the 'none' markers.",
               compare=allclose(0.0, 0.0)))
 
 
@@ -181,15 +183,93 @@ def _points_rebuilt() -> float:
     return float(mt.counters.points_rebuilt)
 
 
+def literal_iter_time(n1, q, *, n: float = 50000, m: float = 500, C: float = 9.0):
+    """The Appendix's iterTime(n1, q) as printed, written out again from Task 3's formulas (an independent check).
+
+    ``p = log_q(n / n1) + 1``, ``searchKd = p log n1 + C p(p-1)/2 log q``, ``addKd = n1 log n1 + m q p log n1
+    + m q/2 p(p-1) log q``, ``iterTime = addKd + C searchKd`` (log = log2; 000 Appendix).
+    """
+    n1, q = np.asarray(n1, dtype=float), np.asarray(q, dtype=float)
+    p = np.log(n / n1) / np.log(q) + 1.0
+    search = p * np.log2(n1) + C * p * (p - 1.0) / 2.0 * np.log2(q)
+    add = n1 * np.log2(n1) + m * q * p * np.log2(n1) + m * q / 2.0 * p * (p - 1.0) * np.log2(q)
+    return add + C * search
+
+
+def literal_optimum_fine() -> tuple[float, float]:
+    """``(n1, q)`` minimising :func:`literal_iter_time` on a grid 10 times finer than the library's (000's ranges)."""
+    N1, Q = np.arange(500.0, 20000.0 + 1e-9, 5.0), np.arange(1.5, 10.0 + 1e-9, 0.005)
+    F = literal_iter_time(N1[:, None], Q[None, :])
+    i, j = np.unravel_index(np.argmin(F), F.shape)
+    return float(N1[i]), float(Q[j])
+
+
+def _literal_accepted() -> tuple[float, float]:
+    n1 = literal_optimum_fine()[0]
+    return n1 - 50.0, n1 + 50.0
+
+
+def rebuilt_count(n1: float, q: float, batches, *, merges_only: bool = False, count_emptied: bool = False) -> int:
+    """Points put into newly built trees by 000 §4.1's insertion rule, counted from the sizes alone.
+
+    After each batch the trees whose contents changed and are not empty are built again (tree 0
+    and every tree that received a merge). ``merges_only`` leaves out tree 0's builds;
+    ``count_emptied`` also counts tree 0 at its size before a merge emptied it (two typical wrong readings).
+    """
+    sizes, total = [0], 0
+    for b in batches:
+        sizes[0] += int(b)
+        changed, i, before = {0}, 0, sizes[0]
+        while sizes[i] > np.floor(n1 * q**i + 1e-9):
+            if i + 1 == len(sizes):
+                sizes.append(0)
+            sizes[i + 1] += sizes[i]
+            sizes[i] = 0
+            changed.add(i + 1)
+            i += 1
+        total += sum(sizes[j] for j in changed if j or not merges_only)
+        if count_emptied and sizes[0] == 0:
+            total += before
+    return total
+
+
+def _rebuilt(**kw) -> float:
+    return float(rebuilt_count(EXPLORE_N1, EXPLORE_Q, EXPLORE_BATCHES, **kw))
+
+
 register(ExplorationTask(
     "04.explore.literal_n1",
     "Exploration 1: the optimum n1 of the Appendix's cost model as printed (n = 50000, s = m = 500, C = 9)",
-    _literal_optimum_n1, atol=50.0,
-    hint="sl.kdtree.cost_model.minimise_iter_time(n=50000, s=500, m=500, C=9.0, reading='literal') on its default "
-         "grid (n1 in steps of 50) returns (n1, q, value, ...)."))
+    _literal_optimum_n1, atol=50.0, accepted=_literal_accepted,
+    why="the formula of Task 3 minimised again on a grid ten times finer than the library's (n1 step 5, q step "
+        "0.005) over 000's plot ranges; ± 50 (one step of the chapter's grid), so any grid of 50 or finer passes.",
+    hint="minimise over both variables together, on 000's plot ranges, with the formula exactly as printed.",
+    more="A minimum on the edge of the ranges means the search stopped there, not that the function did.",
+    wrong=(WrongAnswer("000's plot reading", lambda: 3500.0, atol=25.0,
+                       hint="that is the value 000 reads off its plot: the printed formula, minimised, disagrees "
+                            "with it (that is the point of this exploration)."),
+           WrongAnswer("the changed search term", lambda: 3450.0, atol=24.0,
+                       hint="that is the optimum of the corrected reading (C s T_search); the question asks for the "
+                            "formula as printed."),
+           WrongAnswer("q instead of n1", lambda: literal_optimum_fine()[1], atol=0.1,
+                       hint="that looks like the optimal q, the tree-size ratio: the question asks for n1."))))
 register(ExplorationTask(
     "04.explore.points_rebuilt",
     "Exploration 2: points rebuilt by MultiKDTree(1000, 3.0) over 40 batches of 500",
-    _points_rebuilt,
-    hint="add 40 batches of 500 points (any data, ids 0..19999) to sl.kdtree.MultiKDTree(1000, 3.0, "
-         "tree='ckdtree') and read store.counters.points_rebuilt."))
+    _points_rebuilt, accepted=lambda: (_rebuilt(), _rebuilt()),
+    why="exact: the count follows from the tree sizes alone (000 §4.1's insertion rule replayed on the sizes, "
+        "independent of the store's code), whatever the points' values or dimension.",
+    hint="count every point that goes into a tree built again, batch by batch, including the first tree after "
+         "each batch; follow which trees change in each batch.",
+    more="Watch a batch that makes tree 0 overflow: which trees end up rebuilt, and with how many points each?",
+    wrong=(WrongAnswer("the points stored", lambda: 20000.0,
+                       hint="that is how many points are stored: a merge builds the receiving tree again from all of "
+                            "its points, so points are rebuilt more than once."),
+           WrongAnswer("one tree rebuilt every iteration", lambda: float(sum(np.cumsum(EXPLORE_BATCHES))),
+                       hint="that is what rebuilding a single tree after every batch would cost, not what the store "
+                            "does."),
+           WrongAnswer("merges only", lambda: _rebuilt(merges_only=True),
+                       hint="that leaves out the first tree, which is built again after every batch."),
+           WrongAnswer("emptied trees counted", lambda: _rebuilt(count_emptied=True),
+                       hint="a tree that a merge has just emptied is not built again: count only trees that end up "
+                            "holding points."))))
