@@ -15,8 +15,9 @@ import pytest
 
 PKG = Path(__file__).resolve().parent.parent / "slamlab"
 HEAVY = ("cv2", "ipywidgets", "matplotlib.pyplot")
-#: modules that may use the simulator: they run experiments, draw or build widgets (CONVENTIONS: Layout)
-SIM_USERS = ("experiments", "widgets", "plot", "__init__")
+#: modules that may use the simulator: they run experiments, draw or build widgets (CONVENTIONS: Layout);
+#: ``logs``: localisation's experiments on the CARMEN logs (simulated odometry noise on a corrected log, issue 27)
+SIM_USERS = ("experiments", "widgets", "plot", "__init__", "logs")
 
 
 def _module_names() -> dict[str, Path]:
