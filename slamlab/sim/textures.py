@@ -106,16 +106,47 @@ def crater_heightfield(shape, n_craters: int = 300, radius_px=(3.0, 40.0), slope
     R = (r_lo**a + u * (r_hi**a - r_lo**a)) ** (1.0 / a) if r_hi > r_lo else np.full(n_craters, r_lo)
     cy = rng.uniform(0, rows, n_craters)
     cx = rng.uniform(0, cols, n_craters)
-    for Ri, yi, xi in zip(R, cy, cx, strict=True):  # a few hundred stamps, once per texture
-        ext = int(np.ceil(2.0 * Ri)) + 1
-        ys = np.arange(int(yi) - ext, int(yi) + ext + 1)
-        xs = np.arange(int(xi) - ext, int(xi) + ext + 1)
-        q = np.hypot((ys[:, None] - yi), (xs[None, :] - xi)) / Ri
-        bowl = (q**2 - 1.0) * 0.2 * Ri  # parabolic floor, zero at the rim
-        rim = 0.06 * Ri * np.exp(-((q - 1.0) ** 2) / 0.04)  # raised rim around r = R
-        prof = np.where(q < 1.0, bowl, 0.0) + rim * (q < 2.0)
-        h[np.ix_(ys % rows, xs % cols)] += prof
+    ext = np.ceil(2.0 * R).astype(np.intp) + 1  # stamp half-width: rim to r = 2R
+    if np.any(2 * ext + 1 > min(rows, cols)):  # a stamp that wraps onto itself: one at a time, as fancy indexing adds
+        for Ri, yi, xi, e in zip(R, cy, cx, ext, strict=True):
+            ys = np.arange(int(yi) - e, int(yi) + e + 1)
+            xs = np.arange(int(xi) - e, int(xi) + e + 1)
+            q = np.hypot((ys[:, None] - yi), (xs[None, :] - xi)) / Ri
+            h[np.ix_(ys % rows, xs % cols)] += _crater_profile(q, Ri)
+        return h
+    # all stamps at once, in column blocks of about BLOCK_ELEMENTS stamp texels: a texel's craters are summed
+    # in crater order from zero (np.bincount), as the stamp-by-stamp loop above adds them -- the same bits
+    side = 2 * ext + 1
+    iy, ix = cy.astype(np.intp), cx.astype(np.intp)  # int(): the centres are >= 0
+    n_blocks = max(1, min(cols, int(np.ceil(float(np.sum(side * side)) / BLOCK_ELEMENTS))))
+    edges = np.linspace(0, cols, n_blocks + 1).round().astype(np.intp)
+    for c0, c1 in zip(edges[:-1], edges[1:], strict=True):
+        lo, hi = ix - ext, ix + ext  # column span, unwrapped
+        hit = np.zeros(n_craters, bool)
+        for shift in (-cols, 0, cols):
+            hit |= (lo + shift < c1) & (hi + shift >= c0)
+        k = np.flatnonzero(hit)  # crater order
+        sizes = side[k] * side[k]
+        crater = np.repeat(k, sizes)
+        j = np.arange(crater.size) - np.repeat(np.cumsum(sizes) - sizes, sizes)  # element within its stamp
+        s_k = side[crater]
+        ys = iy[crater] - ext[crater] + j // s_k
+        xs = ix[crater] - ext[crater] + j % s_k
+        cols_w = xs % cols
+        keep = (cols_w >= c0) & (cols_w < c1)
+        crater, ys, xs, cols_w = crater[keep], ys[keep], xs[keep], cols_w[keep]
+        Ri = R[crater]
+        q = np.hypot(ys - cy[crater], xs - cx[crater]) / Ri
+        flat = (ys % rows) * (c1 - c0) + (cols_w - c0)
+        h[:, c0:c1] = np.bincount(flat, weights=_crater_profile(q, Ri), minlength=rows * (c1 - c0)).reshape(rows, c1 - c0)
     return h
+
+
+def _crater_profile(q, R):
+    """Height of a crater of radius ``R`` at ``q = r / R``: a parabolic bowl (depth 0.2 R) and a raised rim."""
+    bowl = (q**2 - 1.0) * 0.2 * R  # parabolic floor, zero at the rim
+    rim = 0.06 * R * np.exp(-((q - 1.0) ** 2) / 0.04)  # raised rim around r = R
+    return np.where(q < 1.0, bowl, 0.0) + rim * (q < 2.0)
 
 
 def lunar_texture(

@@ -83,8 +83,14 @@ def test_left_and_right_images_agree_at_corresponding_points(arena):
 
 def test_rendering_is_deterministic_from_the_seed():
     a1, a2, a3 = StereoArena(3.0, 4.0, seed=5), StereoArena(3.0, 4.0, seed=5), StereoArena(3.0, 4.0, seed=6)
-    assert np.array_equal(a1.wall_texture, a2.wall_texture)
-    assert np.array_equal(a1.floor_texture, a2.floor_texture)
+    # the textures are kept between arenas of the same parameters: a fresh generation gives the same bits
+    from slamlab.sim.arena import _arena_textures
+
+    fresh = _arena_textures.__wrapped__(3.0, 4.0, 0.5, 0.004, 0.01, 0.6, 5)
+    assert np.array_equal(a1.wall_texture, fresh[0])
+    assert np.array_equal(a2.floor_texture, fresh[1])
+    assert all(np.array_equal(a, b) for a, b in zip(a1._wall_mips, fresh[2], strict=True))
+    assert not a1.wall_texture.flags.writeable and not a1._floor_mips[-1].flags.writeable  # shared: read-only
     assert not np.array_equal(a1.wall_texture, a3.wall_texture)
     s1 = StereoSim(a1, noise_std=3.0, drift_std_rad=1e-3, rng=9)
     s2 = StereoSim(a2, noise_std=3.0, drift_std_rad=1e-3, rng=9)
@@ -237,3 +243,40 @@ def test_small_rig_renders_quickly_and_camera_axes():
     assert left.shape == (60, 80)
     assert isinstance(sim.rig.left, PinholeCamera)
     assert not np.array_equal(left, right)
+
+
+def _stamp_by_stamp(shape, n_craters, radius_px, slope, rng):
+    """crater_heightfield as it was first written: one stamp at a time (before the vectorised blocks)."""
+    rows, cols = shape
+    h = np.zeros((rows, cols))
+    u = rng.random(n_craters)
+    a = 1.0 - slope
+    r_lo, r_hi = radius_px
+    R = (r_lo**a + u * (r_hi**a - r_lo**a)) ** (1.0 / a) if r_hi > r_lo else np.full(n_craters, r_lo)
+    cy = rng.uniform(0, rows, n_craters)
+    cx = rng.uniform(0, cols, n_craters)
+    for Ri, yi, xi in zip(R, cy, cx, strict=True):
+        ext = int(np.ceil(2.0 * Ri)) + 1
+        ys = np.arange(int(yi) - ext, int(yi) + ext + 1)
+        xs = np.arange(int(xi) - ext, int(xi) + ext + 1)
+        q = np.hypot((ys[:, None] - yi), (xs[None, :] - xi)) / Ri
+        bowl = (q**2 - 1.0) * 0.2 * Ri
+        rim = 0.06 * Ri * np.exp(-((q - 1.0) ** 2) / 0.04)
+        prof = np.where(q < 1.0, bowl, 0.0) + rim * (q < 2.0)
+        h[np.ix_(ys % rows, xs % cols)] += prof
+    return h
+
+
+@pytest.mark.parametrize("block", [64, 4096, textures.BLOCK_ELEMENTS])
+@pytest.mark.parametrize(("shape", "n_craters", "radius_px"), [
+    ((40, 300), 200, (1.5, 8.0)),    # many overlapping stamps, wrapped at both edges
+    ((125, 700), 112, (2.5, 30.0)),  # a fence's proportions and crater sizes
+    ((30, 30), 5, (6.0, 9.0)),       # stamps wider than the texture: the one-at-a-time path
+    ((9, 500), 0, (1.0, 2.0)),
+])
+def test_crater_blocks_equal_stamp_by_stamp(monkeypatch, block, shape, n_craters, radius_px):
+    # the vectorised crater field sums each texel's craters in the loop's order: the same bits
+    monkeypatch.setattr(textures, "BLOCK_ELEMENTS", block)
+    for seed in (0, 3):
+        h = crater_heightfield(shape, n_craters, radius_px, rng=np.random.default_rng(seed))
+        assert np.array_equal(h, _stamp_by_stamp(shape, n_craters, radius_px, 2.2, np.random.default_rng(seed)))
