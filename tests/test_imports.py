@@ -15,9 +15,8 @@ import pytest
 
 PKG = Path(__file__).resolve().parent.parent / "slamlab"
 HEAVY = ("cv2", "ipywidgets", "matplotlib.pyplot")
-#: modules that may use the simulator: they run experiments, draw or build widgets (CONVENTIONS: Layout);
-#: ``logs``: localisation's experiments on the CARMEN logs (simulated odometry noise on a corrected log, issue 27)
-SIM_USERS = ("experiments", "widgets", "plot", "__init__", "logs")
+#: modules that may use the simulator: they run experiments, draw or build widgets (CONVENTIONS: Layout)
+SIM_USERS = ("experiments", "widgets", "plot", "__init__")
 
 
 def _module_names() -> dict[str, Path]:

@@ -2,11 +2,13 @@
 
 from .angles import angle_mean, wrap_angle
 from .ellipse import covariance_ellipse
+from .odometry import Odometry, simulate_odometry
 from .registration import RigidTransform, apply_transform, umeyama
 from .se2 import check_pose, check_poses, se2_compose, se2_integrate, se2_inverse, se2_relative, se2_transform
 
-__all__ = ["RigidTransform", "angle_mean", "apply_transform", "check_pose", "check_poses", "covariance_ellipse",
-           "se2_compose", "se2_integrate", "se2_inverse", "se2_relative", "se2_transform", "umeyama", "wrap_angle"]
+__all__ = ["Odometry", "RigidTransform", "angle_mean", "apply_transform", "check_pose", "check_poses", "covariance_ellipse",
+           "se2_compose", "se2_integrate", "se2_inverse", "se2_relative", "se2_transform", "simulate_odometry", "umeyama",
+           "wrap_angle"]
 
 # --- pinhole camera, stereo rig, midpoint triangulation, RANSAC, SE(3) helpers (000 §3) ---
 from .camera import PinholeCamera, StereoRig, focal_from_hfov, fundamental_matrix, rotation_xyz

@@ -16,7 +16,7 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
-from ..sim.rangefinder import simulate_odometry
+from ..geometry.odometry import simulate_odometry
 from .mcl import MCL, MCLParams
 
 __all__ = []

@@ -29,7 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
-from ..geometry.se2 import check_pose, check_poses, se2_integrate, se2_relative
+from ..geometry.odometry import Odometry, simulate_odometry  # one place: geometry (re-exported here)
+from ..geometry.se2 import check_pose, check_poses
 from ..scans import OBSTACLE, Scan, check_grid
 
 __all__ = [
@@ -215,64 +216,3 @@ def simulate_scans(grid, poses, rangefinder: Rangefinder | None = None, rng=None
     g = check_grid(grid)
     rng = v.as_rng(rng)
     return [rf.scan(g, p, rng) for p in P]
-
-
-@dataclass(frozen=True)
-class Odometry:
-    """Odometry along a path: measured increments and the pose integrated from the true start (004 §8)."""
-
-    increments: np.ndarray  # (n-1, 3) measured body-frame (dx, dy, dθ)
-    poses: np.ndarray  # (n, 3) integrated odometry, poses[0] = the true start
-    true_increments: np.ndarray  # (n-1, 3)
-
-    def __str__(self) -> str:
-        return f"Odometry over {self.increments.shape[0]} steps"
-
-
-def simulate_odometry(poses, *, trans_std_frac: float = 0.0, rot_std_rad: float = 0.0,
-                      scale_error: float = 0.0, drift_rad_per_cell: float = 0.0, rng=None) -> Odometry:
-    """Noisy odometry with systematic drift along a path of true poses (our model; 004 only argues drift).
-
-    Each true increment ``(dx, dy, dθ)`` over a step of length ``d = |(dx, dy)|``
-    is measured as ``((1 + scale_error)·dx + n_x, (1 + scale_error)·dy + n_y,
-    dθ + drift_rad_per_cell·d + n_θ)`` with ``n_x, n_y ~ N(0, (trans_std_frac·d)²)``
-    and ``n_θ ~ N(0, rot_std_rad²)``; the measured increments are integrated
-    from the true start pose.
-
-    Parameters
-    ----------
-    poses : array_like, shape (n, 3)
-        True poses.
-    trans_std_frac : float
-        Translation noise σ as a fraction of the step length.
-    rot_std_rad : float
-        Heading noise σ per step.
-    scale_error : float
-        Systematic relative error of travelled distance (e.g. 0.02 = wheels 2 % too big).
-    drift_rad_per_cell : float
-        Systematic heading drift per cell travelled.
-    rng : Generator, int or None
-
-    Examples
-    --------
-    >>> P = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.0]])
-    >>> simulate_odometry(P, scale_error=0.5).poses[:, 0].tolist()
-    [0.0, 1.5, 3.0]
-    """
-    P = check_poses(poses)
-    sf = v.check_positive(trans_std_frac, "trans_std_frac", allow_zero=True)
-    sr = v.check_positive(rot_std_rad, "rot_std_rad", allow_zero=True)
-    for name, val in (("scale_error", scale_error), ("drift_rad_per_cell", drift_rad_per_cell)):
-        if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(val):
-            raise TypeError(f"`{name}` must be a finite real number; got {val!r}")
-    rng = v.as_rng(rng)
-    U = se2_relative(P[:-1], P[1:])
-    d = np.hypot(U[:, 0], U[:, 1])
-    noise = rng.standard_normal(U.shape)
-    meas = np.column_stack([
-        (1 + scale_error) * U[:, 0] + sf * d * noise[:, 0],
-        (1 + scale_error) * U[:, 1] + sf * d * noise[:, 1],
-        U[:, 2] + drift_rad_per_cell * d + sr * noise[:, 2],
-    ])
-    return Odometry(meas, se2_integrate(P[0], meas), U)

@@ -14,6 +14,8 @@ same bit for bit as those of the whole-array expressions, see ``tests/sim/test_a
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from .. import _validate as v
@@ -120,7 +122,7 @@ def crater_heightfield(shape, n_craters: int = 300, radius_px=(3.0, 40.0), slope
     iy, ix = cy.astype(np.intp), cx.astype(np.intp)  # int(): the centres are >= 0
     n_blocks = max(1, min(cols, int(np.ceil(float(np.sum(side * side)) / BLOCK_ELEMENTS))))
     edges = np.linspace(0, cols, n_blocks + 1).round().astype(np.intp)
-    for c0, c1 in zip(edges[:-1], edges[1:], strict=True):
+    for c0, c1 in itertools.pairwise(edges):
         lo, hi = ix - ext, ix + ext  # column span, unwrapped
         hit = np.zeros(n_craters, bool)
         for shift in (-cols, 0, cols):

@@ -90,7 +90,8 @@ def test_rendering_is_deterministic_from_the_seed():
     assert np.array_equal(a1.wall_texture, fresh[0])
     assert np.array_equal(a2.floor_texture, fresh[1])
     assert all(np.array_equal(a, b) for a, b in zip(a1._wall_mips, fresh[2], strict=True))
-    assert not a1.wall_texture.flags.writeable and not a1._floor_mips[-1].flags.writeable  # shared: read-only
+    assert not a1.wall_texture.flags.writeable
+    assert not a1._floor_mips[-1].flags.writeable
     assert not np.array_equal(a1.wall_texture, a3.wall_texture)
     s1 = StereoSim(a1, noise_std=3.0, drift_std_rad=1e-3, rng=9)
     s2 = StereoSim(a2, noise_std=3.0, drift_std_rad=1e-3, rng=9)
