@@ -11,7 +11,7 @@ query vs ``cv2.BFMatcher.knnMatch``.
     python benchmarks/bench_stereo.py                    # 30 frames, ORB, SIFT and our SURF
     python benchmarks/bench_stereo.py --drift            # + calibration drift on the loop (SURF, ~2 min)
     python benchmarks/bench_stereo.py --long             # + the ~80 m run of 000 §4.2 (slow)
-    python benchmarks/bench_stereo.py --kitti            # + the 20 KITTI frames, this round's changes off/on
+    python benchmarks/bench_stereo.py --kitti            # + the 20 KITTI frames, issue 17's changes off (before) and on (after)
 
 Every run uses the pipeline's defaults (oldest-landmark policy; store: multi kd-tree for SURF/SIFT,
 exact Hamming brute force for ORB; the two images detected in two threads).
@@ -58,7 +58,7 @@ def main(argv=None):
     ap.add_argument("--detectors", default="orb,sift,surf")
     ap.add_argument("--drift", action="store_true", help="also run the calibration-drift study on the small loop")
     ap.add_argument("--long", action="store_true", help="also run the ~80 m path in the 10x12 m room")
-    ap.add_argument("--kitti", action="store_true", help="also run the 20 KITTI frames with this round's changes off and on")
+    ap.add_argument("--kitti", action="store_true", help="also run the 20 KITTI frames with issue 17's changes off (before) and on (after)")
     ap.add_argument("--markdown", default=None, help="write the tables to this file")
     args = ap.parse_args(argv)
 
