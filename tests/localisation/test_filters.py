@@ -1,5 +1,6 @@
 """Resampling, N_eff, KLD, pose estimate, MCL and Markov grid localisation (003 §2.2; PR Tables 4.4, 8.1-8.4)."""
 
+import copy
 import math
 
 import numpy as np
@@ -57,10 +58,27 @@ def test_kld_sample_count_one_bin_and_many_bins():
     one = np.tile([[5.0, 5.0, 0.1]], (1000, 1))
     assert L.kld_sample_count(one, n_min=50) == 50
     rng = np.random.default_rng(0)
-    spread = np.column_stack([rng.uniform(0, 400, 3000), rng.uniform(0, 400, 3000), rng.uniform(-3, 3, 3000)])
-    m = L.kld_sample_count(spread, n_min=10)
-    k = len({tuple(r) for r in np.floor(spread[:m] / [2, 2, np.radians(10)]).astype(int)})
-    assert m >= L.kld_bound(k) - 1e-9 or m == 3000
+    # Fox 2003 / PR Table 8.4, drawn one particle at a time: stop at the first m with m >= max(n_min, bound(k))
+    z = 2.3263478740408408  # the standard normal's 0.99 quantile (tables)
+
+    def sequential(P, n_min, eps=0.05, size=(2.0, 2.0, 0.17453292519943295)):  # 10 degrees
+        bins = set()
+        for m, (x, y, th) in enumerate(P, start=1):
+            bins.add((math.floor(x / size[0]), math.floor(y / size[1]), math.floor((th % (2 * math.pi)) / size[2])))
+            k = len(bins)
+            bound = 1.0 if k <= 1 else (k - 1) / (2 * eps) * (1 - 2 / (9 * (k - 1)) + math.sqrt(2 / (9 * (k - 1))) * z) ** 3
+            if m >= max(n_min, bound):
+                return m
+        return len(P)
+
+    counts = []
+    for width, turn, n_min in ((10.0, 0.5, 10), (2.0, 0.05, 300), (400.0, 0.5, 10)):
+        P = np.column_stack([rng.uniform(0, width, 3000), rng.uniform(0, width, 3000), rng.uniform(-turn, turn, 3000)])
+        counts.append(sequential(P, n_min))
+        assert L.kld_sample_count(P, n_min=n_min, bin_size=(2.0, 2.0, np.radians(10))) == counts[-1]
+    assert 300 < counts[0] < 3000  # the bound met
+    assert counts[1] == 300  # n_min met first
+    assert counts[2] == 3000  # never met: all kept
 
 
 def test_pose_estimate_against_numpy_and_angle_mean():
@@ -118,19 +136,11 @@ def test_mcl_function_and_class_agree(room_run):
     M, _P, scans, _ = room_run
     f = L.MCL(M, 60.0, n_particles=200, rng=5)
     X0 = f.state.particles.copy()
+    rng = copy.deepcopy(f.rng)  # the filter's own stream, as the step will find it
     rec = f.step(None, None, scans[0])
-    state, rec2 = L.mcl_step(L.MCLState(X0, np.full(200, 1 / 200)), None, None, scans[0], f.model, f.params,
-                             np.random.default_rng(5).spawn(0) or _rng_after_init(200))
+    state, rec2 = L.mcl_step(L.MCLState(X0, np.full(200, 1 / 200)), None, None, scans[0], f.model, f.params, rng)
     np.testing.assert_allclose(rec.mean, rec2.mean, atol=1e-12)
     np.testing.assert_allclose(f.state.particles, state.particles, atol=1e-12)
-
-
-def _rng_after_init(n):
-    """The Generator of MCL(rng=5) after it drew the initial particles (uniform_free_particles draws 3 arrays)."""
-    rng = np.random.default_rng(5)
-    M = S.test_room_200()
-    L.uniform_free_particles(M, n, rng)
-    return rng
 
 
 def test_augmented_mcl_recovers_from_kidnapping_and_plain_mcl_does_not():
