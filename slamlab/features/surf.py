@@ -79,6 +79,7 @@ def _by_chunks(fn, fast, s, chunk, workers, out):
 
 __all__ = [
     "SURF",
+    "box_sums",
     "filter_sizes",
     "haar_xy",
     "hessian_response",
@@ -114,11 +115,29 @@ def filter_sizes(n_octaves: int = 4, n_intervals: int = 4) -> np.ndarray:
     return 3 * ((2 ** (o + 1)) * (i + 1) + 1)
 
 
-def _box(IIp, pad, step, nr, nc, r0, r1, c0, c1):
-    """Sums over rows [r + r0, r + r1) x cols [c + c0, c + c1) for every grid point (r, c) = step·(i, j).
+def box_sums(IIp, pad, step, nr, nc, r0, r1, c0, c1):
+    """Box sums over rows ``[r + r0, r + r1)`` × cols ``[c + c0, c + c1)`` at every grid point ``(r, c) = step·(i, j)``.
 
-    ``IIp`` is the integral image edge-padded by ``pad``: edge padding of II is the
-    same as clipping the box to the image (zero outside).
+    Four corner reads of the integral image per box (Bay 2008 §2; 001 §2.1), for the whole grid at once.
+
+    Parameters
+    ----------
+    IIp : ndarray, shape (H + 1 + 2 pad, W + 1 + 2 pad)
+        The integral image (see :func:`integral_image`) edge-padded by ``pad``: edge padding of the integral image
+        is the same as clipping the box to the image (zero outside).
+    pad : int
+        The padding of ``IIp``; at least the largest box offset.
+    step : int
+        Grid spacing in pixels.
+    nr, nc : int
+        Grid rows and columns.
+    r0, r1, c0, c1 : int
+        The box's row and column offsets from each grid point (half-open).
+
+    Returns
+    -------
+    ndarray, shape (nr, nc)
+        The sum of the image over the box at each grid point.
     """
     def corner(dr, dc):
         return IIp[pad + dr:pad + dr + step * nr:step, pad + dc:pad + dc + step * nc:step][:nr, :nc]
@@ -145,12 +164,12 @@ def hessian_response(II, L: int, step: int, *, IIp=None, pad: int | None = None)
     l = L // 3
     b = (L - 1) // 2
     h = l // 2
-    Dxx = (_box(IIp, pad, step, nr, nc, -l + 1, l, -b, b + 1)
-           - 3.0 * _box(IIp, pad, step, nr, nc, -l + 1, l, -h, -h + l))
-    Dyy = (_box(IIp, pad, step, nr, nc, -b, b + 1, -l + 1, l)
-           - 3.0 * _box(IIp, pad, step, nr, nc, -h, -h + l, -l + 1, l))
-    Dxy = (_box(IIp, pad, step, nr, nc, -l, 0, 1, l + 1) + _box(IIp, pad, step, nr, nc, 1, l + 1, -l, 0)
-           - _box(IIp, pad, step, nr, nc, -l, 0, -l, 0) - _box(IIp, pad, step, nr, nc, 1, l + 1, 1, l + 1))
+    Dxx = (box_sums(IIp, pad, step, nr, nc, -l + 1, l, -b, b + 1)
+           - 3.0 * box_sums(IIp, pad, step, nr, nc, -l + 1, l, -h, -h + l))
+    Dyy = (box_sums(IIp, pad, step, nr, nc, -b, b + 1, -l + 1, l)
+           - 3.0 * box_sums(IIp, pad, step, nr, nc, -h, -h + l, -l + 1, l))
+    Dxy = (box_sums(IIp, pad, step, nr, nc, -l, 0, 1, l + 1) + box_sums(IIp, pad, step, nr, nc, 1, l + 1, -l, 0)
+           - box_sums(IIp, pad, step, nr, nc, -l, 0, -l, 0) - box_sums(IIp, pad, step, nr, nc, 1, l + 1, 1, l + 1))
     inv = 1.0 / (L * L)
     Dxx *= inv
     Dyy *= inv
@@ -165,7 +184,7 @@ class _Phases:
     same as edge padding, i.e. boxes clipped to the image), contiguous and flat with row length
     ``Cq``. The corner ``II[r + dr, c + dc]`` over the whole grid is then one contiguous slice of one
     phase, laid out as ``i·Cq + j`` (columns ``j >= nc`` are padding), so every pass of the box
-    filters runs on contiguous memory -- 2-3x faster than the strided views of :func:`_box`. Phases
+    filters runs on contiguous memory -- 2-3x faster than the strided views of :func:`box_sums`. Phases
     are strided copies of the padded image ``E`` (:class:`_PaddedII`) where it is large enough,
     gathered from ``II`` otherwise (the coarse octaves of ``n_octaves > 4``).
     """

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..features.fast import fast_corner_mask
 from ..features.matching import accept_000, accept_ratio, knn2
-from ..features.surf import _box, hessian_response, integral_image
+from ..features.surf import box_sums, hessian_response, integral_image
 from ..kdtree import KDTree, bbf_trace, hamming_distances
 from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
@@ -27,7 +27,7 @@ def _integral_cases(rng):
 
 def _box_reference(II, r0, r1, c0, c1):
     pad = max(II.shape) + max(abs(r0), abs(r1), abs(c0), abs(c1)) + 1
-    return float(_box(np.pad(II, pad, mode="edge"), pad, 1, 1, 1, r0, r1, c0, c1)[0, 0])
+    return float(box_sums(np.pad(II, pad, mode="edge"), pad, 1, 1, 1, r0, r1, c0, c1)[0, 0])
 
 
 def _box_cases(rng):

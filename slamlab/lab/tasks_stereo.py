@@ -46,9 +46,9 @@ def _tri_cases(rng):
 
 
 def _epi_reference(uv_left, uv_right, F, tol_px):
-    from ..stereo.stages import _epipolar_pairs  # the pipeline's own check, one pair at a time
+    from ..stereo.stages import epipolar_pairs  # the pipeline's own check, one pair at a time
 
-    return np.array([_epipolar_pairs(uv_left[i:i + 1], uv_right[i:i + 1], F, tol_px)[0].size > 0
+    return np.array([epipolar_pairs(uv_left[i:i + 1], uv_right[i:i + 1], F, tol_px)[0].size > 0
                      for i in range(len(uv_left))], dtype=float)
 
 

@@ -31,6 +31,7 @@ __all__ = [
     "PoseEstimate",
     "StereoMatches",
     "detect_features",
+    "epipolar_pairs",
     "estimate_pose",
     "is_rectified",
     "match_to_map",
@@ -105,7 +106,7 @@ def _stereo_match(left, right, F, ratio, epi_tol_px, max_distance=None) -> Stere
     empty = StereoMatches(np.empty(0, np.intp), np.empty(0, np.intp), np.empty(0))
     if len(left.uv) == 0 or len(right.uv) == 0:
         return empty
-    li, ri = _epipolar_pairs(left.uv, right.uv, F, epi_tol_px)
+    li, ri = epipolar_pairs(left.uv, right.uv, F, epi_tol_px)
     if li.size == 0:
         return empty
     d = _pair_distances(left.descriptors, right.descriptors, li, ri)
@@ -137,13 +138,27 @@ def _two_nearest(qi, ti, d):
     return qi[first_min], ti[first_min], d1, d2, second
 
 
-def _epipolar_pairs(uv_left, uv_right, F, tol_px):
+def epipolar_pairs(uv_left, uv_right, F, tol_px):
     """All (left, right) keypoint pairs with the right point within ``tol_px`` of the left one's
-    epipolar line ``l = F x_l``, grouped by left index (ascending).
+    epipolar line ``l = F x_l``, grouped by left index (ascending) (000 §3.3: the epipolar check of stereo matching).
 
     When every epipolar line is nearly horizontal (a rectified or nearly rectified rig), the
     candidates come from a row-sorted list by binary search (a few per keypoint); otherwise every
     pair is tested.
+
+    Parameters
+    ----------
+    uv_left, uv_right : ndarray, shape (N, 2) and (M, 2)
+        Keypoint pixels of the left and right images.
+    F : ndarray, shape (3, 3)
+        Fundamental matrix with ``x_r^T F x_l = 0``.
+    tol_px : float
+        Largest distance of a right keypoint from the left one's epipolar line, pixels.
+
+    Returns
+    -------
+    left, right : ndarray of int
+        Indices of the pairs, grouped by left index (ascending).
     """
     xl = np.column_stack([uv_left, np.ones(len(uv_left))])
     lines = xl @ F.T
