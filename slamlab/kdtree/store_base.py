@@ -1,0 +1,325 @@
+"""The landmark store interface, the base rule and the machinery every store shares (000 §3.4, §4).
+
+:class:`LandmarkStore` (the interface every store implements), :func:`base_rule` and :class:`SightingBook`
+(000 §3.4's rule, kept per point), :class:`StoreCounters` (the operation counts), and the private tree and point
+set the stores build on. The stores themselves are in :mod:`slamlab.kdtree.stores` (which re-exports these names)
+and :mod:`slamlab.kdtree.multi`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, fields
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .. import _validate as v
+from .knn import augment_rows, exact_knn, pad_knn
+from .tree import KDTree
+
+__all__ = ["TREE_KINDS", "LandmarkStore", "SightingBook", "StoreCounters", "base_rule"]
+
+TREE_KINDS = ("bbf", "exact", "ckdtree", "brute")
+
+
+@dataclass
+class StoreCounters:
+    """Operation counts accumulated by a store (the quantities of 000's cost model)."""
+
+    points_added: int = 0
+    points_rebuilt: int = 0  # points put into a newly built tree (build work)
+    trees_built: int = 0
+    queries: int = 0
+    trees_searched: int = 0  # non-empty trees searched, summed over query batches
+    nodes_visited: int = 0  # internal tree nodes passed (teaching tree only)
+    distance_evals: int = 0  # query-to-point distances computed (0 where the backend does not say)
+
+    def as_dict(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def reset(self) -> None:
+        for f in fields(self):
+            setattr(self, f.name, 0)
+
+
+def base_rule(seen, age, base_seen_times: int, max_non_base_time: int):
+    """000 §3.4's base rule: ``(is_base, timed_out)`` per point from its sightings and age.
+
+    A point is *base* once seen ``base_seen_times`` times (000: ``BaseSeenTimes = 3``); a
+    non-base point whose first sighting is ``max_non_base_time`` iterations old (000:
+    ``MaxNonBaseTime = 7``) times out and is dropped. ``age`` = iterations since the first
+    sighting (0 in the iteration it was first seen).
+
+    >>> b, late = base_rule(np.array([3, 1, 2]), np.array([2, 7, 6]), 3, 7)
+    >>> b.tolist(), late.tolist()
+    ([True, False, False], [False, True, False])
+    """
+    seen = np.asarray(seen)
+    is_base = seen >= base_seen_times
+    return is_base, ~is_base & (np.asarray(age) >= max_non_base_time)
+
+
+class SightingBook:
+    """Seen counts and first-sighting iterations of non-base points; :meth:`step` applies :func:`base_rule`.
+
+    >>> book = SightingBook(3, 7)
+    >>> book.add(np.array([1, 2])); book.step()[0].tolist()
+    []
+    >>> for _ in range(2):
+    ...     book.observe(np.array([1])); promoted, dropped = book.step()
+    >>> promoted.tolist(), book.ids.tolist()
+    ([1], [2])
+    """
+
+    def __init__(self, base_seen_times: int, max_non_base_time: int):
+        self.base_seen_times = base_seen_times
+        self.max_non_base_time = max_non_base_time
+        self.ids = np.empty(0, dtype=np.int64)  # sorted
+        self.seen = np.empty(0, dtype=np.int64)
+        self.first = np.empty(0, dtype=np.int64)
+        self.iteration = 0
+
+    def add(self, ids):
+        allid = np.concatenate([self.ids, ids])
+        o = np.argsort(allid, kind="stable")
+        self.ids = allid[o]
+        self.seen = np.concatenate([self.seen, np.ones(ids.size, dtype=np.int64)])[o]
+        self.first = np.concatenate([self.first, np.full(ids.size, self.iteration, dtype=np.int64)])[o]
+
+    def observe(self, ids):
+        if not self.ids.size or not ids.size:
+            return
+        pos = np.searchsorted(self.ids, ids)
+        pos = np.minimum(pos, self.ids.size - 1)
+        hit = self.ids[pos] == ids
+        self.seen += np.bincount(pos[hit], minlength=self.ids.size)
+
+    def step(self):
+        """End the iteration: return (ids that became base, ids that timed out); forget both."""
+        base, late = base_rule(self.seen, self.iteration - self.first, self.base_seen_times,
+                               self.max_non_base_time)
+        promoted, dropped = self.ids[base], self.ids[late]
+        keep = ~(base | late)
+        self.ids, self.seen, self.first = self.ids[keep], self.seen[keep], self.first[keep]
+        self.iteration += 1
+        return promoted, dropped
+
+
+def _as_points(X, name, dim=None, dtype=None, binary_ok=False):
+    """Descriptors as float32 (or uint8 where the store compares binary descriptors)."""
+    X = np.asarray(X)
+    if X.dtype.kind not in "fiu":
+        raise TypeError(f"`{name}` must be a numeric array; got dtype {X.dtype}")
+    if X.dtype == np.uint8 and binary_ok and dtype != np.float32:
+        if X.ndim != 2:
+            raise ValueError(f"`{name}` must be a 2-D (N, d) descriptor array; got shape {X.shape}")
+    else:
+        if dtype == np.uint8:
+            raise TypeError(f"`{name}` must be uint8 (binary) like the stored descriptors; got {X.dtype}")
+        if X.dtype == np.uint8 and X.ndim == 2 and not binary_ok:
+            raise TypeError(f"`{name}`: binary (uint8) descriptors need an exact store (ExactStore, "
+                            "BruteForceStore); a kd-tree compares float descriptors")
+        X = v.as_finite_array(X, name, ndim=2, dtype=np.float32)
+    if dim is not None and X.shape[1] != dim:
+        raise ValueError(f"`{name}` must have shape (N, {dim}) to match the store; got shape {X.shape}")
+    return X
+
+
+def _as_ids(ids, name, n=None):
+    ids = np.asarray(ids)
+    if ids.size == 0:
+        ids = ids.astype(np.int64)
+    if not np.issubdtype(ids.dtype, np.integer):
+        raise TypeError(f"`{name}` must be an integer array; got dtype {ids.dtype}")
+    if ids.ndim != 1 or (n is not None and ids.shape[0] != n):
+        want = f"({n},)" if n is not None else "(N,)"
+        raise ValueError(f"`{name}` must have shape {want}; got shape {ids.shape}")
+    return ids.astype(np.int64)
+
+
+class _Tree:
+    """Thin adapter: one static tree of the chosen kind with a uniform ``query`` (our addition)."""
+
+    def __init__(self, X, ids, kind, leaf_size, checks):
+        self.n = X.shape[0]
+        self.kind = kind
+        self.ids = ids
+        if kind == "ckdtree":
+            self._t = cKDTree(X, leafsize=leaf_size, balanced_tree=True, compact_nodes=False)
+        elif kind == "brute":
+            self._t = X
+        else:
+            self._t = KDTree(X, ids, leaf_size=leaf_size)
+        self.max_leaves = None if kind != "bbf" else max(1, -(-checks // leaf_size))
+
+    def query(self, Q, k, counters):
+        counters.trees_searched += 1
+        if self.kind == "ckdtree":
+            kk = min(k, self.n)
+            d, i = self._t.query(Q, kk)
+            d, i = d.reshape(Q.shape[0], kk), i.reshape(Q.shape[0], kk)
+            out_i = np.where(np.isfinite(d), self.ids[np.minimum(i, self.n - 1)], -1)
+            return pad_knn(d, out_i, k)
+        if self.kind == "brute":
+            counters.distance_evals += Q.shape[0] * self.n
+            return exact_knn(Q, self._t, k, self.ids)
+        d, i = self._t.query(Q, k, max_leaves=self.max_leaves)
+        st = self._t.last_stats
+        counters.nodes_visited += int(st.nodes_visited.sum())
+        counters.distance_evals += int(st.distance_evals.sum())
+        return d, i
+
+
+class LandmarkStore(ABC):
+    """The landmark-store interface (000 §3.4): every store, and the stereo pipeline's, derives from it.
+
+    Subclasses implement ``_add(X, ids)`` (checked batch), ``_query(Q, k)`` (checked, non-empty),
+    ``_stored() -> (X, ids)`` (every stored point) and ``__len__``; ``observe`` and
+    ``end_iteration`` do nothing unless the store applies the base rule or rebuilds.
+    ``query_among`` is exact (brute force over the selected points) for every store.
+    """
+
+    name = "store"
+    insert_only = True
+    #: True for the stores that compare binary uint8 descriptors by Hamming distance (exact stores)
+    binary_ok = False
+
+    def __init__(self):
+        self.counters = StoreCounters()
+        self.dim: int | None = None
+        self.dtype = None
+
+    # -- interface ---------------------------------------------------------------------------------
+    def add(self, X, ids) -> None:
+        """Add a batch of new points (first sighting) with their ids."""
+        X, ids = self._check_batch(X, ids)
+        if X.shape[0]:
+            self.counters.points_added += X.shape[0]
+            self._add(X, ids)
+
+    def observe(self, ids) -> None:
+        """Record re-sightings of stored ids this iteration (only the base rule uses them)."""
+        _as_ids(ids, "ids")
+
+    def end_iteration(self) -> None:  # noqa: B027 (a no-op unless the store rebuilds or applies the base rule)
+        """Close an iteration (apply the base rule, rebuild what the store rebuilds)."""
+
+    def query(self, Q, k: int = 2):
+        """The ``k`` nearest stored points of every row of ``Q``: ``(dist (M, k), ids (M, k))``."""
+        Q, k = self._check_query(Q, k)
+        if len(self) == 0 or Q.shape[0] == 0:
+            return pad_knn(np.empty((Q.shape[0], 0)), np.empty((Q.shape[0], 0), dtype=np.int64), k)
+        return self._query(Q, k)
+
+    def query_among(self, Q, among, k: int = 2):
+        """Like :meth:`query`, searching only (and exactly) the stored points whose ids are in ``among``."""
+        Q, k = self._check_query(Q, k)
+        among = _as_ids(np.asarray(among).ravel(), "among")
+        X, ids = self._stored()
+        rows = np.isin(ids, among)
+        self.counters.distance_evals += Q.shape[0] * int(rows.sum())
+        return exact_knn(Q, X[rows], k, ids[rows])
+
+    @abstractmethod
+    def __len__(self) -> int:
+        """Number of stored points."""
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(n={len(self)})"
+
+    # -- what a store implements --------------------------------------------------------------------
+    @abstractmethod
+    def _add(self, X, ids) -> None:
+        """Store a checked, non-empty batch."""
+
+    @abstractmethod
+    def _query(self, Q, k):
+        """k-NN of a checked, non-empty query batch in a non-empty store."""
+
+    @abstractmethod
+    def _stored(self):
+        """``(X (n, d), ids (n,))``: every stored point."""
+
+    # -- helpers -----------------------------------------------------------------------------------
+    def _check_batch(self, X, ids):
+        X = _as_points(X, "X", self.dim, self.dtype, self.binary_ok)
+        ids = _as_ids(ids, "ids", X.shape[0])
+        if self.dim is None and X.shape[0]:
+            self.dim, self.dtype = X.shape[1], X.dtype
+        return X, ids
+
+    def _check_query(self, Q, k):
+        Q = _as_points(Q, "Q", self.dim, self.dtype, self.binary_ok)
+        k = v.check_int(k, "k", minimum=1)
+        self.counters.queries += Q.shape[0]
+        return Q, k
+
+
+def _check_tree_args(tree, leaf_size, checks):
+    tree = v.check_choice(tree, "tree", TREE_KINDS)
+    leaf_size = v.check_int(leaf_size, "leaf_size", minimum=1)
+    checks = v.check_int(checks, "checks", minimum=1)
+    return tree, leaf_size, checks
+
+
+class _PointSet:
+    """Points + ids in a growing buffer (capacity doubling; no per-add copy of everything)."""
+
+    def __init__(self):
+        self.X = np.empty((0, 0), dtype=np.float32)
+        self.ids = np.empty(0, dtype=np.int64)
+        self.n = 0
+        self._aug = None  # float rows [x, |x|²/2] for the exact search, rows [0, _aug_n) valid
+        self._aug_n = 0
+
+    def append(self, X, ids):
+        need = self.n + X.shape[0]
+        if self.X.shape[0] < need or self.X.shape[1] != X.shape[1] or self.X.dtype != X.dtype:
+            cap = max(need, 2 * self.X.shape[0], 1024)
+            Xn = np.empty((cap, X.shape[1]), dtype=X.dtype)
+            In = np.empty(cap, dtype=np.int64)
+            if self.n:
+                Xn[:self.n], In[:self.n] = self.X[:self.n], self.ids[:self.n]
+            self.X, self.ids = Xn, In
+        self.X[self.n:need], self.ids[self.n:need] = X, ids
+        self.n = need
+
+    def keep(self, mask):
+        k = int(mask.sum())
+        if self._aug is not None and self._aug_n == self.n:
+            self._aug[:k] = self._aug[:self.n][mask]
+            self._aug_n = k
+        else:
+            self._aug_n = 0
+        self.X[:k], self.ids[:k] = self.X[:self.n][mask], self.ids[:self.n][mask]
+        self.n = k
+
+    @property
+    def augmented(self):
+        """``augment_rows(points)`` (float points only), extended by the rows added since the last call.
+
+        Kept between queries (issue 17): rebuilding it for every query of 65000 points cost a
+        quarter of the GEMM it feeds.
+        """
+        if self.X.dtype == np.uint8:
+            return None
+        if self._aug is None or self._aug.shape != (self.X.shape[0], self.X.shape[1] + 1):
+            old, old_n = self._aug, self._aug_n
+            self._aug = np.empty((self.X.shape[0], self.X.shape[1] + 1), dtype=np.float32)
+            self._aug_n = 0
+            if old is not None and old.shape[1] == self._aug.shape[1] and old_n:
+                self._aug[:old_n] = old[:old_n]
+                self._aug_n = old_n
+        if self._aug_n < self.n:
+            augment_rows(self.X[self._aug_n:self.n], out=self._aug[self._aug_n:self.n])
+            self._aug_n = self.n
+        return self._aug[:self.n]
+
+    @property
+    def points(self):
+        return self.X[:self.n]
+
+    @property
+    def point_ids(self):
+        return self.ids[:self.n]
