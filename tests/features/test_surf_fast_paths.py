@@ -21,7 +21,8 @@ from slamlab.features import (
     surf_describe,
     surf_orientation,
 )
-from slamlab.features.surf import _interior_maxima, _PaddedII, _response_stacks
+from slamlab.features.surf_haar import _PaddedII
+from slamlab.features.surf_response import _interior_maxima, _response_stacks
 
 
 @pytest.mark.parametrize(("shape", "init_step", "n_octaves", "phase_octaves"),
