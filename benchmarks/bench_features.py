@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 import slamlab.features as F
-from slamlab.features.experiments import _matching_workload
+from slamlab.features.matching_experiments import _matching_workload
 from slamlab.kdtree import KDTree
 
 

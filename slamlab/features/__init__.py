@@ -25,13 +25,9 @@ from .evaluation import (
 )
 from .experiments import (
     EVAL_DETECTORS,
-    descriptor_pool,
     run_blob_scale,
     run_detector_summary,
-    run_knn_comparison,
     run_pair_evaluation,
-    run_ratio_tradeoff,
-    run_recall_vs_leaves,
     run_surf_threshold,
 )
 from .fast import fast_corner_mask, fast_detect, fast_score
@@ -46,6 +42,12 @@ from .matching import (
     match_descriptors,
     mutual_mask,
     ratio_rule,
+)
+from .matching_experiments import (
+    descriptor_pool,
+    run_knn_comparison,
+    run_ratio_tradeoff,
+    run_recall_vs_leaves,
 )
 from .moravec import moravec_detect, moravec_response
 from .opencv import fast_cv, features_from_keypoints, mser_cv, orb_cv, sift_cv
