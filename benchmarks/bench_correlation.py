@@ -22,7 +22,8 @@ import scipy
 from scipy.signal import fftconvolve
 
 import slamlab as sl
-from slamlab.correlation.algorithm import _beam_samples, _MapSpectrum, _peak_search, _Stamps
+from slamlab.correlation.algorithm import _beam_samples
+from slamlab.correlation.scoring import _MapSpectrum, _peak_search, _Stamps
 
 
 def best_of(fn, repeat=3):

@@ -1,0 +1,283 @@
+"""The correlation of a scan with the map for every heading at once: FFT scoring, peak and rival search (004 §5).
+
+The scan's stamps ``T_n`` (one per heading, rasterised by :func:`~slamlab.correlation.algorithm.rasterise_scan`)
+are correlated with the map by batched real FFTs (the map's spectrum once per quarter turn), pruned to the valid
+shifts; :func:`score_maps` is the public entry (methods ``"batched"``, ``"fftconvolve"``, ``"direct"``). Part of
+:mod:`slamlab.correlation.algorithm`, which re-exports :func:`score_maps`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft as sfft
+from scipy.signal import fftconvolve
+
+from .. import _validate as v
+from ..geometry import wrap_angle
+
+__all__ = ["score_maps"]
+
+_METHODS = ("batched", "fftconvolve", "direct")
+
+
+class _Stamps:
+    """T_n for a list of headings, rasterising each heading modulo 90° once (quarter turns are exact on the grid).
+
+    A point ``(x, y) → (-y, x)`` under a quarter turn: ``T'[o + x, o - y] = T[o + y, o + x]``, i.e.
+    ``T'[i, j] = T[(2o - j) mod S, i]`` (the wrapped row/column is the outer ring, always a_n).
+    """
+
+    def __init__(self, free, obs, headings, a_c, a_p, a_n, o, dtype):
+        S = 2 * o
+        self.S, self.dtype = S, dtype
+        self.quarter = np.floor(np.mod(headings, 2 * np.pi) / (np.pi / 2) + 1e-9).astype(int) % 4
+        base = np.mod(headings, np.pi / 2)
+        base[base > np.pi / 2 - 1e-9] = 0.0
+        ub, self.inv = np.unique(np.round(base, 12), return_inverse=True)
+        self.Tb = np.full((ub.size, S, S), a_n, dtype=dtype)
+        _stamp(self.Tb, ub, free, obs, a_c, a_p, o)
+        self.Tb = self.Tb.reshape(ub.size, S * S)
+        i, j = np.divmod(np.arange(S * S), S)
+        p1 = ((2 * o - j) % S) * S + i
+        self.perm = [None, p1, p1[p1], p1[p1][p1]]
+
+    def take(self, sel: np.ndarray) -> np.ndarray:
+        """The stack ``T[sel]`` of shape ``(len(sel), S, S)``."""
+        out = np.empty((sel.size, self.S * self.S), dtype=self.dtype)
+        q = self.quarter[sel]
+        for k in range(4):
+            m = np.nonzero(q == k)[0]
+            if m.size:
+                block = self.Tb[self.inv[sel[m]]]
+                out[m] = block if k == 0 else np.take(block, self.perm[k], axis=1)
+        return out.reshape(sel.size, self.S, self.S)
+
+
+def _stamp(T: np.ndarray, headings: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p: float,
+           o: int) -> None:
+    """Write a_c at the free samples and then a_p at the obstacle samples of each heading (in place)."""
+    n, S, _ = T.shape
+    flat = T.reshape(-1)
+    big = n * S * S >= 2**24  # float32 holds integers exactly below 2**24
+    ft = np.float64 if big else np.float32
+    c = np.cos(headings).astype(ft)[:, None]
+    s = np.sin(headings).astype(ft)[:, None]
+    base = (np.arange(n, dtype=ft) * (S * S) + o * S + o + 0.5 * (S + 1))[:, None]
+    chunk = max(1, int(4e6 // max(free.shape[0], 1)))
+    for pts, val in ((free, a_c), (obs, a_p)):  # obstacle marks overwrite free ones
+        if pts.shape[0] == 0:
+            continue
+        px, py = pts[:, 0].astype(ft), pts[:, 1].astype(ft)
+        for k0 in range(0, n, chunk):
+            cc, ss = c[k0:k0 + chunk], s[k0:k0 + chunk]
+            x = cc * px
+            x -= ss * py
+            y = ss * px
+            y += cc * py
+            # floor(v + 0.5) for row and column, folded: idx = (floor(y+.5)+o)·S + floor(x+.5)+o + n·S²
+            np.floor(x + 0.5, out=x)
+            np.floor(y + 0.5, out=y)
+            y *= S
+            y += x
+            y += base[k0:k0 + chunk] - 0.5 * (S + 1)
+            flat[y.astype(np.int64).ravel()] = val
+
+
+def _fast_len(n: int) -> int:
+    return sfft.next_fast_len(n, real=True)
+
+
+class _MapSpectrum:
+    """rfft2 of the map zero-padded for the robot-inside-map shifts of an S×S stamp (computed once)."""
+
+    def __init__(self, Mv: np.ndarray, S: int, o: int, dtype, workers: int | None, L: tuple[int, int] | None = None):
+        H, W = Mv.shape
+        # circular correlation c[k] = Σ_i T[i]·Mp[(i + k) mod L] equals the linear one for the shifts
+        # k = row - o, row ∈ [0, H), when L ≥ H + o and L ≥ H + S - 1 - o (derivation in the module docstring)
+        need = (max(H + o, H + S - 1 - o), max(W + o, W + S - 1 - o))
+        self.L = (_fast_len(need[0]), _fast_len(need[1])) if L is None else L
+        if self.L[0] < need[0] or self.L[1] < need[1]:
+            raise ValueError(f"FFT size {self.L} too small for map {Mv.shape} and stamp {S}")
+        self.shape = (H, W)
+        self.S, self.o, self.dtype, self.workers = S, o, dtype, workers
+        self.FM = sfft.rfft2(Mv.astype(dtype, copy=False), s=self.L, workers=workers)
+        self.rows = (np.arange(H) - o) % self.L[0]
+        self.cols = (np.arange(W) - o) % self.L[1]
+
+    def forward(self, T: np.ndarray) -> np.ndarray:
+        """conj(rfft2(T)) at this spectrum's size (pruned: rfft on the S rows only, then fft along rows)."""
+        FT = sfft.rfft(T.astype(self.dtype, copy=False), n=self.L[1], axis=-1, workers=self.workers)
+        FT = sfft.fft(FT, n=self.L[0], axis=-2, workers=self.workers, overwrite_x=True)
+        return np.conjugate(FT, out=FT)
+
+    def inverse(self, FTc: np.ndarray) -> np.ndarray:
+        """Scores ``(n, H, W)`` from ``forward(T)``: product with the map spectrum, pruned irfft2."""
+        P = FTc * self.FM
+        c = sfft.ifft(P, axis=-2, workers=self.workers, overwrite_x=True)[:, self.rows]
+        c = sfft.irfft(c, n=self.L[1], axis=-1, workers=self.workers, overwrite_x=True)
+        return c[:, :, self.cols]
+
+    def scores(self, T: np.ndarray) -> np.ndarray:
+        return self.inverse(self.forward(T))
+
+
+def _map_spectra(Mv, stamps, S, o, *, dtype, workers):
+    """Spectra of the map turned by every quarter turn the stamps use (one FFT size for all)."""
+    H, W = Mv.shape
+    side = max(H, W)
+    L = _fast_len(max(side + o, side + S - 1 - o))
+    return {q: _MapSpectrum(np.ascontiguousarray(np.rot90(Mv, q)), S, o, dtype, workers, L=(L, L))
+            for q in sorted(set(stamps.quarter.tolist()))}
+
+
+def _iter_scores(specs, stamps, sel, S, chunk):
+    """Yield ``(heads, D)``: score maps ``D[k] = D_{heads[k]}`` for the headings ``sel``, in chunks of base stamps.
+
+    Quarter turns: with ``R`` the quarter turn of the stamps, ``D_{T∘R⁻¹}(M) = rot90(D_T(rot90(M)), -1)``
+    (derivation in the notebook), so the spectrum of each base stamp (heading mod 90°) is computed once
+    and correlated with the four rotated maps' spectra.
+    """
+    quarters = sorted(specs)
+    bases = np.unique(stamps.inv[sel])
+    for b0 in range(0, bases.size, chunk):
+        bs = bases[b0:b0 + chunk]
+        FTc = specs[quarters[0]].forward(stamps.Tb[bs].reshape(bs.size, S, S))
+        in_chunk = sel[np.isin(stamps.inv[sel], bs)]
+        for q in quarters:
+            heads = in_chunk[stamps.quarter[in_chunk] == q]
+            if heads.size == 0:
+                continue
+            D = specs[q].inverse(FTc[np.searchsorted(bs, stamps.inv[heads])])
+            if q:
+                D = np.rot90(D, -q, axes=(1, 2))
+            yield heads, D
+
+
+def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None):
+    """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
+
+    Returns ``(best_val, (n, row, col), best_map, best_per_heading, argmax_per_heading)``; ties within
+    ``tol`` go to the smallest heading index, then the first row and column. ``argmax_per_heading``
+    holds the flat cell index of each heading's maximum.
+    """
+    if specs is None:
+        specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=workers)
+    best_per = np.full(headings.size, -np.inf)
+    arg_per = np.zeros(headings.size, dtype=np.int64)
+    best_val, best_idx, best_map = -np.inf, None, None
+    for heads, D in _iter_scores(specs, stamps, np.arange(headings.size), S, chunk):
+        flat_D = D.reshape(D.shape[0], -1)
+        am = flat_D.argmax(axis=1)
+        per = flat_D[np.arange(am.size), am]
+        best_per[heads], arg_per[heads] = per, am
+        m = float(per.max())
+        if m > best_val + tol or (m >= best_val - tol and best_idx is not None and heads.min() < best_idx[0]):
+            cand = np.nonzero(per >= max(m, best_val) - tol)[0]
+            k = cand[np.argmin(heads[cand])]
+            if best_idx is None or m > best_val + tol or heads[k] < best_idx[0]:
+                flat = int(np.argmax(D[k].ravel() >= max(m, best_val) - tol))
+                best_val = max(m, best_val)
+                best_idx = (int(heads[k]), *np.unravel_index(flat, D.shape[1:]))
+                best_map = np.ascontiguousarray(D[k])
+    return best_val, best_idx, best_map, best_per, arg_per
+
+
+def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, radius_cells, heading_rad, chunk):
+    """Best pose more than ``radius_cells`` or ``heading_rad`` away from the peak ``best_idx`` (ours).
+
+    Headings farther than ``heading_rad`` count with their whole map (their maxima are already known);
+    the others are scored again with the disc of radius ``radius_cells`` around the peak cell masked.
+    Returns ``(score, (n, row, col))``, ``(-inf, None)`` when no such pose exists.
+    """
+    n0, r0, c0 = best_idx
+    H, W = specs[next(iter(specs))].shape
+    dh = np.abs(wrap_angle(headings - headings[n0]))
+    far = np.nonzero(dh > heading_rad + 1e-12)[0]
+    val, idx = -np.inf, None
+    if far.size:
+        k = far[np.argmax(best_per[far])]
+        val, idx = float(best_per[k]), (int(k), *np.unravel_index(int(arg_per[k]), (H, W)))
+    near = np.nonzero(dh <= heading_rad + 1e-12)[0]
+    rows, cols = np.ogrid[:H, :W]
+    outside = ((rows - r0) ** 2 + (cols - c0) ** 2 > radius_cells ** 2).ravel()
+    if not outside.any():
+        return val, idx
+    cells = np.nonzero(outside)[0]
+    for heads, D in _iter_scores(specs, stamps, near, S, chunk):
+        Dm = D.reshape(D.shape[0], -1)[:, cells]
+        am = Dm.argmax(axis=1)
+        per = Dm[np.arange(am.size), am]
+        k = int(np.argmax(per))
+        if per[k] > val:
+            val, idx = float(per[k]), (int(heads[k]), *np.unravel_index(int(cells[am[k]]), (H, W)))
+    return val, idx
+
+
+def _direct_scores(Mv: np.ndarray, T: np.ndarray, o: int) -> np.ndarray:
+    """The definition Σ_{i,j} T[i, j]·M[row + i - o, col + j - o] (slow reference; loops over T's cells)."""
+    H, W = Mv.shape
+    n, S, _ = T.shape
+    pad = np.zeros((H + 2 * S, W + 2 * S))
+    pad[S:S + H, S:S + W] = Mv
+    out = np.zeros((n, H, W))
+    for i, j in zip(*np.nonzero(np.any(T != 0, axis=0)), strict=True):
+        block = pad[S + i - o:S + i - o + H, S + j - o:S + j - o + W]
+        out += T[:, i, j][:, None, None] * block[None]
+    return out
+
+
+def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.float64,
+               workers: int | None = None) -> np.ndarray:
+    """Correlation of every T_n with M, indexed by the robot's cell: ``D[n, row, col]`` (004 §7).
+
+    ``D[n, row, col] = Σ_{i,j} T_n[i, j]·M[row + i - o, col + j - o]`` with M = 0
+    (= a_n) outside the map; it is the block of 004's ``C_n`` whose robot cell lies
+    in the map (see the module docstring for the index mapping).
+
+    Parameters
+    ----------
+    M_values : array_like, shape (H, W)
+        The map with 004's constants (see :func:`slamlab.scans.grid_to_values`).
+    T : array_like, shape (n, S, S)
+        From :func:`rasterise_scan`.
+    origin : int
+        ``o``, the robot's cell in T.
+    method : {"batched", "fftconvolve", "direct"}
+        One ``scipy.fft`` rfft2 of all T_n against the map's rfft2 computed once;
+        ``scipy.signal.fftconvolve`` per heading; or the definition (slow).
+    dtype : numpy dtype
+        FFT precision of the batched method (float64 or float32).
+    workers : int, optional
+        ``scipy.fft`` worker threads of the batched method.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, H, W)
+
+    Examples
+    --------
+    >>> M = np.array([[0., 1.], [2., 3.]])
+    >>> T = np.zeros((1, 4, 4)); T[0, 2, 3] = 1.0  # robot at T[2, 2], cell one column to its right
+    >>> score_maps(M, T, 2).round(9).tolist()
+    [[[1.0, 0.0], [3.0, 0.0]]]
+    """
+    Mv = v.as_finite_array(M_values, "M_values", ndim=2)
+    if Mv.size == 0:
+        raise ValueError(f"`M_values` must not be empty; got shape {Mv.shape}")
+    T = v.as_finite_array(T, "T")
+    if T.ndim != 3 or T.shape[1] != T.shape[2] or T.shape[1] < 1:
+        raise ValueError(f"`T` must have shape (n, S, S); got shape {T.shape}")
+    o = v.check_int(origin, "origin", minimum=0, maximum=T.shape[1] - 1)
+    method = v.check_choice(method, "method", _METHODS)
+    if method == "batched":
+        return _MapSpectrum(Mv, T.shape[1], o, dtype, workers).scores(T)
+    if method == "direct":
+        return _direct_scores(Mv, T, o)
+    H, W = Mv.shape
+    S = T.shape[1]
+    out = np.empty((T.shape[0], H, W))
+    for n in range(T.shape[0]):
+        full = fftconvolve(Mv, T[n, ::-1, ::-1], mode="full")  # = correlation of M with T_n
+        a0 = S - 1 - o  # robot row = a + o - (S - 1)
+        out[n] = full[a0:a0 + H, a0:a0 + W]
+    return out
