@@ -574,7 +574,7 @@ def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, 
     ``f b / z`` (``z``: the renderer's depth at the left keypoint's pixel). Returns a table of the
     median absolute error and the share above 1 px per level.
     """
-    from .stages import _stereo_match, detect_features, subpixel_disparity
+    from .local_stages import _stereo_match, detect_features, subpixel_disparity
 
     p = StereoParams.resolve(params, **({"detector": "orb"} | overrides))
     arena = StereoArena(seed=0) if arena is None else arena

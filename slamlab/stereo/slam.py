@@ -23,18 +23,9 @@ from ..geometry.camera import StereoRig
 from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
 from ..kdtree.stores import ExactStore, LandmarkStore, base_rule, make_store
+from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified
+from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
 from .params import StereoParams
-from .stages import (
-    _check_features,
-    _estimate_pose,
-    _match_to_map,
-    _matches_from_knn,
-    _stereo_match,
-    _triangulate_local,
-    _window_match,
-    is_rectified,
-    pose_std,
-)
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
 

@@ -486,7 +486,7 @@ def test_subpixel_disparity_bad_input():
 
 
 def test_radius_pairs_are_every_pair_within_the_radius():
-    from slamlab.stereo.stages import _radius_pairs
+    from slamlab.stereo.map_stages import _radius_pairs
 
     rng = np.random.default_rng(3)
     uq = rng.uniform(-30, 800, (300, 2))
@@ -502,7 +502,7 @@ def test_radius_pairs_are_every_pair_within_the_radius():
 
 
 def test_two_nearest_per_query():
-    from slamlab.stereo.stages import _two_nearest
+    from slamlab.stereo.local_stages import _two_nearest
 
     q, t1, d1, d2, t2 = _two_nearest(np.array([0, 0, 0, 2, 3, 3]), np.array([5, 6, 7, 8, 9, 10]),
                                      np.array([3.0, 1.0, 2.0, 4.0, 1.0, 1.0]))
@@ -514,7 +514,7 @@ def test_two_nearest_per_query():
 
 
 def test_window_match_searches_only_near_the_projections():
-    from slamlab.stereo.stages import _window_match
+    from slamlab.stereo.map_stages import _window_match
 
     rng = np.random.default_rng(5)
     n = 60

@@ -1,0 +1,373 @@
+"""Stereo SLAM stages 3-4: local landmarks matched to the map through a store (000 §3.4), and the pose by
+absolute orientation inside RANSAC, oldest landmarks first (000 §3.5).
+
+Part of :mod:`slamlab.stereo.stages` (which re-exports every name; its docstring gives the pipeline's order).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .. import _validate as v
+from ..features.matching import best_per_target, ratio_rule
+from ..geometry.ransac import ransac
+from ..geometry.registration import RigidTransform, umeyama
+from ..kdtree.stores import LandmarkStore
+from .local_stages import _pair_distances, _two_nearest
+from .params import StereoParams
+
+__all__ = [
+    "MapMatches",
+    "PoseEstimate",
+    "estimate_pose",
+    "match_to_map",
+    "pose_std",
+    "select_oldest",
+]
+
+
+# --- local landmarks to map landmarks through a store (000 §3.4) -----------------------------------
+
+
+class MapMatches(NamedTuple):
+    """``local (M,)`` indices into the local cloud, ``ids (M,)`` landmark ids, ``distance (M,)``,
+    ``unmatched (K - M,)`` local indices that found no landmark (candidates for new landmarks), and
+    ``nearest (K,)``: every local point's nearest landmark by descriptor (-1: none), matched or not."""
+
+    local: np.ndarray
+    ids: np.ndarray
+    distance: np.ndarray
+    unmatched: np.ndarray
+    nearest: np.ndarray | None = None
+
+
+def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | None = None, positions=None,
+                 candidates=None, max_distance: float | None = None, **overrides) -> MapMatches:
+    """Match local descriptors to the stored landmarks: 2-NN query + ratio rule, one local per landmark (000 §3.4).
+
+    The ratio is ``map_ratio`` of ``params`` / ``overrides`` (:class:`StereoParams`). With
+    ``positions`` ((n, 3) landmark positions indexed by id) and ``same_point_m``, two nearest
+    landmarks closer than ``same_point_m`` to each other count as one physical point (a duplicate
+    added when a sighting was missed), so the ratio rule does not reject them (our addition:
+    without it, duplicates make every later sighting of a place ambiguous and the map stops
+    closing loops).
+
+    With ``candidates`` (landmark ids), only those landmarks are searched
+    (:meth:`~slamlab.kdtree.LandmarkStore.query_among`, exact for every store).
+
+    >>> from slamlab.kdtree import ExactStore
+    >>> s = ExactStore(); s.add(np.array([[0.0, 0.0], [5.0, 0.0]]), [7, 8])
+    >>> m = match_to_map(np.array([[0.1, 0.0], [2.4, 0.0]]), s)
+    >>> m.local.tolist(), m.ids.tolist(), m.unmatched.tolist()
+    ([0], [7], [1])
+    """
+    p = StereoParams.resolve(params, **overrides)
+    D = np.asarray(descriptors)
+    if D.ndim != 2:
+        raise ValueError(f"`descriptors` must be 2-D (K, D); got shape {D.shape}")
+    if not isinstance(store, LandmarkStore):
+        raise TypeError(f"`store` must be a slamlab.kdtree.LandmarkStore; got {type(store).__name__}")
+    X = None if positions is None else v.as_finite_array(positions, "positions", ndim=2)
+    cand = None if candidates is None else np.asarray(candidates, dtype=np.int64).ravel()
+    max_distance = None if max_distance is None else v.check_positive(max_distance, "max_distance")
+    return _match_to_map(D, store, p.map_ratio, X, p.same_point_m or None, cand, max_distance)
+
+
+def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates=None, max_distance=None):
+    """:func:`match_to_map` on checked arguments (the per-frame core)."""
+    k = D.shape[0]
+    if k == 0 or len(store) == 0:
+        return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
+    if candidates is not None:
+        dist, ids = store.query_among(D, candidates, k=2)
+    else:
+        dist, ids = store.query(D, k=2)
+    return _matches_from_knn(dist, ids, ratio, positions, same_point_m, max_distance)
+
+
+def _accept_twins(ok, first, second, positions, same_point_m):
+    """Set ``ok`` (in place) where the ratio rule failed only because the nearest and second-nearest
+    landmarks (ids ``first``, ``second``; -1: none) lie within ``same_point_m`` of each other: one point."""
+    if positions is None or same_point_m is None:
+        return
+    both = ~ok & (first >= 0) & (second >= 0)
+    if both.any():
+        gap = np.linalg.norm(positions[first[both]] - positions[second[both]], axis=1)
+        ok[np.flatnonzero(both)[gap < same_point_m]] = True
+
+
+def _matches_from_knn(dist, ids, ratio, positions=None, same_point_m=None, max_distance=None) -> MapMatches:
+    """:class:`MapMatches` from the 2-NN ``(dist, ids)`` of every local point (the rules of :func:`match_to_map`)."""
+    k = dist.shape[0]
+    ok = (ids[:, 0] >= 0) & ratio_rule(dist[:, 0], dist[:, 1], ratio)
+    _accept_twins(ok, ids[:, 0], ids[:, 1], positions, same_point_m)
+    if max_distance is not None:
+        ok &= dist[:, 0] <= max_distance
+    loc = np.flatnonzero(ok)
+    lid, d = ids[ok, 0], dist[ok, 0]
+    sel = best_per_target(lid, d)  # one local point per landmark: the closest descriptor wins
+    claimed = np.zeros(k, dtype=bool)
+    claimed[loc] = True  # ratio-passing points that lost a duplicate are neither matches nor new
+    return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed), ids[:, 0])
+
+
+def _radius_pairs(uv_q, uv_t, radius):
+    """All pairs ``(query, target)`` of 2-D points at most ``radius`` apart, grouped by ascending query
+    index: targets bucketed in a grid of ``radius`` cells, each query looks in its 3 x 3 cells."""
+    lo_xy = np.minimum(uv_q.min(axis=0), uv_t.min(axis=0))
+    cq = np.floor((uv_q - lo_xy) / radius).astype(np.int64)
+    ct = np.floor((uv_t - lo_xy) / radius).astype(np.int64)
+    ny = int(max(cq[:, 1].max(), ct[:, 1].max())) + 3
+    key_t = (ct[:, 0] + 1) * ny + ct[:, 1] + 1
+    order = np.argsort(key_t, kind="stable")
+    keys = key_t[order]
+    # the 3 cells of a column are consecutive keys: one range per column offset
+    base = (cq[:, 0:1] + 1 + np.arange(-1, 2)) * ny + cq[:, 1:2] + 1  # (k, 3) middle cell of each column
+    lo = np.searchsorted(keys, base - 1, side="left")
+    hi = np.searchsorted(keys, base + 1, side="right")
+    cnt = (hi - lo).ravel()
+    qi = np.repeat(np.arange(len(uv_q)), 3)
+    qi = np.repeat(qi, cnt)
+    ti = order[np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt - lo.ravel(), cnt)]
+    d = uv_q[qi] - uv_t[ti]
+    keep = np.einsum("ij,ij->i", d, d) <= radius * radius
+    return qi[keep], ti[keep]
+
+
+def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance, positions=None,
+                  same_point_m=None) -> tuple[MapMatches, int]:
+    """Map matching by projection (our addition to 000 §3.4): each local point (left keypoint ``uv``,
+    descriptor ``D``) is compared only with the landmarks ``ids_lm`` that a predicted pose projects within
+    ``radius_px`` of it (pixels ``uv_lm``, descriptors ``desc_lm``); nearest and second nearest of those
+    decide by the ratio rule (two neighbours closer than ``same_point_m`` count as one), the nearest
+    must be within ``max_distance``, one local point per landmark. Returns the matches and the number of
+    descriptor distances computed."""
+    k = D.shape[0]
+    none = MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
+    if k == 0 or len(ids_lm) == 0:
+        return none, 0
+    qi, rows = _radius_pairs(uv, uv_lm, radius_px)
+    if qi.size == 0:
+        return none, 0
+    d = _pair_distances(D, desc_lm, qi, rows)
+    q, r1, d1, d2, r2 = _two_nearest(qi, rows, d)
+    ok = ratio_rule(d1, d2, ratio)
+    _accept_twins(ok, ids_lm[r1], np.where(r2 >= 0, ids_lm[r2], -1), positions, same_point_m)
+    ok &= d1 <= max_distance
+    nearest = np.full(k, -1, dtype=np.int64)
+    nearest[q] = ids_lm[r1]
+    loc, lid, dd = q[ok], ids_lm[r1[ok]], d1[ok]
+    sel = best_per_target(lid, dd)
+    claimed = np.zeros(k, dtype=bool)
+    claimed[loc] = True
+    return MapMatches(loc[sel], lid[sel], dd[sel], np.flatnonzero(~claimed), nearest), int(qi.size)
+
+
+# --- pose: absolute orientation inside RANSAC, oldest landmarks first (000 §3.5) -----------------
+
+
+def select_oldest(first_seen, n_min: int) -> np.ndarray:
+    """Indices of the matches whose landmarks were first seen longest ago (000 §3.5).
+
+    Sort by the frame of the first sighting and take the earliest ones until at
+    least ``n_min`` are gathered, with every landmark of the last frame included
+    ("seen as long ago as possible and at about the same time").
+
+    >>> select_oldest([5, 0, 3, 0, 9, 3], 3).tolist()
+    [1, 2, 3, 5]
+    """
+    fs = np.asarray(first_seen)
+    if fs.ndim != 1:
+        raise ValueError(f"`first_seen` must be 1-D; got shape {fs.shape}")
+    n_min = v.check_int(n_min, "n_min", minimum=1)
+    if fs.size <= n_min:
+        return np.arange(fs.size)
+    cut = np.sort(fs)[n_min - 1]
+    return np.flatnonzero(fs <= cut)
+
+
+def pose_std(points_map, cov_map, center=None) -> np.ndarray:
+    """Standard deviations of the 6 pose parameters (3 rotations, rad; 3 translations, m)
+    determined by matched points with covariances ``cov_map`` (Gauss-Newton information
+    ``Σ Jᵢᵀ Σᵢ⁻¹ Jᵢ``, ``Jᵢ = [-[pᵢ - c]ₓ, I]``; translations about ``center``, default the
+    points' mean). Our addition: it tells whether a set of landmarks is "sufficiently large
+    for computing the position" (000 §3.5). A wall of points straight ahead, with stereo depth
+    error much larger than the lateral error, leaves yaw and sideways translation nearly
+    interchangeable; this shows as large standard deviations.
+
+    >>> P = np.array([[1.0, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
+    >>> bool(np.all(np.isfinite(pose_std(P, np.tile(np.eye(3) * 1e-4, (4, 1, 1))))))
+    True
+    """
+    P = v.as_finite_array(points_map, "points_map", ndim=2)
+    C = np.asarray(cov_map, dtype=float)
+    if C.shape != (len(P), 3, 3):
+        raise ValueError(f"`cov_map` must have shape ({len(P)}, 3, 3); got {C.shape}")
+    c = P.mean(axis=0) if center is None else np.asarray(center, dtype=float)
+    return _std_from_information(_point_information(P, C, c).sum(axis=0))
+
+
+def _point_information(P, C, center) -> np.ndarray:
+    """(N, 6, 6) Gauss-Newton information ``Jᵢᵀ Cᵢ⁻¹ Jᵢ`` of each point about ``center``."""
+    q = P - center
+    J = np.zeros((len(P), 3, 6))
+    # d(R p)/d(rotation vector) = -[p]x
+    J[:, 0, 1], J[:, 0, 2] = q[:, 2], -q[:, 1]
+    J[:, 1, 0], J[:, 1, 2] = -q[:, 2], q[:, 0]
+    J[:, 2, 0], J[:, 2, 1] = q[:, 1], -q[:, 0]
+    J[:, :, 3:] = np.eye(3)
+    CiJ = np.linalg.solve(C, J)
+    return np.einsum("nki,nkj->nij", J, CiJ)
+
+
+def _std_from_information(info) -> np.ndarray:
+    """Standard deviations from (..., 6, 6) information matrices; inf where one is singular."""
+    info = np.asarray(info)
+    out = np.full(info.shape[:-1], np.inf)
+    ok = np.linalg.cond(info) < 1e12
+    if ok.any():
+        out[ok] = np.sqrt(np.diagonal(np.linalg.inv(info[ok]), axis1=-2, axis2=-1))
+    return out
+
+
+class PoseEstimate(NamedTuple):
+    """Pose ``T`` (4, 4) mapping local points to the map, ``inliers (M,)`` over all matches,
+    ``converged``, ``n_used`` matches the final fit used, ``n_iters`` hypotheses."""
+
+    T: np.ndarray
+    inliers: np.ndarray
+    converged: bool
+    n_used: int
+    n_iters: int
+
+
+def _fit(src, dst, w):
+    return umeyama(src, dst, weights=w)
+
+
+def _residuals(T: RigidTransform, src, dst, w):
+    # residual in units of the per-point scale: sqrt(w) = 1 / scale
+    return np.linalg.norm(src @ T.R.T + T.t - dst, axis=1) * np.sqrt(w)
+
+
+def estimate_pose(local_points, map_points, first_seen=None, *, depth_m=None, cov=None,
+                  params: StereoParams | None = None, rng=None, **overrides) -> PoseEstimate:
+    """Rotation + translation mapping the local cloud onto the map landmarks, by RANSAC + Umeyama (000 §3.5).
+
+    Parameters
+    ----------
+    local_points, map_points : (M, 3) matched points in the body frame and in the map frame.
+    first_seen : (M,) frame at which each matched landmark was first seen (for ``policy="oldest"``).
+    params, overrides : :class:`StereoParams` (``policy``, ``ransac_iters``, ``threshold_m``,
+        ``depth_ref_m``, ``min_inliers``, ``n_oldest``, ``oldest_fraction``, ``keep_fraction``,
+        ``loose_factor``, ``still_fraction``, ``max_std_factor``, ``max_correction_*``).
+    depth_m : (M,) depths of the local points: the inlier threshold grows as
+        ``threshold_m · max(1, (depth / depth_ref_m)²)`` (stereo depth error ∝ depth²; our choice),
+        and the final fit weights points by the inverse square of that scale.
+    policy : ``"oldest"`` — RANSAC on all matches gives a consensus pose; the matches within
+        ``loose_factor`` thresholds of it are candidates; the landmarks among them first seen
+        longest ago (:func:`select_oldest`: at least ``n_oldest`` and ``oldest_fraction`` of the
+        candidates — fewer, all from one edge of the view, leave yaw and sideways translation
+        nearly ambiguous) — extended by the next-oldest until, with ``cov`` given, no pose parameter is
+        more than ``max_std_factor`` times as uncertain as with all candidates (:func:`pose_std`;
+        "sufficiently large for computing the position") — get a RANSAC of their own, whose pose wins when at least
+        ``keep_fraction`` of them agree, it keeps ``still_fraction`` (80 %) of the candidates within the loose band and
+        it differs from the consensus pose by at most ``max_correction_rad`` / ``max_correction_m``
+        (None = unbounded; a bound of 5° / 0.3 m also blocks the loop-closing correction)
+        (our reading of 000 §3.5: old landmarks correct the drift of the recent ones when a place
+        is revisited);
+        ``"all"`` — the pose is the least-squares fit on all RANSAC inliers.
+    cov : (M, 3, 3) covariances of the local points (body frame), for the conditioning test of
+        ``policy="oldest"``; None skips the test.
+    ransac_iters : RANSAC hypotheses (000: about 200), minimal samples of 3, early exit at 99.9 % confidence.
+    min_inliers : inliers needed for a valid pose.
+
+    Raises
+    ------
+    ValueError if fewer than 3 matches are given.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0); P = rng.uniform(-2, 2, (30, 3))
+    >>> from slamlab.geometry import se3_from_planar
+    >>> T = se3_from_planar(0.5, -0.2, 0.3)
+    >>> est = estimate_pose(P, P @ T[:3, :3].T + T[:3, 3], rng=0)
+    >>> bool(np.allclose(est.T, T)), int(est.inliers.sum())
+    (True, 30)
+    """
+    p = StereoParams.resolve(params, **overrides)
+    src = v.as_finite_array(local_points, "local_points", ndim=2)
+    dst = v.as_finite_array(map_points, "map_points", ndim=2)
+    if src.shape != dst.shape or src.shape[1:] != (3,):
+        raise ValueError(f"`local_points` and `map_points` must both have shape (M, 3); got {src.shape} and {dst.shape}")
+    m = src.shape[0]
+    if m < 3:
+        raise ValueError(f"`local_points` must hold at least 3 matches for a 3-D pose; got {m}")
+    if cov is not None:
+        cov = np.asarray(cov, dtype=float)
+        if cov.shape != (m, 3, 3) or not np.all(np.isfinite(cov)):
+            raise ValueError(f"`cov` must be a finite ({m}, 3, 3) array; got shape {cov.shape}")
+    depth = np.linalg.norm(src, axis=1) if depth_m is None else v.as_vector(depth_m, "depth_m", m)
+    first_seen = np.zeros(m, dtype=np.int64) if first_seen is None else np.asarray(first_seen)
+    if first_seen.shape != (m,):
+        raise ValueError(f"`first_seen` must have shape ({m},); got {first_seen.shape}")
+    return _estimate_pose(src, dst, first_seen, depth, cov, p, v.as_rng(rng))
+
+
+def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> PoseEstimate:
+    """:func:`estimate_pose` on checked arguments (the per-frame core)."""
+    m = src.shape[0]
+    threshold_m, min_inliers, max_iters = p.threshold_m, p.min_inliers, p.ransac_iters
+    loose_factor, max_std_factor = p.loose_factor, p.max_std_factor
+    scale = np.maximum(1.0, (depth / p.depth_ref_m) ** 2)
+    w = 1.0 / scale**2
+
+    r = ransac((src, dst, w), _fit, _residuals, 3, threshold_m, max_iters=max_iters, min_inliers=min_inliers, rng=rng)
+    if not r.converged:
+        return PoseEstimate(np.eye(4), np.zeros(m, dtype=bool), False, 0, r.n_iters)
+    Tm = r.model
+    used = np.flatnonzero(r.inliers)
+    if p.policy == "oldest":
+        # 000 §3.5: the pose from the landmarks first seen longest ago and at about the same time.
+        # Candidates: matches within `loose_factor` thresholds of the consensus pose (true matches to
+        # old landmarks that drifted apart from the recent map stay, random false matches go);
+        # then RANSAC again on the oldest of them, kept if most of them agree.
+        loose = np.flatnonzero(_residuals(Tm, src, dst, w) <= loose_factor * threshold_m)
+        n_min = max(p.n_oldest, int(np.ceil(p.oldest_fraction * loose.size)))
+        old = loose[select_oldest(first_seen[loose], n_min)]
+        if cov is not None and max_std_factor is not None and old.size < loose.size:
+            # grow the set by first-sighting time until it determines the pose nearly as well as all candidates
+            # (cumulative information over the loose candidates sorted by first sighting)
+            pts_map = dst[loose]
+            info = _point_information(pts_map, Tm.R @ cov[loose] @ Tm.R.T, pts_map.mean(axis=0))
+            order = np.argsort(first_seen[loose], kind="stable")
+            fs = first_seen[loose][order]
+            cum = np.cumsum(info[order], axis=0)
+            ends = np.flatnonzero(np.r_[fs[1:] != fs[:-1], True])  # last candidate of each sighting time
+            ends = ends[fs[ends] >= first_seen[old].max()]
+            std = _std_from_information(cum[ends])
+            good = np.all(std <= max_std_factor * _std_from_information(cum[-1]), axis=1)
+            cut = ends[np.argmax(good)] if good.any() else len(order) - 1
+            old = loose[np.sort(order[: cut + 1])]
+        if old.size >= 3:
+            r_old = ransac((src[old], dst[old], w[old]), _fit, _residuals, 3, threshold_m, max_iters=max_iters, rng=rng)
+            n_old = int(r_old.inliers.sum())
+            if r_old.converged and n_old >= max(min(min_inliers, old.size), p.keep_fraction * old.size):
+                # and it must still explain the candidates loosely: a wedge of old landmarks at one
+                # edge of the view can otherwise trade yaw for sideways translation
+                T_old = r_old.model
+                still = _residuals(T_old, src[loose], dst[loose], w[loose]) <= loose_factor * threshold_m
+                # the old landmarks may correct the consensus pose by a bounded amount only
+                d_rot = np.arccos(np.clip((np.trace(T_old.R @ Tm.R.T) - 1.0) / 2.0, -1.0, 1.0))
+                d_pos = np.linalg.norm(T_old.t - Tm.t)
+                bounded = (p.max_correction_rad is None or d_rot <= p.max_correction_rad) and (
+                    p.max_correction_m is None or d_pos <= p.max_correction_m
+                )
+                if still.mean() >= p.still_fraction and bounded:
+                    Tm, used = T_old, old[r_old.inliers]
+    inl = _residuals(Tm, src, dst, w) <= threshold_m
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = Tm.R, Tm.t
+    return PoseEstimate(T, inl, bool(inl.sum() >= min_inliers), int(used.size), r.n_iters)
