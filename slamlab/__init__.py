@@ -11,28 +11,21 @@ The notebooks start with::
 
 from __future__ import annotations
 
-import importlib
-from types import ModuleType
+import pkgutil
 
 from . import chapters, data, geometry
+from ._lazy import lazy_exports
 
 __version__ = "0.1.0"
 
 # Every other subpackage (filters, sim, plotting, features, ...) is imported on first use by
-# __getattr__ below, so `import slamlab` loads no ipywidgets, matplotlib.pyplot or cv2 (tested).
+# lazy_exports' __getattr__ below, so `import slamlab` loads no ipywidgets, matplotlib.pyplot or cv2 (tested).
 __all__ = ["__version__", "chapters", "data", "filters", "geometry", "notebook_setup", "plotting", "sim"]
 
 
-def __getattr__(name: str) -> ModuleType:
-    """Import a chapter subpackage on first use: ``sl.kdtree``, ``sl.hough``, ... (PEP 562)."""
-    if name.startswith("_"):
-        raise AttributeError(name)
-    try:
-        return importlib.import_module(f"{__name__}.{name}")
-    except ModuleNotFoundError as exc:
-        if exc.name == f"{__name__}.{name}":
-            raise AttributeError(f"module 'slamlab' has no attribute or subpackage {name!r}") from None
-        raise
+# the chapter subpackages and modules, found without importing them
+__getattr__, __dir__ = lazy_exports(
+    __name__, {}, submodules=[m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")])
 
 
 def notebook_setup(*, dpi: int = 80, precision: int = 4) -> None:

@@ -14,8 +14,6 @@ The generic layer under the features and stereo chapters (it imports neither):
   (loaded on first use) and widgets.
 """
 
-import importlib
-
 from .._lazy import lazy_exports
 from . import cost_model, experiments, stores, workloads
 from .knn import exact_knn, hamming_distances, merge_knn, pad_knn
@@ -43,19 +41,7 @@ _LAZY = {
     "explore_cost_model": ".widgets",
     "explore_stores": ".widgets",
 }
-_SUBMODULES = ("plot", "store_plot", "widgets")
-_lazy_getattr, _lazy_dir = lazy_exports(__name__, _LAZY)
-
-
-def __getattr__(name):
-    if name in _SUBMODULES:  # pyplot / ipywidgets modules load on first use
-        return importlib.import_module(f".{name}", __name__)
-    return _lazy_getattr(name)
-
-
-def __dir__():
-    return sorted(set(_lazy_dir()) | set(_SUBMODULES))
-
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY, submodules=("plot", "store_plot", "widgets"))
 
 __all__ = [
     "BruteForceStore",
