@@ -1,4 +1,5 @@
-"""The 2-D layer: one Scan type, scan → points, occupancy grids and the likelihood field (004 §7).
+"""The 2-D layer: one Scan type, scan → points, occupancy grids, the likelihood field and the grid ray caster
+(004 §7).
 
 Produced alike by the simulator (:mod:`slamlab.sim`) and the log readers
 (:mod:`slamlab.io`); used by correlation localisation, Hough SLAM and
@@ -17,6 +18,7 @@ from .grid import (
     world_to_cell,
 )
 from .occupancy import RULES, OccupancyGrid, likelihood_field, occupancy_grid
+from .raycast import cast_rays
 from .scan import UNITS, Scan, scan_to_points
 
 __all__ = [
@@ -28,6 +30,7 @@ __all__ = [
     "GridFrame",
     "OccupancyGrid",
     "Scan",
+    "cast_rays",
     "cell_to_world",
     "check_grid",
     "grid_to_values",
