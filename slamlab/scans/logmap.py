@@ -116,12 +116,8 @@ def log_grid(log, *, cell_m: float = 0.2, max_range_m: float = 10.0, leave_out=(
 
     Parameters
     ----------
-    log : CarmenLog or similar
-        ``poses`` (n, 3) in metres, ``n_scans``, ``scans(indices=None)`` (metric Scans).
-    cell_m : float
-        Cell size [m].
-    max_range_m : float
-        Readings at or beyond it are dropped [m].
+    log, cell_m, max_range_m
+        The log, the cell size [m] and the range limit [m], as in :func:`log_counts`.
     leave_out : iterable of int
         Indices of the scans that do not draw the map.
 

@@ -94,10 +94,9 @@ def cast_rays(grid, pose, angles_rad, max_range_cells: float) -> tuple[np.ndarra
 
     Examples
     --------
-    >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 8] = 1
-    >>> r, hit = cast_rays(g, [2.0, 2.0, 0.0], [0.0, np.pi], 20.0)
-    >>> r.tolist(), hit.tolist()
-    ([5.5, 20.0], [True, False])
+    >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 0] = 1
+    >>> cast_rays(g, [2.0, 2.0, 0.0], [np.pi, 0.0], 5.0)
+    (array([1.5, 5. ]), array([ True, False]))
     """
     p = check_pose(pose)
     rmax = v.check_positive(max_range_cells, "max_range_cells")
