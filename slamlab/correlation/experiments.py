@@ -23,8 +23,8 @@ from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
 from ..geometry.se2 import se2_compose, se2_relative
-from ..scans import FREE, OBSTACLE, UNEXPLORED, GridFrame, Scan, grid_to_values, occupancy_grid
-from ..scans.occupancy import label_counts
+from ..scans import FREE, OBSTACLE, UNEXPLORED, GridFrame, grid_to_values
+from ..scans.logmap import leave_out_grid, log_counts, log_grid  # log_grid re-exported (one place: scans)
 from ..sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
 from ..sim.paths import random_free_poses
 from ..sim.rangefinder import Rangefinder
@@ -413,47 +413,6 @@ def _carmen_log(path):
     return read_carmen(path)
 
 
-def _limited(scan: Scan, max_range_m: float) -> Scan:
-    """Readings at or beyond ``max_range_m`` become "no return" at ``max_range_m``."""
-    ok = scan.valid & (scan.ranges < max_range_m)
-    return Scan(scan.bearings_rad, np.where(ok, scan.ranges, max_range_m), ok, unit=scan.unit,
-                max_range=max_range_m, time_s=scan.time_s, odom_pose=scan.odom_pose, pose=scan.pose)
-
-
-def _log_counts(log, cell_m: float, max_range_m: float):
-    """Frame, cell-unit scans and poses, and the hit/pass counts of every scan of ``log`` (one grid)."""
-    scans_m = [_limited(s, max_range_m) for s in log.scans()]
-    pts = np.vstack([s.points(q) for s, q in zip(log.scans(range(0, log.n_scans, 10)), log.poses[::10],
-                                                    strict=True)])
-    pts = pts[np.hypot(*(pts - log.poses[:, :2].mean(axis=0)).T) < max_range_m + np.ptp(log.poses[:, :2], axis=0).max()]
-    frame = GridFrame.around(np.vstack([log.poses[:, :2], pts]), cell_m, 1.0)
-    Pc = frame.to_cells(log.poses)
-    scans_c = [s.to_cells(cell_m) for s in scans_m]
-    return frame, scans_c, Pc, occupancy_grid(scans_c, Pc, frame.shape)
-
-
-def _left_out(full, scans_c, Pc, leave) -> np.ndarray:
-    """Cell codes of the counts of ``full`` minus those of the scans ``leave`` (counts add over scans)."""
-    leave = np.asarray(sorted(set(leave)), dtype=np.int64)
-    if leave.size == 0:
-        return full.grid
-    part = occupancy_grid([scans_c[j] for j in leave], Pc[leave], full.grid.shape)
-    return label_counts(full.hits - part.hits, full.passes - part.passes)
-
-
-def log_grid(log, *, cell_m: float = 0.2, max_range_m: float = 10.0, leave_out=()):
-    """Map of a CARMEN log from its logged poses, leaving out some scans (for localising them on it).
-
-    Returns ``(grid, frame, scans_cells, poses_cells)``: the :func:`~slamlab.scans.occupancy_grid`
-    (rule ``"count"``) of every scan not in ``leave_out``, its :class:`~slamlab.scans.GridFrame`,
-    and every scan and pose in cell units.
-    """
-    cell = v.check_positive(cell_m, "cell_m")
-    rmax = v.check_positive(max_range_m, "max_range_m")
-    frame, scans_c, Pc, full = _log_counts(log, cell, rmax)
-    return _left_out(full, scans_c, Pc, leave_out), frame, scans_c, Pc
-
-
 #: Default odometry noise of the joined modes: σ_xy [m], σ_θ [rad] per step between consecutive scans (ours).
 ODOM_STD = (0.05, float(np.radians(1.0)))
 
@@ -581,7 +540,7 @@ def _check_unit(x, name: str) -> float:
 
 def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, headings, joined) -> dict:
     """One sweep task: the leave-out grid of scan ``index`` and its localisation in every mode (deterministic)."""
-    Mv = grid_to_values(_left_out(full, scans_c, Pc, leave), p.a_c, p.a_p, p.a_n)
+    Mv = grid_to_values(leave_out_grid(full, scans_c, Pc, leave), p.a_c, p.a_p, p.a_n)
     row = {}
     for k in joined:
         free, obs, o = _joined_samples(beams[:k], rel[:k], p)
@@ -648,7 +607,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                          f"each are joined); got {idx.min()}..{idx.max()}")
     rng = v.as_rng(rng)
     t0 = time.perf_counter()
-    frame, scans_c, Pc, full = _log_counts(log, cell, rmax)
+    frame, scans_c, Pc, full = log_counts(log, cell_m=cell, max_range_m=rmax)
     noise = rng.normal(size=(idx.size, kmax - 1, 3)) * np.array([sd[0] / cell, sd[0] / cell, sd[1]])
     points = []
     for n, i in enumerate(idx):

@@ -7,12 +7,13 @@ import functools
 import ipywidgets as widgets
 import numpy as np
 
+from ..scans import log_grid
 from ..sim.grid import add_clutter, measurement_room_200, test_room_200
 from ..sim.rangefinder import Rangefinder
 from ..widgets import STYLE as _STYLE
 from ..widgets import slider as _slider
 from .algorithm import heading_error, localise, localise_joined
-from .experiments import _carmen_log, log_grid, random_clutter
+from .experiments import _carmen_log, random_clutter
 from .plot import localisation_figure
 
 __all__ = ["explore_localisation", "explore_log_scan"]

@@ -17,6 +17,7 @@ from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
 from ..geometry.odometry import simulate_odometry
+from ..scans import log_grid
 from .mcl import MCL, MCLParams
 
 __all__ = []
@@ -56,7 +57,6 @@ def _resolve(path) -> str:
 @functools.lru_cache(maxsize=6)
 def _log_map(path: str, cell_m: float, max_range_m: float):
     """The log read and its map built once per (path, cell size, range): ``(log, grid, frame, scans, poses)``."""
-    from ..correlation.experiments import log_grid
     from ..io import read_carmen
 
     log = read_carmen(path)
@@ -137,7 +137,6 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     weightings and injection re-seeds a wrong convergence. Tracking, global and the odometry noise draw from
     three independent streams spawned from ``rng``.
     """
-    from ..correlation.experiments import log_grid
     from ..io import CarmenLog
 
     cell = v.check_positive(cell_m, "cell_m")

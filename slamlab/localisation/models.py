@@ -9,7 +9,7 @@ API summary
 - :class:`LikelihoodFieldModel`: Table 6.3 with the distance table of
   :func:`slamlab.scans.likelihood_field`; ``log_likelihood(poses, beams)`` over
   particles × beams in one gather.
-- :func:`ray_cast` (exact grid traversal from many poses at once) and
+- :func:`ray_cast` (exact grid traversal from many poses at once: :func:`slamlab.scans.cast_rays`) and
   :func:`beam_model_prob` (Table 6.1: z_hit, z_short, z_max, z_rand).
 - :func:`scan_beams`: the beams of a :class:`~slamlab.scans.Scan` a filter uses.
 
@@ -29,7 +29,7 @@ from scipy.special import erf
 from .. import _validate as v
 from .._params import Params, param
 from ..geometry import wrap_angle
-from ..scans import OBSTACLE, Scan, check_grid, likelihood_field
+from ..scans import OBSTACLE, Scan, cast_rays, check_grid, likelihood_field
 
 __all__ = [
     "SCORES",
@@ -407,55 +407,36 @@ class LikelihoodFieldModel:
 
 
 def ray_cast(grid, poses, angles_rad, max_range: float) -> np.ndarray:
-    """Expected ranges ``z*`` from every pose along every beam, shape ``(N, B)`` (exact grid traversal).
+    """Expected ranges ``z*`` from every pose along every beam, shape ``(N, B)`` (PR Table 6.1's ray casting).
 
-    A ray stops on the face of the first OBSTACLE cell it enters; ``max_range``
-    when it meets none within reach or leaves the map. All ``N·B`` rays advance
-    together, one crossed cell face per loop step.
+    The one grid ray caster, :func:`slamlab.scans.cast_rays` (exact Amanatides-Woo
+    traversal of all ``N·B`` rays at once), without its ``hit`` mask: a ray stops on the
+    face of the first OBSTACLE cell it enters, ``max_range`` when it meets none within
+    reach or leaves the map.
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        The map (cell codes).
+    poses : array_like, shape (N, 3)
+        Particles ``(x, y, heading_rad)`` in cells.
+    angles_rad : array_like, shape (B,)
+        Beam angles relative to the heading.
+    max_range : float
+        Maximum range in cells.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N, B)
+
+    Examples
+    --------
     >>> g = np.zeros((5, 9), np.int8); g[:, 8] = 1
     >>> ray_cast(g, [[2, 2, 0], [4, 2, 0]], [0.0, np.pi], 20.0).tolist()
     [[5.5, 20.0], [3.5, 20.0]]
     """
-    g = check_grid(grid)
     P = check_particles(poses, "poses")
-    ang = v.as_vector(angles_rad, "angles_rad")
-    rmax = v.check_positive(max_range, "max_range")
-    H, W = g.shape
-    solid = (g == OBSTACLE).ravel()
-    th = (P[:, 2:3] + ang[None, :]).ravel()
-    ox = np.repeat(P[:, 0], ang.size)
-    oy = np.repeat(P[:, 1], ang.size)
-    ux, uy = np.cos(th), np.sin(th)
-    cx = np.floor(ox + 0.5).astype(np.int64)
-    cy = np.floor(oy + 0.5).astype(np.int64)
-    sx = np.where(ux > 0, 1, -1)
-    sy = np.where(uy > 0, 1, -1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        step_tx = np.where(ux != 0, np.abs(1.0 / ux), np.inf)
-        step_ty = np.where(uy != 0, np.abs(1.0 / uy), np.inf)
-        next_tx = np.where(ux != 0, (cx + 0.5 * sx - ox) / ux, np.inf)
-        next_ty = np.where(uy != 0, (cy + 0.5 * sy - oy) / uy, np.inf)
-    t = np.zeros(th.size)
-    z = np.full(th.size, rmax)
-    live = np.arange(th.size)
-    for _ in range(int(np.ceil(2 * rmax)) + 4):
-        ok = (cy[live] >= 0) & (cy[live] < H) & (cx[live] >= 0) & (cx[live] < W) & (t[live] <= rmax)
-        hit = np.zeros(live.size, bool)
-        hit[ok] = solid[cy[live[ok]] * W + cx[live[ok]]]
-        z[live[hit]] = t[live[hit]]
-        live = live[ok & ~hit]
-        if live.size == 0:
-            break
-        go_x = next_tx[live] < next_ty[live]
-        lx, ly = live[go_x], live[~go_x]
-        t[lx] = next_tx[lx]
-        cx[lx] += sx[lx]
-        next_tx[lx] += step_tx[lx]
-        t[ly] = next_ty[ly]
-        cy[ly] += sy[ly]
-        next_ty[ly] += step_ty[ly]
-    return np.minimum(z, rmax).reshape(P.shape[0], ang.size)
+    return cast_rays(grid, P, angles_rad, max_range)[0]
 
 
 def beam_model_prob(z, z_star, *, z_max: float, z_hit: float = 0.8, z_short: float = 0.1,

@@ -1,11 +1,10 @@
-"""Particle-set tools: normalising log weights, N_eff, low-variance resampling, KLD sampling, the pose
-estimate with its covariance and the "localised" test (003 §2.2; PR Tables 4.4, 8.4).
+"""Particle-set tools: KLD sampling, the pose estimate with its covariance and the "localised" test (003 §2.2;
+PR Table 8.4); normalising log weights, N_eff and low-variance resampling come from the shared particle toolbox.
 
 API summary
 -----------
-- :func:`normalise_log_weights` ``(log_w) -> (w, ok)``: weights summing to 1, never NaN.
-- :func:`n_eff` ``(w) -> float``: ``1 / Σ w²``.
-- :func:`low_variance_resample` ``(w, n, rng) -> indices`` (PR Table 4.4).
+- :func:`normalise_log_weights`, :func:`n_eff`, :func:`low_variance_resample` (PR Table 4.4):
+  re-exported from :mod:`slamlab.filters.particles` (one place, shared with :mod:`slamlab.planes`).
 - :func:`kld_bound` ``(k, epsilon, z_quantile)``: Fox 2003's sample count for ``k`` bins;
   :func:`kld_sample_count` the count for a drawn set (our addition, labelled: 003 has a fixed count).
 - :func:`pose_estimate` ``(particles, w) -> (mean, cov)`` (circular mean of the heading);
@@ -19,6 +18,7 @@ import numpy as np
 from scipy.stats import norm
 
 from .. import _validate as v
+from ..filters.particles import low_variance_resample, n_eff, normalise_log_weights
 from ..geometry import wrap_angle
 from ..scans import FREE, check_grid
 
@@ -34,67 +34,6 @@ __all__ = [
     "pose_estimate",
     "uniform_free_particles",
 ]
-
-
-def normalise_log_weights(log_w) -> tuple[np.ndarray, bool]:
-    """Weights ``exp(log_w − max)`` normalised to sum 1, and whether any weight was finite.
-
-    All ``-inf`` (every particle impossible) or NaN gives uniform weights and ``ok = False``:
-    the caller decides (inject, or report) — the weights never become NaN.
-
-    >>> w, ok = normalise_log_weights([0.0, np.log(3.0)]); w.tolist(), ok
-    ([0.25, 0.75], True)
-    >>> normalise_log_weights([-np.inf, -np.inf])[1]
-    False
-    """
-    lw = np.asarray(log_w, dtype=float)
-    if lw.ndim != 1 or lw.size == 0:
-        raise ValueError(f"`log_w` must be a non-empty 1-D array; got shape {lw.shape}")
-    finite = np.isfinite(lw)
-    if not finite.any():
-        return np.full(lw.size, 1.0 / lw.size), False
-    w = np.where(finite, np.exp(np.where(finite, lw, -np.inf) - lw[finite].max()), 0.0)
-    return w / w.sum(), True
-
-
-def n_eff(weights) -> float:
-    """Effective sample size ``1 / Σ w_i²`` of normalised weights (Kong, Liu & Wong 1994; PR §4.3.4).
-
-    >>> n_eff([0.25, 0.25, 0.25, 0.25]), n_eff([1.0, 0.0])
-    (4.0, 1.0)
-    """
-    w = np.asarray(weights, dtype=float)
-    return float(1.0 / np.sum(w * w))
-
-
-def low_variance_resample(weights, n: int | None = None, rng=None, *, offset: float | None = None) -> np.ndarray:
-    """Indices of ``n`` particles drawn by the low-variance (systematic) sampler (PR Table 4.4).
-
-    One random offset ``r ∈ [0, 1/n)``; particle ``i`` is drawn for every pointer
-    ``r + m/n`` that falls in its slice of the cumulative weights, so a particle of
-    weight ``w`` is drawn ``⌊n·w⌋`` or ``⌈n·w⌉`` times. ``offset`` fixes ``r`` (else drawn from ``rng``).
-
-    >>> low_variance_resample([0.5, 0.25, 0.25], 4, rng=0).tolist()
-    [0, 0, 1, 2]
-    """
-    w = np.asarray(weights, dtype=float)
-    if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)) or np.any(w < 0):
-        raise ValueError("`weights` must be a non-empty 1-D array of finite numbers >= 0")
-    total = w.sum()
-    if total <= 0:
-        raise ValueError("`weights` must not all be 0")
-    m = w.size if n is None else v.check_int(n, "n", minimum=1)
-    rng = v.as_rng(rng)
-    c = np.cumsum(w / total)
-    c[-1] = 1.0
-    if offset is None:
-        r = rng.uniform(0.0, 1.0 / m)
-    else:
-        r = v.check_positive(offset, "offset", allow_zero=True)
-        if r >= 1.0 / m:
-            raise ValueError(f"`offset` must be in [0, 1/n) = [0, {1.0 / m:g}); got {r}")
-    u = r + np.arange(m) / m
-    return np.minimum(np.searchsorted(c, u, side="right"), w.size - 1)
 
 
 def kld_bound(k, epsilon: float = 0.05, z_quantile: float = 0.99):

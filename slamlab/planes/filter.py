@@ -36,6 +36,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate as v
 from .._params import Params, param
+from ..filters.particles import systematic_resample  # the shared particle toolbox (re-exported here)
 from ..geometry import se3_inverse
 from .description import Plane, describe_plane, lookup_local
 from .extraction import Frame, extract_planes
@@ -147,14 +148,6 @@ def intensity_weights(sad) -> np.ndarray:
     star = top - np.where(np.isfinite(s), s, top)
     tot = star.sum()
     return star / tot if tot > 0 else np.full(s.shape, 1.0 / s.size)
-
-
-def systematic_resample(w, rng) -> np.ndarray:
-    """Indices of a systematic (low-variance) importance resampling of weights ``w (P,)`` (ours)."""
-    P = len(w)
-    c = np.cumsum(w)
-    c[-1] = 1.0
-    return np.searchsorted(c, (rng.random() + np.arange(P)) / P)
 
 
 def mean_pose(X, w=None) -> np.ndarray:
@@ -305,7 +298,7 @@ class PlaneSLAM:
         if use and p.intensity_weights:
             self.last_sad = self.sad(planes, pairs)
             w = intensity_weights(self.last_sad)
-            self.X = self.X[systematic_resample(w, self.rng)]
+            self.X = self.X[systematic_resample(w, rng=self.rng)]
         self.weights = w
         t5 = clock()
         self.pose = mean_pose(self.X)

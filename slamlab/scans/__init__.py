@@ -1,4 +1,5 @@
-"""The 2-D layer: one Scan type, scan → points, occupancy grids and the likelihood field (004 §7).
+"""The 2-D layer: one Scan type, scan → points, occupancy grids, a map from a log, the likelihood field and the
+grid ray caster (004 §7).
 
 Produced alike by the simulator (:mod:`slamlab.sim`) and the log readers
 (:mod:`slamlab.io`); used by correlation localisation, Hough SLAM and
@@ -16,7 +17,9 @@ from .grid import (
     make_grid,
     world_to_cell,
 )
+from .logmap import leave_out_grid, log_counts, log_grid
 from .occupancy import RULES, OccupancyGrid, likelihood_field, occupancy_grid
+from .raycast import cast_rays
 from .scan import UNITS, Scan, scan_to_points
 
 __all__ = [
@@ -28,10 +31,14 @@ __all__ = [
     "GridFrame",
     "OccupancyGrid",
     "Scan",
+    "cast_rays",
     "cell_to_world",
     "check_grid",
     "grid_to_values",
+    "leave_out_grid",
     "likelihood_field",
+    "log_counts",
+    "log_grid",
     "make_grid",
     "occupancy_grid",
     "scan_to_points",

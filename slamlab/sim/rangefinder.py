@@ -4,7 +4,7 @@ API summary
 -----------
 - :func:`beam_angles` ``(n_beams, fov_rad) -> (n,)`` beam angles relative to the heading.
 - :func:`cast_rays` ``(grid, pose, angles_rad, max_range_cells) -> (ranges, hit)``:
-  exact grid traversal (Amanatides-Woo), vectorised over beams.
+  exact grid traversal (Amanatides-Woo), vectorised over beams: :func:`slamlab.scans.cast_rays` for one pose.
 - :class:`Rangefinder` (beam count, field of view, maximum range, Gaussian range
   noise, range quantisation) with ``.scan(grid, pose, rng) -> Scan``;
   :func:`simulate_scans` for a whole path.
@@ -31,7 +31,8 @@ import numpy as np
 from .. import _validate as v
 from ..geometry.odometry import Odometry, simulate_odometry  # one place: geometry (re-exported here)
 from ..geometry.se2 import check_pose, check_poses
-from ..scans import OBSTACLE, Scan, check_grid
+from ..scans import Scan, check_grid
+from ..scans.raycast import cast_rays as scans_cast_rays
 
 __all__ = [
     "Odometry",
@@ -71,9 +72,8 @@ def beam_angles(n_beams: int = 360, fov_rad: float = 2 * np.pi) -> np.ndarray:
 def cast_rays(grid, pose, angles_rad, max_range_cells: float) -> tuple[np.ndarray, np.ndarray]:
     """Exact ranges from ``pose`` along each beam to the first obstacle cell (004 §7).
 
-    Amanatides-Woo grid traversal run on all beams at once: one loop step per
-    crossed cell face (at most ``√2·max_range + 2`` steps), each vectorised over
-    the beams.
+    The one grid ray caster, :func:`slamlab.scans.cast_rays` (Amanatides-Woo traversal,
+    vectorised over the beams), for one pose.
 
     Parameters
     ----------
@@ -94,51 +94,13 @@ def cast_rays(grid, pose, angles_rad, max_range_cells: float) -> tuple[np.ndarra
 
     Examples
     --------
-    >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 8] = 1
-    >>> r, hit = cast_rays(g, [2.0, 2.0, 0.0], [0.0, np.pi], 20.0)
-    >>> r.tolist(), hit.tolist()
-    ([5.5, 20.0], [True, False])
+    >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 0] = 1
+    >>> cast_rays(g, [2.0, 2.0, 0.0], [np.pi, 0.0], 5.0)
+    (array([1.5, 5. ]), array([ True, False]))
     """
-    g = check_grid(grid)
     p = check_pose(pose)
-    ang = v.as_vector(angles_rad, "angles_rad")
     rmax = v.check_positive(max_range_cells, "max_range_cells")
-    H, W = g.shape
-    occ = g == OBSTACLE
-    n = ang.size
-    th = p[2] + ang
-    dx, dy = np.cos(th), np.sin(th)
-    x0, y0 = p[0], p[1]
-    c = np.full(n, int(np.floor(x0 + 0.5)), dtype=np.int64)
-    r = np.full(n, int(np.floor(y0 + 0.5)), dtype=np.int64)
-    step_x = np.where(dx > 0, 1, -1)
-    step_y = np.where(dy > 0, 1, -1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t_dx = np.where(dx != 0, 1.0 / np.abs(dx), np.inf)
-        t_dy = np.where(dy != 0, 1.0 / np.abs(dy), np.inf)
-        t_x = np.where(dx != 0, (c + 0.5 * step_x - x0) / dx, np.inf)
-        t_y = np.where(dy != 0, (r + 0.5 * step_y - y0) / dy, np.inf)
-    t_entry = np.zeros(n)
-    ranges = np.full(n, rmax)
-    hit = np.zeros(n, dtype=bool)
-    active = np.ones(n, dtype=bool)
-    n_iter = int(np.ceil(np.sqrt(2.0) * rmax)) + 3
-    for _ in range(n_iter):
-        inside = (r >= 0) & (r < H) & (c >= 0) & (c < W)
-        solid = inside & occ[np.clip(r, 0, H - 1), np.clip(c, 0, W - 1)]
-        new = active & solid & (t_entry <= rmax)
-        ranges[new] = t_entry[new]
-        hit |= new
-        active &= inside & ~solid & (t_entry <= rmax)
-        if not active.any():
-            break
-        go_x = t_x < t_y
-        t_entry = np.where(go_x, t_x, t_y)
-        c += np.where(go_x, step_x, 0)
-        r += np.where(go_x, 0, step_y)
-        t_x = np.where(go_x, t_x + t_dx, t_x)
-        t_y = np.where(go_x, t_y, t_y + t_dy)
-    return ranges, hit
+    return scans_cast_rays(grid, p, angles_rad, rmax)
 
 
 @dataclass(frozen=True)

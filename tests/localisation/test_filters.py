@@ -1,4 +1,5 @@
-"""Resampling, N_eff, KLD, pose estimate, MCL and Markov grid localisation (003 §2.2; PR Tables 4.4, 8.1-8.4)."""
+"""KLD, pose estimate, MCL and Markov grid localisation (003 §2.2; PR Tables 8.1-8.4; resampling and N_eff:
+tests/filters/test_particles.py)."""
 
 import copy
 import math
@@ -10,41 +11,6 @@ from scipy import stats
 from slamlab import localisation as L
 from slamlab import sim as S
 from slamlab.geometry import angle_mean, se2_integrate, se2_relative
-
-
-def test_low_variance_counts_are_floor_or_ceil_of_n_w():
-    rng = np.random.default_rng(0)
-    for _ in range(20):
-        w = rng.random(13) ** 3
-        w /= w.sum()
-        n = 97
-        counts = np.bincount(L.low_variance_resample(w, n, rng), minlength=13)
-        assert counts.sum() == n
-        assert np.all(counts >= np.floor(n * w) - 1e-9)
-        assert np.all(counts <= np.ceil(n * w) + 1e-9)
-
-
-def test_low_variance_is_unbiased():
-    w = np.array([0.1, 0.2, 0.3, 0.4])
-    rng = np.random.default_rng(1)
-    mean = np.mean([np.bincount(L.low_variance_resample(w, 10, rng), minlength=4) for _ in range(4000)], axis=0)
-    np.testing.assert_allclose(mean, 10 * w, atol=0.03)
-
-
-def test_n_eff_closed_forms():
-    assert L.n_eff(np.full(8, 1 / 8)) == pytest.approx(8)
-    assert L.n_eff([0.5, 0.5, 0, 0]) == pytest.approx(2)
-    w = np.array([0.7, 0.1, 0.1, 0.1])
-    assert L.n_eff(w) == pytest.approx(1 / (0.49 + 0.03))
-
-
-def test_normalise_log_weights_never_nan():
-    w, ok = L.normalise_log_weights([-1e308, -np.inf, np.nan])
-    assert ok
-    assert w.tolist() == [1.0, 0.0, 0.0]
-    w, ok = L.normalise_log_weights([np.nan, -np.inf])
-    assert not ok
-    assert np.allclose(w, 0.5)
 
 
 @pytest.mark.parametrize("k", [2, 10, 50, 300])

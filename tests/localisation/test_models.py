@@ -129,14 +129,22 @@ def test_score_is_in_unit_interval_and_one_on_a_perfect_fit():
     assert s[0] == s.max()
 
 
-def test_ray_cast_equals_the_simulator_traversal():
-    M = S.test_room_200()
+def test_ray_cast_expected_ranges_closed_form_in_a_box():
+    """z* of the beam model for many particles: the distance to the box's wall faces (x = 0.5, 58.5; y = 0.5,
+    38.5) along each beam, min over the two axes (the traversal itself: tests/scans/test_raycast.py)."""
+    M = S.make_grid(40, 60, S.OBSTACLE)
+    M[1:39, 1:59] = S.FREE
     X = L.uniform_free_particles(M, 15, 2)
     ang = S.beam_angles(37)
-    z = L.ray_cast(M, X, ang, 60.0)
-    for x, row in zip(X, z, strict=True):
-        ref, _ = S.cast_rays(M, x, ang, 60.0)
-        np.testing.assert_allclose(row, ref, atol=1e-9)
+    z = L.ray_cast(M, X, ang, 200.0)
+    th = X[:, 2:3] + ang
+    c, s = np.cos(th), np.sin(th)
+    with np.errstate(divide="ignore"):
+        tx = np.where(c > 0, (58.5 - X[:, :1]) / c, np.where(c < 0, (0.5 - X[:, :1]) / c, np.inf))
+        ty = np.where(s > 0, (38.5 - X[:, 1:2]) / s, np.where(s < 0, (0.5 - X[:, 1:2]) / s, np.inf))
+    assert z.shape == (15, 37)
+    np.testing.assert_allclose(z, np.minimum(tx, ty), atol=1e-9)
+    assert np.all(L.ray_cast(M, X, ang, 5.0) <= 5.0)
 
 
 def test_beam_model_integrates_to_one_and_matches_scipy_parts():
