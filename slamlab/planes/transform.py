@@ -23,6 +23,8 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..geometry.so3 import hat
+
 __all__ = ["LMResult", "lm_pose", "plane_pair_jacobian", "plane_pair_residuals", "planes_to_body", "planes_to_map"]
 
 
@@ -56,19 +58,11 @@ def plane_pair_residuals(R, t, n_m, p_m, n_b, p_b, mask=None) -> np.ndarray:
     return r if mask is None else r * mask[..., None]
 
 
-def _skew(a):
-    S = np.zeros((*a.shape[:-1], 3, 3))
-    S[..., 0, 1], S[..., 0, 2] = -a[..., 2], a[..., 1]
-    S[..., 1, 0], S[..., 1, 2] = a[..., 2], -a[..., 0]
-    S[..., 2, 0], S[..., 2, 1] = -a[..., 1], a[..., 0]
-    return S
-
-
 def plane_pair_jacobian(R, n_m, mask=None) -> np.ndarray:
     """Jacobian ``(P, F, 4, 6)`` of the residuals w.r.t. ``(δ, t)`` with ``R ← R Exp(δ)`` (ours)."""
     a = n_m @ R                                                # (P, F, 3): a_f = R^T n_f
     J = np.zeros((*a.shape[:2], 4, 6))
-    J[..., :3, :3] = _skew(a)
+    J[..., :3, :3] = hat(a)
     J[..., 3, 3:] = -n_m
     return J if mask is None else J * mask[..., None, None]
 
