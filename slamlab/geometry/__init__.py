@@ -22,7 +22,7 @@ from .camera import (
     rotation_xyz,
 )
 from .homography import apply_homography
-from .ransac import RansacResult, ransac
+from .ransac import RansacResult, ransac, ransac_refit
 from .se3 import (
     planar_from_se3,
     rotate_points,
@@ -49,6 +49,7 @@ __all__ += [
     "planar_from_se3",
     "project_points",
     "ransac",
+    "ransac_refit",
     "rotate_points",
     "rotation_xyz",
     "se3",
