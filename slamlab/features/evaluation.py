@@ -24,6 +24,7 @@ from scipy.spatial import cKDTree
 
 from .. import _validate as v
 from ..data import find_data
+from ..geometry.homography import apply_homography as project
 from .base import Features
 from .matching import Matches
 
@@ -118,18 +119,6 @@ def load_oxford_pair(sequence, j: int, *, scale: float = 1.0):
     S = np.array([[s, 0, s / 2 - 0.5], [0, s, s / 2 - 0.5], [0, 0, 1.0]])
     H = S @ H @ np.linalg.inv(S)
     return img1, img2, H / H[2, 2]
-
-
-def project(H, uv) -> np.ndarray:
-    """Apply a homography to (N, 2) pixel points.
-
-    >>> project(np.diag([2.0, 2.0, 1.0]), [[1.0, 2.0]]).tolist()
-    [[2.0, 4.0]]
-    """
-    H = v.as_matrix(H, "H", (3, 3))
-    uv = v.as_finite_array(uv, "uv").reshape(-1, 2)
-    p = uv @ H[:, :2].T + H[:, 2]
-    return p[:, :2] / p[:, 2:3]
 
 
 def _inside(uv, shape, margin):

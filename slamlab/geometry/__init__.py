@@ -10,9 +10,19 @@ __all__ = ["Odometry", "RigidTransform", "angle_mean", "apply_transform", "check
            "se2_compose", "se2_integrate", "se2_inverse", "se2_relative", "se2_transform", "simulate_odometry", "umeyama",
            "wrap_angle"]
 
-# --- pinhole camera, stereo rig, midpoint triangulation, RANSAC, SE(3) helpers (000 §3) ---
-from .camera import PinholeCamera, StereoRig, focal_from_hfov, fundamental_matrix, rotation_xyz
-from .ransac import RansacResult, ransac
+# --- pinhole camera and projection, stereo rig, midpoint triangulation, RANSAC, SE(3) helpers (000 §3),
+#     SO(3)/SE(3) hat, exp and log (003 §4.4, 002) ---
+from .camera import (
+    PinholeCamera,
+    StereoRig,
+    backproject_points,
+    focal_from_hfov,
+    fundamental_matrix,
+    project_points,
+    rotation_xyz,
+)
+from .homography import apply_homography
+from .ransac import RansacResult, ransac, ransac_refit
 from .se3 import (
     planar_from_se3,
     rotate_points,
@@ -23,6 +33,7 @@ from .se3 import (
     transform_points,
     yaw_from_R,
 )
+from .so3 import hat, se3_exp, se3_log, so3_exp, so3_log, vee
 from .triangulation import Triangulation, triangulate_midpoint, triangulate_stereo
 
 __all__ += [
@@ -30,18 +41,28 @@ __all__ += [
     "RansacResult",
     "StereoRig",
     "Triangulation",
+    "apply_homography",
+    "backproject_points",
     "focal_from_hfov",
     "fundamental_matrix",
+    "hat",
     "planar_from_se3",
+    "project_points",
     "ransac",
+    "ransac_refit",
     "rotate_points",
     "rotation_xyz",
     "se3",
     "se3_compose",
+    "se3_exp",
     "se3_from_planar",
     "se3_inverse",
+    "se3_log",
+    "so3_exp",
+    "so3_log",
     "transform_points",
     "triangulate_midpoint",
     "triangulate_stereo",
+    "vee",
     "yaw_from_R",
 ]

@@ -14,12 +14,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from .so3 import hat
 
 __all__ = [
     "PinholeCamera",
     "StereoRig",
+    "backproject_points",
     "focal_from_hfov",
     "fundamental_matrix",
+    "project_points",
     "rotation_xyz",
 ]
 
@@ -52,6 +55,72 @@ def rotation_xyz(rx_rad: float = 0.0, ry_rad: float = 0.0, rz_rad: float = 0.0) 
     Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
     Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
     return Rz @ Ry @ Rx
+
+
+def project_points(K, X, *, min_depth: float | None = None) -> np.ndarray:
+    """Pixels ``u = fx x / z + cx``, ``v = fy y / z + cy`` of camera-frame points (000 §3.3; 003 §2).
+
+    The one pinhole projection of the library. No checks of ``X`` (hot path: trackers call it
+    every iteration) and no matrix product (element-wise, so the same bits on every machine).
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix ``[[fx, 0, cx], [0, fy, cy], [0, 0, 1]]`` (the skew ``K[0, 1]`` is not used).
+    X : ndarray, shape (N, 3)
+        Points in the camera frame (``x`` right, ``y`` down, ``z`` forward) [m].
+    min_depth : float, optional
+        When given, ``z`` is clamped to at least this value (keeps points behind the camera finite).
+
+    Returns
+    -------
+    ndarray, shape (N, 2)
+        Pixel coordinates ``(u, v)``.
+
+    Examples
+    --------
+    >>> K = np.array([[100.0, 0.0, 50.0], [0.0, 100.0, 40.0], [0.0, 0.0, 1.0]])
+    >>> project_points(K, np.array([[0.2, -0.1, 2.0]]))
+    array([[60., 35.]])
+    """
+    K, X = np.asarray(K), np.asarray(X)
+    if K.shape != (3, 3):
+        raise ValueError(f"`K` must have shape (3, 3); got {K.shape}")
+    if X.ndim != 2 or X.shape[1] != 3:
+        raise ValueError(f"`X` must have shape (N, 3); got {X.shape}")
+    z = X[:, 2] if min_depth is None else np.maximum(X[:, 2], min_depth)
+    return np.column_stack([K[0, 0] * X[:, 0] / z + K[0, 2], K[1, 1] * X[:, 1] / z + K[1, 2]])
+
+
+def backproject_points(K, uv) -> np.ndarray:
+    """Viewing-ray directions ``((u - cx) / fx, (v - cy) / fy, 1)`` through pixels (the inverse of :func:`project_points`).
+
+    No checks of ``uv`` beyond its shape (hot path), element-wise (the same bits on every machine).
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix ``[[fx, 0, cx], [0, fy, cy], [0, 0, 1]]``.
+    uv : ndarray, shape (N, 2)
+        Pixel coordinates ``(u, v)``.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        Ray directions in the camera frame with ``z = 1`` (not unit length).
+
+    Examples
+    --------
+    >>> K = np.array([[100.0, 0.0, 50.0], [0.0, 100.0, 40.0], [0.0, 0.0, 1.0]])
+    >>> backproject_points(K, np.array([[60.0, 35.0]]))
+    array([[ 0.1 , -0.05,  1.  ]])
+    """
+    K, uv = np.asarray(K), np.asarray(uv)
+    if K.shape != (3, 3):
+        raise ValueError(f"`K` must have shape (3, 3); got {K.shape}")
+    if uv.ndim != 2 or uv.shape[1] != 2:
+        raise ValueError(f"`uv` must have shape (N, 2); got {uv.shape}")
+    return np.column_stack([(uv[:, 0] - K[0, 2]) / K[0, 0], (uv[:, 1] - K[1, 2]) / K[1, 1], np.ones(len(uv))])
 
 
 @dataclass(frozen=True)
@@ -101,15 +170,14 @@ class PinholeCamera:
             raise ValueError(f"`points_cam` must have shape (N, 3); got {P.shape}")
         if np.any(P[:, 2] <= 0):
             raise ValueError("`points_cam` must lie in front of the camera (z > 0)")
-        z = P[:, 2]
-        return np.column_stack([self.fx * P[:, 0] / z + self.cx, self.fy * P[:, 1] / z + self.cy])
+        return project_points(self.K, P)
 
     def backproject(self, uv) -> np.ndarray:
         """Viewing-ray directions ``(N, 3)`` with ``z = 1`` through pixels ``uv (N, 2)``."""
         uv = v.as_finite_array(uv, "uv", ndim=2)
         if uv.shape[1] != 2:
             raise ValueError(f"`uv` must have shape (N, 2); got {uv.shape}")
-        return np.column_stack([(uv[:, 0] - self.cx) / self.fx, (uv[:, 1] - self.cy) / self.fy, np.ones(len(uv))])
+        return backproject_points(self.K, uv)
 
     def pixel_rays(self) -> np.ndarray:
         """Ray directions ``(H, W, 3)`` (``z = 1``) through every pixel centre, for rendering."""
@@ -120,10 +188,6 @@ class PinholeCamera:
         rays[..., 1] = w[:, None]
         rays[..., 2] = 1.0
         return rays
-
-
-def _skew(t):
-    return np.array([[0.0, -t[2], t[1]], [t[2], 0.0, -t[0]], [-t[1], t[0], 0.0]])
 
 
 def fundamental_matrix(K_left, K_right, R, t) -> np.ndarray:
@@ -137,7 +201,7 @@ def fundamental_matrix(K_left, K_right, R, t) -> np.ndarray:
     K_right = v.as_matrix(K_right, "K_right", (3, 3))
     R = v.as_matrix(R, "R", (3, 3))
     t = v.as_vector(t, "t", 3)
-    E = _skew(t) @ R
+    E = hat(t) @ R
     return np.linalg.inv(K_right).T @ E @ np.linalg.inv(K_left)
 
 

@@ -21,7 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
+from ..geometry.camera import project_points as project
 from ..geometry.se3 import se3_compose, se3_inverse, transform_points
+from ..geometry.so3 import se3_exp
 
 __all__ = [
     "AlignResult",
@@ -33,40 +35,6 @@ __all__ = [
     "solve_spd",
     "sparse_align",
 ]
-
-
-def _hat(w):
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-
-
-def _mat3(A, B):
-    return np.einsum("ij,jk->ik", A, B)
-
-
-def se3_exp(xi) -> np.ndarray:
-    """4×4 transform ``exp([v, ω]^)`` of a twist ``xi = (v, ω)`` (closed form).
-
-    >>> np.allclose(se3_exp(np.zeros(6)), np.eye(4))
-    True
-    """
-    xi = np.asarray(xi, dtype=np.float64)
-    vv, w = xi[:3], xi[3:]
-    th = math.sqrt(float(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]))
-    W = _hat(w)
-    if th < 1e-10:
-        R = np.eye(3) + W
-        V = np.eye(3) + 0.5 * W
-    else:
-        A = math.sin(th) / th
-        B = (1 - math.cos(th)) / th**2
-        C = (1 - A) / th**2
-        WW = _mat3(W, W)
-        R = np.eye(3) + A * W + B * WW
-        V = np.eye(3) + B * W + C * WW
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = np.einsum("ij,j->i", V, vv)
-    return T
 
 
 def solve_spd(H, g) -> np.ndarray:
@@ -135,12 +103,6 @@ def bilinear(img, u, v_):
     c = img[v0 + 1, u0]
     d = img[v0 + 1, u0 + 1]
     return (a * (1 - du) + b * du) * (1 - dv) + (c * (1 - du) + d * du) * dv
-
-
-def project(K, X):
-    """Pixels ``(N, 2)`` of camera-frame points ``(N, 3)`` (no checks: hot path)."""
-    z = X[:, 2]
-    return np.column_stack([K[0, 0] * X[:, 0] / z + K[0, 2], K[1, 1] * X[:, 1] / z + K[1, 2]])
 
 
 def _d_proj(K, X, scale):
@@ -284,8 +246,7 @@ def refine_pose(K, X_world, uv, T_cam_world_init, *, huber_px: float = 1.0, reje
 
 
 def _residuals(K, Xc, uv):
-    z = np.maximum(Xc[:, 2], 1e-6)
-    return np.column_stack([K[0, 0] * Xc[:, 0] / z + K[0, 2] - uv[:, 0], K[1, 1] * Xc[:, 1] / z + K[1, 2] - uv[:, 1]])
+    return project(K, Xc, min_depth=1e-6) - uv
 
 
 def _reproj_err(K, X, uv, T):

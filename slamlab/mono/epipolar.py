@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry.camera import backproject_points, project_points
 from ..geometry.se3 import rotate_points
 from ..geometry.triangulation import triangulate_midpoint
 from .align import bilinear
@@ -78,9 +79,7 @@ def epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma: float = 2.0):
     ok = (Xa[:, 2] > 1e-6) & (Xb[:, 2] > 1e-6)
     Xa = np.where(ok[:, None], Xa, [0.0, 0.0, 1.0])
     Xb = np.where(ok[:, None], Xb, [0.0, 0.0, 1.0])
-    a = np.column_stack([K[0, 0] * Xa[:, 0] / Xa[:, 2] + K[0, 2], K[1, 1] * Xa[:, 1] / Xa[:, 2] + K[1, 2]])
-    b = np.column_stack([K[0, 0] * Xb[:, 0] / Xb[:, 2] + K[0, 2], K[1, 1] * Xb[:, 1] / Xb[:, 2] + K[1, 2]])
-    return a, b, ok
+    return project_points(K, Xa), project_points(K, Xb), ok
 
 
 @dataclass(frozen=True)
@@ -111,11 +110,10 @@ def affine_warp(K, T_cur_ref, f, depth_m, uv_ref, *, h_px: float = 5.0) -> np.nd
     z = np.asarray(depth_m, dtype=np.float64).reshape(-1)
 
     def cur_px(uv):
-        r = np.column_stack([(uv[:, 0] - K[0, 2]) / K[0, 0], (uv[:, 1] - K[1, 2]) / K[1, 1], np.ones(len(uv))])
+        r = backproject_points(K, uv)
         r /= np.sqrt(np.einsum("ni,ni->n", r, r))[:, None]
         X = np.einsum("ij,nj->ni", R, r * z[:, None]) + t
-        Z = np.maximum(X[:, 2], 1e-6)
-        return np.column_stack([K[0, 0] * X[:, 0] / Z + K[0, 2], K[1, 1] * X[:, 1] / Z + K[1, 2]])
+        return project_points(K, X, min_depth=1e-6)
 
     del f  # the ray of uv_ref is f; the shifted rays are rebuilt from the pixels
     c = cur_px(uv_ref)
@@ -204,8 +202,7 @@ def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv
     # triangulate along f: ray f from the reference centre, ray through uv from the current centre
     R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
     c_cur = -np.einsum("ji,j->i", R, t)  # current centre in the reference frame
-    rays = rotate_points(R.T, np.column_stack([(uv[:, 0] - K[0, 2]) / K[0, 0], (uv[:, 1] - K[1, 2]) / K[1, 1],
-                                               np.ones(n)]))  # R^T r
+    rays = rotate_points(R.T, backproject_points(K, uv))  # R^T r
     tri = triangulate_midpoint(np.zeros(3), f, c_cur, rays, parallel_tol=min_parallax_rad**2)
     depth = tri.s  # f is unit: the ray parameter is the depth along f
     found &= tri.valid

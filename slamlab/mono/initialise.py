@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from ..geometry.homography import apply_homography
 
 __all__ = [
     "INIT_STATUSES",
@@ -139,10 +140,9 @@ def _hartley(uv):
 
 
 def _transfer(Hn, x):
-    w = Hn[2, 0] * x[:, 0] + Hn[2, 1] * x[:, 1] + Hn[2, 2]
-    u = (Hn[0, 0] * x[:, 0] + Hn[0, 1] * x[:, 1] + Hn[0, 2]) / w
-    v = (Hn[1, 0] * x[:, 0] + Hn[1, 1] * x[:, 1] + Hn[1, 2]) / w
-    return u, v, w
+    """``(u, v, w)`` of ``π(Hn x)`` for points ``x (N, 2)``; ``w`` the homogeneous scale (for the Jacobian)."""
+    uv = apply_homography(Hn, x)
+    return uv[:, 0], uv[:, 1], Hn[2, 0] * x[:, 0] + Hn[2, 1] * x[:, 1] + Hn[2, 2]
 
 
 def polish_homography(H, uv0, uv1, *, mantissa_bits: int = 14, max_iter: int = 50) -> np.ndarray:

@@ -6,11 +6,12 @@ line with the odometry, ``T_j = (ᵒT_N)⁻¹ ᵒT_j`` (``ᵒT_j``: body pose of
 the odom frame).
 
 Planes ``n·x = p`` (002's normal form ``n·x − p = 0``) by RANSAC; 002 used PCL's, ours
-is numpy and batched: each round draws ``iterations`` minimal samples (3 points) at
-once from a random subset of ``sample_points`` points, scores all hypotheses on that
-subset at once (ours: preemptive scoring on a subset), takes the best, collects its
+is numpy and batched (:func:`~slamlab.geometry.ransac` with ``batch_size``): each round draws
+``iterations`` minimal samples (3 points) at once from a random subset of ``sample_points``
+points, scores all hypotheses on that subset at once (ours: preemptive scoring on a subset),
+takes the best (the first of the most inliers), collects its
 inliers (``|n·x − p| <= tolerance_m``) among all remaining points, refits by least
-squares (SVD) on them and recounts; a plane needs ``min_support`` inliers. Planes
+squares (SVD) on them and recounts (:func:`~slamlab.geometry.ransac_refit`); a plane needs ``min_support`` inliers. Planes
 are taken greedily until none has enough support or ``max_planes`` were found.
 Sign convention (ours): ``p >= 0``, i.e. the normal points away from the sensor.
 """
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
+from ..geometry.ransac import ransac, ransac_refit
 
 __all__ = ["Frame", "build_frame", "extract_planes", "fit_plane_lsq", "frame_transforms", "plane_distances"]
 
@@ -116,6 +118,22 @@ def plane_distances(points, n, p) -> np.ndarray:
     return np.asarray(points) @ np.asarray(n) - p
 
 
+def _fit_planes(rows):
+    """Planes through 3-point samples ``rows (b, 3, 3)``: ``(n (b', 3), p (b',))`` of the non-degenerate ones."""
+    a, b, c = rows[:, 0], rows[:, 1], rows[:, 2]
+    nrm = np.cross(b - a, c - a)
+    norm = np.linalg.norm(nrm, axis=1)
+    good = norm > 1e-9
+    nrm = nrm[good] / norm[good, None]
+    return nrm, np.einsum("ij,ij->i", nrm, a[good])
+
+
+def _plane_residuals(plane, points):
+    """``|n·x − p|`` of ``points (K, 3)``: ``(K,)`` for one plane ``(n (3,), p)``, ``(b, K)`` for ``(n (b, 3), p (b,))``."""
+    n, p = plane
+    return np.abs(points @ np.transpose(n) - p).T
+
+
 def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, min_support: int = 400,
                    max_planes: int = 12, sample_points: int = 1000, refit_rounds: int = 2,
                    min_width_m: float = 0.0, rng=None):
@@ -164,34 +182,18 @@ def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, 
         sub = remaining if remaining.size <= sample_points else remaining[rng.integers(0, remaining.size,
                                                                                         sample_points)]
         S = X[sub]
-        idx = rng.integers(0, S.shape[0], (iters, 3))
-        a, b, c = S[idx[:, 0]], S[idx[:, 1]], S[idx[:, 2]]
-        nrm = np.cross(b - a, c - a)
-        norm = np.linalg.norm(nrm, axis=1)
-        good = norm > 1e-9
-        if not good.any():
+        best = ransac(S, _fit_planes, _plane_residuals, 3, tol, max_iters=iters, batch_size=iters, refit_rounds=0,
+                      rng=rng)
+        if best.model is None:
             break
-        nrm = nrm[good] / norm[good, None]
-        off = np.einsum("ij,ij->i", nrm, a[good])
-        counts = (np.abs(S @ nrm.T - off) <= tol).sum(axis=0)
-        best = int(np.argmax(counts))
         # the subset's best count predicts the full count; stop early when even that is too small
-        if counts[best] * remaining.size / S.shape[0] < 0.5 * min_support:
+        if int(best.inliers.sum()) * remaining.size / S.shape[0] < 0.5 * min_support:
             break
-        n, p = nrm[best], float(off[best])
+        n, p = best.model[0], float(best.model[1])
         Y = X[remaining]
-        mask = np.abs(Y @ n - p) <= tol
-        for _ in range(refit_rounds):
-            if mask.sum() < 3:
-                break
-            try:
-                n, p = fit_plane_lsq(Y[mask])
-            except ValueError:
-                break
-            new = np.abs(Y @ n - p) <= tol
-            if np.array_equal(new, mask):
-                break
-            mask = new
+        mask = _plane_residuals((n, p), Y) <= tol
+        (n, p), mask = ransac_refit(Y, fit_plane_lsq, _plane_residuals, (n, p), mask, tol, rounds=refit_rounds,
+                                    min_rows=3)
         if mask.sum() < min_support:
             break
         if p < 0:

@@ -32,12 +32,11 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .. import _validate as v
 from .._params import Params, param
 from ..filters.particles import systematic_resample  # the shared particle toolbox (re-exported here)
-from ..geometry import se3_inverse
+from ..geometry import se3_inverse, so3_exp
 from .description import Plane, describe_plane, lookup_local
 from .extraction import Frame, extract_planes
 from .mapping import PlaneMap
@@ -97,10 +96,6 @@ class PlaneSLAMParams(Params):
                 raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
 
 
-def _exp(rotvec):
-    return Rotation.from_rotvec(rotvec).as_matrix()
-
-
 def predict_particles(X, U, V_xyz_m2: float, V_rpy_deg2: float, rng) -> np.ndarray:
     """Motion model: ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t``, ``ε ~ N(0, V)`` (002 "MCL"; composition ours).
 
@@ -110,7 +105,7 @@ def predict_particles(X, U, V_xyz_m2: float, V_rpy_deg2: float, rng) -> np.ndarr
     """
     P = X.shape[0]
     out = X @ U
-    out[:, :3, :3] = out[:, :3, :3] @ _exp(rng.normal(0.0, np.deg2rad(np.sqrt(V_rpy_deg2)), (P, 3)))
+    out[:, :3, :3] = out[:, :3, :3] @ so3_exp(rng.normal(0.0, np.deg2rad(np.sqrt(V_rpy_deg2)), (P, 3)))
     out[:, :3, 3] += rng.normal(0.0, np.sqrt(V_xyz_m2), (P, 3))
     return out
 

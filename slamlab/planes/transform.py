@@ -21,7 +21,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy.spatial.transform import Rotation
+
+from ..geometry.so3 import hat, so3_exp, so3_log
 
 __all__ = ["LMResult", "lm_pose", "plane_pair_jacobian", "plane_pair_residuals", "planes_to_body", "planes_to_map"]
 
@@ -56,19 +57,11 @@ def plane_pair_residuals(R, t, n_m, p_m, n_b, p_b, mask=None) -> np.ndarray:
     return r if mask is None else r * mask[..., None]
 
 
-def _skew(a):
-    S = np.zeros((*a.shape[:-1], 3, 3))
-    S[..., 0, 1], S[..., 0, 2] = -a[..., 2], a[..., 1]
-    S[..., 1, 0], S[..., 1, 2] = a[..., 2], -a[..., 0]
-    S[..., 2, 0], S[..., 2, 1] = -a[..., 1], a[..., 0]
-    return S
-
-
 def plane_pair_jacobian(R, n_m, mask=None) -> np.ndarray:
     """Jacobian ``(P, F, 4, 6)`` of the residuals w.r.t. ``(δ, t)`` with ``R ← R Exp(δ)`` (ours)."""
     a = n_m @ R                                                # (P, F, 3): a_f = R^T n_f
     J = np.zeros((*a.shape[:2], 4, 6))
-    J[..., :3, :3] = _skew(a)
+    J[..., :3, :3] = hat(a)
     J[..., 3, 3:] = -n_m
     return J if mask is None else J * mask[..., None, None]
 
@@ -126,7 +119,7 @@ def lm_pose(R0, t0, n_m, p_m, n_b, p_b, mask=None, *, sigma_n: float = 1.0, sigm
         r_ = plane_pair_residuals(R_, t_, n_m, p_m, n_b, p_b, m) * scale
         c = 0.5 * np.sum(r_.reshape(P, -1) ** 2, axis=1)
         if prior is not None:
-            e = np.c_[Rotation.from_matrix(np.swapaxes(R0c, 1, 2) @ R_).as_rotvec(), t_ - t0c] * prior
+            e = np.c_[so3_log(np.swapaxes(R0c, 1, 2) @ R_), t_ - t0c] * prior
             c = c + 0.5 * np.sum(e**2, axis=1)
             return r_, c, e
         return r_, c, None
@@ -148,7 +141,7 @@ def lm_pose(R0, t0, n_m, p_m, n_b, p_b, mask=None, *, sigma_n: float = 1.0, sigm
             g = g + prior * e
         step = -np.linalg.solve(H + lam[:, None, None] * eye, g[..., None])[..., 0]
         step[done] = 0.0
-        R_new = R @ Rotation.from_rotvec(step[:, :3]).as_matrix()
+        R_new = R @ so3_exp(step[:, :3])
         t_new = t + step[:, 3:]
         r_new, cost_new, e_new = cost_of(R_new, t_new)
         accept = (cost_new < cost) & ~done

@@ -14,6 +14,7 @@ from .. import _validate as v
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.ransac import ransac
 from ..geometry.registration import RigidTransform, umeyama
+from ..geometry.so3 import hat
 from ..kdtree.stores import LandmarkStore
 from .local_stages import _pair_distances, _two_nearest
 from .params import StereoParams
@@ -213,10 +214,7 @@ def _point_information(P, C, center) -> np.ndarray:
     """(N, 6, 6) Gauss-Newton information ``Jᵢᵀ Cᵢ⁻¹ Jᵢ`` of each point about ``center``."""
     q = P - center
     J = np.zeros((len(P), 3, 6))
-    # d(R p)/d(rotation vector) = -[p]x
-    J[:, 0, 1], J[:, 0, 2] = q[:, 2], -q[:, 1]
-    J[:, 1, 0], J[:, 1, 2] = -q[:, 2], q[:, 0]
-    J[:, 2, 0], J[:, 2, 1] = q[:, 1], -q[:, 0]
+    J[:, :, :3] = hat(-q)  # d(R p)/d(rotation vector) = -[p]x = [-p]x
     J[:, :, 3:] = np.eye(3)
     CiJ = np.linalg.solve(C, J)
     return np.einsum("nki,nkj->nij", J, CiJ)

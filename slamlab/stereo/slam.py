@@ -19,7 +19,7 @@ from .. import _validate as v
 from ..features.base import to_gray_uint8
 from ..features.detect import detect
 from ..filters.landmark import landmark_predict, landmark_update
-from ..geometry.camera import StereoRig
+from ..geometry.camera import StereoRig, project_points
 from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
 from ..kdtree.stores import ExactStore, LandmarkStore, base_rule, make_store
@@ -270,7 +270,7 @@ class StereoSLAM:
         cam = self.rig.left
         cand = self.landmarks_in_view(np.rad2deg(p.window_px / cam.fx), T_body=est.T)
         Xc = (self.X[cand] - T_wc[:3, 3]) @ T_wc[:3, :3]
-        uv_lm = np.column_stack([cam.fx * Xc[:, 0] / Xc[:, 2] + cam.cx, cam.fy * Xc[:, 1] / Xc[:, 2] + cam.cy])
+        uv_lm = project_points(cam.K, Xc)
         inside = (uv_lm[:, 1] >= -p.window_px) & (uv_lm[:, 1] <= cam.height_px + p.window_px)
         cand, uv_lm = cand[inside], uv_lm[inside]
         max_d = p.window_max_hamming if p.binary else np.inf

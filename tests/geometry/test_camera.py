@@ -4,7 +4,15 @@ import cv2
 import numpy as np
 import pytest
 
-from slamlab.geometry import PinholeCamera, StereoRig, focal_from_hfov, fundamental_matrix, rotation_xyz
+from slamlab.geometry import (
+    PinholeCamera,
+    StereoRig,
+    backproject_points,
+    focal_from_hfov,
+    fundamental_matrix,
+    project_points,
+    rotation_xyz,
+)
 
 
 def test_focal_from_hfov_closed_form():
@@ -110,3 +118,41 @@ def test_camera_bad_input():
         StereoRig.parallel(0.0)
     with pytest.raises(ValueError, match="same shape"):
         StereoRig.parallel().rays([[1.0, 2.0]], [[1.0, 2.0], [3.0, 4.0]])
+
+
+def test_project_points_matches_the_homogeneous_product_and_cv2():
+    K = np.array([[500.0, 0.0, 320.0], [0.0, 480.0, 240.0], [0.0, 0.0, 1.0]])
+    rng = np.random.default_rng(3)
+    X = np.column_stack([rng.uniform(-2, 2, 40), rng.uniform(-2, 2, 40), rng.uniform(0.5, 9, 40)])
+    h = X @ K.T  # independent reference: K X, then divide by the last coordinate
+    np.testing.assert_allclose(project_points(K, X), h[:, :2] / h[:, 2:], rtol=1e-13)
+    ref, _ = cv2.projectPoints(X, np.zeros(3), np.zeros(3), K, None)
+    np.testing.assert_allclose(project_points(K, X), ref[:, 0, :], atol=1e-9)
+    # the camera's method is this function
+    cam = PinholeCamera(640, 480, 500.0, 480.0, 320.0, 240.0)
+    assert np.array_equal(cam.project(X), project_points(cam.K, X))
+
+
+def test_project_points_min_depth_clamps_z():
+    K = np.diag([100.0, 100.0, 1.0])
+    X = np.array([[1.0, -1.0, -2.0], [1.0, 1.0, 2.0]])
+    np.testing.assert_array_equal(project_points(K, X, min_depth=0.5), [[200.0, -200.0], [50.0, 50.0]])
+
+
+def test_project_points_bad_input():
+    with pytest.raises(ValueError, match=r"`K` must have shape \(3, 3\); got \(2, 2\)"):
+        project_points(np.eye(2), np.ones((3, 3)))
+    with pytest.raises(ValueError, match=r"`X` must have shape \(N, 3\); got \(3, 2\)"):
+        project_points(np.eye(3), np.ones((3, 2)))
+
+
+
+def test_backproject_points_inverts_project_points():
+    K = np.array([[500.0, 0.0, 320.0], [0.0, 480.0, 240.0], [0.0, 0.0, 1.0]])
+    X = np.array([[0.3, -0.2, 2.0], [-1.0, 0.5, 5.0]])
+    np.testing.assert_allclose(backproject_points(K, project_points(K, X)) * X[:, 2:], X, atol=1e-12)
+    # independent reference: K^-1 [u, v, 1]
+    uv = np.array([[10.0, 20.0], [600.0, 400.0]])
+    np.testing.assert_allclose(backproject_points(K, uv), np.c_[uv, np.ones(2)] @ np.linalg.inv(K).T, atol=1e-15)
+    with pytest.raises(ValueError, match=r"`uv` must have shape \(N, 2\); got \(2,\)"):
+        backproject_points(K, np.zeros(2))

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.linalg import expm
 
-from slamlab.geometry import rotation_xyz
+from slamlab.geometry import rotation_xyz, se3_exp
 from slamlab.geometry.se3 import se3_inverse
 from slamlab.mono import MonoParams, MonoSLAM
-from slamlab.mono.align import build_pyramid, refine_pose, se3_exp, sparse_align
+from slamlab.mono.align import build_pyramid, refine_pose, sparse_align
 from slamlab.mono.epipolar import epipolar_segments, extract_patches, search_epipolar, zncc
 
 K = np.array([[300.0, 0, 160], [0, 300.0, 120], [0, 0, 1]])
@@ -19,15 +18,6 @@ def _T(R, t):
     T = np.eye(4)
     T[:3, :3], T[:3, 3] = R, t
     return T
-
-
-def test_se3_exp_equals_matrix_exponential():
-    xi = np.array([0.1, -0.2, 0.3, 0.05, -0.4, 0.2])
-    A = np.zeros((4, 4))
-    w = xi[3:]
-    A[:3, :3] = [[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]
-    A[:3, 3] = xi[:3]
-    np.testing.assert_allclose(se3_exp(xi), expm(A), atol=1e-12)
 
 
 def test_epipolar_segment_contains_the_true_projection():
