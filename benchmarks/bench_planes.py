@@ -139,7 +139,7 @@ def main() -> None:
     print(res.table())
     bench_ransac(args.seed)
     if args.monte_carlo:
-        study = run_intensity_study(args.monte_carlo, seed=args.seed, rounds=args.rounds, n_jobs=args.jobs,
+        study = run_intensity_study(args.monte_carlo, rng=args.seed, rounds=args.rounds, n_jobs=args.jobs,
                                     progress=False)
         print()
         print(study)

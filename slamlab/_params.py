@@ -83,6 +83,29 @@ class Params:
             raise TypeError(f"`params` must be a {cls.__name__} or None; got {type(params).__name__}")
         return base.replace(**overrides)
 
+    @classmethod
+    def as_overrides(cls, params: P | None = None, **overrides: Any) -> dict[str, Any]:
+        """``params`` plus ``overrides`` as one dict of overrides of the defaults (checked by :meth:`resolve`).
+
+        For a ``run_*`` that hands its settings to worker tasks as keyword overrides: the fields of
+        ``params`` that differ from the defaults, then ``overrides`` (which win). With ``params=None`` the
+        result is ``overrides`` unchanged, so a study called the old way runs exactly as before.
+
+        Parameters
+        ----------
+        params : Params or None
+            The base settings (an instance of ``cls``).
+        **overrides
+            Fields to change.
+
+        Returns
+        -------
+        dict
+            Field name → value; ``cls.resolve(None, **result) == cls.resolve(params, **overrides)``.
+        """
+        cls.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
+        return {**(params.changed() if params is not None else {}), **overrides}
+
     def changed(self) -> dict[str, Any]:
         """The fields whose value differs from the class default."""
         default = type(self)()

@@ -32,9 +32,11 @@ import numpy as np
 from . import _validate as v
 from ._progress import progress_bar
 
-__all__ = ["grid_points", "result_row", "root_seed_sequence", "sweep"]
+__all__ = ["fresh_seed_sequence", "grid_points", "raise_failed", "renamed_seed", "result_row", "root_seed_sequence",
+           "sweep"]
 
 BACKENDS = ("sequential", "loky", "dask")
+ON_ERROR = ("row", "raise")
 
 
 def grid_points(grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | None) -> list[dict[str, Any]]:
@@ -86,6 +88,59 @@ def root_seed_sequence(seed, name: str = "seed") -> np.random.SeedSequence:
         return np.random.SeedSequence(seed)
     raise TypeError(f"`{name}` must be a numpy Generator, an int seed, a SeedSequence or None; "
                     f"got {type(seed).__name__}")
+
+
+def fresh_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
+    """:func:`root_seed_sequence` of ``rng`` as a new object that has spawned no children yet.
+
+    ``SeedSequence.spawn`` is stateful (a second call gives the next children), so a study that runs one
+    sweep per variant from the same ``rng`` (run ``i`` of every variant the same simulated run) gives each
+    sweep its own copy. For an int seed the copy is ``SeedSequence(seed)``.
+
+    Parameters
+    ----------
+    rng : int, SeedSequence, Generator or None
+        See :func:`root_seed_sequence`.
+    name : str
+        The argument's name in error messages.
+
+    Returns
+    -------
+    numpy.random.SeedSequence
+        Same entropy and spawn key as ``root_seed_sequence(rng)``, no children spawned.
+
+    >>> ss = np.random.SeedSequence(3); _ = ss.spawn(2)
+    >>> fresh_seed_sequence(ss).spawn(1)[0].spawn_key
+    (0,)
+    """
+    ss = root_seed_sequence(rng, name)
+    return np.random.SeedSequence(ss.entropy, spawn_key=ss.spawn_key, pool_size=ss.pool_size)
+
+
+def renamed_seed(rng, seed, where: str):
+    """``rng``, or the deprecated ``seed=`` a caller still passes (with a ``DeprecationWarning``).
+
+    Parameters
+    ----------
+    rng : int, SeedSequence, Generator or None
+        The value of the ``rng`` argument.
+    seed : int or None
+        The value of the old ``seed`` argument (None: not given).
+    where : str
+        The function's name, for the warning.
+
+    Returns
+    -------
+    int, SeedSequence, Generator or None
+        ``seed`` if it was given, else ``rng``.
+    """
+    if seed is None:
+        return rng
+    import warnings
+
+    warnings.warn(f"{where}(seed=...) is deprecated; pass rng=... (an int seed gives the same streams)",
+                  DeprecationWarning, stacklevel=3)
+    return seed
 
 
 def _is_scalar(x: Any) -> bool:
@@ -143,8 +198,8 @@ def _dask_config(client, n_jobs: int):
 
 def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | None = None, *,
           seeds: int = 1, seed: int = 0, n_jobs: int = 1, backend: str | None = None, client=None,
-          rng_arg: str | None = "rng", progress: bool | None = None, fixed: Mapping[str, Any] | None = None,
-          desc: str | None = None):
+          rng_arg: str | None = "rng", progress=None, fixed: Mapping[str, Any] | None = None,
+          desc: str | None = None, on_error: str = "row"):
     """Run ``fn(**fixed, **point, rng=Generator)`` for every grid point × ``seeds`` replicates.
 
     Parameters
@@ -165,17 +220,28 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
         The cluster for ``backend="dask"`` (default: the active client).
     rng_arg : str or None
         Keyword that receives the run's Generator; None for a deterministic ``fn``.
-    progress : bool, optional
-        Show a progress bar (default: on unless ``$SLAMLAB_PROGRESS=0``).
+    progress : bool, callable or None
+        Show a progress bar (default: on unless ``$SLAMLAB_PROGRESS=0``), or a callable ``progress(i)``
+        (see :mod:`slamlab._progress`).
     fixed : mapping, optional
         Keywords passed unchanged to every run (not columns of the table).
     desc : str, optional
-        The progress bar's label (default: the function's name).
+        The progress bar's label (default: the function's name); also names the sweep in the error
+        raised by ``on_error="raise"``.
+    on_error : {"row", "raise"}
+        What a run that raises becomes: ``"row"`` (default) a row with the error's text in the ``error``
+        column; ``"raise"`` a ``RuntimeError`` after all runs, naming how many failed and the first
+        error (for callers to whom any failure is a bug).
 
     Returns
     -------
     pandas.DataFrame
         One row per run in task order: the parameters, ``replicate``, the results, ``error``.
+
+    Raises
+    ------
+    RuntimeError
+        With ``on_error="raise"``, when any run raised.
 
     Examples
     --------
@@ -188,6 +254,7 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
     import pandas as pd
 
     v.check_callable(fn, "fn")
+    v.check_choice(on_error, "on_error", ON_ERROR)
     points = grid_points(grid)
     n_rep = v.check_int(seeds, "seeds", minimum=1)
     root = root_seed_sequence(seed)
@@ -208,7 +275,8 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
 
     tasks = [(p, r) for p in points for r in range(n_rep)]
     children = root.spawn(len(tasks))
-    bar = progress_bar(total=len(tasks), desc=desc or getattr(fn, "__name__", "sweep"), progress=progress)
+    desc = desc or getattr(fn, "__name__", "sweep")
+    bar = progress_bar(total=len(tasks), desc=desc, progress=progress)
     rows: list[dict[str, Any]] = []
     try:
         if backend == "sequential":
@@ -243,4 +311,32 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
     table = pd.DataFrame.from_records(records)
     # the error column last, the rest in first-seen order
     cols = [c for c in table.columns if c != "error"] + ["error"]
-    return table[cols]
+    table = table[cols]
+    if on_error == "raise":
+        raise_failed(table, desc)
+    return table
+
+
+def raise_failed(table, what: str = "sweep") -> None:
+    """Raise a ``RuntimeError`` if any row of a :func:`sweep` table holds an error (what ``on_error="raise"`` does).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A table returned by :func:`sweep` (its ``error`` column).
+    what : str
+        Names the sweep in the message.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    RuntimeError
+        "``n`` of ``N`` run(s) of ``what`` failed; first: ``<error>``".
+    """
+    failed = table["error"].notna()
+    if failed.any():
+        raise RuntimeError(f"{int(failed.sum())} of {len(table)} run(s) of {what} failed; "
+                           f"first: {table['error'][failed].iloc[0]}")

@@ -50,6 +50,18 @@ def test_resolve_applies_overrides_and_rejects_unknown_names():
         _Demo.resolve({"H_min": 3})
 
 
+def test_as_overrides_merges_params_and_overrides_for_worker_tasks():
+    assert _Demo.as_overrides(None, band_m=0.5) == {"band_m": 0.5}  # params=None: the overrides unchanged
+    assert _Demo.as_overrides(_Demo(H_min=20)) == {"H_min": 20}  # only fields that differ from the defaults
+    ov = _Demo.as_overrides(_Demo(H_min=20, band_m=0.3), band_m=0.5)
+    assert ov == {"H_min": 20, "band_m": 0.5}
+    assert _Demo.resolve(None, **ov) == _Demo.resolve(_Demo(H_min=20, band_m=0.3), band_m=0.5)
+    with pytest.raises(TypeError, match=r"_Demo has no field\(s\) 'Hmin'"):
+        _Demo.as_overrides(None, Hmin=3)
+    with pytest.raises(TypeError, match="`params` must be a _Demo or None; got dict"):
+        _Demo.as_overrides({"H_min": 3})
+
+
 def test_param_rejects_mutable_default_and_missing_source():
     with pytest.raises(TypeError, match="immutable"):
         param([1, 2], "ours")

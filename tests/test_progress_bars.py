@@ -51,3 +51,25 @@ def test_feature_experiments_bars(capsys, monkeypatch, shared_data):
         (1, 5), n_stored=300, n_queries=20, progress=p))
     assert "recall vs leaves" in err
     assert "/2 " in err
+
+
+def test_one_progress_contract_bool_none_or_callable(capsys, monkeypatch):
+    from slamlab._progress import check_progress, progress_bar
+
+    monkeypatch.setenv("SLAMLAB_PROGRESS", "1")
+    done = []
+    assert list(progress_bar(range(3), desc="loop", progress=done.append)) == [0, 1, 2]
+    assert done == [0, 1, 2]  # a callable gets each finished item's index, and no bar is drawn
+    bar = progress_bar(total=2, progress=done.append)
+    bar.update()
+    bar.update()
+    bar.close()
+    assert done == [0, 1, 2, 0, 1]
+    assert capsys.readouterr().err == ""
+    assert list(progress_bar("ab", desc="letters", progress=True)) == ["a", "b"]
+    assert "letters" in capsys.readouterr().err
+    with pytest.raises(TypeError, match=r"`progress` must be True, False, None or a callable progress\(i\); got int"):
+        progress_bar(range(2), progress=1)
+    with pytest.raises(TypeError, match=r"`show` must be True, False, None or a callable progress\(i\); got str"):
+        check_progress("yes", "show")
+

@@ -9,7 +9,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from slamlab.sweep import grid_points, result_row, sweep
+from slamlab.sweep import (
+    fresh_seed_sequence,
+    grid_points,
+    renamed_seed,
+    result_row,
+    root_seed_sequence,
+    sweep,
+)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from sweep_tasks import noisy
@@ -53,6 +60,45 @@ def test_a_failed_run_is_a_row_with_its_error():
     assert table.loc[[0, 2], "error"].isna().all()
 
 
+def test_on_error_raise_names_the_count_and_the_first_error():
+    with pytest.raises(RuntimeError, match=r"^2 of 4 run\(s\) of a study failed; first: ValueError: scale 2.0 is "
+                                           r"not allowed$"):
+        sweep(noisy, {"scale": [1.0, 2.0, 3.0, 2.0]}, fixed={"fail_at": 2.0}, seed=1, progress=False,
+              on_error="raise", desc="a study")
+    # the default names the function; "row" (the default) keeps the failure as a row
+    with pytest.raises(RuntimeError, match=r"^1 of 3 run\(s\) of noisy failed"):
+        sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, seed=1, progress=False, on_error="raise")
+    rows = sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, seed=1, progress=False, on_error="row")
+    assert rows["error"].notna().sum() == 1
+    # with no failure "raise" returns the same table as "row"
+    ok = sweep(noisy, GRID, seed=4, progress=False, on_error="raise")
+    assert ok.equals(sweep(noisy, GRID, seed=4, progress=False))
+    with pytest.raises(ValueError, match="`on_error` must be one of 'row', 'raise'; got 'ignore'"):
+        sweep(noisy, GRID, on_error="ignore")
+
+
+def test_fresh_seed_sequence_restarts_the_children():
+    ss = np.random.SeedSequence(9)
+    first = ss.spawn(2)
+    again = fresh_seed_sequence(ss).spawn(2)  # ss itself would give children 2 and 3 now
+    assert [c.spawn_key for c in again] == [c.spawn_key for c in first] == [(0,), (1,)]
+    assert np.array_equal(np.random.default_rng(again[1]).integers(1 << 30, size=4),
+                          np.random.default_rng(first[1]).integers(1 << 30, size=4))
+    # an int seed gives SeedSequence(seed)'s children, so sweeps from an int keep their streams
+    assert fresh_seed_sequence(9).spawn(1)[0].generate_state(2).tolist() == \
+        np.random.SeedSequence(9).spawn(1)[0].generate_state(2).tolist()
+    g = np.random.default_rng(3)
+    assert fresh_seed_sequence(g).entropy == root_seed_sequence(g).entropy == 3
+    with pytest.raises(TypeError, match="`rng` must be a numpy Generator, an int seed, a SeedSequence or None"):
+        fresh_seed_sequence(1.5)
+
+
+def test_renamed_seed_warns_and_wins():
+    assert renamed_seed(4, None, "run_x") == 4
+    with pytest.warns(DeprecationWarning, match=r"run_x\(seed=...\) is deprecated; pass rng=..."):
+        assert renamed_seed(4, 7, "run_x") == 7
+
+
 def test_progress_bar_only_when_asked(capsys, monkeypatch):
     monkeypatch.setenv("SLAMLAB_PROGRESS", "0")
     sweep(noisy, GRID, seed=1)
@@ -61,6 +107,10 @@ def test_progress_bar_only_when_asked(capsys, monkeypatch):
     assert "noisy" in capsys.readouterr().err  # tqdm's text bar names the function
     sweep(noisy, GRID, seed=1, progress=True, desc="a study")
     assert "a study" in capsys.readouterr().err  # or says what the caller names it
+    done = []
+    sweep(noisy, GRID, seed=1, progress=done.append)  # a callable: called with each finished run's index
+    assert done == list(range(6))
+    assert capsys.readouterr().err == ""
 
 
 def test_result_row_forms():

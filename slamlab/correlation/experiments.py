@@ -132,11 +132,8 @@ def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 
     Mvs = tuple(grid_to_values(M, q.a_c, q.a_p, q.a_n) for q in settings)
     headings = heading_candidates(settings[0].delta_alpha_rad)
     points = [{"choice": j, "pose_index": i, "beams": b} for j in range(len(settings)) for i, b in enumerate(beams)]
-    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress, desc="correlation localisation",
+    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress, on_error="raise", desc="correlation localisation",
                   fixed={"Mvs": Mvs, "settings": tuple(settings), "headings": headings, "margins": margins})
-    failed = table["error"].notna()
-    if failed.any():
-        raise RuntimeError(f"{int(failed.sum())} localisation(s) failed; first: {table['error'][failed].iloc[0]}")
     return table.drop(columns=["beams", "replicate", "error"])
 
 
@@ -620,10 +617,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes}
     table = sweep(_localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed,
-                  desc="localise log scans")
-    failed = table["error"].notna()
-    if failed.any():
-        raise RuntimeError(f"{int(failed.sum())} localisation(s) failed; first: {table['error'][failed].iloc[0]}")
+                  on_error="raise", desc="localise log scans")
     true_m = log.poses[idx]
     est_m = np.stack([frame.to_metres(table[[f"x{k}", f"y{k}", f"h{k}"]].to_numpy(dtype=float)) for k in modes])
     err_p = np.hypot(est_m[..., 0] - true_m[:, 0], est_m[..., 1] - true_m[:, 1])

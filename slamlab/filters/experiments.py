@@ -121,10 +121,7 @@ def _monte_carlo(run, n_runs: int, rng, n_jobs: int, progress, **fixed):
     from ..sweep import root_seed_sequence, sweep
 
     table = sweep(run, None, seeds=n_runs, seed=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress, fixed=fixed,
-                  desc=f"Monte Carlo ({run.__name__.strip('_').replace('_', ' ')})")
-    failed = table["error"].notna()
-    if failed.any():
-        raise RuntimeError(f"{int(failed.sum())} Monte Carlo run(s) failed; first: {table['error'][failed].iloc[0]}")
+                  on_error="raise", desc=f"Monte Carlo ({run.__name__.strip('_').replace('_', ' ')})")
     return table
 
 

@@ -1,4 +1,5 @@
-"""Ch. 6 experiments (004 §Hough SLAM): 004's example line, the 121-pose run, the real logs.
+"""Ch. 6 experiments (004 §Hough SLAM): 004's example line, the 121-pose run, the noise study; the real logs are
+in :mod:`slamlab.hough.logs` (re-exported here).
 
 Each ``run_*`` returns a frozen dataclass: ``str(result)`` is a one-line summary,
 ``result.table()`` a fixed-precision text table (the source's figure beside ours where
@@ -8,20 +9,18 @@ there is one); timings live in their own field, never in the table.
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
-from ..geometry.se2 import se2_relative
-from ..scans import GridFrame, OccupancyGrid, occupancy_grid, scan_to_points
+from ..scans import OccupancyGrid, occupancy_grid, scan_to_points
 from .icp import icp_odometry
 from .lines import canonical_lines, find_peaks
+from .logs import LOG_PARAMS, SHARED_LOGS, RealLogResult, log_format, run_real_log
 from .mapping import map_agreement
 from .slam import HoughSlamParams, HoughSlamResult, hough_slam
 from .transform import (
@@ -34,12 +33,15 @@ from .transform import (
     rasterise_scan,
 )
 
-__all__ = [
+__all__ = [  # LOG_PARAMS, SHARED_LOGS, RealLogResult, log_format, run_real_log: re-exported from .logs
+    "LOG_PARAMS",
+    "SHARED_LOGS",
     "ExampleLineResult",
     "NoiseStudyResult",
     "RealLogResult",
     "SimSlamResult",
     "check_pose_from_two_lines",
+    "log_format",
     "pose_errors",
     "run_example_line",
     "run_noise_study",
@@ -47,9 +49,6 @@ __all__ = [
     "run_sim_slam",
     "time_polar_vs_opencv",
 ]
-
-#: The shared logs run by the notebook, found by :func:`slamlab.data.find_data`.
-SHARED_LOGS = {"urg04lx": "mines-urg04lx-odometry/exp2.dat", "mbicp": "mbicp-laserazos-sick/laserazosSM3.log"}
 
 
 def pose_errors(estimate, truth) -> np.ndarray:
@@ -229,8 +228,10 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
     sigma = v.check_positive(range_std_cells, "range_std_cells", allow_zero=True)
     start = v.check_choice(start, "start", ("truth", "correlation"))
     noise = v.check_positive(odometry_noise, "odometry_noise", allow_zero=True)
-    seeds = np.random.SeedSequence(rng if isinstance(rng, (int, np.integer)) else None).spawn(2) \
-        if not isinstance(rng, np.random.Generator) else rng.spawn(2)
+    from ..sweep import root_seed_sequence
+
+    # a Generator spawns its own children; an int seed, a SeedSequence or None: SeedSequence(rng)'s
+    seeds = rng.spawn(2) if isinstance(rng, np.random.Generator) else root_seed_sequence(rng, "rng").spawn(2)
     room = sim.test_room_200()
     world = sim.measurement_room_200() if clutter else room
     truth = sim.path_004(n_poses)
@@ -267,10 +268,11 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
 # --- noise study (our addition): Monte Carlo over range noise and seeds on slamlab.sweep -------------
 
 
-def _noise_run(*, range_std_cells: float, n_poses: int, clutter: bool, rng: np.random.Generator) -> dict:
+def _noise_run(*, range_std_cells: float, n_poses: int, clutter: bool, rng: np.random.Generator,
+               params: HoughSlamParams | None = None, overrides: dict | None = None) -> dict:
     """One seeded Hough SLAM run of the noise study: its worst and final errors (cells, degrees)."""
-    r = run_sim_slam(n_poses, range_std_cells=range_std_cells, clutter=clutter, with_icp=False, rng=rng,
-                     progress=False)
+    r = run_sim_slam(n_poses, range_std_cells=range_std_cells, clutter=clutter, with_icp=False, params=params,
+                     rng=rng, progress=False, **(overrides or {}))
     e = r.errors["Hough SLAM"]
     pos = np.hypot(e[:, 0], e[:, 1])
     return {"max_pos_err": float(pos.max()), "final_pos_err": float(pos[-1]),
@@ -302,16 +304,44 @@ class NoiseStudyResult:
 
 
 def run_noise_study(range_std_cells=(0.0, 0.1, 0.3, 0.5), n_runs: int = 4, *, n_poses: int = 61,
-                    clutter: bool = False, bad_pos_cells: float = 2.0, n_jobs: int = 1, rng=2010,
-                    progress: bool | None = None) -> NoiseStudyResult:
+                    clutter: bool = False, bad_pos_cells: float = 2.0, params: HoughSlamParams | None = None,
+                    n_jobs: int = 1, rng=2010, progress=None, **overrides) -> NoiseStudyResult:
     """Hough SLAM on 004's room at several range noises σ, ``n_runs`` seeded runs each (our addition).
 
     Runs on :func:`slamlab.sweep.sweep` (run i draws from child i of ``SeedSequence(rng)``), so the
     table is the same for any ``n_jobs``. Each run: :func:`run_sim_slam` without ICP on the first
     ``n_poses`` poses. A run counts as bad when its largest position error passes ``bad_pos_cells``.
+
+    Parameters
+    ----------
+    range_std_cells : float or sequence of float
+        The range noises σ [cells], one grid point each.
+    n_runs : int
+        Seeded runs per noise level.
+    n_poses : int
+        Poses of 004's path per run.
+    clutter : bool
+        Add unmapped clutter to the room.
+    bad_pos_cells : float
+        A run is bad when its largest position error passes this.
+    params : HoughSlamParams, optional
+        Settings of Hough SLAM (default: :func:`run_sim_slam`'s).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    **overrides
+        :class:`HoughSlamParams` fields.
+
+    Returns
+    -------
+    NoiseStudyResult
     """
     from ..sweep import root_seed_sequence, sweep
 
+    HoughSlamParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
     sigmas = [v.check_positive(s, "range_std_cells", allow_zero=True) for s in np.atleast_1d(range_std_cells)]
     if not sigmas:
         raise ValueError("`range_std_cells` must hold at least one noise level")
@@ -319,165 +349,10 @@ def run_noise_study(range_std_cells=(0.0, 0.1, 0.3, 0.5), n_runs: int = 4, *, n_
     n_poses = v.check_int(n_poses, "n_poses", minimum=5)
     bad = v.check_positive(bad_pos_cells, "bad_pos_cells")
     table = sweep(_noise_run, {"range_std_cells": sigmas}, seeds=n_runs, seed=root_seed_sequence(rng, "rng"),
-                  n_jobs=n_jobs, progress=progress, fixed={"n_poses": n_poses, "clutter": bool(clutter)},
-                  desc="Hough SLAM noise study")
-    failed = table["error"].notna()
-    if failed.any():
-        raise RuntimeError(f"{int(failed.sum())} noise-study run(s) failed; first: {table['error'][failed].iloc[0]}")
+                  n_jobs=n_jobs, progress=progress,
+                  fixed={"n_poses": n_poses, "clutter": bool(clutter), "params": params, "overrides": dict(overrides)},
+                  on_error="raise", desc="Hough SLAM noise study")
     return NoiseStudyResult(table, n_poses, bool(clutter), bad)
-
-
-# --- real laser logs ---------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class RealLogResult:
-    """Hough SLAM on a real log beside integrated odometry (no ground truth in these logs)."""
-
-    name: str  # title: format and file name
-    slam: HoughSlamResult = field(repr=False)
-    odometry: np.ndarray = field(repr=False)  # (n, 3)
-    scans: list = field(repr=False)  # the Scans used (metres)
-    map_slam: OccupancyGrid = field(repr=False)
-    map_odometry: OccupancyGrid = field(repr=False)
-    scan_index: np.ndarray = field(repr=False)  # which scans of the log were used
-    frame: GridFrame | None = field(default=None, repr=False)  # metric frame of both maps
-    timing_s: dict = field(default_factory=dict, compare=False)
-
-    @property
-    def path_length_m(self) -> float:
-        """Length of the odometry path."""
-        return float(np.hypot(*np.diff(self.odometry[:, :2], axis=0).T).sum())
-
-    def sharpness(self, which: str = "slam") -> float:
-        """Obstacle cells per 100 returns in the built map: fewer = walls drawn thinner (our measure)."""
-        m = self.map_slam if which == "slam" else self.map_odometry
-        return float(100.0 * (m.grid == 1).sum() / max(1, m.hits.sum()))
-
-    def __str__(self) -> str:
-        return (f"{self.name}: {self.odometry.shape[0]} scans, {self.path_length_m:.1f} m of odometry path; "
-                f"{int(self.slam.lost.sum())} steps fell back on odometry, {int(self.slam.partial.sum())} in part")
-
-    def table(self) -> str:
-        d = self.slam.poses[-1] - self.odometry[-1]
-        rows = [
-            ["scans used", f"{self.odometry.shape[0]}"],
-            ["odometry path length [m]", f"{self.path_length_m:.1f}"],
-            ["median lines per scan", f"{np.median(self.slam.n_lines):.0f}"],
-            ["steps with only parallel lines (move along them from odometry)",
-             f"{self.slam.partial.mean():.0%}"],
-            ["steps without usable lines (odometry used)", f"{self.slam.lost.mean():.0%}"],
-            ["final position, Hough SLAM - odometry [m]", f"{math.hypot(d[0], d[1]):.1f}"],
-            ["final heading, Hough SLAM - odometry [°]", f"{math.degrees(float(wrap_angle(d[2]))):.0f}"],
-            ["obstacle cells per 100 returns, Hough SLAM map", f"{self.sharpness('slam'):.1f}"],
-            ["obstacle cells per 100 returns, odometry map", f"{self.sharpness('odometry'):.1f}"],
-        ]
-        return format_table(["quantity", "value"], rows, title=self.name)
-
-
-#: Per-format settings (ours): rho resolution and thresholds in metres; ``r_max`` None = the log's range limit.
-LOG_PARAMS = {
-    "urg04lx": {"delta_rho": 0.02, "H_min": 15, "a": 0.15, "max_gap": 0.2, "rho_tol": 0.05, "band": 0.03},
-    "carmen": {"delta_rho": 0.02, "H_min": 15, "a": 0.15, "max_gap": 0.3, "rho_tol": 0.05, "band": 0.03},
-}
-_FORMAT_NAMES = {"urg04lx": "URG-04LX", "carmen": "CARMEN"}
-
-
-def log_format(path) -> str:
-    """``"carmen"`` or ``"urg04lx"``: the format of a laser log, from its first data line.
-
-    CARMEN lines start with a message name (``FLASER``, ``ODOM``, ``PARAM`` …); a
-    URG-04LX line of the Mines format is 707 numbers.
-    """
-    from ..io.carmen import _open_text  # plain text or gzip, told apart by the magic bytes
-
-    p = v.as_path(path, "path", kind="file")
-    with _open_text(p) as fh:
-        for line in fh:
-            tok = line.split()
-            if not tok or tok[0].startswith("#"):
-                continue
-            try:
-                float(tok[0])
-            except ValueError:
-                return "carmen"
-            return "urg04lx"
-    raise ValueError(f"{p.name}: empty log")
-
-
-def _load_log(path, fmt):
-    """Scans (metres) and odometry poses of a log; the log's range limit."""
-    if fmt == "urg04lx":
-        from ..io.urg04lx import read_urg04lx_log
-
-        log = read_urg04lx_log(path)
-        return log.scans(), log.odometry_poses(), log.max_range_m
-    from ..io.carmen import read_carmen
-
-    log = read_carmen(path)
-    return log.scans(), log.odom_poses.copy(), log.max_range_m
-
-
-def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = None, step: int = 1,
-                 cell_m: float = 0.05, params: HoughSlamParams | None = None, progress: bool | None = None,
-                 **overrides) -> RealLogResult:
-    """Hough SLAM on a real laser log with raw odometry (a URG-04LX log of the Mines format or a CARMEN log).
-
-    Parameters
-    ----------
-    path : str or os.PathLike, optional
-        Any log of either format; default the Mines URG-04LX log (``SHARED_LOGS["urg04lx"]``
-        found by :func:`slamlab.data.find_data`). The result's title is the format and the
-        file name.
-    fmt : {"urg04lx", "carmen"}, optional
-        The format; default: guessed from the first line (:func:`log_format`).
-    n_scans : int, optional
-        Use only the first ``n_scans`` scans of the log (after ``step``).
-    step : int
-        Use every ``step``-th scan.
-    cell_m : float
-        Cell of the built maps.
-    params, **overrides
-        Defaults are our per-format settings :data:`LOG_PARAMS` (Δrho = 2 cm, H_min = 15,
-        a = 0.15 m, …) with ``r_max`` = the log's range limit.
-    progress : bool, optional
-        A bar over the scans (None: on unless ``$SLAMLAB_PROGRESS=0``).
-    """
-    if path is None:
-        from ..data import find_data
-
-        path = find_data(SHARED_LOGS["urg04lx"])
-    elif isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"`path` must be a str or os.PathLike; got {type(path).__name__}")
-    fmt = log_format(path) if fmt is None else v.check_choice(fmt, "fmt", tuple(LOG_PARAMS))
-    step = v.check_int(step, "step", minimum=1)
-    cell_m = v.check_positive(cell_m, "cell_m")
-    timing = {}
-    t0 = time.perf_counter()
-    scans, odo, max_range_m = _load_log(path, fmt)
-    timing["read"] = time.perf_counter() - t0
-    idx = np.arange(0, len(scans), step)
-    if n_scans is not None:
-        idx = idx[: v.check_int(n_scans, "n_scans", minimum=2)]
-    scans = [scans[k] for k in idx]
-    odo = odo[idx]
-    U = se2_relative(odo[:-1], odo[1:])
-    base = HoughSlamParams(**LOG_PARAMS[fmt], r_max=float(max_range_m)) if params is None else params
-    t0 = time.perf_counter()
-    res = hough_slam(scans, odo[0], U, base, progress=progress, **overrides)
-    timing["hough_slam"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    pts = np.concatenate([odo[:, :2], res.poses[:, :2]])
-    lo = pts.min(axis=0) - 9.0
-    span = np.ceil((pts.max(axis=0) + 9.0 - lo) / cell_m).astype(int)
-    frame = GridFrame(float(lo[0]), float(lo[1]), cell_m, (int(span[1]), int(span[0])))
-    scans_c = [s.to_cells(cell_m) for s in scans]
-    m_slam, m_odo = (occupancy_grid(scans_c, frame.to_cells(P), frame.shape, rule="endpoints", hit_offset_cells=0.0)
-                     for P in (res.poses, odo))
-    timing["build_map"] = time.perf_counter() - t0
-    name = Path(path).name
-    title = f"{_FORMAT_NAMES[fmt]} log {name} (raw odometry)"
-    return RealLogResult(title, res, odo, scans, m_slam, m_odo, idx, frame, timing)
 
 
 def check_pose_from_two_lines(n_cases: int = 1000, *, rng=2010) -> float:

@@ -134,14 +134,14 @@ register(Task("08.augmented", "Task 4, w_slow, w_fast and the injection probabil
 def _global_success() -> float:
     from ..localisation import run_global_localisation
 
-    g = run_global_localisation(seed=2026, **EXPLORE_GLOBAL)
+    g = run_global_localisation(rng=2026, **EXPLORE_GLOBAL)
     return float(g.summary()["success"].iloc[0])
 
 
 def _kidnap_recovery() -> float:
     from ..localisation import demo_run
 
-    _, res = demo_run(seed=2026, **EXPLORE_KIDNAP)
+    _, res = demo_run(rng=2026, **EXPLORE_KIDNAP)
     k = res.converged_at(EXPLORE_KIDNAP["kidnap_step"])
     return float("nan") if k is None else float(k - EXPLORE_KIDNAP["kidnap_step"])
 
@@ -150,11 +150,11 @@ register(ExplorationTask(
     "08.explore.global_success",
     "Exploration 1: the success rate of global localisation with 500 particles (20 runs of 20 steps)",
     _global_success,
-    hint="sl.localisation.run_global_localisation((500,), n_runs=20, n_steps=20, seed=SEED); "
+    hint="sl.localisation.run_global_localisation((500,), n_runs=20, n_steps=20, rng=SEED); "
          "read .summary()['success'].", atol=1e-9))
 register(ExplorationTask(
     "08.explore.kidnap_recovery",
     "Exploration 2: steps after the kidnap until the estimate stays within 3 cells and 5°",
     _kidnap_recovery,
-    hint="run, res = sl.localisation.demo_run(1000, kidnap_step=25, alpha_slow=0.05, alpha_fast=0.5, seed=SEED); "
+    hint="run, res = sl.localisation.demo_run(1000, kidnap_step=25, alpha_slow=0.05, alpha_fast=0.5, rng=SEED); "
          "res.converged_at(25) - 25."))

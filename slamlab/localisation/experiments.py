@@ -176,22 +176,16 @@ def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params
     return FilterRun(est, e, eh, records, snaps, dt)
 
 
-def _raise_failed(df) -> None:
-    """A sweep keeps a failed run as a row with its error; here any failure is a bug: raise it."""
-    if df["error"].notna().any():
-        raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
-
-
 # --- Markov grid vs MCL -------------------------------------------------------------------------------
 
 
-def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int):
+def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int, overrides: dict):
     run = simulate_run(n_steps, rng=rng)
     if method == "markov":
         r = run_filter(run, method="markov", resolution=size, n_headings=n_headings)
         mem = r.records[0]
     else:
-        r = run_filter(run, n_particles=size, rng=rng)
+        r = run_filter(run, rng=rng, **{**overrides, "n_particles": size})
         mem = size * 4 * 8  # particles (x, y, θ) and weights, float64
     return {"start_x": float(run.true_poses[0, 0]), "start_y": float(run.true_poses[0, 1]),
             "success": bool(r.ok[-1]), "final_err_cells": float(r.err_pos[-1]),
@@ -231,23 +225,51 @@ class MarkovVsMclResult:
 
 
 def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *, n_runs: int = 5,
-                      n_steps: int = 30, seed: int = 2, n_jobs: int = 1,
-                      progress: bool | None = None) -> MarkovVsMclResult:
+                      n_steps: int = 30, params: MCLParams | None = None, rng=2, n_jobs: int = 1,
+                      progress=None, seed=None, **overrides) -> MarkovVsMclResult:
     """Markov grids (belief cell size in map cells, headings) and MCL (particle counts) on the same seeded
-    runs (every method's run ``i`` uses the same stream, so the same path, scans and odometry)."""
-    from ..sweep import sweep
+    runs (every method's run ``i`` uses the same stream, so the same path, scans and odometry).
 
+    Parameters
+    ----------
+    markov : sequence of (int, int)
+        Markov grids: (belief cell size in map cells, number of headings).
+    particle_counts : sequence of int
+        MCL particle counts (each replaces ``params.n_particles``).
+    n_runs, n_steps : int
+        Runs per method and steps per run.
+    params : MCLParams, optional
+        Settings of the MCL runs (default: the defaults); the Markov grids keep theirs.
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every method).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields for the MCL runs.
+
+    Returns
+    -------
+    MarkovVsMclResult
+    """
+    import pandas as pd
+
+    from ..sweep import fresh_seed_sequence, renamed_seed, sweep
+
+    rng = renamed_seed(rng, seed, "run_markov_vs_mcl")
+    ov = MCLParams.as_overrides(params, **overrides)
     pts = [{"method": "markov", "size": int(s), "n_headings": int(h)} for s, h in markov]
     pts += [{"method": "mcl", "size": int(n), "n_headings": 0} for n in particle_counts]
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    # one stream per run index, shared by all methods: one sweep per method from the same int seed (a
-    # SeedSequence object would not do: its spawn() is stateful, each sweep would get the next children)
-    frames = [sweep(_compare_task, [p], seeds=n_runs, seed=seed, n_jobs=n_jobs, progress=progress,
-                    fixed={"n_steps": n_steps}) for p in pts]
-    import pandas as pd
-
+    # one stream per run index, shared by all methods: one sweep per method from a fresh copy of the same
+    # SeedSequence (spawn() is stateful: the same object would give each sweep the next children)
+    frames = [sweep(_compare_task, [p], seeds=n_runs, seed=fresh_seed_sequence(rng), n_jobs=n_jobs,
+                    progress=progress, fixed={"n_steps": n_steps, "overrides": ov}, on_error="raise",
+                    desc="Markov grid vs MCL") for p in pts]
     df = pd.concat(frames, ignore_index=True)
-    _raise_failed(df)
     return MarkovVsMclResult(df, n_runs, n_steps)
 
 
@@ -343,13 +365,38 @@ def ours_vs_source(global_result=None, kidnap=None, ablation=None) -> str:
     return format_table(["item", "003", "ours"], rows, title="Ours vs the source (003 §1.2.4, §2.2)")
 
 
-def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: int = 60, seed: int = 7,
-             **overrides):
-    """One recorded global run (with an optional kidnap) for the plots and the time slider; ``overrides``:
-    fields of :class:`MCLParams` (default: its defaults)."""
-    rng = np.random.default_rng(seed)
+def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: int = 60,
+             params: MCLParams | None = None, rng=7, seed=None, **overrides):
+    """One recorded global run (with an optional kidnap) for the plots and the time slider.
+
+    Parameters
+    ----------
+    n_particles : int
+        MCL particles (replaces ``params.n_particles``).
+    kidnap_step : int or None
+        Step at which the robot is carried elsewhere (None: no kidnap).
+    n_steps : int
+        Steps of the run.
+    params : MCLParams, optional
+        Settings of MCL (default: the defaults).
+    rng : int, SeedSequence or Generator
+        The one stream of the simulated run and then of the filter.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields.
+
+    Returns
+    -------
+    (SimRun, FilterRun)
+        The simulated run and the recorded filter run.
+    """
+    from ..sweep import renamed_seed
+
+    rng = v.as_rng(renamed_seed(rng, seed, "demo_run"))
     run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
-    return run, run_filter(run, n_particles=n_particles, rng=rng, keep_particles=True, **overrides)
+    return run, run_filter(run, n_particles=n_particles, rng=rng, keep_particles=True,
+                           **MCLParams.as_overrides(params, **overrides))
 
 
 __all__ += ["demo_run", "uniform_free_particles"]
@@ -358,11 +405,11 @@ __all__ += ["demo_run", "uniform_free_particles"]
 # --- Ch. 5's correlation method on the same scans -----------------------------------------------------
 
 
-def _side_task(rng, n_steps: int, n_particles: int, delta_alpha_deg: float):
+def _side_task(rng, n_steps: int, n_particles: int, delta_alpha_deg: float, overrides: dict):
     from ..correlation import localise
 
     run = simulate_run(n_steps, rng=rng)
-    r = run_filter(run, n_particles=n_particles, rng=rng)
+    r = run_filter(run, rng=rng, **{**overrides, "n_particles": n_particles})
     t0 = time.perf_counter()
     loc = localise(run.grid, run.scans[-1], delta_alpha_rad=float(np.radians(delta_alpha_deg)))
     t_corr = time.perf_counter() - t0
@@ -404,15 +451,43 @@ class SideBySideResult:
 
 
 def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_particles: int = 2000,
-                                 delta_alpha_deg: float = 5.0, seed: int = 3, n_jobs: int = 1,
-                                 progress: bool | None = None) -> SideBySideResult:
-    """Global MCL over each run and Ch. 5's correlation localisation of the run's last scan (on sweep)."""
-    from ..sweep import sweep
+                                 delta_alpha_deg: float = 5.0, params: MCLParams | None = None, rng=3,
+                                 n_jobs: int = 1, progress=None, seed=None, **overrides) -> SideBySideResult:
+    """Global MCL over each run and Ch. 5's correlation localisation of the run's last scan (on sweep).
 
-    df = sweep(_side_task, None, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=seed, n_jobs=n_jobs,
-               progress=progress, fixed={"n_steps": n_steps, "n_particles": n_particles,
-                                         "delta_alpha_deg": delta_alpha_deg})
-    _raise_failed(df)
+    Parameters
+    ----------
+    n_runs, n_steps : int
+        Runs, and steps per run.
+    n_particles : int
+        MCL particles (replaces ``params.n_particles``).
+    delta_alpha_deg : float
+        The correlation search's heading step.
+    params : MCLParams, optional
+        Settings of MCL (default: the defaults).
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from.
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields.
+
+    Returns
+    -------
+    SideBySideResult
+    """
+    from ..sweep import renamed_seed, root_seed_sequence, sweep
+
+    rng = renamed_seed(rng, seed, "run_correlation_side_by_side")
+    ov = MCLParams.as_overrides(params, **overrides)
+    df = sweep(_side_task, None, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=root_seed_sequence(rng, "rng"),
+               n_jobs=n_jobs, progress=progress, on_error="raise", desc="MCL vs correlation",
+               fixed={"n_steps": n_steps, "n_particles": n_particles, "delta_alpha_deg": delta_alpha_deg,
+                      "overrides": ov})
     return SideBySideResult(df, n_runs, n_steps, n_particles, float(delta_alpha_deg))
 
 

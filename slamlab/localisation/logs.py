@@ -286,29 +286,63 @@ def _fmt3(x) -> str:
 
 
 def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs: int = 10, n_scans: int = 30,
-                     seed: int = 0, odo_trans_frac: float = 0.1, odo_rot_std_deg: float = 1.0,
-                     n_jobs: int = 1, progress: bool | None = None, **overrides) -> LogProtocolResult:
-    """Global localisation from no prior on ``n_runs`` stretches of ``n_scans`` scans of every log (names of
-    :data:`CARMEN_LOGS` or paths of any CARMEN log), spread evenly over the log, for every particle count (the
-    same stretches and odometry noise for every count); on :func:`slamlab.sweep.sweep`. Settings as the global
-    run of :func:`run_log_mcl` (``overrides``: :class:`MCLParams` fields)."""
-    from ..sweep import sweep
+                     odo_trans_frac: float = 0.1, odo_rot_std_deg: float = 1.0, params: MCLParams | None = None,
+                     rng=0, n_jobs: int = 1, progress=None, seed=None, **overrides) -> LogProtocolResult:
+    """Global localisation from no prior on ``n_runs`` stretches of ``n_scans`` scans of every log, spread evenly
+    over the log, for every particle count (the same stretches and odometry noise for every count); on
+    :func:`slamlab.sweep.sweep`. Settings as the global run of :func:`run_log_mcl`.
 
+    Parameters
+    ----------
+    logs : str, os.PathLike or a sequence of them
+        Names of :data:`CARMEN_LOGS` or paths of any CARMEN log.
+    particle_counts : sequence of int
+        Particle counts (each replaces ``params.n_particles``).
+    n_runs, n_scans : int
+        Stretches per log, scans per stretch.
+    odo_trans_frac, odo_rot_std_deg : float
+        The odometry noise we add: share of each step's length, degrees per step.
+    params : MCLParams, optional
+        Settings on top of :func:`log_settings` and :func:`global_log_settings` (only the fields that differ
+        from the :class:`MCLParams` defaults count).
+    rng : int, SeedSequence or Generator
+        Where the filters' streams are spawned from; an int seed also keys each stretch's odometry noise
+        (a SeedSequence or Generator keys it by its first generated word).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields.
+
+    Returns
+    -------
+    LogProtocolResult
+    """
+    import numbers
+
+    from ..sweep import renamed_seed, root_seed_sequence, sweep
+
+    rng = renamed_seed(rng, seed, "run_log_protocol")
+    root = root_seed_sequence(rng, "rng")
+    odo_seed = int(rng) if isinstance(rng, numbers.Integral) else int(root.generate_state(1, np.uint64)[0])
+    overrides = MCLParams.as_overrides(params, **overrides)
+    overrides.pop("n_particles", None)  # each count of `particle_counts` replaces it
     if isinstance(logs, (str, bytes)) or not hasattr(logs, "__iter__"):
         logs = [logs]
     paths = [_resolve(p) for p in logs]
     counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_scans = v.check_int(n_scans, "n_scans", minimum=2)
-    MCLParams.resolve(None, **overrides)
     pts = [{"log": p, "log_index": i, "run": r, "n_particles": c} for i, p in enumerate(paths) for c in counts
            for r in range(n_runs)]
-    df = sweep(_protocol_task, pts, seeds=1, seed=seed, n_jobs=n_jobs, progress=progress,
+    df = sweep(_protocol_task, pts, seeds=1, seed=root, n_jobs=n_jobs, progress=progress, on_error="raise",
+               desc="MCL log protocol",
                fixed={"n_runs": n_runs, "n_scans": n_scans, "cell_m": 0.1, "max_range_m": 10.0,
-                      "odo_trans_frac": odo_trans_frac, "odo_rot_std_deg": odo_rot_std_deg, "seed": seed,
+                      "odo_trans_frac": odo_trans_frac, "odo_rot_std_deg": odo_rot_std_deg, "seed": odo_seed,
                       "overrides": dict(overrides)})
-    if df["error"].notna().any():
-        raise RuntimeError(f"a run failed: {df['error'].dropna().iloc[0]}")
     return LogProtocolResult(df, n_runs, n_scans, dict(overrides))
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
-from .experiments import FAIL_DEG, FAIL_POS_CELLS, _raise_failed, simulate_run
+from .experiments import FAIL_DEG, FAIL_POS_CELLS, simulate_run
 from .markov import MarkovGrid
 
 __all__ = ["MARKOV_PRIORS", "MarkovStudyResult", "run_markov_kidnap", "run_markov_prior"]
@@ -92,28 +92,64 @@ class MarkovStudyResult:
         return f"{self.title}, {self.n_runs} runs per variant"
 
 
-def _run(points, fixed, *, n_runs, seed, n_jobs, progress):
+def _run(points, fixed, *, n_runs, rng, n_jobs, progress):
+    """One sweep per point from a fresh copy of the same seed: run i of every point is the same simulated run."""
     import pandas as pd
 
-    from ..sweep import sweep
+    from ..sweep import fresh_seed_sequence, sweep
 
-    frames = []
-    for pt in points:
-        df = sweep(_markov_task, [pt], seeds=n_runs, seed=seed, n_jobs=n_jobs, progress=progress, fixed=fixed)
-        _raise_failed(df)
-        frames.append(df)
+    frames = [sweep(_markov_task, [pt], seeds=n_runs, seed=fresh_seed_sequence(rng), n_jobs=n_jobs,
+                    progress=progress, fixed=fixed, on_error="raise", desc="Markov grid study") for pt in points]
     return pd.concat(frames, ignore_index=True)
 
 
-def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10, resolution: int = 4,
-                     n_headings: int = 36, seed: int = 5, n_jobs: int = 1, progress: bool | None = None,
-                     **overrides) -> MarkovStudyResult:
-    """The Markov grid from a uniform prior and from Gaussian priors (``priors``: (label, "uniform"|"gaussian",
-    offset of the prior's centre from the true start [cells])); the same runs for every prior. ``overrides``:
-    fields of :class:`~slamlab.localisation.markov.MarkovParams` (e.g. fewer beams, ``max_beams=4``)."""
+def _study_overrides(params, overrides: dict) -> dict:
+    """``params`` + ``overrides`` as MarkovParams overrides, without the study's own knobs (its arguments)."""
     from .markov import MarkovParams
 
-    MarkovParams.resolve(None, **overrides)
+    ov = MarkovParams.as_overrides(params, **overrides)
+    for own in ("resolution", "n_headings", "uniform_floor"):
+        if own in ov:
+            raise TypeError(f"`{own}` is an argument of this study (or its variants), not an override; "
+                            f"pass it directly")
+    return ov
+
+
+def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10, resolution: int = 4,
+                     n_headings: int = 36, params=None, rng=5, n_jobs: int = 1, progress=None, seed=None,
+                     **overrides) -> MarkovStudyResult:
+    """The Markov grid from a uniform prior and from Gaussian priors; the same runs for every prior.
+
+    Parameters
+    ----------
+    priors : sequence of (str, {"uniform", "gaussian"}, float)
+        (label, kind, offset of the prior's centre from the true start [cells]).
+    n_runs, n_steps : int
+        Runs per prior, steps per run.
+    resolution, n_headings : int
+        The grid's map cells per belief cell and heading bins.
+    params : MarkovParams, optional
+        Settings of the grid (default: the defaults); ``resolution``, ``n_headings`` and the floor are this
+        study's own arguments.
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every prior).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`~slamlab.localisation.markov.MarkovParams` fields (e.g. fewer beams, ``max_beams=4``).
+
+    Returns
+    -------
+    MarkovStudyResult
+    """
+    from ..sweep import renamed_seed
+
+    rng = renamed_seed(rng, seed, "run_markov_prior")
+    overrides = _study_overrides(params, overrides)
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=2)
     pts = []
@@ -122,7 +158,7 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
             raise ValueError(f"`priors` must hold (label, 'uniform' or 'gaussian', offset) triples; got {item!r}")
         pts.append({"variant": item[0], "kind": item[1], "offset": float(item[2])})
     df = _run(pts, {"floor": 0.0, "n_steps": n_steps, "resolution": resolution, "n_headings": n_headings,
-                    "kidnap_step": None, "overrides": dict(overrides)}, n_runs=n_runs, seed=seed, n_jobs=n_jobs,
+                    "kidnap_step": None, "overrides": dict(overrides)}, n_runs=n_runs, rng=rng, n_jobs=n_jobs,
               progress=progress)
     extra = ", ".join(f"{k} {val}" for k, val in overrides.items())
     return MarkovStudyResult(df, tuple(p["variant"] for p in pts), n_runs, n_steps, resolution, n_headings, None,
@@ -130,14 +166,46 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
 
 
 def run_markov_kidnap(floors=(0.0, 1e-6, 1e-3), *, n_runs: int = 5, n_steps: int = 24, kidnap_step: int = 8,
-                      resolution: int = 4, n_headings: int = 36, seed: int = 6, n_jobs: int = 1,
-                      progress: bool | None = None) -> MarkovStudyResult:
+                      resolution: int = 4, n_headings: int = 36, params=None, rng=6, n_jobs: int = 1,
+                      progress=None, seed=None, **overrides) -> MarkovStudyResult:
     """The kidnapped robot on the Markov grid: tracking from a prior at the true start, carried elsewhere at
-    ``kidnap_step``; per uniform floor ε (0: PR Table 8.1 as it is)."""
+    ``kidnap_step``; per uniform floor ε (0: PR Table 8.1 as it is).
+
+    Parameters
+    ----------
+    floors : sequence of float
+        The uniform floors ε, one variant each.
+    n_runs, n_steps, kidnap_step : int
+        Runs per floor, steps per run, the step of the kidnap.
+    resolution, n_headings : int
+        The grid's map cells per belief cell and heading bins.
+    params : MarkovParams, optional
+        Settings of the grid (default: the defaults); ``resolution``, ``n_headings`` and the floor are this
+        study's own arguments.
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every floor).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`~slamlab.localisation.markov.MarkovParams` fields.
+
+    Returns
+    -------
+    MarkovStudyResult
+    """
+    from ..sweep import renamed_seed
+
+    rng = renamed_seed(rng, seed, "run_markov_kidnap")
+    overrides = _study_overrides(params, overrides)
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     pts = [{"variant": f"uniform floor ε = {v.check_positive(f, 'floors[]', allow_zero=True):g}", "kind": "gaussian",
             "offset": 0.0, "floor": float(f)} for f in floors]
     df = _run(pts, {"n_steps": n_steps, "resolution": resolution, "n_headings": n_headings,
-                    "kidnap_step": kidnap_step}, n_runs=n_runs, seed=seed, n_jobs=n_jobs, progress=progress)
+                    "kidnap_step": kidnap_step, "overrides": dict(overrides)}, n_runs=n_runs, rng=rng, n_jobs=n_jobs,
+              progress=progress)
     return MarkovStudyResult(df, tuple(p["variant"] for p in pts), n_runs, n_steps, resolution, n_headings,
                              kidnap_step, f"Markov grid, kidnapped at step {kidnap_step}")

@@ -18,7 +18,7 @@ import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
-from .experiments import FAIL_DEG, FAIL_POS_CELLS, _raise_failed, run_filter, simulate_run
+from .experiments import FAIL_DEG, FAIL_POS_CELLS, run_filter, simulate_run
 from .mcl import MCLParams
 
 __all__ = [
@@ -200,31 +200,56 @@ class GlobalResult:
         return "Global localisation: success " + ", ".join(f"{r.success:.2f} at {int(n)}" for n, r in s.iterrows())
 
 
-def _paired_sweep(points, *, n_runs, seed, n_jobs, progress, fixed):
-    """One sweep per point from the same seed: run i of every point is the same simulated run."""
+def _paired_sweep(points, *, n_runs, rng, n_jobs, progress, fixed):
+    """One sweep per point from a fresh copy of the same seed: run i of every point is the same simulated run."""
     import pandas as pd
 
-    from ..sweep import sweep
+    from ..sweep import fresh_seed_sequence, sweep
 
-    frames = []
-    for pt in points:
-        df = sweep(_global_task, [pt], seeds=n_runs, seed=seed, n_jobs=n_jobs, progress=progress, fixed=fixed)
-        _raise_failed(df)
-        frames.append(df)
+    frames = [sweep(_global_task, [pt], seeds=n_runs, seed=fresh_seed_sequence(rng), n_jobs=n_jobs,
+                    progress=progress, fixed=fixed, on_error="raise", desc="global localisation")
+              for pt in points]
     return pd.concat(frames, ignore_index=True)
 
 
 def run_global_localisation(particle_counts=(500, 1000, 2500), *, n_runs: int = 50, n_steps: int = 30,
-                            seed: int = 0, n_jobs: int = 1, progress: bool | None = None,
-                            **overrides) -> GlobalResult:
+                            params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None,
+                            seed=None, **overrides) -> GlobalResult:
     """Global localisation in the test room from no prior: ``n_runs`` seeded runs per particle count (the same
-    runs for every count), each from a random place on 004's path, with the defaults of :class:`MCLParams`
-    (``overrides``: its fields)."""
+    runs for every count), each from a random place on 004's path.
+
+    Parameters
+    ----------
+    particle_counts : sequence of int
+        Particle counts (each replaces ``params.n_particles``).
+    n_runs, n_steps : int
+        Runs per count, and steps per run.
+    params : MCLParams, optional
+        Settings of MCL (default: the defaults); ``overrides`` and each variant's overrides apply on top.
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every variant).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields.
+
+    Returns
+    -------
+    GlobalResult
+    """
+    from ..sweep import renamed_seed
+
+    rng = renamed_seed(rng, seed, "run_global_localisation")
     counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=2)
-    MCLParams.resolve(None, **overrides)  # a bad override fails here, naming the fields
-    df = _paired_sweep([{"n_particles": c} for c in counts], n_runs=n_runs, seed=seed, n_jobs=n_jobs,
+    overrides = MCLParams.as_overrides(params, **overrides)  # a bad override fails here, naming the fields
+    overrides.pop("n_particles", None)  # each count of `particle_counts` replaces it
+    df = _paired_sweep([{"n_particles": c} for c in counts], n_runs=n_runs, rng=rng, n_jobs=n_jobs,
                        progress=progress, fixed={"n_steps": n_steps, "overrides": dict(overrides)})
     return GlobalResult(df, n_runs, n_steps, dict(overrides))
 
@@ -242,6 +267,7 @@ class AblationResult:
     n_steps: int = 0
     n_particles: int = 0
     world: str = "map"
+    base: dict = field(default_factory=dict)  # MCLParams overrides under every variant's (params=, **overrides)
 
     @property
     def mid_step(self) -> int:
@@ -268,7 +294,7 @@ class AblationResult:
                             title=f"Global localisation{' among unmapped clutter' if self.world != 'map' else ''}: "
                                   f"{self.n_particles} particles, the same "
                                   f"{self.n_runs} runs for every variant, {self.n_steps} steps; columns after "
-                                  f"the second at step {self.n_steps}\ndefaults: {_params_line()}")
+                                  f"the second at step {self.n_steps}\ndefaults: {_params_line(self.base)}")
 
     def __str__(self) -> str:
         return f"Ablation of global localisation, {len(self.labels)} variants × {self.n_runs} runs"
@@ -278,13 +304,45 @@ _SIZES = {"small": {"n_runs": 8, "n_particles": 2500}, "full": {"n_runs": 50, "n
 
 
 def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int | None = None,
-                        n_particles: int | None = None, n_steps: int = 30, world: str = "map", seed: int = 0,
-                        n_jobs: int = 1, progress: bool | None = None) -> AblationResult:
+                        n_particles: int | None = None, n_steps: int = 30, world: str = "map",
+                        params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None, seed=None,
+                        **overrides) -> AblationResult:
     """Global localisation with one factor changed at a time (``variants``: (label, MCLParams overrides)).
 
-    ``size``: "small" (8 runs of 2500 particles per variant, the notebook) or "full" (50 runs). ``world``: see
-    :func:`~slamlab.localisation.experiments.simulate_run` ("cluttered": scans with unmapped objects).
+    Parameters
+    ----------
+    variants : sequence of (str, dict)
+        (label, :class:`MCLParams` overrides) pairs, applied on top of ``params`` and ``overrides``.
+    size : {"small", "full"}
+        "small" (8 runs of 2500 particles per variant, the notebook) or "full" (50 runs).
+    n_runs, n_particles : int, optional
+        Replace the size's runs per variant and particle count.
+    n_steps : int
+        Steps per run.
+    world : {"map", "cluttered"}
+        See :func:`~slamlab.localisation.experiments.simulate_run` ("cluttered": scans with unmapped objects).
+    params : MCLParams, optional
+        The settings every variant changes (default: the defaults).
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every variant).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields under every variant.
+
+    Returns
+    -------
+    AblationResult
     """
+    from ..sweep import renamed_seed
+
+    rng = renamed_seed(rng, seed, "run_global_ablation")
+    base = MCLParams.as_overrides(params, **overrides)
+    base.pop("n_particles", None)  # the particle count is `n_particles` (or the size's)
     v.check_choice(size, "size", tuple(_SIZES))
     n_runs = v.check_int(_SIZES[size]["n_runs"] if n_runs is None else n_runs, "n_runs", minimum=1)
     n_part = v.check_int(_SIZES[size]["n_particles"] if n_particles is None else n_particles, "n_particles",
@@ -293,15 +351,15 @@ def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int |
     for item in variants:
         if not (isinstance(item, tuple) and len(item) == 2 and isinstance(item[0], str) and isinstance(item[1], dict)):
             raise TypeError(f"`variants` must hold (label, overrides dict) pairs; got {item!r}")
-        MCLParams.resolve(None, **item[1])
+        MCLParams.resolve(None, **{**base, **item[1]})
         labels.append(item[0])
     if len(set(labels)) != len(labels):
         raise ValueError("`variants` labels must be distinct")
-    df = _paired_sweep([{"variant": lab, "overrides": dict(ov)} for lab, ov in variants], n_runs=n_runs, seed=seed,
-                       n_jobs=n_jobs, progress=progress,
+    df = _paired_sweep([{"variant": lab, "overrides": {**base, **ov}} for lab, ov in variants], n_runs=n_runs,
+                       rng=rng, n_jobs=n_jobs, progress=progress,
                        fixed={"n_steps": n_steps, "n_particles": n_part, "world": v.check_choice(world, "world",
                                                                                                 ("map", "cluttered"))})
-    return AblationResult(df, tuple(labels), n_runs, n_steps, n_part, world)
+    return AblationResult(df, tuple(labels), n_runs, n_steps, n_part, world, base)
 
 
 # --- the kidnapped robot --------------------------------------------------------------------------------------
@@ -339,6 +397,7 @@ class KidnapResult:
     n_steps: int = 0
     n_particles: int = 0
     world: str = "map"
+    base: dict = field(default_factory=dict)  # MCLParams overrides under every variant's (params=, **overrides)
 
     def recovered(self, label: str | None = None) -> float:
         """Share of runs that recover (within the bounds from some step after the kidnap to the end)."""
@@ -362,20 +421,50 @@ class KidnapResult:
                                   f"{self.n_particles} particles, the same {self.n_runs} runs per "
                                   f"variant, kidnapped at step {self.kidnap_step} of {self.n_steps}; recovered: "
                                   f"within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}° from some step to the end\n"
-                                  f"defaults: {_params_line()}")
+                                  f"defaults: {_params_line(self.base)}")
 
     def __str__(self) -> str:
         return f"Kidnapped robot, {self.n_runs} runs per variant"
 
 
 def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000, n_steps: int = 40,
-                  kidnap_step: int = 20, world: str = "map", seed: int = 1, n_jobs: int = 1,
-                  progress: bool | None = None) -> KidnapResult:
-    """Track from the known start, kidnap at ``kidnap_step``; recovery per variant ((label, overrides) pairs, the
-    same runs for every variant; on sweep)."""
+                  kidnap_step: int = 20, world: str = "map", params: MCLParams | None = None, rng=1,
+                  n_jobs: int = 1, progress=None, seed=None, **overrides) -> KidnapResult:
+    """Track from the known start, kidnap at ``kidnap_step``; recovery per variant (the same runs for every
+    variant; on sweep).
+
+    Parameters
+    ----------
+    variants : sequence of (str, dict)
+        (label, :class:`MCLParams` overrides) pairs, applied on top of ``params`` and ``overrides``.
+    n_runs, n_particles, n_steps, kidnap_step : int
+        Runs per variant, particles, steps per run, the step of the kidnap.
+    world : {"map", "cluttered"}
+        See :func:`~slamlab.localisation.experiments.simulate_run`.
+    params : MCLParams, optional
+        The settings every variant changes (default: the defaults).
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every variant).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields under every variant.
+
+    Returns
+    -------
+    KidnapResult
+    """
     import pandas as pd
 
-    from ..sweep import sweep
+    from ..sweep import fresh_seed_sequence, renamed_seed, sweep
+
+    rng = renamed_seed(rng, seed, "run_kidnapped")
+    base = MCLParams.as_overrides(params, **overrides)
+    base.pop("n_particles", None)  # the particle count is `n_particles`
 
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=3)
@@ -385,16 +474,16 @@ def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: in
     for item in variants:
         if not (isinstance(item, tuple) and len(item) == 2 and isinstance(item[1], dict)):
             raise TypeError(f"`variants` must hold (label, overrides dict) pairs; got {item!r}")
-        MCLParams.resolve(None, **item[1])
+        MCLParams.resolve(None, **{**base, **item[1]})
         labels.append(item[0])
-        df = sweep(_kidnap_task, [{"variant": item[0], "overrides": dict(item[1])}], seeds=n_runs, seed=seed,
-                   n_jobs=n_jobs, progress=progress,
+        df = sweep(_kidnap_task, [{"variant": item[0], "overrides": {**base, **item[1]}}], seeds=n_runs,
+                   seed=fresh_seed_sequence(rng), n_jobs=n_jobs, progress=progress, on_error="raise",
+                   desc="kidnapped robot",
                    fixed={"n_particles": n_particles, "n_steps": n_steps, "kidnap_step": kidnap_step,
                           "world": v.check_choice(world, "world", ("map", "cluttered"))})
-        _raise_failed(df)
         frames.append(df)
     return KidnapResult(pd.concat(frames, ignore_index=True), tuple(labels), n_runs, kidnap_step, n_steps,
-                        int(n_particles), world)
+                        int(n_particles), world, base)
 
 
 # --- the observation score on both -------------------------------------------------------------------------------
@@ -424,14 +513,48 @@ class ScoreComparison:
 
 
 def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000,
-                         global_particles: int = 2500, seed: int = 0, n_jobs: int = 1,
-                         progress: bool | None = None) -> ScoreComparison:
+                         global_particles: int = 2500, params: MCLParams | None = None, rng=0, n_jobs: int = 1,
+                         progress=None, seed=None, **overrides) -> ScoreComparison:
     """Each score variant on the global study (``global_particles``) and the kidnap study (``n_particles``),
-    ``n_runs`` runs each."""
-    g = run_global_ablation(variants, n_runs=n_runs, n_particles=global_particles, seed=seed, n_jobs=n_jobs,
-                            progress=progress)
-    k = run_kidnapped(variants, n_runs=n_runs, n_particles=n_particles, seed=seed + 1, n_jobs=n_jobs,
-                      progress=progress)
+    ``n_runs`` runs each.
+
+    Parameters
+    ----------
+    variants : sequence of (str, dict)
+        (label, :class:`MCLParams` overrides) pairs.
+    n_runs, n_particles, global_particles : int
+        Runs per variant; particles of the kidnap and of the global study.
+    params : MCLParams, optional
+        The settings every variant changes (default: the defaults).
+    rng : int, SeedSequence or Generator
+        An int seed ``s`` runs the global study from ``s`` and the kidnap study from ``s + 1``; otherwise the
+        two studies draw from two children spawned from ``rng``.
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields under every variant.
+
+    Returns
+    -------
+    ScoreComparison
+    """
+    import numbers
+
+    from ..sweep import renamed_seed, root_seed_sequence
+
+    rng = renamed_seed(rng, seed, "run_score_comparison")
+    if isinstance(rng, numbers.Integral) and not isinstance(rng, bool):
+        rng_g, rng_k = rng, rng + 1
+    else:
+        rng_g, rng_k = root_seed_sequence(rng, "rng").spawn(2)
+    g = run_global_ablation(variants, n_runs=n_runs, n_particles=global_particles, params=params, rng=rng_g,
+                            n_jobs=n_jobs, progress=progress, **overrides)
+    k = run_kidnapped(variants, n_runs=n_runs, n_particles=n_particles, params=params, rng=rng_k, n_jobs=n_jobs,
+                      progress=progress, **overrides)
     return ScoreComparison(g, k)
 
 

@@ -29,7 +29,7 @@ def explore_mcl(**defaults):
         try:
             alpha = tuple(float(a * odo_noise) for a in p0.alpha)
             run, res = demo_run(int(n_particles), kidnap_step=int(kidnap_step) or None, alpha_slow=alpha_slow,
-                                alpha_fast=alpha_fast, seed=d["seed"], z_hit=z_hit, z_rand=1.0 - z_hit,
+                                alpha_fast=alpha_fast, rng=d["seed"], z_hit=z_hit, z_rand=1.0 - z_hit,
                                 sigma_hit=sigma_hit, max_dist=3 * sigma_hit, alpha=alpha)
         except (ValueError, TypeError) as exc:
             print(f"Cannot run with these settings: {exc}")

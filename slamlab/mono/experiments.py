@@ -428,7 +428,9 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
     2 px of displacement. Returns ``{case: MonoRunResult}``.
     """
     out = {}
-    seeds = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(len(cases))
+    from ..sweep import fresh_seed_sequence
+
+    seeds = fresh_seed_sequence(rng).spawn(len(cases))  # an int seed: SeedSequence(seed)'s children as before
     for case, ss in zip(progress_bar(cases, desc="failure cases", progress=progress), seeds, strict=True):
         imgs, Ts, K, ov = _case_frames(case, size, n_frames, np.random.default_rng(ss))
         out[case] = run_mono(imgs, Ts, K, name=case, params=params, progress=False, **{**overrides, **ov})
@@ -450,27 +452,54 @@ def failure_table(results: dict) -> str:
 
 
 # -- the parameters 003 tuned (003 §5.1.1) on slamlab.sweep ---------------------------------------
-def _sweep_run(init_disparity_px, max_keyframes, kf_max_lost_ratio, max_matches, rng, size="tiny", n_frames=30):
+def _sweep_run(init_disparity_px, max_keyframes, kf_max_lost_ratio, max_matches, rng, size="tiny", n_frames=30,
+               params=None):
     imgs, Ts, K, _ = _case_frames("normal", size, n_frames, rng)
-    r = run_mono(imgs, Ts, K, name="sweep", progress=False, init_disparity_px=init_disparity_px,
+    r = run_mono(imgs, Ts, K, name="sweep", params=params, progress=False, init_disparity_px=init_disparity_px,
                  max_keyframes=max_keyframes, kf_max_lost_ratio=kf_max_lost_ratio, max_matches=max_matches,
                  kf_min_frames=10)
     return {"tracked_pct": round(100 * r.fraction_tracked), "ate_mm": round(1000 * r.ate_m),
             "keyframes": r.n_keyframes, "tracking_ms": round(1000 * sum(r.stage_time_s[k] for k in ("align", "match", "refine")), 1)}
 
 
-def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_frames: int = 30, seed: int = 0,
-                        progress=None):
+def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_frames: int = 30,
+                        params: MonoParams | None = None, rng=0, progress=None, seed=None, **overrides):
     """003 §5.1.1's four tuning parameters on the rendered strafe, via :func:`slamlab.sweep.sweep`.
 
-    Default grid: one parameter at a time around the defaults. Returns the sweep's DataFrame
-    (``tracking_ms`` is a timing: print it only where timings are allowed).
-    """
-    from ..sweep import sweep
+    Parameters
+    ----------
+    grid : mapping or sequence of points, optional
+        Points of ``init_disparity_px``, ``max_keyframes``, ``kf_max_lost_ratio``, ``max_matches``
+        (default: one parameter at a time around the defaults).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    size : str
+        Render size of the strafe.
+    n_frames : int
+        Frames per run.
+    params : MonoParams, optional
+        The settings the grid changes (default: the defaults; ``kf_min_frames`` is 10 in these runs).
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MonoParams` fields under the grid's.
 
+    Returns
+    -------
+    pandas.DataFrame
+        The sweep's table (``tracking_ms`` is a timing: print it only where timings are allowed).
+    """
+    from ..sweep import renamed_seed, root_seed_sequence, sweep
+
+    rng = renamed_seed(rng, seed, "run_parameter_sweep")
+    p = MonoParams.resolve(params, **overrides) if (params is not None or overrides) else None
     base = {"init_disparity_px": 15.0, "max_keyframes": 10, "kf_max_lost_ratio": 0.3, "max_matches": 120}
     if grid is None:
         grid = [base, {**base, "init_disparity_px": 5.0}, {**base, "init_disparity_px": 30.0},
                 {**base, "max_keyframes": 3}, {**base, "kf_max_lost_ratio": 0.1}, {**base, "max_matches": 30}]
-    return sweep(_sweep_run, grid, seed=seed, n_jobs=n_jobs, progress=progress,
-                 fixed={"size": size, "n_frames": n_frames})
+    return sweep(_sweep_run, grid, seed=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress,
+                 fixed={"size": size, "n_frames": n_frames, "params": p})

@@ -48,13 +48,37 @@ KITTI_ABLATIONS = {
 }
 
 
-def run_kitti_ablation(folder=None, configs=None, *, n_frames: int | None = None, progress=None) -> dict:
-    """The KITTI run with each of our changes undone: ``{(label, folder name): MonoRunResult}`` on the same frames."""
+def run_kitti_ablation(folder=None, configs=None, *, n_frames: int | None = None, params: MonoParams | None = None,
+                       progress=None, **overrides) -> dict:
+    """The KITTI run with each of our changes undone, on the same frames.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike, optional
+        A KITTI odometry sequence folder (default: the bundled excerpt).
+    configs : mapping, optional
+        Label → :class:`MonoParams` overrides (default :data:`KITTI_ABLATIONS`).
+    n_frames : int, optional
+        Keep the first frames only.
+    params : MonoParams, optional
+        The settings every configuration changes (default: the defaults).
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    **overrides
+        :class:`MonoParams` fields under every configuration's.
+
+    Returns
+    -------
+    dict
+        ``{(label, folder name): MonoRunResult}``.
+    """
     from .._progress import progress_bar
 
     imgs, gt, K, name = load_kitti(folder, n_frames)
     configs = KITTI_ABLATIONS if configs is None else dict(configs)
-    return {(label, name): run_mono(imgs, gt, K, name=f"{name}, {label}", progress=False, **ov)
+    MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
+    return {(label, name): run_mono(imgs, gt, K, name=f"{name}, {label}", params=params, progress=False,
+                                    **{**overrides, **ov})
             for label, ov in progress_bar(list(configs.items()), desc="KITTI ablation", progress=progress)}
 
 

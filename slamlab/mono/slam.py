@@ -182,10 +182,25 @@ class MonoSLAM:
         self.records.append(rec)
         return rec
 
-    def run(self, frames, progress=None) -> MonoSLAM:
-        """Process every frame of an iterable (``progress``: an optional wrapper such as a tqdm bar)."""
-        it = frames if progress is None else progress(frames)
-        for img in it:
+    def run(self, frames, progress=False) -> MonoSLAM:
+        """Process every frame of an iterable.
+
+        Parameters
+        ----------
+        frames : iterable of ndarray
+            Grey images.
+        progress : bool, callable or None
+            The one contract of :mod:`slamlab._progress`: a bar (True; None: unless ``$SLAMLAB_PROGRESS=0``),
+            none (False, the default), or a callable ``progress(i)`` called after frame ``i``.
+
+        Returns
+        -------
+        MonoSLAM
+            ``self``.
+        """
+        from .._progress import progress_bar
+
+        for img in progress_bar(frames, desc="mono SLAM", progress=progress):
             self.process(img)
         return self
 

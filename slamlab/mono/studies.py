@@ -263,23 +263,49 @@ ABLATIONS = {
 }
 
 
-def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_frames: int = 24, rng=0,
-                 progress=None) -> dict:
+def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_frames: int = 24,
+                 params: MonoParams | None = None, rng=0, progress=None, **overrides) -> dict:
     """Our pipeline with 003 §5.4's switches (ours: outlier rejection, motion-only refinement) on rendered cases.
 
-    Returns ``{(config, case): MonoRunResult}``; ``configs`` maps a label to overrides (default
-    :data:`ABLATIONS`). Every configuration sees the same frames.
+    Every configuration sees the same frames.
+
+    Parameters
+    ----------
+    configs : mapping, optional
+        Label → :class:`MonoParams` overrides (default :data:`ABLATIONS`).
+    cases : sequence of str
+        Rendered cases (see :func:`~slamlab.mono.experiments.run_failure_cases`).
+    size : str
+        Render size.
+    n_frames : int
+        Frames per case.
+    params : MonoParams, optional
+        The settings every configuration changes (default: the defaults).
+    rng : int, SeedSequence or Generator
+        One stream per case is spawned from it (the renders).
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    **overrides
+        :class:`MonoParams` fields under every configuration's.
+
+    Returns
+    -------
+    dict
+        ``{(config, case): MonoRunResult}``.
     """
     from .._progress import progress_bar
+    from ..sweep import fresh_seed_sequence
     from .experiments import _case_frames, run_mono
 
     configs = ABLATIONS if configs is None else dict(configs)
-    seeds = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(len(cases))
+    MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
+    seeds = fresh_seed_sequence(rng).spawn(len(cases))  # an int seed: SeedSequence(seed)'s children as before
     out = {}
     for case, ss in zip(cases, seeds, strict=True):
         imgs, Ts, K, ov = _case_frames(case, size, n_frames, np.random.default_rng(ss))
         for label, o in progress_bar(list(configs.items()), desc=case, progress=progress):
-            out[(label, case)] = run_mono(imgs, Ts, K, name=f"{case}, {label}", progress=False, **{**ov, **o})
+            out[(label, case)] = run_mono(imgs, Ts, K, name=f"{case}, {label}", params=params, progress=False,
+                                          **{**overrides, **ov, **o})
     return out
 
 
@@ -421,19 +447,39 @@ def ours_vs_source(failures: dict, sequence: MonoRunResult, kitti: MonoRunResult
 
 
 # -- mono vs stereo on the same frames ----------------------------------------------------------
-def run_mono_vs_stereo(sequence: str = "strafe", *, n_frames: int = 40, size: str = "small", rng=0,
-                       snapshot_frames=()):
+def run_mono_vs_stereo(sequence: str = "strafe", *, n_frames: int = 40, size: str = "small",
+                       params: MonoParams | None = None, rng=0, snapshot_frames=(), **overrides):
     """The monocular pipeline on the left images and Ch. 4's stereo pipeline on the pairs, same poses.
 
-    Returns ``(mono MonoRunResult, stereo ATE SE(3) m, stereo ATE Sim(3) m, stereo RPE m)``.
+    Parameters
+    ----------
+    sequence : str
+        The rendered sequence (see :func:`~slamlab.mono.experiments.sequence_poses`).
+    n_frames : int
+        Frames.
+    size : str
+        Render size.
+    params : MonoParams, optional
+        Settings of the monocular pipeline (the stereo pipeline keeps its defaults).
+    rng : int, SeedSequence or Generator
+        The renderer's seed.
+    snapshot_frames : sequence of int
+        Frames after which the mono seeds' spreads are kept.
+    **overrides
+        :class:`MonoParams` fields.
+
+    Returns
+    -------
+    tuple
+        ``(mono MonoRunResult, stereo ATE SE(3) m, stereo ATE Sim(3) m, stereo RPE m)``.
     """
     from ..stereo.slam import StereoSLAM
 
     sim = mono_sim(size, rng=rng)
     poses = sequence_poses(sequence, n_frames)
     imgs, Ts = render_sequence(sim, poses, progress=False)
-    mono = run_mono(imgs, Ts, sim.rig.left.K, name=f"{sequence} (mono)", progress=False,
-                    snapshot_frames=snapshot_frames)
+    mono = run_mono(imgs, Ts, sim.rig.left.K, name=f"{sequence} (mono)", params=params, progress=False,
+                    snapshot_frames=snapshot_frames, **overrides)
     c, s_ = np.cos(PITCH_DOWN_RAD), np.sin(PITCH_DOWN_RAD)
     tilt = np.eye(4)
     tilt[1:3, 1:3] = [[c, s_], [-s_, c]]

@@ -12,8 +12,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._table import format_table
+from ..sweep import fresh_seed_sequence
 from .experiments import FlightResult, flight_or_simulate, in_frame_rotation_error_deg, run_flight
 from .figures import IntensityResult, run_intensity_figure
+from .filter import PlaneSLAMParams
 
 __all__ = [
     "PAIR_VARIANTS",
@@ -79,33 +81,75 @@ class FlightComparison:
 
 
 def run_pairs_ablation(flight=None, *, duration_s: float = 20.0, n_particles: int = 200,
-                       variants=PAIR_VARIANTS, rng=0) -> FlightComparison:
+                       variants=PAIR_VARIANTS, params: PlaneSLAMParams | None = None, rng=0,
+                       **overrides) -> FlightComparison:
     """002 says the filter works "even with only one pair of planes"; ours asks for two normal directions.
 
     Each variant limits the planes of a frame (``max_planes``: the largest ones RANSAC finds) and sets
     ``min_normal_rank`` (1: any pair corrects, as 002; 2: frames whose normals span one direction keep the
     prediction). Same flight and seed for every variant.
+
+    Parameters
+    ----------
+    flight : Flight, optional
+        A ready flight (default: simulated from ``rng``).
+    duration_s : float
+        The simulated flight's length.
+    n_particles : int
+        Particles (replaces ``params.n_particles``).
+    variants : sequence of (str, int, int)
+        (label, ``max_planes``, ``min_normal_rank``).
+    params : PlaneSLAMParams, optional
+        Filter settings under each run's own (default: the defaults).
+    rng : int, SeedSequence or Generator
+        The flight's and the filter's seed, the same for every run.
+    **overrides
+        :class:`PlaneSLAMParams` fields under each run's own.
+
+    Returns
+    -------
+    FlightComparison
     """
     fl = flight_or_simulate(flight, duration_s, rng)
     labels, res = [], []
     for lab, mp, rank in variants:
         labels.append(lab)
-        res.append(run_flight(flight=fl, rng=rng, n_particles=n_particles, max_planes=mp, min_normal_rank=rank,
-                              progress=False))
+        res.append(run_flight(flight=fl, rng=rng, params=params, progress=False,
+                              **{**overrides, "n_particles": n_particles, "max_planes": mp, "min_normal_rank": rank}))
     return FlightComparison("One plane pair vs two normal directions", tuple(labels), tuple(res))
 
 
 def run_frame_source_ablation(flight=None, *, duration_s: float = 8.0, n_particles: int = 400,
-                              rng=0) -> FlightComparison:
+                              params: PlaneSLAMParams | None = None, rng=0, **overrides) -> FlightComparison:
     """Where the flight's error comes from (ours): frames built and particles predicted with the odometry (002),
-    or with the true poses in one place or the other."""
+    or with the true poses in one place or the other.
+
+    Parameters
+    ----------
+    flight : Flight, optional
+        A ready flight (default: simulated from ``rng``).
+    duration_s : float
+        The simulated flight's length.
+    n_particles : int
+        Particles (replaces ``params.n_particles``).
+    params : PlaneSLAMParams, optional
+        Filter settings under each run's own (default: the defaults).
+    rng : int, SeedSequence or Generator
+        The flight's and the filter's seed, the same for every run.
+    **overrides
+        :class:`PlaneSLAMParams` fields under each run's own.
+
+    Returns
+    -------
+    FlightComparison
+    """
     fl = flight_or_simulate(flight, duration_s, rng)
     cases = (("002: frames and prediction from the odometry", "odometry", "odometry"),
              ("frames from the true poses, prediction from the odometry", "truth", "odometry"),
              ("frames from the odometry, prediction from the true poses", "odometry", "truth"),
              ("both from the true poses", "truth", "truth"))
-    res = tuple(run_flight(flight=fl, rng=rng, n_particles=n_particles, frame_poses=a, increment_poses=b,
-                           progress=False) for _, a, b in cases)
+    res = tuple(run_flight(flight=fl, rng=rng, params=params, frame_poses=a, increment_poses=b, progress=False,
+                           **{**overrides, "n_particles": n_particles}) for _, a, b in cases)
     e = in_frame_rotation_error_deg(fl)
     tilt = [map_normal_error_deg(r, fl.room) for r in res]
     note = ("odometry's rotation error inside a frame (each line against the frame's last line), RMS about x / y / "
@@ -139,11 +183,34 @@ class IncidenceResult:
 
 
 def run_incidence_ablation(flight=None, *, duration_s: float = 20.0, n_particles: int = 200,
-                           fig4_particles: int = 400, rng=0) -> IncidenceResult:
-    """Fig. 4 (one cycle) and a flight with the incidence-angle correction on and off (same seeds)."""
+                           fig4_particles: int = 400, params: PlaneSLAMParams | None = None, rng=0,
+                           **overrides) -> IncidenceResult:
+    """Fig. 4 (one cycle) and a flight with the incidence-angle correction on and off (same seeds).
+
+    Parameters
+    ----------
+    flight : Flight, optional
+        A ready flight (default: simulated from ``rng``).
+    duration_s : float
+        The simulated flight's length.
+    n_particles, fig4_particles : int
+        Particles of the flight and of Fig. 4 (each replaces ``params.n_particles``).
+    params : PlaneSLAMParams, optional
+        Filter settings under each run's own (default: the defaults).
+    rng : int, SeedSequence or Generator
+        The flight's and the filter's seed, the same for every run.
+    **overrides
+        :class:`PlaneSLAMParams` fields under each run's own.
+
+    Returns
+    -------
+    IncidenceResult
+    """
     fl = flight_or_simulate(flight, duration_s, rng)
-    f4: list[IntensityResult] = [run_intensity_figure(n_particles=fig4_particles, rng=rng, incidence_correction=c)
+    f4: list[IntensityResult] = [run_intensity_figure(n_particles=fig4_particles, params=params,
+                                                      rng=fresh_seed_sequence(rng),
+                                                      **{**overrides, "incidence_correction": c})
                                  for c in (True, False)]
-    fls = [run_flight(flight=fl, rng=rng, n_particles=n_particles, incidence_correction=c, progress=False)
-           for c in (True, False)]
+    fls = [run_flight(flight=fl, rng=rng, params=params, progress=False,
+                      **{**overrides, "n_particles": n_particles, "incidence_correction": c}) for c in (True, False)]
     return IncidenceResult(tuple(f4), tuple(fls))

@@ -114,10 +114,13 @@ def in_frame_rotation_error_deg(flight: Flight, frame_lines: int = 40) -> np.nda
 
 
 def flight_or_simulate(flight: Flight | None, duration_s: float, rng) -> Flight:
-    """``flight`` checked, or a new one of ``duration_s`` seconds simulated from ``rng`` — the first of two
-    streams spawned from it, the flight :func:`run_flight` simulates for the same ``rng`` (ours)."""
+    """``flight`` checked, or a new one of ``duration_s`` seconds simulated from ``rng`` (int, SeedSequence or
+    Generator) — the first of two streams spawned from a fresh copy of its SeedSequence, the flight
+    :func:`run_flight` simulates for the same ``rng`` (ours)."""
+    from ..sweep import fresh_seed_sequence
+
     if flight is None:
-        seed = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(2)[0]
+        seed = fresh_seed_sequence(rng).spawn(2)[0]
         return simulate_flight(v.check_positive(duration_s, "duration_s"), rng=np.random.default_rng(seed))
     if not isinstance(flight, Flight):
         raise TypeError(f"`flight` must be a Flight or None; got {type(flight).__name__}")
@@ -265,7 +268,9 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
     if duration_s is None:
         v.check_choice(size, "size", tuple(SIZES))
         duration_s = SIZES[size]
-    seeds = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(2)
+    from ..sweep import fresh_seed_sequence
+
+    seeds = fresh_seed_sequence(rng).spawn(2)  # a fresh copy: the same streams on every call with this `rng`
     flight = flight_or_simulate(flight, duration_s, rng)
     n_frames = len(flight) // v.check_int(frame_lines, "frame_lines", minimum=1)
     if n_frames < 2:

@@ -169,7 +169,7 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz
     ``rounds`` > 1 (ours, not 002's figure) repeats the cycle on the same frame; those later cycles use
     ``V_later_xyz_m2``, ``V_later_rpy_deg2`` (default (2 cm)² and (0.2°)²: a re-run should not undo the first).
     """
-    g = np.random.default_rng(v.check_int(rng, "rng", minimum=0))
+    g = v.as_rng(rng)
     offset_m = float(offset_m)
     rounds = v.check_int(rounds, "rounds", minimum=1)
     for name, val in (("V_xyz_m2", V_xyz_m2), ("V_rpy_deg2", V_rpy_deg2), ("V_later_xyz_m2", V_later_xyz_m2),
@@ -222,18 +222,43 @@ class IntensitySpread:
 
 
 def run_intensity_spread(V_values_m2=(0.01, 0.09, 0.36), offset_m: float = 0.4, *, n_particles: int = 400,
-                         rng=0) -> IntensitySpread:
-    """:func:`run_intensity_figure` (one cycle) for each V in ``V_values_m2`` with the same seed (ours)."""
+                         params: PlaneSLAMParams | None = None, rng=0, **overrides) -> IntensitySpread:
+    """:func:`run_intensity_figure` (one cycle) for each V in ``V_values_m2`` with the same seed (ours).
+
+    Parameters
+    ----------
+    V_values_m2 : sequence of float
+        The prediction's position variances [m²], one run each.
+    offset_m : float
+        How far the vehicle moves along the walls while the odometry says it did not.
+    n_particles : int
+        Particles (replaces ``params.n_particles``).
+    params : PlaneSLAMParams, optional
+        Filter settings under Fig. 4's (see :func:`run_intensity_figure`).
+    rng : int, SeedSequence or Generator
+        The seed every run starts from (the same for every V).
+    **overrides
+        :class:`PlaneSLAMParams` fields.
+
+    Returns
+    -------
+    IntensitySpread
+    """
+    from ..sweep import fresh_seed_sequence
+
     vals = [v.check_positive(x, "V_values_m2") for x in np.atleast_1d(np.asarray(V_values_m2, dtype=float))]
     if not vals:
         raise ValueError("`V_values_m2` must hold at least one variance")
-    return IntensitySpread(tuple(run_intensity_figure(offset_m, n_particles=n_particles, V_xyz_m2=x, rng=rng)
-                                 for x in vals))
+    # a fresh copy of the same SeedSequence per V (an int seed: the stream of default_rng(seed) each time)
+    return IntensitySpread(tuple(run_intensity_figure(offset_m, n_particles=n_particles, V_xyz_m2=x, params=params,
+                                                      rng=fresh_seed_sequence(rng), **overrides) for x in vals))
 
 
-def _fig4_trial(offset_m: float, rng, n_particles: int = 400, rounds: int = 1) -> dict:
+def _fig4_trial(offset_m: float, rng, n_particles: int = 400, rounds: int = 1, params=None,
+                overrides: dict | None = None) -> dict:
     """One Fig. 4 run with a seed drawn from ``rng``: the along-corridor errors with and without the weights."""
-    r = run_intensity_figure(offset_m, n_particles=n_particles, rounds=rounds, rng=int(rng.integers(2**31)))
+    r = run_intensity_figure(offset_m, n_particles=n_particles, rounds=rounds, params=params,
+                             rng=int(rng.integers(2**31)), **(overrides or {}))
     return {"error_with_m": r.error_with_m, "error_without_m": r.error_without_m, "peak": r.peak}
 
 
@@ -262,16 +287,44 @@ class IntensityStudy:
 
 
 def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_particles: int = 400, rounds: int = 1,
-                        seed: int = 0, n_jobs: int = 1, progress: bool | None = None) -> IntensityStudy:
+                        params: PlaneSLAMParams | None = None, rng=0, n_jobs: int = 1, progress=None, seed=None,
+                        **overrides) -> IntensityStudy:
     """Fig. 4 (:func:`run_intensity_figure`) repeated over ``n_seeds`` seeds for each offset, by
-    :func:`slamlab.sweep.sweep` (ours: how reliably the intensities resolve the line)."""
-    from ..sweep import sweep
+    :func:`slamlab.sweep.sweep` (ours: how reliably the intensities resolve the line).
 
+    Parameters
+    ----------
+    n_seeds : int
+        Runs per offset, each from its own stream.
+    offsets_m : sequence of float
+        How far the vehicle moves along the walls while the odometry says it did not.
+    n_particles, rounds : int
+        Particles (replaces ``params.n_particles``) and cycles on the second frame.
+    params : PlaneSLAMParams, optional
+        Filter settings under Fig. 4's (see :func:`run_intensity_figure`).
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from.
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`PlaneSLAMParams` fields.
+
+    Returns
+    -------
+    IntensityStudy
+    """
+    from ..sweep import renamed_seed, root_seed_sequence, sweep
+
+    rng = renamed_seed(rng, seed, "run_intensity_study")
+    PlaneSLAMParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
     n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
     rounds = v.check_int(rounds, "rounds", minimum=1)
-    table = sweep(_fig4_trial, {"offset_m": [float(o) for o in offsets_m]}, seeds=n_seeds, seed=seed, n_jobs=n_jobs,
-                  fixed={"n_particles": n_particles, "rounds": rounds}, progress=progress, desc="Fig. 4 study")
-    bad = table["error"].notna() if "error" in table else None
-    if bad is not None and bad.any():
-        raise RuntimeError(f"{int(bad.sum())} Fig. 4 runs failed: {table.loc[bad, 'error'].iloc[0]}")
+    table = sweep(_fig4_trial, {"offset_m": [float(o) for o in offsets_m]}, seeds=n_seeds,
+                  seed=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, on_error="raise", desc="Fig. 4 study",
+                  fixed={"n_particles": n_particles, "rounds": rounds, "params": params, "overrides": dict(overrides)},
+                  progress=progress)
     return IntensityStudy(table, rounds)

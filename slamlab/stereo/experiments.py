@@ -176,8 +176,8 @@ def run_stereo_slam_variants(
     ``drift_std_rad`` = random-walk step of the right camera's orientation per frame,
     ``arena_seed``), ``arena`` (default the 6×8 m :class:`~slamlab.sim.arena.StereoArena` of
     ``render.arena_seed``), ``rig`` (default the 768×576, 40° pair with a 0.2 m baseline).
-    ``progress``: a callable ``progress(i)`` called after each frame, or True/False/None for a
-    tqdm bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
+    ``progress``: True/False/None for a bar over the frames, or a callable ``progress(i)`` called after
+    frame ``i`` (the one contract of :mod:`slamlab._progress`).
     """
     poses = v.as_finite_array(poses, "poses", ndim=2)
     if poses.shape[1] != 3 or len(poses) < 2:
@@ -195,10 +195,11 @@ def run_stereo_slam_variants(
             raise TypeError(f"`variants[{label!r}]` must be a StereoParams or a dict of overrides; got {type(var).__name__}")
     if isinstance(store, LandmarkStore) and len(settings) > 1:
         raise ValueError("a `store` instance serves one run; give a factory for several variants")
-    frame_done = progress if callable(progress) else None
-    bar = None if frame_done else progress_bar(total=len(poses), desc=f"stereo SLAM: {name}", progress=progress)
+    bar = progress_bar(total=len(poses), desc=f"stereo SLAM: {name}", progress=progress)
     render = RenderParams.resolve(render)
-    r_sim, r_slam = np.random.SeedSequence(v.check_int(rng, "rng", minimum=0)).spawn(2)
+    from ..sweep import fresh_seed_sequence
+
+    r_sim, r_slam = fresh_seed_sequence(rng).spawn(2)  # an int seed: SeedSequence(seed)'s children as before
     arena = StereoArena(seed=render.arena_seed) if arena is None else arena
     sim = StereoSim(arena, rig, camera_height_m=render.camera_height_m, noise_std=render.noise_std,
                     drift_std_rad=render.drift_std_rad, rng=np.random.default_rng(r_sim))
@@ -208,18 +209,14 @@ def run_stereo_slam_variants(
     truth = np.array([planar_from_se3(T0_inv @ se3_from_planar(*p)) for p in poses])
     truth[:, 2] = poses[:, 2] - poses[0, 2]
     t_slam = dict.fromkeys(slams, 0.0)
-    for i, p in enumerate(poses):
+    for p in poses:
         left, right = sim.render_pair(p)
         for k, slam in slams.items():
             t = time.perf_counter()
             slam.process(left, right)
             t_slam[k] += time.perf_counter() - t
-        if frame_done is not None:
-            frame_done(i)
-        else:
-            bar.update()
-    if bar is not None:
-        bar.close()
+        bar.update()
+    bar.close()
     out = {}
     for k, slam in slams.items():
         est = slam.planar_trajectory
@@ -367,23 +364,20 @@ def run_drift_study(
     the same for any ``n_jobs``. ``progress``: a bar over the levels (default: on unless
     ``$SLAMLAB_PROGRESS=0``).
     """
-    from ..sweep import sweep
+    from ..sweep import fresh_seed_sequence, sweep
 
     v.check_choice(experiment, "experiment", _RUNNERS)
     v.check_choice(size, "size", SIZES)
     levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
     if min(levels) < 0:
         raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
-    seed = v.check_int(rng, "rng", minimum=0)
+    seed = fresh_seed_sequence(rng)  # every level's run from the same (fresh) SeedSequence
     p = StereoParams.resolve(params, **overrides)
     render = RenderParams.resolve(render)
     table = sweep(drift_level, {"drift_std_rad": levels}, rng_arg=None, n_jobs=n_jobs, progress=progress,
-                  desc=f"calibration drift study ({experiment})",
+                  on_error="raise", desc=f"calibration drift study ({experiment})",
                   fixed={"experiment": experiment, "size": size, "n_frames": n_frames, "params": p, "render": render,
                          "seed": seed})
-    failed = table["error"].notna()
-    if failed.any():
-        raise RuntimeError(f"{int(failed.sum())} drift level(s) failed; first: {table['error'][failed].iloc[0]}")
     return DriftStudy(experiment, levels, tuple(table["run"]))
 
 

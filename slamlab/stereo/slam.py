@@ -382,12 +382,26 @@ class StereoSLAM:
         p = self.params
         return base_rule(self.n_seen, self.frame - self.first_seen, p.base_seen_times, p.max_non_base_time)
 
-    def run(self, frames, progress: Callable | None = None) -> StereoSLAM:
-        """Process an iterable of ``(left, right)`` pairs; ``progress(i)`` is called after each."""
-        for i, (left, right) in enumerate(frames):
+    def run(self, frames, progress: bool | Callable[[int], object] | None = False) -> StereoSLAM:
+        """Process an iterable of ``(left, right)`` pairs.
+
+        Parameters
+        ----------
+        frames : iterable of (ndarray, ndarray)
+            The left and right images of each frame.
+        progress : bool, callable or None
+            The one contract of :mod:`slamlab._progress`: a bar (True; None: unless ``$SLAMLAB_PROGRESS=0``),
+            none (False, the default), or a callable ``progress(i)`` called after frame ``i``.
+
+        Returns
+        -------
+        StereoSLAM
+            ``self``.
+        """
+        from .._progress import progress_bar
+
+        for left, right in progress_bar(frames, desc="stereo SLAM", progress=progress):
             self.process(left, right)
-            if progress is not None:
-                progress(i)
         return self
 
     # -- results -------------------------------------------------------------------------------------

@@ -109,11 +109,11 @@ def test_mistakes_fail():
 def test_exploration_answers():
     import slamlab as sl
 
-    g = sl.localisation.run_global_localisation((500,), n_runs=20, n_steps=20, seed=2026)
+    g = sl.localisation.run_global_localisation((500,), n_runs=20, n_steps=20, rng=2026)
     rate = float(g.summary()["success"].iloc[0])
     assert lab.answer("08.explore.global_success", rate, quiet=True).passed
     assert lab.answer("08.explore.global_success", rate + 0.05, quiet=True).status == "failed"
-    _, res = sl.localisation.demo_run(1000, kidnap_step=25, alpha_slow=0.05, alpha_fast=0.5, seed=2026)
+    _, res = sl.localisation.demo_run(1000, kidnap_step=25, alpha_slow=0.05, alpha_fast=0.5, rng=2026)
     steps = res.converged_at(25) - 25
     assert lab.answer("08.explore.kidnap_recovery", steps, quiet=True).passed
     assert lab.answer("08.explore.kidnap_recovery", steps + 1, quiet=True).status == "failed"

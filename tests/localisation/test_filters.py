@@ -195,13 +195,35 @@ def test_markov_predict_conserves_mass_and_moves_the_mode():
 def test_markov_vs_mcl_methods_share_the_runs():
     from slamlab.localisation.experiments import run_markov_vs_mcl
 
-    res = run_markov_vs_mcl(markov=((8, 12),), particle_counts=(50, 60), n_runs=3, n_steps=3, seed=4)
+    res = run_markov_vs_mcl(markov=((8, 12),), particle_counts=(50, 60), n_runs=3, n_steps=3, rng=4)
     df = res.table_df
     starts = {m: g[["start_x", "start_y"]].to_numpy() for m, g in df.groupby(["method", "size"], sort=False)}
     first = next(iter(starts.values()))
     assert len(starts) == 3
     assert len({tuple(map(tuple, v)) for v in starts.values()}) == 1  # every method ran the same 3 runs
     assert len({tuple(r) for r in first}) > 1  # and the runs differ from each other
+
+
+def test_studies_take_params_and_any_rng_with_seed_deprecated():
+    """The run_* contract: ``params=`` (+ overrides) and ``rng=`` as an int, a SeedSequence or a Generator;
+    the old ``seed=`` still works, with a DeprecationWarning, and gives the same runs."""
+    from slamlab.localisation.experiments import run_markov_vs_mcl
+
+    kw = {"markov": (), "particle_counts": (40,), "n_runs": 2, "n_steps": 3}
+    cols = ["start_x", "start_y", "final_err_cells"]
+    ref = run_markov_vs_mcl(**kw, rng=4).table_df[cols]
+    assert ref.equals(run_markov_vs_mcl(**kw, rng=np.random.SeedSequence(4)).table_df[cols])
+    assert ref.equals(run_markov_vs_mcl(**kw, rng=np.random.default_rng(4)).table_df[cols])
+    with pytest.warns(DeprecationWarning, match=r"run_markov_vs_mcl\(seed=...\) is deprecated"):
+        old = run_markov_vs_mcl(**kw, seed=4)
+    assert ref.equals(old.table_df[cols])
+    # params= and the same settings as overrides are one run; the particle counts replace params.n_particles
+    p = L.MCLParams(sigma_hit=3.0, n_particles=999)
+    a = run_markov_vs_mcl(**kw, params=p, rng=4).table_df[cols]
+    b = run_markov_vs_mcl(**kw, sigma_hit=3.0, rng=4).table_df[cols]
+    assert a.equals(b)
+    with pytest.raises(TypeError, match="`params` must be a MCLParams or None; got dict"):
+        run_markov_vs_mcl(**kw, params={"sigma_hit": 3.0})
 
 
 def test_amcl_convergence_test_is_a_box_around_the_mean():
@@ -267,9 +289,9 @@ def test_beam_skipping_keeps_the_beams_most_particles_agree_with():
 def test_markov_prior_and_uniform_floor_studies():
     """003's two claims as runs: with a weak sensor (3 beams) a prior at the truth localises where the uniform
     belief does not; after a kidnap a grid with a uniform floor is back within the bounds."""
-    mp = L.run_markov_prior(L.MARKOV_PRIORS[:2], n_runs=2, n_steps=8, seed=2026, progress=False, max_beams=3)
+    mp = L.run_markov_prior(L.MARKOV_PRIORS[:2], n_runs=2, n_steps=8, rng=2026, progress=False, max_beams=3)
     assert mp.success(L.MARKOV_PRIORS[1][0]) > mp.success(L.MARKOV_PRIORS[0][0])
-    mk = L.run_markov_kidnap((1e-3,), n_runs=1, n_steps=12, kidnap_step=6, seed=1, progress=False)
+    mk = L.run_markov_kidnap((1e-3,), n_runs=1, n_steps=12, kidnap_step=6, rng=1, progress=False)
     assert mk.success(mk.labels[0], 5) == 1.0  # tracking before the kidnap
     assert mk.success(mk.labels[0]) == 1.0  # and back after it
     with pytest.raises(ValueError, match="`priors` must hold"):

@@ -55,7 +55,7 @@ def test_protocol_runs_on_a_log_by_path(shared_data):
     (Issue 27's goal, success >= 0.8 over 10 stretches of 30 scans per log with 20 000 particles, does not hold:
     0.68 measured on 2026-11-26, so it is not pinned.)"""
     path = shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz"
-    res = L.run_log_protocol(path, (300, 600), n_runs=2, n_scans=4, seed=0, progress=False)
+    res = L.run_log_protocol(path, (300, 600), n_runs=2, n_scans=4, rng=0, progress=False)
     df = res.table_df
     assert len(df) == 4
     assert df.groupby("n_particles")["start"].apply(list).tolist() == [[0, df["start"].max()]] * 2

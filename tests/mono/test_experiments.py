@@ -49,6 +49,25 @@ def test_lost_tracking_is_reported_with_a_finite_pose(strafe_frames):
     assert rec["tracked"]
 
 
+def test_run_reports_frames_through_the_progress_contract(strafe_frames, capsys, monkeypatch):
+    imgs, _, K = strafe_frames
+    monkeypatch.setenv("SLAMLAB_PROGRESS", "1")
+    done = []
+    by_run = MonoSLAM(K).run(imgs[:4], progress=done.append)  # a callable: each finished frame's index
+    assert done == [0, 1, 2, 3]
+    assert capsys.readouterr().err == ""
+    by_hand = MonoSLAM(K)
+    for img in imgs[:4]:
+        by_hand.process(img)
+    np.testing.assert_array_equal(by_run.trajectory, by_hand.trajectory)
+    MonoSLAM(K).run(imgs[:2])  # default: no bar
+    assert capsys.readouterr().err == ""
+    MonoSLAM(K).run(imgs[:2], progress=True)
+    assert "mono SLAM" in capsys.readouterr().err
+    with pytest.raises(TypeError, match="`progress` must be True, False, None or a callable"):
+        MonoSLAM(K).run(imgs[:2], progress="tqdm")
+
+
 def test_keyframe_cap_drops_the_farthest(strafe_frames):
     imgs, _, K = strafe_frames
     slam = MonoSLAM(K, max_keyframes=2, kf_min_frames=1, kf_lost_ratio=0.01, kf_max_lost_ratio=0.02,

@@ -110,7 +110,7 @@ def test_a_20_s_flight_beats_the_odometry():
 def test_intensity_study_runs_through_sweep():
     from slamlab.planes import run_intensity_study
 
-    s = run_intensity_study(2, (0.4,), n_particles=60, seed=1, progress=False)
+    s = run_intensity_study(2, (0.4,), n_particles=60, rng=1, progress=False)
     assert len(s.runs) == 2
     assert (s.runs.error_without_m > 0.3).all()
     assert "0.40" in s.table()
