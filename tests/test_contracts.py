@@ -30,10 +30,10 @@ ALLOWED: dict[str, dict[str, str]] = {
     "slamlab.features.experiments.run_pair_evaluation": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.experiments.run_detector_summary": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.experiments.run_surf_threshold": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.experiments.run_knn_comparison": {
+    "slamlab.features.matching_experiments.run_knn_comparison": {
         "params": _NO_PIPELINE, "rng": _NO_RANDOMNESS + " (FLANN's trees: cv2.setRNGSeed(0) in kdtree.knn)"},
-    "slamlab.features.experiments.run_recall_vs_leaves": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.experiments.run_ratio_tradeoff": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.features.matching_experiments.run_recall_vs_leaves": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.features.matching_experiments.run_ratio_tradeoff": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.experiments.run_blob_scale": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     # filters: each experiment is one model (F, Q, H, R from its keywords) run through the filters
     "slamlab.filters.experiments.run_cv_target": {"params": _NO_PIPELINE},
