@@ -253,3 +253,58 @@ def test_lab_has_an_open_investigation_with_a_rubric_and_a_time_plan(lab):
     assert "?" in "".join(text["source"])
     assert not _CALL.search("".join(text["source"]))
     assert "Time plan" in "".join(by_id[f"lab{n}_intro"]["source"])
+
+
+# --- labs 08-10: the same rules (issue 26) ----------------------------------------------------------------
+
+CHAPTERS_08_10 = ("08",)
+LABS_08_10 = sorted(p for c in CHAPTERS_08_10 for p in (ROOT / "notebooks" / "labs").glob(f"{c}_*_lab.ipynb"))
+
+
+def _tasks_08_10(kind):
+    return {k: t for k, t in core.all_tasks().items() if k[:2] in CHAPTERS_08_10 and isinstance(t, kind)}
+
+
+EXPLORATIONS_08_10 = _tasks_08_10(core.ExplorationTask)
+
+
+def test_labs_08_10_explorations_spell_no_call():
+    assert len(LABS_08_10) == len(CHAPTERS_08_10)
+    assert ready_made_calls(LABS_08_10) == []
+
+
+@pytest.mark.parametrize("task_id", sorted(_tasks_08_10((core.Task, core.ExplorationTask))))
+def test_hints_of_labs_08_10_hold_no_code(task_id):
+    for h in _hints(core.task(task_id)):
+        assert not _CODE.search(h), f"{task_id}: code in the hint {h!r}"
+
+
+@pytest.mark.parametrize("task_id", sorted(EXPLORATIONS_08_10))
+def test_exploration_of_labs_08_10_has_an_independent_range_why_and_typical_wrong_answers(task_id):
+    t = EXPLORATIONS_08_10[task_id]
+    assert t.accepted is not None  # an independent range, not the library's own seeded run
+    assert len(t.why) > 40
+    assert t.hint
+    assert t.more
+    assert t.wrong
+    lo, hi = t.accepted_range()
+    for w in t.wrong:
+        v = float(w.value())
+        assert not lo <= v <= hi, f"{task_id}: the wrong answer {w.label!r} ({v}) is accepted"
+        first = core.answer(task_id, v, quiet=True)
+        assert first.status == "failed"
+        assert w.hint in first.message
+        if w.more:
+            assert w.more in core.answer(task_id, v, quiet=True).message
+        for shown in {f"{lo:g}", f"{hi:g}", f"{(lo + hi) / 2:g}"} - {"0"}:
+            assert shown not in first.message.split("Hint:", 1)[1], f"{task_id}: the hint gives {shown}"
+    assert core.answer(task_id, (lo + hi) / 2, quiet=True).passed
+
+
+@pytest.mark.parametrize("lab", LABS_08_10, ids=[p.name for p in LABS_08_10])
+def test_labs_08_10_explorations_are_questions_with_an_investigation_rubric_and_time_plan(lab):
+    nb = json.loads(lab.read_text(encoding="utf-8"))
+    texts = [c for c in nb["cells"] if re.search(r"_e\d+_text$", c["metadata"].get("nbgrader", {}).get("grade_id", ""))]
+    assert len(texts) == 2
+    assert all("?" in "".join(c["source"]) for c in texts)
+    test_lab_has_an_open_investigation_with_a_rubric_and_a_time_plan(lab)
