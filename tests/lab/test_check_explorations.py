@@ -257,7 +257,7 @@ def test_lab_has_an_open_investigation_with_a_rubric_and_a_time_plan(lab):
 
 # --- labs 08-10: the same rules (issue 26) ----------------------------------------------------------------
 
-CHAPTERS_08_10 = ("08", "09")
+CHAPTERS_08_10 = ("08", "09", "10")
 LABS_08_10 = sorted(p for c in CHAPTERS_08_10 for p in (ROOT / "notebooks" / "labs").glob(f"{c}_*_lab.ipynb"))
 
 
