@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .. import _validate as v
 from ..planes import fit_plane_lsq, frame_transforms, intensity_weights, planes_to_body
 from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
@@ -128,6 +129,8 @@ def normal_rms_error_deg(n_points: int = EXPLORE_N_POINTS, noise_m: float = EXPL
     float
         The RMS angle, degrees.
     """
+    n_points = v.check_int(n_points, "n_points", minimum=3)
+    noise_m, side_m = v.check_positive(noise_m, "noise_m", allow_zero=True), v.check_positive(side_m, "side_m")
     return float(np.degrees(noise_m * np.sqrt(2.0 / (n_points * side_m**2 / 12.0))))
 
 
@@ -148,6 +151,9 @@ def smallest_safe_angle_deg(offset_error_m: float = EXPLORE_OFFSET_ERROR_M,
     float
         The angle, degrees.
     """
+    offset_error_m, limit_m = v.check_positive(offset_error_m, "offset_error_m"), v.check_positive(limit_m, "limit_m")
+    if not offset_error_m < limit_m:
+        raise ValueError(f"`offset_error_m` must be smaller than `limit_m`; got {offset_error_m} and {limit_m}")
     return float(np.degrees(np.arcsin(offset_error_m / limit_m)))
 
 

@@ -188,3 +188,16 @@ def test_exploration_answers_of_the_instructor_method():
     assert lab.answer("08.explore.warm_up", lo - 1, quiet=True).status == "failed"
     assert lab.answer("08.explore.survivors", 0.62, quiet=True).passed
     assert lab.answer("08.explore.survivors", 0.5, quiet=True).status == "failed"
+
+
+def test_exploration_helpers_reject_bad_input():
+    from slamlab.lab import tasks_localisation as tl
+
+    with pytest.raises(ValueError, match="`M`"):
+        tl.survivor_fraction(0)
+    with pytest.raises(TypeError, match="`M`"):
+        tl.survivor_sd(2.5)
+    with pytest.raises(ValueError, match="`alpha_slow` must be smaller"):
+        tl.warm_up_steps(0.2, 0.1)
+    with pytest.raises(ValueError, match="`drop`"):
+        tl.warm_up_steps(0.001, 0.1, 1.0)

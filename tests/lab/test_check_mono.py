@@ -126,3 +126,18 @@ def test_exploration_answers_of_the_instructor_methods():
     assert lab.answer("09.explore.tau_depth", 9.3, quiet=True).status == "failed"
     assert lab.answer("09.explore.doubling_rate", 0.5, quiet=True).passed
     assert lab.answer("09.explore.doubling_rate", 0.3, quiet=True).status == "failed"
+
+
+def test_exploration_helpers_reject_bad_input():
+    from slamlab.lab import tasks_mono as tm
+
+    with pytest.raises(ValueError, match="`rates`"):
+        tm.half_converged_observations([0.2, 1.0])
+    with pytest.raises(ValueError, match="`n_obs`"):
+        tm.half_converged_observations([0.2], n_obs=0)
+    with pytest.raises(ValueError, match="`step`"):
+        tm.doubling_rate(1, step=0.0)
+    with pytest.raises(ValueError, match="`z_m`"):
+        tm.tau_relative_depth(-1.0)
+    with pytest.raises(ValueError, match="`rel`"):
+        tm.depth_for_relative_error(0.0)

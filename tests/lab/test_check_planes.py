@@ -120,3 +120,14 @@ def test_exploration_answers_of_the_instructor_methods():
     assert lab.answer("10.explore.wall_angle", 3.6, quiet=True).status == "failed"
     assert lab.answer("10.explore.normal_error", 0.1, quiet=True).passed
     assert lab.answer("10.explore.normal_error", 0.13, quiet=True).status == "failed"
+
+
+def test_exploration_helpers_reject_bad_input():
+    from slamlab.lab import tasks_planes as tp
+
+    with pytest.raises(ValueError, match="`n_points`"):
+        tp.normal_rms_error_deg(2)
+    with pytest.raises(ValueError, match="`side_m`"):
+        tp.normal_rms_error_deg(side_m=0.0)
+    with pytest.raises(ValueError, match="`offset_error_m` must be smaller"):
+        tp.smallest_safe_angle_deg(0.6, 0.5)
