@@ -4,15 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate as v
 from ..localisation import LikelihoodFieldModel, low_variance_resample, odometry_deltas, scan_beams
 from ..localisation.mcl import _inject_probability
 from ..localisation.models import motion_from_noise
 from ..scans import Scan
-from .core import Case, ExplorationTask, Task, allclose, register
-
-#: Exploration settings: particle count, runs and steps of the global study; the kidnap run.
-EXPLORE_GLOBAL = {"particle_counts": (500,), "n_runs": 20, "n_steps": 20}
-EXPLORE_KIDNAP = {"n_particles": 1000, "kidnap_step": 25, "alpha_slow": 0.05, "alpha_fast": 0.5}
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 
 def _lv_reference(weights, n, r):
@@ -112,49 +109,153 @@ def _aug_cases(rng):
 
 
 register(Task("08.low_variance", "Task 1, low-variance resampling", _lv_reference, _lv_cases,
-              "normalise the weights, c = cumsum; for m = 0..n-1 the pointer u = r + m/n selects the first i with "
-              "c[i] > u (np.searchsorted(c, u, side='right')); return the n indices.",
+              "all n pointers share the one offset r and are 1/n apart, so the draw is deterministic: compare your "
+              "indices with the case's weights by hand. A pointer that lands exactly on a boundary of the cumulative "
+              "weights belongs to the particle whose slice starts there, and the weights need not sum to 1.",
               compare=allclose(0.0, 0.0), points=2))
 register(Task("08.motion_sample", "Task 2, the odometry motion model (sampling form)", _motion_reference,
               _motion_cases,
-              "δrot1 = atan2(ȳ'-ȳ, x̄'-x̄) - θ̄ (0 when δtrans is tiny), δtrans = distance, δrot2 = θ̄'-θ̄-δrot1, "
-              "angles wrapped; δ̂ = δ - sqrt(variance)·noise with the variances of PR Table 5.6; then move each "
-              "particle and wrap its heading to [-π, π).", compare=allclose(rtol=1e-9, atol=1e-9), points=3))
+              "the noise perturbs the three motion parts read from the odometry (two rotations and a translation), "
+              "not the particles' coordinates; each part's spread grows with the size of the motion (PR Table 5.6). "
+              "Check the turn on the spot (no translation) and the headings near ±π.",
+              compare=allclose(rtol=1e-9, atol=1e-9), points=3))
 register(Task("08.likelihood_field", "Task 3, log p(z | x) by the likelihood field", _lf_reference, _lf_cases,
-              "d = scipy.ndimage.distance_transform_edt(grid != 1) capped at max_dist; end point of beam k at "
-              "x + r_k cos(θ + α_k), y + r_k sin(θ + α_k); cell (row, col) = (floor(y + 0.5), floor(x + 0.5)); "
-              "off the map d = max_dist; skip r_k >= z_max; sum log(z_hit N(d; 0, σ²) + z_rand / z_max).",
+              "the field holds the distance to the nearest obstacle cell, capped at max_dist; an end point is "
+              "rounded to the nearest cell, one off the map counts as max_dist, and a beam at the range limit "
+              "carries no information about a wall. Sum the logs of the mixture, not the log of a sum.",
               compare=allclose(rtol=1e-5, atol=1e-6), points=3))
 register(Task("08.augmented", "Task 4, w_slow, w_fast and the injection probability (003 eqs 2.9-2.11)",
               _aug_reference, _aug_cases,
-              "update both averages first, then p = max(0, 1 - w_fast / w_slow), and p = 0 while w_slow is 0; "
-              "return np.array([w_slow, w_fast, p]).", compare=allclose(rtol=1e-12, atol=1e-12), points=2))
+              "the injection probability is computed from the averages after this step's update, not before; and "
+              "while the slow average is still 0 the ratio is undefined: no particle is injected.",
+              compare=allclose(rtol=1e-12, atol=1e-12), points=2))
+
+# --- explorations -----------------------------------------------------------------------------------------
+
+#: Exploration 1: the particle count; Exploration 2: 003's averages, the steady score and the kidnap's drop.
+EXPLORE_M = 1000
+EXPLORE_ALPHAS = (0.001, 0.1)
+EXPLORE_DROP = 0.5
 
 
-def _global_success() -> float:
-    from ..localisation import run_global_localisation
+def survivor_fraction(M: int = EXPLORE_M) -> float:
+    """Expected fraction of M equally weighted particles drawn at least once by M multinomial draws.
 
-    g = run_global_localisation(rng=2026, **EXPLORE_GLOBAL)
-    return float(g.summary()["success"].iloc[0])
+    Parameters
+    ----------
+    M : int
+        Particle count (and draws).
+
+    Returns
+    -------
+    float
+        ``1 - (1 - 1/M)**M`` (each particle is missed by all M draws with probability ``(1 - 1/M)**M``).
+    """
+    M = v.check_int(M, "M", minimum=1)
+    return float(1.0 - (1.0 - 1.0 / M) ** M)
 
 
-def _kidnap_recovery() -> float:
-    from ..localisation import demo_run
+def survivor_sd(M: int = EXPLORE_M) -> float:
+    """Standard deviation of the surviving fraction of one multinomial resampling of M equal weights.
 
-    _, res = demo_run(rng=2026, **EXPLORE_KIDNAP)
-    k = res.converged_at(EXPLORE_KIDNAP["kidnap_step"])
-    return float("nan") if k is None else float(k - EXPLORE_KIDNAP["kidnap_step"])
+    Parameters
+    ----------
+    M : int
+        Particle count (and draws).
+
+    Returns
+    -------
+    float
+        From the occupancy problem: Var(distinct) = M (M-1) (1-2/M)^M + M (1-1/M)^M - M² (1-1/M)^{2M}.
+    """
+    M = v.check_int(M, "M", minimum=1)
+    q1, q2 = (1.0 - 1.0 / M) ** M, (1.0 - 2.0 / M) ** M
+    var = M * (M - 1) * q2 + M * q1 - (M * q1) ** 2
+    return float(np.sqrt(var) / M)
+
+
+def warm_up_steps(alpha_slow: float = EXPLORE_ALPHAS[0], alpha_fast: float = EXPLORE_ALPHAS[1],
+                  drop: float = EXPLORE_DROP) -> int:
+    """Fewest steady steps before a kidnap after which 003's averages (started at 0) inject (003 eqs 2.9-2.11).
+
+    Closed form: after T steps of a steady score 1 the averages are ``1 - (1 - α)^T``; the kidnap step scores
+    ``drop`` and injects when the updated w_fast falls below the updated w_slow. T is the first integer for which
+    it does, found from the logarithm and confirmed on the integers around it.
+
+    Parameters
+    ----------
+    alpha_slow, alpha_fast : float
+        The averages' rates, 0 < alpha_slow < alpha_fast < 1.
+    drop : float
+        The kidnap step's score as a fraction of the steady score, 0 <= drop < 1.
+
+    Returns
+    -------
+    int
+        The number of steady steps T.
+    """
+    alpha_slow, alpha_fast = v.check_probability(alpha_slow, "alpha_slow"), v.check_probability(alpha_fast, "alpha_fast")
+    if not alpha_slow < alpha_fast:
+        raise ValueError(f"`alpha_slow` must be smaller than `alpha_fast`; got {alpha_slow} and {alpha_fast}")
+    drop = v.check_positive(drop, "drop", allow_zero=True)
+    if not drop < 1:
+        raise ValueError(f"`drop` must be in [0, 1); got {drop}")
+
+    def injects(T):
+        s, f = 1.0 - (1.0 - alpha_slow) ** T, 1.0 - (1.0 - alpha_fast) ** T
+        return f + alpha_fast * (drop - f) < s + alpha_slow * (drop - s)
+
+    # with w_fast ~ 1 the condition is w_slow (1 - α_slow) + α_slow drop > 1 - α_fast (1 - drop)
+    target = (1.0 - alpha_fast * (1.0 - drop) - alpha_slow * drop) / (1.0 - alpha_slow)
+    T = max(1, int(np.floor(np.log1p(-target) / np.log1p(-alpha_slow))) - 2)
+    while not injects(T):
+        T += 1
+    return T
 
 
 register(ExplorationTask(
-    "08.explore.global_success",
-    "Exploration 1: the success rate of global localisation with 500 particles (20 runs of 20 steps)",
-    _global_success,
-    hint="sl.localisation.run_global_localisation((500,), n_runs=20, n_steps=20, rng=SEED); "
-         "read .summary()['success'].", atol=1e-9))
+    "08.explore.survivors",
+    f"Exploration 1: the fraction of {EXPLORE_M} equally weighted particles that survive one multinomial resampling",
+    survivor_fraction,
+    accepted=lambda: (survivor_fraction() - 4 * survivor_sd(), survivor_fraction() + 4 * survivor_sd()),
+    why=f"the closed form 1 - (1 - 1/M)^M = {survivor_fraction():.4f} (each particle is missed by every one of the M "
+        f"draws with probability (1 - 1/M)^M) ± 4 standard deviations of a single resampling "
+        f"({survivor_sd():.4f}, the occupancy problem's variance): one run, an average of many runs and the "
+        f"formula itself all pass.",
+    hint="count the particles that appear at least once among the drawn indices and divide by M; the weights are "
+         "all equal, so any loss is the sampler's doing, not the weights'.",
+    more="Multinomial resampling draws M times independently with replacement: some particles are drawn twice, "
+         "others never.",
+    wrong=(WrongAnswer("the low-variance sampler", lambda: 1.0,
+                       hint="that is what the low-variance sampler gives with equal weights (one pointer per slice); "
+                            "the question asks for independent, multinomial draws."),
+           WrongAnswer("the fraction lost", lambda: 1.0 - survivor_fraction(), atol=0.03,
+                       hint="that is the share of particles that are never drawn; the question asks for the share "
+                            "that survives."),
+           WrongAnswer("a count", lambda: EXPLORE_M * survivor_fraction(), rtol=0.06,
+                       hint="that looks like a number of particles; the question asks for a fraction of M."))))
+
+
 register(ExplorationTask(
-    "08.explore.kidnap_recovery",
-    "Exploration 2: steps after the kidnap until the estimate stays within 3 cells and 5°",
-    _kidnap_recovery,
-    hint="run, res = sl.localisation.demo_run(1000, kidnap_step=25, alpha_slow=0.05, alpha_fast=0.5, rng=SEED); "
-         "res.converged_at(25) - 25."))
+    "08.explore.warm_up",
+    f"Exploration 2: steady steps before a kidnap that halves the score can inject, with (α_slow, α_fast) = "
+    f"{EXPLORE_ALPHAS} and 003's averages starting at 0",
+    lambda: float(warm_up_steps()),
+    accepted=lambda: (float(warm_up_steps()), float(warm_up_steps()) + 1.0),
+    why=f"the closed form of the two averages after T steady steps, 1 - (1 - α)^T, gives T = {warm_up_steps()} "
+        f"(a step-by-step loop over Task 4's update gives the same); T + 1 is accepted too: it counts the kidnap "
+        f"step itself. Any steady score gives the same T (the condition is a ratio).",
+    hint="both averages start at 0 and climb towards the steady score at their own rates; the kidnap step injects "
+         "only when, after its update, the fast average lies below the slow one. Find the first steady length for "
+         "which that happens.",
+    more="Loop over the steady length (or solve for it): run Task 4's update for that many steps, then one step at "
+         "half the score, and look at the injection probability.",
+    wrong=(WrongAnswer("the last length that does not inject", lambda: float(warm_up_steps() - 1),
+                       hint="after that many steady steps the kidnap still injects nothing: it is the last length "
+                            "that fails, not the first that succeeds."),
+           WrongAnswer("the slow average's time constant", lambda: 1.0 / EXPLORE_ALPHAS[0],
+                       hint="that is the slow average's time constant, a rule of thumb; after that many steps it has "
+                            "reached only about two thirds of the steady score, which is not enough here."),
+           WrongAnswer("amcl's initialisation", lambda: 1.0,
+                       hint="that is true when both averages start at the first step's score, as ROS's amcl does; "
+                            "003 starts them at 0."))))

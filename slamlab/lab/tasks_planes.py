@@ -5,11 +5,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .. import _validate as v
 from ..planes import fit_plane_lsq, frame_transforms, intensity_weights, planes_to_body
-from .core import Case, ExplorationTask, Task, allclose, register
-
-#: the lab's seed (the notebook's SEED)
-LAB_SEED = 2017
+from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 
 def _pose(rng, scale=3.0):
@@ -80,41 +78,120 @@ def _weights_cases(rng):
 
 register(Task("10.frame_transforms", "Task 1, moving the lines of a frame into the last line's pose",
               frame_transforms, _frame_cases,
-              "T_j = inv(oT_N) @ oT_j for every j (the last pose is oT_N = odometry[-1]); the inverse of a rigid "
-              "[R t; 0 1] is [R^T, -R^T t; 0 1].", compare=allclose(rtol=1e-9, atol=1e-9)))
+              "each line's pose is re-expressed relative to the last line's pose: undo the last pose, then apply the "
+              "line's (the order matters). The last line itself must come out as the identity.",
+              compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("10.planes_to_body", "Task 2, a map plane seen from the body (002, reconstructed)",
               _body_reference, _body_cases,
-              "n_b = R^T n_m and p_b = p_m - n_m . t for each plane (rows of n_m); return the (K, 4) array "
-              "[n_b, p_b].", compare=allclose(rtol=1e-9, atol=1e-9)))
+              "the normal only turns, into the body frame, so with the inverse of the body's rotation; the offset "
+              "shrinks by how far the body has moved along the normal. Try the wall case by hand.",
+              compare=allclose(rtol=1e-9, atol=1e-9)))
 register(Task("10.fit_plane", "Task 3, a least-squares plane through points", _fit_reference, _fit_cases,
-              "centre the points; n = the right singular vector of the smallest singular value (np.linalg.svd(..., "
-              "full_matrices=False)); p = n . centroid; "
-              "flip both signs when p < 0; return [nx, ny, nz, p].", compare=allclose(rtol=1e-9, atol=1e-9),
+              "the plane passes through the centroid; its normal is the direction in which the centred points spread "
+              "least (not most); finally choose the sign that makes the offset non-negative.",
+              compare=allclose(rtol=1e-9, atol=1e-9),
               points=2))
 register(Task("10.intensity_weights", "Task 4, the intensity weights (002)", intensity_weights, _weights_cases,
-              "SAD* = max SAD - SAD (NaN counts as the max), w = SAD* / sum SAD*; when every SAD* is 0 (all equal, "
-              "or all NaN) return uniform weights.", compare=allclose(rtol=1e-12, atol=1e-12)))
+              "the best particle (smallest SAD) gets the largest weight and the worst gets none; a particle without "
+              "overlap counts as the worst; when no particle is better than another, all weights are equal.",
+              compare=allclose(rtol=1e-12, atol=1e-12)))
 
 
-def _fig4_without_weights() -> float:
-    from ..planes import run_intensity_figure
+# --- explorations -----------------------------------------------------------------------------------------
 
-    return run_intensity_figure(n_particles=200, rng=LAB_SEED).error_without_m
+#: Exploration 1: points on a square patch (side, m), their count and the noise along the normal (m).
+EXPLORE_PATCH_M = 4.0
+EXPLORE_N_POINTS = 200
+EXPLORE_NOISE_M = 0.02
+#: Exploration 2: the error of one wall's measured offset (m) and the largest along-wall error allowed (m).
+EXPLORE_OFFSET_ERROR_M = 0.03
+EXPLORE_ALONG_LIMIT_M = 0.5
 
 
-def _flight_ate() -> float:
-    from ..planes import run_flight
+def normal_rms_error_deg(n_points: int = EXPLORE_N_POINTS, noise_m: float = EXPLORE_NOISE_M,
+                         side_m: float = EXPLORE_PATCH_M) -> float:
+    """RMS angle (deg) between a least-squares plane's normal and the true one, to first order in the noise.
 
-    return run_flight(6.0, rng=LAB_SEED, n_particles=100, intensity_weights=False).ate_m
+    Points uniform on a square of side L have a variance L²/12 along each in-plane axis; the normal tilts about
+    each axis by noise / sqrt(N · L²/12) (a line fit's slope error), and the angle combines both tilts.
+
+    Parameters
+    ----------
+    n_points : int
+        Points on the patch.
+    noise_m : float
+        Noise std along the normal, m.
+    side_m : float
+        Side of the square patch, m.
+
+    Returns
+    -------
+    float
+        The RMS angle, degrees.
+    """
+    n_points = v.check_int(n_points, "n_points", minimum=3)
+    noise_m, side_m = v.check_positive(noise_m, "noise_m", allow_zero=True), v.check_positive(side_m, "side_m")
+    return float(np.degrees(noise_m * np.sqrt(2.0 / (n_points * side_m**2 / 12.0))))
+
+
+def smallest_safe_angle_deg(offset_error_m: float = EXPLORE_OFFSET_ERROR_M,
+                            limit_m: float = EXPLORE_ALONG_LIMIT_M) -> float:
+    """The smallest angle (deg) between two walls at which one wall's offset error moves the position ≤ the limit.
+
+    Two walls n1 · t = p1, n2 · t = p2 with normals α apart: an error δ in p2 moves the solution by δ / sin α along
+    the walls (Cramer's rule on the 2 × 2 system), so α = asin(δ / limit).
+
+    Parameters
+    ----------
+    offset_error_m, limit_m : float
+        The offset error δ and the along-wall error allowed, m.
+
+    Returns
+    -------
+    float
+        The angle, degrees.
+    """
+    offset_error_m, limit_m = v.check_positive(offset_error_m, "offset_error_m"), v.check_positive(limit_m, "limit_m")
+    if not offset_error_m < limit_m:
+        raise ValueError(f"`offset_error_m` must be smaller than `limit_m`; got {offset_error_m} and {limit_m}")
+    return float(np.degrees(np.arcsin(offset_error_m / limit_m)))
 
 
 register(ExplorationTask(
-    "10.explore.fig4",
-    "Exploration 1: the along-corridor error [m] of Fig. 4 with 200 particles when the intensity weights are off",
-    _fig4_without_weights, rtol=0.0, atol=5e-4,
-    hint="sl.planes.run_intensity_figure(n_particles=200, rng=SEED) returns both runs; read error_without_m."))
+    "10.explore.normal_error",
+    f"Exploration 1: the RMS angle [deg] between the fitted and the true normal ({EXPLORE_N_POINTS} points on a "
+    f"{EXPLORE_PATCH_M:.0f} m square, noise {100 * EXPLORE_NOISE_M:.0f} cm along the normal)",
+    normal_rms_error_deg,
+    accepted=lambda: (0.85 * normal_rms_error_deg(), 1.15 * normal_rms_error_deg()),
+    why=f"first-order error propagation: each tilt of the normal has the std of a line fit's slope, noise / "
+        f"sqrt(N L²/12), and the angle combines two tilts: {normal_rms_error_deg():.4f}°; ± 15 %, three standard "
+        f"errors of a Monte Carlo estimate with 100 trials (the RMS of n trials scatters by about 1 / (2 sqrt n)).",
+    hint="repeat the fit on freshly drawn noisy points many times, measure the angle between the fitted and the "
+         "true normal each time (either sign of the normal is the same plane), and take the root mean square.",
+    more="The angle is small: compute it in a way that stays accurate for small angles, and report degrees.",
+    wrong=(WrongAnswer("radians", lambda: float(np.radians(normal_rms_error_deg())), rtol=0.2,
+                       hint="that looks like radians; the question asks for degrees."),
+           WrongAnswer("one axis only", lambda: normal_rms_error_deg() / np.sqrt(2.0), rtol=0.06,
+                       hint="that matches the tilt about one in-plane axis only; the angle between the normals "
+                            "combines the tilts about both axes."))))
 register(ExplorationTask(
-    "10.explore.flight",
-    "Exploration 2: the map-frame ATE [m] of a 6 s flight with 100 particles and the intensity weights off",
-    _flight_ate, rtol=0.0, atol=5e-4,
-    hint="sl.planes.run_flight(6.0, rng=SEED, n_particles=100, intensity_weights=False).ate_m"))
+    "10.explore.wall_angle",
+    f"Exploration 2: the smallest angle [deg] between two walls at which a {100 * EXPLORE_OFFSET_ERROR_M:.0f} cm "
+    f"offset error keeps the along-wall error within {EXPLORE_ALONG_LIMIT_M} m",
+    smallest_safe_angle_deg,
+    accepted=lambda: (smallest_safe_angle_deg() - 0.005, np.ceil(10 * smallest_safe_angle_deg()) / 10 + 0.005),
+    why=f"Cramer's rule on the two wall equations: the error moves the solution by δ / sin α along the walls, so "
+        f"α = asin(δ / 0.5 m) = {smallest_safe_angle_deg():.4f}°; accepted up to the next 0.1° (a scan on a 0.1°, "
+        f"0.05° or 0.01° grid lands there, as does the small-angle δ / limit).",
+    hint="put two walls at an angle, shift one wall's offset by the error, solve the walls' equations for the "
+         "position before and after, and measure the shift along the walls; then find where it drops to the "
+         "limit as the angle grows.",
+    more="The question asks for the first angle that is safe, not the last one that fails; give it in degrees.",
+    wrong=(WrongAnswer("the last failing angle", lambda: np.floor(10 * smallest_safe_angle_deg()) / 10, atol=0.001,
+                       hint="at that angle the shift is still above the limit: it is the last angle that fails, "
+                            "not the first that is safe."),
+           WrongAnswer("radians", lambda: float(np.radians(smallest_safe_angle_deg())), rtol=0.05,
+                       hint="that looks like radians; the question asks for degrees."),
+           WrongAnswer("the complement", lambda: 90.0 - smallest_safe_angle_deg(), atol=0.2,
+                       hint="that is the angle between one wall and the other's normal; the question asks for the "
+                            "angle between the walls (equal to the angle between their normals)."))))

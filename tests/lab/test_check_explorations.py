@@ -253,3 +253,48 @@ def test_lab_has_an_open_investigation_with_a_rubric_and_a_time_plan(lab):
     assert "?" in "".join(text["source"])
     assert not _CALL.search("".join(text["source"]))
     assert "Time plan" in "".join(by_id[f"lab{n}_intro"]["source"])
+
+
+# --- labs 08-10: the same rules (issue 26) ----------------------------------------------------------------
+
+CHAPTERS_08_10 = ("08", "09", "10")
+LABS_08_10 = sorted(p for c in CHAPTERS_08_10 for p in (ROOT / "notebooks" / "labs").glob(f"{c}_*_lab.ipynb"))
+
+
+def _tasks_08_10(kind):
+    return {k: t for k, t in core.all_tasks().items() if k[:2] in CHAPTERS_08_10 and isinstance(t, kind)}
+
+
+EXPLORATIONS_08_10 = _tasks_08_10(core.ExplorationTask)
+
+
+def test_labs_08_10_explorations_spell_no_call():
+    assert len(LABS_08_10) == len(CHAPTERS_08_10)
+    assert ready_made_calls(LABS_08_10) == []
+
+
+@pytest.mark.parametrize("task_id", sorted(_tasks_08_10((core.Task, core.ExplorationTask))))
+def test_hints_of_labs_08_10_hold_no_code(task_id):
+    test_hints_hold_no_code(task_id)
+
+
+@pytest.mark.parametrize("task_id", sorted(EXPLORATIONS_08_10))
+def test_exploration_of_labs_08_10_has_an_independent_range_why_and_typical_wrong_answers(task_id):
+    t = EXPLORATIONS_08_10[task_id]
+    assert t.accepted is not None  # an independent range, not the library's own seeded run
+    assert len(t.why) > 40
+    assert t.hint
+    assert t.more
+    assert t.wrong
+    test_typical_wrong_answers_are_rejected_with_their_hint_and_never_the_answer(task_id)
+    lo, hi = t.accepted_range()
+    assert core.answer(task_id, (lo + hi) / 2, quiet=True).passed
+
+
+@pytest.mark.parametrize("lab", LABS_08_10, ids=[p.name for p in LABS_08_10])
+def test_labs_08_10_explorations_are_questions_with_an_investigation_rubric_and_time_plan(lab):
+    nb = json.loads(lab.read_text(encoding="utf-8"))
+    texts = [c for c in nb["cells"] if re.search(r"_e\d+_text$", c["metadata"].get("nbgrader", {}).get("grade_id", ""))]
+    assert len(texts) == 2
+    assert all("?" in "".join(c["source"]) for c in texts)
+    test_lab_has_an_open_investigation_with_a_rubric_and_a_time_plan(lab)

@@ -105,15 +105,99 @@ def test_mistakes_fail():
     assert res.status in ("failed", "error")
 
 
-@pytest.mark.slow
-def test_exploration_answers():
-    import slamlab as sl
+# --- explorations: accepted ranges against independent computations ------------------------------------------
 
-    g = sl.localisation.run_global_localisation((500,), n_runs=20, n_steps=20, rng=2026)
-    rate = float(g.summary()["success"].iloc[0])
-    assert lab.answer("08.explore.global_success", rate, quiet=True).passed
-    assert lab.answer("08.explore.global_success", rate + 0.05, quiet=True).status == "failed"
-    _, res = sl.localisation.demo_run(1000, kidnap_step=25, alpha_slow=0.05, alpha_fast=0.5, rng=2026)
-    steps = res.converged_at(25) - 25
-    assert lab.answer("08.explore.kidnap_recovery", steps, quiet=True).passed
-    assert lab.answer("08.explore.kidnap_recovery", steps + 1, quiet=True).status == "failed"
+
+def _distinct_fraction_exact(M):
+    """Mean and sd of the surviving fraction by enumerating every one of the M^M multinomial draws (small M)."""
+    import itertools
+
+    counts = np.array([len(set(draw)) for draw in itertools.product(range(M), repeat=M)], float) / M
+    return counts.mean(), counts.std()
+
+
+@pytest.mark.parametrize("M", [2, 3, 4, 5, 6])
+def test_survivor_formula_and_sd_by_enumerating_every_draw(M):
+    from slamlab.lab import tasks_localisation as tl
+
+    mean, sd = _distinct_fraction_exact(M)
+    assert tl.survivor_fraction(M) == pytest.approx(mean, rel=1e-12)
+    assert tl.survivor_sd(M) == pytest.approx(sd, rel=1e-9)
+
+
+def test_survivors_range_holds_for_single_runs_averages_and_the_formula_and_rejects_low_variance():
+    t = lab.task("08.explore.survivors")
+    lo, hi = t.accepted_range()
+    M = 1000
+    assert lo <= 1 - (1 - 1 / M) ** M <= hi
+    rng = np.random.default_rng(11)
+    singles = [np.unique(rng.choice(M, M)).size / M for _ in range(300)]  # numpy's sampler, not ours
+    assert all(lo <= f <= hi for f in singles[:50])
+    assert all(lo <= f <= hi for f in singles)
+    assert lo <= np.mean(singles[:20]) <= hi
+    assert lo <= np.mean(singles) <= hi
+    for M_other in (500, 2000):  # the question fixes M: other particle counts also land in the range's width
+        assert abs((1 - (1 - 1 / M_other) ** M_other) - (1 - (1 - 1 / M) ** M)) < 0.001
+    # the low-variance sampler keeps every particle of equal weights (the typical wrong answer's 1.0)
+    r = float(rng.uniform(0, 1 / M))
+    assert np.unique(low_variance(np.full(M, 1.0), M, r)).size == M
+
+
+def _first_injecting_length(alpha_slow, alpha_fast, drop, *, start_at_first=False):
+    """Brute force with the test's own update: T steady steps of score 1, then one step scoring `drop`."""
+    w_slow = w_fast = 0.0
+    for T in range(1, 100000):
+        if start_at_first and T == 1:  # ROS amcl: an average that is 0 takes the step's score
+            w_slow = w_fast = 1.0
+        else:
+            w_slow, w_fast, _ = augmented(1.0, w_slow, w_fast, alpha_slow, alpha_fast)
+        if augmented(drop, w_slow, w_fast, alpha_slow, alpha_fast)[2] > 0:
+            return T
+    raise AssertionError("no injection")
+
+
+@pytest.mark.parametrize(("a_s", "a_f", "drop"), [(0.001, 0.1, 0.5), (0.05, 0.5, 0.5), (0.001, 0.1, 0.0),
+                                                  (0.01, 0.2, 0.8)])
+def test_warm_up_closed_form_equals_a_step_by_step_loop(a_s, a_f, drop):
+    from slamlab.lab import tasks_localisation as tl
+
+    assert tl.warm_up_steps(a_s, a_f, drop) == _first_injecting_length(a_s, a_f, drop)
+
+
+def test_warm_up_range_and_the_steady_score_does_not_matter():
+    t = lab.task("08.explore.warm_up")
+    lo, hi = t.accepted_range()
+    T = _first_injecting_length(0.001, 0.1, 0.5)
+    assert lo == T
+    assert hi == T + 1
+    # any steady score: the condition is a ratio
+    for s_bar in (1e-4, 0.3, 7.0):
+        w_slow = w_fast = 0.0
+        for _ in range(T - 1):
+            w_slow, w_fast, _ = augmented(s_bar, w_slow, w_fast, 0.001, 0.1)
+        assert augmented(s_bar / 2, w_slow, w_fast, 0.001, 0.1)[2] == 0.0
+        w_slow, w_fast, _ = augmented(s_bar, w_slow, w_fast, 0.001, 0.1)
+        assert augmented(s_bar / 2, w_slow, w_fast, 0.001, 0.1)[2] > 0.0
+    # amcl's start (the typical wrong answer 1) injects at once
+    assert _first_injecting_length(0.001, 0.1, 0.5, start_at_first=True) == 1
+
+
+def test_exploration_answers_of_the_instructor_method():
+    lo, _ = lab.task("08.explore.warm_up").accepted_range()
+    assert lab.answer("08.explore.warm_up", _first_injecting_length(0.001, 0.1, 0.5), quiet=True).passed
+    assert lab.answer("08.explore.warm_up", lo - 1, quiet=True).status == "failed"
+    assert lab.answer("08.explore.survivors", 0.62, quiet=True).passed
+    assert lab.answer("08.explore.survivors", 0.5, quiet=True).status == "failed"
+
+
+def test_exploration_helpers_reject_bad_input():
+    from slamlab.lab import tasks_localisation as tl
+
+    with pytest.raises(ValueError, match="`M`"):
+        tl.survivor_fraction(0)
+    with pytest.raises(TypeError, match="`M`"):
+        tl.survivor_sd(2.5)
+    with pytest.raises(ValueError, match="`alpha_slow` must be smaller"):
+        tl.warm_up_steps(0.2, 0.1)
+    with pytest.raises(ValueError, match="`drop`"):
+        tl.warm_up_steps(0.001, 0.1, 1.0)

@@ -73,10 +73,71 @@ def test_mistakes_fail():
     assert "case 1 of 4" in lab.check("09.tau", no_minus_z, quiet=True).message
 
 
-def test_exploration_answers():
+# --- explorations: accepted ranges against independent computations ------------------------------------------
+
+
+def _half_converged_scalar(rate, seed, n_seeds=150, n_obs=40):
+    """The study with this file's own scalar update (a third implementation): observations to half converged."""
+    rng = np.random.default_rng(seed)
+    rho = rng.uniform(0.2, 2.0, n_seeds)
+    seeds = [(float(rho.mean()), 4.0 / 36, 10.0, 10.0) for _ in range(n_seeds)]
+    for k in range(n_obs + 1):
+        if np.mean([math.sqrt(s[1]) < 2.0 / 200 for s in seeds]) >= 0.5:
+            return k
+        out = rng.random(n_seeds) < rate
+        x = np.where(out, rng.uniform(0.0, 2.0, n_seeds), rho + rng.normal(0.0, 0.01, n_seeds))
+        seeds = [update_seed(*s, float(xi), 1e-4, 2.0) for s, xi in zip(seeds, x, strict=True)]
+    return n_obs + 1
+
+
+def test_doubling_range_holds_for_the_library_and_a_scalar_filter_on_coarse_and_fine_grids():
     import slamlab as sl
 
-    c = sl.mono.run_depth_filter_convergence((0.4,), n_obs=40, rng=2019)
-    k = int(np.flatnonzero(c.converged[0] >= 0.5)[0])
-    assert lab.answer("09.explore.half_converged", k, quiet=True).passed
-    assert not lab.answer("09.explore.half_converged", k + 3, quiet=True).passed
+    lo, hi = lab.task("09.explore.doubling_rate").accepted_range()
+    assert 0.3 < lo < hi < 0.7
+    for seed, step in ((2019, 0.05), (5, 0.05), (8, 0.1), (2019, 0.02)):  # the library's study, another code
+        rates = np.round(np.arange(0.0, 0.7 + step / 2, step), 10)
+        k = np.array([41 if n is None else n for n in
+                      sl.mono.run_depth_filter_convergence(tuple(rates), n_obs=40, rng=seed).first_half()])
+        assert lo <= rates[np.flatnonzero(k >= 2 * k[0])[0]] <= hi, (seed, step)
+    rates = (0.0, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6)
+    k = np.array([_half_converged_scalar(r, 3) for r in rates])
+    assert lo <= rates[np.flatnonzero(k >= 2 * k[0])[0]] <= hi
+
+
+def test_tau_depth_range_from_this_files_tau_the_library_and_a_disparity():
+    from slamlab.mono import compute_tau
+
+    lo, hi = lab.task("09.explore.tau_depth").accepted_range()
+    delta = 2 * math.atan(0.5 / 500)
+    t, f = np.array([0.2, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    z = np.arange(5.0, 12.0, 0.001)
+    rel = np.array([tau(t, f, zi, delta) for zi in z]) / z  # this file's law-of-sines solution
+    assert lo <= z[np.argmax(rel > 0.1)] <= hi
+    rel_lib = compute_tau(t, np.tile(f, (z.size, 1)), z, delta) / z
+    assert lo <= z[np.argmax(rel_lib > 0.1)] <= hi
+    assert lo <= 500 * 0.2 / 11 <= hi  # rectified pair: z' = f b / (d - 1) is 10 % deeper when d = 11 px
+    assert lo <= 9.1 <= hi  # a 0.1 m grid's answer
+    assert not lo <= 0.1 * 0.2 / delta <= hi  # the small-angle estimate is off by more than the resolution
+
+
+def test_exploration_answers_of_the_instructor_methods():
+    assert lab.answer("09.explore.tau_depth", 9.1, quiet=True).passed
+    assert lab.answer("09.explore.tau_depth", 9.3, quiet=True).status == "failed"
+    assert lab.answer("09.explore.doubling_rate", 0.5, quiet=True).passed
+    assert lab.answer("09.explore.doubling_rate", 0.3, quiet=True).status == "failed"
+
+
+def test_exploration_helpers_reject_bad_input():
+    from slamlab.lab import tasks_mono as tm
+
+    with pytest.raises(ValueError, match="`rates`"):
+        tm.half_converged_observations([0.2, 1.0])
+    with pytest.raises(ValueError, match="`n_obs`"):
+        tm.half_converged_observations([0.2], n_obs=0)
+    with pytest.raises(ValueError, match="`step`"):
+        tm.doubling_rate(1, step=0.0)
+    with pytest.raises(ValueError, match="`z_m`"):
+        tm.tau_relative_depth(-1.0)
+    with pytest.raises(ValueError, match="`rel`"):
+        tm.depth_for_relative_error(0.0)
