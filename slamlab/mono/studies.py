@@ -487,7 +487,8 @@ def run_mono_vs_stereo(sequence: str = "strafe", *, n_frames: int = 40, size: st
     T_right_left = np.eye(4)
     T_right_left[:3, :3], T_right_left[:3, 3] = sim.rig.R_rl, sim.rig.t_rl
     T_br = T_bl @ se3_inverse(T_right_left)
-    st = StereoSLAM(sim.rig, T_bl)
+    # RANSAC's own stream, a child of the simulator's: spawning draws nothing, so the right images' noise is unchanged
+    st = StereoSLAM(sim.rig, T_bl, rng=sim.rng.spawn(1)[0])
     for pose, left in zip(poses, imgs, strict=True):
         T_wb = se3_from_planar(*pose)
         right = sim.arena.render(sim.rig.right, T_wb @ T_br) * 255.0
