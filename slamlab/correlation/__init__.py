@@ -13,24 +13,21 @@ from .algorithm import (
     score_maps,
 )
 from .experiments import (
-    DEFAULT_CARMEN_LOG,
     SOURCE_TABLE1,
     ConstantsResult,
     CorridorResult,
-    LogLocalisationResult,
     MonteCarloResult,
     Table1Result,
     corridor_grid,
     log_grid,
-    ours_vs_source,
     random_clutter,
     run_constants_study,
     run_corridor_tie,
-    run_log_localisation,
     run_monte_carlo,
     run_table1,
     time_localise,
 )
+from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, ours_vs_source, run_log_localisation
 
 _PLOT = (
     "constants_figure",

@@ -1,4 +1,5 @@
-"""Ch. 5 experiments (004 §7): Table 1, a Monte Carlo study, the constants a_c/a_p, a real CARMEN log.
+"""Ch. 5 experiments (004 §7): Table 1, a Monte Carlo study, the constants a_c/a_p, the corridor tie (the real
+CARMEN log and the closing table: :mod:`.log_experiments`).
 
 Every ``run_*`` takes ``params=`` (a :class:`~slamlab.correlation.LocaliseParams`, the
 same settings and defaults as :func:`~slamlab.correlation.localise`) plus overrides
@@ -12,8 +13,6 @@ nbval compares); arrays for plotting live in fields, timings in ``time_s``
 
 from __future__ import annotations
 
-import itertools
-import os
 import time
 from dataclasses import dataclass, field
 
@@ -21,19 +20,15 @@ import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
-from ..geometry import wrap_angle
-from ..geometry.se2 import se2_compose, se2_relative
-from ..scans import FREE, OBSTACLE, UNEXPLORED, GridFrame, grid_to_values
-from ..scans.logmap import leave_out_grid, log_counts, log_grid  # log_grid re-exported (one place: scans)
+from ..scans import FREE, OBSTACLE, UNEXPLORED, grid_to_values
+from ..scans.logmap import log_grid  # log_grid re-exported (one place: scans)
 from ..sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
 from ..sim.paths import random_free_poses
 from ..sim.rangefinder import Rangefinder
 from .algorithm import (
     Localisation,
     LocaliseParams,
-    _joined_samples,
     _localise,
-    _localise_samples,
     _scan_beams,
     heading_candidates,
     heading_error,
@@ -42,11 +37,9 @@ from .algorithm import (
 )
 
 __all__ = [
-    "ODOM_STD",
     "SOURCE_TABLE1",
     "ConstantsResult",
     "CorridorResult",
-    "LogLocalisationResult",
     "MonteCarloResult",
     "Table1Result",
     "corridor_grid",
@@ -54,7 +47,6 @@ __all__ = [
     "random_clutter",
     "run_constants_study",
     "run_corridor_tie",
-    "run_log_localisation",
     "run_monte_carlo",
     "run_table1",
     "time_localise",
@@ -389,245 +381,6 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
                            time.perf_counter() - t0)
 
 
-# --- real data: a CARMEN log with (corrected) poses ----------------------------------------------------
-
-#: The default log of :func:`run_log_localisation` (found by :func:`slamlab.data.find_data`).
-DEFAULT_CARMEN_LOG = "carmen-radish-corrected/intel-corrected.log.gz"
-
-
-def _carmen_log(path):
-    """A :class:`~slamlab.io.CarmenLog` from a path (str / os.PathLike; default the Intel log) or a read log."""
-    from ..io import CarmenLog, read_carmen
-
-    if isinstance(path, CarmenLog):
-        return path
-    if path is None:
-        from ..data import find_data
-
-        path = find_data(DEFAULT_CARMEN_LOG)
-    elif isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"`path` must be a str, os.PathLike or CarmenLog; got {type(path).__name__}")
-    return read_carmen(path)
-
-
-#: Default odometry noise of the joined modes: σ_xy [m], σ_θ [rad] per step between consecutive scans (ours).
-ODOM_STD = (0.05, float(np.radians(1.0)))
-
-
-@dataclass(frozen=True)
-class LogLocalisationResult:
-    """Correlation localisation of scans of a CARMEN log on grids built from its logged poses (real data).
-
-    Arrays with a leading ``modes`` axis hold one row per mode: ``joined[m]`` consecutive scans
-    (1 = one scan, 004's method; 2 or 3 = joined by odometry, ours).
-    """
-
-    name: str  # the log's file name
-    scan_indices: np.ndarray
-    true_poses_m: np.ndarray  # (n, 3) logged poses
-    est_poses_m: np.ndarray  # (modes, n, 3)
-    err_pos_m: np.ndarray  # (modes, n)
-    err_heading_rad: np.ndarray  # (modes, n)
-    ambiguity: np.ndarray  # (modes, n) Localisation.ambiguity
-    cell_m: float
-    max_range_m: float
-    exclude: int
-    grid: np.ndarray = field(repr=False)  # the whole log's grid (each scan is localised on it minus ±exclude scans)
-    frame: GridFrame = field(repr=False)
-    joined: tuple[int, ...] = (1,)
-    odom_std: tuple[float, float] = (0.0, 0.0)  # (m, rad) per step between consecutive scans
-    example_points_m: np.ndarray = field(default=None, repr=False)  # the first scan drawn at its estimate (mode 0)
-    params: LocaliseParams = field(default_factory=LocaliseParams, repr=False)
-    time_s: float = field(default=0.0, compare=False)
-
-    @property
-    def success(self) -> np.ndarray:
-        """``(modes, n)``: within 2 cells and 5° of the logged pose."""
-        return (self.err_pos_m <= FAIL_CELLS * self.cell_m) & (np.degrees(self.err_heading_rad) <= FAIL_DEG)
-
-    def _mode(self, k: int) -> str:
-        return "1 scan" if k == 1 else f"{k} scans + odometry"
-
-    def __str__(self) -> str:
-        ok = self.success
-        rates = ", ".join(f"{self._mode(k)} {ok[m].sum()}/{ok.shape[1]}" for m, k in enumerate(self.joined))
-        return (f"{self.name}: scans localised within {FAIL_CELLS * self.cell_m:.1f} m and {FAIL_DEG:g}° "
-                f"from no prior: {rates}")
-
-    def _title(self) -> str:
-        return (f"{self.name} (CARMEN, logged laser poses): grid {self.grid.shape[0]}x{self.grid.shape[1]} cells of "
-                f"{self.cell_m:g} m from the other scans (±{self.exclude} scans left out), ranges < "
-                f"{self.max_range_m:g} m, Δα = {np.degrees(self.params.delta_alpha_rad):g}°, no prior")
-
-    def table(self) -> str:
-        """One row per scan: the logged pose, then per mode the error, the ambiguity and success (the estimate too
-        when there is one mode)."""
-        one = len(self.joined) == 1
-        head = ["scan", "x [m]", "y [m]", "θ [°]"]
-        for k in self.joined:
-            tag = "" if one else f" ({k})"
-            head += (["x est", "y est", "θ est"] if one else []) + [f"err [m]{tag}", f"err [°]{tag}", f"amb.{tag}",
-                                                                    f"ok{tag}"]
-        rows = []
-        for j, (i, t) in enumerate(zip(self.scan_indices, self.true_poses_m, strict=True)):
-            row = [int(i), f"{t[0]:.2f}", f"{t[1]:.2f}", f"{np.degrees(wrap_angle(t[2])):.1f}"]
-            for m in range(len(self.joined)):
-                e = self.est_poses_m[m, j]
-                if one:
-                    row += [f"{e[0]:.2f}", f"{e[1]:.2f}", f"{np.degrees(wrap_angle(e[2])):.1f}"]
-                row += [f"{self.err_pos_m[m, j]:.2f}", f"{np.degrees(self.err_heading_rad[m, j]):.1f}",
-                        f"{self.ambiguity[m, j]:.3f}", "yes" if self.success[m, j] else "NO"]
-            rows.append(row)
-        modes = "" if one else "; modes " + ", ".join(f"({k}) {self._mode(k)}" for k in self.joined)
-        return format_table(head, rows, title=self._title() + modes)
-
-    def summary_table(self) -> str:
-        """Success rate per mode (success: within 2 cells and 5° of the logged pose)."""
-        ok = self.success
-        rows = [[self._mode(k), f"{ok[m].sum()}/{ok.shape[1]}", f"{ok[m].mean():.1%}",
-                 f"{np.median(self.err_pos_m[m][ok[m]]) if ok[m].any() else float('nan'):.3f}",
-                 f"{np.median(np.degrees(self.err_heading_rad[m][ok[m]])) if ok[m].any() else float('nan'):.2f}"]
-                for m, k in enumerate(self.joined)]
-        sx, sa = self.odom_std
-        title = (f"{self.name}: {ok.shape[1]} scans ({_describe(self.scan_indices)}), success = within "
-                 f"{FAIL_CELLS * self.cell_m:.1f} m ({FAIL_CELLS:g} cells) and {FAIL_DEG:g}° of the logged pose; "
-                 f"odometry noise σ = {sx:g} m, {np.degrees(sa):g}° per step")
-        return format_table(["mode", "localised", "rate", "median err [m]", "median err [°]"], rows, title=title)
-
-    def ambiguity_table(self, bins=(0.0, 0.5, 0.75, 0.9, 1.0), threshold: float = 0.75) -> str:
-        """How well the ambiguity separates failures from successes: counts per bin and flag rates at ``threshold``.
-
-        A scan is *flagged* when its ambiguity is at least ``threshold``; the table gives the fraction of
-        failures flagged (caught) and of successes flagged (false alarms), per mode.
-        """
-        b = v.as_vector(bins, "bins")
-        if b.size < 2 or np.any(np.diff(b) <= 0):
-            raise ValueError(f"`bins` must be at least two increasing edges; got {bins!r}")
-        t = _check_unit(threshold, "threshold")
-        head = ["mode", "outcome"] + [f"[{lo:g}, {hi:g}{']' if q == b.size - 2 else ')'}"
-                                      for q, (lo, hi) in enumerate(itertools.pairwise(b))]
-        head += [f"flagged (>= {t:g})"]
-        rows = []
-        for m, k in enumerate(self.joined):
-            a, ok = self.ambiguity[m], self.success[m]
-            for label, sel in (("success", ok), ("failure", ~ok)):
-                idx = np.clip(np.searchsorted(b, a[sel], side="right") - 1, 0, b.size - 2)
-                counts = np.bincount(idx, minlength=b.size - 1)
-                flag = f"{np.sum(a[sel] >= t)}/{sel.sum()}"
-                rows.append([self._mode(k), label, *(str(c) for c in counts), flag])
-        title = (f"Ambiguity = (rival - base) / (best - base), rival = best score of a pose > "
-                 f"{self.params.rival_radius_cells * self.cell_m:g} m or > {np.degrees(self.params.rival_heading_rad):g}° "
-                 "away, base = median of the headings' best scores; scans per bin")
-        return format_table(head, rows, title=title)
-
-
-def _describe(idx) -> str:
-    d = np.diff(idx)
-    if idx.size > 2 and np.all(d == d[0]):
-        return f"every {int(d[0])}th from {int(idx[0])} to {int(idx[-1])}"
-    return "scans " + ", ".join(str(int(i)) for i in idx)
-
-
-def _check_unit(x, name: str) -> float:
-    x = v.check_positive(x, name, allow_zero=True)
-    if x > 1:
-        raise ValueError(f"`{name}` must lie in [0, 1]; got {x}")
-    return x
-
-
-def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, headings, joined) -> dict:
-    """One sweep task: the leave-out grid of scan ``index`` and its localisation in every mode (deterministic)."""
-    Mv = grid_to_values(leave_out_grid(full, scans_c, Pc, leave), p.a_c, p.a_p, p.a_n)
-    row = {}
-    for k in joined:
-        free, obs, o = _joined_samples(beams[:k], rel[:k], p)
-        loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k)
-        row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity})
-    return row
-
-
-def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *,
-                         cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int = 10, joined=(1,),
-                         odom_std=ODOM_STD, params: LocaliseParams | None = None, rng=2017,
-                         n_jobs: int = 1, progress: bool | None = None, **overrides) -> LogLocalisationResult:
-    """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
-
-    Each test scan is localised on the grid (``cell_m`` cells, 004's three values) of every
-    scan of the log except ``±exclude`` scans around it, so a scan is never matched against
-    cells it or its neighbours drew (our stricter choice), from no prior (full 360°), and
-    compared with its logged pose (SLAM-corrected in the Radish logs). A success is a pose
-    within 2 cells and 5° of the logged one.
-
-    Modes (``joined``): 1 = the scan alone (004's method); 2 or 3 = the scan and the 1 or 2
-    scans before it joined by odometry (:func:`~slamlab.correlation.localise_joined`, ours).
-    The corrected logs carry no raw odometry, so each step between consecutive scans is the
-    logged relative pose plus Gaussian noise ``odom_std = (σ_xy [m], σ_θ [rad])`` drawn from ``rng``.
-    Every result carries the ambiguity of :class:`~slamlab.correlation.Localisation`.
-
-    Parameters
-    ----------
-    path : str, os.PathLike or CarmenLog, optional
-        Any CARMEN log (plain or gzip); default the corrected Intel Research Lab log
-        (``carmen-radish-corrected/intel-corrected.log.gz`` via :func:`slamlab.data.find_data`).
-        Results are labelled with the file name.
-    scan_indices : sequence of int
-        The scans to localise (at least ``max(joined) - 1``: the joined scans come before).
-    joined : sequence of int in {1, 2, 3}
-        The modes to run on the same scans.
-    params, **overrides
-        :class:`LocaliseParams` of every localisation (``rival_radius_cells`` 5 = 1 m at 0.2 m cells).
-    n_jobs, progress
-        The scans run on :func:`slamlab.sweep.sweep` (one task per scan; same result for any
-        ``n_jobs``) with a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
-    """
-    from ..sweep import sweep
-
-    p = LocaliseParams.resolve(params, **overrides)
-    log = _carmen_log(path)
-    cell = v.check_positive(cell_m, "cell_m")
-    rmax = v.check_positive(max_range_m, "max_range_m")
-    ex = v.check_int(exclude, "exclude", minimum=0)
-    modes = tuple(int(k) for k in np.atleast_1d(np.asarray(joined)))
-    if not modes or any(k not in (1, 2, 3) for k in modes) or len(set(modes)) != len(modes):
-        raise ValueError(f"`joined` must be distinct numbers of scans from {{1, 2, 3}}; got {joined!r}")
-    kmax = max(modes)
-    if ex < kmax - 1:
-        raise ValueError(f"`exclude` must be >= {kmax - 1} so the joined scans are not in the map; got {ex}")
-    sd = v.as_finite_array(odom_std, "odom_std")
-    if sd.shape != (2,) or np.any(sd < 0):
-        raise ValueError(f"`odom_std` must be (σ_xy_m, σ_θ_rad) >= 0; got {odom_std!r}")
-    idx = np.asarray(scan_indices)
-    if idx.ndim != 1 or idx.size == 0 or not np.issubdtype(idx.dtype, np.integer):
-        raise ValueError(f"`scan_indices` must be a non-empty list of ints; got {scan_indices!r}")
-    if idx.min() < kmax - 1 or idx.max() >= log.n_scans:
-        raise ValueError(f"`scan_indices` must lie in [{kmax - 1}, {log.n_scans - 1}] (the {kmax - 1} scans before "
-                         f"each are joined); got {idx.min()}..{idx.max()}")
-    rng = v.as_rng(rng)
-    t0 = time.perf_counter()
-    frame, scans_c, Pc, full = log_counts(log, cell_m=cell, max_range_m=rmax)
-    noise = rng.normal(size=(idx.size, kmax - 1, 3)) * np.array([sd[0] / cell, sd[0] / cell, sd[1]])
-    points = []
-    for n, i in enumerate(idx):
-        rel = [np.zeros(3)]
-        for j in range(1, kmax):  # chain the noisy steps back from scan i
-            rel.append(se2_compose(rel[-1], se2_relative(Pc[i - j + 1], Pc[i - j]) + noise[n, j - 1]))
-        points.append({"index": int(i), "leave": range(max(0, i - ex), min(log.n_scans, i + ex + 1)),
-                       "beams": [_scan_beams(scans_c[i - j], f"scan {i - j}") for j in range(kmax)],
-                       "rel": np.array(rel)})
-    fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
-             "joined": modes}
-    table = sweep(_localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed,
-                  on_error="raise", desc="localise log scans")
-    true_m = log.poses[idx]
-    est_m = np.stack([frame.to_metres(table[[f"x{k}", f"y{k}", f"h{k}"]].to_numpy(dtype=float)) for k in modes])
-    err_p = np.hypot(est_m[..., 0] - true_m[:, 0], est_m[..., 1] - true_m[:, 1])
-    err_a = heading_error(est_m[..., 2], true_m[:, 2])
-    amb = np.stack([table[f"amb{k}"].to_numpy(dtype=float) for k in modes])
-    example = log.scan(int(idx[0])).points(est_m[0, 0])
-    return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, amb, cell, rmax, ex, full.grid, frame,
-                                 modes, (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0)
-
-
 # --- a constructed corridor: the half-turn tie and how joined scans break it (ours) ----------------------
 
 
@@ -704,42 +457,3 @@ def time_localise(grid, scan, *, dtypes=("float64", "float32")) -> dict:
         localise(grid, scan, dtype=np.dtype(dt).name)
         out[np.dtype(dt).name] = time.perf_counter() - t0
     return out
-
-
-def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = None,
-                   constants: ConstantsResult | None = None, log: LogLocalisationResult | None = None) -> str:
-    """The notebook's closing table: 004's figures (§7, Table 1) beside ours, from the runs' results.
-
-    >>> print(ours_vs_source(run_table1(2, rng=1)).splitlines()[0])
-    Ours vs the source (004 §7)
-    """
-    if not isinstance(table1, Table1Result):
-        raise TypeError(f"`table1` must be a Table1Result; got {type(table1).__name__}")
-    src = SOURCE_TABLE1
-    s_ea, s_ex, s_ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
-    t = table1
-    rows = [
-        ["Table 1: poses", f"{src.shape[0]}", f"{t.true_poses.shape[0]}"],
-        ["Table 1: max position error [cells]", f"{max(s_ex.max(), s_ey.max()):.0f}",
-         f"{max(t.err_x_cells.max(), t.err_y_cells.max()):.0f}"],
-        ["Table 1: max heading error [rad]", f"{s_ea.max():.4f}", f"{t.err_heading_rad.max():.4f}"],
-        ["Table 1: range noise σ [cells]", "not given", f"{t.range_std_cells:g}"],
-    ]
-    if monte_carlo is not None:
-        mc = monte_carlo
-        rows += [[f"Monte Carlo ({mc.n_poses} poses): position exact", "no study", f"{np.mean(mc.err_pos_cells == 0):.1%}"],
-                 [f"Monte Carlo ({mc.n_poses} poses): failures (> 2 cells or > 5°)", "no study",
-                  f"{mc.failure_rate:.1%}"]]
-    if constants is not None:
-        c = constants
-        for k, lb in enumerate(c.labels):
-            rows.append([f"{lb}: heading margin / half-max area [cells]",
-                         "sharpest at a_p = -a_c" if k == 0 else "more robust to clutter",
-                         f"{np.median(c.heading_margin[k]):.3f} / {np.median(c.half_max_area[k]):.0f}"])
-            rows.append([f"{lb}: failures in the crowded room", "not measured", f"{c.failure_rate[k]:.0%}"])
-    if log is not None:
-        for m, k in enumerate(log.joined):
-            rows.append([(f"real log {log.name}, {log._mode(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
-                          f"and {FAIL_DEG:g}°"), "none (simulation only)",
-                         f"{int(log.success[m].sum())}/{log.success.shape[1]}"])
-    return format_table(["quantity", "004", "ours"], rows, title="Ours vs the source (004 §7)")

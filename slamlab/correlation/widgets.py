@@ -13,7 +13,8 @@ from ..sim.rangefinder import Rangefinder
 from ..widgets import STYLE as _STYLE
 from ..widgets import slider as _slider
 from .algorithm import heading_error, localise, localise_joined
-from .experiments import _carmen_log, random_clutter
+from .experiments import random_clutter
+from .log_experiments import _carmen_log
 from .plot import localisation_figure
 
 __all__ = ["explore_localisation", "explore_log_scan"]
