@@ -8,25 +8,21 @@ widgets load on first use.
 from .._lazy import lazy_exports
 from .experiments import (
     COMPARISON,
-    KITTI_PARAMS,
     SIZES,
     DriftStudy,
-    KittiRunResult,
     StereoRunResult,
     comparison_table,
     disparity_errors,
     experiment_poses,
-    kitti_comparison,
-    ours_vs_source,
     record_stereo_stream,
     run_closed_loop,
     run_comparison,
     run_drift_study,
-    run_kitti,
     run_stereo_slam,
     run_stereo_slam_variants,
     run_turn_in_place,
 )
+from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
 from .slam import STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (

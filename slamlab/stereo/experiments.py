@@ -1,4 +1,5 @@
-"""Ch. 4 experiments (000 §3.7): the stereo SLAM loop on rendered arena runs, against ground truth.
+"""Ch. 4 experiments (000 §3.7): the stereo SLAM loop on rendered arena runs, against ground truth (KITTI and the
+closing table: :mod:`.kitti_experiments`).
 
 ``run_turn_in_place`` (000 §3.7.1) and ``run_closed_loop`` (000 §3.7.2) return a
 frozen :class:`StereoRunResult`; ``str(result)`` is a one-line summary and
@@ -30,18 +31,14 @@ __all__ = [
     "COMPARISON",
     "SIZES",
     "DriftStudy",
-    "KittiRunResult",
     "StereoRunResult",
     "comparison_table",
     "disparity_errors",
     "experiment_poses",
-    "kitti_comparison",
-    "ours_vs_source",
     "record_stereo_stream",
     "run_closed_loop",
     "run_comparison",
     "run_drift_study",
-    "run_kitti",
     "run_stereo_slam",
     "run_stereo_slam_variants",
     "run_turn_in_place",
@@ -401,163 +398,6 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
                         base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
 
 
-@dataclass(frozen=True)
-class KittiRunResult:
-    """StereoSLAM on a KITTI odometry sequence against its ground truth (real data)."""
-
-    name: str  # the sequence folder's name
-    truth: np.ndarray = field(repr=False)  # (N, 4, 4) left-camera poses in the frame-0 camera frame
-    estimate: np.ndarray = field(repr=False)  # (N, 4, 4)
-    ate_m: float
-    ate_se3_m: float
-    rpe_m: float
-    final_error_m: float
-    path_length_m: float
-    n_degenerate: int
-    inliers_median: float
-    fps: float = field(compare=False)
-
-    def __str__(self) -> str:
-        return (f"{self.name}, {len(self.truth)} frames: ATE {self.ate_m:.2f} m (after SE(3) alignment "
-                f"{self.ate_se3_m:.2f} m), final error {self.final_error_m:.2f} m over {self.path_length_m:.1f} m")
-
-    @property
-    def length_ratio(self) -> float:
-        """Length of the estimated path over the true path length (1: no scale error)."""
-        return float(np.sum(np.linalg.norm(np.diff(self.estimate[:, :3, 3], axis=0), axis=1)) / self.path_length_m)
-
-    @property
-    def end_distance_ratio(self) -> float:
-        """Distance of the last estimated position from the start over the true one (1: no scale error)."""
-        return float(np.linalg.norm(self.estimate[-1, :3, 3] - self.estimate[0, :3, 3])
-                     / np.linalg.norm(self.truth[-1, :3, 3] - self.truth[0, :3, 3]))
-
-    @property
-    def step_ratios(self) -> np.ndarray:
-        """Length of every estimated frame-to-frame step over the true one, ``(n - 1,)`` (issue 17).
-
-        Their mean and its standard error tell whether a scale bias is resolved by the run."""
-        est = np.linalg.norm(np.diff(self.estimate[:, :3, 3], axis=0), axis=1)
-        return est / np.linalg.norm(np.diff(self.truth[:, :3, 3], axis=0), axis=1)
-
-    def table(self) -> str:
-        rows = [
-            ["frames (degenerate)", f"{len(self.truth)} ({self.n_degenerate})"],
-            ["ATE RMSE, no alignment, m", f"{self.ate_m:.2f}"],
-            ["ATE RMSE, SE(3)-aligned, m", f"{self.ate_se3_m:.2f}"],
-            ["RPE RMSE over 1 frame, m", f"{self.rpe_m:.2f}"],
-            ["final position error, m", f"{self.final_error_m:.2f}"],
-            ["final error / path length, %", f"{100 * self.final_error_m / self.path_length_m:.1f}"],
-            ["path length, estimate / truth", f"{self.length_ratio:.3f}"],
-            ["start-to-end distance, estimate / truth", f"{self.end_distance_ratio:.3f}"],
-            ["RANSAC inliers per frame (median)", f"{self.inliers_median:.0f}"],
-        ]
-        return format_table(["quantity", "ours"], rows,
-                            title=f"{self.name}, frames 0-{len(self.truth) - 1} (real data)")
-
-
-#: the pipeline's settings on KITTI: ``max_depth_m = 40`` because the street scene reaches tens of
-#: metres (the arena's default, 10 m, would drop most of it); ``orb_levels = 1`` (ORB only): at 10 Hz a
-#: feature's scale changes by a few per cent per frame, and ORB's coarse levels doubled the spread of its
-#: per-frame step lengths (sd 5.2 % -> 2.8 % of the true step over frames 0-19, issue 17);
-#: ``map_search = "global"``: 20 frames leave a small map, so ORB keeps 000's search over every landmark
-#: (the window search is for long runs; on these frames it gave ATE 0.19 against 0.18 m); everything else
-#: as :class:`StereoParams`
-KITTI_PARAMS = StereoParams(max_depth_m=40.0, orb_levels=1, map_search="global")
-
-
-def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams | None = None, rng=0,
-              progress: bool | None = None, **overrides) -> KittiRunResult:
-    """StereoSLAM on a KITTI odometry sequence folder (real data); default the shared ``kitti-odometry-06-stereo``.
-
-    ``folder`` (``str`` or ``os.PathLike``) holds ``calib.txt`` (official ``P0: ...`` lines or the
-    bare rows, :func:`~slamlab.io.read_kitti_calib`), ``poses.txt`` (ground truth, one
-    3×4 row per frame), ``image_0/000000.png ...`` (left) and ``image_1/...`` (right). The image
-    size comes from the first left image, the run's name from the folder's name; ``n_frames``
-    keeps the first frames (default: one per pose). ``params`` (default :data:`KITTI_PARAMS`) plus
-    ``overrides``: :class:`StereoParams`. The map frame is the first left-camera frame, as in
-    ``poses.txt``. ATE and RPE by :mod:`slamlab.evaluation` (equal to evo's). ``progress``: a
-    bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
-    """
-    from ..data import find_data
-    from ..evaluation import Trajectory, ate, read_kitti, rpe
-    from ..io.kitti import kitti_rig, read_kitti_image
-
-    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else v.as_path(folder, "folder", kind="dir")
-    p = StereoParams.resolve(KITTI_PARAMS if params is None else params, **overrides)
-    gt34 = read_kitti(d / "poses.txt").poses[:, :3, :]
-    n = len(gt34) if n_frames is None else min(len(gt34), v.check_int(n_frames, "n_frames", minimum=2))
-    gt34 = gt34[:n]
-    left0 = read_kitti_image(d / "image_0" / f"{0:06d}.png")
-    rig = kitti_rig(d / "calib.txt", left0.shape[1], left0.shape[0])
-    slam = StereoSLAM(rig, np.eye(4), params=p, rng=rng)
-    t_slam = 0.0
-    for i in progress_bar(range(n), desc=f"stereo SLAM: {d.name}", progress=progress):
-        left = left0 if i == 0 else read_kitti_image(d / "image_0" / f"{i:06d}.png")
-        right = read_kitti_image(d / "image_1" / f"{i:06d}.png")
-        t = time.perf_counter()
-        slam.process(left, right)
-        t_slam += time.perf_counter() - t
-    est = slam.trajectory
-    truth = np.tile(np.eye(4), (n, 1, 1))
-    truth[:, :3, :] = gt34
-    ts = np.arange(n) * 0.1  # KITTI runs at about 10 Hz
-    ref = Trajectory(truth[:, :3, 3], truth[:, :3, :3], ts)
-    ours = Trajectory(est[:, :3, 3], est[:, :3, :3], ts)
-    return KittiRunResult(
-        name=d.name, truth=truth, estimate=est, ate_m=float(ate(ref, ours, align="none").rmse),
-        ate_se3_m=float(ate(ref, ours, align="se3").rmse), rpe_m=float(rpe(ref, ours, delta=1).rmse),
-        final_error_m=float(np.linalg.norm(est[-1, :3, 3] - truth[-1, :3, 3])),
-        path_length_m=float(np.sum(np.linalg.norm(np.diff(truth[:, :3, 3], axis=0), axis=1))),
-        n_degenerate=len(slam.degenerate_frames), inliers_median=float(np.median(slam.counts()["n_inliers"][1:])),
-        fps=n / t_slam,
-    )  # fmt: skip
-
-
-def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None = None,
-                   kitti: KittiRunResult | None = None) -> str:
-    """000's figures (§3.1 requirements, §3.7 results) beside ours, from the chapter's runs.
-
-    ``turn``: :func:`run_turn_in_place`; ``loops``: :func:`run_comparison` of the closed loop
-    (label -> result; the first is 000's pipeline); ``drift``: :func:`run_drift_study`;
-    ``kitti``: :func:`run_kitti`. Frame rates are timings and stay out (``timing_table``).
-    """
-    deg = np.rad2deg
-    runs = list(loops.items())
-    if not runs:
-        raise ValueError("`loops` is empty")
-    (label0, loop0), others = runs[0], runs[1:]
-
-    def per_run(fmt):
-        main = fmt(loop0)
-        return main + ("" if not others else " (" + "; ".join(f"{k}: {fmt(r)}" for k, r in others) + ")")
-
-    i180 = turn.frame_at_turn(np.pi)
-    rows = [
-        ["turn: max position error, m", "<= 0.15", f"{turn.pos_err_m.max():.2f}"],
-        ["turn: spread of positions, m", "~0.20", f"{turn.position_spread_m:.2f}"],
-        ["turn: heading error at 180 deg, deg", "<= 5", f"{deg(abs(turn.yaw_err_rad[i180])):.1f}"],
-        ["turn: heading error back at 0 deg, deg", "2-3", f"{deg(abs(turn.yaw_err_rad[-1])):.1f}"],
-        [f"loop ({label0}): max position error, m", "<= 0.5 (req.)", per_run(lambda r: f"{r.pos_err_m.max():.2f}")],
-        ["loop: max heading error / turned angle, %", "<= 10 (req.); 000: 10",
-         per_run(lambda r: f"{100 * r.heading_error_ratio:.1f}")],
-        ["loop: revisit pose change, m / deg", "same pose (req.)",
-         per_run(lambda r: f"{r.revisit_difference[0]:.2f} / {deg(abs(r.revisit_difference[1])):.1f}")],
-        ["loop: stereo matches per frame (median)", "~500 (<100 bad)",
-         per_run(lambda r: f"{np.median(r.counts['n_stereo']):.0f}")],
-    ]
-    if drift is not None:
-        levels = ", ".join(f"{1e3 * d:g}: {r.pos_err_m.max():.2f} m / {deg(np.abs(r.yaw_err_rad).max()):.1f} deg"
-                           for d, r in zip(drift.drift_std_rad, drift.runs, strict=True))
-        rows.append([f"calibration drift (mrad/frame): max error, {drift.experiment}, {drift.runs[0].n_frames} frames",
-                     "'tends to change'", levels])
-    if kitti is not None:
-        rows.append([f"real data ({kitti.name}, {len(kitti.truth)} frames): ATE / SE(3)-aligned / final, m",
-                     "— (no ground truth)", (f"{kitti.ate_m:.2f} / {kitti.ate_se3_m:.2f} / {kitti.final_error_m:.2f} "
-                                             f"over {kitti.path_length_m:.1f} m")])
-    return format_table(["quantity", "000", "ours"], rows, title="Stereo SLAM: 000 beside ours (frame rates: timing tables)")
-
-
 def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, params: StereoParams | None = None,
                      rng=0, **overrides) -> str:
     """Stereo disparity errors against the renderer's depth, per ORB pyramid level, before and after
@@ -599,21 +439,3 @@ def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, 
     head = ["level", "matches", "keypoints: median |err|, px", "> 1 px, %", "refined: median |err|, px", "> 1 px, %",
             "refined, %"]
     return format_table(head, rows, title=f"disparity error against the renderer ({p.detector.upper()}, one frame)")
-
-
-def kitti_comparison(variants: dict, folder=None, *, n_frames: int | None = None, rng=0) -> str:
-    """:func:`run_kitti` once per setting (label -> overrides of :data:`KITTI_PARAMS`), side by side:
-    ATE, final error and the scale figures (path length and start-to-end distance, estimate / truth;
-    the per-frame step ratios' mean, standard error and spread, :attr:`KittiRunResult.step_ratios`)."""
-    if not isinstance(variants, dict) or not variants:
-        raise TypeError("`variants` must be a non-empty dict of label -> dict of overrides")
-    rows = []
-    for label, over in variants.items():
-        k = run_kitti(folder, n_frames=n_frames, rng=rng, progress=False, **over)
-        st = k.step_ratios
-        rows.append([label, f"{k.ate_m:.2f}", f"{k.ate_se3_m:.2f}", f"{k.final_error_m:.2f}", f"{k.length_ratio:.3f}",
-                     f"{k.end_distance_ratio:.3f}", f"{st.mean():.3f} ± {st.std(ddof=1) / np.sqrt(st.size):.3f}",
-                     f"{st.std(ddof=1):.3f}"])
-    head = ["setting", "ATE, m", "SE(3)-aligned, m", "final, m", "path length est./true", "start-end est./true",
-            "step est./true: mean ± s.e.", "sd"]
-    return format_table(head, rows, title=f"{k.name}, {len(k.truth)} frames (real data)")
