@@ -38,9 +38,9 @@ ALLOWED: dict[str, dict[str, str]] = {
     # filters: each experiment is one model (F, Q, H, R from its keywords) run through the filters
     "slamlab.filters.experiments.run_cv_target": {"params": _NO_PIPELINE},
     "slamlab.filters.experiments.run_joseph_vs_short": {"params": _NO_PIPELINE},
-    "slamlab.filters.unicycle_experiments.run_unicycle_comparison": {"params": _NO_PIPELINE},
-    "slamlab.filters.unicycle_experiments.run_stabilising_noise": {"params": _NO_PIPELINE},
-    "slamlab.filters.unicycle_experiments.run_sigma_alpha_study": {"params": _NO_PIPELINE},
+    "slamlab.filters.experiments.run_unicycle_comparison": {"params": _NO_PIPELINE},
+    "slamlab.filters.experiments.run_stabilising_noise": {"params": _NO_PIPELINE},
+    "slamlab.filters.experiments.run_sigma_alpha_study": {"params": _NO_PIPELINE},
     "slamlab.filters.experiments.run_landmark_filter": {"params": _NO_PIPELINE},
     # hough
     "slamlab.hough.experiments.run_example_line": {

@@ -111,7 +111,6 @@ def test_import_graph_has_no_cycle_across_subpackages():
 def test_algorithm_modules_never_import_sim():
     bad = [f"{m} -> {t}" for m, targets in _graph().items() for t in targets
            if _subpackage(t) == "sim" and _subpackage(m) != "sim" and m.split(".")[-1] not in SIM_USERS
-           and not m.endswith("_experiments")  # an experiment family split from experiments.py (CONVENTIONS)
            and m != "slamlab"]
     assert not bad, "algorithm modules import slamlab.sim: " + ", ".join(sorted(bad))
 

@@ -9,7 +9,16 @@ from .._lazy import lazy_exports
 from ._linalg import CholeskyError, symmetrize
 from .consistency import chi2_interval, nees, nis
 from .ekf import ExtendedKalmanFilter, check_jacobian, ekf_predict, ekf_update, numerical_jacobian
-from .experiments import run_cv_target, run_joseph_vs_short, run_landmark_filter
+from .experiments import (
+    default_landmarks,
+    ours_vs_source,
+    run_cv_target,
+    run_joseph_vs_short,
+    run_landmark_filter,
+    run_sigma_alpha_study,
+    run_stabilising_noise,
+    run_unicycle_comparison,
+)
 from .kalman import KalmanFilter, Update, kf_predict, kf_update
 from .landmark import LandmarkFilter, landmark_predict, landmark_update
 from .ukf import (
@@ -19,13 +28,6 @@ from .ukf import (
     ukf_predict,
     ukf_update,
     unscented_transform,
-)
-from .unicycle_experiments import (
-    default_landmarks,
-    ours_vs_source,
-    run_sigma_alpha_study,
-    run_stabilising_noise,
-    run_unicycle_comparison,
 )
 
 __all__ = [

@@ -5,9 +5,8 @@ from __future__ import annotations
 import ipywidgets as widgets
 
 from ..widgets import slider as _slider
-from .experiments import run_cv_target
+from .experiments import run_cv_target, run_unicycle_comparison
 from .plot import cv_figure, unicycle_figure
-from .unicycle_experiments import run_unicycle_comparison
 
 __all__ = ["explore_cv_target", "explore_unicycle"]
 

@@ -99,7 +99,7 @@ register(Task("01.sigma_points", "Task 5, sigma points", lambda x, P, alpha, kap
 
 
 def _smallest_q_scale() -> float:
-    from ..filters.unicycle_experiments import run_stabilising_noise
+    from ..filters.experiments import run_stabilising_noise
 
     res = run_stabilising_noise(scales=(1.0, 2.0, 4.0, 8.0, 16.0), n_runs=30, n_steps=60, rng=2010,
                                 progress=False)

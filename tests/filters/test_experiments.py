@@ -4,7 +4,7 @@ import matplotlib
 import numpy as np
 import pytest
 
-import slamlab.filters as E  # the chapter's experiments, from both family modules
+from slamlab.filters import experiments as E
 from slamlab.filters import plot as P
 from slamlab.filters import widgets as W
 

@@ -109,7 +109,7 @@ def test_autograder_mode_raises_on_anything_but_a_pass(monkeypatch):
 
 
 def test_exploration_answers():
-    from slamlab.filters.unicycle_experiments import run_stabilising_noise
+    from slamlab.filters.experiments import run_stabilising_noise
 
     res = run_stabilising_noise(scales=(1.0, 2.0, 4.0, 8.0, 16.0), n_runs=30, n_steps=60, rng=2010, progress=False)
     lo, hi = res.nees_bounds
