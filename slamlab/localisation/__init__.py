@@ -38,7 +38,6 @@ from .models import (
     check_particles,
     motion_density_odometry,
     odometry_deltas,
-    ray_cast,
     sample_motion_odometry,
     scan_beams,
 )
@@ -130,7 +129,6 @@ __all__ = [
     "odometry_deltas",
     "ours_vs_source",
     "pose_estimate",
-    "ray_cast",
     "run_correlation_side_by_side",
     "run_filter",
     "run_global_ablation",

@@ -20,13 +20,12 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import se2_integrate, se2_relative, wrap_angle
-from ..scans import Scan
+from ..scans import Scan, cast_rays
 from ..sim.grid import measurement_room_200, test_room_200
 from ..sim.paths import path_004
 from ..sim.rangefinder import Rangefinder, simulate_odometry
 from .markov import MarkovGrid
 from .mcl import MCL, MCLParams
-from .models import ray_cast
 from .particles import uniform_free_particles
 
 __all__ = [
@@ -109,10 +108,10 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
     M = test_room_200()
     rf = Rangefinder(n_beams=n_beams, max_range_cells=MAX_RANGE, range_std_cells=range_std_cells)
     W = M if world == "map" else measurement_room_200()
-    # the rangefinder's exact traversal for every pose at once (ray_cast = slamlab.sim.cast_rays, tested), then
+    # the rangefinder's exact traversal for every pose at once (slamlab.scans.cast_rays), then
     # its noise pose by pose in order (the same draws as Rangefinder.scan)
     ang = rf.angles_rad
-    Z = ray_cast(W, true, ang, MAX_RANGE)
+    Z = cast_rays(W, true, ang, MAX_RANGE)[0]
     scans = []
     for z, p in zip(Z, true, strict=True):
         hit = z < MAX_RANGE

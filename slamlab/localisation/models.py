@@ -9,7 +9,7 @@ API summary
 - :class:`LikelihoodFieldModel`: Table 6.3 with the distance table of
   :func:`slamlab.scans.likelihood_field`; ``log_likelihood(poses, beams)`` over
   particles × beams in one gather.
-- :func:`ray_cast` (exact grid traversal from many poses at once: :func:`slamlab.scans.cast_rays`) and
+- the expected ranges come from :func:`slamlab.scans.cast_rays` (exact grid traversal from many poses at once), and
   :func:`beam_model_prob` (Table 6.1: z_hit, z_short, z_max, z_rand).
 - :func:`scan_beams`: the beams of a :class:`~slamlab.scans.Scan` a filter uses.
 
@@ -29,7 +29,7 @@ from scipy.special import erf
 from .. import _validate as v
 from .._params import Params, param
 from ..geometry import wrap_angle
-from ..scans import OBSTACLE, Scan, cast_rays, check_grid, likelihood_field
+from ..scans import OBSTACLE, Scan, check_grid, likelihood_field
 
 __all__ = [
     "SCORES",
@@ -40,7 +40,6 @@ __all__ = [
     "check_particles",
     "motion_density_odometry",
     "odometry_deltas",
-    "ray_cast",
     "sample_motion_odometry",
     "scan_beams",
 ]
@@ -404,39 +403,6 @@ class LikelihoodFieldModel:
 
 
 # --- beam model (PR Table 6.1) ------------------------------------------------------------------------
-
-
-def ray_cast(grid, poses, angles_rad, max_range: float) -> np.ndarray:
-    """Expected ranges ``z*`` from every pose along every beam, shape ``(N, B)`` (PR Table 6.1's ray casting).
-
-    The one grid ray caster, :func:`slamlab.scans.cast_rays` (exact Amanatides-Woo
-    traversal of all ``N·B`` rays at once), without its ``hit`` mask: a ray stops on the
-    face of the first OBSTACLE cell it enters, ``max_range`` when it meets none within
-    reach or leaves the map.
-
-    Parameters
-    ----------
-    grid : array_like of int, shape (H, W)
-        The map (cell codes).
-    poses : array_like, shape (N, 3)
-        Particles ``(x, y, heading_rad)`` in cells.
-    angles_rad : array_like, shape (B,)
-        Beam angles relative to the heading.
-    max_range : float
-        Maximum range in cells.
-
-    Returns
-    -------
-    numpy.ndarray of float, shape (N, B)
-
-    Examples
-    --------
-    >>> g = np.zeros((5, 9), np.int8); g[:, 8] = 1
-    >>> ray_cast(g, [[2, 2, 0], [4, 2, 0]], [0.0, np.pi], 20.0).tolist()
-    [[5.5, 20.0], [3.5, 20.0]]
-    """
-    P = check_particles(poses, "poses")
-    return cast_rays(grid, P, angles_rad, max_range)[0]
 
 
 def beam_model_prob(z, z_star, *, z_max: float, z_hit: float = 0.8, z_short: float = 0.1,

@@ -3,7 +3,7 @@
 API summary
 -----------
 - :func:`beam_angles` ``(n_beams, fov_rad) -> (n,)`` beam angles relative to the heading.
-- :func:`cast_rays` ``(grid, pose, angles_rad, max_range_cells) -> (ranges, hit)``:
+- :func:`cast_rays` ``(grid, pose, angles_rad, max_range) -> (ranges, hit)``:
   exact grid traversal (Amanatides-Woo), vectorised over beams: :func:`slamlab.scans.cast_rays` for one pose.
 - :class:`Rangefinder` (beam count, field of view, maximum range, Gaussian range
   noise, range quantisation) with ``.scan(grid, pose, rng) -> Scan``;
@@ -32,7 +32,7 @@ from .. import _validate as v
 from ..geometry.odometry import Odometry, simulate_odometry  # one place: geometry (re-exported here)
 from ..geometry.se2 import check_pose, check_poses
 from ..scans import Scan, check_grid
-from ..scans.raycast import cast_rays as scans_cast_rays
+from ..scans.raycast import cast_rays  # the one grid ray caster (re-exported here)
 
 __all__ = [
     "Odometry",
@@ -67,40 +67,6 @@ def beam_angles(n_beams: int = 360, fov_rad: float = 2 * np.pi) -> np.ndarray:
     if n == 1:
         return np.zeros(1)
     return np.linspace(-fov / 2, fov / 2, n)
-
-
-def cast_rays(grid, pose, angles_rad, max_range_cells: float) -> tuple[np.ndarray, np.ndarray]:
-    """Exact ranges from ``pose`` along each beam to the first obstacle cell (004 §7).
-
-    The one grid ray caster, :func:`slamlab.scans.cast_rays` (Amanatides-Woo traversal,
-    vectorised over the beams), for one pose.
-
-    Parameters
-    ----------
-    grid : array_like of int, shape (H, W)
-        Occupancy grid (see :mod:`slamlab.sim.grid`).
-    pose : array_like, shape (3,)
-        ``(x, y, heading_rad)`` in cells.
-    angles_rad : array_like, shape (n,)
-        Beam angles relative to the heading.
-    max_range_cells : float
-        Maximum range.
-
-    Returns
-    -------
-    ranges : numpy.ndarray, shape (n,)
-        Distance to the obstacle face entered, ``max_range_cells`` when no return.
-    hit : numpy.ndarray of bool, shape (n,)
-
-    Examples
-    --------
-    >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 0] = 1
-    >>> cast_rays(g, [2.0, 2.0, 0.0], [np.pi, 0.0], 5.0)
-    (array([1.5, 5. ]), array([ True, False]))
-    """
-    p = check_pose(pose)
-    rmax = v.check_positive(max_range_cells, "max_range_cells")
-    return scans_cast_rays(grid, p, angles_rad, rmax)
 
 
 @dataclass(frozen=True)

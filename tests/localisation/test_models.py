@@ -9,7 +9,7 @@ from scipy.spatial import cKDTree
 
 from slamlab import localisation as L
 from slamlab import sim as S
-from slamlab.scans import Scan
+from slamlab.scans import Scan, cast_rays
 
 
 def _npdf(x, var):
@@ -136,7 +136,7 @@ def test_ray_cast_expected_ranges_closed_form_in_a_box():
     M[1:39, 1:59] = S.FREE
     X = L.uniform_free_particles(M, 15, 2)
     ang = S.beam_angles(37)
-    z = L.ray_cast(M, X, ang, 200.0)
+    z = cast_rays(M, X, ang, 200.0)[0]
     th = X[:, 2:3] + ang
     c, s = np.cos(th), np.sin(th)
     with np.errstate(divide="ignore"):
@@ -144,7 +144,7 @@ def test_ray_cast_expected_ranges_closed_form_in_a_box():
         ty = np.where(s > 0, (38.5 - X[:, 1:2]) / s, np.where(s < 0, (0.5 - X[:, 1:2]) / s, np.inf))
     assert z.shape == (15, 37)
     np.testing.assert_allclose(z, np.minimum(tx, ty), atol=1e-9)
-    assert np.all(L.ray_cast(M, X, ang, 5.0) <= 5.0)
+    assert np.all(cast_rays(M, X, ang, 5.0)[0] <= 5.0)
 
 
 def test_beam_model_integrates_to_one_and_matches_scipy_parts():
