@@ -28,13 +28,13 @@ ALLOWED: dict[str, dict[str, str]] = {
     "slamlab.correlation.experiments.run_corridor_tie": {"rng": _NO_RANDOMNESS + " (a noise-free corridor)"},
     # features: detectors and matchers on the Oxford images; their settings are the detectors' own arguments
     "slamlab.features.experiments.run_pair_evaluation": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.experiments.run_detector_summary": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.experiments.run_surf_threshold": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.features.detector_experiments.run_detector_summary": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.features.detector_experiments.run_surf_threshold": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.matching_experiments.run_knn_comparison": {
         "params": _NO_PIPELINE, "rng": _NO_RANDOMNESS + " (FLANN's trees: cv2.setRNGSeed(0) in kdtree.knn)"},
     "slamlab.features.matching_experiments.run_recall_vs_leaves": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.matching_experiments.run_ratio_tradeoff": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.experiments.run_blob_scale": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.features.detector_experiments.run_blob_scale": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     # filters: each experiment is one model (F, Q, H, R from its keywords) run through the filters
     "slamlab.filters.experiments.run_cv_target": {"params": _NO_PIPELINE},
     "slamlab.filters.experiments.run_joseph_vs_short": {"params": _NO_PIPELINE},

@@ -63,14 +63,36 @@ class Features:
         return f"{self.method}: {len(self)} keypoints, {d}"
 
     def subset(self, index) -> Features:
-        """The keypoints selected by a boolean mask or an index array."""
+        """The keypoints selected by a boolean mask or an index array.
+
+        Parameters
+        ----------
+        index : (N,) bool or (K,) int array
+            Boolean mask over the keypoints or indices of the keypoints to keep, in that order.
+
+        Returns
+        -------
+        Features
+            The selected keypoints (and descriptors), same ``method``.
+        """
         index = np.asarray(index)
         return Features(self.uv[index], self.scale_px[index], self.orientation_rad[index], self.response[index],
                         self.octave[index], None if self.descriptors is None else self.descriptors[index],
                         self.method)
 
     def strongest(self, n: int) -> Features:
-        """The ``n`` keypoints of largest response (stable order for ties)."""
+        """The ``n`` keypoints of largest response (stable order for ties).
+
+        Parameters
+        ----------
+        n : int
+            Number of keypoints to keep (>= 0); all of them when ``n`` exceeds their number.
+
+        Returns
+        -------
+        Features
+            The ``n`` strongest keypoints, in their original order.
+        """
         n = v.check_int(n, "n", minimum=0)
         order = np.argsort(-self.response, kind="stable")[:n]
         return self.subset(np.sort(order))
@@ -92,6 +114,20 @@ def to_gray_float(image, name: str = "image", *, channel_order: str = "rgb") -> 
 
     ``channel_order`` says how a colour image's channels are ordered: ``"rgb"`` (default:
     numpy, matplotlib, imageio) or ``"bgr"`` (what ``cv2.imread`` returns).
+
+    Parameters
+    ----------
+    image : (H, W) or (H, W, 3|4) array
+        Grey or colour image: uint8 (divided by 255), bool, or float (taken as given).
+    name : str
+        Argument name used in error messages.
+    channel_order : {'rgb', 'bgr'}
+        Channel order of a colour image.
+
+    Returns
+    -------
+    gray : (H, W) float64
+        Grey image, in [0, 1] for uint8 input.
 
     >>> to_gray_float(np.array([[0, 255]], dtype=np.uint8)).tolist()
     [[0.0, 1.0]]
@@ -118,6 +154,20 @@ def to_gray_uint8(image, name: str = "image", *, channel_order: str = "rgb") -> 
     A uint8 colour image is converted by OpenCV (``cv2.COLOR_RGB2GRAY`` or, with
     ``channel_order="bgr"``, ``cv2.COLOR_BGR2GRAY``: the same values as ``cv2.imread(...,
     cv2.IMREAD_GRAYSCALE)`` of a colour file read in colour).
+
+    Parameters
+    ----------
+    image : (H, W) or (H, W, 3|4) array
+        Grey or colour image, uint8 or float in [0, 1] (rounded and clipped to 0..255).
+    name : str
+        Argument name used in error messages.
+    channel_order : {'rgb', 'bgr'}
+        Channel order of a colour image.
+
+    Returns
+    -------
+    gray : (H, W) uint8
+        Grey image (a uint8 grey input is returned as is).
     """
     img = v.as_image(image, name, allow_color=True)
     if img.dtype == np.uint8 and img.ndim == 2:

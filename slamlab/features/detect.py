@@ -23,6 +23,24 @@ def describe_surf(image, features: Features, *, scale_px: float | None = None, u
 
     ``scale_px`` overrides the keypoints' scale (FAST: our choice σ = 2 px);
     ``upright`` uses orientation 0 (U-SURF), otherwise the keypoints' orientation.
+
+    Parameters
+    ----------
+    image : (H, W) or (H, W, 3) array
+        The image the keypoints were found in (converted to grey float in [0, 1]).
+    features : Features
+        Keypoints to describe (their ``uv``, ``scale_px`` and ``orientation_rad`` are used).
+    scale_px : float, optional
+        Scale σ in pixels for every keypoint; None uses each keypoint's ``scale_px``.
+    upright : bool
+        Orientation 0 for every keypoint (U-SURF) instead of ``orientation_rad``.
+    extended : bool
+        128-d descriptors (SURF-128) instead of 64-d.
+
+    Returns
+    -------
+    Features
+        The same keypoints with float SURF ``descriptors`` attached.
     """
     if not isinstance(features, Features):
         raise TypeError(f"`features` must be slamlab.features.Features; got {type(features).__name__}")

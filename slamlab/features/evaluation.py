@@ -49,7 +49,18 @@ _IMAGE_SUFFIXES = (".png", ".ppm", ".pgm", ".jpg", ".tif")
 def oxford_folder(sequence) -> Path:
     """The folder of an Oxford-layout sequence: a shared sequence's name (:data:`OXFORD_SEQUENCES`,
     found by :func:`slamlab.data.find_data`) or a ``str`` / ``os.PathLike`` path to any folder with
-    ``img1.<ext> ... imgN.<ext>`` and the homographies ``H1to2p ... H1toNp`` (the Oxford layout)."""
+    ``img1.<ext> ... imgN.<ext>`` and the homographies ``H1to2p ... H1toNp`` (the Oxford layout).
+
+    Parameters
+    ----------
+    sequence : str or os.PathLike
+        A name in :data:`OXFORD_SEQUENCES` or the path of an Oxford-layout folder.
+
+    Returns
+    -------
+    pathlib.Path
+        The sequence's folder.
+    """
     if isinstance(sequence, str) and sequence in OXFORD_SEQUENCES:
         return Path(find_data(f"oxford-affine/{sequence}/H1to2p")).parent
     if isinstance(sequence, str) and not any(c in sequence for c in "/\\") and not Path(sequence).exists():
@@ -59,7 +70,18 @@ def oxford_folder(sequence) -> Path:
 
 
 def oxford_label(sequence) -> str:
-    """The name of a sequence for tables and titles: the folder's name."""
+    """The name of a sequence for tables and titles: the folder's name.
+
+    Parameters
+    ----------
+    sequence : str or os.PathLike
+        A shared sequence's name or an Oxford-layout folder (see :func:`oxford_folder`).
+
+    Returns
+    -------
+    str
+        The shared name as given, else the folder's name.
+    """
     return sequence if isinstance(sequence, str) and sequence in OXFORD_SEQUENCES else oxford_folder(sequence).name
 
 
@@ -74,7 +96,24 @@ def _image_file(folder: Path, index: int) -> Path:
 def load_oxford_image(sequence, index: int, *, scale: float = 1.0, size=None) -> np.ndarray:
     """Grey uint8 image ``img<index>`` of an Oxford-layout sequence (name or folder path, see
     :func:`oxford_folder`), resized by ``scale`` or to ``size = (width_px, height_px)``
-    (INTER_AREA; e.g. 000's camera, (768, 576)). Colour files are read as OpenCV's grey."""
+    (INTER_AREA; e.g. 000's camera, (768, 576)). Colour files are read as OpenCV's grey.
+
+    Parameters
+    ----------
+    sequence : str or os.PathLike
+        A shared sequence's name or an Oxford-layout folder.
+    index : int
+        Image number, 1-based (``img1`` is the reference image).
+    scale : float
+        Resize factor (> 0); 1 keeps the file's size. Not together with ``size``.
+    size : (int, int), optional
+        Output size (width_px, height_px).
+
+    Returns
+    -------
+    image : (H, W) uint8
+        The grey image.
+    """
     import cv2
 
     folder = oxford_folder(sequence)
@@ -104,6 +143,22 @@ def load_oxford_pair(sequence, j: int, *, scale: float = 1.0):
     ``sequence``: a shared sequence's name or the path of any Oxford-layout folder
     (:func:`oxford_folder`). Resizing by ``s`` maps a pixel centre x to ``s·(x + 0.5) - 0.5``, so
     ``H_s = S·H·S⁻¹`` with ``S = [[s, 0, s/2 - 1/2], [0, s, s/2 - 1/2], [0, 0, 1]]``.
+
+    Parameters
+    ----------
+    sequence : str or os.PathLike
+        A shared sequence's name or an Oxford-layout folder.
+    j : int
+        Number of the second image (>= 2); its homography file is ``H1to<j>p``.
+    scale : float
+        Resize factor (> 0) applied to both images; H is adapted to it.
+
+    Returns
+    -------
+    img1, img_j : (H, W) uint8
+        The grey reference image and image ``j``.
+    H : (3, 3) float
+        Homography from img1 pixels to img_j pixels, normalised so that ``H[2, 2] = 1``.
     """
     folder = oxford_folder(sequence)
     j = v.check_int(j, "j", minimum=2)
@@ -127,7 +182,26 @@ def _inside(uv, shape, margin):
 
 
 def common_region(f1: Features, f2: Features, H, shape1, shape2, *, margin_px: float = 0.0):
-    """Masks of the keypoints of each image that lie in the part of the scene both images see."""
+    """Masks of the keypoints of each image that lie in the part of the scene both images see.
+
+    Parameters
+    ----------
+    f1, f2 : Features
+        Keypoints of image 1 and image 2.
+    H : (3, 3) array
+        Homography from image-1 to image-2 pixels.
+    shape1, shape2 : tuple
+        Shapes ``(H, W, ...)`` of image 1 and image 2.
+    margin_px : float
+        A mapped point must lie at least this many pixels inside the other image's border.
+
+    Returns
+    -------
+    in1 : (len(f1),) bool
+        Image-1 keypoints whose image under H lies inside image 2.
+    in2 : (len(f2),) bool
+        Image-2 keypoints whose preimage lies inside image 1.
+    """
     H = v.as_matrix(H, "H", (3, 3))
     in1 = _inside(project(H, f1.uv), shape2, margin_px) if len(f1) else np.zeros(0, dtype=bool)
     in2 = _inside(project(np.linalg.inv(H), f2.uv), shape1, margin_px) if len(f2) else np.zeros(0, dtype=bool)
@@ -142,7 +216,21 @@ def _check_features(f, name):
 
 @dataclass(frozen=True)
 class PairScores:
-    """Repeatability and (optionally) matching scores of one detector on one image pair."""
+    """Repeatability and (optionally) matching scores of one detector on one image pair.
+
+    Attributes
+    ----------
+    n1, n2 : int
+        Keypoints of img1 and of img2 in the common region.
+    correspondences : int
+        Repeated points (see the module notes).
+    repeatability : float
+        ``correspondences / min(n1, n2)``.
+    matches : int
+        Accepted descriptor matches (0 when matching was not scored).
+    correct : int
+        Matches that the homography confirms; ``precision`` and ``recall`` derive from these.
+    """
 
     n1: int  # keypoints of img1 in the common region
     n2: int
@@ -162,6 +250,22 @@ class PairScores:
 
 def repeatability(f1: Features, f2: Features, H, shape1, shape2, *, tol_px: float = 2.5) -> PairScores:
     """Repeatability of keypoints under a known homography (position only; see the module notes).
+
+    Parameters
+    ----------
+    f1, f2 : Features
+        Keypoints of image 1 and image 2.
+    H : (3, 3) array
+        Homography from image-1 to image-2 pixels.
+    shape1, shape2 : tuple
+        Shapes of image 1 and image 2 (they bound the common region).
+    tol_px : float
+        A correspondence is a pair closer than this, in image-2 pixels.
+
+    Returns
+    -------
+    PairScores
+        ``n1``, ``n2``, ``correspondences`` and ``repeatability`` (matching fields 0).
 
     >>> from slamlab.features.base import Features
     >>> z = np.zeros(3)
@@ -186,7 +290,24 @@ def repeatability(f1: Features, f2: Features, H, shape1, shape2, *, tol_px: floa
 
 
 def correct_matches(f1: Features, f2: Features, matches: Matches, H, *, tol_px: float = 2.5) -> np.ndarray:
-    """True for the matches (f1 as query, f2 as train) that H maps within ``tol_px``."""
+    """True for the matches (f1 as query, f2 as train) that H maps within ``tol_px``.
+
+    Parameters
+    ----------
+    f1, f2 : Features
+        Keypoints of image 1 (query side) and image 2 (train side).
+    matches : Matches
+        Matches between them (:func:`slamlab.features.matching.match_descriptors`).
+    H : (3, 3) array
+        Homography from image-1 to image-2 pixels.
+    tol_px : float
+        Largest distance in image-2 pixels between ``H·p_i`` and ``p_j`` of a correct match.
+
+    Returns
+    -------
+    (len(matches),) bool
+        True for the correct matches.
+    """
     f1, f2 = _check_features(f1, "f1"), _check_features(f2, "f2")
     tol_px = v.check_positive(tol_px, "tol_px")
     if len(matches) == 0:

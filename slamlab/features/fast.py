@@ -94,6 +94,18 @@ def fast_score(image, rows, cols, n: int = 9) -> np.ndarray:
 
     For a corner at threshold t the score is >= t; it is the largest t' for which the
     pixel is still a corner, minus one (OpenCV ``cornerScore``).
+
+    Parameters
+    ----------
+    image : (H, W) uint8 (or float in [0, 1]) image
+    rows, cols : (K,) int
+        Pixel rows and columns, at least 3 pixels from the border.
+    n : int
+        Arc length, 9..12.
+
+    Returns
+    -------
+    score : (K,) int64
     """
     img = to_gray_uint8(image).astype(np.int16)
     rows = np.asarray(rows, dtype=np.int64)
@@ -117,6 +129,23 @@ def fast_detect(image, threshold: int = 20, n: int = 9, *, nonmax: bool = True,
     Same corners as ``cv2.FastFeatureDetector_create(threshold, nonmax, TYPE_9_16)``
     for n = 9 (tested). Keypoints are in row-major order; ``scale_px`` = 3.5 (OpenCV's
     size 7 / 2), ``response`` = the score.
+
+    Parameters
+    ----------
+    image : (H, W) uint8 (or float in [0, 1]) image
+    threshold : int
+        Intensity threshold t (grey levels, 0..255).
+    n : int
+        Arc length, 9..12.
+    nonmax : bool
+        Keep only corners whose score is strictly larger than their 8 neighbours'.
+    high_speed : bool, optional
+        The 1-5-9-13 pre-test (see :func:`fast_corner_mask`).
+
+    Returns
+    -------
+    Features
+        Corners with ``response`` = score, no descriptors, method ``"FAST-<n>"``.
 
     >>> img = np.zeros((9, 9), np.uint8); img[4, 4] = 200
     >>> f = fast_detect(img, 20)

@@ -37,7 +37,15 @@ KNN_METHODS = ("brute", "kdtree", "bbf", "flann")
 
 @dataclass(frozen=True)
 class Matches:
-    """Accepted matches: ``query_idx[i]`` ↔ ``train_idx[i]`` with distances d1 (nearest) and d2 (second)."""
+    """Accepted matches: ``query_idx[i]`` ↔ ``train_idx[i]`` with distances d1 (nearest) and d2 (second).
+
+    Attributes
+    ----------
+    query_idx, train_idx : (K,) int
+        Row of each match in the query and in the train descriptor set.
+    d1, d2 : (K,) float
+        Descriptor distance to the nearest (the match) and to the second-nearest train row.
+    """
 
     query_idx: np.ndarray
     train_idx: np.ndarray
@@ -70,8 +78,14 @@ def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: 
     method : {'brute', 'kdtree', 'bbf', 'flann'}
         Dense exact search, our exact kd-tree, our Best-Bin-First (``max_leaves``),
         OpenCV FLANN (one randomised KD-tree, ``checks``).
+    max_leaves : int
+        Leaves Best-Bin-First visits per query (``method='bbf'``).
+    checks : int
+        Leaves FLANN checks per query (``method='flann'``).
+    leaf_size : int
+        Points per leaf of a kd-tree built here (kdtree/bbf without ``tree``).
     tree : slamlab.kdtree.KDTree, optional
-        A tree already built on ``train`` (kdtree/bbf).
+        A tree already built on ``train`` (kdtree/bbf), or a FLANN index (flann).
 
     Returns
     -------
@@ -111,6 +125,18 @@ def ratio_rule(d1, d2, ratio: float) -> np.ndarray:
     The one copy of the rule, without argument checks (callers check ``ratio`` once);
     :func:`accept_ratio` is the checked version on an (M, 2) array.
 
+    Parameters
+    ----------
+    d1, d2 : (M,) float
+        Distances to the nearest and the second-nearest neighbour.
+    ratio : float
+        Lowe's ratio (0.8 in Lowe's paper).
+
+    Returns
+    -------
+    (M,) bool
+        True where the match is accepted.
+
     >>> ratio_rule(np.array([0.1, 0.29]), np.array([0.3, 0.3]), 0.8).tolist()
     [True, False]
     """
@@ -124,6 +150,18 @@ def best_per_target(target, dist) -> np.ndarray:
     to the first candidate. Used for one-to-one matching (one right keypoint per left one, one
     local point per landmark).
 
+    Parameters
+    ----------
+    target : (M,) int
+        The id each candidate points at.
+    dist : (M,) float
+        Each candidate's distance.
+
+    Returns
+    -------
+    (K,) int
+        Ascending indices of the kept candidates, one per distinct target.
+
     >>> best_per_target(np.array([7, 3, 7, 3]), np.array([0.5, 0.2, 0.1, 0.2])).tolist()
     [1, 2]
     """
@@ -136,6 +174,20 @@ def best_per_target(target, dist) -> np.ndarray:
 
 def accept_000(dist, *, factor: float = 2.0, max_dist: float = np.inf) -> np.ndarray:
     """000's rule: accept C→A when d(C,B) >= factor·d(C,A) and d(C,A) <= max_dist (000 §1.4.3).
+
+    Parameters
+    ----------
+    dist : (M, 2) float
+        Nearest and second-nearest distances (:func:`knn2`).
+    factor : float
+        Required ratio d2 / d1 (000: 2).
+    max_dist : float
+        Largest accepted nearest distance (our parameter; default no limit).
+
+    Returns
+    -------
+    (M,) bool
+        True where the match is accepted.
 
     >>> accept_000(np.array([[0.1, 0.3], [0.2, 0.3], [0.5, 2.0]]), max_dist=0.4).tolist()
     [True, False, False]
@@ -151,6 +203,18 @@ def accept_000(dist, *, factor: float = 2.0, max_dist: float = np.inf) -> np.nda
 def accept_ratio(dist, ratio: float = 0.8) -> np.ndarray:
     """Lowe's ratio test: accept when d(C,A) < ratio·d(C,B).
 
+    Parameters
+    ----------
+    dist : (M, 2) float
+        Nearest and second-nearest distances (:func:`knn2`).
+    ratio : float
+        Lowe's ratio (> 0).
+
+    Returns
+    -------
+    (M,) bool
+        True where the match is accepted.
+
     >>> accept_ratio(np.array([[0.1, 0.3], [0.29, 0.3]]), 0.8).tolist()
     [True, False]
     """
@@ -163,6 +227,18 @@ def accept_ratio(dist, ratio: float = 0.8) -> np.ndarray:
 
 def mutual_mask(idx12, idx21) -> np.ndarray:
     """True where query i's nearest train j has i as its own nearest query (cross check).
+
+    Parameters
+    ----------
+    idx12 : (M,) int
+        Nearest train row of each query row (-1 for none).
+    idx21 : (N,) int
+        Nearest query row of each train row.
+
+    Returns
+    -------
+    (M,) bool
+        True for the mutual nearest neighbours.
 
     >>> mutual_mask(np.array([1, 0, 1]), np.array([1, 2])).tolist()
     [False, True, True]
@@ -182,12 +258,28 @@ def match_descriptors(query, train, *, rule: str = "000", factor: float = 2.0, r
 
     Parameters
     ----------
+    query, train : (M, d), (N, d) descriptor arrays
+        Float, or uint8 binary descriptors (Hamming distance, ``method='brute'`` only).
     rule : {'000', 'ratio', 'none'}
         000's ``d2 >= factor·d1`` (with ``max_dist``), Lowe's ``d1 < ratio·d2`` (with
         ``max_dist``), or every nearest neighbour (``max_dist`` only).
+    factor : float
+        000's factor for ``rule='000'``.
+    ratio : float
+        Lowe's ratio for ``rule='ratio'``.
+    max_dist : float
+        Largest accepted nearest distance (default no limit).
     mutual : bool
         Also require the reverse nearest neighbour to agree.
-    method : see :func:`knn2`.
+    method : {'brute', 'kdtree', 'bbf', 'flann'}
+        Nearest-neighbour search, see :func:`knn2`.
+    max_leaves, checks : int
+        Search budgets of 'bbf' and 'flann' (:func:`knn2`).
+
+    Returns
+    -------
+    Matches
+        ``query_idx``, ``train_idx`` of the accepted matches with their ``d1``, ``d2``.
     """
     rule = v.check_choice(rule, "rule", ("000", "ratio", "none"))
     d, idx = knn2(query, train, method=method, max_leaves=max_leaves, checks=checks)

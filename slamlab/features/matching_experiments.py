@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
 
@@ -18,18 +17,15 @@ from .. import _validate as v
 from .._progress import progress_bar
 from .._table import format_table
 from ..kdtree.knn import flann_index
-from .base import Features
-from .detect import detect
 from .evaluation import (
-    OXFORD_SEQUENCES,
     correct_matches,
-    load_oxford_image,
     load_oxford_pair,
     oxford_label,
     repeatability,
 )
 from .experiments import EVAL_DETECTORS, _detect_named
 from .matching import accept_000, accept_ratio, knn2
+from .matching_workload import _matching_workload, descriptor_pool, surf_features
 
 __all__ = [
     "KnnComparisonResult",
@@ -40,56 +36,36 @@ __all__ = [
     "run_knn_comparison",
     "run_ratio_tradeoff",
     "run_recall_vs_leaves",
+    "surf_features",
 ]
 
 
 # --- descriptor matching: exact vs BBF vs FLANN vs brute ---------------------------------------------
 
 
-@lru_cache(maxsize=64)
-def _surf_cached(sequence, index, scale, threshold):
-    img = load_oxford_image(sequence, index, scale=scale)
-    return surf_features(img, threshold)
-
-
-def surf_features(img, threshold) -> Features:
-    return detect(img, "surf", threshold=threshold)
-
-
-def descriptor_pool(n: int, *, exclude: str = "graf", scale: float = 0.5, threshold: float = 5e-5) -> np.ndarray:
-    """``n`` SURF descriptors (float32) from the Oxford images other than ``exclude``'s (distractors)."""
-    n = v.check_int(n, "n", minimum=0)
-    out, have = [], 0
-    for seq in OXFORD_SEQUENCES:
-        if seq == exclude:
-            continue
-        for idx in range(1, 7):
-            if have >= n:
-                break
-            d = _surf_cached(seq, idx, float(scale), float(threshold)).descriptors
-            out.append(d[: n - have])
-            have += len(out[-1])
-    if have < n:
-        raise ValueError(f"the Oxford images give only {have} SURF descriptors at scale {scale:g}, threshold "
-                         f"{threshold:g}; asked for `n`={n}")
-    return np.concatenate(out) if out else np.zeros((0, 64), np.float32)
-
-
-def _matching_workload(n_stored, n_queries, sequence, j, scale, threshold):
-    img1, img2, H = load_oxford_pair(sequence, j, scale=scale)
-    f1 = surf_features(img1, threshold)
-    f2 = surf_features(img2, threshold)
-    n_true = min(len(f1), n_stored)
-    f1 = f1.strongest(n_true)
-    distract = descriptor_pool(n_stored - n_true, exclude=sequence, scale=scale, threshold=threshold)
-    train = np.concatenate([f1.descriptors, distract]) if len(distract) else f1.descriptors
-    q = f2.strongest(n_queries)
-    return f1, q, train, H
-
-
 @dataclass(frozen=True)
 class KnnComparisonResult:
-    """Per store size and method: recall of the true nearest neighbour, precision after the ratio rule."""
+    """Per store size and method: recall of the true nearest neighbour, precision after the ratio rule.
+
+    Attributes
+    ----------
+    sizes : tuple of int
+        Stored descriptors per run.
+    methods : tuple of str
+        Search labels (:data:`KNN_LABELS`).
+    n_queries : int
+        Query descriptors per run.
+    recall : (n_sizes, n_methods) float
+        Fraction of queries whose nearest neighbour equals brute force's (NaN = not run).
+    precision : (n_sizes, n_methods) float
+        Correct fraction of the matches accepted by ratio 0.8.
+    n_matches : (n_sizes, n_methods) float
+        Matches accepted by ratio 0.8.
+    evals : (n_sizes, n_methods) float
+        Mean distance evaluations per query (our trees; NaN otherwise).
+    times_s : (n_sizes, n_methods) float
+        Search time in seconds for all queries (machine dependent).
+    """
 
     sizes: tuple[int, ...]
     methods: tuple[str, ...]
@@ -141,6 +117,36 @@ def run_knn_comparison(sizes=(2000, 13000), *, n_queries: int = 500, max_leaves:
     ``n_queries``. Our exact tree runs only up to ``max_exact_ours`` points (in 64-d
     it visits nearly every leaf and the lock-step numpy search is then slow). ``progress``: a bar
     over the sizes (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Parameters
+    ----------
+    sizes : sequence of int
+        Store sizes (>= 10 descriptors each).
+    n_queries : int
+        Strongest img_j keypoints used as queries.
+    max_leaves : int
+        BBF leaf budget.
+    checks : int
+        FLANN checks.
+    max_exact_ours : int
+        Largest store our exact kd-tree is run on.
+    sequence : str
+        Shared Oxford sequence.
+    j : int
+        Query image number (img1 → img_j).
+    scale : float
+        Image resize factor.
+    threshold : float
+        SURF Hessian threshold on our scale.
+    tol_px : float
+        Correct-match tolerance in image-j pixels.
+    progress : bool, callable or None
+        Progress bar over the sizes.
+
+    Returns
+    -------
+    KnnComparisonResult
+        ``recall``, ``precision``, ``evals`` and ``times_s`` per (size, method).
     """
     from scipy.spatial import cKDTree
 
@@ -198,7 +204,25 @@ def run_knn_comparison(sizes=(2000, 13000), *, n_queries: int = 500, max_leaves:
 
 @dataclass(frozen=True)
 class LeavesCurveResult:
-    """Recall of the true nearest neighbour against the search budget: our BBF (leaves) and FLANN (checks)."""
+    """Recall of the true nearest neighbour against the search budget: our BBF (leaves) and FLANN (checks).
+
+    Attributes
+    ----------
+    n_stored : int
+        Stored descriptors.
+    n_queries : int
+        Query descriptors.
+    budgets : (n,) int
+        Leaf budgets (BBF ``max_leaves``, FLANN ``checks``).
+    recall_bbf, recall_flann : (n,) float
+        Fraction of queries whose nearest neighbour equals brute force's.
+    evals_bbf : (n,) float
+        Mean distance evaluations per query of BBF.
+    exact_evals : float
+        Mean distance evaluations per query of the exact search (50 queries).
+    times_s : (n,) float
+        BBF search time in seconds per budget (machine dependent).
+    """
 
     n_stored: int
     n_queries: int
@@ -227,6 +251,30 @@ def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, 
     """Recall of BBF and FLANN against the number of leaves / checks (000 §1.4.3: "about 200").
 
     ``progress``: a bar over the budgets (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Parameters
+    ----------
+    budgets : sequence of int
+        Leaf budgets (>= 1).
+    n_stored : int
+        Store size (img1 descriptors plus distractors).
+    n_queries : int
+        Strongest img_j keypoints used as queries.
+    sequence : str
+        Shared Oxford sequence.
+    j : int
+        Query image number.
+    scale : float
+        Image resize factor.
+    threshold : float
+        SURF Hessian threshold on our scale.
+    progress : bool, callable or None
+        Progress bar over the budgets.
+
+    Returns
+    -------
+    LeavesCurveResult
+        ``recall_bbf`` and ``recall_flann`` per budget.
     """
 
     from ..kdtree import KDTree
@@ -255,7 +303,25 @@ def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, 
 
 @dataclass(frozen=True)
 class RatioTradeoffResult:
-    """Precision and recall of the matches against the ratio (000's 2× rule = ratio 0.5)."""
+    """Precision and recall of the matches against the ratio (000's 2× rule = ratio 0.5).
+
+    Attributes
+    ----------
+    detector : str
+        Detector name.
+    pair : str
+        Pair label (sequence, 1→j, scale).
+    ratios : (n,) float
+        Ratios, ascending.
+    precision, recall : (n,) float
+        Match precision and recall per ratio.
+    n_matches : (n,) int
+        Accepted matches per ratio.
+    correspondences : int
+        Repeatable points of the pair (recall's denominator).
+    source_row : tuple
+        (matches, precision, recall, max_dist) of 000's rule with ``max_dist``.
+    """
 
     detector: str
     pair: str
@@ -281,7 +347,32 @@ class RatioTradeoffResult:
 def run_ratio_tradeoff(ratios=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), *, detector: str = "SURF",
                        sequence: str = "graf", j: int = 2, scale: float = 0.5, n_points: int = 1000,
                        tol_px: float = 2.5, max_dist: float = 0.3) -> RatioTradeoffResult:
-    """Precision/recall of the ratio rule and of 000's rule with an absolute limit (000 §1.4.3)."""
+    """Precision/recall of the ratio rule and of 000's rule with an absolute limit (000 §1.4.3).
+
+    Parameters
+    ----------
+    ratios : sequence of float
+        Lowe ratios to score.
+    detector : str
+        Key of :data:`EVAL_DETECTORS`.
+    sequence : str or os.PathLike
+        Oxford sequence.
+    j : int
+        Second image number.
+    scale : float
+        Image resize factor.
+    n_points : int
+        Strongest keypoints kept per image.
+    tol_px : float
+        Correct-match tolerance in image-j pixels.
+    max_dist : float
+        000's absolute limit on d1 (times 256 for ORB's Hamming distances).
+
+    Returns
+    -------
+    RatioTradeoffResult
+        Precision, recall and matches per ratio plus 000's rule in ``source_row``.
+    """
     detector = v.check_choice(detector, "detector", tuple(EVAL_DETECTORS))
     ratios = np.sort(v.as_vector(ratios, "ratios"))
     img1, img2, H = load_oxford_pair(sequence, j, scale=scale)
@@ -309,8 +400,19 @@ def run_ratio_tradeoff(ratios=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), *, detec
 def matching_vs_source(curve: LeavesCurveResult, trade: RatioTradeoffResult, knn: KnnComparisonResult) -> str:
     """000 §1.4.3's statements on kd-tree search and the 2× rule beside our numbers from the chapter's runs.
 
-    ``curve``: :func:`run_recall_vs_leaves`; ``trade``: :func:`run_ratio_tradeoff`; ``knn``:
-    :func:`run_knn_comparison`.
+    Parameters
+    ----------
+    curve : LeavesCurveResult
+        From :func:`run_recall_vs_leaves`.
+    trade : RatioTradeoffResult
+        From :func:`run_ratio_tradeoff`.
+    knn : KnnComparisonResult
+        From :func:`run_knn_comparison`.
+
+    Returns
+    -------
+    str
+        A table: quantity, 000's statement, our figure.
     """
     rows = []
     at200 = np.flatnonzero(curve.budgets == 200)

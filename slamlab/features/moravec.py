@@ -28,6 +28,18 @@ def moravec_response(image, window: int = 3) -> np.ndarray:
 
     Border pixels (closer than ``window // 2 + 1`` to the edge) get 0.
 
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (uint8 or float in [0, 1]) or colour (converted to grey).
+    window : int
+        Odd side of the square SSD window in pixels.
+
+    Returns
+    -------
+    (H, W) float
+        Corner measure (squared grey levels summed over the window).
+
     >>> img = np.zeros((9, 9)); img[4:, 4:] = 1.0
     >>> r = moravec_response(img, 3)
     >>> tuple(int(i) for i in np.unravel_index(np.argmax(r), r.shape))
@@ -55,6 +67,22 @@ def moravec_detect(image, threshold: float = 0.1, window: int = 3, *, nms_size: 
     """Moravec corners: response above ``threshold`` and the maximum of its ``nms_size`` neighbourhood (003 §3.1.2).
 
     ``threshold`` is in squared grey levels of a [0, 1] image summed over the window.
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (uint8 or float in [0, 1]).
+    threshold : float
+        Smallest response (exclusive) of a corner.
+    window : int
+        Odd SSD window side in pixels.
+    nms_size : int
+        Side of the non-maximum-suppression neighbourhood in pixels.
+
+    Returns
+    -------
+    Features
+        Corners (``scale_px`` = window / 2, ``response`` = the measure), no descriptors.
     """
     threshold = v.check_positive(threshold, "threshold")
     nms_size = v.check_int(nms_size, "nms_size", minimum=1)

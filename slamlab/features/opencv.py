@@ -20,6 +20,19 @@ def features_from_keypoints(keypoints, descriptors, method: str) -> Features:
 
     ``scale_px`` = ``size / 2``; OpenCV angles (degrees, -1 = none) become radians in
     [0, 2π) (0 when absent); SIFT's packed octave byte is unpacked to the octave index.
+
+    Parameters
+    ----------
+    keypoints : sequence of cv2.KeyPoint
+        OpenCV keypoints.
+    descriptors : (N, d) array or None
+        Their descriptors, row i for keypoint i.
+    method : str
+        Detector name ("SIFT" unpacks the octave; "ORB" gives uint8 empty descriptors).
+
+    Returns
+    -------
+    Features
     """
     k = len(keypoints)
     if k == 0:
@@ -41,7 +54,23 @@ def features_from_keypoints(keypoints, descriptors, method: str) -> Features:
 
 def sift_cv(image, *, n_features: int = 0, contrast_threshold: float = 0.04, edge_threshold: float = 10.0,
             sigma: float = 1.6, descriptors: bool = True) -> Features:
-    """OpenCV SIFT (000 §1.4.1): 128-d float descriptors."""
+    """OpenCV SIFT (000 §1.4.1): 128-d float descriptors.
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (converted to uint8).
+    n_features : int
+        Keep the best this many (0: all).
+    contrast_threshold, edge_threshold, sigma : float
+        OpenCV's ``contrastThreshold``, ``edgeThreshold`` and base blur σ in pixels.
+    descriptors : bool
+        Compute the descriptors.
+
+    Returns
+    -------
+    Features
+    """
     import cv2
 
     img = to_gray_uint8(image)
@@ -59,7 +88,27 @@ def sift_cv(image, *, n_features: int = 0, contrast_threshold: float = 0.04, edg
 
 def orb_cv(image, *, n_features: int = 2000, scale_factor: float = 1.2, n_levels: int = 8,
            fast_threshold: int = 20, descriptors: bool = True) -> Features:
-    """OpenCV ORB: oriented FAST + rotated BRIEF, 256-bit descriptors as 32 uint8 (Hamming distance)."""
+    """OpenCV ORB: oriented FAST + rotated BRIEF, 256-bit descriptors as 32 uint8 (Hamming distance).
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (converted to uint8).
+    n_features : int
+        Most keypoints kept.
+    scale_factor : float
+        Pyramid scale ratio between levels.
+    n_levels : int
+        Pyramid levels.
+    fast_threshold : int
+        FAST threshold in grey levels.
+    descriptors : bool
+        Compute the descriptors.
+
+    Returns
+    -------
+    Features
+    """
     import cv2
 
     img = to_gray_uint8(image)
@@ -77,7 +126,22 @@ def orb_cv(image, *, n_features: int = 2000, scale_factor: float = 1.2, n_levels
 
 
 def fast_cv(image, *, threshold: int = 20, nonmax: bool = True) -> Features:
-    """OpenCV FAST (type 9_16), the reference for :func:`slamlab.features.fast_detect`."""
+    """OpenCV FAST (type 9_16), the reference for :func:`slamlab.features.fast_detect`.
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (converted to uint8).
+    threshold : int
+        Intensity threshold in grey levels (0..255).
+    nonmax : bool
+        Non-maximum suppression.
+
+    Returns
+    -------
+    Features
+        Corners without descriptors.
+    """
     import cv2
 
     img = to_gray_uint8(image)
@@ -87,7 +151,22 @@ def fast_cv(image, *, threshold: int = 20, nonmax: bool = True) -> Features:
 
 
 def mser_cv(image, *, delta: int = 5, min_area: int = 60, max_area: int = 14400) -> Features:
-    """OpenCV MSER regions as keypoints: centroid, σ = sqrt(area / π), no descriptor."""
+    """OpenCV MSER regions as keypoints: centroid, σ = sqrt(area / π), no descriptor.
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (converted to uint8).
+    delta : int
+        MSER's intensity step Δ.
+    min_area, max_area : int
+        Region size limits in pixels.
+
+    Returns
+    -------
+    Features
+        One keypoint per region, ``response`` = area in pixels.
+    """
     import cv2
 
     img = to_gray_uint8(image)

@@ -34,7 +34,23 @@ DETECTOR_GALLERY = (
 
 
 def plot_detector_gallery(image, detectors=DETECTOR_GALLERY, *, max_points: int = 300, ncols: int = 3):
-    """Keypoints of several detectors on one image, one panel each (000 §1.4); returns the figure."""
+    """Keypoints of several detectors on one image, one panel each (000 §1.4); returns the figure.
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image.
+    detectors : sequence of (str, str, dict)
+        (panel title, method of :func:`slamlab.features.detect`, its parameters) per panel.
+    max_points : int
+        Strongest keypoints drawn per panel.
+    ncols : int
+        Panels per row.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     from .detect import detect
 
     detectors = tuple(detectors)
@@ -51,7 +67,21 @@ def plot_detector_gallery(image, detectors=DETECTOR_GALLERY, *, max_points: int 
 
 
 def plot_keypoint_pair(img1, f1, img2, f2, titles=("image 1", "image 2")):
-    """Keypoints of two images side by side (:func:`plot_keypoints`); returns the figure."""
+    """Keypoints of two images side by side (:func:`plot_keypoints`); returns the figure.
+
+    Parameters
+    ----------
+    img1, img2 : (H, W) array
+        The two grey images.
+    f1, f2 : Features
+        Their keypoints.
+    titles : (str, str)
+        Panel titles.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     plot_keypoints(img1, f1, ax=axes[0], title=titles[0])
     plot_keypoints(img2, f2, ax=axes[1], title=titles[1])
@@ -64,7 +94,29 @@ _COLORS = {"SIFT": "tab:blue", "SURF": "tab:red", "ORB": "tab:green", "FAST": "t
 
 def plot_keypoints(image, features, *, ax=None, max_points: int = 400, color="tab:red", title=None,
                    circles: bool = True):
-    """Keypoints on the image: circles of radius σ with an orientation tick (strongest ``max_points``)."""
+    """Keypoints on the image: circles of radius σ with an orientation tick (strongest ``max_points``).
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image.
+    features : Features
+        Keypoints to draw.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into (a new figure when None).
+    max_points : int
+        Strongest keypoints drawn.
+    color : str
+        Matplotlib colour of the marks.
+    title : str, optional
+        Axes title (default ``str(features)``).
+    circles : bool
+        Circles of radius σ with orientation ticks; False draws ``+`` marks.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=title or str(features))
     ax.imshow(image, cmap="gray", interpolation="nearest")
     f = features.strongest(max_points) if len(features) > max_points else features
@@ -86,7 +138,29 @@ def plot_keypoints(image, features, *, ax=None, max_points: int = 400, color="ta
 
 
 def plot_matches(img1, img2, f1, f2, matches, correct=None, *, ax=None, max_lines: int = 150, title=None):
-    """Two images side by side with match lines (green correct, red wrong when ``correct`` is given)."""
+    """Two images side by side with match lines (green correct, red wrong when ``correct`` is given).
+
+    Parameters
+    ----------
+    img1, img2 : (H, W) array
+        The grey images (query and train side).
+    f1, f2 : Features
+        Their keypoints.
+    matches : Matches
+        Matches, f1 as query and f2 as train.
+    correct : (len(matches),) bool, optional
+        Which matches are correct (lines yellow when None).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    max_lines : int
+        At most this many lines, evenly spaced over the matches.
+    title : str, optional
+        Axes title (default: the number of matches).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     h = max(img1.shape[0], img2.shape[0])
     canvas = np.zeros((h, img1.shape[1] + img2.shape[1]), dtype=float)
     canvas[:img1.shape[0], :img1.shape[1]] = img1
@@ -108,7 +182,19 @@ def plot_matches(img1, img2, f1, f2, matches, correct=None, *, ax=None, max_line
 
 
 def plot_box_filters(L: int = 9, *, axes=None):
-    """The three SURF box filters Dxx, Dyy, Dxy of side L (weights +1 white, -1/-2 dark)."""
+    """The three SURF box filters Dxx, Dyy, Dxy of side L (weights +1 white, -1/-2 dark).
+
+    Parameters
+    ----------
+    L : int
+        Filter side in pixels (9, 15, 21, ...).
+    axes : sequence of 3 matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+    """
     if axes is None:
         _, axes = plt.subplots(1, 3, figsize=(8, 2.8))
     l = L // 3
@@ -135,6 +221,23 @@ def plot_fast_circle(image, row: int, col: int, threshold: int = 20, *, ax=None,
     """A patch around (row, col) with the 16 circle pixels marked brighter (+), darker (-) or similar.
 
     Pixels are numbered as in 003's figure: 1 at the top, clockwise (v down).
+
+    Parameters
+    ----------
+    image : (H, W) uint8
+        Grey image.
+    row, col : int
+        The centre pixel (at least ``half`` pixels inside the image).
+    threshold : int
+        FAST threshold t in grey levels.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    half : int
+        Half-width of the patch shown, in pixels.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
     """
     ax = new_axes(ax, title=f"FAST circle at (u={col}, v={row}), t = {threshold}")
     img = np.asarray(image)
@@ -156,7 +259,19 @@ def plot_fast_circle(image, row: int, col: int, threshold: int = 20, *, ax=None,
 
 
 def plot_pair_evaluation(result, *, axes=None):
-    """Repeatability and matching precision per viewpoint step, one panel per sequence."""
+    """Repeatability and matching precision per viewpoint step, one panel per sequence.
+
+    Parameters
+    ----------
+    result : PairEvaluationResult
+        From :func:`slamlab.features.experiments.run_pair_evaluation`.
+    axes : (2, n_sequences) array of matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    (2, n_sequences) array of matplotlib.axes.Axes
+    """
     n = len(result.sequences)
     if axes is None:
         _, axes = plt.subplots(2, n, figsize=(4.5 * n, 6), squeeze=False)
@@ -176,7 +291,19 @@ def plot_pair_evaluation(result, *, axes=None):
 
 
 def plot_recall_vs_leaves(result, *, ax=None):
-    """Recall of the true nearest neighbour against max_leaves (BBF) and checks (FLANN)."""
+    """Recall of the true nearest neighbour against max_leaves (BBF) and checks (FLANN).
+
+    Parameters
+    ----------
+    result : LeavesCurveResult
+        From :func:`slamlab.features.matching_experiments.run_recall_vs_leaves`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=f"Nearest-neighbour recall, {result.n_stored} stored descriptors",
                   xlabel="max_leaves (BBF) / checks (FLANN)", ylabel="recall")
     ax.semilogx(result.budgets, result.recall_bbf, "o-", label="BBF (ours)")
@@ -188,7 +315,19 @@ def plot_recall_vs_leaves(result, *, ax=None):
 
 
 def plot_ratio_tradeoff(result, *, ax=None):
-    """Precision against recall as the ratio threshold varies; 000's rule marked."""
+    """Precision against recall as the ratio threshold varies; 000's rule marked.
+
+    Parameters
+    ----------
+    result : RatioTradeoffResult
+        From :func:`slamlab.features.matching_experiments.run_ratio_tradeoff`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=f"Ratio rule, {result.detector} on {result.pair}", xlabel="recall",
                   ylabel="precision")
     ax.plot(result.recall, result.precision, "o-")
@@ -203,7 +342,19 @@ def plot_ratio_tradeoff(result, *, ax=None):
 
 
 def plot_surf_threshold(result, *, ax=None):
-    """SURF point count against the threshold on our scale; 000's '~2000 points' marked."""
+    """SURF point count against the threshold on our scale; 000's '~2000 points' marked.
+
+    Parameters
+    ----------
+    result : SurfThresholdResult
+        From :func:`slamlab.features.detector_experiments.run_surf_threshold`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=f"SURF points vs threshold, {result.image_name}", xlabel="threshold (ours)",
                   ylabel="points")
     ax.semilogx(result.thresholds, result.counts, "o-")

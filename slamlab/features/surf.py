@@ -120,6 +120,21 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
 class SURF:
     """SURF detector with its settings as state (000 §3.3 defaults): ``SURF(threshold).detect(image)``.
 
+    Parameters
+    ----------
+    threshold : float
+        Minimum Hessian determinant on our response scale (see :func:`surf_detect`).
+    n_octaves : int
+        Number of octaves, 1..6.
+    init_step : int
+        Sampling step of the first octave in pixels.
+    upright : bool
+        U-SURF (all orientations 0).
+    extended : bool
+        128-d descriptors instead of 64-d.
+    workers : int
+        Threads of the detection (same result for any value).
+
     >>> SURF(threshold=0.001, upright=True).upright
     True
     """
@@ -138,7 +153,20 @@ class SURF:
                 f"upright={self.upright}, extended={self.extended})")
 
     def detect(self, image, *, descriptors: bool = True) -> Features:
-        """Keypoints (and descriptors) of ``image``."""
+        """Keypoints (and descriptors) of ``image``.
+
+        Parameters
+        ----------
+        image : (H, W) array
+            Grey image (uint8, or float in [0, 1]).
+        descriptors : bool
+            Compute descriptors.
+
+        Returns
+        -------
+        Features
+            As :func:`surf_detect` with this detector's settings.
+        """
         return surf_detect(image, self.threshold, n_octaves=self.n_octaves, init_step=self.init_step,
                            upright=self.upright, extended=self.extended, descriptors=descriptors,
                            workers=self.workers)

@@ -89,6 +89,30 @@ def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_ra
     longest count as tied and the first wins (ours: the choice does not depend on rounding).
     ``chunk`` keypoints at a time, split over ``workers`` threads (ours, speed; the result does not
     depend on either).
+
+    Parameters
+    ----------
+    II : (H+1, W+1) float
+        Integral image (:func:`integral_image`).
+    uv : (K, 2) float
+        Keypoint positions (u, v) in pixels.
+    scale_px : (K,) float
+        Keypoint scales σ in pixels (rounded to whole pixels for the samples).
+    window_rad : float
+        Width of the sliding angular window (Bay: π/3).
+    step_rad : float
+        Step of the window's start angle.
+    chunk : int
+        Keypoints per vectorised chunk.
+    workers : int
+        Threads.
+    _padded : _PaddedII, optional
+        Private: a padded integral image already built by :func:`surf_detect`.
+
+    Returns
+    -------
+    (K,) float
+        Orientations in radians.
     """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     s = np.maximum(np.rint(np.asarray(scale_px, dtype=np.float64)), 1).astype(np.int64)
@@ -196,6 +220,30 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
     s·Σdy·g), so only the absolute values need the rotated responses per sample (speed, issue 17;
     same values to rounding). ``chunk`` keypoints at a time, split over ``workers`` threads (the
     result does not depend on either).
+
+    Parameters
+    ----------
+    II : (H+1, W+1) float
+        Integral image (:func:`integral_image`).
+    uv : (K, 2) float
+        Keypoint positions (u, v) in pixels.
+    scale_px : (K,) float
+        Keypoint scales σ in pixels.
+    orientation_rad : (K,) float
+        Keypoint orientations (0 for U-SURF).
+    extended : bool
+        128-d descriptor (sums split by the sign of the other response).
+    chunk : int
+        Keypoints per vectorised chunk.
+    workers : int
+        Threads.
+    _padded : _PaddedII, optional
+        Private: a padded integral image already built by :func:`surf_detect`.
+
+    Returns
+    -------
+    (K, 64) or (K, 128) float32
+        Unit-length descriptors.
     """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     sigma = np.asarray(scale_px, dtype=np.float64)

@@ -49,6 +49,20 @@ def haar_xy(II, rows, cols, half):
 
     dx = right half minus left half, dy = lower half minus upper half (v down),
     boxes clipped to the image. ``rows``, ``cols``, ``half`` broadcast together.
+
+    Parameters
+    ----------
+    II : (H+1, W+1) float
+        Integral image (:func:`slamlab.features.surf.integral_image`).
+    rows, cols : int arrays
+        Centre pixels.
+    half : int or int array
+        Half the wavelet side in pixels.
+
+    Returns
+    -------
+    dx, dy : float arrays
+        The responses, shaped as the broadcast inputs.
     """
     H, W = II.shape[0] - 1, II.shape[1] - 1
     Wp = W + 1

@@ -18,6 +18,15 @@ __all__ = ["box_sums", "filter_sizes", "hessian_response", "integral_image", "th
 def integral_image(image) -> np.ndarray:
     """Integral image with a zero first row and column: ``II[r, c] = Σ I[:r, :c]`` (Bay 2008 §3.1).
 
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (uint8 scaled to [0, 1], float as given).
+
+    Returns
+    -------
+    II : (H+1, W+1) float64
+
     >>> integral_image(np.ones((2, 3)))[-1].tolist()
     [0.0, 2.0, 4.0, 6.0]
     """
@@ -30,6 +39,18 @@ def integral_image(image) -> np.ndarray:
 
 def filter_sizes(n_octaves: int = 4, n_intervals: int = 4) -> np.ndarray:
     """Box-filter sides ``L[o, i] = 3·(2^(o+1)·(i+1) + 1)`` (Bay 2008 §3.3).
+
+    Parameters
+    ----------
+    n_octaves : int
+        Number of octaves (rows).
+    n_intervals : int
+        Filters per octave (columns).
+
+    Returns
+    -------
+    L : (n_octaves, n_intervals) int
+        Filter sides in pixels.
 
     >>> filter_sizes(2).tolist()
     [[9, 15, 21, 27], [15, 27, 39, 51]]
@@ -75,6 +96,19 @@ def hessian_response(II, L: int, step: int, *, IIp=None, pad: int | None = None)
     Box layout of OpenSURF: lobe ``l = L/3``; Dxx = whole (2l-1)×L box minus 3× the
     middle lobe; Dxy = four l×l boxes with signs (+ - / - +) around the centre. Each
     D is divided by L² and ``det = Dxx·Dyy - 0.81·Dxy²``.
+
+    Parameters
+    ----------
+    II : (H+1, W+1) float
+        Integral image.
+    L : int
+        Filter side in pixels (9, 15, ...).
+    step : int
+        Grid step in pixels.
+    IIp : array, optional
+        ``II`` edge-padded by ``pad`` on every side (built here when None).
+    pad : int, optional
+        The padding of ``IIp`` (at least ``L + step``; ignored when ``IIp`` is None).
 
     Returns
     -------
@@ -297,7 +331,24 @@ def _octave_extrema(D, step, Lo, o, threshold, H, W):
 
 
 def threshold_sweep(image, thresholds, *, n_octaves: int = 4, init_step: int = 2) -> np.ndarray:
-    """Number of SURF keypoints for each threshold (one response computation)."""
+    """Number of SURF keypoints for each threshold (one response computation).
+
+    Parameters
+    ----------
+    image : (H, W) array
+        Grey image (uint8, or float in [0, 1]).
+    thresholds : sequence of float
+        Hessian thresholds on our scale.
+    n_octaves : int
+        Number of octaves.
+    init_step : int
+        Sampling step of the first octave in pixels.
+
+    Returns
+    -------
+    (n,) int
+        Keypoints with response above each threshold.
+    """
     img = to_gray_float(image)
     th = v.as_vector(thresholds, "thresholds")
     II = integral_image(img)

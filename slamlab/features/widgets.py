@@ -38,6 +38,16 @@ def explore_detectors(**defaults):
 
     The threshold slider is read as the chosen detector's own knob (SURF: log10 of
     the Hessian threshold). Prints counts and the repeatability (tolerance 2.5 px).
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``detector`` (label), ``threshold`` (slider fraction 0..1), ``sequence``,
+        ``step`` (2..6), ``scale`` (image resize factor), ``draw`` (bool).
+
+    Returns
+    -------
+    ipywidgets.interactive
     """
     d = {"detector": "SURF (ours)", "threshold": 0.5, "sequence": "graf", "step": 2, "scale": 0.5, "draw": True}
     d.update(defaults)
@@ -78,7 +88,18 @@ _MATCH_DETECTORS = {"SURF (ours)": ("surf", {"threshold": 1e-4}), "SIFT (OpenCV)
 
 
 def explore_matching(**defaults):
-    """Ratio threshold, BBF max_leaves (0 = exact brute force) and detector -> matches drawn and scored."""
+    """Ratio threshold, BBF max_leaves (0 = exact brute force) and detector -> matches drawn and scored.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``ratio``, ``max_leaves``, ``detector`` (label), ``sequence``, ``step``,
+        ``scale`` (image resize factor), ``n_points`` (strongest keypoints per image), ``draw``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"ratio": 0.8, "max_leaves": 200, "detector": "SURF (ours)", "sequence": "graf", "step": 2,
          "scale": 0.5, "n_points": 800, "draw": True}
     d.update(defaults)
