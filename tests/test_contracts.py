@@ -52,8 +52,8 @@ ALLOWED: dict[str, dict[str, str]] = {
         "params": "evaluates 000's cost formula at four numbers (n, s, m, C): nothing else to set",
         "rng": _NO_RANDOMNESS},
     "slamlab.kdtree.experiments.run_store_comparison": {"params": _NO_PIPELINE},
-    "slamlab.kdtree.experiments.run_crossover": {"params": _NO_PIPELINE},
-    "slamlab.kdtree.experiments.run_dimension_study": {"params": _NO_PIPELINE},
+    "slamlab.kdtree.crossover.run_crossover": {"params": _NO_PIPELINE},
+    "slamlab.kdtree.tree_studies.run_dimension_study": {"params": _NO_PIPELINE},
     # mono: MonoSLAM draws no random numbers (OpenCV's RANSAC is reseeded to 0 before each call,
     # mono/initialise.py); the streams are the renderer's, taken by the run_* that render
     "slamlab.mono.experiments.run_mono": {"rng": _NO_RANDOMNESS + " (MonoSLAM on given images)"},

@@ -65,6 +65,20 @@ READINGS = ("adjusted", "literal")
 def p_bounds(n, n1, q):
     """Lower and upper bound of the number of non-empty trees ``p`` (000 §4.1.2, eq. 3).
 
+    Parameters
+    ----------
+    n : float or array
+        Points stored.
+    n1 : float or array
+        Maximum size of the smallest tree.
+    q : float or array
+        Size ratio between consecutive trees (> 1).
+
+    Returns
+    -------
+    lo, hi : float arrays
+        ``log_q(n/n1 (q-1) + 1)`` and ``log_q(n/n1) + 1``, broadcast over the inputs.
+
     >>> lo, hi = p_bounds(50000, 3500, 5.5)
     >>> round(float(lo), 3), round(float(hi), 3)
     (2.451, 2.56)
@@ -88,6 +102,20 @@ def _p(n, n1, q, p_rule):
 def t_search(n1, q, p):
     """``T_search = p log2 n1 + p(p-1)/2 log2 q``: one query over ``p`` trees (000 §4.1.2).
 
+    Parameters
+    ----------
+    n1 : float or array
+        Maximum size of the smallest tree.
+    q : float or array
+        Size ratio between consecutive trees.
+    p : float or array
+        Number of non-empty trees.
+
+    Returns
+    -------
+    float array
+        Search cost in units of one search step.
+
     >>> float(t_search(1024, 2.0, 1))
     10.0
     """
@@ -97,6 +125,18 @@ def t_search(n1, q, p):
 
 def t_modify(n1, q, p, m):
     """``T_modify = m q p log2 n1 + m q p(p-1)/2 log2 q``: mean merge cost per iteration (000 §4.1.2).
+
+    Parameters
+    ----------
+    n1, q, p : float or array
+        Smallest tree size, size ratio, number of non-empty trees.
+    m : float
+        Points inserted per iteration.
+
+    Returns
+    -------
+    float array
+        Merge cost in units of one build step.
 
     >>> float(t_modify(1024, 2.0, 1, 10))
     200.0
@@ -108,6 +148,17 @@ def t_modify(n1, q, p, m):
 def search_kd(n1, q, p, C):
     """The Appendix's ``searchKd = p log2 n1 + C p(p-1)/2 log2 q``, literally (``C`` inside).
 
+    Parameters
+    ----------
+    n1, q, p : float or array
+        Smallest tree size, size ratio, number of non-empty trees.
+    C : float
+        Cost of a search step relative to a build step.
+
+    Returns
+    -------
+    float array
+
     >>> float(search_kd(1024, 2.0, 2, 9.0))
     29.0
     """
@@ -117,6 +168,17 @@ def search_kd(n1, q, p, C):
 
 def add_kd(n1, q, p, m):
     """The Appendix's ``addKd = n1 log2 n1 + m q p log2 n1 + m q/2 p(p-1) log2 q`` (build term + ``T_modify``).
+
+    Parameters
+    ----------
+    n1, q, p : float or array
+        Smallest tree size, size ratio, number of non-empty trees.
+    m : float
+        Points inserted per iteration.
+
+    Returns
+    -------
+    float array
 
     >>> float(add_kd(1024, 2.0, 1, 10))
     10440.0
@@ -133,6 +195,32 @@ def iter_time(n1, q, *, n: float = 50000, s: float = 500, m: float = 500, C: flo
     ``"adjusted"`` (default): ``addKd + C s T_search``, the search term of §4.1.2 (the one
     change that lands on 000's optimum). ``p_rule`` picks ``p`` from the bounds (3);
     ``build_term=False`` drops ``n1 log2 n1`` (§4.1.2's ``f = T_modify + C s T_search``).
+
+    Parameters
+    ----------
+    n1 : float or array
+        Maximum size of the smallest tree (> 1).
+    q : float or array
+        Size ratio between consecutive trees (> 1).
+    n : float
+        Points stored (000: 50000).
+    s : float
+        Searches per iteration.
+    m : float
+        Inserts per iteration.
+    C : float
+        Cost of a search step relative to a build step (000: 9).
+    p_rule : {'upper', 'lower', 'integer'}
+        How ``p`` is taken from the bounds.
+    build_term : bool
+        Include the build term ``n1 log2 n1``.
+    reading : {'adjusted', 'literal'}
+        Which reading of 000's formula.
+
+    Returns
+    -------
+    float array
+        Cost per iteration in build steps, broadcast over ``n1`` and ``q``.
 
     >>> round(float(iter_time(3500, 5.5) / iter_time(1200, 2.3)), 3), round(float(
     ...     iter_time(3500, 5.5, reading="literal") / iter_time(1200, 2.3, reading="literal")), 3)
@@ -156,7 +244,27 @@ def calibrate_C(s: float, t_search_s: float, m: float, t_modify_s: float, n: flo
     """``C = C1 / C2`` from one tree: ``C1 s log n = t_s``, ``C2 n log n = t_m`` (000 §4.1.2).
 
     The insert of ``m`` points is modelled as a rebuild of all ``n`` points, so
-    ``m`` does not enter. 000's numbers give 8.98:
+    ``m`` does not enter.
+
+    Parameters
+    ----------
+    s : float
+        Searches timed.
+    t_search_s : float
+        Their time in seconds.
+    m : float
+        Points inserted (checked, unused by the model).
+    t_modify_s : float
+        Time of the inserts in seconds.
+    n : float
+        Points in the tree.
+
+    Returns
+    -------
+    float
+        ``C``.
+
+    000's numbers give 8.98:
 
     >>> round(calibrate_C(526, 0.079, 678, 0.750, 44828), 2)
     8.98
@@ -174,6 +282,25 @@ def minimise_iter_time(*, n: float = 50000, s: float = 500, m: float = 500, C: f
 
     Returns ``(n1, q, value, N1, Q, F)`` with the grid for plotting. The grid
     steps are 50 points in ``n1`` and 0.05 in ``q`` by default.
+
+    Parameters
+    ----------
+    n, s, m, C, p_rule, build_term, reading
+        As in :func:`iter_time`.
+    n1_range, q_range : (float, float)
+        Grid ranges of ``n1`` and ``q``.
+    grid : (int, int)
+        Grid points along ``n1`` and ``q``.
+
+    Returns
+    -------
+    n1, q, value : float
+        The grid minimum and its cost.
+    N1 : (grid[0],) float
+    Q : (grid[1],) float
+        The grid axes.
+    F : (grid[0], grid[1]) float
+        The cost surface.
     """
     N1 = np.linspace(*n1_range, grid[0])
     Q = np.linspace(*q_range, grid[1])
@@ -184,7 +311,21 @@ def minimise_iter_time(*, n: float = 50000, s: float = 500, m: float = 500, C: f
 
 @dataclass(frozen=True)
 class CostModelResult:
-    """Optimum of the multi kd-tree cost model under each reading of 000's formulas."""
+    """Optimum of the multi kd-tree cost model under each reading of 000's formulas.
+
+    Attributes
+    ----------
+    n, s, m, C : float
+        The model's inputs (points, searches, inserts per iteration; relative search cost).
+    readings : tuple of (str, float, float, float, bool)
+        Per reading: name, optimal ``n1``, ``q``, cost and whether the optimum is on the grid's edge.
+    flat_n1, flat_q : (float, float)
+        Ranges of ``n1`` and ``q`` within 1 % of the adjusted reading's minimum.
+    N1, Q : 1-d float
+        Grid axes.
+    F : (len(N1), len(Q)) float
+        The adjusted reading's cost surface.
+    """
 
     n: float
     s: float
@@ -224,7 +365,24 @@ class CostModelResult:
 
 
 def run_cost_model(*, n: float = 50000, s: float = 500, m: float = 500, C: float = 9.0) -> CostModelResult:
-    """Minimise the cost under 000's readings and report each optimum (000 §4.1.2, Appendix)."""
+    """Minimise the cost under 000's readings and report each optimum (000 §4.1.2, Appendix).
+
+    Parameters
+    ----------
+    n : float
+        Points stored.
+    s : float
+        Searches per iteration.
+    m : float
+        Inserts per iteration.
+    C : float
+        Cost of a search step relative to a build step.
+
+    Returns
+    -------
+    CostModelResult
+        ``readings`` (the optimum per reading) and the adjusted surface.
+    """
     n = v.check_positive(n, "n")
     s = v.check_positive(s, "s")
     m = v.check_positive(m, "m")

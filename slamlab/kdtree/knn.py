@@ -28,6 +28,19 @@ def flann_index(data, *, trees: int = 1, seed: int | None = 0):
     whatever drew from that RNG before (in a notebook: any earlier cell). ``seed`` (not None)
     reseeds it with ``cv2.setRNGSeed`` first, so the same data give the same trees in any kernel
     (a side effect on OpenCV's global RNG).
+
+    Parameters
+    ----------
+    data : (N, D) array
+        Points (converted to contiguous float32).
+    trees : int
+        Number of randomised kd-trees.
+    seed : int or None
+        Seed for ``cv2.setRNGSeed`` before the build; None leaves OpenCV's RNG as it is.
+
+    Returns
+    -------
+    cv2.flann_Index
     """
     import cv2
 
@@ -38,6 +51,20 @@ def flann_index(data, *, trees: int = 1, seed: int | None = 0):
 
 def pad_knn(dist, ids, k: int):
     """``(dist (M, k), ids (M, k))`` from lists with ``k_i <= k`` columns: missing neighbours are ``inf`` / ``-1``.
+
+    Parameters
+    ----------
+    dist : (M, k_i) float
+        Distances, ascending per row.
+    ids : (M, k_i) int
+        Their ids.
+    k : int
+        Columns wanted (extra columns of the input are cut).
+
+    Returns
+    -------
+    dist : (M, k) float
+    ids : (M, k) int64
 
     >>> d, i = pad_knn(np.array([[0.5]]), np.array([[4]]), 2)
     >>> d.tolist(), i.tolist()
@@ -61,6 +88,14 @@ def merge_knn(dists, ids, k: int = 2):
     ----------
     dists, ids : lists of (M, k_i) arrays
         Distances (``inf`` for missing) and ids (-1 for missing) from each tree.
+    k : int
+        Neighbours kept per query.
+
+    Returns
+    -------
+    dist : (M, k) float
+        Ascending; ties keep the tree order.
+    ids : (M, k) int64
 
     >>> d, i = merge_knn([np.array([[1.0, 3.0]]), np.array([[2.0, np.inf]])],
     ...                  [np.array([[10, 11]]), np.array([[20, -1]])])
@@ -75,6 +110,18 @@ def merge_knn(dists, ids, k: int = 2):
 
 def hamming_distances(A, B) -> np.ndarray:
     """Pairwise Hamming distances between binary descriptors packed as uint8 bytes.
+
+    Parameters
+    ----------
+    A : (M, b) uint8
+        Binary descriptors, ``b`` bytes each.
+    B : (N, b) uint8
+        Binary descriptors of the same width.
+
+    Returns
+    -------
+    (M, N) int64
+        Number of differing bits.
 
     >>> hamming_distances(np.array([[0b1011]], np.uint8), np.array([[0], [255]], np.uint8)).tolist()
     [[3, 5]]
@@ -135,6 +182,17 @@ def exact_knn(Q, X, k: int = 2, ids=None, *, augmented=None):
 
 def augment_rows(X, out=None) -> np.ndarray:
     """float32 rows ``[x, |x|²/2]`` (the database side of the ranking GEMM of :func:`exact_knn`).
+
+    Parameters
+    ----------
+    X : (N, d) float
+        Points.
+    out : (N, d + 1) float32, optional
+        Array to write into (a new one when None).
+
+    Returns
+    -------
+    (N, d + 1) float32
 
     >>> augment_rows(np.array([[3.0, 4.0]])).tolist()
     [[3.0, 4.0, 12.5]]

@@ -31,6 +31,20 @@ def multi_tree_sizes(n1: int, q: float, batches) -> list[list[int]]:
     points it is merged into tree ``i + 1``; trees are appended so that the last
     one can hold the total.
 
+    Parameters
+    ----------
+    n1 : int
+        Maximum size of the first tree.
+    q : float
+        Size ratio between consecutive trees (> 1).
+    batches : sequence of int
+        Points inserted per batch.
+
+    Returns
+    -------
+    list of list of int
+        The tree sizes after each batch.
+
     >>> multi_tree_sizes(4, 2.0, [3, 3, 3])
     [[3], [0, 6], [3, 6, 0]]
     """
@@ -68,6 +82,19 @@ class MultiKDTree(LandmarkStore):
     the trees whose contents changed are rebuilt. A query searches every non-empty
     tree and merges the k-NN lists (exact when the per-tree search is exact).
 
+    Parameters
+    ----------
+    n1 : int
+        Maximum size of the first tree (000: 3500).
+    q : float
+        Size ratio between consecutive trees, > 1 (000: 5.5).
+    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
+        Search in each tree (:data:`TREE_KINDS`).
+    leaf_size : int
+        Points per leaf of our trees.
+    checks : int
+        Leaf budget of the BBF search.
+
     >>> rng = np.random.default_rng(0)
     >>> mt = MultiKDTree(4, 2.0, tree="ckdtree")
     >>> for b in range(5):
@@ -93,7 +120,17 @@ class MultiKDTree(LandmarkStore):
         self._trees: list[_Tree | None] = []
 
     def max_size(self, i: int) -> int:
-        """``MAX_SIZE[i] = floor(n1 q^i)`` (tree index from 0)."""
+        """``MAX_SIZE[i] = floor(n1 q^i)`` (tree index from 0).
+
+        Parameters
+        ----------
+        i : int
+            Tree index, 0 for the first tree.
+
+        Returns
+        -------
+        int
+        """
         return int(np.floor(self.n1 * self.q ** i + 1e-9))
 
     @property
@@ -175,6 +212,22 @@ class NonBaseBuffer(LandmarkStore):
     point base at once (Table 2). Queries search buffer and base and merge the
     k-NN lists (our choice: 000 does not say how the 2-NN rule is merged).
 
+    Parameters
+    ----------
+    base : LandmarkStore, optional
+        Insert-only store for the base points (default a :class:`MultiKDTree` with ``tree``,
+        ``leaf_size``, ``checks``).
+    base_seen_times : int
+        Sightings that make a point base (000: 3).
+    max_non_base_time : int
+        Iterations after its first sighting at which a non-base point is dropped (000: 7).
+    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
+        Search in the buffer tree (and the default base).
+    leaf_size : int
+        Points per leaf of our trees.
+    checks : int
+        Leaf budget of the BBF search.
+
     >>> rng = np.random.default_rng(0)
     >>> buf = NonBaseBuffer(MultiKDTree(10, 2.0, tree="ckdtree"), tree="ckdtree")
     >>> buf.add(rng.random((5, 3)), np.arange(5)); buf.end_iteration()
@@ -213,6 +266,13 @@ class NonBaseBuffer(LandmarkStore):
         self._book.add(ids)
 
     def observe(self, ids):
+        """Record re-sightings of buffered ids (they count towards ``base_seen_times``).
+
+        Parameters
+        ----------
+        ids : (K,) int
+            Ids seen again this iteration (ids not in the buffer are ignored).
+        """
         self._book.observe(_as_ids(ids, "ids"))
 
     def end_iteration(self):

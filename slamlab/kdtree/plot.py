@@ -14,6 +14,23 @@ def plot_kdtree_2d(tree, *, query=None, events=None, ax=None, max_depth: int | N
 
     ``events`` is the list from :func:`slamlab.kdtree.bbf_trace`; visited leaves are
     numbered in the order BBF examined them.
+
+    Parameters
+    ----------
+    tree : KDTree
+        A tree over 2-D points.
+    query : (2,) float, optional
+        Query point to mark.
+    events : list, optional
+        BBF trace of ``query`` (:func:`slamlab.kdtree.bbf_trace`).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    max_depth : int, optional
+        Draw splits only down to this depth.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
     """
     if tree.dim != 2:
         raise ValueError(f"`tree` must hold 2-D points to be drawn; got dimension {tree.dim}")

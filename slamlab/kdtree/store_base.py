@@ -25,7 +25,25 @@ TREE_KINDS = ("bbf", "exact", "ckdtree", "brute")
 
 @dataclass
 class StoreCounters:
-    """Operation counts accumulated by a store (the quantities of 000's cost model)."""
+    """Operation counts accumulated by a store (the quantities of 000's cost model).
+
+    Attributes
+    ----------
+    points_added : int
+        Points inserted.
+    points_rebuilt : int
+        Points put into a newly built tree (build work).
+    trees_built : int
+        Trees built.
+    queries : int
+        Query points searched.
+    trees_searched : int
+        Non-empty trees searched, summed over query batches.
+    nodes_visited : int
+        Internal tree nodes passed (teaching tree only).
+    distance_evals : int
+        Query-to-point distances computed (0 where the backend does not say).
+    """
 
     points_added: int = 0
     points_rebuilt: int = 0  # points put into a newly built tree (build work)
@@ -51,6 +69,21 @@ def base_rule(seen, age, base_seen_times: int, max_non_base_time: int):
     ``MaxNonBaseTime = 7``) times out and is dropped. ``age`` = iterations since the first
     sighting (0 in the iteration it was first seen).
 
+    Parameters
+    ----------
+    seen : (N,) int
+        Sightings per point.
+    age : (N,) int
+        Iterations since each point's first sighting.
+    base_seen_times : int
+        Sightings that make a point base.
+    max_non_base_time : int
+        Age at which a non-base point times out.
+
+    Returns
+    -------
+    is_base, timed_out : (N,) bool
+
     >>> b, late = base_rule(np.array([3, 1, 2]), np.array([2, 7, 6]), 3, 7)
     >>> b.tolist(), late.tolist()
     ([True, False, False], [False, True, False])
@@ -62,6 +95,13 @@ def base_rule(seen, age, base_seen_times: int, max_non_base_time: int):
 
 class SightingBook:
     """Seen counts and first-sighting iterations of non-base points; :meth:`step` applies :func:`base_rule`.
+
+    Parameters
+    ----------
+    base_seen_times : int
+        Sightings that make a point base.
+    max_non_base_time : int
+        Age in iterations at which a non-base point times out.
 
     >>> book = SightingBook(3, 7)
     >>> book.add(np.array([1, 2])); book.step()[0].tolist()
@@ -81,6 +121,13 @@ class SightingBook:
         self.iteration = 0
 
     def add(self, ids):
+        """Start the book of new points: seen once, first sighting this iteration.
+
+        Parameters
+        ----------
+        ids : (K,) int64
+            Ids not yet in the book.
+        """
         allid = np.concatenate([self.ids, ids])
         o = np.argsort(allid, kind="stable")
         self.ids = allid[o]
@@ -88,6 +135,13 @@ class SightingBook:
         self.first = np.concatenate([self.first, np.full(ids.size, self.iteration, dtype=np.int64)])[o]
 
     def observe(self, ids):
+        """Count one more sighting of every booked id in ``ids``.
+
+        Parameters
+        ----------
+        ids : (K,) int64
+            Ids seen again (ids not in the book are ignored).
+        """
         if not self.ids.size or not ids.size:
             return
         pos = np.searchsorted(self.ids, ids)
@@ -192,28 +246,73 @@ class LandmarkStore(ABC):
 
     # -- interface ---------------------------------------------------------------------------------
     def add(self, X, ids) -> None:
-        """Add a batch of new points (first sighting) with their ids."""
+        """Add a batch of new points (first sighting) with their ids.
+
+        Parameters
+        ----------
+        X : (N, d) float or uint8
+            Points (descriptors); every batch has the store's dimension.
+        ids : (N,) int
+            Their ids.
+        """
         X, ids = self._check_batch(X, ids)
         if X.shape[0]:
             self.counters.points_added += X.shape[0]
             self._add(X, ids)
 
     def observe(self, ids) -> None:
-        """Record re-sightings of stored ids this iteration (only the base rule uses them)."""
+        """Record re-sightings of stored ids this iteration (only the base rule uses them).
+
+        Parameters
+        ----------
+        ids : (K,) int
+            Ids seen again.
+        """
         _as_ids(ids, "ids")
 
     def end_iteration(self) -> None:  # noqa: B027 (a no-op unless the store rebuilds or applies the base rule)
         """Close an iteration (apply the base rule, rebuild what the store rebuilds)."""
 
     def query(self, Q, k: int = 2):
-        """The ``k`` nearest stored points of every row of ``Q``: ``(dist (M, k), ids (M, k))``."""
+        """The ``k`` nearest stored points of every row of ``Q``: ``(dist (M, k), ids (M, k))``.
+
+        Parameters
+        ----------
+        Q : (M, d) array
+            Query points.
+        k : int
+            Neighbours per query.
+
+        Returns
+        -------
+        dist : (M, k) float
+            Ascending; ``inf`` where fewer than ``k`` points are stored.
+        ids : (M, k) int
+            Ids of the neighbours; -1 where missing.
+        """
         Q, k = self._check_query(Q, k)
         if len(self) == 0 or Q.shape[0] == 0:
             return pad_knn(np.empty((Q.shape[0], 0)), np.empty((Q.shape[0], 0), dtype=np.int64), k)
         return self._query(Q, k)
 
     def query_among(self, Q, among, k: int = 2):
-        """Like :meth:`query`, searching only (and exactly) the stored points whose ids are in ``among``."""
+        """Like :meth:`query`, searching only (and exactly) the stored points whose ids are in ``among``.
+
+        Parameters
+        ----------
+        Q : (M, d) array
+            Query points.
+        among : int array
+            Ids of the stored points to search.
+        k : int
+            Neighbours per query.
+
+        Returns
+        -------
+        dist : (M, k) float
+        ids : (M, k) int
+            As :meth:`query`.
+        """
         Q, k = self._check_query(Q, k)
         among = _as_ids(np.asarray(among).ravel(), "among")
         X, ids = self._stored()

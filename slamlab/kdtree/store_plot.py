@@ -21,7 +21,21 @@ _NAMES = {"rebuild": "kd-tree (rebuilt)", "multi": "buffer + multi kd-tree", "fl
 
 
 def plot_cost_surface(result, *, ax=None, cmap: str = "viridis"):
-    """000's Maple plot: iterTime over (n1, q) as a 3D surface with the optimum marked (000 Appendix)."""
+    """000's Maple plot: iterTime over (n1, q) as a 3D surface with the optimum marked (000 Appendix).
+
+    Parameters
+    ----------
+    result : CostModelResult
+        From :func:`slamlab.kdtree.cost_model.run_cost_model`.
+    ax : mpl_toolkits.mplot3d.Axes3D, optional
+        3-D axes to draw into.
+    cmap : str
+        Matplotlib colour map of the surface.
+
+    Returns
+    -------
+    mpl_toolkits.mplot3d.Axes3D
+    """
     if ax is None:
         fig = plt.figure(figsize=(7, 5))
         ax = fig.add_subplot(projection="3d")
@@ -41,7 +55,23 @@ def plot_cost_surface(result, *, ax=None, cmap: str = "viridis"):
 
 
 def plot_cost_contour(result, *, ax=None, levels: int = 30, mark_000: bool = True):
-    """Contour of the cost surface with our optimum, 000's optimum and the 1 % region (000 §4.1.2)."""
+    """Contour of the cost surface with our optimum, 000's optimum and the 1 % region (000 §4.1.2).
+
+    Parameters
+    ----------
+    result : CostModelResult
+        From :func:`slamlab.kdtree.cost_model.run_cost_model`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    levels : int
+        Number of filled contour levels.
+    mark_000 : bool
+        Mark 000's optimum (n1 ≈ 3500, q = 5.5).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, figsize=(7, 5), title="iterTime(n1, q): contour (000 Appendix reading)", xlabel="n1",
                   ylabel="q")
     N1, Q, F = result.N1, result.Q, result.F
@@ -58,7 +88,25 @@ def plot_cost_contour(result, *, ax=None, levels: int = 30, mark_000: bool = Tru
 
 
 def plot_multi_tree_sizes(history, n1: int, q: float, *, ax=None, n_trees: int | None = None):
-    """Sizes of trees 1..p after each add, with the maximum sizes ``n1 q^i`` dashed (000 §4.1 invariant)."""
+    """Sizes of trees 1..p after each add, with the maximum sizes ``n1 q^i`` dashed (000 §4.1 invariant).
+
+    Parameters
+    ----------
+    history : list of list of int
+        Tree sizes after each add (:func:`slamlab.kdtree.multi_tree_sizes`).
+    n1 : int
+        Maximum size of the first tree.
+    q : float
+        Size ratio between consecutive trees.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    n_trees : int, optional
+        Trees drawn (default: the most the history holds).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, figsize=(8, 4), title=f"multi kd-tree, n1 = {n1}, q = {q:g}: tree sizes after each add",
                   xlabel="add", ylabel="points in tree")
     p = n_trees or max(len(h) for h in history)
@@ -76,7 +124,19 @@ def plot_multi_tree_sizes(history, n1: int, q: float, *, ax=None, n_trees: int |
 
 
 def plot_crossover(result, *, ax=None):
-    """Iteration time vs stored points for each store, log-log, with the crossover marked (000 §4.3)."""
+    """Iteration time vs stored points for each store, log-log, with the crossover marked (000 §4.3).
+
+    Parameters
+    ----------
+    result : CrossoverResult
+        From :func:`slamlab.kdtree.crossover.run_crossover`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, figsize=(7, 4.5), title="mean iteration time vs stored points", xlabel="stored points",
                   ylabel="iteration time [ms]")
     for s in result.stores:
@@ -93,7 +153,19 @@ def plot_crossover(result, *, ax=None):
 
 
 def plot_iteration_times(result, *, ax=None):
-    """Per-iteration time (search + add) of each store over a Table 1/2 run (000 §4.2)."""
+    """Per-iteration time (search + add) of each store over a Table 1/2 run (000 §4.2).
+
+    Parameters
+    ----------
+    result : StoreComparisonResult
+        From :func:`slamlab.kdtree.experiments.run_store_comparison`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, figsize=(8, 4), title=f"000 {result.scenario.replace('table', 'Table ')} workload: time per iteration", xlabel="iteration",
                   ylabel="time [ms]")
     for s in result.stores:

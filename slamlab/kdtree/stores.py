@@ -127,6 +127,19 @@ class RebuildStore(_BaseRuleStore):
     non-base points that time out (Table 1 scenario), so it holds the same points
     as :class:`NonBaseBuffer` + :class:`MultiKDTree`.
 
+    Parameters
+    ----------
+    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
+        Search in the tree (:data:`TREE_KINDS`).
+    leaf_size : int
+        Points per leaf of our trees.
+    checks : int
+        Leaf budget of the BBF search.
+    base_seen_times : int
+        Sightings that make a point base; 1 keeps every point.
+    max_non_base_time : int
+        Age in iterations at which a non-base point is dropped.
+
     >>> rng = np.random.default_rng(0)
     >>> s = RebuildStore(tree="ckdtree")
     >>> s.add(rng.random((50, 4)), np.arange(50)); s.end_iteration()
@@ -170,6 +183,13 @@ class ExactStore(_BaseRuleStore):
     Euclidean for float ones, by :func:`~slamlab.kdtree.knn.exact_knn`. Non-base points
     first seen ``max_non_base_time`` iterations ago are dropped (``dropped_ids``);
     ``base_seen_times = 1`` keeps every point (:class:`BruteForceStore`).
+
+    Parameters
+    ----------
+    base_seen_times : int
+        Sightings that make a point base (000: 3).
+    max_non_base_time : int
+        Age in iterations at which a non-base point is dropped (000: 7).
 
     Examples
     --------
@@ -223,6 +243,15 @@ class FlannStore(LandmarkStore):
     reachable from Python). FLANN draws its random split dimensions from OpenCV's
     global RNG; ``seed`` (not None) reseeds it with ``cv2.setRNGSeed`` before each
     build so that runs repeat (a side effect on OpenCV's global RNG).
+
+    Parameters
+    ----------
+    trees : int
+        Randomised kd-trees in the index.
+    checks : int
+        Leaves checked per query.
+    seed : int or None
+        Seed of OpenCV's RNG before each build (None: not reseeded).
     """
 
     name = "FLANN (OpenCV)"
@@ -280,6 +309,26 @@ def make_store(name: str, *, n1: int = 3500, q: float = 5.5, base_seen_times: in
     ``"rebuild"`` -- :class:`RebuildStore` (it applies the base rule itself);
     ``"multi"``, ``"flann"``, ``"brute"`` -- :class:`MultiKDTree`,
     :class:`FlannStore`, :class:`BruteForceStore` behind a :class:`NonBaseBuffer`.
+
+    Parameters
+    ----------
+    name : {'rebuild', 'multi', 'flann', 'brute'}
+        The store (:data:`STORE_NAMES`).
+    n1, q : int, float
+        Multi kd-tree sizes (``"multi"`` only).
+    base_seen_times, max_non_base_time : int
+        000 §3.4's base rule (:func:`base_rule`).
+    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
+        Search in our trees (the buffer of ``"brute"`` is always brute force).
+    leaf_size : int
+        Points per leaf of our trees.
+    checks : int
+        BBF leaf budget, and FLANN's checks.
+
+    Returns
+    -------
+    LandmarkStore
+        A :class:`RebuildStore` or a :class:`NonBaseBuffer` in front of the named base.
 
     >>> make_store("multi", n1=1000, q=4).base
     MultiKDTree(n1=1000, q=4.0, sizes=[])

@@ -40,7 +40,17 @@ __all__ = ["KDTree", "SearchStats", "bbf_trace", "build_kdtree"]
 
 @dataclass(frozen=True)
 class SearchStats:
-    """Work done by the last :meth:`KDTree.query` (per query arrays and totals)."""
+    """Work done by the last :meth:`KDTree.query` (per query arrays and totals).
+
+    Attributes
+    ----------
+    nodes_visited : (Q,) int
+        Internal nodes passed on the way down, per query.
+    leaves_visited : (Q,) int
+        Leaf buckets evaluated, per query.
+    distance_evals : (Q,) int
+        Point-to-query distances computed, per query.
+    """
 
     nodes_visited: np.ndarray  # (Q,) internal nodes passed on the way down
     leaves_visited: np.ndarray  # (Q,) leaf buckets evaluated
@@ -417,6 +427,26 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None):
 
     Returns the neighbours and a list of events ``(kind, node, bound)`` where kind
     is ``"pop"``, ``"push"`` or ``"leaf"``; the same search as :meth:`KDTree.query`.
+
+    Parameters
+    ----------
+    tree : KDTree
+        The tree searched.
+    q : (dim,) float
+        The query point.
+    k : int
+        Neighbours wanted.
+    max_leaves : int, optional
+        BBF leaf budget; None searches exactly.
+
+    Returns
+    -------
+    dist : (k,) float
+        Distances of the neighbours, ascending.
+    ids : (k,) int
+        Their ids.
+    events : list of (str, int, float)
+        ``(kind, node, bound)`` in search order.
 
     >>> tree = KDTree(np.array([[0.0], [1.0], [2.0], [3.0]]))
     >>> d, ids, events = bbf_trace(tree, [2.2], k=1)

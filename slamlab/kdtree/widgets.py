@@ -19,6 +19,15 @@ def explore_cost_model(**defaults):
 
     Calls :func:`~slamlab.kdtree.cost_model.run_cost_model`; a bad combination
     prints its message instead of failing.
+
+    Parameters
+    ----------
+    **defaults
+        Initial slider values: ``n1``, ``q``, ``s``, ``m``, ``n``, ``C``.
+
+    Returns
+    -------
+    ipywidgets.interactive
     """
     d = {"n1": 3500, "q": 5.5, "s": 500, "m": 500, "n": 50000, "C": 9.0}
     d.update(defaults)
@@ -53,6 +62,16 @@ def explore_stores(**defaults):
 
     ``s`` queries per iteration (90 % re-observations of stored points, 10 %
     clutter), ``m`` new points per iteration, ``n_iterations`` iterations.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``n1``, ``q``, ``s``, ``m``, ``n_iterations``, ``checks`` and ``rng`` (seed of
+        the workload).
+
+    Returns
+    -------
+    ipywidgets.interactive
     """
     d = {"n1": 1000, "q": 4.0, "s": 400, "m": 500, "n_iterations": 8, "checks": 200, "rng": 2010}
     d.update(defaults)

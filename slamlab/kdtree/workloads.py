@@ -37,7 +37,35 @@ DIM = 64
 
 @dataclass(frozen=True)
 class Scenario:
-    """Parameters of a descriptor stream (our choices where 000 is silent)."""
+    """Parameters of a descriptor stream (our choices where 000 is silent).
+
+    Attributes
+    ----------
+    name : str
+        Scenario name.
+    n_iterations : int
+        Iterations of the stream.
+    n_new : int
+        New points per iteration.
+    p_track : float
+        Probability in [0, 1) that a tracked landmark is re-seen in the next iteration.
+    n_old : int
+        Queries re-observing older base landmarks per iteration.
+    n_clutter : int
+        Queries of features that are not stored landmarks, per iteration.
+    base_seen_times : int
+        000's BaseSeenTimes (3 in Table 1; 1 = all base at once).
+    max_non_base_time : int
+        000's MaxNonBaseTime in iterations.
+    n_clusters : int
+        Texture prototypes the descriptors are drawn around.
+    sigma_cluster : float
+        Spread of landmarks around their prototype (before normalising).
+    sigma_obs : float
+        Descriptor noise of a re-observation (before normalising).
+    clustered : bool
+        False: descriptors uniform on the unit sphere.
+    """
 
     name: str
     n_iterations: int
@@ -65,6 +93,17 @@ SCENARIOS = {
 def scenario(name: str = "table2", **changes) -> Scenario:
     """One of :data:`SCENARIOS` with fields changed, e.g. ``scenario("table2", n_iterations=20)``.
 
+    Parameters
+    ----------
+    name : {'table1', 'table2'}
+        Key of :data:`SCENARIOS`.
+    **changes
+        :class:`Scenario` fields to replace (``ValueError`` for an unknown field).
+
+    Returns
+    -------
+    Scenario
+
     >>> scenario("table1", n_iterations=5).n_iterations
     5
     """
@@ -86,6 +125,27 @@ def surf_like_descriptors(n: int, *, n_clusters: int = 256, sigma_cluster: float
 
     Returns ``(X float32 (n, 64), prototypes (n_clusters, 64))``. With
     ``clustered=False`` the descriptors are uniform on the unit sphere.
+
+    Parameters
+    ----------
+    n : int
+        Number of descriptors.
+    n_clusters : int
+        Prototypes drawn when ``prototypes`` is None.
+    sigma_cluster : float
+        Spread around the prototype (before normalising).
+    clustered : bool
+        Draw around prototypes; False: uniform on the unit sphere (prototypes None).
+    rng : numpy.random.Generator, int or None
+        Randomness (see :func:`slamlab._validate.as_rng`).
+    prototypes : (n_clusters, 64) float, optional
+        Prototypes to reuse (from an earlier call).
+
+    Returns
+    -------
+    X : (n, 64) float32
+        Unit-length descriptors.
+    prototypes : (n_clusters, 64) float or None
 
     >>> X, P = surf_like_descriptors(5, rng=0)
     >>> X.shape, X.dtype.name, bool(np.allclose(np.linalg.norm(X, axis=1), 1, atol=1e-5))
@@ -116,7 +176,21 @@ def _observe(X, sigma, rng):
 
 @dataclass(frozen=True)
 class Iteration:
-    """One SLAM iteration: the queries (with their true landmark, -1 = none) and the new points."""
+    """One SLAM iteration: the queries (with their true landmark, -1 = none) and the new points.
+
+    Attributes
+    ----------
+    queries : (M, 64) float32
+        Query descriptors.
+    truth : (M,) int
+        Id of the landmark each query observes, -1 for clutter (or unknown).
+    new_X : (m, 64) float32
+        Descriptors of the new points.
+    new_ids : (m,) int
+        Their ids.
+    observed_ids : (K,) int or None
+        Ids the SLAM loop re-sighted (a recorded stream); None: taken from ``truth``.
+    """
 
     queries: np.ndarray  # (M, 64) float32
     truth: np.ndarray  # (M,) id of the landmark observed, -1 for clutter (or unknown)
@@ -134,7 +208,17 @@ class Iteration:
 
 @dataclass(frozen=True)
 class Workload:
-    """A descriptor stream and the number of stored points after each iteration."""
+    """A descriptor stream and the number of stored points after each iteration.
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The stream's parameters.
+    iterations : tuple of Iteration
+        The stream.
+    stored : (T,) int
+        Points kept after each iteration (base + non-base), by the base rule.
+    """
 
     scenario: Scenario
     iterations: tuple[Iteration, ...]
@@ -151,6 +235,20 @@ class Workload:
 
 def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload:
     """Generate the descriptor stream of a scenario (000 §4.2 runs, reproduced synthetically).
+
+    Parameters
+    ----------
+    name_or_scenario : str or Scenario
+        A key of :data:`SCENARIOS` or a :class:`Scenario`.
+    rng : numpy.random.Generator, int or None
+        Randomness of the descriptors, tracks and query order.
+    **changes
+        :class:`Scenario` fields to replace.
+
+    Returns
+    -------
+    Workload
+        The iterations and the points stored after each.
 
     >>> w = make_workload("table1", n_iterations=10, rng=0)
     >>> len(w), w.iterations[0].queries.shape[1]
@@ -221,6 +319,11 @@ class RecordingStore(LandmarkStore):
     ``end_iteration``. :meth:`workload` turns the recording into a
     :class:`Workload` that :func:`~slamlab.kdtree.experiments.run_store_comparison`
     replays through any store.
+
+    Parameters
+    ----------
+    store : LandmarkStore
+        The store every call is passed on to.
     """
 
     def __init__(self, store: LandmarkStore):
@@ -237,18 +340,64 @@ class RecordingStore(LandmarkStore):
         return len(self.store)
 
     def query(self, Q, k: int = 2):
+        """Record the queries and pass them on (:meth:`LandmarkStore.query`).
+
+        Parameters
+        ----------
+        Q : (M, d) array
+            Query points.
+        k : int
+            Neighbours per query.
+
+        Returns
+        -------
+        dist, ids : (M, k) arrays
+            The wrapped store's answer.
+        """
         self._q.append(np.asarray(Q))
         return self.store.query(Q, k=k)
 
     def query_among(self, Q, among, k: int = 2):
+        """Record the queries and pass them on (:meth:`LandmarkStore.query_among`).
+
+        Parameters
+        ----------
+        Q : (M, d) array
+            Query points.
+        among : int array
+            Ids of the stored points to search.
+        k : int
+            Neighbours per query.
+
+        Returns
+        -------
+        dist, ids : (M, k) arrays
+            The wrapped store's answer.
+        """
         self._q.append(np.asarray(Q))
         return self.store.query_among(Q, among, k=k)
 
     def observe(self, ids) -> None:
+        """Record re-sighted ids and pass them on.
+
+        Parameters
+        ----------
+        ids : (K,) int
+            Ids seen again this iteration.
+        """
         self._obs.append(np.asarray(ids, dtype=np.int64))
         self.store.observe(ids)
 
     def add(self, X, ids) -> None:
+        """Record new points and pass them on.
+
+        Parameters
+        ----------
+        X : (N, d) array
+            New points.
+        ids : (N,) int
+            Their ids.
+        """
         self._X.append(np.asarray(X))
         self._ids.append(np.asarray(ids, dtype=np.int64))
         self.store.add(X, ids)
@@ -272,7 +421,20 @@ class RecordingStore(LandmarkStore):
         self._q, self._obs, self._X, self._ids = [], [], [], []
 
     def workload(self, name: str = "recorded", *, base_seen_times: int = 3, max_non_base_time: int = 7) -> Workload:
-        """The recording as a :class:`Workload` (points stored per iteration counted by the base rule)."""
+        """The recording as a :class:`Workload` (points stored per iteration counted by the base rule).
+
+        Parameters
+        ----------
+        name : str
+            Name of the workload's scenario.
+        base_seen_times, max_non_base_time : int
+            The base rule used to count the stored points (000: 3 and 7).
+
+        Returns
+        -------
+        Workload
+            The recorded iterations (empty ones dropped).
+        """
         its = tuple(it for it in self.iterations if it.queries.size or it.new_X.size)
         if not its:
             raise ValueError("nothing was recorded: run the SLAM loop with this store first")
