@@ -43,7 +43,20 @@ def _fmt_rms(r: FlightResult) -> list[str]:
 
 def map_normal_error_deg(result: FlightResult, room) -> float:
     """Median over the map's planes of the angle [deg] between a plane's normal and the nearest normal of the
-    room's planes (``room`` a :class:`~slamlab.sim.PlaneRoom`; ours: how tilted the map is)."""
+    room's planes (``room`` a :class:`~slamlab.sim.PlaneRoom`; ours: how tilted the map is).
+
+    Parameters
+    ----------
+    result : FlightResult
+        A run whose ``map`` holds the planes.
+    room : slamlab.sim.PlaneRoom
+        The true room (its ``normals``).
+
+    Returns
+    -------
+    float
+        Median angle in degrees; NaN for an empty map.
+    """
     if len(result.map) == 0:
         return float("nan")
     N = np.array([pl.n for pl in result.map.planes])
@@ -54,7 +67,19 @@ def map_normal_error_deg(result: FlightResult, room) -> float:
 @dataclass(frozen=True)
 class FlightComparison:
     """Several runs of the filter on one flight: ``labels`` and ``results`` (:class:`FlightResult`), the odometry's
-    errors as the last row; ``note`` a line printed under the table."""
+    errors as the last row; ``note`` a line printed under the table.
+
+    Attributes
+    ----------
+    title : str
+        Table title.
+    labels : tuple of str
+        One label per run.
+    results : tuple of FlightResult
+        The runs, in ``labels`` order.
+    note : str
+        Line printed under the table.
+    """
 
     title: str
     labels: tuple
@@ -160,7 +185,15 @@ def run_frame_source_ablation(flight=None, *, duration_s: float = 8.0, n_particl
 
 @dataclass(frozen=True)
 class IncidenceResult:
-    """The incidence-angle correction (002 after [17]) on and off: Fig. 4's first cycle and a flight."""
+    """The incidence-angle correction (002 after [17]) on and off: Fig. 4's first cycle and a flight.
+
+    Attributes
+    ----------
+    fig4 : tuple of 2 IntensityResult
+        Fig. 4's first cycle with and without the correction.
+    flights : tuple of 2 FlightResult
+        The flight with and without the correction.
+    """
 
     fig4: tuple = field(repr=False)
     flights: tuple = field(repr=False)

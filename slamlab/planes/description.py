@@ -26,7 +26,18 @@ _OFF = 1 << 20   # cell indices in [-2^20, 2^20): ±262 km at 0.25 m cells
 
 
 def cell_keys(ij) -> np.ndarray:
-    """One int64 key per cell index pair ``(M, 2)`` (sortable, for look-ups)."""
+    """One int64 key per cell index pair ``(M, 2)`` (sortable, for look-ups).
+
+    Parameters
+    ----------
+    ij : (..., 2) int
+        Cell indices, each in [-2^20, 2^20).
+
+    Returns
+    -------
+    (...) int64
+        Keys ordered by ``i`` then ``j``.
+    """
     ij = np.asarray(ij, dtype=np.int64)
     return (ij[..., 0] + _OFF) * (2 * _OFF) + (ij[..., 1] + _OFF)
 
@@ -35,7 +46,25 @@ def cell_keys(ij) -> np.ndarray:
 class Plane:
     """A described plane ``Π = {n, p, T, A}`` (002): ``n (3,)``, ``p``, ``T (4, 4)`` plane frame → parent,
     ``cell_m``, cells ``ij (M, 2)`` (in ascending ``keys`` order) with ``counts (M,)`` and intensity ``sums
-    (M,)``; ``mean_intensity`` ``I_k = Σ I / N_k``."""
+    (M,)``; ``mean_intensity`` ``I_k = Σ I / N_k``.
+
+    Attributes
+    ----------
+    n : (3,) float
+        Unit normal in the parent frame.
+    p : float
+        Distance term of ``n·x − p = 0`` in metres.
+    T : (4, 4) float
+        Plane frame → parent frame.
+    cell_m : float
+        Cell side in metres.
+    ij : (M, 2) int
+        Cell indices in the plane frame's x, y, in ascending key order.
+    counts : (M,) int
+        Points per cell ``N_k``.
+    sums : (M,) float
+        Intensity sum per cell.
+    """
 
     n: np.ndarray
     p: float
@@ -61,7 +90,18 @@ class Plane:
         return local @ self.T[:3, :3].T + self.T[:3, 3]
 
     def moved(self, X) -> Plane:
-        """The same plane in another frame: ``X (4, 4)`` maps this plane's parent into the new one."""
+        """The same plane in another frame: ``X (4, 4)`` maps this plane's parent into the new one.
+
+        Parameters
+        ----------
+        X : (4, 4) float
+            Homogeneous transform from the current parent frame to the new one.
+
+        Returns
+        -------
+        Plane
+            Same cells, with ``n``, ``p`` and ``T`` expressed in the new frame.
+        """
         R, t = X[:3, :3], X[:3, 3]
         n = R @ self.n
         return Plane(n, float(self.p + n @ t), X @ self.T, self.cell_m, self.ij, self.counts, self.sums)
@@ -71,7 +111,23 @@ class Plane:
 
 
 def plane_frame(n, p: float, origin_hint) -> np.ndarray:
-    """The 4×4 frame of plane ``(n, p)``: origin = ``origin_hint`` projected on the plane, ``z = n`` (ours)."""
+    """The 4×4 frame of plane ``(n, p)``: origin = ``origin_hint`` projected on the plane, ``z = n`` (ours).
+
+    Parameters
+    ----------
+    n : (3,) float
+        Unit normal.
+    p : float
+        Distance term in metres.
+    origin_hint : (3,) float
+        Point projected onto the plane to give the origin (e.g. the points' centroid).
+
+    Returns
+    -------
+    T : (4, 4) float
+        Plane frame → parent; x axis the parent's z projected on the plane (parent's x for
+        floors and ceilings).
+    """
     n = np.asarray(n, dtype=float)
     ref = np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     x = ref - (ref @ n) * n
@@ -86,6 +142,30 @@ def plane_frame(n, p: float, origin_hint) -> np.ndarray:
 def describe_plane(points, intensities, n, p: float, *, cell_m: float = 0.25, rays=None,
                    incidence_correction: bool = True, cos_min: float = 0.2) -> Plane:
     """Cell grid of a plane's points: counts and intensity sums (002 "Plane representation", Fig. 6).
+
+    Parameters
+    ----------
+    points : (K, 3) float
+        The plane's points in the parent frame, metres.
+    intensities : (K,) float
+        Their return intensities.
+    n : (3,) float
+        Unit normal.
+    p : float
+        Distance term in metres.
+    cell_m : float
+        Cell side in metres.
+    rays : (K, 3) float, optional
+        Unit ray directions of the points (needed for the incidence correction).
+    incidence_correction : bool
+        Divide each intensity by ``max(|cos θ|, cos_min)``.
+    cos_min : float
+        Floor of ``|cos θ|`` in the correction.
+
+    Returns
+    -------
+    Plane
+        The plane with its cell counts and intensity sums.
 
     >>> pts = np.array([[0.1, 0.1, 1.0], [0.2, 0.1, 1.0], [0.6, 0.1, 1.0]])
     >>> pl = describe_plane(pts, [10.0, 20.0, 40.0], [0, 0, 1.0], 1.0, cell_m=0.5, incidence_correction=False)
@@ -125,13 +205,37 @@ def _bin_cells(ij, counts, sums):
 
 
 def lookup_mean_intensity(plane: Plane, points) -> np.ndarray:
-    """Mean intensity of the cell of ``plane`` under each point ``(..., 3)`` (parent frame); NaN off the grid."""
+    """Mean intensity of the cell of ``plane`` under each point ``(..., 3)`` (parent frame); NaN off the grid.
+
+    Parameters
+    ----------
+    plane : Plane
+        The described plane.
+    points : (..., 3) float
+        Points in the plane's parent frame (projected onto the plane along ``n``).
+
+    Returns
+    -------
+    (...) float
+    """
     X = np.asarray(points, dtype=float)
     return lookup_local(plane, (X - plane.T[:3, 3]) @ plane.T[:3, :2])
 
 
 def lookup_local(plane: Plane, local) -> np.ndarray:
-    """Mean intensity of the cell under each in-plane point ``local (..., 2)`` (plane frame); NaN off the grid."""
+    """Mean intensity of the cell under each in-plane point ``local (..., 2)`` (plane frame); NaN off the grid.
+
+    Parameters
+    ----------
+    plane : Plane
+        The described plane.
+    local : (..., 2) float
+        In-plane coordinates in metres (plane frame x, y).
+
+    Returns
+    -------
+    (...) float
+    """
     k = cell_keys(np.floor(local / plane.cell_m).astype(np.int64))
     keys = plane.keys
     pos = np.clip(np.searchsorted(keys, k), 0, len(keys) - 1)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -23,7 +22,7 @@ from ..evaluation import Trajectory, ate, rpe
 from ..sim.planes_room import Flight, PlaneRoom, build_corridor, simulate_flight
 from .extraction import Frame, build_frame
 from .filter import STAGES, PlaneSLAM, PlaneSLAMParams
-from .mapping import PlaneMap
+from .reports import GOAL_S, SOURCE_TIMES_S, FlightResult, ours_vs_source, timing_goal, timing_table
 
 __all__ = [
     "GOAL_S",
@@ -42,13 +41,7 @@ __all__ = [
     "timing_table",
 ]
 
-#: 002's table: mean seconds per cycle on one thread of a Core i5-3427U (1.8 GHz)
-SOURCE_TIMES_S = {"extraction": 0.061, "description": 0.020, "motion": 0.003, "equations": 0.037,
-                  "weights": 0.050, "pose": 0.011, "total": 0.182}
 SIZES = {"small": 6.0, "medium": 20.0, "full": 60.0}
-#: the speed goal of one cycle with 400 particles on one core (ours, set by the project's issue 13: half of
-#: 002's 0.182 s total, rounded down from 0.091 s; 002 itself sets no goal)
-GOAL_S = 0.09
 
 
 #: where the frame building and the odometry increments take their poses from (ours: "truth" is an ablation)
@@ -67,6 +60,28 @@ def flight_frames(flight: Flight, frame_lines: int = 40, *, frame_poses: str = "
     002 moves the lines of a frame into the last line's pose with the odometry and predicts with the odometry's
     increment; ``frame_poses="truth"`` / ``increment_poses="truth"`` use the true poses instead (ours: ablations
     that remove the odometry's error from the frame, or from the prediction).
+
+    Parameters
+    ----------
+    flight : slamlab.sim.Flight
+        The simulated flight.
+    frame_lines : int
+        Scan lines per frame (002: ~1 s = 40 lines).
+    frame_poses : {'odometry', 'truth'}
+        Poses that move a frame's lines into its last line's pose.
+    increment_poses : {'odometry', 'truth'}
+        Poses whose increment between frames is the prediction's input.
+
+    Yields
+    ------
+    k : int
+        Frame index.
+    frame : Frame
+        The frame's points in the last line's body frame.
+    odometry_increment : (4, 4) float
+        Pose increment since the previous frame (identity for the first).
+    true_pose : (4, 4) float
+        True pose of the frame's last line.
     """
     frame_lines = v.check_int(frame_lines, "frame_lines", minimum=1)
     T_frame = _poses(flight, frame_poses, "frame_poses")
@@ -82,7 +97,19 @@ def flight_frames(flight: Flight, frame_lines: int = 40, *, frame_poses: str = "
 
 
 def flight_head(flight: Flight, duration_s: float) -> Flight:
-    """The first ``duration_s`` seconds of ``flight`` (the same lines, poses and odometry; ours)."""
+    """The first ``duration_s`` seconds of ``flight`` (the same lines, poses and odometry; ours).
+
+    Parameters
+    ----------
+    flight : slamlab.sim.Flight
+        The flight to cut.
+    duration_s : float
+        Seconds kept (at most the flight's length).
+
+    Returns
+    -------
+    slamlab.sim.Flight
+    """
     if not isinstance(flight, Flight):
         raise TypeError(f"`flight` must be a Flight; got {type(flight).__name__}")
     n = round(v.check_positive(duration_s, "duration_s") * flight.scanner.lines_per_s)
@@ -94,7 +121,20 @@ def flight_head(flight: Flight, duration_s: float) -> Flight:
 
 
 def euler_errors(T_est, T_true) -> np.ndarray:
-    """Per pose ``(F, 6)``: x, y, z errors [m] (map frame) and roll, pitch, yaw [deg] of ``T_trueᵀ T_est``."""
+    """Per pose ``(F, 6)``: x, y, z errors [m] (map frame) and roll, pitch, yaw [deg] of ``T_trueᵀ T_est``.
+
+    Parameters
+    ----------
+    T_est : (F, 4, 4) float
+        Estimated poses (body → map).
+    T_true : (F, 4, 4) float
+        True poses.
+
+    Returns
+    -------
+    (F, 6) float
+        Position errors in metres, then xyz Euler angles of the rotation error in degrees.
+    """
     dpos = T_est[:, :3, 3] - T_true[:, :3, 3]
     dR = np.swapaxes(T_true[:, :3, :3], 1, 2) @ T_est[:, :3, :3]
     return np.c_[dpos, np.rad2deg(Rotation.from_matrix(dR).as_euler("xyz"))]
@@ -102,7 +142,20 @@ def euler_errors(T_est, T_true) -> np.ndarray:
 
 def in_frame_rotation_error_deg(flight: Flight, frame_lines: int = 40) -> np.ndarray:
     """RMS per axis ``(3,)`` [deg] of the odometry's error in the relative pose of each line to its frame's last
-    line: the rotation error with which 002's frame building moves the lines (ours)."""
+    line: the rotation error with which 002's frame building moves the lines (ours).
+
+    Parameters
+    ----------
+    flight : slamlab.sim.Flight
+        The flight (odometry and true poses per line).
+    frame_lines : int
+        Scan lines per frame.
+
+    Returns
+    -------
+    (3,) float
+        RMS rotation-vector error per axis in degrees.
+    """
     frame_lines = v.check_int(frame_lines, "frame_lines", minimum=1)
     n = (len(flight) // frame_lines) * frame_lines
     last = (np.arange(n) // frame_lines + 1) * frame_lines - 1
@@ -116,7 +169,21 @@ def in_frame_rotation_error_deg(flight: Flight, frame_lines: int = 40) -> np.nda
 def flight_or_simulate(flight: Flight | None, duration_s: float, rng) -> Flight:
     """``flight`` checked, or a new one of ``duration_s`` seconds simulated from ``rng`` (int, SeedSequence or
     Generator) — the first of two streams spawned from a fresh copy of its SeedSequence, the flight
-    :func:`run_flight` simulates for the same ``rng`` (ours)."""
+    :func:`run_flight` simulates for the same ``rng`` (ours).
+
+    Parameters
+    ----------
+    flight : slamlab.sim.Flight or None
+        A ready flight, returned as is.
+    duration_s : float
+        Seconds to simulate when ``flight`` is None.
+    rng : int, numpy.random.SeedSequence or numpy.random.Generator
+        Randomness of the simulated flight.
+
+    Returns
+    -------
+    slamlab.sim.Flight
+    """
     from ..sweep import fresh_seed_sequence
 
     if flight is None:
@@ -133,6 +200,20 @@ def three_plane_room(length_m: float = 12.0, width_m: float = 3.0, height_m: flo
     """002 Fig. 4's scene: "three planes, two of which are parallel" — two parallel walls and the floor (ours:
     :func:`~slamlab.sim.build_corridor` without its ceiling; 1 m panels of two reflectances).
 
+    Parameters
+    ----------
+    length_m, width_m, height_m : float
+        Corridor size in metres.
+    panel_m : float
+        Side of the reflectance panels in metres.
+    rng : numpy.random.Generator, int or None
+        Randomness of the panels' reflectances.
+
+    Returns
+    -------
+    slamlab.sim.PlaneRoom
+        Planes "y-", "y+" and "z-".
+
     >>> three_plane_room().names
     ('y-', 'y+', 'z-')
     """
@@ -144,7 +225,21 @@ def three_plane_room(length_m: float = 12.0, width_m: float = 3.0, height_m: flo
 
 def offset_frames(offset_m: float, rng) -> tuple[list[Flight], list[Frame]]:
     """Fig. 4's two one-second hovers in :func:`three_plane_room`: at a start pose and ``offset_m`` further along
-    the walls (perfect odometry); their flights and frames (ours)."""
+    the walls (perfect odometry); their flights and frames (ours).
+
+    Parameters
+    ----------
+    offset_m : float
+        Distance between the two hover positions along the walls, metres.
+    rng : numpy.random.Generator, int or None
+        Randomness of the room and the flights.
+
+    Returns
+    -------
+    flights : list of 2 slamlab.sim.Flight
+    frames : list of 2 Frame
+        The first frame of each flight.
+    """
     g = v.as_rng(rng)
     room = three_plane_room(rng=g.integers(2**31))
     start = np.array([5.0, 1.5, 1.5])
@@ -154,103 +249,6 @@ def offset_frames(offset_m: float, rng) -> tuple[list[Flight], list[Frame]]:
         flights.append(simulate_flight(1.0, room=room, speed_m_s=0.0, waypoints_m=wp, odometry_noise=0.0,
                                        rng=g.integers(2**31)))
     return flights, [next(flight_frames(f, 40))[1] for f in flights]
-
-
-@dataclass(frozen=True)
-class FlightResult:
-    """A flight (002 Fig. 8, 9): per frame ``times_s``, ``poses_true``, ``poses_est``, ``poses_odo``, ``errors
-    (F, 6)`` (x, y, z [m]; roll, pitch, yaw [deg]); ATE/RPE of the estimate and of the odometry; the map;
-    ``stage_times_s (F, 7)`` wall seconds per stage and ``cpu_times_s (F,)`` CPU seconds per cycle (timings:
-    never in ``table()``)."""
-
-    times_s: np.ndarray
-    poses_true: np.ndarray
-    poses_est: np.ndarray
-    poses_odo: np.ndarray
-    errors: np.ndarray
-    errors_odo: np.ndarray
-    ate_m: float
-    ate_odo_m: float
-    ate_aligned_m: float
-    ate_aligned_odo_m: float
-    rpe_m: float
-    rpe_deg: float
-    n_frames: int
-    n_kept_prediction: int
-    mean_planes: float
-    mean_points: float
-    map: PlaneMap = field(repr=False)
-    params: PlaneSLAMParams = field(repr=False)
-    stage_times_s: np.ndarray = field(repr=False)
-    cpu_times_s: np.ndarray = field(repr=False)
-
-    def __str__(self) -> str:
-        return (f"Flight: {self.n_frames} frames, ATE {self.ate_m:.3f} m (odometry {self.ate_odo_m:.3f} m), "
-                f"{len(self.map)} map planes, {self.n_kept_prediction} frames kept the prediction")
-
-    def rms(self) -> tuple[np.ndarray, np.ndarray]:
-        """RMS over the frames after the first (the first founds the map at the known pose) of the six errors
-        ``(6,)`` of the estimate and of the odometry."""
-        return (np.sqrt(np.mean(self.errors[1:] ** 2, axis=0)), np.sqrt(np.mean(self.errors_odo[1:] ** 2, axis=0)))
-
-    def table(self) -> str:
-        rms, rms_o = self.rms()
-        mx = np.abs(self.errors[1:]).max(axis=0)
-        names = ("x [m]", "y [m]", "z [m]", "roll [deg]", "pitch [deg]", "yaw [deg]")
-        rows = [[n, f"{a:.2f}" if "deg" in n else f"{a:.3f}", f"{b:.2f}" if "deg" in n else f"{b:.3f}",
-                 f"{c:.2f}" if "deg" in n else f"{c:.3f}"] for n, a, b, c in zip(names, rms, mx, rms_o, strict=True)]
-        rows += [["ATE, map frame (no alignment) [m]", f"{self.ate_m:.3f}", "", f"{self.ate_odo_m:.3f}"],
-                 ["ATE, SE(3)-aligned [m]", f"{self.ate_aligned_m:.3f}", "", f"{self.ate_aligned_odo_m:.3f}"],
-                 ["RPE per frame [m]", f"{self.rpe_m:.3f}", "", ""],
-                 ["RPE per frame [deg]", f"{self.rpe_deg:.2f}", "", ""],
-                 ["frames / kept prediction", f"{self.n_frames} / {self.n_kept_prediction}", "", ""],
-                 ["planes per frame / in the map", f"{self.mean_planes:.1f} / {len(self.map)}", "", ""],
-                 ["points per frame", f"{self.mean_points:.0f}", "", ""]]
-        return format_table(["error", "RMS (SLAM)", "max |.| (SLAM)", "RMS (odometry)"], rows,
-                            title=f"Flight errors over {self.n_frames} s (002 Fig. 8; ours)")
-
-    def mean_stage_times(self) -> dict:
-        """Mean seconds per stage over the frames after the first (the first only builds the map); ``"total"``
-        their sum (wall), ``"cpu"`` the mean CPU seconds of a cycle."""
-        sl = slice(1, None) if len(self.stage_times_s) > 1 else slice(None)
-        t = self.stage_times_s[sl]
-        out = {s: float(t[:, i].mean()) for i, s in enumerate(STAGES)}
-        out["total"] = float(t.sum(axis=1).mean())
-        out["cpu"] = float(np.mean(self.cpu_times_s[sl]))
-        return out
-
-
-def timing_goal() -> str:
-    """002's timing table checked (its stages sum to its total) and where the 0.09 s goal comes from."""
-    parts = [SOURCE_TIMES_S[s] for s in STAGES if s in SOURCE_TIMES_S]
-    total = sum(parts)
-    rows = [["002's machine", "Core i5-3427U, 1.8 GHz, one thread"],
-            ["sum of 002's six stages [s]", " + ".join(f"{x:.3f}" for x in parts) + f" = {total:.3f}"],
-            ["002's 'total' row [s]", f"{SOURCE_TIMES_S['total']:.3f}"],
-            ["half of 002's total [s]", f"{SOURCE_TIMES_S['total'] / 2:.3f}"],
-            ["the goal (ours, issue 13; 002 sets none) [s]", f"{GOAL_S:.2f}"]]
-    return format_table(["quantity", "value"], rows, title="002's timing table and the speed goal")
-
-
-def timing_table(times: dict, *, load: str | None = None) -> str:
-    """Seconds per cycle by stage, ours beside 002's (ratio = ours / 002) and the goal; ``load``: the machine's
-    load average. ``times`` as :meth:`FlightResult.mean_stage_times` returns it (``"cpu"`` optional)."""
-    rows = []
-    for s in (*STAGES, "total"):
-        src = SOURCE_TIMES_S.get(s)
-        ours = times.get(s, float("nan"))
-        rows.append([s + (" (wall)" if s == "total" else ""), f"{ours:.4f}", "-" if src is None else f"{src:.3f}",
-                     "-" if src is None else f"{ours / src:.2f}"])
-    if "cpu" in times:
-        rows.append(["total (CPU)", f"{times['cpu']:.4f}", f"{SOURCE_TIMES_S['total']:.3f}",
-                     f"{times['cpu'] / SOURCE_TIMES_S['total']:.2f}"])
-    title = "Seconds per cycle (002: one thread of a Core i5-3427U)"
-    if load:
-        title += f"; ours under load average {load}"
-    tab = format_table(["stage", "ours [s]", "002 [s]", "ours / 002"], rows, title=title)
-    wall = times.get("total", float("nan"))
-    verdict = "meets" if wall <= GOAL_S else "misses"
-    return tab + f"\ngoal {GOAL_S:.2f} s per cycle (half of 002's {SOURCE_TIMES_S['total']:.3f} s): wall time {verdict} it"
 
 
 def run_flight(duration_s: float | None = None, *, size: str = "small", frame_lines: int = 40,
@@ -263,6 +261,32 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
     (002: ~1 s = 40 lines), ``params`` plus overrides for :class:`PlaneSLAMParams`, ``flight`` a ready
     :class:`~slamlab.sim.Flight` (else simulated from ``rng``); ``frame_poses``, ``increment_poses``: see
     :func:`~slamlab.planes.flight_frames` ("odometry" is 002's; "truth" an ablation of ours).
+
+    Parameters
+    ----------
+    duration_s : float, optional
+        Flight length in seconds (default by ``size``).
+    size : {'small', 'medium', 'full'}
+        6, 20 or 60 s when ``duration_s`` is None.
+    frame_lines : int
+        Scan lines per frame.
+    params : PlaneSLAMParams, optional
+        Filter settings (defaults when None).
+    flight : slamlab.sim.Flight, optional
+        A ready flight (else simulated from ``rng``).
+    rng : int, numpy.random.SeedSequence or numpy.random.Generator
+        Randomness of the simulated flight and of the filter (two spawned streams).
+    frame_poses, increment_poses : {'odometry', 'truth'}
+        See :func:`flight_frames`.
+    progress : bool, callable or None
+        Progress bar over the frames.
+    **overrides
+        :class:`PlaneSLAMParams` fields that replace those of ``params``.
+
+    Returns
+    -------
+    FlightResult
+        Per-frame poses and errors, ATE/RPE, the map, the stage timings.
     """
     p = PlaneSLAMParams.resolve(params, **overrides)
     if duration_s is None:
@@ -304,7 +328,20 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
 
 
 def setup_table(flight: Flight, frame_lines: int = 40) -> str:
-    """002's sensor and frame figures beside those of our simulated ``flight`` (002 "Experimental trial")."""
+    """002's sensor and frame figures beside those of our simulated ``flight`` (002 "Experimental trial").
+
+    Parameters
+    ----------
+    flight : slamlab.sim.Flight
+        The simulated flight.
+    frame_lines : int
+        Scan lines per frame.
+
+    Returns
+    -------
+    str
+        A table: quantity, 002, ours.
+    """
     if not isinstance(flight, Flight):
         raise TypeError(f"`flight` must be a Flight; got {type(flight).__name__}")
     frame_lines = v.check_int(frame_lines, "frame_lines", minimum=1)
@@ -328,37 +365,3 @@ def setup_table(flight: Flight, frame_lines: int = 40) -> str:
             ["points per frame (the first frame)", "over 40000", f"{n_frame}"],
             ["room floor area [m^2]", "about 200", f"{area:.0f}"]]
     return format_table(["quantity", "002", "ours"], rows, title="002's sensor and frame beside our simulation")
-
-
-def ours_vs_source(flight: FlightResult, pairs, fig4, *, one_pair=None, incidence=None) -> str:
-    """"Ours vs the source" for Ch. 10: what 002 reports beside what we measured (timings: see timing_table);
-    ``pairs`` a :class:`~slamlab.planes.PairsResult`, ``fig4`` an :class:`~slamlab.planes.IntensityResult`;
-    optional ``one_pair`` (:func:`~slamlab.planes.run_pairs_ablation`'s result) and ``incidence``
-    (:func:`~slamlab.planes.run_incidence_ablation`'s) add their rows."""
-    dims = [int(np.sum(s > 1e-6)) for s in pairs.spread_after]
-    cyc = "one cycle" if fig4.rounds == 1 else f"{fig4.rounds} cycles"
-    rows = [
-        ["particles", "400", str(flight.params.n_particles)],
-        ["points per frame", "> 40000", f"{flight.mean_points:.0f} (mean)"],
-        ["locus for 1 / 2 / 3 pairs", "plane / line / point", f"{dims[0]}-D / {dims[1]}-D / {dims[2]}-D"],
-        ["Fig. 4: planes in the frame", "3, two of them parallel",
-         f"{fig4.n_planes}, {fig4.normal_rank} normal directions"],
-        ["Fig. 4: the weights' maximum", "well expressed", f"{fig4.peak:.2f} x the uniform weight"],
-        ["Fig. 4: along-line error", "resolved after resampling",
-         f"{fig4.error_with_m:.3f} m after {cyc} (weights off: {fig4.error_without_m:.3f} m)"],
-        ["flight position error", "Fig. 8 (plot only)",
-         f"ATE {flight.ate_m:.3f} m (odometry {flight.ate_odo_m:.3f} m), {flight.n_frames} frames"],
-        ["map", "Fig. 9: planes of the room", f"{len(flight.map)} planes"],
-        ["cycle time", "0.182 s (i5-3427U, 1 thread)", "timing table (machine-dependent, not compared)"],
-    ]
-    if one_pair is not None:
-        r1, r0 = one_pair.results[-1], one_pair.results[0]
-        rows.append(["one pair of planes", "work is possible",
-                     (f"largest plane only: ATE {r1.ate_m:.3f} m (all planes {r0.ate_m:.3f} m, odometry "
-                     f"{r0.ate_odo_m:.3f} m)")])
-    if incidence is not None:
-        on, off = incidence.flights
-        rows.append(["incidence correction", "needed for a stable result ([17])",
-                     (f"flight ATE {on.ate_m:.3f} m on, {off.ate_m:.3f} m off; Fig. 4 error "
-                     f"{incidence.fig4[0].error_with_m:.3f} / {incidence.fig4[1].error_with_m:.3f} m")])
-    return format_table(["quantity", "002", "ours"], rows, title="Ch. 10: ours vs the source (002)")

@@ -31,6 +31,16 @@ __all__ = ["Frame", "build_frame", "extract_planes", "fit_plane_lsq", "frame_tra
 def frame_transforms(odometry) -> np.ndarray:
     """``T_j = (ᵒT_N)⁻¹ ᵒT_j`` for every line ``j`` of a buffer (002, reconstructed): ``(N, 4, 4)``.
 
+    Parameters
+    ----------
+    odometry : (N, 4, 4) float
+        Body poses of the lines in the odometry frame.
+
+    Returns
+    -------
+    (N, 4, 4) float
+        Each line's pose in the last line's body frame (the last is the identity).
+
     >>> T = np.tile(np.eye(4), (2, 1, 1)); T[0, 0, 3] = 1.0
     >>> frame_transforms(T)[0, :3, 3].tolist()
     [1.0, 0.0, 0.0]
@@ -50,7 +60,19 @@ def frame_transforms(odometry) -> np.ndarray:
 class Frame:
     """A 3-D range frame in the body pose of its last line (002): ``points (K, 3)``, ``intensities (K,)``,
     ``rays (K, 3)`` unit beam directions (for the incidence-angle correction), ``n_dropped`` points without
-    a return (NaN) left out."""
+    a return (NaN) left out.
+
+    Attributes
+    ----------
+    points : (K, 3) float
+        Points in the last line's body frame, metres.
+    intensities : (K,) float
+        Their return intensities.
+    rays : (K, 3) float
+        Unit beam directions in the same frame.
+    n_dropped : int
+        Beams without a return that were left out.
+    """
 
     points: np.ndarray
     intensities: np.ndarray
@@ -95,6 +117,18 @@ def build_frame(points, intensities, odometry, *, origin_m=(0.0, 0.0, 0.0)) -> F
 def fit_plane_lsq(points) -> tuple[np.ndarray, float]:
     """Least-squares plane through ``points (K >= 3, 3)``: ``(n, p)`` with ``n·x = p``, ``p >= 0`` (SVD; ours).
 
+    Parameters
+    ----------
+    points : (K, 3) float
+        At least three non-collinear points, metres.
+
+    Returns
+    -------
+    n : (3,) float
+        Unit normal.
+    p : float
+        Distance of the plane from the origin in metres (>= 0).
+
     >>> n, p = fit_plane_lsq([[0, 0, 2.0], [1, 0, 2], [0, 1, 2], [1, 1, 2]])
     >>> np.round(n, 12).tolist(), round(p, 12)
     ([0.0, 0.0, 1.0], 2.0)
@@ -114,7 +148,22 @@ def fit_plane_lsq(points) -> tuple[np.ndarray, float]:
 
 
 def plane_distances(points, n, p) -> np.ndarray:
-    """Signed distances ``n·x − p`` of ``points (K, 3)`` to the plane ``(n, p)``."""
+    """Signed distances ``n·x − p`` of ``points (K, 3)`` to the plane ``(n, p)``.
+
+    Parameters
+    ----------
+    points : (K, 3) float
+        Points, metres.
+    n : (3,) float
+        Unit normal.
+    p : float
+        Distance term in metres.
+
+    Returns
+    -------
+    (K,) float
+        Signed distances in metres.
+    """
     return np.asarray(points) @ np.asarray(n) - p
 
 

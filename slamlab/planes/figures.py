@@ -29,7 +29,17 @@ __all__ = ["IntensityResult", "IntensitySpread", "IntensityStudy", "PairsResult"
 @dataclass(frozen=True)
 class PairsResult:
     """Per number of pairs (1, 2, 3): particle positions before ``(P, 3)`` and after the LM, and the singular
-    values of the solved positions (the locus: plane, line, point)."""
+    values of the solved positions (the locus: plane, line, point).
+
+    Attributes
+    ----------
+    before, after : tuple of 3 (P, 3) float
+        Particle positions in metres before and after the LM, for 1, 2, 3 pairs.
+    spread_before, spread_after : (3, 3) float
+        Singular values (RMS spread in metres) of those positions, one row per number of pairs.
+    true_t : (3,) float
+        The true position.
+    """
 
     before: tuple
     after: tuple
@@ -54,7 +64,22 @@ class PairsResult:
 
 def run_pairs_figure(n_particles: int = 300, sigma_m: float = 0.3, *, rng=0) -> PairsResult:
     """002 Fig. 2: three perpendicular map planes; particles predicted around the truth, solved by LM on 1, 2, 3
-    pairs (our exact synthetic case: noise-free planes, 002's bare system, no prior)."""
+    pairs (our exact synthetic case: noise-free planes, 002's bare system, no prior).
+
+    Parameters
+    ----------
+    n_particles : int
+        Particles (>= 2).
+    sigma_m : float
+        Standard deviation of the predicted positions around the truth, metres.
+    rng : numpy.random.Generator, int or None
+        Randomness of the prediction.
+
+    Returns
+    -------
+    PairsResult
+        Positions and their spread per number of pairs.
+    """
     n_particles = v.check_int(n_particles, "n_particles", minimum=2)
     sigma_m = v.check_positive(sigma_m, "sigma_m")
     g = v.as_rng(rng)
@@ -84,7 +109,35 @@ PROFILE_BINS_M = (0.0, 0.1, 0.2, 0.4, 0.7, np.inf)
 class IntensityResult:
     """002 Fig. 4: particles ``predicted``, ``solved`` (after the LM: spread along the corridor), their ``sad`` and
     ``weights`` and the ``resampled`` ones of the first cycle; the along-corridor error of the pose after
-    ``rounds`` cycles with and without the intensity weights; the frame's planes and normal directions."""
+    ``rounds`` cycles with and without the intensity weights; the frame's planes and normal directions.
+
+    Attributes
+    ----------
+    predicted, solved, resampled : (P, 3) float
+        Particle positions in metres of the first cycle: predicted, after the LM, after resampling.
+    sad : (P,) float
+        Intensity SAD per particle.
+    weights : (P,) float
+        Normalised intensity weights.
+    true_t : (3,) float
+        True position of the second frame.
+    error_with_m, error_without_m : float
+        Along-corridor error in metres after ``rounds`` cycles, with and without intensity weights.
+    spread_solved_m : (3,) float
+        Standard deviation of the solved positions per axis, metres.
+    n_planes : int
+        Planes in the frame.
+    normal_rank : int
+        Distinct normal directions among them.
+    V_xyz_m2 : float
+        Prediction variance of the position, m².
+    rounds : int
+        Cycles run on the frame.
+    frame : Frame
+        The second frame.
+    map : PlaneMap
+        The map built from the first frame.
+    """
 
     predicted: np.ndarray
     solved: np.ndarray
@@ -168,6 +221,32 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz
 
     ``rounds`` > 1 (ours, not 002's figure) repeats the cycle on the same frame; those later cycles use
     ``V_later_xyz_m2``, ``V_later_rpy_deg2`` (default (2 cm)² and (0.2°)²: a re-run should not undo the first).
+
+    Parameters
+    ----------
+    offset_m : float
+        True motion along the walls between the two frames, metres (the odometry says 0).
+    n_particles : int
+        Particles.
+    V_xyz_m2 : float
+        Prediction variance of the position, m².
+    V_rpy_deg2 : float
+        Prediction variance of roll, pitch, yaw, deg².
+    rounds : int
+        Cycles on the second frame.
+    V_later_xyz_m2, V_later_rpy_deg2 : float
+        Prediction variances of the cycles after the first.
+    params : PlaneSLAMParams, optional
+        Filter settings under the figure's own.
+    rng : numpy.random.Generator, int or None
+        Randomness of the room, flights and particles.
+    **overrides
+        :class:`PlaneSLAMParams` fields that replace the figure's settings.
+
+    Returns
+    -------
+    IntensityResult
+        The first cycle's particles and weights and the errors with and without the weights.
     """
     g = v.as_rng(rng)
     offset_m = float(offset_m)
@@ -201,7 +280,13 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz
 
 @dataclass(frozen=True)
 class IntensitySpread:
-    """Fig. 4's first cycle for several V (ours): how the weights' peak follows the particles' spread."""
+    """Fig. 4's first cycle for several V (ours): how the weights' peak follows the particles' spread.
+
+    Attributes
+    ----------
+    results : tuple of IntensityResult
+        One run per V.
+    """
 
     results: tuple = field(repr=False)
 
@@ -264,7 +349,15 @@ def _fig4_trial(offset_m: float, rng, n_particles: int = 400, rounds: int = 1, p
 
 @dataclass(frozen=True)
 class IntensityStudy:
-    """Fig. 4 over seeds and offsets (ours: 002 shows one cycle): one row per run in ``runs`` (a DataFrame)."""
+    """Fig. 4 over seeds and offsets (ours: 002 shows one cycle): one row per run in ``runs`` (a DataFrame).
+
+    Attributes
+    ----------
+    runs : pandas.DataFrame
+        One row per (seed, offset) run.
+    rounds : int
+        Cycles per run.
+    """
 
     runs: object = field(repr=False)
     rounds: int = 1

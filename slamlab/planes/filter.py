@@ -36,10 +36,11 @@ import numpy as np
 from .. import _validate as v
 from .._params import Params, param
 from ..filters.particles import systematic_resample  # the shared particle toolbox (re-exported here)
-from ..geometry import se3_inverse, so3_exp
+from ..geometry import se3_inverse
 from .description import Plane, describe_plane, lookup_local
 from .extraction import Frame, extract_planes
 from .mapping import PlaneMap
+from .stages import intensity_weights, mean_pose, pair_planes, predict_particles
 from .transform import lm_pose
 
 __all__ = ["STAGES", "CycleReport", "PlaneSLAM", "PlaneSLAMParams", "intensity_weights", "mean_pose",
@@ -51,7 +52,52 @@ STAGES = ("extraction", "description", "motion", "equations", "weights", "pose",
 
 @dataclass(frozen=True)
 class PlaneSLAMParams(Params):
-    """Settings of the plane particle filter (002; "ours" where 002 gives no value)."""
+    """Settings of the plane particle filter (002; "ours" where 002 gives no value).
+
+    Attributes
+    ----------
+    n_particles : int
+        Particles (002: 400).
+    V_xyz_m2, V_rpy_deg2 : float
+        Prediction noise variances per axis per frame: position in m², roll/pitch/yaw in deg².
+    ransac_tolerance_m : float
+        Inlier distance of the plane RANSAC, metres.
+    ransac_iterations, ransac_min_support, ransac_sample_points : int
+        RANSAC minimal samples per plane, smallest inlier count of a plane, random points the hypotheses are
+        drawn and scored on.
+    max_planes : int
+        Most planes extracted per frame.
+    min_width_m : float
+        Planes narrower than this (10-90 % spread) are dropped, metres.
+    cell_m : float
+        Cell side of the plane description, metres.
+    thin : int
+        Every ``thin``-th cell enters the SAD (and every ``thin``-th leftover point the voxel map).
+    pair_angle_deg, pair_dist_m : float
+        Pairing tolerances of frame and map planes: normal angle in degrees, offset in metres.
+    lm_iters : int
+        Levenberg-Marquardt iterations per cycle.
+    sigma_normal : float
+        Scale of the normal residuals (unitless).
+    sigma_offset_m : float
+        Scale of the offset residuals, metres.
+    lm_prior : bool
+        A weak prior at the prediction in the LM (False: 002's bare system).
+    lm_prior_scale : float
+        The prior's standard deviations are this times √V.
+    lm_lambda : float
+        Initial LM damping.
+    min_normal_rank : int
+        Distinct normal directions (1-3) a frame needs to be used.
+    intensity_weights : bool
+        Weight and resample the particles by the intensity SAD (002).
+    incidence_correction : bool
+        Divide intensities by the incidence cosine (002 after [17]).
+    merge_angle_deg, merge_dist_m : float
+        Tolerances for merging a new plane into a map plane: degrees, metres.
+    voxel_m : float
+        Voxel side of the map's leftover points, metres.
+    """
 
     n_particles: int = param(400, "002: 400 particles")
     V_xyz_m2: float = param(9e-4, "002: ε ~ N(0, V), V a variance; value ours: (3 cm)² per axis per frame")
@@ -96,70 +142,25 @@ class PlaneSLAMParams(Params):
                 raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
 
 
-def predict_particles(X, U, V_xyz_m2: float, V_rpy_deg2: float, rng) -> np.ndarray:
-    """Motion model: ``R ← R ΔR Exp(ε_r)``, ``t ← t + R Δt + ε_t``, ``ε ~ N(0, V)`` (002 "MCL"; composition ours).
-
-    ``X (P, 4, 4)`` particles ``ᵐT_b``, ``U (4, 4)`` the odometry increment between the frames;
-    ``V_xyz_m2`` [m²] and ``V_rpy_deg2`` [deg²] the *variances* of ε per axis (002: "with a variance
-    equal to V"), so the draws have standard deviations ``√V``.
-    """
-    P = X.shape[0]
-    out = X @ U
-    out[:, :3, :3] = out[:, :3, :3] @ so3_exp(rng.normal(0.0, np.deg2rad(np.sqrt(V_rpy_deg2)), (P, 3)))
-    out[:, :3, 3] += rng.normal(0.0, np.sqrt(V_xyz_m2), (P, 3))
-    return out
-
-
-def pair_planes(X, n_b, p_b, n_map, p_map, *, angle_deg: float, dist_m: float) -> np.ndarray:
-    """Map plane paired with each frame plane for each particle, ``(P, F)`` (-1: none) (002; rule ours).
-
-    A frame plane moved by the particle pairs with the map plane of the smallest
-    ``(1 − cos)/(1 − cos tol) + (Δp / dist_m)²`` among those within both tolerances.
-    """
-    if len(n_map) == 0 or len(n_b) == 0:
-        return np.full((X.shape[0], len(n_b)), -1, dtype=int)
-    n_w = np.einsum("pij,fj->pfi", X[:, :3, :3], n_b)                     # (P, F, 3)
-    p_w = p_b[None] + np.einsum("pfi,pi->pf", n_w, X[:, :3, 3])
-    cos = np.einsum("pfi,mi->pfm", n_w, n_map)
-    dp = np.abs(p_w[..., None] - p_map)
-    c_tol = np.cos(np.deg2rad(angle_deg))
-    ok = (cos > c_tol) & (dp < dist_m)
-    cost = np.where(ok, (1 - cos) / (1 - c_tol) + (dp / dist_m) ** 2, np.inf)
-    k = np.argmin(cost, axis=2)
-    return np.where(np.isfinite(np.take_along_axis(cost, k[..., None], 2)[..., 0]), k, -1)
-
-
-def intensity_weights(sad) -> np.ndarray:
-    """``SAD*_i = max SAD − SAD_i``, ``w_i = SAD*_i / Σ SAD*`` (002); NaN SAD (no overlap) counts as the max;
-    all equal → uniform.
-
-    >>> intensity_weights([1.0, 3.0, 2.0]).tolist()
-    [0.6666666666666666, 0.0, 0.3333333333333333]
-    """
-    s = np.asarray(sad, dtype=float)
-    if not np.isfinite(s).any():
-        return np.full(s.shape, 1.0 / s.size)
-    top = np.nanmax(s)
-    star = top - np.where(np.isfinite(s), s, top)
-    tot = star.sum()
-    return star / tot if tot > 0 else np.full(s.shape, 1.0 / s.size)
-
-
-def mean_pose(X, w=None) -> np.ndarray:
-    """Weighted mean pose of particles ``(P, 4, 4)``: mean position; chordal mean rotation (SVD projection)."""
-    w = np.full(X.shape[0], 1.0 / X.shape[0]) if w is None else np.asarray(w) / np.sum(w)
-    M = np.einsum("p,pij->ij", w, X[:, :3, :3])
-    U, _, Vt = np.linalg.svd(M)
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt))])
-    T = np.eye(4)
-    T[:3, :3] = U @ D @ Vt
-    T[:3, 3] = w @ X[:, :3, 3]
-    return T
-
-
 @dataclass(frozen=True)
 class CycleReport:
-    """What one cycle did: planes found, pairs, whether the frame was used, ``times_s`` per stage."""
+    """What one cycle did: planes found, pairs, whether the frame was used, ``times_s`` per stage.
+
+    Attributes
+    ----------
+    n_points : int
+        Points in the frame.
+    n_planes : int
+        Planes extracted.
+    normal_rank : int
+        Distinct normal directions among them.
+    corrected : bool
+        The frame corrected the particles (False: the prediction was kept).
+    mean_pairs : float
+        Mean paired planes per particle.
+    times_s : dict
+        Wall seconds per stage (:data:`STAGES`).
+    """
 
     n_points: int
     n_planes: int
@@ -180,6 +181,17 @@ class PlaneSLAM:
     """The plane-based particle-filter SLAM of 002: particles ``X (P, 4, 4)`` (``ᵐT_b``), ``map``, counters.
 
     ``step(frame, odometry_increment)`` runs one cycle; ``history`` keeps the pose estimates.
+
+    Parameters
+    ----------
+    initial_pose : (4, 4) float, optional
+        Pose of every particle at the start (identity when None).
+    params : PlaneSLAMParams, optional
+        Settings (defaults when None).
+    rng : numpy.random.Generator, int or None
+        Randomness of RANSAC, prediction and resampling.
+    **overrides
+        :class:`PlaneSLAMParams` fields that replace those of ``params``.
     """
 
     def __init__(self, initial_pose=None, *, params: PlaneSLAMParams | None = None, rng=None, **overrides):
@@ -202,7 +214,20 @@ class PlaneSLAM:
 
     # --- the stages -------------------------------------------------------------------------------------------
     def detect(self, frame: Frame):
-        """Stages 1-2: planes of ``frame`` and their descriptions (body frame), the leftover mask."""
+        """Stages 1-2: planes of ``frame`` and their descriptions (body frame), the leftover mask.
+
+        Parameters
+        ----------
+        frame : Frame
+            The range frame.
+
+        Returns
+        -------
+        found : list of (n, p, idx)
+            Per plane: normal ``(3,)``, offset in metres, indices of its points.
+        leftover : (K,) bool
+            Points in no plane.
+        """
         p = self.params
         found, leftover = extract_planes(frame.points, tolerance_m=p.ransac_tolerance_m,
                                          iterations=p.ransac_iterations, min_support=p.ransac_min_support,
@@ -212,13 +237,38 @@ class PlaneSLAM:
         return found, leftover
 
     def describe(self, frame: Frame, found) -> list[Plane]:
+        """Stage 2: the cell description of each found plane (:func:`~slamlab.planes.describe_plane`).
+
+        Parameters
+        ----------
+        frame : Frame
+            The range frame.
+        found : list of (n, p, idx)
+            Planes from :meth:`detect`.
+
+        Returns
+        -------
+        list of Plane
+            In the body frame.
+        """
         p = self.params
         return [describe_plane(frame.points[idx], frame.intensities[idx], n, off, cell_m=p.cell_m,
                                rays=frame.rays[idx], incidence_correction=p.incidence_correction)
                 for n, off, idx in found]
 
     def solve(self, planes: list[Plane]):
-        """Stage 4: pair and solve per particle; returns the pairs ``(P, F)``."""
+        """Stage 4: pair and solve per particle; returns the pairs ``(P, F)``.
+
+        Parameters
+        ----------
+        planes : list of Plane
+            The frame's planes (body frame).
+
+        Returns
+        -------
+        pairs : (P, F) int
+            Map plane per particle and frame plane, -1 for none (:func:`pair_planes`).
+        """
         p = self.params
         n_b = np.array([pl.n for pl in planes])
         p_b = np.array([pl.p for pl in planes])
@@ -238,7 +288,20 @@ class PlaneSLAM:
         return pairs
 
     def sad(self, planes: list[Plane], pairs) -> np.ndarray:
-        """Stage 5a: ``SAD_i`` per particle (NaN where no cell overlaps) (002)."""
+        """Stage 5a: ``SAD_i`` per particle (NaN where no cell overlaps) (002).
+
+        Parameters
+        ----------
+        planes : list of Plane
+            The frame's planes (body frame).
+        pairs : (P, F) int
+            From :meth:`solve`.
+
+        Returns
+        -------
+        (P,) float
+            Mean absolute intensity difference over the overlapping cells.
+        """
         P = self.X.shape[0]
         tot, cnt = np.zeros(P), np.zeros(P)
         for f, pl in enumerate(planes):
@@ -263,7 +326,19 @@ class PlaneSLAM:
 
     # --- one cycle --------------------------------------------------------------------------------------------
     def step(self, frame: Frame, odometry_increment) -> CycleReport:
-        """One cycle on ``frame`` (body frame of its last line) after the odometry increment ``(4, 4)``."""
+        """One cycle on ``frame`` (body frame of its last line) after the odometry increment ``(4, 4)``.
+
+        Parameters
+        ----------
+        frame : Frame
+            The range frame.
+        odometry_increment : (4, 4) float
+            Odometry pose increment since the previous frame.
+
+        Returns
+        -------
+        CycleReport
+        """
         if not isinstance(frame, Frame):
             raise TypeError(f"`frame` must be a Frame (see build_frame); got {type(frame).__name__}")
         U = v.as_matrix(odometry_increment, "odometry_increment", (4, 4))

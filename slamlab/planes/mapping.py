@@ -23,7 +23,13 @@ __all__ = ["PlaneMap", "VoxelStore", "merge_planes", "planes_touch"]
 
 
 class VoxelStore:
-    """Points off every plane, as counts per voxel of side ``voxel_m`` (002 [11]: an octree; ours: a voxel hash)."""
+    """Points off every plane, as counts per voxel of side ``voxel_m`` (002 [11]: an octree; ours: a voxel hash).
+
+    Parameters
+    ----------
+    voxel_m : float
+        Voxel side in metres.
+    """
 
     def __init__(self, voxel_m: float = 0.1):
         self.voxel_m = float(voxel_m)
@@ -31,6 +37,13 @@ class VoxelStore:
         self.counts = np.zeros(0, dtype=np.int64)
 
     def add(self, points) -> None:
+        """Count ``points`` into their voxels.
+
+        Parameters
+        ----------
+        points : (K, 3) float
+            Points in the map frame, metres.
+        """
         X = np.asarray(points, dtype=float).reshape(-1, 3)
         if X.size == 0:
             return
@@ -50,7 +63,17 @@ class VoxelStore:
 
 def planes_touch(a: Plane, b: Plane) -> bool:
     """Whether the borders of ``a`` and ``b`` (same parent frame) intersect: a cell centre of one in or next to
-    an occupied cell of the other (ours)."""
+    an occupied cell of the other (ours).
+
+    Parameters
+    ----------
+    a, b : Plane
+        Two planes in the same parent frame.
+
+    Returns
+    -------
+    bool
+    """
     c = b.cell_centres()
     local = (c - a.T[:3, 3]) @ a.T[:3, :2]
     ij = np.floor(local / a.cell_m).astype(np.int64)
@@ -66,7 +89,18 @@ def planes_touch(a: Plane, b: Plane) -> bool:
 
 def merge_planes(planes: list[Plane]) -> Plane:
     """One plane from several (same parent): count-weighted ``n, p``; cells re-binned into the largest
-    member's frame with their counts and intensity sums (002 "Updating the database")."""
+    member's frame with their counts and intensity sums (002 "Updating the database").
+
+    Parameters
+    ----------
+    planes : list of Plane
+        Planes in the same parent frame, with the same ``cell_m``.
+
+    Returns
+    -------
+    Plane
+        The merged plane.
+    """
     w = np.array([pl.n_points for pl in planes], dtype=float)
     big = planes[int(np.argmax(w))]
     n = np.sum([wi * pl.n for wi, pl in zip(w, planes, strict=True)], axis=0)
@@ -83,7 +117,17 @@ def merge_planes(planes: list[Plane]) -> Plane:
 
 
 class PlaneMap:
-    """The plane database (map frame) and the voxel store of off-plane points (002)."""
+    """The plane database (map frame) and the voxel store of off-plane points (002).
+
+    Parameters
+    ----------
+    angle_deg : float
+        Largest normal angle of planes that may merge, degrees.
+    dist_m : float
+        Largest offset difference of planes that may merge, metres.
+    voxel_m : float
+        Voxel side of the off-plane point store, metres.
+    """
 
     def __init__(self, *, angle_deg: float = 8.0, dist_m: float = 0.15, voxel_m: float = 0.1):
         self.planes: list[Plane] = []
@@ -103,7 +147,18 @@ class PlaneMap:
         return self._cache
 
     def add(self, new: Plane) -> int:
-        """Merge ``new`` (map frame) into the database; returns how many database planes it absorbed."""
+        """Merge ``new`` (map frame) into the database; returns how many database planes it absorbed.
+
+        Parameters
+        ----------
+        new : Plane
+            A plane in the map frame.
+
+        Returns
+        -------
+        int
+            Database planes merged into it (0: added as a new plane).
+        """
         self._cache = None
         if not self.planes:
             self.planes.append(new)
@@ -124,5 +179,17 @@ class PlaneMap:
         return len(group)
 
     def mean_intensity_at(self, k: int, points) -> np.ndarray:
-        """Mean intensity of map plane ``k`` under map-frame ``points`` (NaN where it has no cell)."""
+        """Mean intensity of map plane ``k`` under map-frame ``points`` (NaN where it has no cell).
+
+        Parameters
+        ----------
+        k : int
+            Index of the map plane.
+        points : (..., 3) float
+            Points in the map frame, metres.
+
+        Returns
+        -------
+        (...) float
+        """
         return lookup_mean_intensity(self.planes[k], points)

@@ -37,7 +37,21 @@ def _ax3d(ax=None, figsize=(6, 5), title=None):
 def scanner_geometry_figure(scanner: PlaneScanner | None = None, *, yaw_rate_deg_s: float = 45.0,
                             frame_s: float = 1.0):
     """Left: the vertical 270° fan in the body x-z plane (gap down). Right: seen from above, the fan's trace
-    swept by the yaw over one frame: two sectors of ``yaw_rate · frame_s`` degrees, 180° apart (002 Fig. 5)."""
+    swept by the yaw over one frame: two sectors of ``yaw_rate · frame_s`` degrees, 180° apart (002 Fig. 5).
+
+    Parameters
+    ----------
+    scanner : slamlab.sim.PlaneScanner, optional
+        The scanner (defaults when None).
+    yaw_rate_deg_s : float
+        Yaw rate in degrees per second.
+    frame_s : float
+        Frame length in seconds.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     s = PlaneScanner.resolve(scanner)
     d = scanner_beam_directions(s)
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4.5))
@@ -71,7 +85,23 @@ def _thin(n, max_points, rng=0):
 
 
 def plot_frame_points(frame, *, ax=None, max_points: int = 6000, title: str | None = None):
-    """A frame's points (body frame of its last line) coloured by intensity (002 Fig. 3)."""
+    """A frame's points (body frame of its last line) coloured by intensity (002 Fig. 3).
+
+    Parameters
+    ----------
+    frame : Frame
+        The range frame.
+    ax : mpl_toolkits.mplot3d.Axes3D, optional
+        3-D axes to draw into.
+    max_points : int
+        At most this many points, a fixed random subset.
+    title : str, optional
+        Axes title.
+
+    Returns
+    -------
+    mpl_toolkits.mplot3d.Axes3D
+    """
     ax = _ax3d(ax, title=title or f"one frame: {len(frame)} points, coloured by intensity")
     k = _thin(len(frame), max_points)
     sc = ax.scatter(*frame.points[k].T, c=frame.intensities[k], s=1, cmap="gray")
@@ -80,7 +110,25 @@ def plot_frame_points(frame, *, ax=None, max_points: int = 6000, title: str | No
 
 
 def plot_frame_planes(frame, found, *, ax=None, max_points: int = 6000, title: str | None = None):
-    """The frame's points coloured by the RANSAC plane they belong to (grey: on no plane)."""
+    """The frame's points coloured by the RANSAC plane they belong to (grey: on no plane).
+
+    Parameters
+    ----------
+    frame : Frame
+        The range frame.
+    found : list of (n, p, idx)
+        Planes from :func:`~slamlab.planes.extract_planes`.
+    ax : mpl_toolkits.mplot3d.Axes3D, optional
+        3-D axes to draw into.
+    max_points : int
+        At most this many points, a fixed random subset.
+    title : str, optional
+        Axes title.
+
+    Returns
+    -------
+    mpl_toolkits.mplot3d.Axes3D
+    """
     ax = _ax3d(ax, title=title or f"{len(found)} planes found by RANSAC")
     lab = np.full(len(frame), -1)
     for i, (_, _, idx) in enumerate(found):
@@ -96,7 +144,17 @@ def plot_frame_planes(frame, found, *, ax=None, max_points: int = 6000, title: s
 
 
 def plot_pairs_figure(result):
-    """002 Fig. 2: the predicted particles (grey) and the LM solutions for one, two, three pairs (colour)."""
+    """002 Fig. 2: the predicted particles (grey) and the LM solutions for one, two, three pairs (colour).
+
+    Parameters
+    ----------
+    result : PairsResult
+        From :func:`~slamlab.planes.run_pairs_figure`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig = plt.figure(figsize=(13, 4.2))
     for k in range(3):
         ax = fig.add_subplot(1, 3, k + 1, projection="3d")
@@ -112,7 +170,19 @@ def plot_pairs_figure(result):
 
 def plot_intensity_figure(result, *, ax=None):
     """002 Fig. 4: solved particles along the corridor (x) with their intensity weights, and the particles after
-    resampling; the truth and the odometry's guess marked."""
+    resampling; the truth and the odometry's guess marked.
+
+    Parameters
+    ----------
+    result : IntensityResult
+        From :func:`~slamlab.planes.run_intensity_figure`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, figsize=(8, 4), title="002 Fig. 4: weights along the line of uncertainty (first cycle)",
                   xlabel="x along the corridor [m]", ylabel="weight × number of particles")
     P = len(result.weights)
@@ -127,7 +197,17 @@ def plot_intensity_figure(result, *, ax=None):
 
 
 def plot_flight_errors(result):
-    """002 Fig. 8: x, y, z [m] and roll, pitch, yaw [deg] errors against time, SLAM and odometry."""
+    """002 Fig. 8: x, y, z [m] and roll, pitch, yaw [deg] errors against time, SLAM and odometry.
+
+    Parameters
+    ----------
+    result : FlightResult
+        From :func:`~slamlab.planes.run_flight`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axs = plt.subplots(2, 3, figsize=(12, 5.5), sharex=True)
     names = ("x [m]", "y [m]", "z [m]", "roll [deg]", "pitch [deg]", "yaw [deg]")
     for i, ax in enumerate(axs.ravel()):
@@ -143,7 +223,21 @@ def plot_flight_errors(result):
 
 
 def plot_plane_map(result, *, ax=None, max_cells: int = 20000):
-    """002 Fig. 9: the plane map (cell centres coloured by mean intensity) with the true and estimated paths."""
+    """002 Fig. 9: the plane map (cell centres coloured by mean intensity) with the true and estimated paths.
+
+    Parameters
+    ----------
+    result : FlightResult
+        From :func:`~slamlab.planes.run_flight`.
+    ax : mpl_toolkits.mplot3d.Axes3D, optional
+        3-D axes to draw into.
+    max_cells : int
+        At most this many cells, a fixed random subset.
+
+    Returns
+    -------
+    mpl_toolkits.mplot3d.Axes3D
+    """
     ax = _ax3d(ax, figsize=(8, 6), title=f"plane map: {len(result.map)} planes")
     c = np.concatenate([pl.cell_centres() for pl in result.map.planes])
     I = np.concatenate([pl.mean_intensity for pl in result.map.planes])
@@ -159,8 +253,20 @@ def plot_plane_description(plane, points=None, *, axs=None, max_points: int = 40
     """002 Fig. 6: a plane's points in its own frame ``Π`` (left: projected on its ``OXY`` plane) and its cells
     (right: the parts ``A``, coloured by the mean intensity ``I_k = Σ I / N_k``, a cell outlined per part).
 
-    ``plane`` a :class:`~slamlab.planes.Plane`; ``points (K, 3)`` its points in the plane's parent frame
-    (optional: without them only the cells are drawn).
+    Parameters
+    ----------
+    plane : Plane
+        The described plane.
+    points : (K, 3) float, optional
+        Its points in the plane's parent frame (without them only the cells are drawn).
+    axs : (2,) matplotlib.axes.Axes, optional
+        Axes to draw into.
+    max_points : int
+        At most this many points, a fixed random subset.
+
+    Returns
+    -------
+    (2,) matplotlib.axes.Axes
     """
     if axs is None:
         _fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -194,7 +300,23 @@ def plot_plane_description(plane, points=None, *, axs=None, max_points: int = 40
 def plot_room(room, *, ax=None, path=None, hide=("room z+",)):
     """002 Fig. 7: the model of the room — every bounded plane drawn with its reflectance panels (grey levels);
     ``path (N, 3)`` optional, e.g. a flight's true positions; ``hide`` names of planes left out (the ceiling, so
-    that the inside shows)."""
+    that the inside shows).
+
+    Parameters
+    ----------
+    room : slamlab.sim.PlaneRoom
+        The room.
+    ax : mpl_toolkits.mplot3d.Axes3D, optional
+        3-D axes to draw into.
+    path : (N, 3) float, optional
+        A path to draw, metres.
+    hide : tuple of str
+        Names of planes left out.
+
+    Returns
+    -------
+    mpl_toolkits.mplot3d.Axes3D
+    """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     ax = _ax3d(ax, figsize=(8, 6), title=f"the room: {len(room)} planes, {room.panel_m} m reflectance panels")

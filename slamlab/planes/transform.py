@@ -32,6 +32,24 @@ def planes_to_body(n_m, p_m, R, t):
 
     Batched: ``n_m (..., 3)``, ``p_m (...)``, ``R (..., 3, 3)``, ``t (..., 3)`` broadcast together.
 
+    Parameters
+    ----------
+    n_m : (..., 3) float
+        Map planes' unit normals.
+    p_m : (...) float
+        Their offsets in metres.
+    R : (..., 3, 3) float
+        Body → map rotation.
+    t : (..., 3) float
+        Body position in the map, metres.
+
+    Returns
+    -------
+    n_b : (..., 3) float
+        Normals in the body frame.
+    p_b : (...) float
+        Offsets in the body frame, metres.
+
     >>> n, p = planes_to_body([1.0, 0, 0], 5.0, np.eye(3), [2.0, 0, 0])
     >>> n.tolist(), float(p)
     ([1.0, 0.0, 0.0], 3.0)
@@ -43,14 +61,55 @@ def planes_to_body(n_m, p_m, R, t):
 
 
 def planes_to_map(n_b, p_b, R, t):
-    """Body planes in the map: ``ᵐn = R ᵇn``, ``ᵐp = ᵇp + ᵐn·t`` (the inverse of :func:`planes_to_body`)."""
+    """Body planes in the map: ``ᵐn = R ᵇn``, ``ᵐp = ᵇp + ᵐn·t`` (the inverse of :func:`planes_to_body`).
+
+    Parameters
+    ----------
+    n_b : (..., 3) float
+        Body planes' unit normals.
+    p_b : (...) float
+        Their offsets in metres.
+    R : (..., 3, 3) float
+        Body → map rotation.
+    t : (..., 3) float
+        Body position in the map, metres.
+
+    Returns
+    -------
+    n_m : (..., 3) float
+    p_m : (...) float
+        The planes in the map frame.
+    """
     n_b, p_b, R, t = (np.asarray(a, dtype=float) for a in (n_b, p_b, R, t))
     n_m = np.einsum("...ij,...j->...i", R, n_b)
     return n_m, p_b + np.einsum("...i,...i->...", n_m, t)
 
 
 def plane_pair_residuals(R, t, n_m, p_m, n_b, p_b, mask=None) -> np.ndarray:
-    """Residuals ``(P, F, 4)`` of the plane pairs at poses ``R (P, 3, 3)``, ``t (P, 3)`` (zero where masked)."""
+    """Residuals ``(P, F, 4)`` of the plane pairs at poses ``R (P, 3, 3)``, ``t (P, 3)`` (zero where masked).
+
+    Parameters
+    ----------
+    R : (P, 3, 3) float
+        Body → map rotations.
+    t : (P, 3) float
+        Body positions, metres.
+    n_m : (P, F, 3) float
+        Paired map planes' normals.
+    p_m : (P, F) float
+        Their offsets, metres.
+    n_b : (P, F, 3) or (F, 3) float
+        Frame planes' normals (body frame).
+    p_b : (P, F) or (F,) float
+        Their offsets, metres.
+    mask : (P, F) bool, optional
+        Which pairs exist (default all).
+
+    Returns
+    -------
+    (P, F, 4) float
+        Normal residual (3) and offset residual in metres (1) per pair.
+    """
     nb_pred = n_m @ R                                          # rows: (R^T n)^T = n^T R
     pb_pred = p_m - (n_m @ t[..., None])[..., 0]
     r = np.concatenate([nb_pred - n_b, (pb_pred - p_b)[..., None]], axis=-1)
@@ -58,7 +117,21 @@ def plane_pair_residuals(R, t, n_m, p_m, n_b, p_b, mask=None) -> np.ndarray:
 
 
 def plane_pair_jacobian(R, n_m, mask=None) -> np.ndarray:
-    """Jacobian ``(P, F, 4, 6)`` of the residuals w.r.t. ``(δ, t)`` with ``R ← R Exp(δ)`` (ours)."""
+    """Jacobian ``(P, F, 4, 6)`` of the residuals w.r.t. ``(δ, t)`` with ``R ← R Exp(δ)`` (ours).
+
+    Parameters
+    ----------
+    R : (P, 3, 3) float
+        Body → map rotations.
+    n_m : (P, F, 3) float
+        Paired map planes' normals.
+    mask : (P, F) bool, optional
+        Which pairs exist (default all).
+
+    Returns
+    -------
+    (P, F, 4, 6) float
+    """
     a = n_m @ R                                                # (P, F, 3): a_f = R^T n_f
     J = np.zeros((*a.shape[:2], 4, 6))
     J[..., :3, :3] = hat(a)
@@ -67,7 +140,21 @@ def plane_pair_jacobian(R, n_m, mask=None) -> np.ndarray:
 
 
 class LMResult(NamedTuple):
-    """``R (P, 3, 3)``, ``t (P, 3)``, final ``cost (P,)`` (½Σr²), ``n_iters``, ``converged (P,)``."""
+    """``R (P, 3, 3)``, ``t (P, 3)``, final ``cost (P,)`` (½Σr²), ``n_iters``, ``converged (P,)``.
+
+    Attributes
+    ----------
+    R : (P, 3, 3) float
+        Solved rotations.
+    t : (P, 3) float
+        Solved positions, metres.
+    cost : (P,) float
+        Final cost ½Σr² (scaled residuals, plus the prior).
+    n_iters : int
+        Iterations run.
+    converged : (P,) bool
+        Particles that met the stopping rule.
+    """
 
     R: np.ndarray
     t: np.ndarray
@@ -82,16 +169,36 @@ def lm_pose(R0, t0, n_m, p_m, n_b, p_b, mask=None, *, sigma_n: float = 1.0, sigm
 
     Parameters
     ----------
-    R0 : (P, 3, 3), t0 : (P, 3) start poses (the predicted particles).
-    n_m : (P, F, 3), p_m : (P, F) the paired map planes; n_b : (P, F, 3) or (F, 3), p_b : (P, F) or (F,) the frame
-        planes; mask : (P, F) bool, which pairs exist (default all).
-    sigma_n, sigma_p_m : scales of the normal and offset residuals (each residual row is divided by its sigma;
+    R0 : (P, 3, 3) float
+        Start rotations (the predicted particles).
+    t0 : (P, 3) float
+        Start positions, metres.
+    n_m : (P, F, 3) float
+        The paired map planes' normals.
+    p_m : (P, F) float
+        Their offsets, metres.
+    n_b : (P, F, 3) or (F, 3) float
+        The frame planes' normals.
+    p_b : (P, F) or (F,) float
+        Their offsets, metres.
+    mask : (P, F) bool, optional
+        Which pairs exist (default all).
+    sigma_n, sigma_p_m : float
+        Scales of the normal and offset residuals (each residual row is divided by its sigma;
         ours: the two have different units).
-    prior_sigma : None, or (6,) stds ``(rotation [rad] ×3, translation [m] ×3)`` of a prior pulling the pose
+    prior_sigma : None or (6,) float
+        Standard deviations ``(rotation [rad] ×3, translation [m] ×3)`` of a prior pulling the pose
         towards ``(R0, t0)`` (ours: keeps nearly unconstrained directions — two nearly parallel walls — at the
         prediction; its Jacobian is taken as the identity, exact at the start).
-    lambda0 : initial damping; ×10 on a rejected step, ÷10 on an accepted one.
-    max_iters, tol : stop after ``max_iters`` or when every step is shorter than ``tol`` (or cost < tol²).
+    lambda0 : float
+        Initial damping; ×10 on a rejected step, ÷10 on an accepted one.
+    max_iters, tol : int, float
+        Stop after ``max_iters`` or when every step is shorter than ``tol`` (or cost < tol²).
+
+    Returns
+    -------
+    LMResult
+        Solved ``R``, ``t``, final ``cost``, ``n_iters`` and ``converged`` per particle.
     """
     R = np.array(R0, dtype=float)
     t = np.array(t0, dtype=float)

@@ -15,7 +15,18 @@ __all__ = ["explore_flight", "explore_intensity_figure"]
 
 def explore_flight(**defaults):
     """A short flight: particle count, V (the variances of ε, 002), RANSAC tolerance, intensity weights on/off and
-    frame length → :func:`~slamlab.planes.run_flight`'s table and the Fig. 8 errors."""
+    frame length → :func:`~slamlab.planes.run_flight`'s table and the Fig. 8 errors.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``duration_s``, ``n_particles``, ``V_xyz_m2``, ``V_rpy_deg2``,
+        ``ransac_tolerance_m``, ``intensity_weights``, ``frame_lines``, ``rng`` (seed).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"duration_s": 5.0, "n_particles": 200, "V_xyz_m2": 9e-4, "V_rpy_deg2": 0.25,
          "ransac_tolerance_m": 0.04, "intensity_weights": True, "frame_lines": 40, "rng": 0}
     d.update(defaults)
@@ -49,7 +60,17 @@ def explore_flight(**defaults):
 
 def explore_intensity_figure(**defaults):
     """002 Fig. 4, one cycle: the offset along the walls, V of the prediction (a variance, m²), particle count and
-    the incidence correction → :func:`~slamlab.planes.run_intensity_figure`'s tables and the weights plot."""
+    the incidence correction → :func:`~slamlab.planes.run_intensity_figure`'s tables and the weights plot.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``offset_m``, ``V_xyz_m2``, ``n_particles``, ``incidence_correction``, ``rng`` (seed).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"offset_m": 0.4, "V_xyz_m2": 0.09, "n_particles": 400, "incidence_correction": True, "rng": 0}
     d.update(defaults)
 
