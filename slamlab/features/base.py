@@ -129,6 +129,8 @@ def to_gray_float(image, name: str = "image", *, channel_order: str = "rgb") -> 
     gray : (H, W) float64
         Grey image, in [0, 1] for uint8 input.
 
+    Examples
+    --------
     >>> to_gray_float(np.array([[0, 255]], dtype=np.uint8)).tolist()
     [[0.0, 1.0]]
     >>> bgr = np.array([[[255, 0, 0]]], np.uint8)  # pure blue in OpenCV's order

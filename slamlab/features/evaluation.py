@@ -267,6 +267,8 @@ def repeatability(f1: Features, f2: Features, H, shape1, shape2, *, tol_px: floa
     PairScores
         ``n1``, ``n2``, ``correspondences`` and ``repeatability`` (matching fields 0).
 
+    Examples
+    --------
     >>> from slamlab.features.base import Features
     >>> z = np.zeros(3)
     >>> f = Features(np.array([[10.0, 10], [20, 20], [30, 5]]), z, z, z, z.astype(int))

@@ -60,6 +60,8 @@ def fast_corner_mask(image, threshold: int = 20, n: int = 9, *, high_speed: bool
     high_speed : bool, optional
         Apply the 1-5-9-13 pre-test first; default True for n >= 12. Raises for n < 12.
 
+    Examples
+    --------
     >>> img = np.zeros((9, 9), np.uint8); img[4, 4] = 200
     >>> np.argwhere(fast_corner_mask(img, 20)).tolist()
     [[4, 4]]
@@ -147,6 +149,8 @@ def fast_detect(image, threshold: int = 20, n: int = 9, *, nonmax: bool = True,
     Features
         Corners with ``response`` = score, no descriptors, method ``"FAST-<n>"``.
 
+    Examples
+    --------
     >>> img = np.zeros((9, 9), np.uint8); img[4, 4] = 200
     >>> f = fast_detect(img, 20)
     >>> f.uv.tolist(), f.response.tolist()

@@ -137,6 +137,8 @@ def ratio_rule(d1, d2, ratio: float) -> np.ndarray:
     (M,) bool
         True where the match is accepted.
 
+    Examples
+    --------
     >>> ratio_rule(np.array([0.1, 0.29]), np.array([0.3, 0.3]), 0.8).tolist()
     [True, False]
     """
@@ -162,6 +164,8 @@ def best_per_target(target, dist) -> np.ndarray:
     (K,) int
         Ascending indices of the kept candidates, one per distinct target.
 
+    Examples
+    --------
     >>> best_per_target(np.array([7, 3, 7, 3]), np.array([0.5, 0.2, 0.1, 0.2])).tolist()
     [1, 2]
     """
@@ -189,6 +193,8 @@ def accept_000(dist, *, factor: float = 2.0, max_dist: float = np.inf) -> np.nda
     (M,) bool
         True where the match is accepted.
 
+    Examples
+    --------
     >>> accept_000(np.array([[0.1, 0.3], [0.2, 0.3], [0.5, 2.0]]), max_dist=0.4).tolist()
     [True, False, False]
     """
@@ -215,6 +221,8 @@ def accept_ratio(dist, ratio: float = 0.8) -> np.ndarray:
     (M,) bool
         True where the match is accepted.
 
+    Examples
+    --------
     >>> accept_ratio(np.array([[0.1, 0.3], [0.29, 0.3]]), 0.8).tolist()
     [True, False]
     """
@@ -240,6 +248,8 @@ def mutual_mask(idx12, idx21) -> np.ndarray:
     (M,) bool
         True for the mutual nearest neighbours.
 
+    Examples
+    --------
     >>> mutual_mask(np.array([1, 0, 1]), np.array([1, 2])).tolist()
     [False, True, True]
     """

@@ -40,6 +40,8 @@ def moravec_response(image, window: int = 3) -> np.ndarray:
     (H, W) float
         Corner measure (squared grey levels summed over the window).
 
+    Examples
+    --------
     >>> img = np.zeros((9, 9)); img[4:, 4:] = 1.0
     >>> r = moravec_response(img, 3)
     >>> tuple(int(i) for i in np.unravel_index(np.argmax(r), r.shape))

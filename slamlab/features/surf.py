@@ -135,6 +135,8 @@ class SURF:
     workers : int
         Threads of the detection (same result for any value).
 
+    Examples
+    --------
     >>> SURF(threshold=0.001, upright=True).upright
     True
     """

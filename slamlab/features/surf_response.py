@@ -27,6 +27,8 @@ def integral_image(image) -> np.ndarray:
     -------
     II : (H+1, W+1) float64
 
+    Examples
+    --------
     >>> integral_image(np.ones((2, 3)))[-1].tolist()
     [0.0, 2.0, 4.0, 6.0]
     """
@@ -52,6 +54,8 @@ def filter_sizes(n_octaves: int = 4, n_intervals: int = 4) -> np.ndarray:
     L : (n_octaves, n_intervals) int
         Filter sides in pixels.
 
+    Examples
+    --------
     >>> filter_sizes(2).tolist()
     [[9, 15, 21, 27], [15, 27, 39, 51]]
     """

@@ -79,6 +79,8 @@ def p_bounds(n, n1, q):
     lo, hi : float arrays
         ``log_q(n/n1 (q-1) + 1)`` and ``log_q(n/n1) + 1``, broadcast over the inputs.
 
+    Examples
+    --------
     >>> lo, hi = p_bounds(50000, 3500, 5.5)
     >>> round(float(lo), 3), round(float(hi), 3)
     (2.451, 2.56)
@@ -116,6 +118,8 @@ def t_search(n1, q, p):
     float array
         Search cost in units of one search step.
 
+    Examples
+    --------
     >>> float(t_search(1024, 2.0, 1))
     10.0
     """
@@ -138,6 +142,8 @@ def t_modify(n1, q, p, m):
     float array
         Merge cost in units of one build step.
 
+    Examples
+    --------
     >>> float(t_modify(1024, 2.0, 1, 10))
     200.0
     """
@@ -159,6 +165,8 @@ def search_kd(n1, q, p, C):
     -------
     float array
 
+    Examples
+    --------
     >>> float(search_kd(1024, 2.0, 2, 9.0))
     29.0
     """
@@ -180,6 +188,8 @@ def add_kd(n1, q, p, m):
     -------
     float array
 
+    Examples
+    --------
     >>> float(add_kd(1024, 2.0, 1, 10))
     10440.0
     """
@@ -222,6 +232,8 @@ def iter_time(n1, q, *, n: float = 50000, s: float = 500, m: float = 500, C: flo
     float array
         Cost per iteration in build steps, broadcast over ``n1`` and ``q``.
 
+    Examples
+    --------
     >>> round(float(iter_time(3500, 5.5) / iter_time(1200, 2.3)), 3), round(float(
     ...     iter_time(3500, 5.5, reading="literal") / iter_time(1200, 2.3, reading="literal")), 3)
     (0.717, 1.45)
@@ -264,6 +276,8 @@ def calibrate_C(s: float, t_search_s: float, m: float, t_modify_s: float, n: flo
     float
         ``C``.
 
+    Examples
+    --------
     000's numbers give 8.98:
 
     >>> round(calibrate_C(526, 0.079, 678, 0.750, 44828), 2)

@@ -66,6 +66,8 @@ def pad_knn(dist, ids, k: int):
     dist : (M, k) float
     ids : (M, k) int64
 
+    Examples
+    --------
     >>> d, i = pad_knn(np.array([[0.5]]), np.array([[4]]), 2)
     >>> d.tolist(), i.tolist()
     ([[0.5, inf]], [[4, -1]])
@@ -97,6 +99,8 @@ def merge_knn(dists, ids, k: int = 2):
         Ascending; ties keep the tree order.
     ids : (M, k) int64
 
+    Examples
+    --------
     >>> d, i = merge_knn([np.array([[1.0, 3.0]]), np.array([[2.0, np.inf]])],
     ...                  [np.array([[10, 11]]), np.array([[20, -1]])])
     >>> d.tolist(), i.tolist()
@@ -123,6 +127,8 @@ def hamming_distances(A, B) -> np.ndarray:
     (M, N) int64
         Number of differing bits.
 
+    Examples
+    --------
     >>> hamming_distances(np.array([[0b1011]], np.uint8), np.array([[0], [255]], np.uint8)).tolist()
     [[3, 5]]
     """
@@ -156,6 +162,8 @@ def exact_knn(Q, X, k: int = 2, ids=None, *, augmented=None):
     dist : (M, k) float, ascending; ``inf`` where ``X`` has fewer than ``k`` rows
     ids : (M, k) int; ``-1`` where missing
 
+    Examples
+    --------
     >>> X = np.array([[0.0, 0.0], [3.0, 0.0], [1.0, 1.0]])
     >>> d, i = exact_knn(np.array([[1.0, 0.0]]), X, 2, ids=np.array([10, 11, 12]))
     >>> d.tolist(), i.tolist()
@@ -194,6 +202,8 @@ def augment_rows(X, out=None) -> np.ndarray:
     -------
     (N, d + 1) float32
 
+    Examples
+    --------
     >>> augment_rows(np.array([[3.0, 4.0]])).tolist()
     [[3.0, 4.0, 12.5]]
     """

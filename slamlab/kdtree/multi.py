@@ -45,6 +45,8 @@ def multi_tree_sizes(n1: int, q: float, batches) -> list[list[int]]:
     list of list of int
         The tree sizes after each batch.
 
+    Examples
+    --------
     >>> multi_tree_sizes(4, 2.0, [3, 3, 3])
     [[3], [0, 6], [3, 6, 0]]
     """
@@ -95,6 +97,8 @@ class MultiKDTree(LandmarkStore):
     checks : int
         Leaf budget of the BBF search.
 
+    Examples
+    --------
     >>> rng = np.random.default_rng(0)
     >>> mt = MultiKDTree(4, 2.0, tree="ckdtree")
     >>> for b in range(5):
@@ -228,6 +232,8 @@ class NonBaseBuffer(LandmarkStore):
     checks : int
         Leaf budget of the BBF search.
 
+    Examples
+    --------
     >>> rng = np.random.default_rng(0)
     >>> buf = NonBaseBuffer(MultiKDTree(10, 2.0, tree="ckdtree"), tree="ckdtree")
     >>> buf.add(rng.random((5, 3)), np.arange(5)); buf.end_iteration()

@@ -84,6 +84,8 @@ def base_rule(seen, age, base_seen_times: int, max_non_base_time: int):
     -------
     is_base, timed_out : (N,) bool
 
+    Examples
+    --------
     >>> b, late = base_rule(np.array([3, 1, 2]), np.array([2, 7, 6]), 3, 7)
     >>> b.tolist(), late.tolist()
     ([True, False, False], [False, True, False])
@@ -103,6 +105,8 @@ class SightingBook:
     max_non_base_time : int
         Age in iterations at which a non-base point times out.
 
+    Examples
+    --------
     >>> book = SightingBook(3, 7)
     >>> book.add(np.array([1, 2])); book.step()[0].tolist()
     []

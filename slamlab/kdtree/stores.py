@@ -140,6 +140,8 @@ class RebuildStore(_BaseRuleStore):
     max_non_base_time : int
         Age in iterations at which a non-base point is dropped.
 
+    Examples
+    --------
     >>> rng = np.random.default_rng(0)
     >>> s = RebuildStore(tree="ckdtree")
     >>> s.add(rng.random((50, 4)), np.arange(50)); s.end_iteration()
@@ -330,6 +332,8 @@ def make_store(name: str, *, n1: int = 3500, q: float = 5.5, base_seen_times: in
     LandmarkStore
         A :class:`RebuildStore` or a :class:`NonBaseBuffer` in front of the named base.
 
+    Examples
+    --------
     >>> make_store("multi", n1=1000, q=4).base
     MultiKDTree(n1=1000, q=4.0, sizes=[])
     """

@@ -448,6 +448,8 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None):
     events : list of (str, int, float)
         ``(kind, node, bound)`` in search order.
 
+    Examples
+    --------
     >>> tree = KDTree(np.array([[0.0], [1.0], [2.0], [3.0]]))
     >>> d, ids, events = bbf_trace(tree, [2.2], k=1)
     >>> int(ids[0]), round(float(d[0]), 6)

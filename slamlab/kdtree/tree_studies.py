@@ -35,6 +35,8 @@ def recall_at_1(dist, exact_dist, *, rtol: float = 1e-4) -> float:
     float
         Recall in [0, 1]; NaN when no query has an exact neighbour.
 
+    Examples
+    --------
     >>> recall_at_1(np.array([[1.0], [2.0]]), np.array([[1.0], [1.5]]))
     0.5
     """

@@ -104,6 +104,8 @@ def scenario(name: str = "table2", **changes) -> Scenario:
     -------
     Scenario
 
+    Examples
+    --------
     >>> scenario("table1", n_iterations=5).n_iterations
     5
     """
@@ -147,6 +149,8 @@ def surf_like_descriptors(n: int, *, n_clusters: int = 256, sigma_cluster: float
         Unit-length descriptors.
     prototypes : (n_clusters, 64) float or None
 
+    Examples
+    --------
     >>> X, P = surf_like_descriptors(5, rng=0)
     >>> X.shape, X.dtype.name, bool(np.allclose(np.linalg.norm(X, axis=1), 1, atol=1e-5))
     ((5, 64), 'float32', True)
@@ -250,6 +254,8 @@ def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload
     Workload
         The iterations and the points stored after each.
 
+    Examples
+    --------
     >>> w = make_workload("table1", n_iterations=10, rng=0)
     >>> len(w), w.iterations[0].queries.shape[1]
     (10, 64)

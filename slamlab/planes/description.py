@@ -167,6 +167,8 @@ def describe_plane(points, intensities, n, p: float, *, cell_m: float = 0.25, ra
     Plane
         The plane with its cell counts and intensity sums.
 
+    Examples
+    --------
     >>> pts = np.array([[0.1, 0.1, 1.0], [0.2, 0.1, 1.0], [0.6, 0.1, 1.0]])
     >>> pl = describe_plane(pts, [10.0, 20.0, 40.0], [0, 0, 1.0], 1.0, cell_m=0.5, incidence_correction=False)
     >>> pl.counts.tolist(), pl.mean_intensity.tolist()

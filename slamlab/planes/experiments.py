@@ -214,6 +214,8 @@ def three_plane_room(length_m: float = 12.0, width_m: float = 3.0, height_m: flo
     slamlab.sim.PlaneRoom
         Planes "y-", "y+" and "z-".
 
+    Examples
+    --------
     >>> three_plane_room().names
     ('y-', 'y+', 'z-')
     """

@@ -41,6 +41,8 @@ def frame_transforms(odometry) -> np.ndarray:
     (N, 4, 4) float
         Each line's pose in the last line's body frame (the last is the identity).
 
+    Examples
+    --------
     >>> T = np.tile(np.eye(4), (2, 1, 1)); T[0, 0, 3] = 1.0
     >>> frame_transforms(T)[0, :3, 3].tolist()
     [1.0, 0.0, 0.0]
@@ -129,6 +131,8 @@ def fit_plane_lsq(points) -> tuple[np.ndarray, float]:
     p : float
         Distance of the plane from the origin in metres (>= 0).
 
+    Examples
+    --------
     >>> n, p = fit_plane_lsq([[0, 0, 2.0], [1, 0, 2], [0, 1, 2], [1, 1, 2]])
     >>> np.round(n, 12).tolist(), round(p, 12)
     ([0.0, 0.0, 1.0], 2.0)

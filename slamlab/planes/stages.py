@@ -98,6 +98,8 @@ def intensity_weights(sad) -> np.ndarray:
     (P,) float
         Weights summing to 1.
 
+    Examples
+    --------
     >>> intensity_weights([1.0, 3.0, 2.0]).tolist()
     [0.6666666666666666, 0.0, 0.3333333333333333]
     """

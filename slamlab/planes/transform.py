@@ -50,6 +50,8 @@ def planes_to_body(n_m, p_m, R, t):
     p_b : (...) float
         Offsets in the body frame, metres.
 
+    Examples
+    --------
     >>> n, p = planes_to_body([1.0, 0, 0], 5.0, np.eye(3), [2.0, 0, 0])
     >>> n.tolist(), float(p)
     ([1.0, 0.0, 0.0], 3.0)
