@@ -80,6 +80,11 @@ def detect(image, method: str = "surf", *, descriptors: bool = True, max_points:
     >>> f = detect(img, "fast", threshold=50)
     >>> f.uv.tolist(), f.descriptors.shape
     ([[20.0, 20.0]], (1, 64))
+
+    Returns
+    -------
+    Features
+        Keypoints with descriptors (None where the method has none or ``descriptors=False``).
     """
     method = v.check_choice(method, "method", DETECTORS)
     if np.ndim(image) == 3:  # colour: one conversion, in the stated channel order

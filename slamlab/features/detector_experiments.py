@@ -60,12 +60,25 @@ class DetectorSummaryResult:
             f"{n} {c}" for n, c in zip(self.names, self.counts, strict=True))
 
     def table(self) -> str:
+        """Keypoint count and descriptor size per detector (stable; what nbval compares).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = [[n, str(c), d] for n, c, d in zip(self.names, self.counts, self.dims, strict=True)]
         return format_table(["detector", "keypoints", "descriptor"], rows,
                             f"{self.image_name}, {self.shape[1]}x{self.shape[0]} pixels")
 
     def timing_table(self) -> str:
-        """Detection (+ description) time per detector -- machine dependent, not for nbval."""
+        """Detection (+ description) time per detector -- machine dependent, not for nbval.
+
+        Returns
+        -------
+        str
+            Milliseconds per detector.
+        """
         rows = [[n, f"{1000 * self.times_s[n]:.0f}"] for n in self.names]
         return format_table(["detector", "time [ms]"], rows)
 
@@ -170,6 +183,13 @@ class SurfThresholdResult:
         return float(self.thresholds[ok].max()) if ok.any() else float("nan")
 
     def table(self) -> str:
+        """SURF points per threshold, on our scale, OpenCV's (x 255²) and as its square root.
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = [[f"{t:.1e}", f"{t * 255**2:.3g}", f"{np.sqrt(t):.4f}", str(c)]
                 for t, c in zip(self.thresholds, self.counts, strict=True)]
         return format_table(["ours (image in [0,1])", "OpenCV hessianThreshold", "sqrt(ours)", "points"], rows,
@@ -233,6 +253,13 @@ class BlobScaleResult:
         return f"blob scale: SURF sigma / blob size {r.min():.2f}-{r.max():.2f} over sizes {self.sizes_px.tolist()}"
 
     def table(self) -> str:
+        """Per blob size: where the strongest keypoint was found, its SURF scale and σ / s.
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = [[f"{s:.0f}", f"{u:.2f}, {w:.2f}", f"{g:.2f}", f"{g / s:.2f}"]
                 for s, (u, w), g in zip(self.sizes_px, self.uv, self.sigma_px, strict=True)]
         return format_table(["blob s [px]", "found at (u, v)", "SURF σ [px]", "σ / s"], rows)

@@ -127,14 +127,26 @@ class PairEvaluationResult:
         return rows
 
     def table(self) -> str:
-        """Repeatability (fraction of the common-region points found again within ``tol_px``)."""
+        """Repeatability (fraction of the common-region points found again within ``tol_px``).
+
+        Returns
+        -------
+        str
+            One row per (sequence, pair) and a mean row; one column per detector.
+        """
         title = (f"Repeatability, {self.n_points} strongest points per image, tolerance {self.tol_px:g} px, "
                  f"images x{self.scale:g}")
         return format_table(["sequence", "pair", *self.detectors], self._pivot(self.rep, lambda x: f"{x:.2f}"),
                             title)
 
     def matching_table(self) -> str:
-        """Precision / recall of the matches (rule stated in the title)."""
+        """Precision / recall of the matches (rule stated in the title).
+
+        Returns
+        -------
+        str
+            ``precision/recall`` per (sequence, pair) and detector.
+        """
         def fmt(pr):
             return "—" if not np.isfinite(pr[0]) else f"{pr[0]:.2f}/{pr[1]:.2f}"
 

@@ -65,6 +65,11 @@ def fast_corner_mask(image, threshold: int = 20, n: int = 9, *, high_speed: bool
     >>> img = np.zeros((9, 9), np.uint8); img[4, 4] = 200
     >>> np.argwhere(fast_corner_mask(img, 20)).tolist()
     [[4, 4]]
+
+    Returns
+    -------
+    (H, W) bool
+        True at the corners.
     """
     img = to_gray_uint8(image)
     threshold = v.check_int(threshold, "threshold", minimum=0, maximum=255)

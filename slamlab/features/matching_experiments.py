@@ -80,6 +80,13 @@ class KnnComparisonResult:
         return f"{self.n_queries} SURF queries against {', '.join(map(str, self.sizes))} stored descriptors"
 
     def table(self) -> str:
+        """NN recall, matches, precision and distance evaluations per store size and method (stable).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = []
         for i, n in enumerate(self.sizes):
             for k, m in enumerate(self.methods):
@@ -93,6 +100,13 @@ class KnnComparisonResult:
                             f"{self.n_queries} queries, 2-NN + ratio 0.8; NN recall = same nearest as brute force")
 
     def timing_table(self) -> str:
+        """Search time per store size and method, and its ratio to brute force (machine dependent).
+
+        Returns
+        -------
+        str
+            Milliseconds per batch of queries.
+        """
         rows = []
         for i, n in enumerate(self.sizes):
             brute = self.times_s[i, self.methods.index("brute")] if "brute" in self.methods else np.nan
@@ -238,6 +252,13 @@ class LeavesCurveResult:
                 f"{int(self.budgets[-1])} leaves; exact search evaluates {self.exact_evals:.0f} points per query")
 
     def table(self) -> str:
+        """BBF and FLANN recall and BBF distance evaluations per budget (stable).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = [[str(int(b)), f"{rb:.3f}", f"{rf:.3f}", f"{e:.0f}"]
                 for b, rb, rf, e in zip(self.budgets, self.recall_bbf, self.recall_flann, self.evals_bbf,
                                         strict=True)]
@@ -336,6 +357,13 @@ class RatioTradeoffResult:
         return f"{self.detector} on {self.pair}: {self.correspondences} repeatable points"
 
     def table(self) -> str:
+        """Matches, precision and recall per ratio, and 000's rule as the last row.
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = [[f"{r:.2f}", str(int(n)), f"{p:.3f}", f"{rc:.3f}"]
                 for r, n, p, rc in zip(self.ratios, self.n_matches, self.precision, self.recall, strict=True)]
         m, p, rc, md = self.source_row

@@ -95,6 +95,12 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
     >>> f = surf_detect(blob, 1e-4)
     >>> np.round(f.uv[np.argmax(f.response)]).tolist()
     [50.0, 50.0]
+
+    Returns
+    -------
+    Features
+        Keypoints (``scale_px`` = 1.2·L/9, ``response`` = Hessian determinant) and float32 descriptors
+        (None with ``descriptors=False``).
     """
     img = to_gray_float(image)
     threshold = v.check_positive(threshold, "threshold", allow_zero=True)

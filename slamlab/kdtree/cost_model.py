@@ -370,6 +370,13 @@ class CostModelResult:
                 f"(000: n1 ≈ 3500, q = 5.5)")
 
     def table(self) -> str:
+        """The optimum ``n1``, ``q`` of each reading beside 000's, and the 1 % region.
+
+        Returns
+        -------
+        str
+            Text table and one line on the region within 1 % of the minimum.
+        """
         rows = [[name, f"{n1:.0f}", f"{q:.2f}", "edge of the range" if edge else ""]
                 for name, n1, q, _, edge in self.readings]
         rows.append(["000 (read off its Maple plot)", "3500", "5.50", ""])

@@ -99,12 +99,25 @@ class CrossoverResult:
                 f"{self.n_queries} queries and {self.n_new} new points per iteration")
 
     def table(self) -> str:
-        """Recall@1 of each store at each size (stable; times are in :meth:`timed_table`)."""
+        """Recall@1 of each store at each size (stable; times are in :meth:`timed_table`).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         heads = ["stored points", *(f"recall {_LABEL[s]}" for s in self.stores)]
         rows = [[f"{int(n)}", *(f"{self.recall[s][i]:.2f}" for s in self.stores)] for i, n in enumerate(self.sizes)]
         return format_table(heads, rows)
 
     def timed_table(self) -> str:
+        """Milliseconds per iteration of each store at each size and the crossover (volatile).
+
+        Returns
+        -------
+        str
+            Text table and one line on the crossover.
+        """
         heads = ["stored points", *(f"{_LABEL[s]} ms" for s in self.stores)]
         rows = [[f"{int(n)}", *(f"{1e3 * self.iteration_s(s)[i]:.0f}" for s in self.stores)]
                 for i, n in enumerate(self.sizes)]

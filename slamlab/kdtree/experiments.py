@@ -92,7 +92,13 @@ class StoreComparisonResult:
                 f"recall@1 {r}")
 
     def table(self) -> str:
-        """Operation counts and recall (stable; what nbval checks)."""
+        """Operation counts and recall (stable; what nbval checks).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         heads = ["per iteration", *(_LABEL[s] for s in self.stores)]
         rows = []
         for key, label, fmt in (("rebuilt_mean", "mean points rebuilt (add)", "{:.0f}"),

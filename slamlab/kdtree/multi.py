@@ -181,7 +181,13 @@ class MultiKDTree(LandmarkStore):
                 self._trees[j] = None
 
     def check_invariant(self) -> bool:
-        """000's invariant: tree i empty or > MAX_SIZE[i-1], never > MAX_SIZE[i]; last max > total."""
+        """000's invariant: tree i empty or > MAX_SIZE[i-1], never > MAX_SIZE[i]; last max > total.
+
+        Returns
+        -------
+        bool
+            True when the invariant holds.
+        """
         for i, n in enumerate(self.sizes):
             if n > self.max_size(i):
                 return False

@@ -54,6 +54,13 @@ class StoreCounters:
     distance_evals: int = 0  # query-to-point distances computed (0 where the backend does not say)
 
     def as_dict(self) -> dict:
+        """The counts as a dict.
+
+        Returns
+        -------
+        dict
+            Field name → count.
+        """
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
     def reset(self) -> None:
@@ -154,7 +161,13 @@ class SightingBook:
         self.seen += np.bincount(pos[hit], minlength=self.ids.size)
 
     def step(self):
-        """End the iteration: return (ids that became base, ids that timed out); forget both."""
+        """End the iteration: return (ids that became base, ids that timed out); forget both.
+
+        Returns
+        -------
+        promoted, dropped : (K,) int64
+            Ids that became base and ids that timed out.
+        """
         base, late = base_rule(self.seen, self.iteration - self.first, self.base_seen_times,
                                self.max_non_base_time)
         promoted, dropped = self.ids[base], self.ids[late]

@@ -158,6 +158,13 @@ class DimensionStudyResult:
         return f"exact vs BBF search on {self.n} points, {self.n_queries} queries, checks = {self.checks}"
 
     def table(self) -> str:
+        """% leaves and % distances an exact search visits and BBF recall, per case.
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = [[d, f"{k}", f"{lv:.1f}", f"{ev:.1f}", f"{r:.2f}"] for d, k, lv, ev, r in self.rows]
         return format_table(["data", "dim", "exact: % leaves visited", "exact: % distances", "BBF recall@1"],
                             rows, title=str(self))

@@ -91,6 +91,13 @@ class FlightComparison:
                                              zip(self.labels, self.results, strict=True))
 
     def table(self) -> str:
+        """RMS errors and ATE per run, the odometry alone as the last row.
+
+        Returns
+        -------
+        str
+            Fixed-precision text table (and ``note``).
+        """
         rows = []
         for lab, r in zip(self.labels, self.results, strict=True):
             used = r.n_frames - r.n_kept_prediction
@@ -204,6 +211,13 @@ class IncidenceResult:
                 f"{self.flights[1].ate_m:.3f} m")
 
     def table(self) -> str:
+        """Fig. 4's error and peak weight, the flight's ATE and RMS errors, with the correction on and off.
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = []
         for lab, f4, fl in zip(("on (002 after [17])", "off"), self.fig4, self.flights, strict=True):
             rms, _ = fl.rms()

@@ -85,7 +85,13 @@ class Plane:
         return int(self.counts.sum())
 
     def cell_centres(self) -> np.ndarray:
-        """Cell centres ``(M, 3)`` in the parent frame."""
+        """Cell centres ``(M, 3)`` in the parent frame.
+
+        Returns
+        -------
+        (M, 3) float
+            Metres, parent frame.
+        """
         local = np.c_[(self.ij + 0.5) * self.cell_m, np.zeros(len(self.ij))]
         return local @ self.T[:3, :3].T + self.T[:3, 3]
 
@@ -107,6 +113,12 @@ class Plane:
         return Plane(n, float(self.p + n @ t), X @ self.T, self.cell_m, self.ij, self.counts, self.sums)
 
     def area_m2(self) -> float:
+        """Area of the occupied cells in m².
+
+        Returns
+        -------
+        float
+        """
         return float(len(self.ij) * self.cell_m**2)
 
 

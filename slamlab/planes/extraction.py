@@ -94,6 +94,11 @@ def build_frame(points, intensities, odometry, *, origin_m=(0.0, 0.0, 0.0)) -> F
     intensities : (N, B) intensities.
     odometry : (N, 4, 4) body poses ``ᵒT_j`` of the lines in the odom frame.
     origin_m : (3,) scanner origin in the body frame (for the beam directions).
+
+    Returns
+    -------
+    Frame
+        The frame's finite points, intensities and ray directions in the last line's body frame.
     """
     P = np.asarray(points, dtype=float)
     if P.ndim != 3 or P.shape[2] != 3:

@@ -52,6 +52,13 @@ class PairsResult:
         return f"Fig. 2: solved positions span {dims[0]}-D, {dims[1]}-D, {dims[2]}-D sets for 1, 2, 3 pairs"
 
     def table(self) -> str:
+        """Spread of the particles before and after the LM and the locus dimension per number of pairs (002 Fig. 2).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = []
         for k in range(3):
             sb, sa = self.spread_before[k], self.spread_after[k]
@@ -162,7 +169,12 @@ class IntensityResult:
 
     def sad_bound(self) -> float:
         """``(max SAD − min SAD) / (max SAD − mean SAD)``: what ``peak`` must equal under 002's ``SAD* = max SAD −
-        SAD`` (the identity behind the flat weights; NaN SADs count as the max)."""
+        SAD`` (the identity behind the flat weights; NaN SADs count as the max).
+
+        Returns
+        -------
+        float
+        """
         s = self._sad_filled()
         return 1.0 if s.max() - s.mean() <= 0 else float((s.max() - s.min()) / (s.max() - s.mean()))
 
@@ -176,6 +188,13 @@ class IntensityResult:
                 f"uniform")
 
     def table(self) -> str:
+        """Fig. 4's first cycle: planes, spread, weights' peak and the errors with and without the weights.
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         s = self._sad_filled()
         cyc = "one cycle" if self.rounds == 1 else f"{self.rounds} cycles"
         rows = [["planes in the frame / normal directions", f"{self.n_planes} / {self.normal_rank}"],
@@ -190,7 +209,13 @@ class IntensityResult:
                             title=f"002 Fig. 4: three planes (two parallel walls + floor), {cyc}")
 
     def profile_table(self) -> str:
-        """The first cycle's SAD and weight against the distance from the truth along the line (ours)."""
+        """The first cycle's SAD and weight against the distance from the truth along the line (ours).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table, one row per distance bin (:data:`PROFILE_BINS_M`).
+        """
         d = np.abs(self.solved[:, 0] - self.true_t[0])
         P = len(self.weights)
         rows = []
@@ -295,6 +320,13 @@ class IntensitySpread:
                                                          for r in self.results)
 
     def table(self) -> str:
+        """Spread, SAD range, peak weight and the errors with and without the weights, per V (ours).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = []
         for r in self.results:
             s = r._sad_filled()
@@ -368,6 +400,13 @@ class IntensityStudy:
                 f"weights, {r.error_without_m.median():.3f} m without")
 
     def table(self) -> str:
+        """Median and 90 % errors with and without the weights per offset, over the seeds (ours).
+
+        Returns
+        -------
+        str
+            Fixed-precision text table.
+        """
         rows = []
         for off, g in self.runs.groupby("offset_m"):
             rows.append([f"{off:.2f}", str(len(g)), f"{g.error_with_m.median():.3f}",

@@ -54,7 +54,13 @@ class VoxelStore:
         self.keys, self.counts = u, np.bincount(inv.ravel(), weights=allc, minlength=len(u)).astype(np.int64)
 
     def centres(self) -> np.ndarray:
-        """Voxel centres ``(V, 3)``."""
+        """Voxel centres ``(V, 3)``.
+
+        Returns
+        -------
+        (V, 3) float
+            Metres, map frame.
+        """
         return (self.keys + 0.5) * self.voxel_m
 
     def __len__(self) -> int:
@@ -140,7 +146,14 @@ class PlaneMap:
         return len(self.planes)
 
     def arrays(self):
-        """``normals (M, 3)``, ``offsets (M,)`` of the map planes (cached)."""
+        """``normals (M, 3)``, ``offsets (M,)`` of the map planes (cached).
+
+        Returns
+        -------
+        normals : (M, 3) float
+        offsets : (M,) float
+            Metres.
+        """
         if self._cache is None:
             self._cache = (np.array([pl.n for pl in self.planes]).reshape(-1, 3),
                            np.array([pl.p for pl in self.planes], dtype=float))
