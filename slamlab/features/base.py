@@ -99,6 +99,21 @@ class Features:
 
     @classmethod
     def empty(cls, method: str = "", dim: int | None = None, dtype=np.float32) -> Features:
+        """No keypoints (what a detector returns when it finds none).
+
+        Parameters
+        ----------
+        method : str
+            Name of the detector.
+        dim : int, optional
+            Descriptor length: a ``(0, dim)`` descriptor array; None for no descriptors.
+        dtype : numpy dtype
+            Descriptor type (float32, or uint8 for binary descriptors).
+
+        Returns
+        -------
+        Features
+        """
         z = np.zeros(0)
         desc = None if dim is None else np.zeros((0, dim), dtype=dtype)
         return cls(np.zeros((0, 2)), z, z, z, np.zeros(0, dtype=np.int64), desc, method)
