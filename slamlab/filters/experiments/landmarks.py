@@ -14,7 +14,21 @@ from ..._table import format_table
 
 @dataclass(frozen=True)
 class LandmarkDemoResult:
-    """Static landmarks refined by the §3.6 filter: error vs number of sightings."""
+    """Static landmarks refined by the §3.6 filter: error vs number of sightings.
+
+    Attributes
+    ----------
+    sightings : numpy.ndarray of int, shape (S,)
+        Sighting counts reported.
+    rmse_filtered_m : numpy.ndarray, shape (S,)
+        RMSE per coordinate of the filtered landmarks after that many sightings [m].
+    rmse_single_m : numpy.ndarray, shape (S,)
+        RMSE of the latest single sighting [m].
+    predicted_std_m : numpy.ndarray, shape (S,)
+        RMS of the filter's predicted std per coordinate [m].
+    n_landmarks : int
+        Landmarks observed.
+    """
 
     sightings: np.ndarray
     rmse_filtered_m: np.ndarray
@@ -27,6 +41,12 @@ class LandmarkDemoResult:
                 f"{self.rmse_filtered_m[-1]:.4f} m after {self.sightings[-1]} sightings")
 
     def table(self) -> str:
+        """Table: one row per reported sighting count, with the ``1/sqrt(n)`` reference.
+
+        Returns
+        -------
+        str
+        """
         rows = [[f"{n}", f"{f:.4f}", f"{p:.4f}", f"{s:.4f}", f"{s / np.sqrt(n):.4f}"]
                 for n, f, p, s in zip(self.sightings, self.rmse_filtered_m, self.predicted_std_m,
                                       self.rmse_single_m, strict=True)]
@@ -41,6 +61,25 @@ def run_landmark_filter(n_landmarks: int = 500, n_sightings: int = 20, *, obs_st
     RMSE is per coordinate, over all landmarks. With ``state_std_m = 0`` the
     estimate is the running mean of the sightings, so its error falls as
     ``1/sqrt(n)``.
+
+    Parameters
+    ----------
+    n_landmarks : int, default 500
+        Landmarks, uniform in a 10 m cube.
+    n_sightings : int, default 20
+        Sightings of each landmark.
+    obs_std_m : float, default 0.05
+        Std of one sighting per coordinate [m].
+    state_std_m : float, default 0.0
+        Std the filter lets a landmark drift per step [m].
+    report : sequence of int
+        Sighting counts at which to record the errors (those beyond ``n_sightings`` are dropped).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator.
+
+    Returns
+    -------
+    LandmarkDemoResult
     """
     from ..landmark import LandmarkFilter
 

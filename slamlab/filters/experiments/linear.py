@@ -19,7 +19,29 @@ from ._common import _monte_carlo
 
 @dataclass(frozen=True)
 class CVTargetResult:
-    """Linear constant-velocity target tracked by the KF (000 §1.2.1)."""
+    """Linear constant-velocity target tracked by the KF (000 §1.2.1).
+
+    Attributes
+    ----------
+    n_runs, n_steps : int
+        Monte Carlo runs and steps per run.
+    rmse_pos_m : float
+        KF position RMSE over all runs and steps [m].
+    rmse_meas_m : float
+        RMSE of the raw position measurements [m].
+    predicted_pos_std_m : float
+        RMS of the KF's predicted position std, ``sqrt(P_xx + P_yy)`` [m].
+    anees, anis : numpy.ndarray, shape (n_steps,)
+        NEES (dim 4) and NIS (dim 2) averaged over runs.
+    nees_bounds, nis_bounds : tuple of float
+        95 % chi-square intervals of the run-averaged NEES and NIS.
+    example_truth : numpy.ndarray, shape (n_steps, 4)
+        First run's true state ``(x, vx, y, vy)``.
+    example_meas : numpy.ndarray, shape (n_steps, 2)
+        First run's measured positions [m].
+    example_est : numpy.ndarray, shape (n_steps, 4)
+        First run's KF estimates.
+    """
 
     n_runs: int
     n_steps: int
@@ -40,6 +62,12 @@ class CVTargetResult:
                 f"mean NEES {self.anees.mean():.2f} (dim 4), mean NIS {self.anis.mean():.2f} (dim 2)")
 
     def table(self) -> str:
+        """Fixed-precision table: RMSEs, predicted std, mean NEES/NIS and the share of steps inside their bounds.
+
+        Returns
+        -------
+        str
+        """
         lo, hi = self.nees_bounds
         nlo, nhi = self.nis_bounds
         inside_nees = np.mean((self.anees >= lo) & (self.anees <= hi))
@@ -80,7 +108,31 @@ def _cv_run(*, F, Q, H, R, P0, n_steps: int, rng: np.random.Generator) -> dict:
 
 def run_cv_target(n_runs: int = 50, n_steps: int = 50, *, dt_s: float = 1.0, accel_std: float = 0.2,
                   pos_std_m: float = 1.0, rng=2010, n_jobs: int = 1, progress: bool | None = None) -> CVTargetResult:
-    """Track a 2-D constant-velocity target with the KF over seeded Monte Carlo runs (on :func:`~slamlab.sweep.sweep`)."""
+    """Track a 2-D constant-velocity target with the KF over seeded Monte Carlo runs (on :func:`~slamlab.sweep.sweep`).
+
+    Parameters
+    ----------
+    n_runs : int, default 50
+        Monte Carlo runs.
+    n_steps : int, default 50
+        Steps per run.
+    dt_s : float, default 1.0
+        Time step [s].
+    accel_std : float, default 0.2
+        Std of the white acceleration noise [m/s²].
+    pos_std_m : float, default 1.0
+        Std of each position measurement coordinate [m]; also the prior position std.
+    rng : int, numpy.random.Generator or SeedSequence, default 2010
+        Seed or generator; run ``r`` draws from child ``r`` of its seed sequence.
+    n_jobs : int, default 1
+        Worker processes for the runs.
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+
+    Returns
+    -------
+    CVTargetResult
+    """
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=1)
     F, Q, H, R = constant_velocity_model(dt_s, accel_std, pos_std_m, dims=2)
@@ -99,7 +151,19 @@ def run_cv_target(n_runs: int = 50, n_steps: int = 50, *, dt_s: float = 1.0, acc
 
 @dataclass(frozen=True)
 class JosephResult:
-    """Posterior position variance from the short and Joseph forms vs the sampled truth."""
+    """Posterior position variance from the short and Joseph forms vs the sampled truth.
+
+    Attributes
+    ----------
+    gain_scales : numpy.ndarray, shape (G,)
+        Gain as a multiple of the optimal gain ``K_opt``.
+    var_short, var_joseph : numpy.ndarray, shape (G,)
+        Posterior position variance from the short and the Joseph form [m²].
+    var_sampled : numpy.ndarray, shape (G,)
+        Sampled variance of the true posterior error [m²].
+    n_samples : int
+        Samples per gain.
+    """
 
     gain_scales: np.ndarray
     var_short: np.ndarray
@@ -112,6 +176,12 @@ class JosephResult:
                 f"{len(self.gain_scales)} gains, {self.n_samples} samples each")
 
     def table(self) -> str:
+        """Fixed-precision table: one row per gain scale, the three variances.
+
+        Returns
+        -------
+        str
+        """
         rows = [[f"{g:.2f}", f"{s:.4f}", f"{j:.4f}", f"{m:.4f}"]
                 for g, s, j, m in zip(self.gain_scales, self.var_short, self.var_joseph, self.var_sampled,
                                       strict=True)]
@@ -124,6 +194,19 @@ def run_joseph_vs_short(gain_scales=(0.0, 0.5, 0.8, 1.0, 1.2, 1.5, 2.0), *, n_sa
 
     One position/velocity prior, a position measurement; the true posterior
     error is sampled ``n_samples`` times per gain.
+
+    Parameters
+    ----------
+    gain_scales : sequence of float
+        Multiples of the optimal gain to try.
+    n_samples : int, default 100000
+        Sampled prior states and measurements (at least 100).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator of the samples.
+
+    Returns
+    -------
+    JosephResult
     """
     g = v.as_rng(rng)
     n_samples = v.check_int(n_samples, "n_samples", minimum=100)
@@ -149,7 +232,19 @@ def run_joseph_vs_short(gain_scales=(0.0, 0.5, 0.8, 1.0, 1.2, 1.5, 2.0), *, n_sa
 
 @dataclass(frozen=True)
 class SigmaAlphaResult:
-    """UKF vs KF on a linear model for several ``alpha``: centre weight and rounding error."""
+    """UKF vs KF on a linear model for several ``alpha``: centre weight and rounding error.
+
+    Attributes
+    ----------
+    alphas : numpy.ndarray, shape (A,)
+        Tried values of ``alpha``.
+    w0 : numpy.ndarray, shape (A,)
+        Centre mean weight ``W_s^0`` for ``L = 2``.
+    max_rel_err_P, max_rel_err_x : numpy.ndarray, shape (A,)
+        Largest relative UKF-KF difference of the covariance and the state over the run (inf when the UKF failed).
+    n_steps : int
+        Steps of the run.
+    """
 
     alphas: np.ndarray
     w0: np.ndarray
@@ -162,6 +257,12 @@ class SigmaAlphaResult:
                 f"{self.max_rel_err_P[0]:.0e}; alpha={self.alphas[-1]:g}: {self.max_rel_err_P[-1]:.0e}")
 
     def table(self) -> str:
+        """Table of ``alpha``, ``W_s^0`` and the decade of each rounding error.
+
+        Returns
+        -------
+        str
+        """
         rows = [[f"{a:g}", f"{w:.6g}", _order(e), _order(ex)]
                 for a, w, e, ex in zip(self.alphas, self.w0, self.max_rel_err_P, self.max_rel_err_x, strict=True)]
         return format_table(["alpha", "W_s^0", "max rel. error of P", "max rel. error of x"], rows)
@@ -181,6 +282,21 @@ def run_sigma_alpha_study(alphas=(1e-5, 1e-4, 1e-3, 1e-2, 0.1, 1.0), n_steps: in
     The centre weight is ``W_s^0 = 1 - 1/alpha^2`` for ``kappa = 0``: about
     ``-10^6`` at 000's default ``alpha = 1e-3``. The mean is then a difference of
     numbers ~10^6 times larger than itself, so rounding errors are amplified.
+
+    Parameters
+    ----------
+    alphas : sequence of float
+        Values of ``alpha`` to try (``kappa = 0``, ``beta = 2``).
+    n_steps : int, default 30
+        Steps of the 1-D constant-velocity run.
+    form : str, default "additive"
+        Not used: the study always runs the additive UKF (the model is linear with additive noise).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator of the simulated measurements.
+
+    Returns
+    -------
+    SigmaAlphaResult
     """
     alphas = v.as_vector(alphas, "alphas")
     F, Q, H, R = constant_velocity_model(1.0, 0.5, 1.0, dims=1)

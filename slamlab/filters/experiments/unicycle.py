@@ -19,13 +19,49 @@ from ._common import DIVERGED_RMSE_M, FILTER_NAMES, _monte_carlo, _nanmean
 
 
 def default_landmarks() -> np.ndarray:
-    """Three landmarks near the circular path (start at the origin heading +x, radius 5 m)."""
+    """Three landmarks near the circular path (start at the origin heading +x, radius 5 m).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 2)
+        Landmark positions [m].
+    """
     return np.array([[0.0, 5.0], [4.0, 8.0], [-4.0, 2.0]])
 
 
 @dataclass(frozen=True)
 class UnicycleResult:
-    """KF/EKF/UKF on the range-bearing unicycle: RMSE and NEES over Monte Carlo runs."""
+    """KF/EKF/UKF on the range-bearing unicycle: RMSE and NEES over Monte Carlo runs.
+
+    Attributes
+    ----------
+    filters : tuple of str
+        Filter names, in row order (from ``FILTER_NAMES``).
+    n_runs, n_steps : int
+        Monte Carlo runs and steps per run.
+    params : dict
+        The noise and sigma-point settings of the run.
+    rmse_pos_m : numpy.ndarray, shape (n_filters,)
+        Position RMSE over the runs that did not fail [m].
+    rmse_heading_rad : numpy.ndarray, shape (n_filters,)
+        Heading RMSE [rad].
+    anees : numpy.ndarray, shape (n_filters, n_steps)
+        NEES averaged over runs (dim 3).
+    failures : numpy.ndarray, shape (n_filters,)
+        Runs with a numerical failure (excluded from the averages).
+    run_rmse_pos_m : numpy.ndarray, shape (n_filters, n_runs)
+        Per-run position RMSE, NaN for a failed run [m].
+    nees_bounds : tuple of float
+        95 % chi-square interval of the run-averaged NEES.
+    example_truth : numpy.ndarray, shape (n_steps, 3)
+        First run's true poses ``(x_m, y_m, theta_rad)``.
+    example_est : numpy.ndarray, shape (n_filters, n_steps, 3)
+        First run's estimates.
+    example_P : numpy.ndarray, shape (n_filters, n_steps, 3, 3)
+        First run's covariances.
+    landmarks_m : numpy.ndarray, shape (L, 2)
+        Landmark positions [m].
+    """
 
     filters: tuple[str, ...]
     n_runs: int
@@ -54,6 +90,12 @@ class UnicycleResult:
         return np.sum(np.nan_to_num(self.run_rmse_pos_m, nan=0.0) > DIVERGED_RMSE_M, axis=1)
 
     def table(self) -> str:
+        """Fixed-precision table: one row per filter (RMSEs, NEES, diverged and failed runs).
+
+        Returns
+        -------
+        str
+        """
         lo, hi = self.nees_bounds
         rows = []
         for i, name in enumerate(self.filters):
@@ -165,6 +207,49 @@ def run_unicycle_comparison(n_runs: int = 30, n_steps: int = 60, *, filters=FILT
     the process noise the filters assume (000's "stabilising noise" for the
     EKF; 1 = the true noise). A run in which a filter fails numerically (e.g. a
     Cholesky failure) is counted in ``failures`` and left out of its averages.
+
+    Parameters
+    ----------
+    n_runs : int, default 30
+        Monte Carlo runs.
+    n_steps : int, default 60
+        Steps per run.
+    filters : sequence of str
+        Any of ``FILTER_NAMES``: "LKF" (KF about the nominal path), "EKF", "UKF-aug", "UKF-add".
+    range_std_m : float, default 0.5
+        Range noise std [m].
+    bearing_std_deg : float, default 10.0
+        Bearing noise std [deg].
+    v_std_mps : float, default 0.2
+        Speed noise std [m/s].
+    omega_std_degps : float, default 10.0
+        Turn-rate noise std [deg/s].
+    init_pos_std_m : float, default 1.0
+        Initial position std of ``P0`` [m].
+    init_heading_std_deg : float, default 90.0
+        Initial heading std of ``P0`` [deg].
+    landmarks_m : array_like, shape (L, 2), optional
+        Landmark positions [m]; None for :func:`default_landmarks`.
+    dt_s : float, default 0.5
+        Time step [s].
+    speed_mps : float, default 1.0
+        Commanded speed [m/s].
+    turn_rate_degps : float, default 11.46
+        Commanded turn rate [deg/s].
+    alpha, beta, kappa : float
+        Sigma-point parameters of both UKFs (000's defaults 1e-3, 2, 0).
+    stabilising_noise : float, default 1.0
+        Factor on the process noise the filters assume (> 0).
+    rng : int, numpy.random.Generator or SeedSequence, default 2010
+        Seed or generator; run ``r`` draws from child ``r`` of its seed sequence.
+    n_jobs : int, default 1
+        Worker processes for the runs.
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+
+    Returns
+    -------
+    UnicycleResult
     """
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=1)
@@ -208,7 +293,21 @@ def run_unicycle_comparison(n_runs: int = 30, n_steps: int = 60, *, filters=FILT
 
 @dataclass(frozen=True)
 class StabilisingNoiseResult:
-    """EKF consistency as the assumed process noise is inflated."""
+    """EKF consistency as the assumed process noise is inflated.
+
+    Attributes
+    ----------
+    scales : numpy.ndarray, shape (S,)
+        Process-noise factors tried.
+    rmse_pos_m : numpy.ndarray, shape (S,)
+        EKF position RMSE per factor [m].
+    mean_nees : numpy.ndarray, shape (S,)
+        EKF NEES averaged over runs and steps per factor (consistent: 3).
+    nees_bounds : tuple of float
+        95 % chi-square interval of the run-averaged NEES.
+    n_runs : int
+        Monte Carlo runs per factor.
+    """
 
     scales: np.ndarray
     rmse_pos_m: np.ndarray
@@ -221,6 +320,12 @@ class StabilisingNoiseResult:
                 f"{self.mean_nees[-1]:.1f} with x{self.scales[-1]:g} process noise (consistent: 3)")
 
     def table(self) -> str:
+        """Table: one row per Q scale, RMSE, mean NEES and whether it lies in the bounds.
+
+        Returns
+        -------
+        str
+        """
         lo, hi = self.nees_bounds
         rows = [[f"{s:g}", f"{r:.3f}", f"{n:.2f}", "yes" if lo <= n <= hi else ("over-confident" if n > hi else
                                                                                    "pessimistic")]
@@ -230,7 +335,25 @@ class StabilisingNoiseResult:
 
 def run_stabilising_noise(scales=(1.0, 2.0, 4.0, 8.0), n_runs: int = 30, n_steps: int = 60, *, rng=2010,
                           **scenario) -> StabilisingNoiseResult:
-    """EKF on the unicycle scenario with the assumed process noise scaled by ``scales`` (000 §1.2.2)."""
+    """EKF on the unicycle scenario with the assumed process noise scaled by ``scales`` (000 §1.2.2).
+
+    Parameters
+    ----------
+    scales : sequence of float
+        Process-noise factors (``stabilising_noise`` of :func:`run_unicycle_comparison`).
+    n_runs : int, default 30
+        Monte Carlo runs per factor.
+    n_steps : int, default 60
+        Steps per run.
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator; the same runs for every factor.
+    **scenario
+        Further keywords of :func:`run_unicycle_comparison` (noise levels, landmarks...).
+
+    Returns
+    -------
+    StabilisingNoiseResult
+    """
     scales = v.as_vector(scales, "scales")
     rm, nn = [], []
     bounds = (0.0, 0.0)

@@ -26,6 +26,26 @@ def ours_vs_source(cv: CVTargetResult, joseph: JosephResult, unicycle: UnicycleR
 
     ``unicycle`` is the run with 000's sigma-point defaults (α = 10⁻³, κ = 0), ``unicycle_wide``
     one with spread-out sigma points; both must hold the LKF, EKF and UKF-aug rows.
+
+    Parameters
+    ----------
+    cv : CVTargetResult
+        From :func:`run_cv_target`.
+    joseph : JosephResult
+        From :func:`run_joseph_vs_short`.
+    unicycle : UnicycleResult
+        :func:`run_unicycle_comparison` with 000's sigma-point defaults.
+    unicycle_wide : UnicycleResult
+        The same with spread-out sigma points.
+    stabilising : StabilisingNoiseResult
+        From :func:`run_stabilising_noise`.
+    landmark : LandmarkDemoResult
+        From :func:`run_landmark_filter`.
+
+    Returns
+    -------
+    str
+        The table: claim, our figures, agreement.
     """
     for name, res, cls in (("cv", cv, CVTargetResult), ("joseph", joseph, JosephResult),
                            ("unicycle", unicycle, UnicycleResult), ("unicycle_wide", unicycle_wide, UnicycleResult),
