@@ -74,7 +74,22 @@ def _check_real(value, name: str) -> float:
 
 
 def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
-    """Validate 004's constants: real numbers with ``a_c ≠ a_p`` (004 §7, conditions (1)-(3))."""
+    """Validate 004's constants: real numbers with ``a_c ≠ a_p`` (004 §7, conditions (1)-(3)).
+
+    Parameters
+    ----------
+    a_c : float
+        Value of a free (scan-crossed) cell in T_n and of a free map cell.
+    a_p : float
+        Value of an obstacle (beam end) cell.
+    a_n : float
+        Value of every other cell (unexplored map cells, unmarked T_n cells).
+
+    Returns
+    -------
+    tuple of float
+        ``(a_c, a_p, a_n)`` as floats.
+    """
     a_c, a_p, a_n = _check_real(a_c, "a_c"), _check_real(a_p, "a_p"), _check_real(a_n, "a_n")
     if a_c == a_p:
         raise ValueError(f"`a_c` and `a_p` must differ (free and obstacle must be told apart); got both {a_c}")
@@ -88,6 +103,20 @@ def heading_candidates(delta_alpha_rad: float, *, center_rad: float | None = Non
     Full search (``center_rad`` None): ``α0n = n·Δα`` for ``0 ≤ α0n < 2π``
     (004 prints "n·360/Δα", a slip for ``n·Δα``). Tracking mode: ``center + k·Δα``
     for every integer ``k`` with ``|k·Δα| ≤ window_rad``.
+
+    Parameters
+    ----------
+    delta_alpha_rad : float
+        Heading step Δα [rad], in (0, π].
+    center_rad : float, optional
+        Previous heading [rad] (tracking mode); None searches the full circle.
+    window_rad : float, optional
+        Half-width of the tracking window [rad] (default π); only with ``center_rad``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        Candidate headings [rad].
 
     Examples
     --------
@@ -201,7 +230,32 @@ def _reach(r, h, p) -> float:
 
 @dataclass(frozen=True)
 class Localisation:
-    """Result of :func:`localise`: the pose at the correlation maximum (004 §7)."""
+    """Result of :func:`localise`: the pose at the correlation maximum (004 §7).
+
+    Attributes
+    ----------
+    pose : numpy.ndarray, shape (3,)
+        ``(x = col, y = row)`` [cells] and heading [rad], in [0, 2π) for a full search.
+    row, col : int
+        The peak's map cell.
+    heading_index : int
+        Index of the peak's heading in ``headings_rad``.
+    score : float
+        Correlation at the peak.
+    headings_rad : numpy.ndarray, shape (n,)
+        Candidate headings.
+    best_per_heading : numpy.ndarray, shape (n,)
+        Maximum of each D_n.
+    score_map : numpy.ndarray, shape (H, W)
+        D at the best heading.
+    rival_score : float
+        Best score of a pose more than ``rival_radius_cells`` or ``rival_heading_rad`` away (NaN: not searched,
+        -inf: no such pose).
+    rival_pose : numpy.ndarray, shape (3,) or None
+        That pose (None: not searched).
+    n_scans : int
+        Scans joined by odometry into the stamp (:func:`localise_joined`).
+    """
 
     pose: np.ndarray  # (3,) x = col, y = row [cells], heading [rad] in [0, 2π) for a full search
     row: int
@@ -242,6 +296,33 @@ class LocaliseParams(Params):
     """Every setting of :func:`localise` and of the ``run_*`` experiments built on it (004 §7).
 
     ``prior_heading_rad`` / ``window_rad`` (tracking mode) are per call, not settings.
+
+    Attributes
+    ----------
+    delta_alpha_rad : float
+        Heading step Δα [rad] (004: 1°).
+    a_c, a_p, a_n : float
+        004's values of free, obstacle and other cells (-1, 1, 0).
+    delta_l_cells : float
+        ±Δl around a beam end marked as obstacle [cells] (0 marks one cell).
+    hit_offset_cells : float
+        How far beyond the range the obstacle mark sits [cells] (0.5: the range ends on the cell's face).
+    step_cells : float
+        Sampling step along a beam [cells], at most 1.
+    use_misses : bool
+        Mark beams without a return as free along their length.
+    chunk : int
+        Base stamps per batched FFT call.
+    dtype : {"float32", "float64"}
+        FFT precision.
+    workers : int or None
+        scipy.fft threads (None: scipy's default).
+    ambiguity : bool
+        Also search the best rival pose (:attr:`Localisation.ambiguity`).
+    rival_radius_cells : float
+        A rival lies farther than this from the peak [cells] ...
+    rival_heading_rad : float
+        ... or its heading differs by more than this [rad], below π.
     """
 
     delta_alpha_rad: float = param(float(np.radians(1.0)), "004 §7: Δα = 1°")
@@ -435,5 +516,16 @@ def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = 
 
 
 def heading_error(est_rad, true_rad):
-    """Absolute wrapped heading difference ``|wrap(est - true)|`` [rad]."""
+    """Absolute wrapped heading difference ``|wrap(est - true)|`` [rad].
+
+    Parameters
+    ----------
+    est_rad, true_rad : array_like
+        Estimated and true headings [rad] (broadcast together).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``|wrap(est - true)|`` in [0, π] [rad].
+    """
     return np.abs(wrap_angle(np.asarray(est_rad, dtype=float) - np.asarray(true_rad, dtype=float)))

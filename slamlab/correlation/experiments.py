@@ -88,6 +88,26 @@ def _worlds(clutter: bool, extra_clutter: int, rng):
 def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int = 3, rng=None) -> list[tuple]:
     """``n`` extra unmapped discs ("people's legs", bins) on free cells of ``grid`` (our addition).
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes; discs are centred on free cells.
+    n : int
+        Number of discs.
+    radius_cells : float, default 1.5
+        Disc radius [cells].
+    margin_cells : int, default 3
+        Centres keep this many cells from obstacles (see :func:`slamlab.sim.grid.free_cells`).
+    rng : int or numpy.random.Generator, optional
+        Seed or generator of the centres.
+
+    Returns
+    -------
+    list of tuple
+        ``("disc", col, row, radius_cells)`` shapes for :func:`slamlab.sim.grid.add_clutter`.
+
+    Examples
+    --------
     >>> len(random_clutter(test_room_200(), 5, rng=0))
     5
     """
@@ -146,7 +166,25 @@ def _errors(true, est):
 
 @dataclass(frozen=True)
 class Table1Result:
-    """004 Table 1 reproduced: 10 random free poses, Δα = 1°, range noise, unmapped clutter."""
+    """004 Table 1 reproduced: 10 random free poses, Δα = 1°, range noise, unmapped clutter.
+
+    Attributes
+    ----------
+    true_poses, est_poses : numpy.ndarray, shape (n, 3)
+        True and estimated poses ``(x, y)`` [cells], heading [rad].
+    err_heading_rad : numpy.ndarray, shape (n,)
+        Wrapped heading errors [rad].
+    err_x_cells, err_y_cells : numpy.ndarray, shape (n,)
+        Absolute position errors [cells].
+    range_std_cells : float
+        Range noise std of the scans [cells].
+    n_beams : int
+        Beams per scan.
+    params : LocaliseParams
+        Settings of the localisations.
+    time_s : float
+        Wall time of the localisations [s] (not compared).
+    """
 
     true_poses: np.ndarray  # (n, 3)
     est_poses: np.ndarray  # (n, 3)
@@ -164,6 +202,12 @@ class Table1Result:
                 f"(004: 0.0098 rad, 0, 1)")
 
     def table(self) -> str:
+        """Our Table 1 (rows per pose, then our and 004's maximum errors).
+
+        Returns
+        -------
+        str
+        """
         rows = []
         for i, (t, e) in enumerate(zip(self.true_poses, self.est_poses, strict=True)):
             rows.append([i + 1, f"{t[2]:.4f}", f"{e[2]:.4f}", f"{t[0]:.0f}", f"{e[0]:.0f}", f"{t[1]:.0f}",
@@ -181,7 +225,12 @@ class Table1Result:
         return format_table(head, rows, title=title)
 
     def source_table(self) -> str:
-        """004's Table 1 as printed (radians, cells)."""
+        """004's Table 1 as printed (radians, cells).
+
+        Returns
+        -------
+        str
+        """
         src = SOURCE_TABLE1
         ea, ex, ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
         rows = [[i + 1, f"{r[0]:.4f}", f"{r[1]:.4f}", f"{r[2]:.0f}", f"{r[3]:.0f}", f"{r[4]:.0f}", f"{r[5]:.0f}",
@@ -201,6 +250,33 @@ def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int 
     search. 004 does not give σ, the beam count or the range limit: ours are
     parameters. ``params`` / ``**overrides``: the :class:`LocaliseParams` of every localisation.
     ``n_jobs`` / ``progress``: the localisations run on :func:`slamlab.sweep.sweep` (same result for any ``n_jobs``).
+
+    Parameters
+    ----------
+    n_poses : int, default 10
+        Random free poses.
+    range_std_cells : float, default 0.3
+        Range noise std [cells].
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    clutter : bool, default True
+        Cast in the measurement room (unmapped clutter of 004 Fig. 3b); False casts in the map itself.
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator of poses and scan noise.
+    n_jobs : int, default 1
+        Worker processes for the localisations (same result for any value).
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    Table1Result
     """
     p = LocaliseParams.resolve(params, **overrides)
     n = v.check_int(n_poses, "n_poses", minimum=1)
@@ -220,7 +296,25 @@ def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int 
 
 @dataclass(frozen=True)
 class MonteCarloResult:
-    """Error distribution and failure rate of the full 360° search over many random poses (our addition)."""
+    """Error distribution and failure rate of the full 360° search over many random poses (our addition).
+
+    Attributes
+    ----------
+    n_poses : int
+        Localised poses.
+    err_heading_rad : numpy.ndarray, shape (n_poses,)
+        Wrapped heading errors [rad].
+    err_pos_cells : numpy.ndarray, shape (n_poses,)
+        Euclidean position errors [cells].
+    failed : numpy.ndarray of bool, shape (n_poses,)
+        Position error > 2 cells or heading error > 5°.
+    range_std_cells : float
+        Range noise std [cells].
+    extra_clutter : int
+        Random discs added to 004's clutter.
+    time_s : float
+        Wall time of the localisations [s] (not compared).
+    """
 
     n_poses: int
     err_heading_rad: np.ndarray
@@ -240,6 +334,12 @@ class MonteCarloResult:
                 f"exact position {np.mean(self.err_pos_cells == 0):.0%}")
 
     def table(self) -> str:
+        """Error distribution table (exact, ≤ 1 cell, heading percentiles, failures).
+
+        Returns
+        -------
+        str
+        """
         ok = ~self.failed
         ea = np.degrees(self.err_heading_rad[ok]) if ok.any() else np.array([np.nan])
         ep = self.err_pos_cells
@@ -271,6 +371,33 @@ def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, 
     runs here; the localisations, which draw nothing, run on :func:`slamlab.sweep.sweep`
     with ``n_jobs`` workers (one task per pose; the result is the same for any ``n_jobs``)
     and a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
+
+    Parameters
+    ----------
+    size : {"small", "full"} or int
+        Number of poses: "small" 12, "full" 200, or the int itself.
+    range_std_cells : float, default 0.3
+        Range noise std [cells].
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    extra_clutter : int, default 0
+        Random unmapped discs added (:func:`random_clutter`).
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    rng : int or numpy.random.Generator, default 2011
+        Seed or generator of clutter, poses and scan noise.
+    n_jobs : int, default 1
+        Worker processes for the localisations (same result for any value).
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    MonteCarloResult
     """
     p = LocaliseParams.resolve(params, **overrides)
     n = _SIZES[v.check_choice(size, "size", _SIZES)] if isinstance(size, str) else v.check_int(size, "size",
@@ -294,7 +421,31 @@ def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, 
 
 @dataclass(frozen=True)
 class ConstantsResult:
-    """Peak sharpness and robustness to unmapped clutter of two choices of 004's constants."""
+    """Peak sharpness and robustness to unmapped clutter of two choices of 004's constants.
+
+    Attributes
+    ----------
+    labels : tuple of str
+        One label per choice of constants.
+    constants : tuple of tuple of float
+        ``(a_c, a_p, a_n)`` per choice.
+    half_max_area : numpy.ndarray, shape (k, n)
+        Cells scoring at least halfway from the median to the peak at the best heading.
+    heading_margin : numpy.ndarray, shape (k, n)
+        (Peak minus the best score ≥ 3° away) over (peak minus the median over headings).
+    failure_rate : numpy.ndarray, shape (k,)
+        Share of failed poses per choice.
+    err_pos_cells : numpy.ndarray, shape (k, n)
+        Position errors [cells].
+    extra_clutter : int
+        Random discs added to 004's clutter.
+    example_maps : tuple of numpy.ndarray
+        Score maps of the first scan at its true heading, one per choice.
+    example_pose : numpy.ndarray, shape (3,)
+        The first scan's true pose.
+    time_s : float
+        Wall time [s] (not compared).
+    """
 
     labels: tuple[str, ...]
     constants: tuple[tuple[float, float, float], ...]
@@ -311,6 +462,12 @@ class ConstantsResult:
         return "; ".join(f"{lb}: failures {fr:.0%}" for lb, fr in zip(self.labels, self.failure_rate, strict=True))
 
     def table(self) -> str:
+        """Median sharpness measures and failure rate per choice.
+
+        Returns
+        -------
+        str
+        """
         rows = []
         for k, lb in enumerate(self.labels):
             rows.append([lb, f"{np.median(self.half_max_area[k]):.0f}", f"{np.median(self.heading_margin[k]):.3f}",
@@ -353,6 +510,35 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     The scans are drawn here; the ``len(choices) × n_poses`` localisations run on
     :func:`slamlab.sweep.sweep` with ``n_jobs`` workers (same result for any ``n_jobs``)
     and a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
+
+    Parameters
+    ----------
+    n_poses : int, default 12
+        Random free poses, the same scans for every choice.
+    extra_clutter : int, default 60
+        Random unmapped discs added to 004's clutter.
+    range_std_cells : float, default 0.3
+        Range noise std [cells].
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    choices : sequence of tuple of float
+        ``(a_c, a_p, a_n)`` triples to compare.
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    rng : int or numpy.random.Generator, default 2012
+        Seed or generator of clutter, poses and scan noise.
+    n_jobs : int, default 1
+        Worker processes for the localisations (same result for any value).
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    ConstantsResult
     """
     base = LocaliseParams.resolve(params, **overrides)
     n = v.check_int(n_poses, "n_poses", minimum=1)
@@ -389,6 +575,13 @@ def corridor_grid() -> np.ndarray:
     end at column 150 (52×160 cells; our test case): symmetric under a half turn wherever a 25-cell scan sees
     neither end.
 
+    Returns
+    -------
+    numpy.ndarray of int8, shape (52, 160)
+        Cell codes.
+
+    Examples
+    --------
     >>> g = corridor_grid(); g.shape, int(g[25, 150]), int(g[25, 149])
     ((52, 160), 1, 0)
     """
@@ -400,7 +593,19 @@ def corridor_grid() -> np.ndarray:
 
 @dataclass(frozen=True)
 class CorridorResult:
-    """One scan vs two scans joined by odometry in :func:`corridor_grid` (ours)."""
+    """One scan vs two scans joined by odometry in :func:`corridor_grid` (ours).
+
+    Attributes
+    ----------
+    true_pose : numpy.ndarray, shape (3,)
+        Pose of the last scan [cells, rad].
+    odom_poses : numpy.ndarray, shape (k, 3)
+        The scans' poses, last scan first.
+    single : Localisation
+        The last scan alone.
+    joined : Localisation
+        The scans joined by odometry.
+    """
 
     true_pose: np.ndarray  # (3,) cells, rad: the pose of the last scan
     odom_poses: np.ndarray  # (k, 3) the scans' poses, last scan first
@@ -414,6 +619,12 @@ class CorridorResult:
                f"{self.joined.n_scans} joined {e2:.0f}° off (ambiguity {self.joined.ambiguity:.3f})"
 
     def table(self) -> str:
+        """One row per mode: estimate, errors, score, rival and ambiguity.
+
+        Returns
+        -------
+        str
+        """
         t = self.true_pose
         rows = []
         for label, loc in (("1 scan", self.single), (f"{self.joined.n_scans} scans + odometry", self.joined)):
@@ -436,6 +647,21 @@ def run_corridor_tie(*, max_range_cells: float = 25.0, step_cells: float = 30.0,
     180° off); the scan ``step_cells`` before it sees the dead end, which pins the pose once both are
     joined by (exact) odometry. ``params`` / ``**overrides``: :class:`LocaliseParams` (default float64,
     Δα = 10°, for exact scores).
+
+    Parameters
+    ----------
+    max_range_cells : float, default 25.0
+        Range limit of the noise-free scans [cells].
+    step_cells : float, default 30.0
+        Distance between the two scans [cells].
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    CorridorResult
     """
     p = LocaliseParams.resolve(params, **{"dtype": "float64", "delta_alpha_rad": float(np.radians(10.0)),
                                           **overrides})
@@ -450,7 +676,22 @@ def run_corridor_tie(*, max_range_cells: float = 25.0, step_cells: float = 30.0,
 
 
 def time_localise(grid, scan, *, dtypes=("float64", "float32")) -> dict:
-    """Wall time in seconds of one full 360° :func:`localise` per dtype (volatile: print only in ignored cells)."""
+    """Wall time in seconds of one full 360° :func:`localise` per dtype (volatile: print only in ignored cells).
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Map as cell codes.
+    scan : Scan
+        Scan in cell units.
+    dtypes : sequence of str or dtype
+        FFT precisions to time.
+
+    Returns
+    -------
+    dict
+        dtype name -> seconds.
+    """
     out = {}
     for dt in dtypes:
         t0 = time.perf_counter()
