@@ -25,7 +25,7 @@ _NO_PIPELINE = ("no pipeline Params dataclass: a textbook experiment whose every
 #: function (module.name) -> {missing parameter: why it makes no sense there}
 ALLOWED: dict[str, dict[str, str]] = {
     # correlation: the constructed corridor is built without noise; its settings are LocaliseParams (params=)
-    "slamlab.correlation.experiments.run_corridor_tie": {"rng": _NO_RANDOMNESS + " (a noise-free corridor)"},
+    "slamlab.correlation.experiments.corridor.run_corridor_tie": {"rng": _NO_RANDOMNESS + " (a noise-free corridor)"},
     # features: detectors and matchers on the Oxford images; their settings are the detectors' own arguments
     "slamlab.features.experiments.run_pair_evaluation": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.experiments.run_detector_summary": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},

@@ -34,9 +34,9 @@ from .experiments import (
     ConstantsResult,
     MonteCarloResult,
     Table1Result,
-    _errors,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
+from .experiments.common import _errors
 
 __all__ = [
     "DEFAULT_CARMEN_LOG",
