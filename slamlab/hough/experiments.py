@@ -54,6 +54,17 @@ __all__ = [  # LOG_PARAMS, SHARED_LOGS, RealLogResult, log_format, run_real_log:
 def pose_errors(estimate, truth) -> np.ndarray:
     """``(Ex, Ey, Ea)`` per pose: estimate minus truth, heading wrapped (004 Fig. 10).
 
+    Parameters
+    ----------
+    estimate, truth : array_like, shape (n, 3)
+        Poses ``(x, y, φ)``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 3)
+
+    Examples
+    --------
     >>> pose_errors([[1.0, 2.0, 0.1]], [[0.5, 2.0, 2 * np.pi]]).round(6).tolist()
     [[0.5, 0.0, 0.1]]
     """
@@ -71,7 +82,35 @@ def pose_errors(estimate, truth) -> np.ndarray:
 
 @dataclass(frozen=True)
 class ExampleLineResult:
-    """Polar vs classic Hough transform of 004's example line (004 Fig. 5-8)."""
+    """Polar vs classic Hough transform of 004's example line (004 Fig. 5-8).
+
+    Attributes
+    ----------
+    n_points : int
+        Beams that hit the line.
+    polar_size, classic_size : tuple of int
+        Accumulator sizes ``(n_theta, n_rho)``, 004's order.
+    image_size : tuple of int
+        Size of the rasterised scan [px].
+    polar_line : tuple of float
+        ``(rho, θ_deg)`` of the polar transform's strongest peak.
+    classic_line : tuple of float
+        The classic transform's peak, origin at the image corner.
+    classic_line_centred : tuple of float
+        The same re-expressed about the sensor.
+    polar_cost, classic_cost : float
+        004's operation counts (eq. (8), (6)).
+    polar_votes, classic_votes : int
+        Votes of the two peaks.
+    timing_s : dict
+        Mean time per transform [s] (not compared).
+    polar, classic : HoughAccumulator or None
+        The accumulators.
+    image : numpy.ndarray or None
+        The rasterised scan.
+    scan : tuple or None
+        ``(bearings_rad, ranges)``.
+    """
 
     n_points: int
     polar_size: tuple[int, int]  # (n_theta, n_rho), 004's order
@@ -117,6 +156,23 @@ def run_example_line(rho: float = 10.0, theta_deg: float = 45.0, r_max: float = 
 
     The beam step (1°) is ours: 004 does not give it. ``n_repeat`` sets how many times
     each transform is timed (``timing_s``).
+
+    Parameters
+    ----------
+    rho : float, default 10.0
+        Distance of the line [cells].
+    theta_deg : float, default 45.0
+        Direction of its normal [deg].
+    r_max : float, default 16.0
+        Longest range [cells].
+    delta_phi_deg : float, default 1.0
+        Beam step [deg].
+    n_repeat : int, default 200
+        Timing repetitions.
+
+    Returns
+    -------
+    ExampleLineResult
     """
     phi, r = line_scan(rho, math.radians(theta_deg), r_max=r_max, delta_phi_rad=math.radians(delta_phi_deg))
     n_repeat = v.check_int(n_repeat, "n_repeat", minimum=1)
@@ -153,7 +209,31 @@ ODOMETRY_NOISE = {"trans_std_frac": 0.05, "rot_std_rad": 0.01, "drift_rad_per_ce
 
 @dataclass(frozen=True)
 class SimSlamResult:
-    """Hough SLAM, integrated odometry and ICP on 004's path (004 Fig. 9-11)."""
+    """Hough SLAM, integrated odometry and ICP on 004's path (004 Fig. 9-11).
+
+    Attributes
+    ----------
+    truth : numpy.ndarray, shape (n, 3)
+        True poses ``(x, y)`` [cells], φ [rad].
+    slam : HoughSlamResult
+        The Hough SLAM run.
+    odometry : numpy.ndarray, shape (n, 3)
+        Integrated odometry.
+    icp : numpy.ndarray, shape (n, 3) or None
+        Chained ICP (None when not run).
+    built_map : OccupancyGrid
+        Map built from the SLAM poses.
+    reference_map : numpy.ndarray of int
+        The room's true grid.
+    range_std_cells : float
+        Range noise std [cells].
+    clutter : bool
+        Scans taken in the cluttered room.
+    timing_s : dict
+        Wall times [s] (not compared).
+    odometry_noise : float
+        Factor on the odometry noise.
+    """
 
     truth: np.ndarray = field(repr=False)  # (n, 3)
     slam: HoughSlamResult = field(repr=False)
@@ -211,16 +291,32 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
     ----------
     n_poses : int
         Poses along the path (121 in 004).
+    range_std_cells : float, default 0.1
+        Range noise std [cells].
+    clutter : bool, default False
+        Measure in the room with unmapped chair legs, people and bins.
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    odometry_noise : float, default 1.0
+        Factor on our odometry noise (5 % translation, 0.01 rad heading, 0.002 rad per cell drift).
     with_icp : bool
         Also run the ICP baseline (scan-to-scan, odometry as the initial guess).
     start : {"truth", "correlation"}
         Where the SLAM starts: the true first pose, or the pose that correlation localisation
         (:func:`slamlab.correlation.localise`, Δα = 1°, on the mapped room) finds from the first
         scan — 004's whole system (Fig. 2). The ICP baseline and odometry start from the truth.
-    progress : bool, optional
-        A bar over the scans of the SLAM run (None: on unless ``$SLAMLAB_PROGRESS=0``).
     params, **overrides
         :class:`HoughSlamParams` and fields to change.
+    rng : int, numpy.random.Generator or SeedSequence, default 2010
+        Seed or generator: one child stream for the scans, one for the odometry.
+    progress : bool, optional
+        A bar over the scans of the SLAM run (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Returns
+    -------
+    SimSlamResult
     """
     from .. import sim
 
@@ -282,7 +378,19 @@ def _noise_run(*, range_std_cells: float, n_poses: int, clutter: bool, rng: np.r
 
 @dataclass(frozen=True)
 class NoiseStudyResult:
-    """Hough SLAM errors against range noise, over seeded runs (our addition; 004 gives one run)."""
+    """Hough SLAM errors against range noise, over seeded runs (our addition; 004 gives one run).
+
+    Attributes
+    ----------
+    runs : pandas.DataFrame
+        The sweep's table, one row per run.
+    n_poses : int
+        Poses per run.
+    clutter : bool
+        Scans taken in the cluttered room.
+    bad_pos_cells : float
+        Final position error above which a run counts as bad [cells].
+    """
 
     runs: object = field(repr=False)  # the sweep's table (pandas DataFrame), one row per run
     n_poses: int = 121
@@ -361,6 +469,18 @@ def check_pose_from_two_lines(n_cases: int = 1000, *, rng=2010) -> float:
     Each case: a random pose change and two non-parallel lines; the lines seen
     after the move are put into the flipped ``(-rho, theta + 180°)`` form and
     back, then the pose is recovered. Returns ``max |estimate - truth|``.
+
+    Parameters
+    ----------
+    n_cases : int, default 1000
+        Random cases.
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator.
+
+    Returns
+    -------
+    float
+        Largest absolute error over cases and pose components.
     """
     from .lines import align_lines, transform_lines
     from .pose import pose_from_two_lines
@@ -386,6 +506,24 @@ def time_polar_vs_opencv(*, cell_m: float = 0.05, r_max_m: float = 30.0, room_ha
     The scan is a square room (``room_half_m`` to each wall) seen over 270°;
     OpenCV gets the scan rasterised at ``cell_m``. Returns the times in seconds,
     the image size and the ratio OpenCV / ours (volatile: print only in ignored cells).
+
+    Parameters
+    ----------
+    cell_m : float, default 0.05
+        Pixel size of OpenCV's image and our Δrho [m].
+    r_max_m : float, default 30.0
+        Longest range [m].
+    room_half_m : float, default 5.0
+        Distance to each wall [m].
+    n_beams : int, default 1081
+        Beams over 270°.
+    repeats : int, default 20
+        Timed repetitions.
+
+    Returns
+    -------
+    dict
+        ``ours_s``, ``opencv_s``, ``image_px``, ``ratio``.
     """
     import cv2
 
@@ -416,6 +554,26 @@ def ours_vs_source(sim: SimSlamResult, *, example: ExampleLineResult | None = No
 
     ``variants``: ``(label, SimSlamResult)`` pairs (e.g. 004's two-line pose, no refit);
     ``two_lines_error``: :func:`check_pose_from_two_lines`'s result; ``real``: :class:`RealLogResult` objects.
+
+    Parameters
+    ----------
+    sim : SimSlamResult
+        From :func:`run_sim_slam` (the noisy run).
+    example : ExampleLineResult, optional
+        From :func:`run_example_line`.
+    exact : SimSlamResult, optional
+        A run without range noise.
+    variants : sequence of (str, SimSlamResult)
+        Labelled variant runs.
+    two_lines_error : float, optional
+        :func:`check_pose_from_two_lines`'s result.
+    real : sequence of RealLogResult
+        Real-log runs.
+
+    Returns
+    -------
+    str
+        The table: 004's statement, ours.
     """
     if not isinstance(sim, SimSlamResult):
         raise TypeError(f"`sim` must be a SimSlamResult; got {type(sim).__name__}")
