@@ -43,7 +43,7 @@ ALLOWED: dict[str, dict[str, str]] = {
     "slamlab.filters.experiments.linear.run_sigma_alpha_study": {"params": _NO_PIPELINE},
     "slamlab.filters.experiments.landmarks.run_landmark_filter": {"params": _NO_PIPELINE},
     # hough
-    "slamlab.hough.experiments.run_example_line": {
+    "slamlab.hough.example.run_example_line": {
         "params": "004's worked example: one line, both transforms at 004's resolutions (no Hough SLAM run)",
         "rng": _NO_RANDOMNESS},
     "slamlab.hough.logs.run_real_log": {"rng": _REPLAY},
