@@ -50,7 +50,33 @@ SIZES = {"small": (10.0, 0.5, 20.0), "full": (5.0, 0.25, 15.0)}
 
 @dataclass(frozen=True)
 class StereoRunResult:
-    """One stereo SLAM run on a rendered trajectory, errors against the ground truth (000 §3.7)."""
+    """One stereo SLAM run on a rendered trajectory, errors against the ground truth (000 §3.7).
+
+    Attributes
+    ----------
+    name : str
+        Run label.
+    params : StereoParams
+        Pipeline settings.
+    n_frames : int
+        Frames processed.
+    truth, estimate : numpy.ndarray, shape (N, 3)
+        ``(x_m, y_m, yaw_rad)`` in the map frame (yaw unwrapped).
+    pos_err_m : numpy.ndarray, shape (N,)
+        Position errors [m].
+    yaw_err_rad : numpy.ndarray, shape (N,)
+        Wrapped yaw errors, estimate minus truth [rad].
+    counts : dict
+        Per-frame counts of :meth:`StereoSLAM.process` (``n_inliers``, ``n_new``...), as arrays.
+    landmarks_xy : numpy.ndarray, shape (K, 2)
+        Base landmarks in the map frame [m].
+    degenerate : numpy.ndarray of int
+        Frames that kept the last pose.
+    stage_time_s : dict
+        Per-frame stage times [s] (not compared).
+    fps : float
+        SLAM frames per second, rendering excluded (not compared).
+    """
 
     name: str
     params: StereoParams = field(repr=False)
@@ -82,7 +108,18 @@ class StereoRunResult:
 
     # -- figures of 000 §3.7 -------------------------------------------------------------------------
     def frame_at_turn(self, angle_rad: float) -> int:
-        """First frame whose true turned angle reaches ``angle_rad``."""
+        """First frame whose true turned angle reaches ``angle_rad``.
+
+        Parameters
+        ----------
+        angle_rad : float
+            Turned angle [rad].
+
+        Returns
+        -------
+        int
+            Frame index (the last frame when the angle is never reached).
+        """
         turned = np.abs(self.truth[:, 2] - self.truth[0, 2])
         return int(np.argmax(turned >= angle_rad - 1e-9)) if np.any(turned >= angle_rad - 1e-9) else len(turned) - 1
 
@@ -142,6 +179,33 @@ def run_stereo_slam(poses, *, name: str = "run", params: StereoParams | None = N
     The map frame is the first body pose; truth is expressed in it. ``params`` plus ``overrides``
     set the pipeline (:class:`StereoParams`), ``store`` its landmark store (or a factory),
     ``render`` / ``arena`` / ``rig`` / ``progress`` the renderer (see :func:`run_stereo_slam_variants`).
+
+    Parameters
+    ----------
+    poses : array_like, shape (N, 3)
+        Body poses ``(x_m, y_m, yaw_rad)``, N ≥ 2.
+    name : str, default "run"
+        Run label.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    store : LandmarkStore or callable, optional
+        Landmark store or a factory (default :func:`~slamlab.stereo.slam.default_store`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    arena : StereoArena, optional
+        Scene (default from ``render.arena_seed``).
+    rig : StereoRig, optional
+        Camera pair (default 768×576, 40°, 0.2 m baseline).
+    progress : bool, None or callable
+        A bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``), or ``progress(i)`` after frame ``i``.
+    rng : int or numpy.random.Generator, default 0
+        Seed of the RANSAC stream (and the image noise).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    StereoRunResult
     """
     p = StereoParams.resolve(params, **overrides)
     return run_stereo_slam_variants(poses, {name: p}, name=name, store=store, render=render, arena=arena, rig=rig,
@@ -175,6 +239,34 @@ def run_stereo_slam_variants(
     ``render.arena_seed``), ``rig`` (default the 768×576, 40° pair with a 0.2 m baseline).
     ``progress``: True/False/None for a bar over the frames, or a callable ``progress(i)`` called after
     frame ``i`` (the one contract of :mod:`slamlab._progress`).
+
+    Parameters
+    ----------
+    poses : array_like, shape (N, 3)
+        Body poses ``(x_m, y_m, yaw_rad)``, N ≥ 2.
+    variants : dict
+        Label -> :class:`StereoParams` or dict of overrides of ``params``.
+    name : str, default "run"
+        Run label.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    store : LandmarkStore or callable, optional
+        Landmark store or a factory (default :func:`~slamlab.stereo.slam.default_store`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    arena : StereoArena, optional
+        Scene.
+    rig : StereoRig, optional
+        Camera pair.
+    progress : bool, None or callable
+        A bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``), or ``progress(i)`` after frame ``i``.
+    rng : int or numpy.random.Generator, default 0
+        Seed of the RANSAC stream (and the image noise).
+
+    Returns
+    -------
+    dict
+        Label -> :class:`StereoRunResult`.
     """
     poses = v.as_finite_array(poses, "poses", ndim=2)
     if poses.shape[1] != 3 or len(poses) < 2:
@@ -231,7 +323,20 @@ def _first(poses, n_frames):
 
 
 def experiment_poses(experiment: str, size: str = "small") -> np.ndarray:
-    """Body poses ``(N, 3)`` of the turn in place or the closed loop at ``size`` (000 §3.7)."""
+    """Body poses ``(N, 3)`` of the turn in place or the closed loop at ``size`` (000 §3.7).
+
+    Parameters
+    ----------
+    experiment : {"turn in place", "closed loop"}
+        The trajectory.
+    size : {"small", "full"}
+        Frame step (see :func:`run_turn_in_place`, :func:`run_closed_loop`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        ``(x_m, y_m, yaw_rad)``.
+    """
     v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
     v.check_choice(size, "size", SIZES)
     turn_deg, step_m, loop_turn_deg = SIZES[size]
@@ -247,6 +352,29 @@ def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, param
     ``size="small"``: 10° per frame (37 frames); ``"full"``: 5° per frame (73 frames);
     ``n_frames`` keeps only the first frames (for quick checks). ``params`` + ``overrides``:
     :class:`StereoParams`; ``render``: :class:`RenderParams`.
+
+    Parameters
+    ----------
+    size : {"small", "full"}
+        Frame step: see above.
+    n_frames : int, optional
+        Keep only the first frames.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    store : LandmarkStore or callable, optional
+        Landmark store or a factory (default :func:`~slamlab.stereo.slam.default_store`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    progress : bool, None or callable
+        A bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``), or ``progress(i)`` after frame ``i``.
+    rng : int or numpy.random.Generator, default 0
+        Seed of the RANSAC stream (and the image noise).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    StereoRunResult
     """
     v.check_choice(size, "size", SIZES)
     poses = _first(experiment_poses("turn in place", size), n_frames)
@@ -261,6 +389,29 @@ def run_closed_loop(size: str = "small", *, n_frames: int | None = None, params:
     ``size="small"``: 0.5 m and 20° per frame (57 frames); ``"full"``: 0.25 m and 15° per frame;
     ``n_frames`` keeps only the first frames (for quick checks). ``params`` + ``overrides``:
     :class:`StereoParams`; ``render``: :class:`RenderParams`.
+
+    Parameters
+    ----------
+    size : {"small", "full"}
+        Frame step: see above.
+    n_frames : int, optional
+        Keep only the first frames.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    store : LandmarkStore or callable, optional
+        Landmark store or a factory (default :func:`~slamlab.stereo.slam.default_store`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    progress : bool, None or callable
+        A bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``), or ``progress(i)`` after frame ``i``.
+    rng : int or numpy.random.Generator, default 0
+        Seed of the RANSAC stream (and the image noise).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    StereoRunResult
     """
     v.check_choice(size, "size", SIZES)
     poses = _first(experiment_poses("closed loop", size), n_frames)
@@ -285,6 +436,30 @@ def run_comparison(
     ``variants`` maps a label to a :class:`StereoParams` or to overrides of ``params`` (default
     :data:`COMPARISON`); ``render``: :class:`RenderParams` (``noise_std``, ``drift_std_rad``, ...).
     Returns label -> :class:`StereoRunResult`; :func:`comparison_table` prints them side by side.
+
+    Parameters
+    ----------
+    experiment : {"closed loop", "turn in place"}
+        The trajectory.
+    size : {"small", "full"}
+        Frame step.
+    variants : dict, optional
+        Label -> :class:`StereoParams` or overrides of ``params`` (default ``COMPARISON``).
+    n_frames : int, optional
+        Keep only the first frames.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    progress : bool, None or callable
+        A bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``), or ``progress(i)`` after frame ``i``.
+    rng : int or numpy.random.Generator, default 0
+        Seed of the RANSAC stream (and the image noise).
+
+    Returns
+    -------
+    dict
+        Label -> :class:`StereoRunResult`.
     """
     v.check_choice(size, "size", SIZES)
     v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
@@ -294,7 +469,17 @@ def run_comparison(
 
 
 def comparison_table(results: dict) -> str:
-    """000's figures for the turn or the loop, one column per run of :func:`run_comparison`."""
+    """000's figures for the turn or the loop, one column per run of :func:`run_comparison`.
+
+    Parameters
+    ----------
+    results : dict
+        Label -> :class:`StereoRunResult` from :func:`run_comparison`, all of one experiment.
+
+    Returns
+    -------
+    str
+    """
     runs = list(results.values())
     if not runs:
         raise ValueError("`results` is empty")
@@ -315,7 +500,17 @@ def comparison_table(results: dict) -> str:
 
 @dataclass(frozen=True)
 class DriftStudy:
-    """Runs of one experiment at several calibration-drift levels (000 §3.2; our experiment)."""
+    """Runs of one experiment at several calibration-drift levels (000 §3.2; our experiment).
+
+    Attributes
+    ----------
+    experiment : str
+        "turn in place" or "closed loop".
+    drift_std_rad : tuple of float
+        Random-walk step of the right camera per axis and frame [rad], one per level.
+    runs : tuple of StereoRunResult
+        One run per level.
+    """
 
     experiment: str
     drift_std_rad: tuple
@@ -340,7 +535,30 @@ _RUNNERS = {"turn in place": "run_turn_in_place", "closed loop": "run_closed_loo
 
 def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, params: StereoParams,
                 render: RenderParams, seed) -> dict:
-    """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``seed``)."""
+    """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``seed``).
+
+    Parameters
+    ----------
+    drift_std_rad : float
+        Drift level [rad per axis and frame].
+    experiment : {"turn in place", "closed loop"}
+        The run.
+    size : {"small", "full"}
+        Frame step.
+    n_frames : int or None
+        Keep only the first frames.
+    params : StereoParams
+        Pipeline settings.
+    render : RenderParams
+        Renderer settings (its ``drift_std_rad`` is replaced).
+    seed : int or SeedSequence
+        The run's seed, the same for every level.
+
+    Returns
+    -------
+    dict
+        ``{"run": StereoRunResult}``.
+    """
     runner = globals()[_RUNNERS[experiment]]
     return {"run": runner(size, n_frames=n_frames, params=params, render=render.replace(drift_std_rad=drift_std_rad),
                           progress=False, rng=seed)}
@@ -360,6 +578,33 @@ def run_drift_study(
     deterministic and the sweep gives it no stream of its own (``rng_arg=None``); the study is
     the same for any ``n_jobs``. ``progress``: a bar over the levels (default: on unless
     ``$SLAMLAB_PROGRESS=0``).
+
+    Parameters
+    ----------
+    drift_std_rad : sequence of float
+        Drift levels [rad per axis and frame], ≥ 0.
+    experiment : {"turn in place", "closed loop"}
+        The run.
+    size : {"small", "full"}
+        Frame step.
+    n_frames : int, optional
+        Keep only the first frames.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    rng : int, numpy.random.Generator or SeedSequence, default 0
+        Seed shared by every level.
+    n_jobs : int, default 1
+        Worker processes.
+    progress : bool or None
+        A bar over the levels.
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    DriftStudy
     """
     from ..sweep import fresh_seed_sequence, sweep
 
@@ -389,6 +634,21 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
     descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. The map search is 000's
     global one for every detector (ORB's window search would leave the store almost no queries).
     ``progress``: a bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Parameters
+    ----------
+    n_frames : int, optional
+        Keep only the first frames.
+    detector : str, default "sift"
+        Detector of the run ("sift", "surf").
+    rng : int, default 0
+        RANSAC seed.
+    progress : bool or None
+        A bar over the frames.
+
+    Returns
+    -------
+    Workload
     """
     p = StereoParams(detector=detector, map_search="global")
     rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
@@ -407,6 +667,23 @@ def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, 
     ``overrides``, default ORB), stereo matches, and for each match the disparity minus the true one
     ``f b / z`` (``z``: the renderer's depth at the left keypoint's pixel). Returns a table of the
     median absolute error and the share above 1 px per level.
+
+    Parameters
+    ----------
+    pose : array_like, shape (3,)
+        Body pose ``(x_m, y_m, yaw_rad)``.
+    arena : StereoArena, optional
+        Scene (default the 6×8 m arena, seed 0).
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    rng : int or numpy.random.Generator, default 0
+        Seed of the simulator.
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    str
     """
     from .local_stages import _stereo_match, detect_features, subpixel_disparity
 

@@ -51,6 +51,15 @@ def default_store(params: StereoParams | None = None) -> LandmarkStore:
     checks) behind the non-base buffer (:func:`slamlab.kdtree.make_store`). Binary descriptors
     (ORB, Hamming distance): a kd-tree does not apply, so :class:`~slamlab.kdtree.ExactStore`
     (brute force). Both apply the base rule with ``params``' ``base_seen_times`` / ``max_non_base_time``.
+
+    Parameters
+    ----------
+    params : StereoParams, optional
+        Settings (``detector``, ``base_seen_times``, ``max_non_base_time``); default :class:`StereoParams`.
+
+    Returns
+    -------
+    LandmarkStore
     """
     p = StereoParams.resolve(params)
     if p.binary:
@@ -99,6 +108,8 @@ class StereoSLAM:
         addition): a first pose from the last frame's landmarks, then each point only against the
         landmarks projected near it; the store serves the global search when that gives no pose.
     rng : RANSAC's random stream.
+    **overrides
+        :class:`~slamlab.stereo.params.StereoParams` fields to change (``detector="orb"``).
 
     Examples
     --------
@@ -163,6 +174,16 @@ class StereoSLAM:
 
         ``left`` and ``right`` must have the same shape, the rig's image size; colour images are
         converted with ``params.channel_order``.
+
+        Parameters
+        ----------
+        left, right : array_like, shape (H, W) or (H, W, 3)
+            The stereo pair.
+
+        Returns
+        -------
+        FrameRecord
+            Counts per stage, ``status``, the pose.
         """
         self._check_pair(left, right)
         p = self.params
@@ -322,7 +343,20 @@ class StereoSLAM:
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
         within its horizontal field of view widened by ``margin_deg`` per side and up to
-        ``params.view_depth_factor × params.max_depth_m`` (1.5 × 10 m by default) away."""
+        ``params.view_depth_factor × params.max_depth_m`` (1.5 × 10 m by default) away.
+
+        Parameters
+        ----------
+        margin_deg : float, default 0.0
+            Widening of the field of view per side [deg].
+        T_body : array_like, shape (4, 4), optional
+            Body pose in the map (default the last pose).
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Landmark ids.
+        """
         T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
         T_wc = T @ self.T_body_left
         live = np.flatnonzero(self.alive)
@@ -339,6 +373,19 @@ class StereoSLAM:
 
         Observations whose innovation fails ``update_gate`` leave their landmark unchanged;
         returns the mask of the updated ones.
+
+        Parameters
+        ----------
+        ids : numpy.ndarray of int, shape (M,)
+            Landmark ids.
+        Z : numpy.ndarray, shape (M, 3)
+            Observed positions in the map frame [m].
+        Rz : numpy.ndarray, shape (M, 3, 3)
+            Their covariances [m²].
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (M,)
         """
         gate = self.params.update_gate
         P_pred = landmark_predict(self.P[ids], self.params.state_var)
@@ -426,7 +473,18 @@ class StereoSLAM:
 
     def stage_times(self, cpu: bool = False) -> dict:
         """Per-frame time of each stage in seconds, as arrays: wall clock, or with ``cpu`` the process's
-        CPU time (all its threads: detection runs the two images in two threads)."""
+        CPU time (all its threads: detection runs the two images in two threads).
+
+        Parameters
+        ----------
+        cpu : bool, default False
+            CPU time of the process instead of wall clock.
+
+        Returns
+        -------
+        dict
+            Stage name -> per-frame times [s].
+        """
         times = self.cpu_times if cpu else self.times
         return {s: np.array([t[s] for t in times]) for s in STAGES}
 
@@ -436,6 +494,16 @@ class StereoSLAM:
         return np.array([r["frame"] for r in self.records if r["status"] not in ("ok", "init")], dtype=np.int64)
 
     def landmark_map(self, base_only: bool = True) -> np.ndarray:
-        """(K, 3) landmark positions in the map frame (000's 2D map: the first two columns)."""
+        """(K, 3) landmark positions in the map frame (000's 2D map: the first two columns).
+
+        Parameters
+        ----------
+        base_only : bool, default True
+            Only the base landmarks (seen often enough, 000 §3.4); False adds the live non-base ones.
+
+        Returns
+        -------
+        numpy.ndarray, shape (K, 3)
+        """
         keep = self.alive & self._base_rule()[0] if base_only else self.alive
         return self.X[keep]
