@@ -77,6 +77,13 @@ TEST_ROOM_CLUTTER: tuple[tuple, ...] = (
 def free_cells(grid, margin_cells: int = 0) -> np.ndarray:
     """``(row, col)`` of the free cells at least ``margin_cells`` (Chebyshev) from any non-free cell.
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes.
+    margin_cells : int, default 0
+        Smallest Chebyshev distance to a non-free cell or the border [cells].
+
     Returns
     -------
     numpy.ndarray of int64, shape (K, 2)
@@ -175,6 +182,17 @@ def build_test_room_200() -> np.ndarray:
 def grid_to_text(grid) -> str:
     """Text form of a grid: one line per row (row 0 first), ``.`` free, ``#`` obstacle, ``~`` unexplored.
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
     >>> grid_to_text([[0, 1, -1]])
     '.#~\\n'
     """
@@ -186,6 +204,17 @@ def grid_to_text(grid) -> str:
 def grid_from_text(text: str) -> np.ndarray:
     """Inverse of :func:`grid_to_text`.
 
+    Parameters
+    ----------
+    text : str
+        One line per row of ``.``, ``#``, ``~``, all of one length.
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (H, W)
+
+    Examples
+    --------
     >>> grid_from_text(".#~\\n..~\\n").tolist()
     [[0, 1, -1], [0, 0, -1]]
     """
@@ -231,6 +260,17 @@ test_room_200.__test__ = False  # not a pytest test despite the name
 def measurement_room_200(clutter: Sequence[tuple] = TEST_ROOM_CLUTTER) -> np.ndarray:
     """The test room with unmapped clutter, the world the rangefinder measures (004 Fig. 3b).
 
+    Parameters
+    ----------
+    clutter : sequence of tuple
+        Shapes added to the test room (default ``TEST_ROOM_CLUTTER``, as for :func:`add_clutter`).
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (200, 200)
+
+    Examples
+    --------
     >>> int((measurement_room_200() != test_room_200()).sum()) > 0
     True
     """
