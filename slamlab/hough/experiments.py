@@ -94,7 +94,7 @@ class SimSlamResult:
     built_map : OccupancyGrid
         Map built from the SLAM poses.
     reference_map : numpy.ndarray of int
-        The room's true grid.
+        The mapped test room (without the clutter), to compare ``built_map`` with.
     range_std_cells : float
         Range noise std [cells].
     clutter : bool

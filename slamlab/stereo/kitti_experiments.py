@@ -40,11 +40,11 @@ class KittiRunResult:
     truth, estimate : numpy.ndarray, shape (N, 4, 4)
         Left-camera poses in the frame-0 camera frame.
     ate_m : float
-        Absolute trajectory error (RMSE) [m].
+        Absolute trajectory error (RMSE, no alignment: both start at frame 0) [m].
     ate_se3_m : float
         ATE after an SE(3) alignment [m].
     rpe_m : float
-        Relative pose error per frame [m].
+        RMSE of the relative pose error over one-frame steps [m].
     final_error_m : float
         Position error of the last frame [m].
     path_length_m : float

@@ -42,7 +42,7 @@ class StereoRunResult:
     yaw_err_rad : numpy.ndarray, shape (N,)
         Wrapped yaw errors, estimate minus truth [rad].
     counts : dict
-        Per-frame counts of :meth:`StereoSLAM.process` (``n_inliers``, ``n_new``...), as arrays.
+        Per-frame counts of :meth:`StereoSLAM.process` (``n_inliers``, ``n_new``...), as arrays (:meth:`StereoSLAM.counts`).
     landmarks_xy : numpy.ndarray, shape (K, 2)
         Base landmarks in the map frame [m].
     degenerate : numpy.ndarray of int
