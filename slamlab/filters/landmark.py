@@ -76,6 +76,8 @@ def landmark_update(X, P, Z, R):
     -------
     X, P : updated positions and covariances.
 
+    Examples
+    --------
     >>> X, P = landmark_update(np.zeros((1, 3)), np.eye(3)[None], np.ones((1, 3)), 1.0)
     >>> X, np.diag(P[0])
     (array([[0.5, 0.5, 0.5]]), array([0.5, 0.5, 0.5]))

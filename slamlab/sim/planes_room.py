@@ -141,6 +141,8 @@ def quad_flight(duration_s: float = 20.0, *, rate_hz: float = 40.0, yaw_rate_deg
     -------
     times_s (N,), poses (N, 4, 4) at ``rate_hz`` (one per scan line).
 
+    Examples
+    --------
     >>> t, T = quad_flight(1.0); T.shape, float(t[-1])
     ((40, 4, 4), 0.975)
     """

@@ -113,6 +113,8 @@ def build_plane_room(length_m: float = 20.0, width_m: float = 10.0, height_m: fl
         values plus a uniform ±0.05 jitter).
     rng : seed of the panel pattern.
 
+    Examples
+    --------
     >>> room = build_plane_room(); len(room), float(room.half_u[0] * 2 * room.half_v[0] * 2)
     (15, 30.0)
     """
@@ -189,6 +191,8 @@ def cast_rays_planes(room: PlaneRoom, origins, directions, range_max_m: float = 
     -------
     ranges (K,) (NaN: no hit), plane (K,) index of the plane hit (-1: none), cos_incidence (K,) ``|n·d|``.
 
+    Examples
+    --------
     >>> room = build_plane_room()
     >>> r, k, c = cast_rays_planes(room, [[5.0, 5.0, 1.0]], [[0.0, 0.0, -1.0]])
     >>> float(r[0]), room.names[k[0]], float(c[0])
