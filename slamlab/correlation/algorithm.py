@@ -314,6 +314,11 @@ def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = 
     params, prior_heading_rad, window_rad, **overrides
         As in :func:`localise`.
 
+    Returns
+    -------
+    Localisation
+        The pose of the first scan; ``n_scans`` = number of scans joined.
+
     Examples
     --------
     >>> from slamlab.sim import Rangefinder, test_room_200

@@ -156,7 +156,12 @@ class LogLocalisationResult:
 
     def table(self) -> str:
         """One row per scan: the logged pose, then per mode the error, the ambiguity and success (the estimate too
-        when there is one mode)."""
+        when there is one mode).
+
+        Returns
+        -------
+        str
+        """
         one = len(self.joined) == 1
         head = ["scan", "x [m]", "y [m]", "θ [°]"]
         for k in self.joined:
@@ -177,7 +182,12 @@ class LogLocalisationResult:
         return format_table(head, rows, title=self._title() + modes)
 
     def summary_table(self) -> str:
-        """Success rate per mode (success: within 2 cells and 5° of the logged pose)."""
+        """Success rate per mode (success: within 2 cells and 5° of the logged pose).
+
+        Returns
+        -------
+        str
+        """
         ok = self.success
         rows = [[self._mode(k), f"{ok[m].sum()}/{ok.shape[1]}", f"{ok[m].mean():.1%}",
                  f"{np.median(self.err_pos_m[m][ok[m]]) if ok[m].any() else float('nan'):.3f}",

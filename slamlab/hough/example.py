@@ -80,6 +80,12 @@ class ExampleLineResult:
                 f"classic {self.classic_size[0]}×{self.classic_size[1]}")
 
     def table(self) -> str:
+        """004's sizes and lines beside ours (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = [
             ["scan points N", "-", f"{self.n_points}"],
             ["input image (classic)", "33×33", f"{self.image_size[0]}×{self.image_size[1]}"],

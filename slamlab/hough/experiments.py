@@ -132,6 +132,12 @@ class SimSlamResult:
                 f"{int(self.slam.lost.sum())} lost")
 
     def table(self) -> str:
+        """Error maxima and final errors of Hough SLAM, odometry and ICP (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = []
         for name, e in self.errors.items():
             rows.append([name, f"{np.abs(e[:, 0]).max():.2f}", f"{np.abs(e[:, 1]).max():.2f}",
@@ -268,6 +274,12 @@ class NoiseStudyResult:
     bad_pos_cells: float = 2.0
 
     def table(self) -> str:
+        """Errors per range noise level over the runs (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = []
         for sigma, g in self.runs.groupby("range_std_cells", sort=True):
             rows.append([f"{sigma:g}", f"{len(g)}", f"{g['max_pos_err'].mean():.2f}", f"{g['max_pos_err'].max():.2f}",

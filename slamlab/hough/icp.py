@@ -101,6 +101,11 @@ def icp(source, target, init=(0.0, 0.0, 0.0), *, max_iter: int = 50, tol: float 
     tree : cKDTree, optional
         A kd-tree of ``target`` to reuse.
 
+    Returns
+    -------
+    IcpResult
+        ``pose`` of ``source`` in ``target``'s frame, ``converged``, ``n_iter``, ``rmse``, ``n_inliers``.
+
     Examples
     --------
     >>> g = np.linspace(0, 10, 41)

@@ -89,6 +89,12 @@ class RealLogResult:
                 f"{int(self.slam.lost.sum())} steps fell back on odometry, {int(self.slam.partial.sum())} in part")
 
     def table(self) -> str:
+        """Hough SLAM against integrated odometry on the log (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         d = self.slam.poses[-1] - self.odometry[-1]
         rows = [
             ["scans used", f"{self.odometry.shape[0]}"],
@@ -181,6 +187,10 @@ def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = Non
         a = 0.15 m, …) with ``r_max`` = the log's range limit.
     progress : bool, optional
         A bar over the scans (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Returns
+    -------
+    RealLogResult
     """
     if path is None:
         from ..data import find_data

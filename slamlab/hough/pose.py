@@ -75,6 +75,11 @@ def pose_from_two_lines(line_i1, line_i2, line_j1, line_j2, *, angle_tol_rad: fl
     min_angle_rad : float
         Smallest angle between the lines (our choice: near-parallel lines make D ≈ 0).
 
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``(Δx, Δy, Δφ)`` of scan j in scan i's frame.
+
     Examples
     --------
     >>> from slamlab.hough import transform_lines

@@ -126,6 +126,10 @@ def add_clutter(grid, clutter: Sequence[tuple] = TEST_ROOM_CLUTTER) -> np.ndarra
     clutter : sequence of tuples
         ``("disc", x, y, radius)`` or ``("rect", x0, y0, x1, y1)`` in cells (inclusive).
 
+    Returns
+    -------
+    numpy.ndarray of int8, shape (H, W)
+
     Examples
     --------
     >>> g = add_clutter(make_grid(5, 5), [("rect", 1, 2, 1, 2)])
@@ -154,6 +158,10 @@ def build_test_room_200() -> np.ndarray:
     a round column, shelves, a sofa), placed without symmetry so that the
     correlation has a single best match. ``data/test_room_200.txt`` holds its
     output (:func:`test_room_200` reads it; a test checks they agree).
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (200, 200)
     """
     g = make_grid(200, 200, OBSTACLE)
     _draw_rect(g, 152, 162, 199, 199, UNEXPLORED)  # outside the L: never seen
@@ -244,6 +252,10 @@ def _room_path() -> Path:
 
 def test_room_200() -> np.ndarray:
     """The 200×200 test room M that the robot keeps in memory (004 Fig. 3a), from ``data/test_room_200.txt``.
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (200, 200)
 
     Examples
     --------

@@ -113,6 +113,10 @@ def build_plane_room(length_m: float = 20.0, width_m: float = 10.0, height_m: fl
         values plus a uniform ±0.05 jitter).
     rng : seed of the panel pattern.
 
+    Returns
+    -------
+    PlaneRoom
+
     Examples
     --------
     >>> room = build_plane_room(); len(room), float(room.half_u[0] * 2 * room.half_v[0] * 2)

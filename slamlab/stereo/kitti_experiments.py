@@ -93,6 +93,12 @@ class KittiRunResult:
         return est / np.linalg.norm(np.diff(self.truth[:, :3, 3], axis=0), axis=1)
 
     def table(self) -> str:
+        """ATE, RPE, final error and path length of the run (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = [
             ["frames (degenerate)", f"{len(self.truth)} ({self.n_degenerate})"],
             ["ATE RMSE, no alignment, m", f"{self.ate_m:.2f}"],

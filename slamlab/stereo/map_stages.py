@@ -365,6 +365,11 @@ def estimate_pose(local_points, map_points, first_seen=None, *, depth_m=None, co
     ransac_iters : RANSAC hypotheses (000: about 200), minimal samples of 3, early exit at 99.9 % confidence.
     min_inliers : inliers needed for a valid pose.
 
+    Returns
+    -------
+    PoseEstimate
+        ``T`` (4, 4) body-to-map, the inlier mask, ``converged``, ``n_used``, ``n_iters``.
+
     Raises
     ------
     ValueError if fewer than 3 matches are given.

@@ -270,7 +270,12 @@ class StereoParams(Params):
         return self.detector == "orb"
 
     def detect_kwargs(self) -> dict:
-        """Keyword arguments of :func:`slamlab.features.detect` for this pipeline's detector (000 §3.3)."""
+        """Keyword arguments of :func:`slamlab.features.detect` for this pipeline's detector (000 §3.3).
+
+        Returns
+        -------
+        dict
+        """
         kw = {"max_points": self.n_features, "channel_order": self.channel_order}
         if self.detector == "orb":
             kw.update(n_features=self.n_features, fast_threshold=self.orb_fast_threshold, n_levels=self.orb_levels)

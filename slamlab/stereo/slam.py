@@ -402,7 +402,13 @@ class StereoSLAM:
         return p
 
     def counts(self) -> dict:
-        """Per-frame counts as arrays: points, matches, inliers, landmarks."""
+        """Per-frame counts as arrays: points, matches, inliers, landmarks.
+
+        Returns
+        -------
+        dict
+            Count name -> numpy.ndarray over the frames.
+        """
         keys = [k for k in self.records[0] if k != "status"] if self.records else []
         return {k: np.array([r[k] for r in self.records]) for k in keys}
 

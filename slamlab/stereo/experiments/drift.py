@@ -31,7 +31,12 @@ class DriftStudy:
     runs: tuple = field(repr=False)  # StereoRunResult per level
 
     def table(self) -> str:
-        """Errors, stereo matches and inliers per drift level (fixed precision)."""
+        """Errors, stereo matches and inliers per drift level (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = []
         for d, r in zip(self.drift_std_rad, self.runs, strict=True):
             c = r.counts

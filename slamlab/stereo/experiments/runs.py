@@ -118,7 +118,12 @@ class StereoRunResult:
         return float(np.hypot(d[0], d[1])), float(wrap_angle(d[2]))
 
     def table(self) -> str:
-        """Our errors beside 000's figures and requirements (fixed precision)."""
+        """Our errors beside 000's figures and requirements (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         deg = np.rad2deg
         rows = [
             ["frames (degenerate)", f"{self.n_frames} ({len(self.degenerate)})", ""],
@@ -140,7 +145,12 @@ class StereoRunResult:
         return format_table(["quantity", "ours", "000"], rows, title=f"{self.name} ({self.detector}, policy {self.policy})")
 
     def timing_table(self) -> str:
-        """Mean time per stage in ms and frames per second (volatile: not for nbval)."""
+        """Mean time per stage in ms and frames per second (volatile: not for nbval).
+
+        Returns
+        -------
+        str
+        """
         rows = [[s, f"{1000 * np.mean(self.stage_time_s[s]):.1f}"] for s in STAGES]
         rows.append(["frames/s", f"{self.fps:.2f}"])
         return format_table(["stage", "ms/frame"], rows)
