@@ -34,9 +34,9 @@ from .experiments import (
     ConstantsResult,
     MonteCarloResult,
     Table1Result,
-    _errors,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
+from .experiments.common import _errors
 
 __all__ = [
     "DEFAULT_CARMEN_LOG",
@@ -78,6 +78,43 @@ class LogLocalisationResult:
 
     Arrays with a leading ``modes`` axis hold one row per mode: ``joined[m]`` consecutive scans
     (1 = one scan, 004's method; 2 or 3 = joined by odometry, ours).
+
+    Attributes
+    ----------
+    name : str
+        The log's file name.
+    scan_indices : numpy.ndarray of int, shape (n,)
+        The localised scans.
+    true_poses_m : numpy.ndarray, shape (n, 3)
+        Logged poses ``(x_m, y_m, theta_rad)``.
+    est_poses_m : numpy.ndarray, shape (modes, n, 3)
+        Estimated poses.
+    err_pos_m : numpy.ndarray, shape (modes, n)
+        Position errors [m].
+    err_heading_rad : numpy.ndarray, shape (modes, n)
+        Wrapped heading errors [rad].
+    ambiguity : numpy.ndarray, shape (modes, n)
+        :attr:`Localisation.ambiguity` of each localisation.
+    cell_m : float
+        Grid cell size [m].
+    max_range_m : float
+        Range limit of the scans used [m].
+    exclude : int
+        Scans on either side of a test scan left out of its grid.
+    grid : numpy.ndarray of int, shape (H, W)
+        The whole log's grid.
+    frame : GridFrame
+        Metric frame of ``grid``.
+    joined : tuple of int
+        Scans joined per mode.
+    odom_std : tuple of float
+        ``(σ_xy [m], σ_θ [rad])`` of the simulated odometry per step.
+    example_points_m : numpy.ndarray, shape (k, 2)
+        The first scan's returns drawn at its mode-0 estimate [m].
+    params : LocaliseParams
+        Settings of the localisations.
+    time_s : float
+        Wall time [s] (not compared).
     """
 
     name: str  # the log's file name
@@ -119,7 +156,12 @@ class LogLocalisationResult:
 
     def table(self) -> str:
         """One row per scan: the logged pose, then per mode the error, the ambiguity and success (the estimate too
-        when there is one mode)."""
+        when there is one mode).
+
+        Returns
+        -------
+        str
+        """
         one = len(self.joined) == 1
         head = ["scan", "x [m]", "y [m]", "θ [°]"]
         for k in self.joined:
@@ -140,7 +182,12 @@ class LogLocalisationResult:
         return format_table(head, rows, title=self._title() + modes)
 
     def summary_table(self) -> str:
-        """Success rate per mode (success: within 2 cells and 5° of the logged pose)."""
+        """Success rate per mode (success: within 2 cells and 5° of the logged pose).
+
+        Returns
+        -------
+        str
+        """
         ok = self.success
         rows = [[self._mode(k), f"{ok[m].sum()}/{ok.shape[1]}", f"{ok[m].mean():.1%}",
                  f"{np.median(self.err_pos_m[m][ok[m]]) if ok[m].any() else float('nan'):.3f}",
@@ -157,6 +204,17 @@ class LogLocalisationResult:
 
         A scan is *flagged* when its ambiguity is at least ``threshold``; the table gives the fraction of
         failures flagged (caught) and of successes flagged (false alarms), per mode.
+
+        Parameters
+        ----------
+        bins : sequence of float
+            Bin edges of the ambiguity in [0, 1].
+        threshold : float, default 0.75
+            Ambiguity at or above which a scan is flagged.
+
+        Returns
+        -------
+        str
         """
         b = v.as_vector(bins, "bins")
         if b.size < 2 or np.any(np.diff(b) <= 0):
@@ -230,13 +288,27 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         Results are labelled with the file name.
     scan_indices : sequence of int
         The scans to localise (at least ``max(joined) - 1``: the joined scans come before).
+    cell_m : float, default 0.2
+        Grid cell size [m].
+    max_range_m : float, default 10.0
+        Returns farther than this are not used [m].
+    exclude : int, default 10
+        Scans on either side of each test scan left out of its grid (at least ``max(joined) - 1``).
     joined : sequence of int in {1, 2, 3}
         The modes to run on the same scans.
+    odom_std : tuple of float
+        ``(σ_xy [m], σ_θ [rad])`` of the noise added to each logged step (default ``ODOM_STD``, 0.05 m and 1°).
     params, **overrides
         :class:`LocaliseParams` of every localisation (``rival_radius_cells`` 5 = 1 m at 0.2 m cells).
+    rng : int or numpy.random.Generator, default 2017
+        Seed or generator of the odometry noise.
     n_jobs, progress
         The scans run on :func:`slamlab.sweep.sweep` (one task per scan; same result for any
         ``n_jobs``) with a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
+
+    Returns
+    -------
+    LogLocalisationResult
     """
     from ..sweep import sweep
 
@@ -290,6 +362,24 @@ def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = 
                    constants: ConstantsResult | None = None, log: LogLocalisationResult | None = None) -> str:
     """The notebook's closing table: 004's figures (§7, Table 1) beside ours, from the runs' results.
 
+    Parameters
+    ----------
+    table1 : Table1Result
+        From :func:`run_table1`.
+    monte_carlo : MonteCarloResult, optional
+        From :func:`run_monte_carlo`; its row is left out when None.
+    constants : ConstantsResult, optional
+        From :func:`run_constants_study`.
+    log : LogLocalisationResult, optional
+        From :func:`run_log_localisation`.
+
+    Returns
+    -------
+    str
+        The table: 004's claim, our figures, agreement.
+
+    Examples
+    --------
     >>> print(ours_vs_source(run_table1(2, rng=1)).splitlines()[0])
     Ours vs the source (004 §7)
     """

@@ -28,7 +28,27 @@ _GRID_CMAP = ListedColormap(["0.82", "white", "black"])
 
 
 def plot_grid(grid, *, ax=None, extent=None, title: str | None = None, figsize=None, **kw):
-    """Occupancy grid with 004's colours: free white, obstacle black, unexplored grey; ``origin="lower"``."""
+    """Occupancy grid with 004's colours: free white, obstacle black, unexplored grey; ``origin="lower"``.
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    extent : tuple of float, optional
+        ``(left, right, bottom, top)`` in metres; None labels the axes in cells.
+    title : str, optional
+        Axes title.
+    figsize : tuple of float, optional
+        Size of a new figure [in].
+    **kw
+        Passed to ``imshow``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=title, figsize=figsize, xlabel="x [cells]" if extent is None else "x [m]",
                   ylabel="y [cells]" if extent is None else "y [m]")
     ax.imshow(np.asarray(grid), origin="lower", cmap=_GRID_CMAP, vmin=-1.5, vmax=1.5, interpolation="nearest",
@@ -37,7 +57,25 @@ def plot_grid(grid, *, ax=None, extent=None, title: str | None = None, figsize=N
 
 
 def plot_stamp(T_n, origin: int, *, a_c: float = -1.0, a_p: float = 1.0, ax=None, title=None):
-    """One image T_n of 004 §7 with the map's colours: a_c white, a_p black, a_n grey; robot cell marked."""
+    """One image T_n of 004 §7 with the map's colours: a_c white, a_p black, a_n grey; robot cell marked.
+
+    Parameters
+    ----------
+    T_n : array_like, shape (S, S)
+        One image of :func:`~slamlab.correlation.rasterise_scan`.
+    origin : int
+        The robot's cell ``T_n[origin, origin]``.
+    a_c, a_p : float
+        The values drawn white and black.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    title : str, optional
+        Axes title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     T_n = np.asarray(T_n)
     codes = np.select([T_n == a_c, T_n == a_p], [0, 1], -1)
     ax = plot_grid(codes, ax=ax, title=title)
@@ -48,7 +86,23 @@ def plot_stamp(T_n, origin: int, *, a_c: float = -1.0, a_p: float = 1.0, ax=None
 
 
 def plot_stamps(T, origin: int, headings_deg=(0, 30, 135), *, a_c: float = -1.0, a_p: float = 1.0):
-    """Several images T_n side by side (004 §7), one per heading index in ``headings_deg``; returns the figure."""
+    """Several images T_n side by side (004 §7), one per heading index in ``headings_deg``; returns the figure.
+
+    Parameters
+    ----------
+    T : array_like, shape (n, S, S)
+        Images at 1° headings (index = heading in degrees).
+    origin : int
+        The robot's cell.
+    headings_deg : sequence of int
+        Heading indices to draw.
+    a_c, a_p : float
+        The values drawn white and black.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     headings = tuple(int(n) for n in headings_deg)
     fig, axes = plt.subplots(1, len(headings), figsize=(4.7 * len(headings), 4.6), squeeze=False)
     for ax, n in zip(axes[0], headings, strict=True):
@@ -58,7 +112,19 @@ def plot_stamps(T, origin: int, headings_deg=(0, 30, 135), *, a_c: float = -1.0,
 
 
 def plot_grids(grids, titles):
-    """Grids side by side with 004's colours (:func:`plot_grid`); returns the figure."""
+    """Grids side by side with 004's colours (:func:`plot_grid`); returns the figure.
+
+    Parameters
+    ----------
+    grids : sequence of array_like
+        Cell-code grids.
+    titles : sequence of str
+        One title per grid.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     grids, titles = list(grids), list(titles)
     if len(grids) != len(titles):
         raise ValueError(f"`titles` must have one entry per grid ({len(grids)}); got {len(titles)}")
@@ -75,7 +141,27 @@ def _pose_arrow(ax, pose, length, **kw):
 
 
 def plot_localisation(grid, scan, loc, truth=None, *, ax=None, title="Scan drawn at the estimated pose"):
-    """The map, the scan's returns drawn from the estimated pose, the true and estimated poses."""
+    """The map, the scan's returns drawn from the estimated pose, the true and estimated poses.
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        The map.
+    scan : Scan
+        The localised scan in cell units.
+    loc : Localisation
+        Result of :func:`~slamlab.correlation.localise`.
+    truth : array_like, shape (3,), optional
+        True pose ``(x, y)`` [cells], heading [rad].
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    title : str
+        Axes title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = plot_grid(grid, ax=ax, title=title)
     pts = scan.points(loc.pose)
     ax.plot(pts[:, 0], pts[:, 1], **{**STYLE["measurement"], "markersize": 2.5}, label="scan at estimate")
@@ -89,7 +175,21 @@ def plot_localisation(grid, scan, loc, truth=None, *, ax=None, title="Scan drawn
 
 
 def plot_score_map(loc, *, ax=None, title=None):
-    """The correlation scores D_n(row, col) at the best heading, with the peak marked."""
+    """The correlation scores D_n(row, col) at the best heading, with the peak marked.
+
+    Parameters
+    ----------
+    loc : Localisation
+        Result of :func:`~slamlab.correlation.localise`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    title : str, optional
+        Axes title (default names the best heading).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=title or f"Scores at heading {np.degrees(loc.pose[2]):.0f}°", xlabel="x [cells]",
                   ylabel="y [cells]")
     im = ax.imshow(loc.score_map, origin="lower", cmap="viridis", interpolation="nearest")
@@ -99,7 +199,21 @@ def plot_score_map(loc, *, ax=None, title=None):
 
 
 def plot_heading_profile(loc, truth_heading_rad=None, *, ax=None):
-    """The best score of every candidate heading (the maximum over each D_n)."""
+    """The best score of every candidate heading (the maximum over each D_n).
+
+    Parameters
+    ----------
+    loc : Localisation
+        Result of :func:`~slamlab.correlation.localise`.
+    truth_heading_rad : float, optional
+        True heading [rad], drawn dotted.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title="Best score per heading", xlabel="heading [deg]", ylabel="max C_n")
     ax.plot(np.degrees(loc.headings_rad), loc.best_per_heading, color=STYLE["estimate"]["color"], lw=1.2)
     ax.axvline(np.degrees(loc.headings_rad[loc.heading_index]), color="red", lw=1, ls="--", label="estimate")
@@ -112,7 +226,23 @@ def plot_heading_profile(loc, truth_heading_rad=None, *, ax=None):
 
 
 def localisation_figure(grid, scan, loc, truth=None):
-    """Map with the localised scan, the score map at the best heading and the heading profile."""
+    """Map with the localised scan, the score map at the best heading and the heading profile.
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        The map.
+    scan : Scan
+        The localised scan in cell units.
+    loc : Localisation
+        Result of :func:`~slamlab.correlation.localise`.
+    truth : array_like, shape (3,), optional
+        True pose.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1, 1.15, 1.1]})
     plot_localisation(grid, scan, loc, truth, ax=axes[0])
     plot_score_map(loc, ax=axes[1])
@@ -122,7 +252,21 @@ def localisation_figure(grid, scan, loc, truth=None):
 
 
 def plot_table1(result, grid, *, ax=None):
-    """Table 1 poses on the map: truth (black circles) and estimates (blue crosses), with headings."""
+    """Table 1 poses on the map: truth (black circles) and estimates (blue crosses), with headings.
+
+    Parameters
+    ----------
+    result : Table1Result
+        From :func:`~slamlab.correlation.run_table1`.
+    grid : array_like of int, shape (H, W)
+        The map.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = plot_grid(grid, ax=ax, title="Table 1: true (o) and estimated (x) poses", figsize=(7, 7))
     for i, (t, e) in enumerate(zip(result.true_poses, result.est_poses, strict=True)):
         ax.plot(t[0], t[1], "o", color="black", mfc="none", ms=9)
@@ -134,7 +278,19 @@ def plot_table1(result, grid, *, ax=None):
 
 
 def plot_error_distribution(result, *, axes=None):
-    """Monte Carlo: histogram of heading errors [deg] and of position errors [cells]."""
+    """Monte Carlo: histogram of heading errors [deg] and of position errors [cells].
+
+    Parameters
+    ----------
+    result : MonteCarloResult
+        From :func:`~slamlab.correlation.run_monte_carlo`.
+    axes : sequence of two matplotlib.axes.Axes, optional
+        None makes a new figure.
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+    """
     if axes is None:
         _fig, axes = plt.subplots(1, 2, figsize=(11, 3.8))
     ea = np.degrees(result.err_heading_rad)
@@ -155,7 +311,19 @@ def plot_error_distribution(result, *, axes=None):
 
 
 def constants_figure(result, grid):
-    """Score maps of one scan at its true heading for each choice of constants."""
+    """Score maps of one scan at its true heading for each choice of constants.
+
+    Parameters
+    ----------
+    result : ConstantsResult
+        From :func:`~slamlab.correlation.run_constants_study`.
+    grid : array_like of int, shape (H, W)
+        The map (not drawn; kept for a uniform call).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     k = len(result.labels)
     fig, axes = plt.subplots(1, k, figsize=(5.2 * k, 4.4))
     axes = np.atleast_1d(axes)
@@ -171,7 +339,21 @@ def constants_figure(result, grid):
 
 def plot_log_localisation(result, *, mode: int = 0, ax=None):
     """A log's grid (metres), the logged poses of the test scans, estimates of ``result.joined[mode]`` and the
-    first scan at its single-mode estimate."""
+    first scan at its single-mode estimate.
+
+    Parameters
+    ----------
+    result : LogLocalisationResult
+        From :func:`~slamlab.correlation.run_log_localisation`.
+    mode : int, default 0
+        Index into ``result.joined``.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     f = result.frame
     extent = (f.x0_m - f.cell_m / 2, f.x0_m + (f.shape[1] - 0.5) * f.cell_m,
               f.y0_m - f.cell_m / 2, f.y0_m + (f.shape[0] - 0.5) * f.cell_m)

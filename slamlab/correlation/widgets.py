@@ -27,6 +27,17 @@ def explore_localisation(**defaults):
 
     Calls :func:`~slamlab.correlation.localise` with the slider values. A bad
     combination (a_c = a_p, a pose inside an obstacle) prints its message.
+
+    Parameters
+    ----------
+    **defaults
+        Initial slider values: ``x`` (60), ``y`` (40) [cells], ``heading_deg`` (30), ``range_std_cells`` (0.3),
+        ``clutter`` (True), ``extra_clutter`` (0), ``delta_alpha_deg`` (1), ``a_c`` (-1), ``a_p`` (1),
+        ``n_beams`` (360) and the fixed ``rng`` (2010).
+
+    Returns
+    -------
+    ipywidgets.interactive
     """
     d = {"x": 60, "y": 40, "heading_deg": 30.0, "range_std_cells": 0.3, "clutter": True, "extra_clutter": 0,
          "delta_alpha_deg": 1.0, "a_c": -1.0, "a_p": 1.0, "n_beams": 360, "rng": 2010}
@@ -74,7 +85,20 @@ def _log(path):
 def explore_log_scan(path=None, **defaults):
     """Pick a scan of a CARMEN log (default: the corrected Intel log), a_c/a_p and how many consecutive scans to
     join by (logged) odometry; it is localised on a grid built from the log's poses without its neighbours
-    (what :func:`run_log_localisation` does) and its ambiguity printed."""
+    (what :func:`run_log_localisation` does) and its ambiguity printed.
+
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        CARMEN log; default the corrected Intel log.
+    **defaults
+        Initial values: ``scan`` (250), ``a_c`` (-1), ``a_p`` (1), ``exclude`` (10), ``joined`` (1) and the fixed
+        ``cell_m`` (0.2), ``max_range_m`` (10).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"scan": 250, "a_c": -1.0, "a_p": 1.0, "exclude": 10, "joined": 1, "cell_m": 0.2, "max_range_m": 10.0}
     d.update(defaults)
     log = _log(path)

@@ -16,6 +16,20 @@ def nees(err, P):
     ``err`` is ``(..., n)`` (true minus estimated state, angles wrapped), ``P``
     is ``(..., n, n)``. For a consistent filter its mean is ``n``.
 
+    Parameters
+    ----------
+    err : array_like, shape (..., n)
+        Estimation error, true minus estimated state (angles wrapped).
+    P : array_like, shape (..., n, n)
+        The filter's covariance for each error.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        NEES per leading index, shape ``(...)``.
+
+    Examples
+    --------
     >>> float(nees(np.array([1.0, 2.0]), np.diag([1.0, 4.0])))
     2.0
     """
@@ -30,6 +44,20 @@ def nees(err, P):
 def nis(y, S):
     """Normalised innovation squared ``y^T S^-1 y`` (same maths as :func:`nees`).
 
+    Parameters
+    ----------
+    y : array_like, shape (..., m)
+        Innovation ``z - h(x_{k|k-1})``.
+    S : array_like, shape (..., m, m)
+        Innovation covariance.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        NIS per leading index, shape ``(...)``.
+
+    Examples
+    --------
     >>> float(nis(np.array([3.0]), np.array([[9.0]])))
     1.0
     """
@@ -42,6 +70,22 @@ def chi2_interval(dof: int, n_runs: int = 1, prob: float = 0.95):
     The average NEES of ``N`` independent runs times ``N`` is chi-square with
     ``N * dof`` degrees of freedom, so the bounds are ``chi2.ppf(.., N dof) / N``.
 
+    Parameters
+    ----------
+    dof : int
+        Degrees of freedom of one value (the state dimension for NEES, the measurement dimension for NIS).
+    n_runs : int, default 1
+        Number of independent runs averaged.
+    prob : float, default 0.95
+        Probability mass inside the interval.
+
+    Returns
+    -------
+    lo, hi : float
+        Bounds of the run-averaged statistic.
+
+    Examples
+    --------
     >>> [round(b, 3) for b in chi2_interval(2, 50)]
     [1.484, 2.591]
     """

@@ -46,11 +46,23 @@ def ekf_predict(x, P, f, F_jac, Q, u=None):
 
     Parameters
     ----------
-    x : (n,) posterior state.  P : (n, n) its covariance.
-    f : callable ``f(x, u) -> (n,)`` motion model.
-    F_jac : callable ``F_jac(x, u) -> (n, n)``, the Jacobian ``df/dx``.
-    Q : (n, n) process noise covariance (in state space).
-    u : control passed through to ``f`` and ``F_jac`` (may be None).
+    x : array_like, shape (n,)
+        Posterior state ``x_{k-1|k-1}``.
+    P : array_like, shape (n, n)
+        Its covariance.
+    f : callable
+        ``f(x, u) -> (n,)`` motion model.
+    F_jac : callable
+        ``F_jac(x, u) -> (n, n)``, the Jacobian ``df/dx``.
+    Q : array_like, shape (n, n)
+        Process noise covariance (in state space).
+    u : optional
+        Control passed through to ``f`` and ``F_jac`` (may be None).
+
+    Returns
+    -------
+    x, P : numpy.ndarray
+        The prior ``x_{k|k-1}``, shape ``(n,)``, and ``P_{k|k-1}``, shape ``(n, n)``.
 
     Examples
     --------
@@ -76,11 +88,25 @@ def ekf_update(x, P, z, h, H_jac, R, *, residual=np.subtract) -> Update:
 
     Parameters
     ----------
-    x : (n,) prior state.  P : (n, n) prior covariance.
-    z : (m,) measurement.
-    h : callable ``h(x) -> (m,)``.  H_jac : callable ``H_jac(x) -> (m, n)``.
-    R : (m, m) measurement noise covariance.
-    residual : ``residual(z, z_pred) -> y``; default subtraction (wrap bearings here).
+    x : array_like, shape (n,)
+        Prior state ``x_{k|k-1}``.
+    P : array_like, shape (n, n)
+        Prior covariance.
+    z : array_like, shape (m,)
+        Measurement.
+    h : callable
+        ``h(x) -> (m,)`` measurement model.
+    H_jac : callable
+        ``H_jac(x) -> (m, n)``, the Jacobian ``dh/dx``.
+    R : array_like, shape (m, m)
+        Measurement noise covariance.
+    residual : callable, default numpy.subtract
+        ``residual(z, z_pred) -> y``; wrap bearings here.
+
+    Returns
+    -------
+    Update
+        ``(x, P, y, S, K)``: posterior, innovation, its covariance, the gain.
 
     Examples
     --------
@@ -106,6 +132,24 @@ def numerical_jacobian(fun, x, *args, eps: float | None = None) -> np.ndarray:
 
     Step ``eps`` defaults to ``cbrt(machine eps) * max(1, |x_j|)`` per coordinate.
 
+    Parameters
+    ----------
+    fun : callable
+        ``fun(x, *args) -> (m,)``.
+    x : array_like, shape (n,)
+        Point of differentiation.
+    *args
+        Extra arguments passed to ``fun``.
+    eps : float, optional
+        Step for every coordinate; None for the scaled default above.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, n)
+        The Jacobian.
+
+    Examples
+    --------
     >>> numerical_jacobian(lambda x: np.array([x[0] * x[1]]), np.array([2.0, 3.0])).round(6)
     array([[3., 2.]])
     """
@@ -126,6 +170,26 @@ def check_jacobian(fun, jac, x, *args, rtol: float = 1e-5, atol: float = 1e-7) -
 
     Raises ``ValueError`` naming the worst entry when ``|J - J_num| > atol + rtol |J_num|``.
 
+    Parameters
+    ----------
+    fun : callable
+        ``fun(x, *args) -> (m,)``.
+    jac : callable
+        ``jac(x, *args) -> (m, n)``, the analytic Jacobian under test.
+    x : array_like, shape (n,)
+        Point of comparison.
+    *args
+        Extra arguments passed to ``fun`` and ``jac``.
+    rtol, atol : float
+        Relative and absolute tolerance of the entrywise check.
+
+    Returns
+    -------
+    float
+        The largest absolute difference between ``jac`` and the finite differences.
+
+    Examples
+    --------
     >>> check_jacobian(lambda x: x**2, lambda x: np.diag(2 * x), np.array([1.0, 2.0])) < 1e-8
     True
     """
@@ -149,6 +213,27 @@ class ExtendedKalmanFilter:
 
     ``f(x, u)``, ``F_jac(x, u)``, ``h(x)``, ``H_jac(x)``; ``Q`` and ``R`` may be
     replaced between steps (e.g. a control-dependent ``Q``).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Initial state.
+    P : array_like, shape (n, n)
+        Initial covariance.
+    f : callable
+        ``f(x, u) -> (n,)`` motion model.
+    F_jac : callable
+        ``F_jac(x, u) -> (n, n)``.
+    Q : array_like, shape (n, n)
+        Process noise covariance (attribute ``Q``, may be replaced).
+    h : callable
+        ``h(x) -> (m,)`` measurement model.
+    H_jac : callable
+        ``H_jac(x) -> (m, n)``.
+    R : array_like, shape (m, m)
+        Measurement noise covariance.
+    residual : callable, default numpy.subtract
+        ``residual(z, z_pred)``, as in :func:`ekf_update`.
     """
 
     def __init__(self, x, P, f, F_jac, Q, h, H_jac, R, *, residual=np.subtract):
@@ -165,10 +250,24 @@ class ExtendedKalmanFilter:
         self.y = self.S = self.K = None
 
     def predict(self, u=None) -> None:
+        """Predict with the stored ``f``, ``F_jac`` and ``Q``; sets ``x, P`` and ``x_prior, P_prior``.
+
+        Parameters
+        ----------
+        u : optional
+            Control passed to ``f`` and ``F_jac``.
+        """
         self.x, self.P = _ekf_predict(self.x, self.P, self.f, self.F_jac, self.Q, u)
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
 
     def update(self, z) -> None:
+        """Update with measurement ``z``; sets ``x, P``, ``x_post, P_post`` and ``y, S, K``.
+
+        Parameters
+        ----------
+        z : array_like, shape (m,)
+            Measurement (validated for shape and finiteness).
+        """
         z = v.as_measurement(z, "z", self.R.shape[0])
         self.x, self.P, self.y, self.S, self.K = _ekf_update(
             self.x, self.P, z, self.h, self.H_jac, self.R, self.residual)

@@ -18,7 +18,21 @@ __all__ = ["KalmanFilter", "Update", "kf_predict", "kf_update", "symmetrize"]
 
 
 class Update(NamedTuple):
-    """Result of a measurement update: posterior ``x, P``, innovation ``y``, its covariance ``S``, gain ``K``."""
+    """Result of a measurement update: posterior ``x, P``, innovation ``y``, its covariance ``S``, gain ``K``.
+
+    Attributes
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Posterior state.
+    P : numpy.ndarray, shape (n, n)
+        Posterior covariance.
+    y : numpy.ndarray, shape (m,)
+        Innovation.
+    S : numpy.ndarray, shape (m, m)
+        Innovation covariance.
+    K : numpy.ndarray, shape (n, m)
+        Gain.
+    """
 
     x: np.ndarray
     P: np.ndarray
@@ -144,6 +158,25 @@ class KalmanFilter:
     Keeps ``x_prior, P_prior`` (after :meth:`predict`) and ``x_post, P_post``,
     ``y, S, K`` (after :meth:`update`).
 
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Initial state.
+    P : array_like, shape (n, n)
+        Initial covariance.
+    F : array_like, shape (n, n)
+        State transition matrix.
+    Q : array_like, shape (n, n)
+        Process noise covariance.
+    H : array_like, shape (m, n)
+        Measurement matrix.
+    R : array_like, shape (m, m)
+        Measurement noise covariance.
+    B : array_like, shape (n, k), optional
+        Control matrix; needed when :meth:`predict` gets a control.
+    form : {"short", "joseph"}
+        Covariance update form, as in :func:`kf_update`.
+
     Examples
     --------
     >>> kf = KalmanFilter(x=[0.0], P=[[1.0]], F=[[1.0]], Q=[[0.0]], H=[[1.0]], R=[[1.0]])
@@ -171,7 +204,13 @@ class KalmanFilter:
         return self.x.shape[0]
 
     def predict(self, u=None) -> None:
-        """Predict with the stored ``F, Q`` (and ``B u`` when a control is given)."""
+        """Predict with the stored ``F, Q`` (and ``B u`` when a control is given).
+
+        Parameters
+        ----------
+        u : array_like, shape (k,), optional
+            Control; requires ``B``.
+        """
         Bu = None
         if u is not None:
             if self.B is None:
@@ -181,7 +220,13 @@ class KalmanFilter:
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
 
     def update(self, z) -> None:
-        """Update with measurement ``z`` (validated for shape and finiteness)."""
+        """Update with measurement ``z`` (validated for shape and finiteness).
+
+        Parameters
+        ----------
+        z : array_like, shape (m,)
+            Measurement.
+        """
         z = v.as_measurement(z, "z", self.H.shape[0])
         self.x, self.P, self.y, self.S, self.K = _update(self.x, self.P, z - self.H @ self.x, self.H, self.R, self.form)
         self.x_post, self.P_post = self.x.copy(), self.P.copy()

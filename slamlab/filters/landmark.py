@@ -33,6 +33,20 @@ def landmark_predict(P, Q):
 
     ``P`` is ``(N, k, k)``; ``Q`` a scalar variance, ``(k, k)`` or ``(N, k, k)``.
 
+    Parameters
+    ----------
+    P : array_like, shape (N, k, k)
+        Covariances of ``N`` landmarks.
+    Q : float or array_like
+        Process noise: a scalar variance, ``(k, k)`` or ``(N, k, k)``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, k, k)
+        Predicted covariances.
+
+    Examples
+    --------
     >>> landmark_predict(np.eye(2)[None], 0.5)[0]
     array([[1.5, 0. ],
            [0. , 1.5]])
@@ -49,14 +63,21 @@ def landmark_update(X, P, Z, R):
 
     Parameters
     ----------
-    X : (N, k) landmark positions.  P : (N, k, k) covariances.
-    Z : (N, k) new observations of the same landmarks.
-    R : scalar variance, (k, k) or (N, k, k) observation covariance.
+    X : array_like, shape (N, k)
+        Landmark positions.
+    P : array_like, shape (N, k, k)
+        Their covariances.
+    Z : array_like, shape (N, k)
+        New observations of the same landmarks.
+    R : float or array_like
+        Observation covariance: a scalar variance, ``(k, k)`` or ``(N, k, k)``.
 
     Returns
     -------
     X, P : updated positions and covariances.
 
+    Examples
+    --------
     >>> X, P = landmark_update(np.zeros((1, 3)), np.eye(3)[None], np.ones((1, 3)), 1.0)
     >>> X, np.diag(P[0])
     (array([[0.5, 0.5, 0.5]]), array([0.5, 0.5, 0.5]))
@@ -91,6 +112,17 @@ class LandmarkFilter:
     with covariance ``obs_var I``; :meth:`observe` runs predict + update on the
     landmarks ``idx`` with their new observations.
 
+    Parameters
+    ----------
+    state_var : float, default 1e-4
+        Variance added per observation step (``Q = state_var I``); 0 gives the running mean.
+    obs_var : float, default 1e-2
+        Variance of one sighting per coordinate (``R = obs_var I``, also a new landmark's covariance).
+    dim : int, default 3
+        Landmark dimension ``k``.
+
+    Examples
+    --------
     >>> lf = LandmarkFilter(state_var=0.0, obs_var=1.0, dim=2)
     >>> _ = lf.add([[0.0, 0.0]]); lf.observe([0], [[2.0, 2.0]]); lf.X
     array([[1., 1.]])
@@ -107,7 +139,18 @@ class LandmarkFilter:
         return self.X.shape[0]
 
     def add(self, Z) -> np.ndarray:
-        """Append landmarks first seen at ``Z (M, k)``; returns their indices."""
+        """Append landmarks first seen at ``Z (M, k)``; returns their indices.
+
+        Parameters
+        ----------
+        Z : array_like, shape (M, k)
+            First sightings of the new landmarks.
+
+        Returns
+        -------
+        numpy.ndarray, shape (M,)
+            Indices of the new landmarks.
+        """
         Z = v.as_finite_array(Z, "Z", ndim=2)
         if Z.shape[1] != self.dim:
             raise ValueError(f"`Z` must have shape (M, {self.dim}); got {Z.shape}")
@@ -117,7 +160,15 @@ class LandmarkFilter:
         return np.arange(start, len(self))
 
     def observe(self, idx, Z) -> None:
-        """Predict (``P += state_var I``) and update the landmarks ``idx`` with ``Z``."""
+        """Predict (``P += state_var I``) and update the landmarks ``idx`` with ``Z``.
+
+        Parameters
+        ----------
+        idx : array_like of int, shape (M,)
+            Indices of existing landmarks, no repeats.
+        Z : array_like, shape (M, k)
+            Their new observations, in the order of ``idx``.
+        """
         idx = np.asarray(idx)
         if idx.ndim != 1 or not np.issubdtype(idx.dtype, np.integer):
             raise TypeError(f"`idx` must be a 1-D integer index array; got dtype {idx.dtype}, shape {idx.shape}")

@@ -15,7 +15,21 @@ _FILTER_COLORS = {"LKF": "tab:red", "EKF": "tab:orange", "UKF-aug": "tab:blue", 
 
 
 def plot_cv_example(result, *, ax=None, ellipse_every: int = 5):
-    """One run of the constant-velocity target: truth, measurements, KF estimate."""
+    """One run of the constant-velocity target: truth, measurements, KF estimate.
+
+    Parameters
+    ----------
+    result : CVTargetResult
+        Its ``example_*`` fields are drawn.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    ellipse_every : int, default 5
+        Accepted for symmetry with :func:`plot_unicycle_paths`; this plot draws no ellipses.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title="Constant-velocity target (one run)", xlabel="x [m]", ylabel="y [m]", equal=True)
     X, Z, E = result.example_truth, result.example_meas, result.example_est
     ax.plot(X[:, 0], X[:, 2], **STYLE["truth"], label="truth")
@@ -26,7 +40,27 @@ def plot_cv_example(result, *, ax=None, ellipse_every: int = 5):
 
 
 def plot_nees(anees, bounds, *, labels=None, ax=None, dim: int | None = None, title: str = "NEES"):
-    """Run-averaged NEES (or NIS) per step with its chi-square interval; log scale when it explodes."""
+    """Run-averaged NEES (or NIS) per step with its chi-square interval; log scale when it explodes.
+
+    Parameters
+    ----------
+    anees : array_like, shape (n_steps,) or (n_filters, n_steps)
+        Run-averaged NEES, one row per filter.
+    bounds : tuple of float
+        Chi-square interval ``(lo, hi)``, shaded.
+    labels : list of str, optional
+        Filter name per row (also picks its colour).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    dim : int, optional
+        Expected value, drawn as a dotted line.
+    title : str, default "NEES"
+        Axes title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     anees = np.atleast_2d(np.asarray(anees, dtype=float))
     ax = new_axes(ax, title=title, xlabel="step", ylabel="run-averaged NEES")
     labels = labels or [None] * len(anees)
@@ -44,7 +78,23 @@ def plot_nees(anees, bounds, *, labels=None, ax=None, dim: int | None = None, ti
 
 
 def plot_unicycle_paths(result, *, ax=None, ellipse_every: int = 10, n_std: float = 2.0):
-    """First Monte Carlo run: true path, each filter's estimate, 2-sigma position ellipses, landmarks."""
+    """First Monte Carlo run: true path, each filter's estimate, 2-sigma position ellipses, landmarks.
+
+    Parameters
+    ----------
+    result : UnicycleResult
+        Its first run, filters and landmarks are drawn.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    ellipse_every : int, default 10
+        Draw an ellipse every this many steps.
+    n_std : float, default 2.0
+        Ellipse size in standard deviations.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title="Unicycle with range-bearing landmarks (run 1)", xlabel="x [m]", ylabel="y [m]",
                   equal=True)
     X = result.example_truth
@@ -70,7 +120,19 @@ def plot_unicycle_paths(result, *, ax=None, ellipse_every: int = 10, n_std: floa
 
 
 def plot_joseph(result, *, ax=None):
-    """Posterior variance vs gain scale: short form, Joseph form, sampled truth."""
+    """Posterior variance vs gain scale: short form, Joseph form, sampled truth.
+
+    Parameters
+    ----------
+    result : JosephResult
+        From :func:`~slamlab.filters.run_joseph_vs_short`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title="Covariance update with a scaled gain", xlabel="K / K_opt",
                   ylabel="posterior position variance [m²]")
     g = result.gain_scales
@@ -83,7 +145,17 @@ def plot_joseph(result, *, ax=None):
 
 
 def unicycle_figure(result):
-    """Paths and NEES side by side (used by the widget)."""
+    """Paths and NEES side by side (used by the widget).
+
+    Parameters
+    ----------
+    result : UnicycleResult
+        From :func:`~slamlab.filters.run_unicycle_comparison`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     plot_unicycle_paths(result, ax=axes[0])
     plot_nees(result.anees, result.nees_bounds, labels=list(result.filters), ax=axes[1], dim=3)
@@ -92,7 +164,17 @@ def unicycle_figure(result):
 
 
 def cv_figure(result):
-    """One constant-velocity run and the KF's NEES side by side."""
+    """One constant-velocity run and the KF's NEES side by side.
+
+    Parameters
+    ----------
+    result : CVTargetResult
+        From :func:`~slamlab.filters.run_cv_target`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     plot_cv_example(result, ax=axes[0])
     plot_nees(result.anees, result.nees_bounds, labels=["KF"], ax=axes[1], dim=4, title="KF NEES (expect 4)")

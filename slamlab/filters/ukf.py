@@ -40,6 +40,26 @@ FORMS = ("augmented", "additive")
 def sigma_weights(L: int, alpha: float = 1e-3, beta: float = 2.0, kappa: float = 0.0):
     """Weights ``(Ws, Wc)`` of the ``2L+1`` sigma points and ``lambda`` (000 §1.2.3).
 
+    Parameters
+    ----------
+    L : int
+        Dimension of the (augmented) state the sigma points sample.
+    alpha : float, default 1e-3
+        Spread of the sigma points.
+    beta : float, default 2.0
+        Prior-knowledge term added to the centre covariance weight (2 for Gaussians).
+    kappa : float, default 0.0
+        Secondary scaling; ``L + lambda = alpha^2 (L + kappa)`` must be positive.
+
+    Returns
+    -------
+    Ws, Wc : numpy.ndarray, shape (2L+1,)
+        Mean and covariance weights.
+    lam : float
+        ``lambda``.
+
+    Examples
+    --------
     >>> Ws, Wc, lam = sigma_weights(2, alpha=1.0, beta=2.0, kappa=1.0)
     >>> Ws, Wc, lam
     (array([0.3333, 0.1667, 0.1667, 0.1667, 0.1667]), array([2.3333, 0.1667, 0.1667, 0.1667, 0.1667]), 1.0)
@@ -73,6 +93,22 @@ def sigma_points(x, P, alpha: float = 1e-3, kappa: float = 0.0) -> np.ndarray:
 
     ``A_i`` is column ``i`` of the lower Cholesky factor of ``(L + lambda) P``.
 
+    Parameters
+    ----------
+    x : array_like, shape (L,)
+        Mean.
+    P : array_like, shape (L, L)
+        Covariance.
+    alpha, kappa : float
+        Sigma-point parameters, as in :func:`sigma_weights`.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2L+1, L)
+        Sigma points as rows.
+
+    Examples
+    --------
     >>> sigma_points([0.0, 0.0], np.eye(2), alpha=1.0, kappa=2.0)
     array([[ 0.,  0.],
            [ 2.,  0.],
@@ -92,6 +128,26 @@ def unscented_transform(sigmas, Ws, Wc, noise_cov=None, mean_fn=None, residual_f
     ``mean_fn(sigmas, Ws)`` and ``residual_fn(a, b)`` (broadcasting over rows)
     replace the linear mean and subtraction, e.g. for angles.
 
+    Parameters
+    ----------
+    sigmas : array_like, shape (2L+1, d)
+        Transformed sigma points as rows.
+    Ws, Wc : array_like, shape (2L+1,)
+        Mean and covariance weights from :func:`sigma_weights`.
+    noise_cov : array_like, shape (d, d), optional
+        Added to the covariance (additive noise).
+    mean_fn : callable, optional
+        ``mean_fn(sigmas, Ws) -> (d,)``, replaces the weighted mean.
+    residual_fn : callable, optional
+        ``residual_fn(a, b)``, replaces subtraction.
+
+    Returns
+    -------
+    mean : numpy.ndarray, shape (d,)
+    cov : numpy.ndarray, shape (d, d)
+
+    Examples
+    --------
     >>> Ws, Wc, _ = sigma_weights(1, alpha=1.0, kappa=2.0)
     >>> unscented_transform(np.array([[0.0], [3.0], [-3.0]]), Ws, Wc)
     (array([0.]), array([[3.]]))
@@ -177,16 +233,27 @@ def ukf_predict(x, P, f, Q, u=None, *, form: str = "augmented", alpha: float = 1
 
     Parameters
     ----------
-    x : (n,) posterior state.  P : (n, n) its covariance.
-    f : ``f(x, u, w)`` for ``form="augmented"`` (``w`` the process-noise
+    x : array_like, shape (n,)
+        Posterior state.
+    P : array_like, shape (n, n)
+        Its covariance.
+    f : callable
+        ``f(x, u, w)`` for ``form="augmented"`` (``w`` the process-noise
         component of the sigma point), ``f(x, u)`` for ``"additive"``.
-    Q : covariance of ``w`` (augmented; any size) or of the state noise
+    Q : array_like
+        Covariance of ``w`` (augmented; any size) or of the state noise
         (additive; (n, n)).
-    u : control, passed to ``f``.
-    alpha, beta, kappa : sigma-point parameters (000's defaults 1e-3, 2, 0).
-    mean_fn, residual_fn : state mean ``mean_fn(sigmas, Ws)`` and difference
+    u : optional
+        Control, passed to ``f``.
+    form : {"augmented", "additive"}
+        000's augmented form or the additive-noise form.
+    alpha, beta, kappa : float
+        Sigma-point parameters (000's defaults 1e-3, 2, 0).
+    mean_fn, residual_fn : callable, optional
+        State mean ``mean_fn(sigmas, Ws)`` and difference
         ``residual_fn(a, b)`` hooks (angles), broadcasting over rows.
-    vectorized : ``f`` accepts all sigma points at once as rows.
+    vectorized : bool
+        ``f`` accepts all sigma points at once as rows.
 
     Returns
     -------
@@ -205,6 +272,34 @@ def ukf_update(x, P, z, h, R, *, form: str = "augmented", alpha: float = 1e-3, b
 
     ``h(x, v)`` for ``form="augmented"``, ``h(x)`` for ``"additive"``. Returns
     :class:`~slamlab.filters.Update` with ``S = P_zz`` and ``K = P_xz P_zz^-1``.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Prior state ``x_{k|k-1}``.
+    P : array_like, shape (n, n)
+        Prior covariance.
+    z : array_like, shape (m,)
+        Measurement.
+    h : callable
+        ``h(x, v)`` (augmented) or ``h(x)`` (additive), returning ``(m,)``.
+    R : array_like
+        Covariance of ``v`` (augmented; any size) or ``(m, m)`` (additive).
+    form : {"augmented", "additive"}
+        As in :func:`ukf_predict`.
+    alpha, beta, kappa : float
+        Sigma-point parameters (000's defaults 1e-3, 2, 0).
+    z_mean_fn, z_residual_fn : callable, optional
+        Mean and difference hooks in measurement space (bearings).
+    x_residual_fn : callable, optional
+        Difference hook in state space (headings).
+    vectorized : bool
+        ``h`` accepts all sigma points at once as rows.
+
+    Returns
+    -------
+    Update
+        Posterior ``x, P``, innovation ``y``, ``S = P_zz``, ``K``.
     """
     x, P = _check_common(x, P, form, alpha, beta, kappa)
     z = v.as_vector(z, "z")
@@ -219,6 +314,31 @@ class UnscentedKalmanFilter:
 
     Keeps ``x_prior, P_prior, x_post, P_post, y, S, K``. ``Q`` and ``R`` may be
     reassigned between steps. The hooks are as in :func:`ukf_predict`.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Initial state.
+    P : array_like, shape (n, n)
+        Initial covariance.
+    f : callable
+        Motion model, ``f(x, u, w)`` or ``f(x, u)`` by ``form``.
+    Q : array_like
+        Process noise covariance, as in :func:`ukf_predict`.
+    h : callable
+        Measurement model, ``h(x, v)`` or ``h(x)`` by ``form``.
+    R : array_like
+        Measurement noise covariance, as in :func:`ukf_update`.
+    form : {"augmented", "additive"}
+        Which UKF.
+    alpha, beta, kappa : float
+        Sigma-point parameters.
+    x_mean_fn, x_residual_fn : callable, optional
+        State-space mean and difference hooks.
+    z_mean_fn, z_residual_fn : callable, optional
+        Measurement-space mean and difference hooks.
+    vectorized : bool
+        ``f`` and ``h`` take all sigma points at once as rows.
     """
 
     def __init__(self, x, P, f, Q, h, R, *, form: str = "augmented", alpha: float = 1e-3, beta: float = 2.0,
@@ -239,11 +359,25 @@ class UnscentedKalmanFilter:
         self.y = self.S = self.K = None
 
     def predict(self, u=None) -> None:
+        """Predict with the stored model; sets ``x, P`` and ``x_prior, P_prior``.
+
+        Parameters
+        ----------
+        u : optional
+            Control passed to ``f``.
+        """
         self.x, self.P = _ukf_predict(self.x, self.P, self.f, self.Q, u, self.form, self.alpha, self.beta,
                                       self.kappa, self.x_mean_fn, self.x_residual_fn, self.vectorized)
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
 
     def update(self, z) -> None:
+        """Update with measurement ``z``; sets ``x, P``, ``x_post, P_post`` and ``y, S, K``.
+
+        Parameters
+        ----------
+        z : array_like, shape (m,)
+            Measurement.
+        """
         z = v.as_measurement(z, "z", self.R.shape[0])
         self.x, self.P, self.y, self.S, self.K = _ukf_update(
             self.x, self.P, z, self.h, self.R, self.form, self.alpha, self.beta, self.kappa,

@@ -18,6 +18,17 @@ def explore_unicycle(**defaults):
 
     Calls :func:`run_unicycle_comparison` with the slider values; ``alpha`` is
     set on a log scale. A bad combination prints its message instead of failing.
+
+    Parameters
+    ----------
+    **defaults
+        Initial slider values and fixed settings: ``n_runs`` (10), ``n_steps`` (60), ``range_std_m``,
+        ``bearing_std_deg``, ``omega_std_degps``, ``init_heading_std_deg``, ``alpha``, ``beta``, ``kappa``,
+        ``stabilising_noise``, ``rng`` (2010).
+
+    Returns
+    -------
+    ipywidgets.interactive
     """
     d = {"n_runs": 10, "n_steps": 60, "range_std_m": 0.5, "bearing_std_deg": 10.0, "omega_std_degps": 10.0,
              "init_heading_std_deg": 90.0, "alpha": 1e-3, "beta": 2.0, "kappa": 0.0, "stabilising_noise": 1.0, "rng": 2010}
@@ -54,7 +65,17 @@ def explore_unicycle(**defaults):
 
 
 def explore_cv_target(**defaults):
-    """Constant-velocity target: acceleration noise and measurement noise -> KF table, NEES plot."""
+    """Constant-velocity target: acceleration noise and measurement noise -> KF table, NEES plot.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``n_runs`` (30), ``n_steps`` (50), ``accel_std`` (0.2), ``pos_std_m`` (1.0), ``rng`` (2010).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"n_runs": 30, "n_steps": 50, "accel_std": 0.2, "pos_std_m": 1.0, "rng": 2010}
     d.update(defaults)
 

@@ -102,6 +102,22 @@ def associate(P, *, p_min: float = 0.05, one_to_one: bool = True) -> np.ndarray:
     ``one_to_one`` (our addition): when two new lines pick the same old one, the one with
     the higher P keeps it and the other becomes new.
 
+    Parameters
+    ----------
+    P : array_like, shape (n_new, n_old)
+        Association probabilities (:func:`association_probability`).
+    p_min : float, default 0.05
+        Below this a new line starts a new id.
+    one_to_one : bool, default True
+        At most one new line per old line.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (n_new,)
+        Index of the old line each new line continues, or -1.
+
+    Examples
+    --------
     >>> associate(np.array([[0.9, 0.1], [0.8, 0.2], [0.01, 0.02]])).tolist()
     [0, -1, -1]
     """
@@ -157,6 +173,17 @@ class LineHistory:
         """Append one scan: ``match_ids[m]`` is the id line m continues, or -1 for a new line.
 
         Returns the global ids of the scan's lines.
+
+        Parameters
+        ----------
+        lines : Lines
+            The scan's lines.
+        match_ids : array_like of int, shape (L,)
+            Global id each line continues, or -1 for a new line.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (L,)
         """
         if not isinstance(lines, Lines):
             raise TypeError(f"`lines` must be Lines; got {type(lines).__name__}")
@@ -179,13 +206,34 @@ class LineHistory:
         return ids
 
     def scan(self, n: int) -> tuple[np.ndarray, Lines]:
-        """Ids and lines (unwrapped representation) of scan ``n``."""
+        """Ids and lines (unwrapped representation) of scan ``n``.
+
+        Parameters
+        ----------
+        n : int
+            Scan index (negative counts from the end).
+
+        Returns
+        -------
+        ids : numpy.ndarray of int
+        lines : Lines
+        """
         n = v.check_int(n, "n", minimum=-len(self), maximum=len(self) - 1)
         ids, rho, theta, votes = self._rows[n]
         return ids, Lines(rho, theta, votes)
 
     def last_representation(self, ids) -> tuple[np.ndarray, np.ndarray]:
-        """The last stored (rho, θ) of each id (unwrapped)."""
+        """The last stored (rho, θ) of each id (unwrapped).
+
+        Parameters
+        ----------
+        ids : array_like of int
+            Global line ids.
+
+        Returns
+        -------
+        rho, theta_rad : numpy.ndarray
+        """
         pairs = np.array([self._last[int(i)] for i in np.asarray(ids).reshape(-1)]).reshape(-1, 2)
         return pairs[:, 0], pairs[:, 1]
 

@@ -18,22 +18,14 @@ from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
 from ..scans import OccupancyGrid, occupancy_grid, scan_to_points
+from .example import ExampleLineResult, check_pose_from_two_lines, run_example_line, time_polar_vs_opencv
 from .icp import icp_odometry
-from .lines import canonical_lines, find_peaks
 from .logs import LOG_PARAMS, SHARED_LOGS, RealLogResult, log_format, run_real_log
 from .mapping import map_agreement
 from .slam import HoughSlamParams, HoughSlamResult, hough_slam
-from .transform import (
-    HoughAccumulator,
-    hough_classic,
-    hough_cost,
-    hough_polar,
-    line_scan,
-    lines_about_centre,
-    rasterise_scan,
-)
 
-__all__ = [  # LOG_PARAMS, SHARED_LOGS, RealLogResult, log_format, run_real_log: re-exported from .logs
+__all__ = [  # LOG_PARAMS, SHARED_LOGS, RealLogResult, log_format, run_real_log: re-exported from .logs;
+    # ExampleLineResult, check_pose_from_two_lines, run_example_line, time_polar_vs_opencv: from .example
     "LOG_PARAMS",
     "SHARED_LOGS",
     "ExampleLineResult",
@@ -54,6 +46,17 @@ __all__ = [  # LOG_PARAMS, SHARED_LOGS, RealLogResult, log_format, run_real_log:
 def pose_errors(estimate, truth) -> np.ndarray:
     """``(Ex, Ey, Ea)`` per pose: estimate minus truth, heading wrapped (004 Fig. 10).
 
+    Parameters
+    ----------
+    estimate, truth : array_like, shape (n, 3)
+        Poses ``(x, y, φ)``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 3)
+
+    Examples
+    --------
     >>> pose_errors([[1.0, 2.0, 0.1]], [[0.5, 2.0, 2 * np.pi]]).round(6).tolist()
     [[0.5, 0.0, 0.1]]
     """
@@ -66,83 +69,6 @@ def pose_errors(estimate, truth) -> np.ndarray:
     return err
 
 
-# --- 004's example: the line θ = 45°, p = 10 ---------------------------------------------------
-
-
-@dataclass(frozen=True)
-class ExampleLineResult:
-    """Polar vs classic Hough transform of 004's example line (004 Fig. 5-8)."""
-
-    n_points: int
-    polar_size: tuple[int, int]  # (n_theta, n_rho), 004's order
-    classic_size: tuple[int, int]
-    image_size: tuple[int, int]
-    polar_line: tuple[float, float]  # (rho, θ_deg) of the strongest peak
-    classic_line: tuple[float, float]  # as found, origin at the image corner
-    classic_line_centred: tuple[float, float]  # re-expressed about the sensor
-    polar_cost: float
-    classic_cost: float
-    polar_votes: int
-    classic_votes: int
-    timing_s: dict = field(default_factory=dict, compare=False)
-    polar: HoughAccumulator | None = field(default=None, repr=False, compare=False)
-    classic: HoughAccumulator | None = field(default=None, repr=False, compare=False)
-    image: np.ndarray | None = field(default=None, repr=False, compare=False)
-    scan: tuple | None = field(default=None, repr=False, compare=False)
-
-    def __str__(self) -> str:
-        return (f"004's line (θ = 45°, rho = 10): polar accumulator {self.polar_size[0]}×{self.polar_size[1]}, "
-                f"classic {self.classic_size[0]}×{self.classic_size[1]}")
-
-    def table(self) -> str:
-        rows = [
-            ["scan points N", "-", f"{self.n_points}"],
-            ["input image (classic)", "33×33", f"{self.image_size[0]}×{self.image_size[1]}"],
-            ["accumulator, polar (θ × rho)", "180×33", f"{self.polar_size[0]}×{self.polar_size[1]}"],
-            ["accumulator, classic (θ × rho)", "180×93", f"{self.classic_size[0]}×{self.classic_size[1]}"],
-            ["line found, polar (rho, θ°)", "(10, 45)", f"({self.polar_line[0]:.1f}, {self.polar_line[1]:.1f})"],
-            ["line found, classic, image corner", "-", f"({self.classic_line[0]:.1f}, {self.classic_line[1]:.1f})"],
-            ["line found, classic, about the sensor", "(10, 45)",
-             f"({self.classic_line_centred[0]:.1f}, {self.classic_line_centred[1]:.1f})"],
-            ["votes of the peak, polar / classic", "-", f"{self.polar_votes} / {self.classic_votes}"],
-            ["cost N·180/Δθ (eq. 8)", "-", f"{self.polar_cost:.0f}"],
-            ["cost (r_max/Δr)²·180/Δθ, image side (eq. 6)", "-", f"{self.classic_cost:.0f}"],
-        ]
-        return format_table(["quantity", "004", "ours"], rows)
-
-
-def run_example_line(rho: float = 10.0, theta_deg: float = 45.0, r_max: float = 16.0,
-                     delta_phi_deg: float = 1.0, n_repeat: int = 200) -> ExampleLineResult:
-    """004's example: ranges to the line θ = 45°, p = 10, both transforms, their sizes and costs.
-
-    The beam step (1°) is ours: 004 does not give it. ``n_repeat`` sets how many times
-    each transform is timed (``timing_s``).
-    """
-    phi, r = line_scan(rho, math.radians(theta_deg), r_max=r_max, delta_phi_rad=math.radians(delta_phi_deg))
-    n_repeat = v.check_int(n_repeat, "n_repeat", minimum=1)
-    polar = hough_polar(phi, r, r_max=r_max)
-    img, c = rasterise_scan(phi, r, r_max=r_max)
-    classic = hough_classic(img)
-    lp = find_peaks(polar, max(2, phi.size // 2), max_lines=1)
-    lc = find_peaks(classic, 2, max_lines=1)
-    rc, tc = lines_about_centre(lc.rho, lc.theta_rad, c)
-    rc, tc = canonical_lines(rc, tc)
-    timing = {}
-    for name, fn in (("polar", lambda: hough_polar(phi, r, r_max=r_max)),
-                     ("rasterise + classic", lambda: hough_classic(rasterise_scan(phi, r, r_max=r_max)[0]))):
-        t0 = time.perf_counter()
-        for _ in range(n_repeat):
-            fn()
-        timing[name] = (time.perf_counter() - t0) / n_repeat
-    return ExampleLineResult(
-        int(phi.size), polar.size_theta_rho, classic.size_theta_rho, img.shape,
-        (float(lp.rho[0]), math.degrees(float(lp.theta_rad[0]))),
-        (float(lc.rho[0]), math.degrees(float(lc.theta_rad[0]))),
-        (float(rc[0]), math.degrees(float(tc[0]))),
-        hough_cost(n_points=int(phi.size)), hough_cost(r_max=float(img.shape[0])),
-        int(lp.votes[0]), int(lc.votes[0]), timing, polar, classic, img, (phi, r))
-
-
 #: Our odometry model of :func:`run_sim_slam` at ``odometry_noise = 1`` (004 gives none; 000 §1.3.2 asks for
 #: at most 2 cm per metre and 2° per 45° of turn).
 ODOMETRY_NOISE = {"trans_std_frac": 0.05, "rot_std_rad": 0.01, "drift_rad_per_cell": 0.002}
@@ -153,7 +79,31 @@ ODOMETRY_NOISE = {"trans_std_frac": 0.05, "rot_std_rad": 0.01, "drift_rad_per_ce
 
 @dataclass(frozen=True)
 class SimSlamResult:
-    """Hough SLAM, integrated odometry and ICP on 004's path (004 Fig. 9-11)."""
+    """Hough SLAM, integrated odometry and ICP on 004's path (004 Fig. 9-11).
+
+    Attributes
+    ----------
+    truth : numpy.ndarray, shape (n, 3)
+        True poses ``(x, y)`` [cells], φ [rad].
+    slam : HoughSlamResult
+        The Hough SLAM run.
+    odometry : numpy.ndarray, shape (n, 3)
+        Integrated odometry.
+    icp : numpy.ndarray, shape (n, 3) or None
+        Chained ICP (None when not run).
+    built_map : OccupancyGrid
+        Map built from the SLAM poses.
+    reference_map : numpy.ndarray of int
+        The mapped test room (without the clutter), to compare ``built_map`` with.
+    range_std_cells : float
+        Range noise std [cells].
+    clutter : bool
+        Scans taken in the cluttered room.
+    timing_s : dict
+        Wall times [s] (not compared).
+    odometry_noise : float
+        Factor on the odometry noise.
+    """
 
     truth: np.ndarray = field(repr=False)  # (n, 3)
     slam: HoughSlamResult = field(repr=False)
@@ -182,6 +132,12 @@ class SimSlamResult:
                 f"{int(self.slam.lost.sum())} lost")
 
     def table(self) -> str:
+        """Error maxima and final errors of Hough SLAM, odometry and ICP (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = []
         for name, e in self.errors.items():
             rows.append([name, f"{np.abs(e[:, 0]).max():.2f}", f"{np.abs(e[:, 1]).max():.2f}",
@@ -211,16 +167,32 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
     ----------
     n_poses : int
         Poses along the path (121 in 004).
+    range_std_cells : float, default 0.1
+        Range noise std [cells].
+    clutter : bool, default False
+        Measure in the room with unmapped chair legs, people and bins.
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    odometry_noise : float, default 1.0
+        Factor on our odometry noise (5 % translation, 0.01 rad heading, 0.002 rad per cell drift).
     with_icp : bool
         Also run the ICP baseline (scan-to-scan, odometry as the initial guess).
     start : {"truth", "correlation"}
         Where the SLAM starts: the true first pose, or the pose that correlation localisation
         (:func:`slamlab.correlation.localise`, Δα = 1°, on the mapped room) finds from the first
         scan — 004's whole system (Fig. 2). The ICP baseline and odometry start from the truth.
-    progress : bool, optional
-        A bar over the scans of the SLAM run (None: on unless ``$SLAMLAB_PROGRESS=0``).
     params, **overrides
         :class:`HoughSlamParams` and fields to change.
+    rng : int, numpy.random.Generator or SeedSequence, default 2010
+        Seed or generator: one child stream for the scans, one for the odometry.
+    progress : bool, optional
+        A bar over the scans of the SLAM run (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Returns
+    -------
+    SimSlamResult
     """
     from .. import sim
 
@@ -282,7 +254,19 @@ def _noise_run(*, range_std_cells: float, n_poses: int, clutter: bool, rng: np.r
 
 @dataclass(frozen=True)
 class NoiseStudyResult:
-    """Hough SLAM errors against range noise, over seeded runs (our addition; 004 gives one run)."""
+    """Hough SLAM errors against range noise, over seeded runs (our addition; 004 gives one run).
+
+    Attributes
+    ----------
+    runs : pandas.DataFrame
+        The sweep's table, one row per run.
+    n_poses : int
+        Poses per run.
+    clutter : bool
+        Scans taken in the cluttered room.
+    bad_pos_cells : float
+        Final position error above which a run counts as bad [cells].
+    """
 
     runs: object = field(repr=False)  # the sweep's table (pandas DataFrame), one row per run
     n_poses: int = 121
@@ -290,6 +274,12 @@ class NoiseStudyResult:
     bad_pos_cells: float = 2.0
 
     def table(self) -> str:
+        """Errors per range noise level over the runs (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = []
         for sigma, g in self.runs.groupby("range_std_cells", sort=True):
             rows.append([f"{sigma:g}", f"{len(g)}", f"{g['max_pos_err'].mean():.2f}", f"{g['max_pos_err'].max():.2f}",
@@ -355,59 +345,6 @@ def run_noise_study(range_std_cells=(0.0, 0.1, 0.3, 0.5), n_runs: int = 4, *, n_
     return NoiseStudyResult(table, n_poses, bool(clutter), bad)
 
 
-def check_pose_from_two_lines(n_cases: int = 1000, *, rng=2010) -> float:
-    """Largest error of :func:`~slamlab.hough.pose.pose_from_two_lines` on exact random cases (004; our check).
-
-    Each case: a random pose change and two non-parallel lines; the lines seen
-    after the move are put into the flipped ``(-rho, theta + 180°)`` form and
-    back, then the pose is recovered. Returns ``max |estimate - truth|``.
-    """
-    from .lines import align_lines, transform_lines
-    from .pose import pose_from_two_lines
-
-    n_cases = v.check_int(n_cases, "n_cases", minimum=1)
-    g = v.as_rng(rng)
-    worst = 0.0
-    for _ in range(n_cases):  # a closed-form check per case, cheap
-        pose = g.uniform([-2, -2, -0.5], [2, 2, 0.5])
-        ri, ti = g.uniform(-8, 8, 2), g.uniform(-1.5, 1.5) + np.array([0.0, g.uniform(0.6, 2.5)])
-        rj, tj = transform_lines(ri, ti, pose)
-        rj, tj = canonical_lines(-rj, tj + np.pi)  # the flipped form
-        rj, tj = align_lines(rj, tj, ti - pose[2])  # back to the continuous one
-        got = pose_from_two_lines((ri[0], ti[0]), (ri[1], ti[1]), (rj[0], tj[0]), (rj[1], tj[1]))
-        worst = max(worst, float(np.abs(got - pose).max()))
-    return worst
-
-
-def time_polar_vs_opencv(*, cell_m: float = 0.05, r_max_m: float = 30.0, room_half_m: float = 5.0,
-                         n_beams: int = 1081, repeats: int = 20) -> dict:
-    """Median times of our polar transform and ``cv2.HoughLines`` on the same 1081-beam scan (004; our addition).
-
-    The scan is a square room (``room_half_m`` to each wall) seen over 270°;
-    OpenCV gets the scan rasterised at ``cell_m``. Returns the times in seconds,
-    the image size and the ratio OpenCV / ours (volatile: print only in ignored cells).
-    """
-    import cv2
-
-    phi = np.linspace(-0.75 * np.pi, 0.75 * np.pi, v.check_int(n_beams, "n_beams", minimum=2))
-    r = room_half_m / np.maximum(np.abs(np.cos(phi)), np.abs(np.sin(phi)))
-    img, _ = rasterise_scan(phi, r, cell=cell_m, r_max=r_max_m)
-
-    def median_s(fn):
-        fn()
-        t = []
-        for _ in range(v.check_int(repeats, "repeats", minimum=1)):
-            t0 = time.perf_counter()
-            fn()
-            t.append(time.perf_counter() - t0)
-        return float(np.median(t))
-
-    ours = median_s(lambda: hough_polar(phi, r, delta_rho=cell_m, r_max=r_max_m))
-    ref = median_s(lambda: cv2.HoughLines(img, 1, np.pi / 180, 30))
-    return {"ours_s": ours, "opencv_s": ref, "image_px": img.shape[0], "ratio": ref / ours}
-
-
-
 def ours_vs_source(sim: SimSlamResult, *, example: ExampleLineResult | None = None,
                    exact: SimSlamResult | None = None, variants=(), two_lines_error: float | None = None,
                    real=()) -> str:
@@ -416,6 +353,26 @@ def ours_vs_source(sim: SimSlamResult, *, example: ExampleLineResult | None = No
 
     ``variants``: ``(label, SimSlamResult)`` pairs (e.g. 004's two-line pose, no refit);
     ``two_lines_error``: :func:`check_pose_from_two_lines`'s result; ``real``: :class:`RealLogResult` objects.
+
+    Parameters
+    ----------
+    sim : SimSlamResult
+        From :func:`run_sim_slam` (the noisy run).
+    example : ExampleLineResult, optional
+        From :func:`run_example_line`.
+    exact : SimSlamResult, optional
+        A run without range noise.
+    variants : sequence of (str, SimSlamResult)
+        Labelled variant runs.
+    two_lines_error : float, optional
+        :func:`check_pose_from_two_lines`'s result.
+    real : sequence of RealLogResult
+        Real-log runs.
+
+    Returns
+    -------
+    str
+        The table: 004's statement, ours.
     """
     if not isinstance(sim, SimSlamResult):
         raise TypeError(f"`sim` must be a SimSlamResult; got {type(sim).__name__}")

@@ -22,7 +22,21 @@ __all__ = ["IcpResult", "icp", "icp_odometry", "rigid_fit_2d"]
 
 @dataclass(frozen=True)
 class IcpResult:
-    """``pose`` = ``(Δx, Δy, Δφ)`` of the source scan in the target's frame."""
+    """``pose`` = ``(Δx, Δy, Δφ)`` of the source scan in the target's frame.
+
+    Attributes
+    ----------
+    pose : numpy.ndarray, shape (3,)
+        ``(Δx, Δy, Δφ)`` (point unit, rad).
+    converged : bool
+        The update fell below ``tol`` before ``max_iter``.
+    n_iter : int
+        Iterations run.
+    rmse : float
+        RMS distance of the last inlier pairs.
+    n_inliers : int
+        Pairs within ``max_dist`` in the last iteration.
+    """
 
     pose: np.ndarray
     converged: bool
@@ -43,6 +57,18 @@ def _points(value, name):
 def rigid_fit_2d(src, dst) -> np.ndarray:
     """Least-squares rotation + translation with ``dst ≈ R(φ)·src + t`` (SVD); returns ``(tx, ty, φ)``.
 
+    Parameters
+    ----------
+    src, dst : array_like, shape (N, 2)
+        Corresponding points.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``(tx, ty, φ)``.
+
+    Examples
+    --------
     >>> a = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 2.0]])
     >>> R = np.array([[0.0, -1.0], [1.0, 0.0]])
     >>> rigid_fit_2d(a, a @ R.T + [1.0, 2.0]).round(12).tolist()
@@ -74,6 +100,11 @@ def icp(source, target, init=(0.0, 0.0, 0.0), *, max_iter: int = 50, tol: float 
         Pairs farther apart are rejected (default: keep all).
     tree : cKDTree, optional
         A kd-tree of ``target`` to reuse.
+
+    Returns
+    -------
+    IcpResult
+        ``pose`` of ``source`` in ``target``'s frame, ``converged``, ``n_iter``, ``rmse``, ``n_inliers``.
 
     Examples
     --------
@@ -119,8 +150,13 @@ def icp_odometry(points, start_pose=(0.0, 0.0, 0.0), init_increments=None, *, ma
     points : sequence of (N_k, 2) arrays
         Each scan's returns in its sensor frame.
     start_pose : (3,) array_like
+        Pose of the first scan ``(x, y, φ)``.
     init_increments : (n-1, 3) array_like, optional
         Initial guesses (odometry increments); zeros by default.
+    max_dist : float, optional
+        Pairs farther apart are rejected (default: keep all).
+    max_iter : int, default 50
+        Iterations per scan pair.
 
     Returns
     -------

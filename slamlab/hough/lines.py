@@ -31,7 +31,17 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Lines:
-    """A set of lines: ``rho``, ``theta_rad`` and the ``votes`` (points) behind each, all ``(L,)``."""
+    """A set of lines: ``rho``, ``theta_rad`` and the ``votes`` (points) behind each, all ``(L,)``.
+
+    Attributes
+    ----------
+    rho : numpy.ndarray, shape (L,)
+        Distance of each line from the sensor (the scan's range unit).
+    theta_rad : numpy.ndarray, shape (L,)
+        Direction of its normal [rad].
+    votes : numpy.ndarray of int, shape (L,)
+        Points behind each line.
+    """
 
     rho: np.ndarray = field(repr=False)
     theta_rad: np.ndarray = field(repr=False)
@@ -49,6 +59,20 @@ class Lines:
 def canonical_lines(rho, theta_rad) -> tuple[np.ndarray, np.ndarray]:
     """The representation with θ in [-π/2, π/2) (flipping rho's sign when θ moves by π).
 
+    Parameters
+    ----------
+    rho : array_like
+        Distances of the lines from the origin.
+    theta_rad : array_like
+        Directions of their normals [rad].
+
+    Returns
+    -------
+    rho, theta_rad : numpy.ndarray
+        The same lines, θ in [-π/2, π/2).
+
+    Examples
+    --------
     >>> r, t = canonical_lines(5.0, np.radians(135.0))
     >>> float(r), round(float(np.degrees(t)))
     (-5.0, -45)
@@ -62,6 +86,22 @@ def canonical_lines(rho, theta_rad) -> tuple[np.ndarray, np.ndarray]:
 def align_lines(rho, theta_rad, theta_ref_rad) -> tuple[np.ndarray, np.ndarray]:
     """The representation whose θ lies within ±π/2 of ``theta_ref_rad`` (broadcasts).
 
+    Parameters
+    ----------
+    rho : array_like
+        Distances of the lines from the origin.
+    theta_rad : array_like
+        Directions of their normals [rad].
+    theta_ref_rad : array_like
+        Reference direction [rad].
+
+    Returns
+    -------
+    rho, theta_rad : numpy.ndarray
+        The same lines, θ within ±π/2 of the reference.
+
+    Examples
+    --------
     >>> r, t = align_lines(-5.0, np.radians(-89.0), np.radians(89.0))
     >>> float(r), round(float(np.degrees(t)))
     (5.0, 91)
@@ -79,6 +119,20 @@ def line_difference(rho_a, theta_a_rad, rho_b, theta_b_rad) -> tuple[np.ndarray,
     Broadcasts, so ``line_difference(r[:, None], t[:, None], r[None], t[None])`` gives
     all pairs. ``|Δθ| <= π/2``.
 
+    Parameters
+    ----------
+    rho_a, theta_a_rad : array_like
+        Lines a (rho, θ [rad]).
+    rho_b, theta_b_rad : array_like
+        Lines b.
+
+    Returns
+    -------
+    d_rho, d_theta_rad : numpy.ndarray
+        Differences, broadcast shape.
+
+    Examples
+    --------
     >>> d_rho, d_theta = line_difference(5.0, np.radians(89.5), -5.0, np.radians(-89.5))
     >>> round(float(d_rho), 9), round(float(np.degrees(d_theta)), 6)
     (0.0, -1.0)
@@ -225,6 +279,22 @@ def merge_duplicates(lines: Lines, *, rho_tol: float, theta_tol_rad: float) -> L
     After the refit two peaks (a false neighbour, or the two sides of the θ = ±90° seam) may
     settle on the same wall.
 
+    Parameters
+    ----------
+    lines : Lines
+        Candidate lines.
+    rho_tol : float
+        rho tolerance (range unit).
+    theta_tol_rad : float
+        θ tolerance [rad].
+
+    Returns
+    -------
+    Lines
+        The lines kept, in input order.
+
+    Examples
+    --------
     >>> dup = Lines(np.array([5.0, -5.01, 2.0]), np.array([1.57, -1.5716, 0.0]), np.array([30, 40, 20]))
     >>> merge_duplicates(dup, rho_tol=0.1, theta_tol_rad=0.01).votes.tolist()
     [40, 20]
@@ -258,6 +328,26 @@ def refine_lines(lines: Lines, bearings_rad, ranges, *, band: float = 1.0, n_ite
     are more than ``max_gap`` apart and only the segment with the most points is fitted:
     a Hough peak may collect points of several objects that happen to be collinear in
     this scan only.
+
+    Parameters
+    ----------
+    lines : Lines
+        Lines to refit (e.g. accumulator peaks).
+    bearings_rad : array_like, shape (N,)
+        Beam directions of the scan [rad].
+    ranges : array_like, shape (N,)
+        Their ranges.
+    band : float, default 1.0
+        Initial half-width of the band of points fitted to a line (range unit).
+    n_iter : int, default 3
+        Refits per line.
+    max_gap : float, optional
+        Split the band's points at gaps longer than this and fit the largest segment; None keeps all.
+
+    Returns
+    -------
+    Lines
+        Refitted lines, ``votes`` = points used.
 
     Examples
     --------
@@ -330,6 +420,22 @@ def transform_lines(rho, theta_rad, pose) -> tuple[np.ndarray, np.ndarray]:
     ``θ_j = θ_i - Δφ``, ``rho_j = rho_i - (Δx·cos θ_i + Δy·sin θ_i)``; θ is not wrapped (the
     representation moves continuously, which :func:`~slamlab.hough.pose_from_two_lines` needs).
 
+    Parameters
+    ----------
+    rho : array_like
+        Distances of the lines from the origin.
+    theta_rad : array_like
+        Directions of their normals [rad].
+    pose : array_like, shape (3,)
+        Frame j's pose in frame i ``(Δx, Δy, Δφ)`` (range unit, rad).
+
+    Returns
+    -------
+    rho, theta_rad : numpy.ndarray
+        The lines in frame j.
+
+    Examples
+    --------
     >>> r, t = transform_lines(10.0, 0.0, (3.0, 1.0, 0.1))
     >>> float(r), float(t)
     (7.0, -0.1)

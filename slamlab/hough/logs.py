@@ -32,7 +32,27 @@ SHARED_LOGS = {"urg04lx": "mines-urg04lx-odometry/exp2.dat", "mbicp": "mbicp-las
 
 @dataclass(frozen=True)
 class RealLogResult:
-    """Hough SLAM on a real log beside integrated odometry (no ground truth in these logs)."""
+    """Hough SLAM on a real log beside integrated odometry (no ground truth in these logs).
+
+    Attributes
+    ----------
+    name : str
+        Title: format and file name.
+    slam : HoughSlamResult
+        The SLAM run.
+    odometry : numpy.ndarray, shape (n, 3)
+        Integrated odometry ``(x_m, y_m, φ_rad)``.
+    scans : list of Scan
+        The scans used (metres).
+    map_slam, map_odometry : OccupancyGrid
+        Maps built from the SLAM and the odometry poses.
+    scan_index : numpy.ndarray of int, shape (n,)
+        Which scans of the log were used.
+    frame : GridFrame or None
+        Metric frame of both maps.
+    timing_s : dict
+        Wall times [s] (not compared).
+    """
 
     name: str  # title: format and file name
     slam: HoughSlamResult = field(repr=False)
@@ -50,7 +70,17 @@ class RealLogResult:
         return float(np.hypot(*np.diff(self.odometry[:, :2], axis=0).T).sum())
 
     def sharpness(self, which: str = "slam") -> float:
-        """Obstacle cells per 100 returns in the built map: fewer = walls drawn thinner (our measure)."""
+        """Obstacle cells per 100 returns in the built map: fewer = walls drawn thinner (our measure).
+
+        Parameters
+        ----------
+        which : {"slam", "odometry"}
+            The map to measure.
+
+        Returns
+        -------
+        float
+        """
         m = self.map_slam if which == "slam" else self.map_odometry
         return float(100.0 * (m.grid == 1).sum() / max(1, m.hits.sum()))
 
@@ -59,6 +89,12 @@ class RealLogResult:
                 f"{int(self.slam.lost.sum())} steps fell back on odometry, {int(self.slam.partial.sum())} in part")
 
     def table(self) -> str:
+        """Hough SLAM against integrated odometry on the log (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         d = self.slam.poses[-1] - self.odometry[-1]
         rows = [
             ["scans used", f"{self.odometry.shape[0]}"],
@@ -88,6 +124,15 @@ def log_format(path) -> str:
 
     CARMEN lines start with a message name (``FLASER``, ``ODOM``, ``PARAM`` …); a
     URG-04LX line of the Mines format is 707 numbers.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Log file, plain or gzip.
+
+    Returns
+    -------
+    str
     """
     from ..io.carmen import _open_text  # plain text or gzip, told apart by the magic bytes
 
@@ -142,6 +187,10 @@ def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = Non
         a = 0.15 m, …) with ``r_max`` = the log's range limit.
     progress : bool, optional
         A bar over the scans (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Returns
+    -------
+    RealLogResult
     """
     if path is None:
         from ..data import find_data

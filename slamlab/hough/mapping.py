@@ -20,6 +20,22 @@ def map_agreement(built: OccupancyGrid, reference, *, tolerance_cells: int = 1) 
     obstacle; ``recall``: share of reference obstacle cells that the built map saw (within
     the tolerance), counted over reference obstacles next to built free space.
 
+    Parameters
+    ----------
+    built : OccupancyGrid
+        The built map.
+    reference : array_like of int, shape (H, W)
+        Reference cell codes, same size and origin.
+    tolerance_cells : int, default 1
+        Distance within which an obstacle counts as matched [cells].
+
+    Returns
+    -------
+    dict
+        ``{"precision": float, "recall": float}``.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> ref = np.zeros((5, 5), np.int8); ref[:, 4] = 1
     >>> b = OccupancyGrid(ref.copy(), ref.astype(int), np.zeros((5, 5), int))

@@ -26,7 +26,23 @@ _ERR_COLORS = {"Ex": "tab:blue", "Ey": "tab:red", "Ea": "tab:green"}
 
 
 def plot_accumulator(acc: HoughAccumulator, lines=None, *, ax=None, title: str = "Hough accumulator"):
-    """The votes H(rho, θ) as an image, θ in degrees across, rho up; peaks circled when ``lines`` is given."""
+    """The votes H(rho, θ) as an image, θ in degrees across, rho up; peaks circled when ``lines`` is given.
+
+    Parameters
+    ----------
+    acc : HoughAccumulator
+        The votes.
+    lines : Lines, optional
+        Peaks to circle.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    title : str
+        Axes title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     if not isinstance(acc, HoughAccumulator):
         raise TypeError(f"`acc` must be a HoughAccumulator; got {type(acc).__name__}")
     ax = new_axes(ax, title=title, xlabel="θ [°]", ylabel="ρ")
@@ -44,7 +60,25 @@ def plot_accumulator(acc: HoughAccumulator, lines=None, *, ax=None, title: str =
 
 def plot_scan_lines(bearings_rad, ranges, lines=None, *, ax=None, title: str = "Scan and its lines",
                     extent: float | None = None):
-    """Scan points in the sensor frame with the detected lines drawn across them."""
+    """Scan points in the sensor frame with the detected lines drawn across them.
+
+    Parameters
+    ----------
+    bearings_rad, ranges : array_like, shape (N,)
+        The scan; ranges ≤ 0 are skipped.
+    lines : Lines, optional
+        Lines to draw across the points.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    title : str
+        Axes title.
+    extent : float, optional
+        Half-width of the drawn lines; default the farthest point coordinate.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=title, xlabel="x", ylabel="y")
     ax.set_aspect("equal", adjustable="box")
     phi, r = np.asarray(bearings_rad, float), np.asarray(ranges, float)
@@ -65,7 +99,23 @@ def plot_scan_lines(bearings_rad, ranges, lines=None, *, ax=None, title: str = "
 
 
 def accumulator_figure(acc: HoughAccumulator, peaks, bearings_rad, ranges, lines):
-    """A scan's accumulator with its peaks beside the scan and the refitted lines; returns the figure."""
+    """A scan's accumulator with its peaks beside the scan and the refitted lines; returns the figure.
+
+    Parameters
+    ----------
+    acc : HoughAccumulator
+        The scan's accumulator.
+    peaks : Lines
+        Its peaks, circled.
+    bearings_rad, ranges : array_like, shape (N,)
+        The scan.
+    lines : Lines
+        The refitted lines, drawn over the scan.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axs = plt.subplots(1, 2, figsize=(14, 5))
     plot_accumulator(acc, peaks, ax=axs[0])
     plot_scan_lines(bearings_rad, ranges, lines, ax=axs[1])
@@ -74,7 +124,17 @@ def accumulator_figure(acc: HoughAccumulator, peaks, bearings_rad, ranges, lines
 
 
 def example_figure(result):
-    """004 Fig. 5-8: the scan of the line θ = 45°, p = 10, its 33×33 image, both accumulators."""
+    """004 Fig. 5-8: the scan of the line θ = 45°, p = 10, its 33×33 image, both accumulators.
+
+    Parameters
+    ----------
+    result : ExampleLineResult
+        From :func:`~slamlab.hough.run_example_line`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axs = plt.subplots(1, 4, figsize=(17, 4.2))
     phi, r = result.scan
     plot_scan_lines(phi, r, ax=axs[0], title="Fig. 5: scan D_i of the line", extent=16.0)
@@ -90,7 +150,23 @@ def example_figure(result):
 
 
 def plot_pose_errors(errors, *, ax=None, title: str = "Hough SLAM errors (cf. 004 Fig. 10)", deg: bool = True):
-    """Ex(n), Ey(n) [cells] and Ea(n) (004 Fig. 10: Ex blue, Ey red, Ea green)."""
+    """Ex(n), Ey(n) [cells] and Ea(n) (004 Fig. 10: Ex blue, Ey red, Ea green).
+
+    Parameters
+    ----------
+    errors : array_like, shape (n, 3)
+        ``(Ex, Ey, Ea)`` per pose (:func:`~slamlab.hough.pose_errors`).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    title : str
+        Axes title.
+    deg : bool, default True
+        Draw Ea in degrees (else radians).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     e = np.asarray(errors, dtype=float)
     ax = new_axes(ax, title=title, xlabel="pose n", ylabel="Ex, Ey [cells]")
     n = np.arange(e.shape[0])
@@ -115,6 +191,23 @@ def plot_built_map(built, *, frame=None, truth=None, estimate=None, ax=None,
     """The three-valued built map (obstacle black, free white, unexplored grey) with the paths.
 
     ``frame``: the map's :class:`~slamlab.scans.GridFrame` (default: cell units, cell (0, 0) at the origin).
+
+    Parameters
+    ----------
+    built : OccupancyGrid
+        The built map.
+    frame : GridFrame, optional
+        The map's frame.
+    truth, estimate : array_like, shape (n, 3), optional
+        Paths to draw (in the frame's unit).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    title : str
+        Axes title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
     """
     ax = new_axes(ax, title=title, xlabel="x", ylabel="y", equal=True)
     g = built.grid
@@ -133,7 +226,17 @@ def plot_built_map(built, *, frame=None, truth=None, estimate=None, ax=None,
 
 
 def sim_figure(result):
-    """004's experiment: error curves (Fig. 10), the comparison with odometry and ICP, the built map (Fig. 11)."""
+    """004's experiment: error curves (Fig. 10), the comparison with odometry and ICP, the built map (Fig. 11).
+
+    Parameters
+    ----------
+    result : SimSlamResult
+        From :func:`~slamlab.hough.run_sim_slam`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axs = plt.subplots(1, 3, figsize=(17, 5))
     plot_pose_errors(result.errors["Hough SLAM"], ax=axs[0])
     ax = new_axes(axs[1], title="Position error: Hough SLAM vs odometry and ICP (our addition)", xlabel="pose n",
@@ -149,7 +252,19 @@ def sim_figure(result):
 
 
 def real_log_figure(result, *, every: int = 2):
-    """A real log: the map and path from Hough SLAM beside those from integrated odometry."""
+    """A real log: the map and path from Hough SLAM beside those from integrated odometry.
+
+    Parameters
+    ----------
+    result : RealLogResult
+        From :func:`~slamlab.hough.run_real_log`.
+    every : int, default 2
+        Draw the points of every ``every``-th scan.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axs = plt.subplots(1, 2, figsize=(14, 6.5))
     for ax, poses, name, color in ((axs[0], result.slam.poses, "Hough SLAM", STYLE["estimate"]["color"]),
                                    (axs[1], result.odometry, "integrated odometry", "tab:orange")):

@@ -28,7 +28,21 @@ __all__ = ["PoseChange", "pose_from_lines", "pose_from_two_lines", "select_line_
 
 @dataclass(frozen=True)
 class PoseChange:
-    """Scan j's pose ``(Δx, Δy, Δφ)`` in scan i's frame, and the lines it used."""
+    """Scan j's pose ``(Δx, Δy, Δφ)`` in scan i's frame, and the lines it used.
+
+    Attributes
+    ----------
+    pose : numpy.ndarray, shape (3,)
+        ``(Δx, Δy, Δφ)`` (range unit, rad).
+    ok : bool
+        A pose was found.
+    used : numpy.ndarray of int
+        Indices of the lines used.
+    angle_error_rad : float
+        How much the angle between the two lines changed [rad].
+    message : str
+        Why no pose was found.
+    """
 
     pose: np.ndarray
     ok: bool
@@ -60,6 +74,11 @@ def pose_from_two_lines(line_i1, line_i2, line_j1, line_j2, *, angle_tol_rad: fl
         between them did not change").
     min_angle_rad : float
         Smallest angle between the lines (our choice: near-parallel lines make D ≈ 0).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``(Δx, Δy, Δφ)`` of scan j in scan i's frame.
 
     Examples
     --------
@@ -101,6 +120,24 @@ def select_line_pair(theta_i_rad, theta_j_rad, votes=None, *, angle_tol_rad: flo
     ``min_angle_rad``, take the one maximising ``|sin(angle)|·sqrt(votes_1·votes_2)``.
     Returns ``None`` when no pair qualifies.
 
+    Parameters
+    ----------
+    theta_i_rad, theta_j_rad : array_like, shape (L,)
+        θ of the common lines in scans i and j [rad], paired by index.
+    votes : array_like, shape (L,), optional
+        Weight of each line (default 1).
+    angle_tol_rad : float, default 2°
+        Largest change of the pair's angle [rad].
+    min_angle_rad : float, default 20°
+        Smallest angle between the two lines [rad].
+
+    Returns
+    -------
+    tuple of int or None
+        Indices of the two lines.
+
+    Examples
+    --------
     >>> select_line_pair([0.0, 0.1, 1.6], [0.0, 0.1, 1.6], [50, 80, 40])
     (1, 2)
     """
@@ -147,6 +184,23 @@ def pose_from_lines(rho_i, theta_i_rad, rho_j, theta_j_rad, votes=None, *, metho
     rho_i - rho_j`` by weighted least squares, dropping lines whose residual exceeds
     ``rho_tol`` and solving again (lines on round objects or through corners move in
     ways a rigid motion cannot explain).
+
+    Parameters
+    ----------
+    rho_i, theta_i_rad : array_like, shape (L,)
+        Common lines in scan i (range unit, rad).
+    rho_j, theta_j_rad : array_like, shape (L,)
+        The same lines in scan j.
+    votes : array_like, shape (L,), optional
+        Weights (default 1).
+    method : {"two_lines", "least_squares"}
+        004's pair or our weighted least squares.
+    angle_tol_rad : float, default 2°
+        Angle tolerance [rad] (pair selection, or agreement with the median Δφ).
+    min_angle_rad : float, default 20°
+        Smallest angle of the pair [rad] (``two_lines``).
+    rho_tol : float, optional
+        Residual above which a line is dropped (``least_squares``; None keeps all).
 
     Returns
     -------

@@ -48,6 +48,51 @@ class HoughSlamParams(Params):
 
     Lengths (``delta_rho``, ``r_max``, ``band``, ``max_gap``, ``a``, ``b``, ``rho_tol``,
     ``gate``) are in the scans' unit (cells in simulation, metres on a real log).
+
+    Attributes
+    ----------
+    delta_rho : float
+        rho bin width (004: 1 cell).
+    delta_theta_rad : float
+        θ bin width [rad] (004: 1°).
+    r_max : float or None
+        Longest range used (None: each scan's longest).
+    H_min : int
+        Fewest votes of a line (004 leaves the value open).
+    max_lines : int
+        Strongest lines kept per scan.
+    suppress_rho, suppress_theta_rad : float or None
+        Window of false neighbours suppressed around a peak (None: 3 Δrho, 3 Δθ).
+    refine : bool
+        Least-squares refit of each line (:func:`~slamlab.hough.refine_lines`).
+    band : float or None
+        Refit band (None: Δrho).
+    max_gap : float or None
+        The refit cuts the band's points at longer gaps.
+    a, b : float
+        004's association widths in rho and in the along-line direction (b None: b = a).
+    a_theta_rad : float
+        Association width in θ [rad]: largest rotation left after odometry.
+    parallel_tol_rad : float
+        Lines this close in θ count as parallel [rad].
+    p_min : float
+        Below this association probability a line is new.
+    method : {"least_squares", "two_lines"}
+        Pose from all agreeing lines (ours) or from one pair (004).
+    angle_tol_rad : float
+        Largest change of the angle between lines [rad].
+    rho_tol : float or None
+        Least squares drops lines with a larger residual.
+    min_angle_rad : float
+        Smallest angle of a usable pair [rad].
+    min_common : int
+        The reference scan moves on when fewer lines are shared.
+    gate : float or None
+        Reject a pose farther than this from odometry's (None: off).
+    gate_theta_rad : float
+        Heading gate [rad].
+    partial : bool
+        With only parallel lines, move along them from odometry.
     """
 
     delta_rho: float = param(1.0, "004 §Hough SLAM: Δrho = 1 cell")
@@ -100,7 +145,25 @@ class HoughSlamParams(Params):
 
 @dataclass(frozen=True)
 class HoughSlamResult:
-    """Poses of every scan, how each was obtained, and the line history."""
+    """Poses of every scan, how each was obtained, and the line history.
+
+    Attributes
+    ----------
+    poses : numpy.ndarray, shape (n, 3)
+        Estimated ``(x, y, φ)`` per scan (scan unit, rad; φ unwrapped).
+    lost : numpy.ndarray of bool, shape (n,)
+        Odometry had to be used.
+    n_lines : numpy.ndarray of int, shape (n,)
+        Lines found per scan.
+    reference : numpy.ndarray of int, shape (n,)
+        Scan each pose was computed from (-1 for scan 0).
+    history : LineHistory
+        Every scan's lines under global ids.
+    params : HoughSlamParams
+        The settings of the run.
+    partial : numpy.ndarray of bool, shape (n,) or None
+        Pose from parallel lines plus odometry.
+    """
 
     poses: np.ndarray = field(repr=False)  # (n, 3) estimated (x, y, φ), φ unwrapped
     lost: np.ndarray = field(repr=False)  # (n,) bool: odometry had to be used
@@ -128,6 +191,20 @@ def detect_lines(scan: Scan, params: HoughSlamParams | None = None, **overrides)
     """Lines of one scan: polar Hough, peaks above H_min, optional refit (004 §Hough SLAM).
 
     ``params`` / ``**overrides``: the :class:`HoughSlamParams` (lengths in the scan's unit).
+
+    Parameters
+    ----------
+    scan : Scan
+        One scan (cells or metres).
+    params : HoughSlamParams, optional
+        Settings (default :class:`HoughSlamParams`).
+    **overrides
+        Fields of :class:`HoughSlamParams` to change.
+
+    Returns
+    -------
+    Lines
+        Strongest first.
 
     Examples
     --------

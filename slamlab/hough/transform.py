@@ -44,6 +44,19 @@ class HoughAccumulator:
 
     ``H[i, k]`` counts the points on the line ``(rho[i], theta_rad[k])``. 004 quotes
     the size as θ×rho ("180×33"); :attr:`size_theta_rho` gives it that way round.
+
+    Attributes
+    ----------
+    H : numpy.ndarray of int, shape (n_rho, n_theta)
+        Votes.
+    rho : numpy.ndarray, shape (n_rho,)
+        rho of each row (pixels, or the scan's range unit).
+    theta_rad : numpy.ndarray, shape (n_theta,)
+        θ of each column [rad], in [-π/2, π/2).
+    delta_rho : float
+        rho bin width.
+    delta_theta_rad : float
+        θ bin width [rad].
     """
 
     H: np.ndarray = field(repr=False)
@@ -58,13 +71,37 @@ class HoughAccumulator:
         return (self.H.shape[1], self.H.shape[0])
 
     def line(self, i: int, k: int) -> tuple[float, float]:
-        """``(rho, θ)`` of the accumulator cell ``(i, k)``."""
+        """``(rho, θ)`` of the accumulator cell ``(i, k)``.
+
+        Parameters
+        ----------
+        i : int
+            Row (rho index).
+        k : int
+            Column (θ index).
+
+        Returns
+        -------
+        rho, theta_rad : float
+        """
         return float(self.rho[i]), float(self.theta_rad[k])
 
 
 def theta_axis(delta_theta_rad: float) -> np.ndarray:
     """θ bins ``-π/2 + k·Δθ`` covering [-90°, 90°) (004 §Hough).
 
+    Parameters
+    ----------
+    delta_theta_rad : float
+        Bin width Δθ [rad]; must divide 180°.
+
+    Returns
+    -------
+    numpy.ndarray, shape (π/Δθ,)
+        Bin values [rad].
+
+    Examples
+    --------
     >>> np.degrees(theta_axis(np.radians(45.0))).round(6).tolist()
     [-90.0, -45.0, 0.0, 45.0]
     """
@@ -178,6 +215,19 @@ def rasterise_scan(bearings_rad, ranges, *, cell: float = 1.0, r_max: float | No
     c + round(x/cell))`` with ``c = centre_px`` (default ``ceil(r_max/cell)``); the image
     is ``(2c+1)×(2c+1)`` (33×33 for 004's r_max = 16). Rows grow with y (no flip).
 
+    Parameters
+    ----------
+    bearings_rad : array_like, shape (N,)
+        Beam directions [rad].
+    ranges : array_like, shape (N,)
+        Ranges (any unit; ``cell`` in the same unit); ranges ≤ 0 or beyond ``r_max`` are dropped.
+    cell : float, default 1.0
+        Pixel size.
+    r_max : float, optional
+        Longest range drawn; default the longest range.
+    centre_px : int, optional
+        Sensor pixel ``c``; default ``ceil(r_max/cell)``.
+
     Returns
     -------
     image : (2c+1, 2c+1) uint8 array of 0/255
@@ -213,6 +263,20 @@ def hough_classic(image, *, delta_rho: float = 1.0, delta_theta_rad: float = mat
     axis is ``n·Δrho`` for ``|n| <= ceil(D/Δrho)``, ``D = sqrt((H-1)² + (W-1)²)``: a 33×33
     image gives 93 rho bins (004's 180×93).
 
+    Parameters
+    ----------
+    image : array_like, shape (H, W)
+        Binary image; every non-zero pixel votes.
+    delta_rho : float, default 1.0
+        rho bin width [px].
+    delta_theta_rad : float, default π/180
+        θ bin width [rad].
+
+    Returns
+    -------
+    HoughAccumulator
+        rho axis in pixels about pixel (0, 0).
+
     Examples
     --------
     >>> img = np.zeros((33, 33), np.uint8); img[:, 5] = 1          # the line x = 5
@@ -243,6 +307,24 @@ def lines_about_centre(rho, theta_rad, centre_px: int, *, cell: float = 1.0) -> 
     A line ``x·cos θ + y·sin θ = rho`` in image pixels (origin at pixel (0, 0)) is
     ``rho' = (rho - c·(cos θ + sin θ))·cell`` about the sensor at pixel ``(c, c)``.
 
+    Parameters
+    ----------
+    rho : array_like
+        rho of the lines in image pixels (origin at pixel (0, 0)).
+    theta_rad : array_like
+        Their θ [rad].
+    centre_px : int
+        The sensor's pixel ``c`` along both axes (from :func:`rasterise_scan`).
+    cell : float, default 1.0
+        Pixel size in the scan's range unit.
+
+    Returns
+    -------
+    rho, theta_rad : numpy.ndarray
+        The lines about the sensor, rho in range units.
+
+    Examples
+    --------
     >>> rho, theta = lines_about_centre([26.0], [0.0], 16)
     >>> rho.tolist(), theta.tolist()
     ([10.0], [0.0])
@@ -268,6 +350,8 @@ def line_scan(rho: float, theta_rad: float, *, r_max: float, bearings_rad=None,
         Longest range kept.
     bearings_rad : (M,) array_like, optional
         Beam directions; default every ``delta_phi_rad`` over [-180°, 180°).
+    delta_phi_rad : float, default π/180
+        Beam spacing [rad] when ``bearings_rad`` is None.
 
     Returns
     -------
@@ -299,6 +383,24 @@ def hough_cost(*, n_points: int | None = None, r_max: float | None = None, delta
 
     Give ``n_points`` for the polar transform or ``r_max`` for the classic one.
 
+    Parameters
+    ----------
+    n_points : int, optional
+        Scan points (polar transform).
+    r_max : float, optional
+        Longest range (classic transform over the ``(r_max/Δr)²`` image).
+    delta_r : float, default 1.0
+        Image cell size, in the unit of ``r_max``.
+    delta_theta_rad : float, default π/180
+        θ bin width [rad].
+
+    Returns
+    -------
+    float
+        Operation count.
+
+    Examples
+    --------
     >>> hough_cost(n_points=103), hough_cost(r_max=33.0)
     (18540.0, 196020.0)
     """

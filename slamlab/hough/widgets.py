@@ -23,7 +23,18 @@ def _theta_choice(value):
 
 
 def explore_accumulator(**defaults):
-    """One scan of 004's path: its polar accumulator, the peaks above H_min and the lines they give."""
+    """One scan of 004's path: its polar accumulator, the peaks above H_min and the lines they give.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``pose_index`` (20), ``range_std_cells`` (0.1), ``clutter`` (False), ``delta_theta_deg`` (1),
+        ``delta_rho`` (1), ``H_min`` (15) and the fixed ``rng`` (2010).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     from .. import sim
 
     d = {"pose_index": 20, "range_std_cells": 0.1, "clutter": False, "delta_theta_deg": 1.0, "delta_rho": 1.0,
@@ -60,7 +71,18 @@ def explore_accumulator(**defaults):
 
 
 def explore_hough_slam(**defaults):
-    """004's experiment with the knobs: noise, clutter, Δθ, Δrho, H_min, method -> table and figures."""
+    """004's experiment with the knobs: noise, clutter, Δθ, Δrho, H_min, method -> table and figures.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``n_poses`` (61), ``range_std_cells`` (0.1), ``clutter`` (False), ``delta_theta_deg`` (1),
+        ``delta_rho`` (1), ``H_min`` (15), ``method`` ("least_squares"), ``refine`` (True) and the fixed ``rng`` (2010).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"n_poses": 61, "range_std_cells": 0.1, "clutter": False, "delta_theta_deg": 1.0, "delta_rho": 1.0,
          "H_min": 15, "method": "least_squares", "refine": True, "rng": 2010}
     d.update(defaults)
@@ -91,7 +113,18 @@ def explore_hough_slam(**defaults):
 
 
 def explore_real_log(**defaults):
-    """Hough SLAM on a real log: log choice, number of scans, H_min and Δrho -> table and maps."""
+    """Hough SLAM on a real log: log choice, number of scans, H_min and Δrho -> table and maps.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``name`` ("mbicp", a key of ``SHARED_LOGS``), ``n_scans`` (160), ``step`` (1), ``H_min`` (15),
+        ``delta_rho_cm`` (2).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"name": "mbicp", "n_scans": 160, "step": 1, "H_min": 15, "delta_rho_cm": 2.0}
     d.update(defaults)
 

@@ -172,7 +172,17 @@ class StereoArena:
         return 2.0 * (self.width_m + self.length_m)
 
     def contains(self, xy_m) -> np.ndarray:
-        """True where the points ``(N, 2)`` lie strictly inside the arena."""
+        """True where the points ``(N, 2)`` lie strictly inside the arena.
+
+        Parameters
+        ----------
+        xy_m : array_like, shape (N, 2)
+            Points in the arena frame [m].
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (N,)
+        """
         xy = v.as_finite_array(xy_m, "xy_m", ndim=2)
         return (xy[:, 0] > 0) & (xy[:, 0] < self.width_m) & (xy[:, 1] > 0) & (xy[:, 1] < self.length_m)
 
@@ -190,6 +200,19 @@ class StereoArena:
 
         ``surface`` is 0 (background), 1 (floor) or 2 (fence); ``t`` the ray parameter
         (depth ``z`` in the camera frame, rays have ``z = 1``); ``points`` world hits (NaN on the background).
+
+        Parameters
+        ----------
+        camera : PinholeCamera
+            The camera (image size, intrinsics).
+        T_world_cam : array_like, shape (4, 4)
+            Camera pose in the arena frame.
+
+        Returns
+        -------
+        surface : numpy.ndarray of int, shape (H, W)
+        t : numpy.ndarray, shape (H, W)
+        points : numpy.ndarray, shape (H, W, 3)
         """
         surface, t, d, o = self._cast(camera, T_world_cam)
         pts = o + t[:, None].astype(np.float64) * np.stack(d, axis=1)
@@ -223,7 +246,18 @@ class StereoArena:
         return surface, t, (dx, dy, dz), o
 
     def wall_coordinate(self, points_m) -> np.ndarray:
-        """Arc length ``s`` along the fence (y=0 wall, then x=W, y=L, x=0) of points on it."""
+        """Arc length ``s`` along the fence (y=0 wall, then x=W, y=L, x=0) of points on it.
+
+        Parameters
+        ----------
+        points_m : array_like, shape (N, 2) or (N, 3)
+            Points on the fence (x, y used) [m].
+
+        Returns
+        -------
+        numpy.ndarray, shape (N,)
+            Arc length [m].
+        """
         P = v.as_finite_array(points_m, "points_m", ndim=2)
         return self._wall_coordinate(P[:, 0], P[:, 1])[0]
 
@@ -245,6 +279,19 @@ class StereoArena:
     def render(self, camera: PinholeCamera, T_world_cam) -> np.ndarray:
         """Noise-free float32 image ``(H, W)`` in ``[0, 1]`` seen by ``camera`` at pose ``T_world_cam``.
 
+        Parameters
+        ----------
+        camera : PinholeCamera
+            The camera (image size, intrinsics).
+        T_world_cam : array_like, shape (4, 4)
+            Camera pose in the arena frame.
+
+        Returns
+        -------
+        numpy.ndarray of float32, shape (H, W)
+
+        Examples
+        --------
         >>> arena = StereoArena(2.0, 3.0, texel_m=0.01, seed=1)
         >>> cam = PinholeCamera.from_hfov(64, 48)
         >>> T = se3(R_BODY_CAM, [1.0, 1.0, 0.3])
@@ -323,7 +370,17 @@ class StereoSim:
         self.T_body_left = se3(R_BODY_CAM, [0.0, 0.5 * b, self.camera_height_m])
 
     def T_body_right(self, drift_rad=None) -> np.ndarray:
-        """Pose of the right camera in the body frame (with a drift rotation, if given)."""
+        """Pose of the right camera in the body frame (with a drift rotation, if given).
+
+        Parameters
+        ----------
+        drift_rad : array_like, shape (3,), optional
+            Rotation ``(rx, ry, rz)`` [rad] applied to the right camera on top of the calibration.
+
+        Returns
+        -------
+        numpy.ndarray, shape (4, 4)
+        """
         R_rl = self.rig.R_rl if drift_rad is None else rotation_xyz(*drift_rad) @ self.rig.R_rl
         T_right_left = se3(R_rl, self.rig.t_rl)
         # T_body_right = T_body_left @ inv(T_right_left)
@@ -331,7 +388,17 @@ class StereoSim:
         return self.T_body_left @ se3(Rt, -Rt @ T_right_left[:3, 3])
 
     def render_pair(self, pose) -> tuple[np.ndarray, np.ndarray]:
-        """Left and right uint8 images for the body pose ``(x_m, y_m, yaw_rad)``; advances the drift."""
+        """Left and right uint8 images for the body pose ``(x_m, y_m, yaw_rad)``; advances the drift.
+
+        Parameters
+        ----------
+        pose : array_like, shape (3,)
+            Body pose ``(x_m, y_m, yaw_rad)``.
+
+        Returns
+        -------
+        left, right : numpy.ndarray of uint8, shape (H, W)
+        """
         pose = v.as_vector(pose, "pose", 3)
         T_wb = se3_from_planar(*pose)
         if self.drift_std_rad > 0:
@@ -348,5 +415,15 @@ class StereoSim:
         return out[0], out[1]
 
     def ground_truth_se3(self, pose) -> np.ndarray:
-        """4×4 world pose of the body for ``(x_m, y_m, yaw_rad)``."""
+        """4×4 world pose of the body for ``(x_m, y_m, yaw_rad)``.
+
+        Parameters
+        ----------
+        pose : array_like, shape (3,)
+            ``(x_m, y_m, yaw_rad)``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (4, 4)
+        """
         return se3_from_planar(*v.as_vector(pose, "pose", 3))

@@ -77,6 +77,13 @@ TEST_ROOM_CLUTTER: tuple[tuple, ...] = (
 def free_cells(grid, margin_cells: int = 0) -> np.ndarray:
     """``(row, col)`` of the free cells at least ``margin_cells`` (Chebyshev) from any non-free cell.
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes.
+    margin_cells : int, default 0
+        Smallest Chebyshev distance to a non-free cell or the border [cells].
+
     Returns
     -------
     numpy.ndarray of int64, shape (K, 2)
@@ -119,6 +126,10 @@ def add_clutter(grid, clutter: Sequence[tuple] = TEST_ROOM_CLUTTER) -> np.ndarra
     clutter : sequence of tuples
         ``("disc", x, y, radius)`` or ``("rect", x0, y0, x1, y1)`` in cells (inclusive).
 
+    Returns
+    -------
+    numpy.ndarray of int8, shape (H, W)
+
     Examples
     --------
     >>> g = add_clutter(make_grid(5, 5), [("rect", 1, 2, 1, 2)])
@@ -147,6 +158,10 @@ def build_test_room_200() -> np.ndarray:
     a round column, shelves, a sofa), placed without symmetry so that the
     correlation has a single best match. ``data/test_room_200.txt`` holds its
     output (:func:`test_room_200` reads it; a test checks they agree).
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (200, 200)
     """
     g = make_grid(200, 200, OBSTACLE)
     _draw_rect(g, 152, 162, 199, 199, UNEXPLORED)  # outside the L: never seen
@@ -175,6 +190,17 @@ def build_test_room_200() -> np.ndarray:
 def grid_to_text(grid) -> str:
     """Text form of a grid: one line per row (row 0 first), ``.`` free, ``#`` obstacle, ``~`` unexplored.
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
     >>> grid_to_text([[0, 1, -1]])
     '.#~\\n'
     """
@@ -186,6 +212,17 @@ def grid_to_text(grid) -> str:
 def grid_from_text(text: str) -> np.ndarray:
     """Inverse of :func:`grid_to_text`.
 
+    Parameters
+    ----------
+    text : str
+        One line per row of ``.``, ``#``, ``~``, all of one length.
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (H, W)
+
+    Examples
+    --------
     >>> grid_from_text(".#~\\n..~\\n").tolist()
     [[0, 1, -1], [0, 0, -1]]
     """
@@ -216,6 +253,10 @@ def _room_path() -> Path:
 def test_room_200() -> np.ndarray:
     """The 200×200 test room M that the robot keeps in memory (004 Fig. 3a), from ``data/test_room_200.txt``.
 
+    Returns
+    -------
+    numpy.ndarray of int8, shape (200, 200)
+
     Examples
     --------
     >>> M = test_room_200()
@@ -231,6 +272,17 @@ test_room_200.__test__ = False  # not a pytest test despite the name
 def measurement_room_200(clutter: Sequence[tuple] = TEST_ROOM_CLUTTER) -> np.ndarray:
     """The test room with unmapped clutter, the world the rangefinder measures (004 Fig. 3b).
 
+    Parameters
+    ----------
+    clutter : sequence of tuple
+        Shapes added to the test room (default ``TEST_ROOM_CLUTTER``, as for :func:`add_clutter`).
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (200, 200)
+
+    Examples
+    --------
     >>> int((measurement_room_200() != test_room_200()).sum()) > 0
     True
     """

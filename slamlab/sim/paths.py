@@ -88,6 +88,16 @@ def path_004(n_poses: int = 121) -> np.ndarray:
     :data:`PATH_004_SEGMENTS` (our choice). ``n_poses`` other than 121 rescales
     the number of steps of every segment (the geometry stays).
 
+    Parameters
+    ----------
+    n_poses : int, default 121
+        Poses along the path (at least 5).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_poses, 3)
+        ``(x, y)`` [cells] and heading [rad].
+
     Examples
     --------
     >>> P = path_004()

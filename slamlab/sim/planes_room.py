@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import _validate as v
 from .._params import Params, param
+from .room_of_planes import _RAY_CHUNK, PlaneRoom, build_corridor, build_plane_room, cast_rays_planes
 
 __all__ = [
     "Flight",
@@ -42,175 +43,28 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class PlaneRoom:
-    """Bounded rectangles ``n·x = p`` with in-plane axes and reflectance panels (002 Fig. 7; ours).
-
-    Attributes: ``centres (P, 3)``, ``normals (P, 3)`` (unit, pointing into the free space),
-    ``axes_u (P, 3)``, ``axes_v (P, 3)`` (unit, in-plane), ``half_u (P,)``, ``half_v (P,)`` in
-    metres, ``panels (P, Nu, Nv)`` reflectance of the panels (index from the ``-u, -v`` corner),
-    ``panel_m`` panel size, ``names`` one label per plane.
-    """
-
-    centres: np.ndarray
-    normals: np.ndarray
-    axes_u: np.ndarray
-    axes_v: np.ndarray
-    half_u: np.ndarray
-    half_v: np.ndarray
-    panels: np.ndarray
-    panel_m: float
-    names: tuple[str, ...]
-
-    @property
-    def offsets(self) -> np.ndarray:
-        """``p`` of each plane in ``n·x = p``."""
-        return np.einsum("ij,ij->i", self.normals, self.centres)
-
-    def __len__(self) -> int:
-        return self.centres.shape[0]
-
-    def reflectance(self, plane_idx, points) -> np.ndarray:
-        """Reflectance of the panel under each point ``(K, 3)`` lying on plane ``plane_idx (K,)``."""
-        k = np.asarray(plane_idx, dtype=int)
-        d = np.asarray(points, dtype=float) - self.centres[k]
-        s = np.einsum("ij,ij->i", d, self.axes_u[k]) + self.half_u[k]
-        t = np.einsum("ij,ij->i", d, self.axes_v[k]) + self.half_v[k]
-        iu = np.clip((s // self.panel_m).astype(int), 0, self.panels.shape[1] - 1)
-        iv = np.clip((t // self.panel_m).astype(int), 0, self.panels.shape[2] - 1)
-        return self.panels[k, iu, iv]
-
-
-def _box_faces(lo, hi, inward: bool, skip=()):
-    """Six faces of an axis-aligned box (normals into the room: inward for the room, outward for objects)."""
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    c, h = (lo + hi) / 2, (hi - lo) / 2
-    faces = []
-    for ax, nm in ((0, "x"), (1, "y"), (2, "z")):
-        u_ax, v_ax = [a for a in range(3) if a != ax]
-        for sgn, side in ((-1, "-"), (1, "+")):
-            if f"{nm}{side}" in skip:
-                continue
-            centre = c.copy()
-            centre[ax] += sgn * h[ax]
-            n = np.zeros(3)
-            n[ax] = -sgn if inward else sgn
-            u, w = np.zeros(3), np.zeros(3)
-            u[u_ax], w[v_ax] = 1.0, 1.0
-            faces.append((f"{nm}{side}", centre, n, u, w, h[u_ax], h[v_ax]))
-    return faces
-
-
-def build_plane_room(length_m: float = 20.0, width_m: float = 10.0, height_m: float = 3.0, *,
-                     panel_m: float = 1.0, rho_low: float = 0.2, rho_high: float = 0.9, rng=0) -> PlaneRoom:
-    """The test room: walls, floor, ceiling, a pillar and a box, with random reflectance panels (002 Fig. 7; ours).
-
-    Parameters
-    ----------
-    length_m, width_m, height_m : room size (default 20 × 10 × 3 m: 002's ~200 m²).
-    panel_m : side of a reflectance panel.
-    rho_low, rho_high : reflectance range of the panels (contrasting panels: each panel draws one of the two
-        values plus a uniform ±0.05 jitter).
-    rng : seed of the panel pattern.
-
-    >>> room = build_plane_room(); len(room), float(room.half_u[0] * 2 * room.half_v[0] * 2)
-    (15, 30.0)
-    """
-    L = v.check_positive(length_m, "length_m")
-    W = v.check_positive(width_m, "width_m")
-    H = v.check_positive(height_m, "height_m")
-    panel_m = v.check_positive(panel_m, "panel_m")
-    lo_r, hi_r = v.check_probability(rho_low, "rho_low"), v.check_probability(rho_high, "rho_high")
-    rng = v.as_rng(rng)
-    faces = [("room " + f[0], *f[1:]) for f in _box_faces((0, 0, 0), (L, W, H), inward=True)]
-    # a pillar (floor to ceiling, its top and bottom hidden) and a box on the floor (its bottom hidden)
-    pil_lo, pil_hi = (0.62 * L, 0.55 * W, 0.0), (0.62 * L + 0.8, 0.55 * W + 0.8, H)
-    faces += [("pillar " + f[0], *f[1:]) for f in _box_faces(pil_lo, pil_hi, inward=False, skip=("z-", "z+"))]
-    box_lo, box_hi = (0.3 * L, 0.15 * W, 0.0), (0.3 * L + 2.0, 0.15 * W + 1.2, 1.0)
-    faces += [("box " + f[0], *f[1:]) for f in _box_faces(box_lo, box_hi, inward=False, skip=("z-",))]
-    names, c, n, u, w, hu, hv = zip(*faces, strict=True)
-    hu, hv = np.array(hu), np.array(hv)
-    nu = int(np.ceil(2 * hu.max() / panel_m))
-    nv = int(np.ceil(2 * hv.max() / panel_m))
-    pick = rng.random((len(faces), nu, nv)) < 0.5
-    panels = np.where(pick, hi_r, lo_r) + rng.uniform(-0.05, 0.05, (len(faces), nu, nv))
-    return PlaneRoom(np.array(c), np.array(n), np.array(u), np.array(w), hu, hv,
-                     np.clip(panels, 0.0, 1.0), panel_m, tuple(names))
-
-
-def build_corridor(length_m: float = 12.0, width_m: float = 3.0, height_m: float = 3.0, *, panel_m: float = 1.0,
-                   rng=0) -> PlaneRoom:
-    """A corridor: floor, ceiling and two parallel walls, no end walls (002 Fig. 4's situation; ours).
-
-    Its planes leave the position along the corridor (``x``) free: only the panels' intensities fix it.
-
-    >>> c = build_corridor(); len(c), c.names
-    (4, ('y-', 'y+', 'z-', 'z+'))
-    """
-    L, W, H = (v.check_positive(a, n) for a, n in ((length_m, "length_m"), (width_m, "width_m"),
-                                                      (height_m, "height_m")))
-    room = build_plane_room(L, W, H, panel_m=panel_m, rng=rng)
-    keep = [i for i, n in enumerate(room.names) if n in ("room y-", "room y+", "room z-", "room z+")]
-    return PlaneRoom(room.centres[keep], room.normals[keep], room.axes_u[keep], room.axes_v[keep],
-                     room.half_u[keep], room.half_v[keep], room.panels[keep], room.panel_m,
-                     tuple(room.names[i][5:] for i in keep))
-
-
-def cast_rays_planes(room: PlaneRoom, origins, directions, range_max_m: float = np.inf):
-    """Vectorised ray casting against the room's bounded planes (ours).
-
-    Parameters
-    ----------
-    origins : (K, 3) or (3,) ray origins; directions : (K, 3) unit directions.
-    range_max_m : rays hitting nothing closer return NaN.
-
-    Returns
-    -------
-    ranges (K,) (NaN: no hit), plane (K,) index of the plane hit (-1: none), cos_incidence (K,) ``|n·d|``.
-
-    >>> room = build_plane_room()
-    >>> r, k, c = cast_rays_planes(room, [[5.0, 5.0, 1.0]], [[0.0, 0.0, -1.0]])
-    >>> float(r[0]), room.names[k[0]], float(c[0])
-    (1.0, 'room z-', 1.0)
-    """
-    d = v.as_finite_array(directions, "directions", ndim=2)
-    if d.shape[1] != 3:
-        raise ValueError(f"`directions` must have shape (K, 3); got {d.shape}")
-    o = v.as_finite_array(origins, "origins")
-    o = np.broadcast_to(o, d.shape) if o.shape == (3,) else o
-    if o.shape != d.shape:
-        raise ValueError(f"`origins` must have shape (3,) or {d.shape}; got {o.shape}")
-    out = [_cast_chunk(room, o[i:i + _RAY_CHUNK], d[i:i + _RAY_CHUNK], range_max_m)
-           for i in range(0, max(len(d), 1), _RAY_CHUNK)]  # chunks: the (K, P, 3) temporaries stay small
-    return tuple(np.concatenate(parts) for parts in zip(*out, strict=True))
-
-
-#: Rays per chunk of :func:`cast_rays_planes` (a (chunk, planes, 3) float64 temporary: ~6 MB for 15 planes).
-_RAY_CHUNK = 16384
-
-
-def _cast_chunk(room: PlaneRoom, o: np.ndarray, d: np.ndarray, range_max_m: float):
-    nd = d @ room.normals.T                                    # (K, P)
-    no = o @ room.normals.T
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (room.offsets[None, :] - no) / nd
-    t = np.where(np.isfinite(t) & (t > 1e-9), t, np.inf)
-    finite = np.isfinite(t)
-    tt = np.where(finite, t, 0.0)
-    rel = o[:, None, :] + tt[..., None] * d[:, None, :] - room.centres[None]   # hit - centre, (K, P, 3)
-    su = np.einsum("kpj,pj->kp", rel, room.axes_u)
-    sv = np.einsum("kpj,pj->kp", rel, room.axes_v)
-    inside = finite & (np.abs(su) <= room.half_u + 1e-9) & (np.abs(sv) <= room.half_v + 1e-9)
-    t = np.where(inside, t, np.inf)
-    k = np.argmin(t, axis=1)
-    r = t[np.arange(len(k)), k]
-    ok = np.isfinite(r) & (r <= range_max_m)
-    cos_inc = np.abs(nd[np.arange(len(k)), k])
-    return np.where(ok, r, np.nan), np.where(ok, k, -1), np.where(ok, cos_inc, np.nan)
-
-
-@dataclass(frozen=True)
 class PlaneScanner(Params):
-    """A Hokuyo UTM-30LX-like line scanner with a vertical scan plane (002 "Experimental trial")."""
+    """A Hokuyo UTM-30LX-like line scanner with a vertical scan plane (002 "Experimental trial").
+
+    Attributes
+    ----------
+    fov_deg : float
+        Field of view [deg] (002: 270°).
+    step_deg : float
+        Beam spacing [deg] (002: 0.25°, 1081 points).
+    lines_per_s : float
+        Scan lines per second (002: 40).
+    range_max_m : float
+        Longest range [m] (ours; UTM-30LX data sheet: 30 m).
+    sigma_range_m : float
+        Range noise std [m] (ours; data sheet: ±30 mm up to 10 m).
+    intensity_gain : float
+        ``I0`` of the intensity model ``I = I0·ρ·|cos θ|`` (ours).
+    sigma_intensity : float
+        Intensity noise std (ours).
+    mount_m : tuple of float
+        Scanner origin in the body frame [m] (ours).
+    """
 
     fov_deg: float = param(270.0, "002: 270°")
     step_deg: float = param(0.25, "002: 0.25° (1081 points)")
@@ -242,6 +96,17 @@ class PlaneScanner(Params):
 def scanner_beam_directions(scanner: PlaneScanner | None = None) -> np.ndarray:
     """Unit beam directions ``(n_beams, 3)`` in the body frame: ``(sin a, 0, cos a)``, a from ``+z`` (ours).
 
+    Parameters
+    ----------
+    scanner : PlaneScanner, optional
+        The sensor (default ``PlaneScanner()``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_beams, 3)
+
+    Examples
+    --------
     >>> d = scanner_beam_directions(); d.shape, np.round(d[540], 12).tolist()
     ((1081, 3), [0.0, 0.0, 1.0])
     """
@@ -257,10 +122,27 @@ def quad_flight(duration_s: float = 20.0, *, rate_hz: float = 40.0, yaw_rate_deg
     A polyline through ``waypoints_m`` at ``speed_m_s`` (height varies along it), constant yaw rate
     (002: 45°/s), roll and pitch small sinusoids of amplitude ``tilt_deg`` (a stabilised airframe).
 
+    Parameters
+    ----------
+    duration_s : float, default 20.0
+        Flight time [s].
+    rate_hz : float, default 40.0
+        Poses per second (scan lines).
+    yaw_rate_deg_s : float, default 45.0
+        Constant yaw rate [deg/s].
+    speed_m_s : float, default 0.6
+        Speed along the polyline [m/s].
+    waypoints_m : array_like, shape (N, 3), optional
+        Polyline [m] (default a tour of the 20×10 m room).
+    tilt_deg : float, default 2.0
+        Roll and pitch amplitude [deg].
+
     Returns
     -------
     times_s (N,), poses (N, 4, 4) at ``rate_hz`` (one per scan line).
 
+    Examples
+    --------
     >>> t, T = quad_flight(1.0); T.shape, float(t[-1])
     ((40, 4, 4), 0.975)
     """
@@ -295,6 +177,25 @@ def simulate_odometry_3d(poses, *, sigma_trans_m: float = 0.002, sigma_rot_deg: 
 
     The odom frame coincides with the map frame at the first pose. The bias (per line, in the body frame) is
     the drift; roll and pitch get noise but no bias (gravity keeps them observable to an IMU).
+
+    Parameters
+    ----------
+    poses : array_like, shape (N, 4, 4)
+        True poses.
+    sigma_trans_m : float, default 0.002
+        Translation noise per step [m].
+    sigma_rot_deg : float, default 0.05
+        Rotation noise per step and axis [deg].
+    bias_m_per_step : array_like, shape (3,)
+        Translation bias per step in the body frame [m].
+    bias_yaw_deg_per_step : float, default 0.01
+        Yaw bias per step [deg].
+    rng : int or numpy.random.Generator, optional
+        Seed or generator.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 4, 4)
     """
     T = v.as_finite_array(poses, "poses", ndim=3)
     if T.shape[1:] != (4, 4):
@@ -318,7 +219,27 @@ def simulate_odometry_3d(poses, *, sigma_trans_m: float = 0.002, sigma_rot_deg: 
 class Flight:
     """A simulated flight: per scan line ``times_s (N,)``, true ``poses (N, 4, 4)``, ``odometry (N, 4, 4)``,
     ``ranges_m (N, B)`` (NaN: no return), ``intensities (N, B)``, ``plane_ids (N, B)`` (ground truth, -1: none),
-    and the ``room`` and ``scanner``."""
+    and the ``room`` and ``scanner``.
+
+    Attributes
+    ----------
+    times_s : numpy.ndarray, shape (N,)
+        Time of each scan line [s].
+    poses : numpy.ndarray, shape (N, 4, 4)
+        True body poses ``mT_b``.
+    odometry : numpy.ndarray, shape (N, 4, 4)
+        Odometry poses ``oT_b``.
+    ranges_m : numpy.ndarray, shape (N, B)
+        Ranges [m], NaN without a return.
+    intensities : numpy.ndarray, shape (N, B)
+        Return intensities.
+    plane_ids : numpy.ndarray of int, shape (N, B)
+        Plane hit by each beam (-1: none).
+    room : PlaneRoom
+        The scene.
+    scanner : PlaneScanner
+        The sensor.
+    """
 
     times_s: np.ndarray
     poses: np.ndarray
@@ -333,7 +254,18 @@ class Flight:
         return self.times_s.shape[0]
 
     def body_points(self, lines=slice(None)) -> np.ndarray:
-        """Points ``(n, B, 3)`` of the chosen lines in the body frame (NaN where no return)."""
+        """Points ``(n, B, 3)`` of the chosen lines in the body frame (NaN where no return).
+
+        Parameters
+        ----------
+        lines : slice or array_like of int
+            Scan lines to take (default all).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, B, 3)
+            Points [m].
+        """
         d = scanner_beam_directions(self.scanner)
         return self.ranges_m[lines][..., None] * d + np.asarray(self.scanner.mount_m)
 
@@ -349,6 +281,29 @@ def simulate_flight(duration_s: float = 20.0, *, room: PlaneRoom | None = None, 
     """Fly :func:`quad_flight` through ``room`` and record every scan line and the odometry (002; ours).
 
     ``odometry_noise`` scales every noise and bias of :func:`simulate_odometry_3d` (0 = perfect odometry).
+
+    Parameters
+    ----------
+    duration_s : float, default 20.0
+        Flight time [s].
+    room : PlaneRoom, optional
+        Scene (default :func:`build_plane_room`).
+    scanner : PlaneScanner, optional
+        Sensor (default ``PlaneScanner()``).
+    yaw_rate_deg_s : float, default 45.0
+        Yaw rate [deg/s].
+    speed_m_s : float, default 0.6
+        Speed [m/s].
+    waypoints_m : array_like, shape (N, 3), optional
+        Polyline of :func:`quad_flight`.
+    odometry_noise : float, default 1.0
+        Factor on every odometry noise and bias.
+    rng : int or numpy.random.Generator, optional
+        Seed or generator of range, intensity and odometry noise.
+
+    Returns
+    -------
+    Flight
     """
     rng = v.as_rng(rng)
     room = build_plane_room() if room is None else room

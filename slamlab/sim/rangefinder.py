@@ -51,6 +51,17 @@ def beam_angles(n_beams: int = 360, fov_rad: float = 2 * np.pi) -> np.ndarray:
     ahead, no repeated beam); a sector gives ``n`` angles evenly from
     ``-fov/2`` to ``+fov/2`` inclusive (the SICK / CARMEN layout).
 
+    Parameters
+    ----------
+    n_beams : int, default 360
+        Number of beams.
+    fov_rad : float, default 2π
+        Field of view [rad], at most 2π.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_beams,)
+
     Examples
     --------
     >>> np.degrees(beam_angles(4)).tolist()
@@ -112,7 +123,21 @@ class Rangefinder:
         return beam_angles(self.n_beams, self.fov_rad)
 
     def measure(self, true_ranges, hit, rng=None) -> np.ndarray:
-        """Add noise to the returns, quantise and clip to ``[0, max_range]``; no-return beams stay at max range."""
+        """Add noise to the returns, quantise and clip to ``[0, max_range]``; no-return beams stay at max range.
+
+        Parameters
+        ----------
+        true_ranges : array_like, shape (n_beams,)
+            Exact ranges [cells].
+        hit : array_like of bool, shape (n_beams,)
+            Beams with a return.
+        rng : int or numpy.random.Generator, optional
+            Seed or generator of the noise.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n_beams,)
+        """
         rng = v.as_rng(rng)
         out = np.asarray(true_ranges, dtype=float).copy()
         if self.range_std_cells > 0:
@@ -123,7 +148,22 @@ class Rangefinder:
         return out
 
     def scan(self, grid, pose, rng=None) -> Scan:
-        """Measure the scan seen from ``pose`` in ``grid`` (noise drawn from ``rng``)."""
+        """Measure the scan seen from ``pose`` in ``grid`` (noise drawn from ``rng``).
+
+        Parameters
+        ----------
+        grid : array_like of int, shape (H, W)
+            Cell codes of the world.
+        pose : array_like, shape (3,)
+            ``(x, y)`` [cells], heading [rad].
+        rng : int or numpy.random.Generator, optional
+            Seed or generator of the noise.
+
+        Returns
+        -------
+        Scan
+            In cell units, with ``pose`` recorded.
+        """
         ang = self.angles_rad
         true_r, hit = cast_rays(grid, pose, ang, self.max_range_cells)
         return Scan(ang, self.measure(true_r, hit, rng), hit, unit="cell", max_range=float(self.max_range_cells),
@@ -133,6 +173,23 @@ class Rangefinder:
 def simulate_scans(grid, poses, rangefinder: Rangefinder | None = None, rng=None) -> list[Scan]:
     """One :class:`~slamlab.scans.Scan` per pose of a path (004 §8), noise from one seeded stream.
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes of the world.
+    poses : array_like, shape (N, 3)
+        Poses of the path.
+    rangefinder : Rangefinder, optional
+        The sensor (default ``Rangefinder()``).
+    rng : int or numpy.random.Generator, optional
+        One stream for all the scans' noise.
+
+    Returns
+    -------
+    list of Scan
+
+    Examples
+    --------
     >>> g = np.zeros((5, 9), dtype=np.int8); g[:, 8] = 1
     >>> [float(s.ranges[0]) for s in simulate_scans(g, [[2, 2, 0], [3, 2, 0]], Rangefinder(4, max_range_cells=9))]
     [5.5, 4.5]

@@ -19,7 +19,17 @@ __all__ = ["RangeBearingSensor", "UnicycleModel", "simulate_unicycle"]
 
 @dataclass(frozen=True)
 class UnicycleModel:
-    """Unicycle motion with control noise ``w ~ N(0, diag(v_std^2, omega_std^2))``."""
+    """Unicycle motion with control noise ``w ~ N(0, diag(v_std^2, omega_std^2))``.
+
+    Attributes
+    ----------
+    dt_s : float
+        Time step [s].
+    v_std_mps : float
+        Speed noise std [m/s].
+    omega_std_radps : float
+        Turn-rate noise std [rad/s].
+    """
 
     dt_s: float = 0.5
     v_std_mps: float = 0.1
@@ -36,7 +46,22 @@ class UnicycleModel:
         return np.diag([self.v_std_mps**2, self.omega_std_radps**2])
 
     def f(self, x, u, w=None):
-        """``x_k = f(x_{k-1}, u + w)``: Euler step of the unicycle (noise ``w`` on the control)."""
+        """``x_k = f(x_{k-1}, u + w)``: Euler step of the unicycle (noise ``w`` on the control).
+
+        Parameters
+        ----------
+        x : array_like, shape (..., 3)
+            State(s) ``(x_m, y_m, theta_rad)``.
+        u : array_like, shape (2,)
+            Control ``(v_mps, omega_radps)``.
+        w : array_like, shape (..., 2), optional
+            Control noise (augmented UKF).
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., 3)
+            Heading wrapped.
+        """
         x = np.asarray(x, dtype=float)
         u = np.asarray(u, dtype=float)
         vel = u[0] if w is None else u[0] + np.asarray(w)[..., 0]
@@ -47,17 +72,53 @@ class UnicycleModel:
                          wrap_angle(th + om * self.dt_s)], axis=-1)
 
     def F_jac(self, x, u):
-        """``df/dx`` (3, 3) at ``(x, u)``."""
+        """``df/dx`` (3, 3) at ``(x, u)``.
+
+        Parameters
+        ----------
+        x : array_like, shape (3,)
+            State ``(x_m, y_m, theta_rad)``.
+        u : array_like, shape (2,)
+            Control ``(v_mps, omega_radps)``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (3, 3)
+        """
         th, s = x[2], u[0] * self.dt_s
         return np.array([[1.0, 0.0, -s * np.sin(th)], [0.0, 1.0, s * np.cos(th)], [0.0, 0.0, 1.0]])
 
     def V_jac(self, x, u):
-        """``df/du`` (3, 2): maps control noise into the state."""
+        """``df/du`` (3, 2): maps control noise into the state.
+
+        Parameters
+        ----------
+        x : array_like, shape (3,)
+            State ``(x_m, y_m, theta_rad)``.
+        u : array_like, shape (2,)
+            Control ``(v_mps, omega_radps)``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (3, 2)
+        """
         th, dt = x[2], self.dt_s
         return np.array([[dt * np.cos(th), 0.0], [dt * np.sin(th), 0.0], [0.0, dt]])
 
     def Q(self, x, u):
-        """State-space process noise ``V M V^T`` linearised at ``(x, u)`` (EKF, additive UKF)."""
+        """State-space process noise ``V M V^T`` linearised at ``(x, u)`` (EKF, additive UKF).
+
+        Parameters
+        ----------
+        x : array_like, shape (3,)
+            State ``(x_m, y_m, theta_rad)``.
+        u : array_like, shape (2,)
+            Control ``(v_mps, omega_radps)``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (3, 3)
+        """
         V = self.V_jac(x, u)
         return V @ self.M @ V.T
 
@@ -78,7 +139,17 @@ class UnicycleModel:
 
 @dataclass(frozen=True)
 class RangeBearingSensor:
-    """Range and bearing to every landmark: ``z = [r_1, b_1, r_2, b_2, ...]``."""
+    """Range and bearing to every landmark: ``z = [r_1, b_1, r_2, b_2, ...]``.
+
+    Attributes
+    ----------
+    landmarks_m : numpy.ndarray, shape (M, 2)
+        Landmark positions [m].
+    range_std_m : float
+        Range noise std [m].
+    bearing_std_rad : float
+        Bearing noise std [rad].
+    """
 
     landmarks_m: np.ndarray = field(default_factory=lambda: np.array([[5.0, 5.0], [-5.0, 5.0], [0.0, -5.0]]))
     range_std_m: float = 0.1
@@ -101,7 +172,20 @@ class RangeBearingSensor:
         return np.diag(np.tile([self.range_std_m**2, self.bearing_std_rad**2], self.landmarks_m.shape[0]))
 
     def h(self, x, v_noise=None):
-        """Predicted measurement (..., 2M); ``v_noise`` is added (augmented UKF)."""
+        """Predicted measurement (..., 2M); ``v_noise`` is added (augmented UKF).
+
+        Parameters
+        ----------
+        x : array_like, shape (..., 3)
+            State(s) ``(x_m, y_m, theta_rad)``.
+        v_noise : array_like, shape (..., 2M), optional
+            Measurement noise to add.
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., 2M)
+            Ranges [m] and bearings [rad] (wrapped), interleaved.
+        """
         x = np.asarray(x, dtype=float)
         dx = self.landmarks_m[:, 0] - x[..., 0, None]
         dy = self.landmarks_m[:, 1] - x[..., 1, None]
@@ -114,7 +198,17 @@ class RangeBearingSensor:
         return z
 
     def H_jac(self, x):
-        """``dh/dx`` (2M, 3)."""
+        """``dh/dx`` (2M, 3).
+
+        Parameters
+        ----------
+        x : array_like, shape (3,)
+            State ``(x_m, y_m, theta_rad)``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (2M, 3)
+        """
         dx = self.landmarks_m[:, 0] - x[0]
         dy = self.landmarks_m[:, 1] - x[1]
         q = dx**2 + dy**2
@@ -144,6 +238,24 @@ def simulate_unicycle(model: UnicycleModel, sensor: RangeBearingSensor, x0, cont
 
     ``controls`` is ``(K, 2)``; returns ``(X, Z)`` with ``X (K, 3)`` the true
     states after each step and ``Z (K, 2M)`` the measurements taken there.
+
+    Parameters
+    ----------
+    model : UnicycleModel
+        Motion model and control noise.
+    sensor : RangeBearingSensor
+        Landmarks and measurement noise.
+    x0 : array_like, shape (3,)
+        Initial state.
+    controls : array_like, shape (K, 2)
+        Commanded ``(v_mps, omega_radps)`` per step.
+    rng : int or numpy.random.Generator, optional
+        Seed or generator of both noises.
+
+    Returns
+    -------
+    X : numpy.ndarray, shape (K, 3)
+    Z : numpy.ndarray, shape (K, 2M)
     """
     rng = v.as_rng(rng)
     x = v.as_vector(x0, "x0", 3)

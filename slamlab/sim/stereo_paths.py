@@ -37,6 +37,24 @@ LONG_PATH_WAYPOINTS = (
 def turn_in_place(step_rad: float = np.deg2rad(5.0), *, center_m=(3.0, 4.0), start_yaw_rad: float = np.pi / 2, turns: float = 1.0) -> np.ndarray:
     """A turn of ``turns × 360°`` in place, ``step_rad`` per frame, counter-clockwise (000 §3.7.1).
 
+    Parameters
+    ----------
+    step_rad : float, default 5°
+        Turn per frame [rad].
+    center_m : array_like, shape (2,)
+        Position [m].
+    start_yaw_rad : float, default π/2
+        First heading [rad].
+    turns : float, default 1.0
+        Full turns.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        ``(x_m, y_m, yaw_rad)``, yaw unwrapped.
+
+    Examples
+    --------
     >>> p = turn_in_place(np.deg2rad(90.0), start_yaw_rad=0.0)
     >>> np.round(np.rad2deg(p[:, 2])).tolist()
     [0.0, 90.0, 180.0, 270.0, 360.0]
@@ -54,10 +72,21 @@ def waypoint_path(waypoints_m, *, step_m: float = 0.1, turn_step_rad: float = np
 
     Parameters
     ----------
-    waypoints_m : (K, 2) points, K >= 2, consecutive points distinct.
-    step_m : largest straight step per frame.  turn_step_rad : largest turn per frame.
-    start_yaw_rad : initial heading (default: towards the second waypoint).
-    end_yaw_rad : final heading to turn to at the last waypoint (default: none).
+    waypoints_m : (K, 2) array_like
+        Points [m], K >= 2, consecutive points distinct.
+    step_m : float, default 0.1
+        Largest straight step per frame [m].
+    turn_step_rad : float, default 10°
+        Largest turn per frame [rad].
+    start_yaw_rad : float, optional
+        Initial heading (default: towards the second waypoint).
+    end_yaw_rad : float, optional
+        Final heading to turn to at the last waypoint (default: none).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        ``(x_m, y_m, yaw_rad)``.
 
     Examples
     --------
@@ -104,6 +133,20 @@ def rectangular_loop(step_m: float = 0.25, turn_step_rad: float = np.deg2rad(15.
     The robot starts facing the ``x = 6`` wall (perpendicular to it, as in 000) and ends at the start
     with the same heading after a full counter-clockwise turn.
 
+    Parameters
+    ----------
+    step_m : float, default 0.25
+        Largest straight step per frame [m].
+    turn_step_rad : float, default 15°
+        Largest turn per frame [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        ``(x_m, y_m, yaw_rad)``, yaw unwrapped.
+
+    Examples
+    --------
     >>> p = rectangular_loop(1.0, np.pi / 2)
     >>> p[0].tolist(), np.round(p[-1], 6).tolist()
     ([1.0, 1.5, 0.0], [1.0, 1.5, 6.283185])
@@ -114,6 +157,20 @@ def rectangular_loop(step_m: float = 0.25, turn_step_rad: float = np.deg2rad(15.
 def long_path(step_m: float = 0.1, turn_step_rad: float = np.deg2rad(10.0)) -> np.ndarray:
     """About 80 m in a 10×12 m room (000 §4.2): loops turning both ways, back to the start.
 
+    Parameters
+    ----------
+    step_m : float, default 0.1
+        Largest straight step per frame [m].
+    turn_step_rad : float, default 10°
+        Largest turn per frame [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        ``(x_m, y_m, yaw_rad)``.
+
+    Examples
+    --------
     >>> p = long_path(0.5)
     >>> round(float(np.sum(np.hypot(*np.diff(p[:, :2], axis=0).T))), 1)
     79.0

@@ -16,6 +16,25 @@ def constant_velocity_model(dt_s: float = 1.0, accel_std: float = 0.1, pos_std_m
     ``Q`` is the discretised white-noise-acceleration model
     ``q [[dt^3/3, dt^2/2], [dt^2/2, dt]]`` with ``q = accel_std^2``.
 
+    Parameters
+    ----------
+    dt_s : float, default 1.0
+        Time step [s].
+    accel_std : float, default 0.1
+        Std of the white acceleration noise [m/s²].
+    pos_std_m : float, default 1.0
+        Position measurement std per axis [m].
+    dims : int, default 2
+        Number of axes (1 to 3).
+
+    Returns
+    -------
+    F, Q : numpy.ndarray, shape (2 dims, 2 dims)
+    H : numpy.ndarray, shape (dims, 2 dims)
+    R : numpy.ndarray, shape (dims, dims)
+
+    Examples
+    --------
     >>> F, Q, H, R = constant_velocity_model(1.0, 1.0, 1.0, dims=1)
     >>> F, H
     (array([[1., 1.],
@@ -37,6 +56,28 @@ def simulate_linear(F, Q, H, R, x0, n_steps: int, rng=None):
 
     Returns ``(X, Z)``: true states ``(n_steps, n)`` (after each transition) and
     measurements ``(n_steps, m)``.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, n)
+        State transition.
+    Q : array_like, shape (n, n)
+        Process noise covariance.
+    H : array_like, shape (m, n)
+        Measurement matrix.
+    R : array_like, shape (m, m)
+        Measurement noise covariance.
+    x0 : array_like, shape (n,)
+        Initial state (before the first transition).
+    n_steps : int
+        Steps.
+    rng : int or numpy.random.Generator, optional
+        Seed or generator.
+
+    Returns
+    -------
+    X : numpy.ndarray, shape (n_steps, n)
+    Z : numpy.ndarray, shape (n_steps, m)
     """
     rng = v.as_rng(rng)
     x = v.as_vector(x0, "x0")

@@ -44,6 +44,21 @@ def fractal_noise(shape, beta: float = 2.0, rng=None) -> np.ndarray:
     Peak memory: about twice the float64 result (the half spectrum and the result; the 2-D inverse
     FFT runs as its two 1-D passes on blocks).
 
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(rows, cols)``, each ≥ 2.
+    beta : float, default 2.0
+        Spectral exponent (0: white noise).
+    rng : int or numpy.random.Generator, optional
+        Seed or generator.
+
+    Returns
+    -------
+    numpy.ndarray, shape (rows, cols)
+
+    Examples
+    --------
     >>> z = fractal_noise((32, 64), rng=0)
     >>> z.shape, round(float(z.mean()), 12), round(float(z.std()), 12)
     ((32, 64), 0.0, 1.0)
@@ -88,6 +103,26 @@ def crater_heightfield(shape, n_craters: int = 300, radius_px=(3.0, 40.0), slope
     Radii follow a power law ``p(R) ~ R^-slope`` between ``radius_px``; depth is
     ``0.2 R``; the field wraps around both edges.
 
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(rows, cols)``, each ≥ 2.
+    n_craters : int, default 300
+        Number of craters.
+    radius_px : tuple of float
+        ``(min, max)`` crater radius [px].
+    slope : float, default 2.2
+        Power-law exponent of the radius distribution.
+    rng : int or numpy.random.Generator, optional
+        Seed or generator.
+
+    Returns
+    -------
+    numpy.ndarray, shape (rows, cols)
+        Height [px].
+
+    Examples
+    --------
     >>> h = crater_heightfield((64, 64), n_craters=1, radius_px=(10.0, 10.0), rng=0)
     >>> bool(h.min() < 0 < h.max())
     True
@@ -168,6 +203,32 @@ def lunar_texture(
     Height = ``noise_amp_px`` × fractal noise + craters; brightness = albedo × Lambert
     shading under a sun at ``sun_azimuth_rad`` / ``sun_elevation_rad``.
 
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(rows, cols)``, each ≥ 2.
+    n_craters : int, default 300
+        Number of craters (:func:`crater_heightfield`).
+    radius_px : tuple of float
+        ``(min, max)`` crater radius [px].
+    noise_beta : float, default 2.4
+        Spectral exponent of the height noise.
+    noise_amp_px : float, default 4.0
+        Amplitude of the height noise [px].
+    sun_azimuth_rad, sun_elevation_rad : float
+        Direction of the sun [rad].
+    contrast : float, default 1.0
+        Factor on the brightness deviations from the mean.
+    rng : int or numpy.random.Generator, optional
+        Seed or generator (three child streams: noise, craters, albedo).
+
+    Returns
+    -------
+    numpy.ndarray, shape (rows, cols)
+        Brightness in [0, 1].
+
+    Examples
+    --------
     >>> t = lunar_texture((64, 96), rng=3)
     >>> t.shape, bool(0.0 <= t.min() and t.max() <= 1.0)
     ((64, 96), True)

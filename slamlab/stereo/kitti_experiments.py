@@ -31,7 +31,31 @@ __all__ = [
 
 @dataclass(frozen=True)
 class KittiRunResult:
-    """StereoSLAM on a KITTI odometry sequence against its ground truth (real data)."""
+    """StereoSLAM on a KITTI odometry sequence against its ground truth (real data).
+
+    Attributes
+    ----------
+    name : str
+        The sequence folder's name.
+    truth, estimate : numpy.ndarray, shape (N, 4, 4)
+        Left-camera poses in the frame-0 camera frame.
+    ate_m : float
+        Absolute trajectory error (RMSE, no alignment: both start at frame 0) [m].
+    ate_se3_m : float
+        ATE after an SE(3) alignment [m].
+    rpe_m : float
+        RMSE of the relative pose error over one-frame steps [m].
+    final_error_m : float
+        Position error of the last frame [m].
+    path_length_m : float
+        True path length [m].
+    n_degenerate : int
+        Frames that kept the last pose.
+    inliers_median : float
+        Median RANSAC inliers per frame.
+    fps : float
+        SLAM frames per second (not compared).
+    """
 
     name: str  # the sequence folder's name
     truth: np.ndarray = field(repr=False)  # (N, 4, 4) left-camera poses in the frame-0 camera frame
@@ -69,6 +93,12 @@ class KittiRunResult:
         return est / np.linalg.norm(np.diff(self.truth[:, :3, 3], axis=0), axis=1)
 
     def table(self) -> str:
+        """ATE, RPE, final error and path length of the run (fixed precision).
+
+        Returns
+        -------
+        str
+        """
         rows = [
             ["frames (degenerate)", f"{len(self.truth)} ({self.n_degenerate})"],
             ["ATE RMSE, no alignment, m", f"{self.ate_m:.2f}"],
@@ -106,6 +136,25 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
     ``overrides``: :class:`StereoParams`. The map frame is the first left-camera frame, as in
     ``poses.txt``. ATE and RPE by :mod:`slamlab.evaluation` (equal to evo's). ``progress``: a
     bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Parameters
+    ----------
+    folder : str or os.PathLike, optional
+        Sequence folder (default ``kitti-odometry-06-stereo``).
+    n_frames : int, optional
+        Keep only the first frames (≥ 2).
+    params : StereoParams, optional
+        Pipeline settings (default ``KITTI_PARAMS``).
+    rng : int or numpy.random.Generator, default 0
+        RANSAC seed.
+    progress : bool or None
+        A bar over the frames.
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    KittiRunResult
     """
     from ..data import find_data
     from ..evaluation import Trajectory, ate, read_kitti, rpe
@@ -149,6 +198,21 @@ def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None 
     ``turn``: :func:`run_turn_in_place`; ``loops``: :func:`run_comparison` of the closed loop
     (label -> result; the first is 000's pipeline); ``drift``: :func:`run_drift_study`;
     ``kitti``: :func:`run_kitti`. Frame rates are timings and stay out (``timing_table``).
+
+    Parameters
+    ----------
+    turn : StereoRunResult
+        From :func:`run_turn_in_place`.
+    loops : dict
+        Label -> :class:`StereoRunResult` of the closed loop, 000's pipeline first.
+    drift : DriftStudy, optional
+        From :func:`run_drift_study`.
+    kitti : KittiRunResult, optional
+        From :func:`run_kitti`.
+
+    Returns
+    -------
+    str
     """
     deg = np.rad2deg
     runs = list(loops.items())
@@ -189,7 +253,23 @@ def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None 
 def kitti_comparison(variants: dict, folder=None, *, n_frames: int | None = None, rng=0) -> str:
     """:func:`run_kitti` once per setting (label -> overrides of :data:`KITTI_PARAMS`), side by side:
     ATE, final error and the scale figures (path length and start-to-end distance, estimate / truth;
-    the per-frame step ratios' mean, standard error and spread, :attr:`KittiRunResult.step_ratios`)."""
+    the per-frame step ratios' mean, standard error and spread, :attr:`KittiRunResult.step_ratios`).
+
+    Parameters
+    ----------
+    variants : dict
+        Label -> dict of overrides of ``KITTI_PARAMS``.
+    folder : str or os.PathLike, optional
+        Sequence folder (default the shared one).
+    n_frames : int, optional
+        Keep only the first frames.
+    rng : int or numpy.random.Generator, default 0
+        RANSAC seed.
+
+    Returns
+    -------
+    str
+    """
     if not isinstance(variants, dict) or not variants:
         raise TypeError("`variants` must be a non-empty dict of label -> dict of overrides")
     rows = []

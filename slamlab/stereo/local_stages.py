@@ -41,6 +41,21 @@ def detect_features(image, *, params: StereoParams | None = None, **overrides) -
     is the features chapter's own SURF (its threshold, not ``n_features``, limits it to about 600
     points on the arena); ``"orb"`` and ``"sift"`` are OpenCV's (ORB is the fast one).
 
+    Parameters
+    ----------
+    image : array_like
+        Grey or colour image.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    Features
+
+    Examples
+    --------
     >>> img = (np.indices((64, 64)).sum(0) % 16 < 8).astype(np.uint8) * 255
     >>> f = detect_features(img, detector="orb", n_features=50); f.uv.shape[1], f.descriptors.dtype
     (2, dtype('uint8'))
@@ -50,7 +65,15 @@ def detect_features(image, *, params: StereoParams | None = None, **overrides) -
 
 
 class StereoMatches(NamedTuple):
-    """Indices ``left (M,)`` / ``right (M,)`` into the two keypoint sets and descriptor ``distance (M,)``."""
+    """Indices ``left (M,)`` / ``right (M,)`` into the two keypoint sets and descriptor ``distance (M,)``.
+
+    Attributes
+    ----------
+    left, right : numpy.ndarray of int, shape (M,)
+        Indices into the left and right keypoints.
+    distance : numpy.ndarray, shape (M,)
+        Descriptor distances.
+    """
 
     left: np.ndarray
     right: np.ndarray
@@ -75,6 +98,23 @@ def stereo_match(left: Features, right: Features, rig: StereoRig, *, params: Ste
     distance is below ``ratio`` × the second nearest (Lowe's rule; 000 does not say how it
     matched — our choice) and when no other left keypoint claims it with a smaller distance.
     ``params`` / ``overrides``: :class:`StereoParams` (``ratio``, ``epi_tol_px``).
+
+    Parameters
+    ----------
+    left, right : Features
+        Keypoints of the two images.
+    rig : StereoRig
+        Calibration giving the epipolar lines.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    max_distance : float, optional
+        Largest descriptor distance accepted (None: no limit).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    StereoMatches
     """
     p = StereoParams.resolve(params, **overrides)
     _check_features(left, "left")
@@ -194,7 +234,19 @@ def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
 
 def is_rectified(rig: StereoRig, tol: float = 1e-9) -> bool:
     """True when ``rig``'s epipolar lines are image rows: parallel axes, a baseline along ``x`` and
-    equal ``fy``, ``cy`` (then a left pixel's match lies on the same row of the right image)."""
+    equal ``fy``, ``cy`` (then a left pixel's match lies on the same row of the right image).
+
+    Parameters
+    ----------
+    rig : StereoRig
+        The calibrated pair.
+    tol : float, default 1e-9
+        Tolerance on the rotation and the baseline's y, z [m].
+
+    Returns
+    -------
+    bool
+    """
     return bool(np.allclose(rig.R_rl, np.eye(3), atol=tol) and abs(rig.t_rl[1]) <= tol and abs(rig.t_rl[2]) <= tol
                 and np.isclose(rig.left.fy, rig.right.fy) and np.isclose(rig.left.cy, rig.right.cy))
 
@@ -213,6 +265,24 @@ def subpixel_disparity(left_image, right_image, uv_left, uv_right, *, half_px: i
     sits on a grid of ``1.2^L`` pixels; the disparity of two such keypoints carries that error
     into the depth (``z² δd / (f b)``). The patch search measures the disparity at full resolution.
 
+    Parameters
+    ----------
+    left_image, right_image : array_like, shape (H, W)
+        The rectified pair.
+    uv_left, uv_right : array_like, shape (M, 2)
+        Matched keypoints ``(u, v)`` [px].
+    half_px : int, default 5
+        Patch half-size [px].
+    search_px : int, default 4
+        Search half-width along the row [px].
+
+    Returns
+    -------
+    uv_left, uv_right : numpy.ndarray, shape (M, 2)
+    ok : numpy.ndarray of bool, shape (M,)
+
+    Examples
+    --------
     >>> rng = np.random.default_rng(0); L = rng.integers(0, 256, (40, 60)).astype(np.uint8)
     >>> R = np.roll(L, -7, axis=1)  # disparity 7 px everywhere
     >>> _, uvr, ok = subpixel_disparity(L, R, [[30.2, 20.0]], [[21.0, 20.0]])
@@ -277,6 +347,17 @@ class LocalCloud(NamedTuple):
 
     ``points (K, 3)``, their covariances ``cov (K, 3, 3)`` from the pixel error,
     ``left (K,)`` indices of their left keypoints, ``gap_m (K,)`` ray gaps.
+
+    Attributes
+    ----------
+    points : numpy.ndarray, shape (K, 3)
+        Points in the left-camera frame [m].
+    cov : numpy.ndarray, shape (K, 3, 3)
+        Their covariances [m²].
+    left : numpy.ndarray of int, shape (K,)
+        Indices of their left keypoints.
+    gap_m : numpy.ndarray, shape (K,)
+        Gap between the two rays at the midpoint [m].
     """
 
     points: np.ndarray
@@ -298,6 +379,25 @@ def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: 
     the matches it does not confirm are dropped (what :class:`~slamlab.stereo.StereoSLAM` does). ``params`` /
     ``overrides``: :class:`StereoParams` (``min_depth_m``, ``max_depth_m``, ``pixel_std``,
     ``subpixel_*``).
+
+    Parameters
+    ----------
+    rig : StereoRig
+        The calibrated pair.
+    left, right : Features
+        Keypoints of the two images.
+    matches : StereoMatches
+        From :func:`stereo_match`.
+    images : tuple of array_like, optional
+        ``(left_image, right_image)`` for the sub-pixel refinement.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    LocalCloud
     """
     p = StereoParams.resolve(params, **overrides)
     if not isinstance(rig, StereoRig):

@@ -35,7 +35,21 @@ __all__ = [
 class MapMatches(NamedTuple):
     """``local (M,)`` indices into the local cloud, ``ids (M,)`` landmark ids, ``distance (M,)``,
     ``unmatched (K - M,)`` local indices that found no landmark (candidates for new landmarks), and
-    ``nearest (K,)``: every local point's nearest landmark by descriptor (-1: none), matched or not."""
+    ``nearest (K,)``: every local point's nearest landmark by descriptor (-1: none), matched or not.
+
+    Attributes
+    ----------
+    local : numpy.ndarray of int, shape (M,)
+        Indices into the local cloud.
+    ids : numpy.ndarray of int, shape (M,)
+        Landmark ids.
+    distance : numpy.ndarray, shape (M,)
+        Descriptor distances.
+    unmatched : numpy.ndarray of int, shape (K - M,)
+        Local indices without a landmark.
+    nearest : numpy.ndarray of int, shape (K,) or None
+        Each local point's nearest landmark id (-1: none).
+    """
 
     local: np.ndarray
     ids: np.ndarray
@@ -58,6 +72,29 @@ def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | No
     With ``candidates`` (landmark ids), only those landmarks are searched
     (:meth:`~slamlab.kdtree.LandmarkStore.query_among`, exact for every store).
 
+    Parameters
+    ----------
+    descriptors : array_like, shape (K, D)
+        Descriptors of the local points.
+    store : LandmarkStore
+        The map's descriptor store.
+    params : StereoParams, optional
+        Pipeline settings (``map_ratio``, ``same_point_m``).
+    positions : array_like, shape (n, 3), optional
+        Landmark positions by id [m] (for the same-point rule).
+    candidates : array_like of int, optional
+        Landmark ids to search (None: all).
+    max_distance : float, optional
+        Largest descriptor distance accepted.
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    MapMatches
+
+    Examples
+    --------
     >>> from slamlab.kdtree import ExactStore
     >>> s = ExactStore(); s.add(np.array([[0.0, 0.0], [5.0, 0.0]]), [7, 8])
     >>> m = match_to_map(np.array([[0.1, 0.0], [2.4, 0.0]]), s)
@@ -176,6 +213,20 @@ def select_oldest(first_seen, n_min: int) -> np.ndarray:
     least ``n_min`` are gathered, with every landmark of the last frame included
     ("seen as long ago as possible and at about the same time").
 
+    Parameters
+    ----------
+    first_seen : array_like of int, shape (M,)
+        Frame of each match's first sighting.
+    n_min : int
+        Fewest matches to take.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Indices of the selected matches.
+
+    Examples
+    --------
     >>> select_oldest([5, 0, 3, 0, 9, 3], 3).tolist()
     [1, 2, 3, 5]
     """
@@ -198,6 +249,22 @@ def pose_std(points_map, cov_map, center=None) -> np.ndarray:
     error much larger than the lateral error, leaves yaw and sideways translation nearly
     interchangeable; this shows as large standard deviations.
 
+    Parameters
+    ----------
+    points_map : array_like, shape (M, 3)
+        Matched points in the map frame [m].
+    cov_map : array_like, shape (M, 3, 3)
+        Their covariances [m²].
+    center : array_like, shape (3,), optional
+        Centre of the rotations (default the points' mean).
+
+    Returns
+    -------
+    numpy.ndarray, shape (6,)
+        Std of 3 rotations [rad] and 3 translations [m]; inf when undetermined.
+
+    Examples
+    --------
     >>> P = np.array([[1.0, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
     >>> bool(np.all(np.isfinite(pose_std(P, np.tile(np.eye(3) * 1e-4, (4, 1, 1))))))
     True
@@ -232,7 +299,21 @@ def _std_from_information(info) -> np.ndarray:
 
 class PoseEstimate(NamedTuple):
     """Pose ``T`` (4, 4) mapping local points to the map, ``inliers (M,)`` over all matches,
-    ``converged``, ``n_used`` matches the final fit used, ``n_iters`` hypotheses."""
+    ``converged``, ``n_used`` matches the final fit used, ``n_iters`` hypotheses.
+
+    Attributes
+    ----------
+    T : numpy.ndarray, shape (4, 4)
+        Body-to-map transform.
+    inliers : numpy.ndarray of bool, shape (M,)
+        Inlier mask over all matches.
+    converged : bool
+        A valid pose was found.
+    n_used : int
+        Matches in the final fit.
+    n_iters : int
+        RANSAC hypotheses drawn.
+    """
 
     T: np.ndarray
     inliers: np.ndarray
@@ -279,8 +360,15 @@ def estimate_pose(local_points, map_points, first_seen=None, *, depth_m=None, co
         ``"all"`` — the pose is the least-squares fit on all RANSAC inliers.
     cov : (M, 3, 3) covariances of the local points (body frame), for the conditioning test of
         ``policy="oldest"``; None skips the test.
+    rng : int or numpy.random.Generator, optional
+        Seed or generator of the RANSAC samples.
     ransac_iters : RANSAC hypotheses (000: about 200), minimal samples of 3, early exit at 99.9 % confidence.
     min_inliers : inliers needed for a valid pose.
+
+    Returns
+    -------
+    PoseEstimate
+        ``T`` (4, 4) body-to-map, the inlier mask, ``converged``, ``n_used``, ``n_iters``.
 
     Raises
     ------

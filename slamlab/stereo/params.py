@@ -41,6 +41,95 @@ def _optional_positive(value, name, allow_zero=False):
 class StereoParams(Params):
     """Settings of the stereo SLAM pipeline (000 §3.3-3.6); ``print(p.table())`` lists them with sources.
 
+    Attributes
+    ----------
+    detector : str
+        000 §3.3: SURF (ours, the features chapter's; 'orb' is the fast one)
+    n_features : int
+        000 §3.3: about 2000 points per 768x576 image
+    orb_fast_threshold : int
+        ours: ORB's FAST threshold (OpenCV: 20); 12 finds 2000 points on the arena
+    orb_levels : int
+        ours: ORB's pyramid levels, 1.2x apart (OpenCV's 8; KITTI: 1, see run_kitti)
+    channel_order : str
+        ours: channel order of colour images ('bgr' for cv2.imread)
+    parallel_detect : bool
+        ours: the two images in two threads (same result)
+    ratio : float
+        ours: Lowe's ratio for left-right matches (000 does not say how it matched)
+    epi_tol_px : float
+        ours: distance from the epipolar line
+    min_depth_m : float
+        ours: nearest depth a stereo point may have, m
+    max_depth_m : float
+        ours: the 6x8 m arena (KITTI: 40, see run_kitti)
+    pixel_std : float
+        ours: pixel error behind a stereo point's covariance
+    subpixel_stereo : bool or None
+        ours: refine each match's disparity by a patch search along the row (rectified rigs); None: for ORB only, whose pyramid keypoints are off by up to 1.2^L / 2 px
+    subpixel_half_px : int
+        ours: half size of the patch of the disparity refinement (11x11 px)
+    subpixel_search_px : int
+        ours: columns searched on each side of the matched right keypoint
+    map_ratio : float
+        ours: ratio rule against the landmark store
+    same_point_m : float or None
+        ours: two nearest landmarks this close count as one for the ratio rule (0: off; None: 0.03 m with the window search, off with the global one)
+    duplicate_gap_m : float or None
+        ours: an unmatched point whose nearest landmark by descriptor lies this close to it (after the pose) is that landmark again, not a new one (None: off)
+    map_search : str or None
+        ours: 'global' (000: every stored landmark by descriptor) or 'window' (a pose from the last frame's landmarks, then the landmarks it projects near each point); None: 'window' for ORB, 'global' otherwise
+    window_px : float
+        ours: radius of the window search around each keypoint, px
+    window_max_hamming : int
+        ours: largest Hamming distance (of 256 bits) a window match may have; binary only
+    window_min_share : float
+        ours: fewer window matches than this share of the points: search globally (a first pose from repeated texture is confirmed by few windows)
+    view_margin_deg : float or None
+        ours: match only landmarks in view (None: the whole map, as 000)
+    view_depth_factor : float
+        ours: the view gate keeps landmarks up to this times max_depth_m away
+    base_seen_times : int
+        000 §3.4: BaseSeenTimes = 3
+    max_non_base_time : int
+        000 §3.4: MaxNonBaseTime = 7
+    policy : str
+        000 §3.5: the oldest landmarks ('all': every RANSAC inlier)
+    ransac_iters : int
+        000 §3.5: about 200 hypotheses
+    threshold_m : float
+        ours: RANSAC inlier distance at depth_ref_m
+    depth_ref_m : float
+        ours: the threshold grows as (depth / depth_ref_m)^2 beyond it
+    min_inliers : int
+        ours: RANSAC inliers needed for a valid pose
+    n_oldest : int
+        ours: 000 §3.5 says 'sufficiently large'
+    oldest_fraction : float
+        ours: the oldest set holds at least this share of the candidates
+    keep_fraction : float
+        ours: share of the oldest set that must agree
+    loose_factor : float
+        ours: candidates within this many thresholds of the consensus pose
+    still_fraction : float
+        ours: share of the candidates the oldest set's pose must still explain
+    max_std_factor : float or None
+        ours: grow the oldest set until the pose is this well determined
+    max_correction_rad : float or None
+        ours: bound on the oldest set's correction (None: none)
+    max_correction_m : float or None
+        ours: bound on the oldest set's correction (None: none)
+    max_rot_std_rad : float or None
+        ours: reject a pose whose rotation std exceeds this (None: off)
+    state_var : float
+        000 §3.6: static landmarks; ours: a small process variance, m^2
+    pose_std_m : float
+        ours: pose uncertainty added to an observation
+    pose_std_rad : float
+        ours: pose uncertainty added to an observation
+    update_gate : float or None
+        ours: chi^2_3 at 99.9 % (None: always update)
+
     Examples
     --------
     >>> p = StereoParams(detector="orb")
@@ -181,7 +270,12 @@ class StereoParams(Params):
         return self.detector == "orb"
 
     def detect_kwargs(self) -> dict:
-        """Keyword arguments of :func:`slamlab.features.detect` for this pipeline's detector (000 §3.3)."""
+        """Keyword arguments of :func:`slamlab.features.detect` for this pipeline's detector (000 §3.3).
+
+        Returns
+        -------
+        dict
+        """
         kw = {"max_points": self.n_features, "channel_order": self.channel_order}
         if self.detector == "orb":
             kw.update(n_features=self.n_features, fast_threshold=self.orb_fast_threshold, n_levels=self.orb_levels)
@@ -192,7 +286,19 @@ class StereoParams(Params):
 
 @dataclass(frozen=True)
 class RenderParams(Params):
-    """Settings of the rendered arena runs (the simulator's, not the pipeline's; 000 §3.7)."""
+    """Settings of the rendered arena runs (the simulator's, not the pipeline's; 000 §3.7).
+
+    Attributes
+    ----------
+    arena_seed : int
+        ours: texture seed of the 6x8 m arena
+    camera_height_m : float
+        ours: height of the cameras above the floor, m
+    noise_std : float
+        ours: image noise, grey levels
+    drift_std_rad : float
+        ours: random-walk step of the right camera per frame (000 §3.2)
+    """
 
     arena_seed: int = param(0, "ours: texture seed of the 6x8 m arena")
     camera_height_m: float = param(0.4, "ours")

@@ -12,7 +12,21 @@ __all__ = ["plot_frame_stages", "plot_kitti", "plot_run_errors", "plot_run_map",
 
 
 def plot_triangulation(*, ax=None, baseline_m: float = 0.4, skew_m: float = 0.15):
-    """The midpoint of the common perpendicular of two skew viewing rays (000 §3.3), drawn in 3-D."""
+    """The midpoint of the common perpendicular of two skew viewing rays (000 §3.3), drawn in 3-D.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes (3-D), optional
+        Axes to draw on; None makes a new figure.
+    baseline_m : float, default 0.4
+        Distance between the camera centres [m].
+    skew_m : float, default 0.15
+        Vertical offset that makes the rays skew [m].
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     if ax is None:
         ax = plt.figure(figsize=(6, 4.5)).add_subplot(projection="3d")
     c1, c2 = np.zeros(3), np.array([baseline_m, 0.0, 0.0])
@@ -38,7 +52,27 @@ def plot_triangulation(*, ax=None, baseline_m: float = 0.4, skew_m: float = 0.15
 
 
 def plot_frame_stages(left, right, left_features, right_features, matches, cloud, inliers=None, *, axes=None):
-    """One frame's stages: keypoints, stereo matches, local cloud (top view) and RANSAC inliers."""
+    """One frame's stages: keypoints, stereo matches, local cloud (top view) and RANSAC inliers.
+
+    Parameters
+    ----------
+    left, right : array_like
+        The stereo pair.
+    left_features, right_features : Features
+        Their keypoints.
+    matches : StereoMatches
+        Stereo matches (every 10th drawn).
+    cloud : LocalCloud
+        The triangulated points.
+    inliers : array_like of bool, shape (K,), optional
+        RANSAC inliers over the cloud's points.
+    axes : array_like of four matplotlib.axes.Axes, optional
+        None makes a new figure.
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+    """
     if axes is None:
         _fig, axes = plt.subplots(2, 2, figsize=(11, 8))
     axes = np.asarray(axes).ravel()
@@ -77,7 +111,21 @@ def plot_frame_stages(left, right, left_features, right_features, matches, cloud
 
 
 def plot_run_map(result, *, ax=None, every: int = 1):
-    """Estimated path, true path and the base landmarks in the map frame (000 §3.7.2, Fig. 11)."""
+    """Estimated path, true path and the base landmarks in the map frame (000 §3.7.2, Fig. 11).
+
+    Parameters
+    ----------
+    result : StereoRunResult
+        The run.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+    every : int, default 1
+        Draw every ``every``-th landmark.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title=f"{result.name}: path and landmark map", xlabel="x [m]", ylabel="y [m]", equal=True)
     L = result.landmarks_xy
     ax.plot(L[::every, 0], L[::every, 1], ".", color="tab:gray", markersize=1, label=f"landmarks ({len(L)})")
@@ -90,7 +138,21 @@ def plot_run_map(result, *, ax=None, every: int = 1):
 
 
 def plot_run_errors(result, *, axes=None, label: str | None = None):
-    """Position and heading error per frame against the ground truth."""
+    """Position and heading error per frame against the ground truth.
+
+    Parameters
+    ----------
+    result : StereoRunResult
+        The run.
+    axes : sequence of two matplotlib.axes.Axes, optional
+        None makes a new figure.
+    label : str, optional
+        Legend label (default detector and policy).
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+    """
     if axes is None:
         _fig, axes = plt.subplots(1, 2, figsize=(11, 3.5))
     label = label or f"{result.detector}, {result.policy}"
@@ -107,7 +169,19 @@ def plot_run_errors(result, *, axes=None, label: str | None = None):
 
 
 def run_figure(result, *, others=()):
-    """Map of the run on top, error curves below (``others``: more results drawn on the error axes)."""
+    """Map of the run on top, error curves below (``others``: more results drawn on the error axes).
+
+    Parameters
+    ----------
+    result : StereoRunResult
+        The run drawn on the map.
+    others : sequence of StereoRunResult
+        More runs drawn on the error axes.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig = plt.figure(figsize=(11, 7.5))
     gs = fig.add_gridspec(2, 2, height_ratios=(2, 1))
     plot_run_map(result, ax=fig.add_subplot(gs[0, :]))
@@ -119,7 +193,19 @@ def run_figure(result, *, others=()):
 
 
 def plot_kitti(result, *, ax=None):
-    """KITTI run seen from above: the left camera's path (x right, z forward) against the ground truth."""
+    """KITTI run seen from above: the left camera's path (x right, z forward) against the ground truth.
+
+    Parameters
+    ----------
+    result : KittiRunResult
+        From :func:`~slamlab.stereo.run_kitti`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; None makes a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
     ax = new_axes(ax, title="KITTI 06, frames 0-19: path from above", xlabel="x [m]", ylabel="z (forward) [m]",
                   equal=True)  # fmt: skip
     gt, est = result.truth[:, :3, 3], result.estimate[:, :3, 3]

@@ -9,79 +9,23 @@ landmark store (000 §3.4).
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from .. import _validate as v
 from ..features.base import to_gray_uint8
-from ..features.detect import detect
 from ..filters.landmark import landmark_predict, landmark_update
 from ..geometry.camera import StereoRig, project_points
 from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
-from ..kdtree.stores import ExactStore, LandmarkStore, base_rule, make_store
+from ..kdtree.stores import LandmarkStore, base_rule
+from .frame import STAGES, FrameRecord, _detect_pair, _StageClock, default_store
 from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified
 from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
 from .params import StereoParams
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
-
-_EXECUTOR: ThreadPoolExecutor | None = None
-
-
-def _detect_pair(left, right, method, kwargs, parallel):
-    """Features of both images by :func:`slamlab.features.detect`; in two threads when ``parallel``
-    (OpenCV and numpy release the GIL)."""
-    global _EXECUTOR
-    if not parallel:
-        return detect(left, method, **kwargs), detect(right, method, **kwargs)
-    if _EXECUTOR is None:
-        _EXECUTOR = ThreadPoolExecutor(max_workers=2, thread_name_prefix="slamlab-detect")
-    fut = _EXECUTOR.submit(detect, right, method, **kwargs)
-    return detect(left, method, **kwargs), fut.result()
-
-
-def default_store(params: StereoParams | None = None) -> LandmarkStore:
-    """The landmark store the pipeline uses unless told otherwise (000 §3.4, §4).
-
-    Float descriptors (SURF, SIFT): 000's multi kd-tree (n1 = 3500, q = 5.5, BBF with 200
-    checks) behind the non-base buffer (:func:`slamlab.kdtree.make_store`). Binary descriptors
-    (ORB, Hamming distance): a kd-tree does not apply, so :class:`~slamlab.kdtree.ExactStore`
-    (brute force). Both apply the base rule with ``params``' ``base_seen_times`` / ``max_non_base_time``.
-    """
-    p = StereoParams.resolve(params)
-    if p.binary:
-        return ExactStore(p.base_seen_times, p.max_non_base_time)
-    return make_store("multi", base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
-
-
-#: the per-frame stages whose times are recorded
-STAGES = ("detect", "stereo", "triangulate", "map_match", "pose", "update")
-
-
-class _StageClock:
-    """Wall-clock and process CPU time per stage: ``lap(stage)`` adds the time since the last lap."""
-
-    def __init__(self):
-        self.wall = dict.fromkeys(STAGES, 0.0)
-        self.cpu = dict.fromkeys(STAGES, 0.0)
-        self._w, self._c = time.perf_counter(), time.process_time()
-
-    def lap(self, stage):
-        w, c = time.perf_counter(), time.process_time()
-        self.wall[stage] += w - self._w
-        self.cpu[stage] += c - self._c
-        self._w, self._c = w, c
-
-
-class FrameRecord(dict):
-    """Counts of one frame (a plain dict with attribute access)."""
-
-    __getattr__ = dict.__getitem__
-
 
 class StereoSLAM:
     """Stereo SLAM with a landmark map (000 §3.3-3.6).
@@ -99,6 +43,8 @@ class StereoSLAM:
         addition): a first pose from the last frame's landmarks, then each point only against the
         landmarks projected near it; the store serves the global search when that gives no pose.
     rng : RANSAC's random stream.
+    **overrides
+        :class:`~slamlab.stereo.params.StereoParams` fields to change (``detector="orb"``).
 
     Examples
     --------
@@ -163,6 +109,16 @@ class StereoSLAM:
 
         ``left`` and ``right`` must have the same shape, the rig's image size; colour images are
         converted with ``params.channel_order``.
+
+        Parameters
+        ----------
+        left, right : array_like, shape (H, W) or (H, W, 3)
+            The stereo pair.
+
+        Returns
+        -------
+        FrameRecord
+            Counts per stage, ``status``, the pose.
         """
         self._check_pair(left, right)
         p = self.params
@@ -322,7 +278,20 @@ class StereoSLAM:
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
         within its horizontal field of view widened by ``margin_deg`` per side and up to
-        ``params.view_depth_factor × params.max_depth_m`` (1.5 × 10 m by default) away."""
+        ``params.view_depth_factor × params.max_depth_m`` (1.5 × 10 m by default) away.
+
+        Parameters
+        ----------
+        margin_deg : float, default 0.0
+            Widening of the field of view per side [deg].
+        T_body : array_like, shape (4, 4), optional
+            Body pose in the map (default the last pose).
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Landmark ids.
+        """
         T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
         T_wc = T @ self.T_body_left
         live = np.flatnonzero(self.alive)
@@ -339,6 +308,19 @@ class StereoSLAM:
 
         Observations whose innovation fails ``update_gate`` leave their landmark unchanged;
         returns the mask of the updated ones.
+
+        Parameters
+        ----------
+        ids : numpy.ndarray of int, shape (M,)
+            Landmark ids.
+        Z : numpy.ndarray, shape (M, 3)
+            Observed positions in the map frame [m].
+        Rz : numpy.ndarray, shape (M, 3, 3)
+            Their covariances [m²].
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (M,)
         """
         gate = self.params.update_gate
         P_pred = landmark_predict(self.P[ids], self.params.state_var)
@@ -420,13 +402,30 @@ class StereoSLAM:
         return p
 
     def counts(self) -> dict:
-        """Per-frame counts as arrays: points, matches, inliers, landmarks."""
+        """Per-frame counts as arrays: points, matches, inliers, landmarks.
+
+        Returns
+        -------
+        dict
+            Count name -> numpy.ndarray over the frames.
+        """
         keys = [k for k in self.records[0] if k != "status"] if self.records else []
         return {k: np.array([r[k] for r in self.records]) for k in keys}
 
     def stage_times(self, cpu: bool = False) -> dict:
         """Per-frame time of each stage in seconds, as arrays: wall clock, or with ``cpu`` the process's
-        CPU time (all its threads: detection runs the two images in two threads)."""
+        CPU time (all its threads: detection runs the two images in two threads).
+
+        Parameters
+        ----------
+        cpu : bool, default False
+            CPU time of the process instead of wall clock.
+
+        Returns
+        -------
+        dict
+            Stage name -> per-frame times [s].
+        """
         times = self.cpu_times if cpu else self.times
         return {s: np.array([t[s] for t in times]) for s in STAGES}
 
@@ -436,6 +435,16 @@ class StereoSLAM:
         return np.array([r["frame"] for r in self.records if r["status"] not in ("ok", "init")], dtype=np.int64)
 
     def landmark_map(self, base_only: bool = True) -> np.ndarray:
-        """(K, 3) landmark positions in the map frame (000's 2D map: the first two columns)."""
+        """(K, 3) landmark positions in the map frame (000's 2D map: the first two columns).
+
+        Parameters
+        ----------
+        base_only : bool, default True
+            Only the base landmarks (seen often enough, 000 §3.4); False adds the live non-base ones.
+
+        Returns
+        -------
+        numpy.ndarray, shape (K, 3)
+        """
         keep = self.alive & self._base_rule()[0] if base_only else self.alive
         return self.X[keep]

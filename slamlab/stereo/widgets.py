@@ -20,6 +20,16 @@ def explore_stereo_slam(**defaults):
     Each change starts a run of 15-30 s; the run button (``manual``) avoids a run per slider step.
     ``n_frames`` (a default, not a slider) keeps the first frames only (quick checks).
     A bad combination prints its message instead of failing.
+
+    Parameters
+    ----------
+    **defaults
+        Initial values: ``experiment`` ("turn in place"), ``detector`` ("surf"), ``policy`` ("oldest"),
+        ``ransac_iters`` (200), ``noise_std`` (0), ``drift_mrad`` (0) and the fixed ``rng`` (0), ``n_frames`` (None).
+
+    Returns
+    -------
+    ipywidgets.interactive
     """
     d = {"experiment": "turn in place", "detector": "surf", "policy": "oldest", "ransac_iters": 200,
          "noise_std": 0.0, "drift_mrad": 0.0, "rng": 0, "n_frames": None}  # fmt: skip

@@ -145,7 +145,9 @@ def test_ray_casting_in_chunks_equals_one_pass(monkeypatch):
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     o = np.array([5.0, 5.0, 1.2]) + 0.1 * rng.standard_normal((5000, 3))
     one = pr.cast_rays_planes(room, o, d, 30.0)
-    monkeypatch.setattr(pr, "_RAY_CHUNK", 333)
+    import slamlab.sim.room_of_planes as rp  # the caster and its chunk size live there (re-exported by planes_room)
+
+    monkeypatch.setattr(rp, "_RAY_CHUNK", 333)
     chunked = pr.cast_rays_planes(room, o, d, 30.0)
     for a, b in zip(one, chunked, strict=True):
         np.testing.assert_array_equal(a, b)

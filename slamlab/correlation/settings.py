@@ -1,0 +1,185 @@
+"""Settings and result of correlation localisation (004 §7): 004's constants, :class:`LocaliseParams`,
+:class:`Localisation` (re-exported by :mod:`slamlab.correlation.algorithm`)."""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as v
+from .._params import Params, param
+
+__all__ = ["Localisation", "LocaliseParams", "check_constants"]
+
+
+def _check_real(value, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value):
+        raise TypeError(f"`{name}` must be a finite real number; got {value!r}")
+    return float(value)
+
+
+def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
+    """Validate 004's constants: real numbers with ``a_c ≠ a_p`` (004 §7, conditions (1)-(3)).
+
+    Parameters
+    ----------
+    a_c : float
+        Value of a free (scan-crossed) cell in T_n and of a free map cell.
+    a_p : float
+        Value of an obstacle (beam end) cell.
+    a_n : float
+        Value of every other cell (unexplored map cells, unmarked T_n cells).
+
+    Returns
+    -------
+    tuple of float
+        ``(a_c, a_p, a_n)`` as floats.
+    """
+    a_c, a_p, a_n = _check_real(a_c, "a_c"), _check_real(a_p, "a_p"), _check_real(a_n, "a_n")
+    if a_c == a_p:
+        raise ValueError(f"`a_c` and `a_p` must differ (free and obstacle must be told apart); got both {a_c}")
+    return a_c, a_p, a_n
+
+
+@dataclass(frozen=True)
+class Localisation:
+    """Result of :func:`localise`: the pose at the correlation maximum (004 §7).
+
+    Attributes
+    ----------
+    pose : numpy.ndarray, shape (3,)
+        ``(x = col, y = row)`` [cells] and heading [rad], in [0, 2π) for a full search.
+    row, col : int
+        The peak's map cell.
+    heading_index : int
+        Index of the peak's heading in ``headings_rad``.
+    score : float
+        Correlation at the peak.
+    headings_rad : numpy.ndarray, shape (n,)
+        Candidate headings.
+    best_per_heading : numpy.ndarray, shape (n,)
+        Maximum of each D_n.
+    score_map : numpy.ndarray, shape (H, W)
+        D at the best heading.
+    rival_score : float
+        Best score of a pose more than ``rival_radius_cells`` or ``rival_heading_rad`` away (NaN: not searched,
+        -inf: no such pose).
+    rival_pose : numpy.ndarray, shape (3,) or None
+        That pose (None: not searched).
+    n_scans : int
+        Scans joined by odometry into the stamp (:func:`localise_joined`).
+    """
+
+    pose: np.ndarray  # (3,) x = col, y = row [cells], heading [rad] in [0, 2π) for a full search
+    row: int
+    col: int
+    heading_index: int
+    score: float
+    headings_rad: np.ndarray = field(repr=False)  # (n,) candidates
+    best_per_heading: np.ndarray = field(repr=False)  # (n,) max of each D_n
+    score_map: np.ndarray = field(repr=False)  # (H, W) D at the best heading
+    rival_score: float = float("nan")  # best score of a pose > rival_radius_cells or > rival_heading_rad away
+    rival_pose: np.ndarray | None = field(default=None, repr=False)  # (3,) that pose (None: not searched)
+    n_scans: int = 1  # scans joined by odometry into the stamp (localise_joined)
+
+    @property
+    def ambiguity(self) -> float:
+        """How close the best rival comes to the peak, in [0, 1] (ours): 1 = a tie, 0 = no better than a wrong heading.
+
+        ``(rival − base) / (score − base)`` with ``base`` the median over headings of each heading's best
+        score (what a wrong heading typically reaches: with a_c < 0 every pose in open space collects the
+        free-cell matches, so the raw ratio rival/score sits near 1 even for a unique pose). NaN when the
+        rival was not searched (``ambiguity=False``); 0 when no pose lies outside the window.
+        """
+        if not np.isfinite(self.rival_score):
+            return 0.0 if self.rival_score == -np.inf else float("nan")
+        base = float(np.median(self.best_per_heading))
+        if self.score - base <= 0:
+            return 1.0
+        return float(np.clip((self.rival_score - base) / (self.score - base), 0.0, 1.0))
+
+    def __str__(self) -> str:
+        amb = f", ambiguity {self.ambiguity:.3f}" if np.isfinite(self.ambiguity) else ""
+        return (f"pose x={self.pose[0]:.0f}, y={self.pose[1]:.0f} cells, heading "
+                f"{np.degrees(self.pose[2]):.1f} deg (score {self.score:.1f}{amb})")
+
+
+@dataclass(frozen=True)
+class LocaliseParams(Params):
+    """Every setting of :func:`localise` and of the ``run_*`` experiments built on it (004 §7).
+
+    ``prior_heading_rad`` / ``window_rad`` (tracking mode) are per call, not settings.
+
+    Attributes
+    ----------
+    delta_alpha_rad : float
+        Heading step Δα [rad] (004: 1°).
+    a_c, a_p, a_n : float
+        004's values of free, obstacle and other cells (-1, 1, 0).
+    delta_l_cells : float
+        ±Δl around a beam end marked as obstacle [cells] (0 marks one cell).
+    hit_offset_cells : float
+        How far beyond the range the obstacle mark sits [cells] (0.5: the range ends on the cell's face).
+    step_cells : float
+        Sampling step along a beam [cells], at most 1.
+    use_misses : bool
+        Mark beams without a return as free along their length.
+    chunk : int
+        Base stamps per batched FFT call.
+    dtype : {"float32", "float64"}
+        FFT precision.
+    workers : int or None
+        scipy.fft threads (None: scipy's default).
+    ambiguity : bool
+        Also search the best rival pose (:attr:`Localisation.ambiguity`).
+    rival_radius_cells : float
+        A rival lies farther than this from the peak [cells] ...
+    rival_heading_rad : float
+        ... or its heading differs by more than this [rad], below π.
+    """
+
+    delta_alpha_rad: float = param(float(np.radians(1.0)), "004 §7: Δα = 1°")
+    a_c: float = param(-1.0, "004 §7: a_c < 0 < a_p, a_n = 0; sharpest peak at a_p = -a_c")
+    a_p: float = param(1.0, "004 §7")
+    a_n: float = param(0.0, "004 §7: conditions (1)-(3) give a_n = 0")
+    delta_l_cells: float = param(0.0, "004 §7: ±Δl, value not given (0 marks one cell)")
+    hit_offset_cells: float = param(0.5, "ours: a range ends on the obstacle cell's face")
+    step_cells: float = param(0.5, "ours: sampling step along a beam")
+    use_misses: bool = param(False, "ours: 004 is silent on beams without a return")
+    chunk: int = param(8, "ours: base stamps per batched FFT call (CPU caches)")
+    dtype: str = param("float32", "ours: float32 FFTs find the float64 peak (test) in about half the time")
+    workers: int | None = param(None, "ours: scipy.fft threads (None = scipy's default)")
+    ambiguity: bool = param(True, "ours: also find the best rival pose (re-scores the headings near the peak)")
+    rival_radius_cells: float = param(5.0, "ours: a rival is farther than this from the peak (1 m at 0.2 m)")
+    rival_heading_rad: float = param(float(np.radians(30.0)), "ours: ... or its heading is more than 30° off")
+
+    def __post_init__(self) -> None:
+        with contextlib.suppress(TypeError):  # accept numpy dtypes (np.float32) too; check() names a bad one
+            object.__setattr__(self, "dtype", np.dtype(self.dtype).name)
+        super().__post_init__()
+
+    def check(self) -> None:
+        d = v.check_positive(self.delta_alpha_rad, "delta_alpha_rad")
+        if d > np.pi:
+            raise ValueError(f"`delta_alpha_rad` must be <= π; got {d}")
+        check_constants(self.a_c, self.a_p, self.a_n)
+        v.check_positive(self.delta_l_cells, "delta_l_cells", allow_zero=True)
+        v.check_positive(self.hit_offset_cells, "hit_offset_cells", allow_zero=True)
+        st = v.check_positive(self.step_cells, "step_cells")
+        if st > 1:
+            raise ValueError(f"`step_cells` must be <= 1 (a larger step skips cells); got {st}")
+        if not isinstance(self.use_misses, (bool, np.bool_)):
+            raise TypeError(f"`use_misses` must be a bool; got {type(self.use_misses).__name__}")
+        v.check_int(self.chunk, "chunk", minimum=1)
+        v.check_choice(self.dtype, "dtype", ("float32", "float64"))
+        if self.workers is not None:
+            v.check_int(self.workers, "workers", minimum=1)
+        if not isinstance(self.ambiguity, (bool, np.bool_)):
+            raise TypeError(f"`ambiguity` must be a bool; got {type(self.ambiguity).__name__}")
+        v.check_positive(self.rival_radius_cells, "rival_radius_cells", allow_zero=True)
+        h = v.check_positive(self.rival_heading_rad, "rival_heading_rad", allow_zero=True)
+        if h >= np.pi:
+            raise ValueError(f"`rival_heading_rad` must be < π (else no heading is far enough); got {h}")

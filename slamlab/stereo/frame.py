@@ -1,0 +1,77 @@
+"""The pieces of one frame of the stereo loop (000 §3.3-3.6): both images' features in two threads, the stage
+names and clock, the frame record, the default landmark store. Split from :mod:`slamlab.stereo.slam` (which
+re-exports the public names)."""
+
+from __future__ import annotations
+
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+from ..features.detect import detect
+from ..kdtree.stores import ExactStore, LandmarkStore, make_store
+from .params import StereoParams
+
+__all__ = ["STAGES", "FrameRecord", "default_store"]
+
+
+_EXECUTOR: ThreadPoolExecutor | None = None
+
+
+def _detect_pair(left, right, method, kwargs, parallel):
+    """Features of both images by :func:`slamlab.features.detect`; in two threads when ``parallel``
+    (OpenCV and numpy release the GIL)."""
+    global _EXECUTOR
+    if not parallel:
+        return detect(left, method, **kwargs), detect(right, method, **kwargs)
+    if _EXECUTOR is None:
+        _EXECUTOR = ThreadPoolExecutor(max_workers=2, thread_name_prefix="slamlab-detect")
+    fut = _EXECUTOR.submit(detect, right, method, **kwargs)
+    return detect(left, method, **kwargs), fut.result()
+
+
+def default_store(params: StereoParams | None = None) -> LandmarkStore:
+    """The landmark store the pipeline uses unless told otherwise (000 §3.4, §4).
+
+    Float descriptors (SURF, SIFT): 000's multi kd-tree (n1 = 3500, q = 5.5, BBF with 200
+    checks) behind the non-base buffer (:func:`slamlab.kdtree.make_store`). Binary descriptors
+    (ORB, Hamming distance): a kd-tree does not apply, so :class:`~slamlab.kdtree.ExactStore`
+    (brute force). Both apply the base rule with ``params``' ``base_seen_times`` / ``max_non_base_time``.
+
+    Parameters
+    ----------
+    params : StereoParams, optional
+        Settings (``detector``, ``base_seen_times``, ``max_non_base_time``); default :class:`StereoParams`.
+
+    Returns
+    -------
+    LandmarkStore
+    """
+    p = StereoParams.resolve(params)
+    if p.binary:
+        return ExactStore(p.base_seen_times, p.max_non_base_time)
+    return make_store("multi", base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
+
+
+#: the per-frame stages whose times are recorded
+STAGES = ("detect", "stereo", "triangulate", "map_match", "pose", "update")
+
+
+class _StageClock:
+    """Wall-clock and process CPU time per stage: ``lap(stage)`` adds the time since the last lap."""
+
+    def __init__(self):
+        self.wall = dict.fromkeys(STAGES, 0.0)
+        self.cpu = dict.fromkeys(STAGES, 0.0)
+        self._w, self._c = time.perf_counter(), time.process_time()
+
+    def lap(self, stage):
+        w, c = time.perf_counter(), time.process_time()
+        self.wall[stage] += w - self._w
+        self.cpu[stage] += c - self._c
+        self._w, self._c = w, c
+
+
+class FrameRecord(dict):
+    """Counts of one frame (a plain dict with attribute access)."""
+
+    __getattr__ = dict.__getitem__
