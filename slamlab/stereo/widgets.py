@@ -7,7 +7,7 @@ from IPython.display import display
 
 from ..widgets import STYLE as _STYLE
 from .experiments import experiment_poses, run_closed_loop, run_turn_in_place
-from .params import RenderParams
+from .params import STEREO_DETECTORS, RenderParams
 from .plot import run_figure
 
 __all__ = ["explore_stereo_slam"]
@@ -57,7 +57,7 @@ def explore_stereo_slam(**defaults):
         show,
         {"manual": True, "manual_name": "run"},
         experiment=widgets.Dropdown(options=["turn in place", "closed loop"], value=d["experiment"], description="experiment"),
-        detector=widgets.Dropdown(options=["surf", "orb", "sift"], value=d["detector"], description="detector"),
+        detector=widgets.Dropdown(options=list(STEREO_DETECTORS), value=d["detector"], description="detector"),
         policy=widgets.Dropdown(options=["oldest", "all"], value=d["policy"], description="landmarks"),
         ransac_iters=widgets.IntSlider(value=d["ransac_iters"], min=1, max=500, step=1, description="RANSAC iterations",
                                        continuous_update=False, style=_STYLE),

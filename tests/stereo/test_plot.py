@@ -43,12 +43,15 @@ def test_plots():
 
 def test_widget_runs_the_same_run_as_the_tests(capsys):
     from slamlab.stereo import RenderParams, run_turn_in_place
+    from slamlab.stereo.params import STEREO_DETECTORS
     from slamlab.stereo.widgets import explore_stereo_slam
 
     w = explore_stereo_slam(policy="oldest", n_frames=3)
     names = [getattr(c, "description", "") for c in w.children]
     assert "landmarks" in names
     assert "run" in names  # manual: nothing runs until the button is pressed
+    detector = next(c for c in w.children if getattr(c, "description", "") == "detector")
+    assert tuple(detector.options) == STEREO_DETECTORS  # the one detector table, not a list of the widget's own
     capsys.readouterr()
     sliders = {"experiment": "turn in place", "policy": "oldest", "ransac_iters": 200}
     w.f(**sliders, detector="orb", noise_std=1.0, drift_mrad=0.5)  # what the button calls
