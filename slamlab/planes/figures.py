@@ -295,7 +295,7 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz
             if r == 0:
                 first = (slam.X_predicted[:, :3, 3].copy(), slam.X_solved[:, :3, 3].copy(), slam.last_sad.copy(),
                          slam.weights.copy(), slam.X[:, :3, 3].copy(), rep)
-                slam.params = slam.params.replace(V_xyz_m2=V_later_xyz_m2, V_rpy_deg2=V_later_rpy_deg2)
+                slam.reconfigure(V_xyz_m2=V_later_xyz_m2, V_rpy_deg2=V_later_rpy_deg2)
         out[use] = (first, abs(slam.pose[0, 3] - flights[1].poses[-1][0, 3]), slam)
     (pred, solved, sad, w, res, rep), err_on, slam_on = out[True]
     return IntensityResult(pred, solved, sad, w, res, flights[1].poses[-1][:3, 3], float(err_on),

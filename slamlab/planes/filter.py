@@ -212,6 +212,35 @@ class PlaneSLAM:
         #: False freezes the map (ours: for one-cycle studies such as 002 Fig. 4)
         self.update_map = True
 
+    #: fields read once, when the filter is built (the particle array, the map's merge and voxel settings)
+    FIXED_AT_START = ("n_particles", "merge_angle_deg", "merge_dist_m", "voxel_m")
+
+    def reconfigure(self, **overrides) -> PlaneSLAMParams:
+        """Change settings between cycles (ours): the next :meth:`step` uses them, as a re-tuned filter would.
+
+        Parameters
+        ----------
+        **overrides
+            :class:`PlaneSLAMParams` fields read at every cycle (e.g. the prediction variances ``V_xyz_m2``,
+            ``V_rpy_deg2``); checked as at construction.
+
+        Returns
+        -------
+        PlaneSLAMParams
+            The settings now in force (also ``self.params``).
+
+        Raises
+        ------
+        ValueError
+            For a field in :attr:`FIXED_AT_START`, which only a new filter can change.
+        """
+        fixed = sorted(set(overrides) & set(self.FIXED_AT_START))
+        if fixed:
+            raise ValueError(f"{', '.join(map(repr, fixed))} cannot change after the filter is built "
+                             "(build a new PlaneSLAM)")
+        self.params = self.params.replace(**overrides)
+        return self.params
+
     # --- the stages -------------------------------------------------------------------------------------------
     def detect(self, frame: Frame):
         """Stages 1-2: planes of ``frame`` and their descriptions (body frame), the leftover mask.

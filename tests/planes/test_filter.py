@@ -178,3 +178,20 @@ def test_V_is_a_variance():
         PlaneSLAMParams(V_xyz_m2=-1.0)
     with pytest.raises(TypeError, match="sigma_xyz_m"):
         PlaneSLAMParams.resolve(None, sigma_xyz_m=0.03)
+
+
+def test_reconfigure_changes_the_next_prediction_and_refuses_fixed_fields():
+    empty = Frame(np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), 0)  # keeps the prediction: X moves by ε only
+    s = PlaneSLAM(n_particles=4000, rng=0, V_xyz_m2=0.04)
+    s.step(empty, np.eye(4))
+    assert np.std(s.X[:, :3, 3]) == pytest.approx(0.2, rel=0.05)  # sqrt(V) of the first setting
+    before = s.X[:, :3, 3].copy()
+    assert s.reconfigure(V_xyz_m2=1e-4) is s.params and s.params.V_xyz_m2 == 1e-4
+    s.step(empty, np.eye(4))
+    assert np.std(s.X[:, :3, 3] - before) == pytest.approx(0.01, rel=0.05)  # the new V: sqrt(1e-4)
+    with pytest.raises(ValueError, match="'n_particles' cannot change"):
+        s.reconfigure(n_particles=10)
+    with pytest.raises(ValueError, match="V_xyz_m2"):
+        s.reconfigure(V_xyz_m2=-1.0)
+    with pytest.raises(TypeError, match="no field"):
+        s.reconfigure(sigma_xyz_m=0.1)
