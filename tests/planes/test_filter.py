@@ -186,7 +186,8 @@ def test_reconfigure_changes_the_next_prediction_and_refuses_fixed_fields():
     s.step(empty, np.eye(4))
     assert np.std(s.X[:, :3, 3]) == pytest.approx(0.2, rel=0.05)  # sqrt(V) of the first setting
     before = s.X[:, :3, 3].copy()
-    assert s.reconfigure(V_xyz_m2=1e-4) is s.params and s.params.V_xyz_m2 == 1e-4
+    assert s.reconfigure(V_xyz_m2=1e-4) is s.params
+    assert s.params.V_xyz_m2 == 1e-4
     s.step(empty, np.eye(4))
     assert np.std(s.X[:, :3, 3] - before) == pytest.approx(0.01, rel=0.05)  # the new V: sqrt(1e-4)
     with pytest.raises(ValueError, match="'n_particles' cannot change"):
