@@ -66,6 +66,20 @@ def sequence_poses(name: str, n_frames: int = 60, *, step_m: float = 0.02) -> np
     yaw sway (the easy case for a monocular camera: parallax from translation across the view).
     ``"arc"``: forward on a circle of 2.5 m radius about the arena centre (parallax mostly
     along the optical axis). ``"turn"``: rotation in place (003 §5.3's pure rotation).
+
+    Parameters
+    ----------
+    name : str
+        ``"strafe"``, ``"arc"`` or ``"turn"``.
+    n_frames : int
+        Number of poses, at least 2 (default 60).
+    step_m : float
+        Distance between frames [m] (default 0.02; ``"turn"`` ignores it).
+
+    Returns
+    -------
+    poses : ndarray, shape (n_frames, 3)
+        ``(x_m, y_m, yaw_rad)`` per frame.
     """
     v.check_choice(name, "name", (*SEQUENCES, "turn"))
     n = v.check_int(n_frames, "n_frames", minimum=2)
@@ -88,6 +102,24 @@ def mono_sim(size: str = "small", *, arena: StereoArena | None = None, noise_std
     Default arena: seed 0 with the floor texture at full contrast (ours: a monocular camera
     needs points off the fence's plane; with the fence alone, a thin band of coplanar points,
     vertical translation and pitch are nearly indistinguishable).
+
+    Parameters
+    ----------
+    size : str
+        Image size: ``"tiny"`` (192×144), ``"small"`` (320×240, default) or ``"full"`` (768×576).
+    arena : StereoArena, optional
+        The scene; ``None`` = seed 0 with a full-contrast floor.
+    noise_std : float
+        Image noise [grey levels] (default 1).
+    camera_height_m : float
+        Height of the camera above the floor [m] (default 0.6).
+    rng : Generator, int or None
+        Randomness of the image noise (default 0).
+
+    Returns
+    -------
+    StereoSim
+        The simulator (its ``rig.left`` is the monocular camera).
     """
     w, h = SIZES[v.check_choice(size, "size", tuple(SIZES))]
     return StereoSim(StereoArena(seed=0, floor_contrast=1.0) if arena is None else arena,
@@ -103,6 +135,28 @@ def render_sequence(sim: StereoSim, poses, *, blur_px: float = 0.0, contrast: fl
     """Left-camera images ``(N, H, W)`` uint8 and true camera poses ``(N, 4, 4)`` (world ← camera).
 
     ``contrast`` < 1 and ``blur_px`` > 0 turn a scene into a low-texture one (ours, for 003 §5.3).
+
+    Parameters
+    ----------
+    sim : StereoSim
+        The simulator (:func:`mono_sim`).
+    poses : array_like, shape (N, 3)
+        Body poses ``(x_m, y_m, yaw_rad)`` (:func:`sequence_poses`).
+    blur_px : float
+        Gaussian blur σ [px] (default 0: none).
+    contrast : float
+        Contrast factor about mid-grey (default 1).
+    pitch_down_rad : float
+        Downward tilt of the camera [rad] (default 20°).
+    progress : bool, callable or None
+        Progress display (``slamlab._progress``).
+
+    Returns
+    -------
+    images : ndarray of uint8, shape (N, H, W)
+        Left-camera images.
+    T_wc : ndarray, shape (N, 4, 4)
+        True camera poses (camera to world).
     """
     import cv2
 
@@ -131,6 +185,20 @@ def trajectory_errors(truth, estimate, tracked):
 
     ``truth``/``estimate`` (N, 4, 4). Returns ``(ate_m, rpe_m)``; NaN-free: ``inf`` when fewer
     than 3 frames were tracked.
+
+    Parameters
+    ----------
+    truth, estimate : ndarray, shape (N, 4, 4)
+        True and estimated camera poses.
+    tracked : array_like of bool, shape (N,)
+        Frames to evaluate.
+
+    Returns
+    -------
+    ate_m : float
+        ATE RMSE after Sim(3) alignment [m].
+    rpe_m : float
+        RPE RMSE of one-frame translations [m].
     """
     from ..evaluation import Trajectory, ate, rpe
 
@@ -157,6 +225,35 @@ class MonoRunResult:
     within ``score.tol_m`` after the run's Sim(3), :func:`~slamlab.mono.evaluate.score_run`); ``ate_m``
     is over all frames (a frame not tracked counts with the pose the tracker reports for it),
     ``ate_claimed_m`` over the claimed ones.
+
+    Attributes
+    ----------
+    name : str
+        Label of the run.
+    truth : ndarray, shape (N, 4, 4)
+        True camera poses in the first frame's camera frame.
+    estimate : ndarray, shape (N, 4, 4)
+        Estimated camera poses (map units).
+    claimed : ndarray of bool, shape (N,)
+        The tracker's own "tracked" flags.
+    status : tuple of str
+        Status of every frame.
+    score : RunScore
+        Per-frame errors after the run's Sim(3), ``correct`` frames, ATE and scale figures.
+    rpe_m : float
+        RPE of one-frame translations [m].
+    n_keyframes, n_points : int
+        Size of the final map.
+    counts : dict
+        Status → number of frames.
+    stage_time_s : dict
+        Seconds spent per stage.
+    fps : float
+        Frames per second of the run.
+    points : ndarray, shape (M, 3), optional
+        Final map points.
+    seed_snapshots : dict, optional
+        Frame → the seeds' ``σ_ρ / ρ_range`` after it.
     """
 
     name: str
@@ -268,6 +365,32 @@ def run_mono(images, truth_T_wc, K, *, name: str = "run", params: MonoParams | N
     ``track_tol``: a claimed frame is correctly tracked when its position error after the run's Sim(3)
     is at most this share of the path length (ours, default 5 %). Raises ``ValueError`` naming the argument when the frames differ in size or ``truth_T_wc``
     does not hold one pose per frame.
+
+    Parameters
+    ----------
+    images : sequence of ndarray, shape (H, W)
+        Grey frames of one size.
+    truth_T_wc : array_like, shape (N, 4, 4)
+        True camera poses, one per frame.
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    name : str
+        Label of the run (default ``"run"``).
+    params : MonoParams, optional
+        Settings (default values).
+    progress : bool, callable or None
+        Progress display.
+    snapshot_frames : iterable of int
+        Frames after which the seeds are kept.
+    track_tol : float
+        Tolerance of a correctly tracked frame as a fraction of the path length (default 0.05).
+    **overrides
+        Fields of :class:`MonoParams` to change.
+
+    Returns
+    -------
+    MonoRunResult
+        ``tracked``, ``ate_m``, ``rpe_m``, ``counts``, ``fps`` among others.
     """
     images = _check_frames(images)
     truth_T_wc = _check_truth(truth_T_wc, len(images))
@@ -295,7 +418,33 @@ def run_mono(images, truth_T_wc, K, *, name: str = "run", params: MonoParams | N
 def run_mono_sequence(sequence: str = "strafe", *, n_frames: int = 60, size: str = "small", step_m: float = 0.02,
                       noise_std: float = 1.0, params: MonoParams | None = None, progress=None, rng=0,
                       **overrides) -> MonoRunResult:
-    """Render a sequence of the arena with the left camera and run the monocular pipeline on it."""
+    """Render a sequence of the arena with the left camera and run the monocular pipeline on it.
+
+    Parameters
+    ----------
+    sequence : str
+        ``"strafe"``, ``"arc"`` or ``"turn"`` (:func:`sequence_poses`; default ``"strafe"``).
+    n_frames : int
+        Number of frames (default 60).
+    size : str
+        Image size (:func:`mono_sim`; default ``"small"``).
+    step_m : float
+        Distance between frames [m] (default 0.02).
+    noise_std : float
+        Image noise [grey levels] (default 1).
+    params : MonoParams, optional
+        Settings (default values).
+    progress : bool, callable or None
+        Progress display.
+    rng : Generator, int or None
+        Randomness of the image noise (default 0).
+    **overrides
+        Fields of :class:`MonoParams` to change.
+
+    Returns
+    -------
+    MonoRunResult
+    """
     sim = mono_sim(size, noise_std=noise_std, rng=rng)
     poses = sequence_poses(sequence, n_frames, step_m=step_m)
     imgs, Ts = render_sequence(sim, poses, progress=progress)
@@ -313,6 +462,25 @@ class ConvergenceStudy:
     ``sigma`` (R, n_obs + 1) median σ_ρ (1/m), ``inlier`` (R, n_obs + 1) median a/(a+b),
     ``error`` (R, n_obs + 1) median |ρ − ρ_true| (1/m), ``converged`` (R, n_obs + 1) share of seeds
     passing SVO's σ test, ``mu`` (R, n_seeds) final means, ``rho_true`` (n_seeds,).
+
+    Attributes
+    ----------
+    outlier_rates : tuple of float
+        The outlier rates studied (R of them).
+    sigma : ndarray, shape (R, n_obs + 1)
+        Median σ_ρ [1/m].
+    inlier : ndarray, shape (R, n_obs + 1)
+        Median ``a / (a + b)``.
+    error : ndarray, shape (R, n_obs + 1)
+        Median ``|ρ − ρ_true|`` [1/m].
+    converged : ndarray, shape (R, n_obs + 1)
+        Share of seeds passing SVO's σ test.
+    mu : ndarray, shape (R, n_seeds)
+        Final means [1/m].
+    rho_true : ndarray, shape (n_seeds,)
+        True inverse depths [1/m].
+    tau : float
+        Measurement standard deviation [1/m].
     """
 
     outlier_rates: tuple
@@ -337,6 +505,17 @@ class ConvergenceStudy:
         return out
 
     def table(self, at=(0, 5, 10, 20, 40)) -> str:
+        """The medians per outlier rate after some numbers of observations, as a printed table.
+
+        Parameters
+        ----------
+        at : tuple of int
+            Numbers of observations to show (those beyond ``n_obs`` are left out).
+
+        Returns
+        -------
+        str
+        """
         at = [k for k in at if k < self.sigma.shape[1]]
         rows = []
         for i, r in enumerate(self.outlier_rates):
@@ -350,7 +529,28 @@ class ConvergenceStudy:
 
 def run_depth_filter_convergence(outlier_rates=(0.0, 0.2, 0.4, 0.6), *, n_obs: int = 40, n_seeds: int = 500,
                                  tau: float = 0.01, depth_min_m: float = 0.5, rng=0) -> ConvergenceStudy:
-    """Gaussian × Beta seeds (SVO's start) fed inliers ``N(ρ_true, τ²)`` and outliers ``U(0, ρ_range)``."""
+    """Gaussian × Beta seeds (SVO's start) fed inliers ``N(ρ_true, τ²)`` and outliers ``U(0, ρ_range)``.
+
+    Parameters
+    ----------
+    outlier_rates : sequence of float
+        Outlier rates in ``[0, 1)``, one study each.
+    n_obs : int
+        Observations per seed (default 40).
+    n_seeds : int
+        Seeds per rate (default 500).
+    tau : float
+        Measurement standard deviation [1/m] (default 0.01).
+    depth_min_m : float
+        Smallest depth [m]; ``ρ_range = 1 / depth_min_m`` (default 0.5).
+    rng : Generator, int or None
+        Randomness of the scene and the measurements (default 0).
+
+    Returns
+    -------
+    ConvergenceStudy
+        ``sigma``, ``inlier``, ``error``, ``converged`` per rate and observation.
+    """
     from .depth_filter import converged_sigma, init_seeds, inlier_ratio, update_seeds
 
     rng = v.as_rng(rng)
@@ -426,6 +626,28 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
     frame; ``pure_rotation`` 2° per frame in place; ``distant_points`` a 60×60 m arena seen from
     its middle; ``kidnap`` carried 2 m between two frames; ``bad_initial_map`` initialised after
     2 px of displacement. Returns ``{case: MonoRunResult}``.
+
+    Parameters
+    ----------
+    cases : sequence of str
+        Cases to run (default ``"normal"`` and every one of ``FAILURE_CASES``).
+    size : str
+        Image size (:func:`mono_sim`; default ``"tiny"``).
+    n_frames : int
+        Frames per case (default 30).
+    params : MonoParams, optional
+        Settings (default values).
+    progress : bool, callable or None
+        Progress display.
+    rng : Generator, int or None
+        Randomness; each case gets its own spawned stream (default 0).
+    **overrides
+        Fields of :class:`MonoParams` to change.
+
+    Returns
+    -------
+    dict
+        Case → :class:`MonoRunResult`.
     """
     out = {}
     from ..sweep import fresh_seed_sequence
@@ -438,7 +660,18 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
 
 
 def failure_table(results: dict) -> str:
-    """003 §5.5.1's table layout: the correctly tracked share with its mark (X < 30 %, * 30-70 %) and the ATE."""
+    """003 §5.5.1's table layout: the correctly tracked share with its mark (X < 30 %, * 30-70 %) and the ATE.
+
+    Parameters
+    ----------
+    results : dict
+        Case → :class:`MonoRunResult` (:func:`run_failure_cases`).
+
+    Returns
+    -------
+    str
+        The printed table.
+    """
     rows = []
     for name, r in results.items():
         ate_txt = f"{r.ate_m:.3f}" if np.isfinite(r.ate_m) else "-"

@@ -50,6 +50,30 @@ def track_lk(img0, img1, uv0, *, win_px: int = 21, levels: int = 3, uv1_guess=No
     ``cv2.calcOpticalFlowPyrLK`` with a ``win_px`` window on ``levels`` pyramid levels;
     ``ok`` also drops tracks that leave the image. ``uv1_guess`` starts from a prediction.
     ``fb_max_px`` (ours): also track back and drop tracks that do not return within it.
+
+    Parameters
+    ----------
+    img0, img1 : array_like, shape (H, W)
+        Grey images tracked from and to.
+    uv0 : array_like, shape (N, 2)
+        Pixels in ``img0``.
+    win_px : int
+        Search window side [px] (default 21).
+    levels : int
+        Pyramid levels above the image (default 3).
+    uv1_guess : array_like, shape (N, 2), optional
+        Predicted pixels in ``img1`` to start from.
+    max_err : float, optional
+        Largest OpenCV tracking error of a kept track; ``None`` = no limit.
+    fb_max_px : float, optional
+        Largest forward-backward distance [px]; ``None`` = no backward check.
+
+    Returns
+    -------
+    uv1 : ndarray, shape (N, 2)
+        Tracked pixels in ``img1``.
+    ok : ndarray of bool, shape (N,)
+        Tracks found and kept.
     """
     import cv2
 
@@ -92,6 +116,23 @@ class TwoViewPose:
     ``inliers`` (N,) the RANSAC inliers; ``n_front`` points in front of both cameras for the
     chosen solution; ``normal`` the plane normal in view 0 (homography) or None; ``ok`` False
     when the input was degenerate (then ``R = I``, ``t = 0``); ``reason`` says why.
+
+    Attributes
+    ----------
+    R : ndarray, shape (3, 3)
+        Rotation of view 0 into view 1.
+    t : ndarray, shape (3,)
+        Unit translation (0 when not ``ok``).
+    inliers : ndarray of bool, shape (N,)
+        RANSAC inliers.
+    n_front : int
+        Points in front of both cameras for the chosen solution.
+    normal : ndarray, shape (3,), or None
+        Plane normal in view 0 (homography), else ``None``.
+    ok : bool
+        False when the input was degenerate.
+    reason : str
+        Why it failed (``""`` when ``ok``).
     """
 
     R: np.ndarray
@@ -114,7 +155,26 @@ def _norm3(x) -> float:
 
 
 def triangulate_two_view(K, R, t, uv0, uv1):
-    """Points in view 0 from pixel pairs (linear DLT, ``cv2.triangulatePoints``): ``(X0 (N, 3), in_front)``."""
+    """Points in view 0 from pixel pairs (linear DLT, ``cv2.triangulatePoints``): ``(X0 (N, 3), in_front)``.
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    R : array_like, shape (3, 3)
+        Rotation of view 0 into view 1.
+    t : array_like, shape (3,)
+        Translation of view 1 (``X_1 = R X_0 + t``).
+    uv0, uv1 : array_like, shape (N, 2)
+        Matched pixels in views 0 and 1.
+
+    Returns
+    -------
+    X0 : ndarray, shape (N, 3)
+        Points in the frame of view 0 (units of ``t``).
+    in_front : ndarray of bool, shape (N,)
+        Finite and in front of both cameras.
+    """
     import cv2
 
     K = v.as_matrix(K, "K", (3, 3))
@@ -157,6 +217,22 @@ def polish_homography(H, uv0, uv1, *, mantissa_bits: int = 14, max_iter: int = 5
     rounding boundary), then refined by Levenberg-Marquardt on the one-sided transfer error
     ``|π(H x0) − x1|²`` written without BLAS/LAPACK (see :func:`slamlab.mono.align.solve_spd`),
     to convergence: the result depends on the inliers, not on the machine.
+
+    Parameters
+    ----------
+    H : array_like, shape (3, 3)
+        OpenCV's homography from view 0 to view 1.
+    uv0, uv1 : array_like, shape (N, 2)
+        Inlier pixel pairs.
+    mantissa_bits : int
+        Significant bits kept when snapping ``H`` (default 14).
+    max_iter : int
+        Levenberg-Marquardt steps at most (default 50).
+
+    Returns
+    -------
+    H : ndarray, shape (3, 3)
+        The re-fitted homography.
     """
     from .align import solve_spd
 
@@ -222,6 +298,22 @@ def relative_pose_homography(uv0, uv1, K, *, ransac_px: float = 2.0, min_points:
     ``cv2.findHomography(RANSAC)`` then ``cv2.decomposeHomographyMat`` (up to four
     solutions); we keep the one with most inliers triangulated in front of both views and,
     on a tie, the plane normal most facing view 0 (our choice). ``t`` is normalised.
+
+    Parameters
+    ----------
+    uv0, uv1 : array_like, shape (N, 2)
+        Tracked pixel pairs in views 0 and 1.
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    ransac_px : float
+        RANSAC reprojection threshold [px] (default 2).
+    min_points : int
+        Fewest pairs (at least 4) before failing with ``"too_few_points"`` (default 8).
+
+    Returns
+    -------
+    TwoViewPose
+        ``R``, ``t``, ``inliers``, ``normal``, ``ok``, ``reason``.
     """
     import cv2
 
@@ -259,7 +351,26 @@ def relative_pose_homography(uv0, uv1, K, *, ransac_px: float = 2.0, min_points:
 
 def relative_pose_essential(uv0, uv1, K, *, ransac_px: float = 1.0, prob: float = 0.999,
                             min_points: int = 8) -> TwoViewPose:
-    """Pose by the 5-point algorithm: ``cv2.findEssentialMat`` (RANSAC) + ``cv2.recoverPose`` (003 §4.3.1)."""
+    """Pose by the 5-point algorithm: ``cv2.findEssentialMat`` (RANSAC) + ``cv2.recoverPose`` (003 §4.3.1).
+
+    Parameters
+    ----------
+    uv0, uv1 : array_like, shape (N, 2)
+        Tracked pixel pairs in views 0 and 1.
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    ransac_px : float
+        RANSAC threshold [px] (default 1).
+    prob : float
+        RANSAC confidence (default 0.999).
+    min_points : int
+        Fewest pairs (at least 5) before failing with ``"too_few_points"`` (default 8).
+
+    Returns
+    -------
+    TwoViewPose
+        ``R``, ``t``, ``inliers``, ``n_front``, ``ok`` (``normal`` is ``None``).
+    """
     import cv2
 
     uv0, uv1 = _check_uv_pair(uv0, uv1)
@@ -287,6 +398,19 @@ class InitResult:
     tracks, ``X0`` (M, 3) their points in the first keyframe's frame scaled to a median
     depth of ``median_depth_m`` (SVO's convention; the scale of a monocular map is free),
     ``frame0``/``frame1`` the indices of the two keyframes.
+
+    Attributes
+    ----------
+    pose : TwoViewPose
+        Relative pose of the second keyframe.
+    uv0, uv1 : ndarray, shape (M, 2)
+        Inlier tracks in the two keyframes.
+    X0 : ndarray, shape (M, 3)
+        Their points in the first keyframe's frame, scaled to a median depth of ``median_depth_m``.
+    frame0, frame1 : int
+        Indices of the two keyframes.
+    scale : float
+        Factor applied to the triangulated points.
     """
 
     pose: TwoViewPose
@@ -304,6 +428,43 @@ class Initialiser:
 
     Feed frames to :meth:`add_frame`; it returns a status in :data:`INIT_STATUSES` and, once
     ``"done"``, :attr:`result` holds the map. ``counts`` tallies every status.
+
+    Attributes
+    ----------
+    K : ndarray, shape (3, 3)
+        Intrinsic matrix.
+    detect : callable
+        ``detect(image) -> (N, 2)`` corners.
+    min_corners : int
+        Fewest corners of a first frame (default 50).
+    min_disparity_px : float
+        Mean track length [px] before a pose is tried (default 15).
+    min_tracked_ratio : float
+        Share of ``min_corners`` that must survive tracking, else restart (default 0.5).
+    method : str
+        ``"homography"`` (003), ``"essential"`` or ``"auto"`` (default ``"homography"``).
+    ransac_px : float
+        RANSAC threshold [px] (default 2).
+    min_parallax_deg : float
+        Median triangulation angle needed [deg] (default 1).
+    min_point_parallax_deg : float
+        Triangulation angle a point of the first map needs [deg] (default 0).
+    plane_share : float
+        ``"auto"``: the homography when its inliers are at least this share of the 5-point's (default 0.9).
+    median_depth_m : float
+        Median depth the first map is scaled to (default 1).
+    lk_win_px : int
+        Lucas-Kanade window [px] (default 21).
+    fb_max_px : float
+        Forward-backward tolerance of the tracks [px] (default 1).
+    ref_image, ref_uv, cur_uv : ndarray or None
+        State: first keyframe, its corners and their current tracks.
+    ref_index, frame_index : int
+        State: index of the first keyframe and of the last frame.
+    result : InitResult or None
+        The map once the status is ``"done"``.
+    counts : dict
+        Status → number of frames.
     """
 
     K: np.ndarray
@@ -342,6 +503,20 @@ class Initialiser:
         return status
 
     def reset(self, image, index):
+        """Start over with ``image`` as the first keyframe (003 §4.3.1); return the status.
+
+        Parameters
+        ----------
+        image : ndarray, shape (H, W)
+            Grey image.
+        index : int
+            Its frame index.
+
+        Returns
+        -------
+        status : str
+            ``"first_frame"`` or ``"too_few_corners"``.
+        """
         uv = np.asarray(self.detect(image), float).reshape(-1, 2)
         if uv.shape[0] < self.min_corners:
             self.ref_image = None
@@ -351,7 +526,18 @@ class Initialiser:
         return self._count("first_frame")
 
     def add_frame(self, image) -> str:
-        """Process one grey image; return the status (003 §4.3.1)."""
+        """Process one grey image; return the status (003 §4.3.1).
+
+        Parameters
+        ----------
+        image : array_like, shape (H, W)
+            Next grey image.
+
+        Returns
+        -------
+        status : str
+            One of ``INIT_STATUSES``; ``"done"`` sets :attr:`result`.
+        """
         image = v.as_image(image, "image")
         self.frame_index += 1
         if self.ref_image is None:

@@ -50,7 +50,18 @@ STAGES = ("detect", "align", "match", "refine", "mapping", "keyframe")
 def orthonormalise(T) -> np.ndarray:
     """``T`` with its rotation pulled back onto SO(3) by two Newton-Schulz steps ``R ← R (3I − RᵀR) / 2``
     (ours; einsum, no BLAS). A constant-velocity prior composes a pose with the inverse (the transpose)
-    of the last one every frame: without this, a 1e-16 departure from orthonormality grows ~2.4× per frame."""
+    of the last one every frame: without this, a 1e-16 departure from orthonormality grows ~2.4× per frame.
+
+    Parameters
+    ----------
+    T : array_like, shape (4, 4)
+        Rigid transform whose rotation has drifted from SO(3).
+
+    Returns
+    -------
+    T : ndarray, shape (4, 4)
+        A copy with the rotation re-orthonormalised (translation unchanged).
+    """
     T = np.array(T, dtype=np.float64)
     R = T[:3, :3]
     for _ in range(2):
@@ -61,7 +72,19 @@ def orthonormalise(T) -> np.ndarray:
 
 @dataclass
 class Keyframe:
-    """A keyframe (003 §4.3): its id, frame index, pose ``T_cw`` (world → camera) and image."""
+    """A keyframe (003 §4.3): its id, frame index, pose ``T_cw`` (world → camera) and image.
+
+    Attributes
+    ----------
+    id : int
+        Keyframe number.
+    frame : int
+        Index of its frame in the sequence.
+    T_cw : ndarray, shape (4, 4)
+        Pose, world to camera.
+    image : ndarray, shape (H, W)
+        Its grey image.
+    """
 
     id: int
     frame: int
@@ -78,8 +101,12 @@ class MonoSLAM:
 
     Parameters
     ----------
-    K : (3, 3) intrinsic matrix of the (undistorted) camera.
-    params : :class:`MonoParams` (default values with their sources).
+    K : array_like, shape (3, 3)
+        Intrinsic matrix of the (undistorted) camera.
+    params : MonoParams, optional
+        Settings (default: :class:`MonoParams`' values with their sources).
+    **overrides
+        Fields of :class:`MonoParams` to change (``MonoParams.resolve(params, **overrides)``).
 
     The world frame is the first keyframe's camera frame; the map's scale is set by the
     initialisation (median depth 1 of the first map, SVO's convention): compare with ground
@@ -145,7 +172,19 @@ class MonoSLAM:
 
     # -- public ----------------------------------------------------------------------------
     def process(self, image) -> dict:
-        """Process one grey frame; returns its record (status, pose, counts, stage times)."""
+        """Process one grey frame; returns its record (status, pose, counts, stage times).
+
+        Parameters
+        ----------
+        image : array_like, shape (H, W)
+            Next grey frame, the size of the first one.
+
+        Returns
+        -------
+        record : dict
+            ``frame``, ``status``, ``tracked``, ``T_wc`` (4, 4), ``n_inliers``, ``n_matched``, ``align_rms``,
+            ``n_points``, ``n_seeds``, ``n_keyframes``, ``times`` (seconds per stage).
+        """
         image = v.as_image(image, "image")
         if image.ndim == 3:
             raise ValueError(f"`image` must be a grey image (H, W); got shape {image.shape}")

@@ -57,7 +57,18 @@ __all__ = [
 
 # -- 003 §2.1: the pinhole camera ----------------------------------------------------------------
 def chapter_cameras(kitti_folder=None) -> dict:
-    """``{name: (K, width_px, height_px)}``: the rendered camera (tiny size) and KITTI 06's left camera."""
+    """``{name: (K, width_px, height_px)}``: the rendered camera (tiny size) and KITTI 06's left camera.
+
+    Parameters
+    ----------
+    kitti_folder : str or Path, optional
+        KITTI odometry folder with ``calib.txt``; ``None`` = the bundled 06 set.
+
+    Returns
+    -------
+    dict
+        Camera name → ``(K (3, 3), width_px, height_px)``.
+    """
     from ..data import find_data
     from ..io.kitti import read_kitti_calib
     from .experiments import SIZES, mono_sim
@@ -72,7 +83,20 @@ def chapter_cameras(kitti_folder=None) -> dict:
 
 def pinhole_table(X_cam=(0.5, -0.2, 4.0), cameras=None) -> str:
     """003 §2.1 (eq. 2.1-2.4, lost; reconstruction): ``K = [[fx, 0, u0], [0, fy, v0], [0, 0, 1]]`` and
-    ``u = fx X/Z + u0``, ``v = fy Y/Z + v0``, for a point ``X_cam`` (m, camera frame) in each camera."""
+    ``u = fx X/Z + u0``, ``v = fy Y/Z + v0``, for a point ``X_cam`` (m, camera frame) in each camera.
+
+    Parameters
+    ----------
+    X_cam : array_like, shape (3,)
+        Point in the camera frame [m], ``Z > 0``.
+    cameras : dict, optional
+        Name → ``(K, width_px, height_px)``; ``None`` = :func:`chapter_cameras`.
+
+    Returns
+    -------
+    str
+        One row per camera: ``fx``, ``fy``, ``u0``, ``v0``, field of view and the point's pixel.
+    """
     X = v.as_vector(X_cam, "X_cam", 3)
     if X[2] <= 0:
         raise ValueError(f"`X_cam` must lie in front of the camera (Z > 0); got Z = {X[2]}")
@@ -98,6 +122,24 @@ def inverse_depth_point_table(K=None, uv=(150.0, 40.0), rhos=(0.5, 0.2, 0.05, 1e
     pose in the world is ``R_F`` (a yaw of ``yaw_deg`` about the camera's y axis, ours) and ``T_F``.
     Computed with :func:`~slamlab.mono.seed_points`; the last column reprojects X into F (it must give
     the pixel back for every ρ: the depth moves the point along the ray only).
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3), optional
+        Intrinsic matrix; ``None`` = the rendered (tiny) camera.
+    uv : array_like, shape (2,)
+        The pixel in keyframe F [px].
+    rhos : array_like, shape (n,)
+        Inverse depths [1/m], one row each.
+    yaw_deg : float
+        Rotation of F about its camera ``y`` axis [deg] (default 30).
+    T_F_m : array_like, shape (3,)
+        Position of F in the world [m].
+
+    Returns
+    -------
+    str
+        One row per ρ: the world point and its reprojection into F.
     """
     from ..geometry.camera import rotation_xyz
     from .depth_filter import Seeds, seed_points
@@ -137,6 +179,22 @@ def tau_table(depths_m=(2.0, 5.0, 10.0), baselines_m=(0.02, 0.1, 0.5), *, f_px: 
     The point lies straight ahead of the reference camera (``f = (0, 0, 1)``), the current camera
     ``baseline_m`` to the side. ``τ_ρ = ½ (1/(z − τ) − 1/(z + τ))`` (SVO) is printed beside its
     first-order form ``τ / z²`` (``dρ/dz = −1/z²``).
+
+    Parameters
+    ----------
+    depths_m : sequence of float
+        Depths of the point straight ahead [m].
+    baselines_m : sequence of float
+        Sideways offsets of the current camera [m].
+    f_px : float, optional
+        Focal length [px]; ``None`` = the rendered (tiny) camera's.
+    px_noise : float
+        Measurement error [px] (default 1).
+
+    Returns
+    -------
+    str
+        One row per (depth, baseline): ``τ`` [m], ``τ_ρ`` [1/m] and its first-order form.
     """
     f_px = float(chapter_cameras()["rendered (tiny)"][0][0, 0]) if f_px is None else v.check_positive(f_px, "f_px")
     ang = 2 * np.arctan(px_noise / (2 * f_px))
@@ -160,6 +218,19 @@ class ConvergenceTests:
     ``conv_L`` / ``conv_svo`` (R, n_obs + 1) cumulative share converged by 003's ``L < L_max`` and by
     SVO's ``σ < ρ_range/200``; ``err_L`` / ``err_svo`` (R,) median relative range error of the seeds
     at the moment each test accepted them.
+
+    Attributes
+    ----------
+    outlier_rates : tuple of float
+        The outlier rates studied (R of them).
+    step_m : float
+        Sideways camera motion per frame [m].
+    L_max : float
+        Threshold of 003's linearity test.
+    conv_L, conv_svo : ndarray, shape (R, n_obs + 1)
+        Cumulative share of seeds converged by 003's test and by SVO's.
+    err_L, err_svo : ndarray, shape (R,)
+        Median relative range error of the seeds when each test accepted them.
     """
 
     outlier_rates: tuple
@@ -175,7 +246,18 @@ class ConvergenceTests:
                 f"outliers {', '.join(f'{r:.0%}' for r in self.outlier_rates)}")
 
     def first_half(self, which: str = "L") -> list:
-        """Observations until half of the seeds pass the test (None if never), per outlier rate."""
+        """Observations until half of the seeds pass the test (None if never), per outlier rate.
+
+        Parameters
+        ----------
+        which : str
+            ``"L"`` (003's test, default) or any other value for SVO's.
+
+        Returns
+        -------
+        list of int or None
+            One number of observations per outlier rate.
+        """
         c = self.conv_L if which == "L" else self.conv_svo
         out = []
         for row in c:
@@ -184,6 +266,17 @@ class ConvergenceTests:
         return out
 
     def table(self, at=(5, 10, 20, 30)) -> str:
+        """Converged shares after some numbers of observations, by both tests, as a printed table.
+
+        Parameters
+        ----------
+        at : tuple of int
+            Numbers of observations to show (those beyond ``n_obs`` are left out).
+
+        Returns
+        -------
+        str
+        """
         at = [k for k in at if k < self.conv_L.shape[1]]
         rows = []
         hL, hS = self.first_half("L"), self.first_half("svo")
@@ -205,6 +298,30 @@ def run_convergence_tests(outlier_rates=(0.0, 0.2, 0.4), *, n_obs: int = 30, n_s
     true inverse range plus noise of the ``τ`` of that baseline (one pixel, :func:`compute_tau`), or
     with probability ``r`` an outlier uniform on ``[0, ρ_range]``. A seed counts as converged from
     the first observation at which a test passes (the pipeline then stops updating it).
+
+    Parameters
+    ----------
+    outlier_rates : sequence of float
+        Outlier rates in ``[0, 1)``, one study each.
+    n_obs : int
+        Observations per seed (default 30).
+    n_seeds : int
+        Seeds per rate (default 400).
+    step_m : float
+        Sideways camera motion per frame [m] (default 0.02).
+    depth_range_m : tuple of float
+        Range of the seeds' depths [m] (default 1.5 to 6).
+    f_px : float
+        Focal length [px] (default 263.76, the rendered tiny camera).
+    L_max : float
+        Threshold of 003's linearity test (default 0.1).
+    rng : Generator, int or None
+        Randomness of the scene and the measurements (default 0).
+
+    Returns
+    -------
+    ConvergenceTests
+        ``conv_L``, ``conv_svo``, ``err_L``, ``err_svo`` per rate.
     """
     rng = v.as_rng(rng)
     n_obs = v.check_int(n_obs, "n_obs", minimum=1)
@@ -310,7 +427,19 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
 
 
 def ablation_table(results: dict, *, title: str = "003 §5.4's switches and the motion prior on our pipeline (rendered)") -> str:
-    """One row per (configuration, case): claimed and correct shares, ATE over all and claimed frames."""
+    """One row per (configuration, case): claimed and correct shares, ATE over all and claimed frames.
+
+    Parameters
+    ----------
+    results : dict
+        ``(configuration, case)`` → :class:`MonoRunResult` (:func:`run_ablation`).
+    title : str
+        Table title.
+
+    Returns
+    -------
+    str
+    """
     rows = []
     for (label, case), r in results.items():
         f3 = lambda x: f"{x:.3f}" if np.isfinite(x) else "-"
@@ -326,6 +455,18 @@ def source_findings_table(ablation: dict, failures: dict) -> str:
     ``ablation``: ``{(configuration, case): MonoRunResult}`` with at least the labels ``"defaults"``,
     ``"no outlier rejection (RdE off)"`` and ``"no refinement (alignment only)"`` for each case (the
     rendered :func:`run_ablation` and the KITTI ablation may be merged into one dict).
+
+    Parameters
+    ----------
+    ablation : dict
+        ``(configuration, case)`` → :class:`MonoRunResult`.
+    failures : dict
+        Case → :class:`MonoRunResult` (:func:`run_failure_cases`).
+
+    Returns
+    -------
+    str
+        One row per finding: 003's words beside our figures.
     """
     cases = list(dict.fromkeys(case for _, case in ablation))
     fails = {k: r for k, r in failures.items() if k != "normal"}
@@ -368,6 +509,22 @@ def compare_init_methods(*, n_points: int = 200, noise_px: float = 0.5, n_trials
 
     Synthetic views (K: f = 500 px, 640×480; a 0.4 m mostly sideways baseline with a small rotation) of a
     tilted plane 4 m ahead and of a deep scene (2.5-8 m); pixel noise ``noise_px``; ``n_trials`` draws.
+
+    Parameters
+    ----------
+    n_points : int
+        Points per scene (default 200).
+    noise_px : float
+        Pixel noise σ [px] (default 0.5).
+    n_trials : int
+        Random draws per scene (default 20).
+    rng : Generator, int or None
+        Randomness of the scenes and the noise (default 0).
+
+    Returns
+    -------
+    str
+        One row per (scene, method): median rotation and translation-direction errors [deg].
     """
     from ..geometry.camera import rotation_xyz
     from .initialise import relative_pose_essential, relative_pose_homography
@@ -411,7 +568,24 @@ def compare_init_methods(*, n_points: int = 200, noise_px: float = 0.5, n_trials
 
 def ours_vs_source(failures: dict, sequence: MonoRunResult, kitti: MonoRunResult | None = None,
                    convergence: ConvergenceStudy | None = None) -> str:
-    """003's stated figures beside ours (003 §4.3, §4.4.1, §5.1.1, §5.2, §5.4, §5.5.1), from the runs' results."""
+    """003's stated figures beside ours (003 §4.3, §4.4.1, §5.1.1, §5.2, §5.4, §5.5.1), from the runs' results.
+
+    Parameters
+    ----------
+    failures : dict
+        Case → :class:`MonoRunResult` (:func:`run_failure_cases`).
+    sequence : MonoRunResult
+        A rendered sequence run.
+    kitti : MonoRunResult, optional
+        The KITTI run, when there is one.
+    convergence : ConvergenceStudy, optional
+        The depth-filter study, when there is one.
+
+    Returns
+    -------
+    str
+        One row per figure: 003's value beside ours.
+    """
     p = MonoParams()
     n_fail_ok = sum(r.verdict == "ok" for k, r in failures.items() if k != "normal")
     n_cases = sum(k != "normal" for k in failures)
@@ -510,7 +684,17 @@ def run_mono_vs_stereo(sequence: str = "strafe", *, n_frames: int = 40, size: st
 
 @dataclass(frozen=True)
 class MonoVsStereo:
-    """The monocular run and Ch. 4's stereo pipeline on the same rendered poses."""
+    """The monocular run and Ch. 4's stereo pipeline on the same rendered poses.
+
+    Attributes
+    ----------
+    mono : MonoRunResult
+        The monocular run.
+    stereo_ate_se3_m, stereo_ate_sim3_m : float
+        ATE of the stereo pipeline after SE(3) and after Sim(3) alignment [m].
+    stereo_rpe_m : float
+        RPE of the stereo pipeline [m].
+    """
 
     mono: MonoRunResult
     stereo_ate_se3_m: float
