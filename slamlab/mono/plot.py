@@ -16,7 +16,7 @@ def plot_convergence(study, *, axes=None):
     Parameters
     ----------
     study : ConvergenceStudy
-        Result of :func:`~slamlab.mono.experiments.run_depth_filter_convergence`.
+        Result of :func:`~slamlab.mono.convergence.run_depth_filter_convergence`.
     axes : sequence of two Axes, optional
         Where to draw; ``None`` = a new figure.
 
@@ -118,7 +118,7 @@ def plot_map_top(result, *, ax=None, aligned=True):
     Parameters
     ----------
     result : MonoRunResult
-        A run (:func:`~slamlab.mono.experiments.run_mono`).
+        A run (:func:`~slamlab.mono.runs.run_mono`).
     ax : Axes, optional
         Where to draw; ``None`` = new axes.
     aligned : bool
