@@ -135,6 +135,8 @@ def fresh_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
     numpy.random.SeedSequence
         Same entropy and spawn key as ``root_seed_sequence(rng)``, no children spawned.
 
+    Examples
+    --------
     >>> ss = np.random.SeedSequence(3); _ = ss.spawn(2)
     >>> fresh_seed_sequence(ss).spawn(1)[0].spawn_key
     (0,)

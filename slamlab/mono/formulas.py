@@ -8,11 +8,7 @@ import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
-from .depth_filter import (
-    compute_tau,
-    init_seeds,
-    tau_inverse,
-)
+from .depth_filter import compute_tau, init_seeds, tau_inverse
 
 __all__ = ["chapter_cameras", "inverse_depth_point_table", "pinhole_table", "tau_table"]
 

@@ -5,7 +5,8 @@ Per frame: initialisation until two keyframes exist (003 §4.3.1); then tracking
 points projected and refined by Lucas-Kanade from their keyframe → motion-only
 refinement), the depth filter of every seed (003 §4.2, §4.3.2) and the keyframe rules
 (003 §4.3). SDVL runs tracking and mapping in two threads; we run them in turn (our
-simplification: the results do not depend on thread timing).
+simplification: the results do not depend on thread timing). The mapping steps live in
+:mod:`slamlab.mono.mapping` (a mixin :class:`MonoSLAM` inherits).
 
 Failure (ours): a frame is *lost* when too few points, or too small a share of the matched
 points, reproject within ``reproj_inlier_deg``, or when the alignment's photometric RMS is
@@ -25,9 +26,7 @@ import numpy as np
 from .. import _validate as v
 from ..geometry.se3 import se3_compose, se3_inverse, transform_points
 from .align import build_pyramid, project, refine_pose, sparse_align
-from .depth_filter import (
-    init_seeds,
-)
+from .depth_filter import init_seeds
 from .initialise import Initialiser, track_lk
 from .mapping import Keyframe, _MonoMapping, orthonormalise
 from .params import MonoParams
