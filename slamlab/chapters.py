@@ -80,6 +80,18 @@ SHARED_TOPICS: tuple[tuple[str, str, str, str, str], ...] = (
 def get_chapter(number: int) -> Chapter:
     """The chapter with the given notebook number.
 
+    Parameters
+    ----------
+    number : int
+        Notebook number of the chapter.
+
+    Returns
+    -------
+    Chapter
+        Its entry in ``CHAPTERS``; ``ValueError`` for an unknown number.
+
+    Examples
+    --------
     >>> get_chapter(1).notebook
     '01_kalman_filters.ipynb'
     """

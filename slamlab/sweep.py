@@ -43,6 +43,18 @@ def grid_points(grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | Non
     """The points of a grid: the Cartesian product of a ``{name: values}`` mapping (first name slowest),
     a list of ``{name: value}`` points as given, or one empty point for ``None``.
 
+    Parameters
+    ----------
+    grid : mapping of str to sequence, sequence of mapping, or None
+        ``{name: values}`` (Cartesian product), a list of ``{name: value}`` points, or ``None``.
+
+    Returns
+    -------
+    list of dict
+        One ``{name: value}`` dict per point.
+
+    Examples
+    --------
     >>> grid_points({"a": [1, 2], "b": ["x"]})
     [{'a': 1, 'b': 'x'}, {'a': 2, 'b': 'x'}]
     """
@@ -75,6 +87,20 @@ def root_seed_sequence(seed, name: str = "seed") -> np.random.SeedSequence:
     """The ``SeedSequence`` the runs' streams are spawned from: ``SeedSequence(seed)`` for an int or None,
     the sequence itself, or a Generator's own (so ``Generator.spawn`` and :func:`sweep` give the same streams).
 
+    Parameters
+    ----------
+    seed : int, SeedSequence, Generator or None
+        Non-negative int, an existing sequence, a Generator (its own sequence is used) or ``None`` (fresh entropy).
+    name : str
+        Argument name used in the error messages (default ``"seed"``).
+
+    Returns
+    -------
+    SeedSequence
+        The root sequence.
+
+    Examples
+    --------
     >>> root_seed_sequence(7).entropy
     7
     """
@@ -109,6 +135,8 @@ def fresh_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
     numpy.random.SeedSequence
         Same entropy and spawn key as ``root_seed_sequence(rng)``, no children spawned.
 
+    Examples
+    --------
     >>> ss = np.random.SeedSequence(3); _ = ss.spawn(2)
     >>> fresh_seed_sequence(ss).spawn(1)[0].spawn_key
     (0,)
@@ -150,6 +178,19 @@ def _is_scalar(x: Any) -> bool:
 def result_row(result: Any) -> dict[str, Any]:
     """A run's result as table columns (see the module docstring).
 
+    Parameters
+    ----------
+    result : mapping, object with ``row()``, dataclass or scalar
+        What a run returned.
+
+    Returns
+    -------
+    dict
+        Column name → value: the mapping itself, ``row()``'s mapping, the dataclass's scalar fields, or
+        ``{"value": result}``.
+
+    Examples
+    --------
     >>> result_row(2.5)
     {'value': 2.5}
     >>> result_row({"rmse_m": 0.1, "ok": True})

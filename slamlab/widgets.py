@@ -15,6 +15,24 @@ STYLE = {"description_width": "initial"}
 def slider(cls, value, lo, hi, step, desc: str, **kw):
     """An ipywidgets slider of class ``cls`` that updates on release only.
 
+    Parameters
+    ----------
+    cls : type
+        The ipywidgets slider class (``FloatSlider``, ``IntSlider``, ...).
+    value, lo, hi, step : float or int
+        Initial value, minimum, maximum and step.
+    desc : str
+        The slider's label.
+    **kw
+        Further keyword arguments for ``cls``.
+
+    Returns
+    -------
+    slider : ipywidgets.Widget
+        The slider with ``continuous_update=False`` and the shared label style.
+
+    Examples
+    --------
     >>> import ipywidgets as widgets
     >>> s = slider(widgets.FloatSlider, 0.5, 0.0, 1.0, 0.1, "noise")
     >>> s.continuous_update, s.description

@@ -55,14 +55,14 @@ ALLOWED: dict[str, dict[str, str]] = {
     "slamlab.kdtree.crossover.run_crossover": {"params": _NO_PIPELINE},
     "slamlab.kdtree.tree_studies.run_dimension_study": {"params": _NO_PIPELINE},
     # mono: MonoSLAM draws no random numbers (OpenCV's RANSAC is reseeded to 0 before each call,
-    # mono/initialise.py); the streams are the renderer's, taken by the run_* that render
-    "slamlab.mono.experiments.run_mono": {"rng": _NO_RANDOMNESS + " (MonoSLAM on given images)"},
+    # mono/twoview.py); the streams are the renderer's, taken by the run_* that render
+    "slamlab.mono.runs.run_mono": {"rng": _NO_RANDOMNESS + " (MonoSLAM on given images)"},
     "slamlab.mono.kitti.run_kitti_mono": {"rng": _REPLAY},
     "slamlab.mono.kitti.run_kitti_ablation": {"rng": _REPLAY},
-    "slamlab.mono.experiments.run_depth_filter_convergence": {
+    "slamlab.mono.convergence.run_depth_filter_convergence": {
         "params": "the depth filter's maths on synthetic seeds (τ, outlier rates are the study's axes): "
                   "no MonoSLAM run, so no MonoParams"},
-    "slamlab.mono.studies.run_convergence_tests": {
+    "slamlab.mono.convergence.run_convergence_tests": {
         "params": "the two convergence tests on synthetic seeds (τ from the geometry, L_max the axis): "
                   "no MonoSLAM run, so no MonoParams"},
     # planes: Fig. 2 is 002's bare LM system (noise-free planes, no prior, 40 iterations), not the filter

@@ -37,7 +37,21 @@ ALIGNMENTS = ("se3", "sim3", "none")
 
 @dataclass(frozen=True)
 class ErrorStats:
-    """Statistics of a per-pose error vector, as evo reports them."""
+    """Statistics of a per-pose error vector, as evo reports them.
+
+    Attributes
+    ----------
+    rmse, mean, median, std, min, max : float
+        Statistics of the per-pose errors, in ``unit``.
+    sse : float
+        Sum of squared errors.
+    n : int
+        Number of errors (poses or pose pairs).
+    unit : str
+        ``"m"`` or ``"deg"``.
+    errors : ndarray, shape (n,)
+        The per-pose errors themselves.
+    """
 
     rmse: float
     mean: float
@@ -74,6 +88,18 @@ def associate(ref: Trajectory, est: Trajectory, max_diff_s: float = 0.01):
     none of its poses is used twice. Trajectories without timestamps are paired
     by frame number when one lists ``frame_ids`` (the other then holds every
     frame from 0), otherwise by index (equal length). Returns ``(ref_sub, est_sub)``.
+
+    Parameters
+    ----------
+    ref, est : Trajectory
+        Reference (ground truth) and estimated trajectories.
+    max_diff_s : float
+        Largest timestamp difference of a pair [s] (default 0.01).
+
+    Returns
+    -------
+    ref_sub, est_sub : Trajectory
+        The paired poses, equal length, in pair order.
     """
     if ref.timestamps_s is None or est.timestamps_s is None:
         for a, b, swap in ((ref, est, False), (est, ref, True)):
@@ -112,6 +138,22 @@ def align_trajectory(est: Trajectory, ref: Trajectory, method: str = "se3"):
 
     Returns ``(aligned_est, transform)``; the transform is applied to the
     whole pose (``R`` to the rotations, scale to the positions).
+
+    Parameters
+    ----------
+    est : Trajectory
+        Estimated trajectory, associated with ``ref``.
+    ref : Trajectory
+        Reference trajectory of the same length.
+    method : str
+        ``"se3"`` (rotation and translation), ``"sim3"`` (also scale) or ``"none"`` (default ``"se3"``).
+
+    Returns
+    -------
+    aligned_est : Trajectory
+        ``est`` mapped onto ``ref``.
+    transform : RigidTransform or None
+        ``R``, ``t``, ``c`` of the alignment; ``None`` for ``method="none"``.
     """
     v.check_choice(method, "method", ALIGNMENTS)
     if len(est) != len(ref):
@@ -130,6 +172,20 @@ def ate(ref: Trajectory, est: Trajectory, *, align: str = "se3", max_diff_s: flo
     Associates by timestamp (``max_diff_s``), aligns ``est`` to ``ref``
     (``"se3"``, ``"sim3"`` or ``"none"``) and measures ``|p_est - p_ref|`` per pose,
     in metres. Equal to ``evo_ape ... -a`` (``-as`` for ``"sim3"``).
+
+    Parameters
+    ----------
+    ref, est : Trajectory
+        Reference (ground truth) and estimated trajectories.
+    align : str
+        ``"se3"``, ``"sim3"`` or ``"none"`` (default ``"se3"``).
+    max_diff_s : float
+        Largest timestamp difference when pairing poses [s] (default 0.01).
+
+    Returns
+    -------
+    ErrorStats
+        ``rmse``, ``mean``, ``max``, ... of the position errors [m], ``errors`` per pose.
     """
     v.check_choice(align, "align", ALIGNMENTS)
     r, e = associate(ref, est, max_diff_s)
@@ -175,6 +231,30 @@ def rpe(ref: Trajectory, est: Trajectory, *, delta=1, delta_unit: str = "frames"
     makes the pairs independent of the estimate, which is fairer when comparing
     systems. Equal to ``evo_rpe ... --delta d --delta_unit f|m`` (``-as`` with
     ``align="sim3"``).
+
+    Parameters
+    ----------
+    ref, est : Trajectory
+        Reference (ground truth) and estimated trajectories.
+    delta : int or float
+        Pair spacing, in frames or metres of travel (default 1).
+    delta_unit : str
+        ``"frames"`` or ``"m"`` (default ``"frames"``).
+    relation : str
+        ``"translation"`` (error in metres) or ``"rotation_deg"`` (degrees).
+    align : str
+        ``"se3"``, ``"sim3"`` or ``"none"`` (default ``"none"``).
+    all_pairs : bool
+        Use every pair ``delta`` apart, not only consecutive ones (default False).
+    pairs_from : str
+        ``"estimate"`` or ``"reference"``: whose travelled path defines the pairs for ``delta_unit="m"``.
+    max_diff_s : float
+        Largest timestamp difference when pairing poses [s] (default 0.01).
+
+    Returns
+    -------
+    ErrorStats
+        Statistics of the per-pair errors, ``unit`` ``"m"`` or ``"deg"``.
     """
     v.check_choice(delta_unit, "delta_unit", ("frames", "m"))
     v.check_choice(relation, "relation", ("translation", "rotation_deg"))

@@ -30,6 +30,19 @@ class Trajectory:
     """Poses ``T_world_body``: ``positions_m (N, 3)``, ``rotations (N, 3, 3)``, ``timestamps_s (N,)`` or None.
 
     ``frame_ids (N,)``: frame numbers of the poses when a file lists them (else None).
+
+    Attributes
+    ----------
+    positions_m : ndarray, shape (N, 3)
+        Positions [m].
+    rotations : ndarray, shape (N, 3, 3)
+        Rotation matrices (body to world).
+    timestamps_s : ndarray, shape (N,), optional
+        Timestamps [s], ``None`` when the file has none.
+    name : str
+        Label (the file name for read trajectories).
+    frame_ids : ndarray of int, shape (N,), optional
+        Frame numbers of the poses, ``None`` when the file lists none.
     """
 
     positions_m: np.ndarray
@@ -75,7 +88,18 @@ class Trajectory:
         return cls(P[:, :3, 3].copy(), P[:, :3, :3].copy(), timestamps_s, name, frame_ids)
 
     def subset(self, idx) -> Trajectory:
-        """The poses at integer indices ``idx``."""
+        """The poses at integer indices ``idx``.
+
+        Parameters
+        ----------
+        idx : array_like of int
+            Indices of the poses to keep.
+
+        Returns
+        -------
+        Trajectory
+            The selected poses with their timestamps and frame ids.
+        """
         idx = np.asarray(idx, dtype=int)
         ts = None if self.timestamps_s is None else self.timestamps_s[idx]
         ids = None if self.frame_ids is None else self.frame_ids[idx]
@@ -113,6 +137,16 @@ def read_tum(path) -> Trajectory:
     """Read a TUM trajectory (``timestamp tx ty tz qx qy qz qw`` per line).
 
     Quaternions are normalised before conversion (files round them).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TUM file.
+
+    Returns
+    -------
+    Trajectory
+        With ``timestamps_s``; ``name`` is the file name.
     """
     arr = _load_rows(path, 8, "TUM")
     q = arr[:, 4:8]
@@ -124,7 +158,20 @@ def read_tum(path) -> Trajectory:
 
 
 def read_kitti(path, timestamps_s=None) -> Trajectory:
-    """Read a KITTI pose file: 12 numbers per line (rows of the 3×4 pose matrix), or 13 with a leading frame index."""
+    """Read a KITTI pose file: 12 numbers per line (rows of the 3×4 pose matrix), or 13 with a leading frame index.
+
+    Parameters
+    ----------
+    path : str or Path
+        The KITTI pose file.
+    timestamps_s : array_like, shape (N,), optional
+        Timestamps [s] of the poses (KITTI files have none).
+
+    Returns
+    -------
+    Trajectory
+        ``frame_ids`` set when the file has 13 columns; ``name`` is the file name.
+    """
     arr = _load_rows(path, (12, 13), "KITTI")
     ids = None
     if arr.shape[1] == 13:
@@ -137,7 +184,15 @@ def read_kitti(path, timestamps_s=None) -> Trajectory:
 
 
 def write_tum(path, traj: Trajectory) -> None:
-    """Write ``traj`` in TUM format (needs timestamps)."""
+    """Write ``traj`` in TUM format (needs timestamps).
+
+    Parameters
+    ----------
+    path : str or Path
+        File to write.
+    traj : Trajectory
+        Trajectory with timestamps.
+    """
     if traj.timestamps_s is None:
         raise ValueError("`traj` needs timestamps to be written in TUM format")
     q = Rotation.from_matrix(traj.rotations).as_quat()
@@ -146,5 +201,13 @@ def write_tum(path, traj: Trajectory) -> None:
 
 
 def write_kitti(path, traj: Trajectory) -> None:
-    """Write ``traj`` in KITTI format (12 numbers per line)."""
+    """Write ``traj`` in KITTI format (12 numbers per line).
+
+    Parameters
+    ----------
+    path : str or Path
+        File to write.
+    traj : Trajectory
+        Trajectory to write (timestamps and frame ids are not written).
+    """
     np.savetxt(os.fspath(path), traj.poses[:, :3, :].reshape(len(traj), 12), fmt="%.9e")

@@ -32,6 +32,20 @@ def focal_from_hfov(width_px: int, hfov_rad: float) -> float:
 
     ``f = (W / 2) / tan(hfov / 2)``.
 
+    Parameters
+    ----------
+    width_px : int
+        Image width [px], at least 1.
+    hfov_rad : float
+        Horizontal field of view [rad], in ``(0, pi)``.
+
+    Returns
+    -------
+    f : float
+        Focal length [px].
+
+    Examples
+    --------
     >>> round(focal_from_hfov(768, np.deg2rad(40.0)), 3)
     1055.031
     """
@@ -45,6 +59,18 @@ def focal_from_hfov(width_px: int, hfov_rad: float) -> float:
 def rotation_xyz(rx_rad: float = 0.0, ry_rad: float = 0.0, rz_rad: float = 0.0) -> np.ndarray:
     """Rotation ``Rz @ Ry @ Rx`` from three angles (small extrinsic changes, our helper).
 
+    Parameters
+    ----------
+    rx_rad, ry_rad, rz_rad : float
+        Rotation angles about ``x``, ``y`` and ``z`` [rad] (default 0), applied in that order.
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3)
+        The rotation matrix ``Rz @ Ry @ Rx``.
+
+    Examples
+    --------
     >>> np.allclose(rotation_xyz(0, 0, np.pi / 2) @ [1, 0, 0], [0, 1, 0])
     True
     """
@@ -129,6 +155,17 @@ class PinholeCamera:
 
     Build it from the field of view with :meth:`from_hfov`.
 
+    Attributes
+    ----------
+    width_px, height_px : int
+        Image size [px], at least 1.
+    fx, fy : float
+        Focal lengths [px] along ``u`` and ``v``, positive.
+    cx, cy : float
+        Principal point ``(u, v)`` [px].
+
+    Examples
+    --------
     >>> cam = PinholeCamera.from_hfov(768, 576, np.deg2rad(40.0))
     >>> cam.project([[0.0, 0.0, 2.0]])
     array([[383.5, 287.5]])
@@ -164,7 +201,18 @@ class PinholeCamera:
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
 
     def project(self, points_cam) -> np.ndarray:
-        """Pixel coordinates ``(N, 2)`` of camera-frame points ``(N, 3)`` (``z`` must be > 0)."""
+        """Pixel coordinates ``(N, 2)`` of camera-frame points ``(N, 3)`` (``z`` must be > 0).
+
+        Parameters
+        ----------
+        points_cam : array_like, shape (N, 3)
+            Points in the camera frame [m]; ``z > 0`` (raises ``ValueError`` otherwise).
+
+        Returns
+        -------
+        uv : ndarray, shape (N, 2)
+            Pixel coordinates ``(u, v)``.
+        """
         P = v.as_finite_array(points_cam, "points_cam", ndim=2)
         if P.shape[1] != 3:
             raise ValueError(f"`points_cam` must have shape (N, 3); got {P.shape}")
@@ -173,7 +221,18 @@ class PinholeCamera:
         return project_points(self.K, P)
 
     def backproject(self, uv) -> np.ndarray:
-        """Viewing-ray directions ``(N, 3)`` with ``z = 1`` through pixels ``uv (N, 2)``."""
+        """Viewing-ray directions ``(N, 3)`` with ``z = 1`` through pixels ``uv (N, 2)``.
+
+        Parameters
+        ----------
+        uv : array_like, shape (N, 2)
+            Pixel coordinates ``(u, v)``.
+
+        Returns
+        -------
+        rays : ndarray, shape (N, 3)
+            Ray directions in the camera frame, ``z = 1`` (not unit length).
+        """
         uv = v.as_finite_array(uv, "uv", ndim=2)
         if uv.shape[1] != 2:
             raise ValueError(f"`uv` must have shape (N, 2); got {uv.shape}")
@@ -193,6 +252,22 @@ class PinholeCamera:
 def fundamental_matrix(K_left, K_right, R, t) -> np.ndarray:
     """``F`` with ``x_r^T F x_l = 0`` for a right camera at ``x_r = R x_l + t`` (000 §3.3).
 
+    Parameters
+    ----------
+    K_left, K_right : array_like, shape (3, 3)
+        Intrinsic matrices of the left and right cameras.
+    R : array_like, shape (3, 3)
+        Rotation from the left to the right camera frame.
+    t : array_like, shape (3,)
+        Translation of that transform [m] (``x_r = R x_l + t``).
+
+    Returns
+    -------
+    F : ndarray, shape (3, 3)
+        ``K_right^-T [t]x R K_left^-1``.
+
+    Examples
+    --------
     >>> K = np.eye(3); F = fundamental_matrix(K, K, np.eye(3), [-1.0, 0, 0])
     >>> float(np.array([0.5, 0.2, 1.0]) @ F @ np.array([0.7, 0.2, 1.0]))
     0.0
@@ -213,6 +288,17 @@ class StereoRig:
     other" of 000 §3.3. :meth:`parallel` builds the usual rig: same camera
     twice, the right one ``baseline_m`` to the right of the left one.
 
+    Attributes
+    ----------
+    left, right : PinholeCamera
+        The two cameras.
+    R_rl : ndarray, shape (3, 3)
+        Proper rotation from the left to the right camera frame.
+    t_rl : ndarray, shape (3,)
+        Translation [m] of that transform; ``(-baseline_m, 0, 0)`` for a parallel rig.
+
+    Examples
+    --------
     >>> rig = StereoRig.parallel(baseline_m=0.2)
     >>> rig.right_center_m
     array([0.2, 0. , 0. ])
@@ -261,14 +347,42 @@ class StereoRig:
         return fundamental_matrix(self.left.K, self.right.K, self.R_rl, self.t_rl)
 
     def project(self, points_left) -> tuple[np.ndarray, np.ndarray]:
-        """Pixels in the left and right images of points given in the left camera frame."""
+        """Pixels in the left and right images of points given in the left camera frame.
+
+        Parameters
+        ----------
+        points_left : array_like, shape (N, 3)
+            Points in the left camera frame [m], in front of both cameras.
+
+        Returns
+        -------
+        uv_left, uv_right : ndarray, shape (N, 2)
+            Pixel coordinates in the left and right images.
+        """
         P = v.as_finite_array(points_left, "points_left", ndim=2)
         if P.shape[1] != 3:
             raise ValueError(f"`points_left` must have shape (N, 3); got {P.shape}")
         return self.left.project(P), self.right.project(P @ self.R_rl.T + self.t_rl)
 
     def rays(self, uv_left, uv_right) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Both viewing rays in the left frame: ``(c_left, d_left, c_right, d_right)`` (000 §3.3)."""
+        """Both viewing rays in the left frame: ``(c_left, d_left, c_right, d_right)`` (000 §3.3).
+
+        Parameters
+        ----------
+        uv_left, uv_right : array_like, shape (N, 2)
+            Matched pixel coordinates in the left and right images (same number of rows).
+
+        Returns
+        -------
+        c_left : ndarray, shape (3,)
+            Left optical centre (the origin).
+        d_left : ndarray, shape (N, 3)
+            Left ray directions.
+        c_right : ndarray, shape (3,)
+            Right optical centre in the left frame [m].
+        d_right : ndarray, shape (N, 3)
+            Right ray directions rotated into the left frame.
+        """
         d_l = self.left.backproject(uv_left)
         d_r = self.right.backproject(uv_right) @ self.R_rl  # R^T d for each row
         if d_l.shape != d_r.shape:

@@ -18,7 +18,17 @@ __all__ = ["Odometry", "simulate_odometry"]
 
 @dataclass(frozen=True)
 class Odometry:
-    """Odometry along a path: measured increments and the pose integrated from the true start (004 §8)."""
+    """Odometry along a path: measured increments and the pose integrated from the true start (004 §8).
+
+    Attributes
+    ----------
+    increments : ndarray, shape (n-1, 3)
+        Measured body-frame increments ``(dx_m, dy_m, dtheta_rad)``.
+    poses : ndarray, shape (n, 3)
+        Integrated odometry poses; ``poses[0]`` is the true start.
+    true_increments : ndarray, shape (n-1, 3)
+        The noise-free increments between the true poses.
+    """
 
     increments: np.ndarray  # (n-1, 3) measured body-frame (dx, dy, dθ)
     poses: np.ndarray  # (n, 3) integrated odometry, poses[0] = the true start

@@ -30,7 +30,19 @@ __all__ = ["RansacResult", "ransac", "ransac_refit"]
 
 class RansacResult(NamedTuple):
     """``model`` (``None`` when nothing fitted), ``inliers`` (N,) bool mask, ``converged``
-    (a model with at least ``min_inliers`` inliers was found), ``n_iters`` hypotheses tried."""
+    (a model with at least ``min_inliers`` inliers was found), ``n_iters`` hypotheses tried.
+
+    Attributes
+    ----------
+    model : object or None
+        The refitted model, ``None`` when nothing fitted.
+    inliers : ndarray of bool, shape (N,)
+        Inlier mask of the final model.
+    converged : bool
+        A model with at least ``min_inliers`` inliers was found.
+    n_iters : int
+        Number of hypotheses tried.
+    """
 
     model: Any
     inliers: np.ndarray

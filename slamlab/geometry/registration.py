@@ -18,7 +18,17 @@ __all__ = ["RigidTransform", "apply_transform", "umeyama"]
 
 
 class RigidTransform(NamedTuple):
-    """``x' = c R x + t``: rotation ``R`` (d, d), translation ``t`` (d,), scale ``c`` (1 for rigid)."""
+    """``x' = c R x + t``: rotation ``R`` (d, d), translation ``t`` (d,), scale ``c`` (1 for rigid).
+
+    Attributes
+    ----------
+    R : ndarray, shape (d, d)
+        Rotation.
+    t : ndarray, shape (d,)
+        Translation.
+    c : float
+        Scale (1 for a rigid transform).
+    """
 
     R: np.ndarray
     t: np.ndarray
@@ -86,6 +96,20 @@ def umeyama(src, dst, *, with_scale: bool = False, weights=None) -> RigidTransfo
 def apply_transform(T: RigidTransform, points) -> np.ndarray:
     """``c R x + t`` for each row of ``points`` (N, d).
 
+    Parameters
+    ----------
+    T : RigidTransform
+        The transform ``(R, t, c)``.
+    points : array_like, shape (N, d)
+        Points to map.
+
+    Returns
+    -------
+    mapped : ndarray, shape (N, d)
+        ``c R x + t`` for each row.
+
+    Examples
+    --------
     >>> apply_transform(RigidTransform(np.eye(2), np.array([1.0, 2.0]), 2.0), [[1.0, 1.0]])
     array([[3., 4.]])
     """

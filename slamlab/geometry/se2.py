@@ -38,6 +38,20 @@ __all__ = ["check_pose", "check_poses", "se2_compose", "se2_integrate", "se2_inv
 def check_pose(pose, name: str = "pose") -> np.ndarray:
     """A finite pose ``(x, y, heading_rad)`` as a float vector of length 3.
 
+    Parameters
+    ----------
+    pose : array_like, shape (3,)
+        ``(x, y, heading_rad)``.
+    name : str
+        Argument name used in the error message (default ``"pose"``).
+
+    Returns
+    -------
+    pose : ndarray, shape (3,)
+        The pose as floats; ``ValueError`` when not finite or not of length 3.
+
+    Examples
+    --------
     >>> check_pose([1, 2, 0.5])
     array([1. , 2. , 0.5])
     """
@@ -47,6 +61,22 @@ def check_pose(pose, name: str = "pose") -> np.ndarray:
 def check_poses(poses, name: str = "poses", *, n: int | None = None) -> np.ndarray:
     """Finite poses as a float ``(n, 3)`` array of ``(x, y, heading_rad)`` rows (at least one).
 
+    Parameters
+    ----------
+    poses : array_like, shape (n, 3)
+        ``(x, y, heading_rad)`` rows.
+    name : str
+        Argument name used in the error messages (default ``"poses"``).
+    n : int, optional
+        Required number of rows; ``None`` = any number of at least one.
+
+    Returns
+    -------
+    poses : ndarray, shape (n, 3)
+        The poses as floats.
+
+    Examples
+    --------
     >>> check_poses([[0, 0, 0], [1, 2, 3]]).shape
     (2, 3)
     >>> check_poses([0, 0, 0])
@@ -101,6 +131,18 @@ def se2_compose(a, b) -> np.ndarray:
 def se2_inverse(a) -> np.ndarray:
     """``a⁻¹``: the world origin seen from pose ``a``, so that ``a ⊕ a⁻¹ = 0``.
 
+    Parameters
+    ----------
+    a : array_like, shape (..., 3)
+        Pose(s) ``(x, y, heading_rad)``.
+
+    Returns
+    -------
+    inverse : ndarray, shape (..., 3)
+        Heading wrapped to ``[-pi, pi)``.
+
+    Examples
+    --------
     >>> se2_inverse([1.0, 0.0, np.pi / 2]).round(12).tolist()
     [-0.0, 1.0, -1.570796326795]
     """
@@ -114,6 +156,18 @@ def se2_inverse(a) -> np.ndarray:
 def se2_relative(a, b) -> np.ndarray:
     """``a⁻¹ ⊕ b``: pose ``b`` in the frame of pose ``a`` (the body-frame increment from ``a`` to ``b``).
 
+    Parameters
+    ----------
+    a, b : array_like, shape (..., 3)
+        Poses ``(x, y, heading_rad)``; leading axes broadcast.
+
+    Returns
+    -------
+    relative : ndarray, shape (..., 3)
+        ``b`` in the frame of ``a``; heading wrapped to ``[-pi, pi)``.
+
+    Examples
+    --------
     >>> se2_relative([0.0, 0.0, np.pi / 2], [0.0, 2.0, np.pi]).round(12).tolist()
     [2.0, 0.0, 1.570796326795]
     """

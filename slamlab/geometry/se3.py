@@ -18,6 +18,20 @@ __all__ = ["planar_from_se3", "rotate_points", "se3", "se3_compose", "se3_from_p
 def se3(R, t) -> np.ndarray:
     """4×4 matrix from rotation ``R`` (3, 3) and translation ``t`` (3,).
 
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation.
+    t : array_like, shape (3,)
+        Translation [m].
+
+    Returns
+    -------
+    T : ndarray, shape (4, 4)
+        Homogeneous transform.
+
+    Examples
+    --------
     >>> se3(np.eye(3), [1.0, 2.0, 3.0])[:3, 3]
     array([1., 2., 3.])
     """
@@ -34,6 +48,18 @@ def se3_inverse(T) -> np.ndarray:
     Not ``np.linalg.inv``: a pose read from a file is orthonormal only to its
     printed precision, and its inverse is still the rigid one.
 
+    Parameters
+    ----------
+    T : array_like, shape (4, 4) or (..., 4, 4)
+        Rigid transform(s).
+
+    Returns
+    -------
+    T_inv : ndarray, same shape as ``T``
+        The rigid inverse(s).
+
+    Examples
+    --------
     >>> T = se3_from_planar(1.0, 2.0, 0.5); np.allclose(se3_inverse(T) @ T, np.eye(4))
     True
     """
@@ -56,6 +82,20 @@ def rotate_points(R, points) -> np.ndarray:
     turns that last-bit difference into a different pixel. ``R`` is cast to the points' dtype
     (float32 rays stay float32).
 
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation matrix.
+    points : array_like, shape (N, 3)
+        Points, floating dtype.
+
+    Returns
+    -------
+    rotated : ndarray, shape (N, 3)
+        ``points @ R.T`` in the dtype of ``points``.
+
+    Examples
+    --------
     >>> rotate_points(se3_from_planar(0, 0, np.pi / 2)[:3, :3], [[1.0, 0.0, 0.0]]).round(12)
     array([[0., 1., 0.]])
     """
@@ -76,6 +116,20 @@ def rotate_components(R, x, y, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     The same sums in the same order, so the same bits; contiguous arrays in and out, which is
     faster for large point sets (a renderer's rays). ``R`` is cast to ``x``'s dtype.
 
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation matrix.
+    x, y, z : array_like
+        Coordinates of the points, arrays of one shape.
+
+    Returns
+    -------
+    x_rot, y_rot, z_rot : ndarray
+        Rotated coordinates, each of the shape of ``x``.
+
+    Examples
+    --------
     >>> [c.tolist() for c in rotate_components(se3_from_planar(0, 0, np.pi / 2)[:3, :3], [1.0], [0.0], [0.0])]
     [[6.123233995736766e-17], [1.0], [0.0]]
     """
@@ -87,6 +141,20 @@ def rotate_components(R, x, y, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def transform_points(T, points) -> np.ndarray:
     """``points @ R.T + t`` for a 4×4 ``T`` and ``points (N, 3)``, without BLAS (see :func:`rotate_points`).
 
+    Parameters
+    ----------
+    T : array_like, shape (4, 4)
+        Rigid transform.
+    points : array_like, shape (N, 3)
+        Points, floating dtype.
+
+    Returns
+    -------
+    transformed : ndarray, shape (N, 3)
+        ``points @ R.T + t``.
+
+    Examples
+    --------
     >>> transform_points(se3_from_planar(1.0, 0.0, 0.0), [[0.0, 2.0, 0.0]])
     array([[1., 2., 0.]])
     """
@@ -103,6 +171,18 @@ def se3_compose(A, B) -> np.ndarray:
     every BLAS kernel and thread count (``A @ B`` does not: a 1-ulp difference in a pose is
     enough to change a later inlier decision of a tracker).
 
+    Parameters
+    ----------
+    A, B : array_like, shape (..., 4, 4)
+        Transforms; leading axes broadcast.
+
+    Returns
+    -------
+    AB : ndarray, shape (..., 4, 4)
+        The product ``A @ B`` (float64).
+
+    Examples
+    --------
     >>> T = se3_from_planar(1.0, 2.0, 0.5); np.allclose(se3_compose(T, se3_inverse(T)), np.eye(4))
     True
     """
@@ -116,6 +196,22 @@ def se3_compose(A, B) -> np.ndarray:
 def se3_from_planar(x_m: float, y_m: float, yaw_rad: float, z_m: float = 0.0) -> np.ndarray:
     """4×4 pose of a body at ``(x, y, z)`` turned by ``yaw`` about the vertical ``z`` axis.
 
+    Parameters
+    ----------
+    x_m, y_m : float
+        Position in the plane [m].
+    yaw_rad : float
+        Heading about ``z`` [rad].
+    z_m : float
+        Height [m] (default 0).
+
+    Returns
+    -------
+    T : ndarray, shape (4, 4)
+        The pose.
+
+    Examples
+    --------
     >>> np.round(se3_from_planar(0, 0, np.pi / 2)[:3, :3] @ [1, 0, 0], 12)
     array([0., 1., 0.])
     """
@@ -129,6 +225,18 @@ def se3_from_planar(x_m: float, y_m: float, yaw_rad: float, z_m: float = 0.0) ->
 def yaw_from_R(R) -> float:
     """Heading about ``z`` of a rotation matrix: ``atan2(R[1, 0], R[0, 0])``.
 
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation matrix.
+
+    Returns
+    -------
+    yaw_rad : float
+        Heading in ``[-pi, pi]``.
+
+    Examples
+    --------
     >>> round(yaw_from_R(se3_from_planar(0, 0, 0.3)[:3, :3]), 12)
     0.3
     """
@@ -139,6 +247,18 @@ def yaw_from_R(R) -> float:
 def planar_from_se3(T) -> np.ndarray:
     """``(x, y, yaw)`` of a 4×4 pose (height, roll and pitch dropped).
 
+    Parameters
+    ----------
+    T : array_like, shape (4, 4)
+        Rigid transform.
+
+    Returns
+    -------
+    pose : ndarray, shape (3,)
+        ``(x_m, y_m, yaw_rad)``.
+
+    Examples
+    --------
     >>> planar_from_se3(se3_from_planar(1.0, 2.0, 0.25))
     array([1.  , 2.  , 0.25])
     """

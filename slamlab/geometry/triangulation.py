@@ -28,6 +28,17 @@ class Triangulation(NamedTuple):
     ``points`` (N, 3) midpoints; ``gap_m`` (N,) length of the common perpendicular;
     ``s, t`` (N,) ray parameters; ``valid`` (N,) both parameters positive and the
     rays not parallel.
+
+    Attributes
+    ----------
+    points : ndarray, shape (N, 3)
+        Midpoints of the common perpendiculars [m].
+    gap_m : ndarray, shape (N,)
+        Length of the common perpendicular [m].
+    s, t : ndarray, shape (N,)
+        Ray parameters of the closest points on ray 1 and ray 2.
+    valid : ndarray of bool, shape (N,)
+        Both parameters positive and the rays not parallel.
     """
 
     points: np.ndarray
@@ -96,6 +107,20 @@ def triangulate_midpoint(c1, d1, c2, d2, *, parallel_tol: float = 1e-12) -> Tria
 def triangulate_stereo(rig, uv_left, uv_right) -> Triangulation:
     """Landmarks in the left camera frame from matched pixels of a :class:`StereoRig` (000 §3.3).
 
+    Parameters
+    ----------
+    rig : StereoRig
+        The calibrated rig.
+    uv_left, uv_right : array_like, shape (N, 2)
+        Matched pixel coordinates in the left and right images.
+
+    Returns
+    -------
+    Triangulation
+        ``points`` (N, 3) in the left camera frame [m], ``gap_m``, ``valid``.
+
+    Examples
+    --------
     >>> from slamlab.geometry.camera import StereoRig
     >>> rig = StereoRig.parallel(0.2)
     >>> uvl, uvr = rig.project([[0.3, -0.1, 2.5]])

@@ -41,6 +41,18 @@ def flaser_angles(n_beams: int, fov_rad: float = np.pi) -> np.ndarray:
     short of ``+fov/2`` (180 beams: -90° .. +89°), as in the CARMEN/GMapping
     convention described in the data's PROVENANCE.md.
 
+    Parameters
+    ----------
+    n_beams : int
+        Beams per scan.
+    fov_rad : float
+        Field of view [rad] (default ``pi``, 180°).
+
+    Returns
+    -------
+    bearings_rad : ndarray, shape (n_beams,)
+        Beam angles relative to the robot heading [rad].
+
     Examples
     --------
     >>> np.degrees(flaser_angles(181))[[0, 1, -1]].round(6).tolist()
@@ -57,7 +69,31 @@ def flaser_angles(n_beams: int, fov_rad: float = np.pi) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CarmenLog:
-    """A CARMEN laser log read by :func:`read_carmen`; metres and radians."""
+    """A CARMEN laser log read by :func:`read_carmen`; metres and radians.
+
+    Attributes
+    ----------
+    path : str
+        The log file read.
+    ranges_m : ndarray, shape (n_scans, n_beams)
+        FLASER ranges [m], NaN where the log has NaN.
+    valid : ndarray of bool, shape (n_scans, n_beams)
+        Reading finite, > 0 and < ``max_range_m``.
+    poses : ndarray, shape (n_scans, 3)
+        Laser pose of each FLASER line ``(x_m, y_m, heading_rad)``.
+    odom_poses : ndarray, shape (n_scans, 3)
+        Odometry pose of each FLASER line.
+    timestamps_s : ndarray, shape (n_scans,)
+        ipc timestamp [s], NaN when absent.
+    odom : ndarray, shape (n_odom, 4)
+        ODOM messages: ``x_m, y_m, heading_rad, timestamp_s`` (NaN when absent).
+    max_range_m : float
+        Maximum range of the laser [m].
+    params : dict
+        ``PARAM`` lines of the log, name → value string.
+    skipped : dict
+        Message type → number of lines skipped.
+    """
 
     path: str
     ranges_m: np.ndarray  # (n_scans, n_beams), NaN where the log has NaN
@@ -100,6 +136,16 @@ class CarmenLog:
         ``pose`` is the FLASER line's laser pose (SLAM-corrected in the corrected Radish
         logs, the odometry in the MbICP log), ``odom_pose`` its odometry pose. Invalid
         readings get ``ranges = max_range_m`` and ``valid = False``.
+
+        Parameters
+        ----------
+        i : int
+            Scan index, negative counts from the end.
+
+        Returns
+        -------
+        Scan
+            ``ranges``, ``valid``, ``bearings``, ``pose``, ``odom_pose``, ``time_s`` of that scan.
         """
         i = v.check_int(i, "i", minimum=-self.n_scans, maximum=self.n_scans - 1)
         return self._scan(i, self.bearings_rad)
@@ -112,7 +158,18 @@ class CarmenLog:
                     pose=self.poses[i])
 
     def scans(self, indices=None) -> list[Scan]:
-        """Every scan (or those at ``indices``) as :class:`~slamlab.scans.Scan` objects."""
+        """Every scan (or those at ``indices``) as :class:`~slamlab.scans.Scan` objects.
+
+        Parameters
+        ----------
+        indices : iterable of int, optional
+            Scan indices to return; ``None`` = every scan.
+
+        Returns
+        -------
+        list of Scan
+            One :class:`~slamlab.scans.Scan` per index, as :meth:`scan` builds it.
+        """
         idx = range(self.n_scans) if indices is None else [
             v.check_int(int(i), "indices[k]", minimum=-self.n_scans, maximum=self.n_scans - 1) for i in indices]
         b = self.bearings_rad

@@ -19,6 +19,18 @@ def read_kitti_calib(path) -> dict:
     Accepts the official format (``P0: 12 numbers`` per line, also ``Tr:``) and the stripped
     one (12 numbers per line, no labels: the rows are named P0, P1, ... in order).
 
+    Parameters
+    ----------
+    path : str or Path
+        The ``calib.txt`` file.
+
+    Returns
+    -------
+    dict
+        Name (``"P0"``, ``"P1"``, ..., ``"Tr"``) → ndarray of shape (3, 4).
+
+    Examples
+    --------
     >>> import tempfile, pathlib
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "calib.txt"
     >>> _ = f.write_text("P0: 7 0 6 0 0 7 1 0 0 0 1 0\\nP1: 7 0 6 -3 0 7 1 0 0 0 1 0\\n")
@@ -46,7 +58,20 @@ def read_kitti_calib(path) -> dict:
 
 
 def kitti_rig(calib_path, width_px: int, height_px: int) -> StereoRig:
-    """The rectified grey stereo pair (cameras 0 and 1) of a KITTI ``calib.txt``, images ``width_px`` × ``height_px``."""
+    """The rectified grey stereo pair (cameras 0 and 1) of a KITTI ``calib.txt``, images ``width_px`` × ``height_px``.
+
+    Parameters
+    ----------
+    calib_path : str or Path
+        The sequence's ``calib.txt``.
+    width_px, height_px : int
+        Image size [px].
+
+    Returns
+    -------
+    StereoRig
+        Identical cameras from ``P0``, the right one offset by the baseline ``(P1[0, 3] - P0[0, 3]) / fx``.
+    """
     P = read_kitti_calib(calib_path)
     P0, P1 = P["P0"], P["P1"]
     fx, fy, cx, cy = P0[0, 0], P0[1, 1], P0[0, 2], P0[1, 2]
@@ -56,7 +81,18 @@ def kitti_rig(calib_path, width_px: int, height_px: int) -> StereoRig:
 
 
 def read_kitti_image(path) -> np.ndarray:
-    """A grey uint8 KITTI image; ``FileNotFoundError`` naming the file when it is missing or unreadable."""
+    """A grey uint8 KITTI image; ``FileNotFoundError`` naming the file when it is missing or unreadable.
+
+    Parameters
+    ----------
+    path : str or Path
+        The image file (PNG).
+
+    Returns
+    -------
+    image : ndarray of uint8, shape (H, W)
+        The grey image.
+    """
     import cv2
 
     path = v.as_path(path, "image", kind="file")

@@ -50,7 +50,23 @@ _MIN_VALID_MM = 20.0
 
 @dataclass(frozen=True)
 class UrgLog:
-    """A URG-04LX log: ``ranges_m`` (n, 682) with NaN where there is no return, wheel ticks, times."""
+    """A URG-04LX log: ``ranges_m`` (n, 682) with NaN where there is no return, wheel ticks, times.
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (n,)
+        Time of each scan [s] from the first scan.
+    ticks : ndarray, shape (n, 2)
+        Cumulative ``(left, right)`` encoder ticks.
+    ranges_m : ndarray, shape (n, 682)
+        Ranges [m], NaN where there is no return.
+    bearings_rad : ndarray, shape (682,)
+        Beam directions [rad] (:func:`urg04lx_bearings`).
+    path : str
+        The log file read.
+    max_range_m : float
+        Maximum range of the sensor [m] (default 4).
+    """
 
     time_s: np.ndarray = field(repr=False)  # (n,) seconds from the first scan
     ticks: np.ndarray = field(repr=False)  # (n, 2) cumulative (left, right) encoder ticks
@@ -73,7 +89,18 @@ class UrgLog:
                 f"{self.time_s[-1]:.1f} s, {valid:.0%} valid ranges")
 
     def odometry_poses(self, *, offset_m: float = 0.145) -> np.ndarray:
-        """The laser's pose per scan integrated from the wheel ticks, starting at ``(0, 0, 0)``; ``(n, 3)``."""
+        """The laser's pose per scan integrated from the wheel ticks, starting at ``(0, 0, 0)``; ``(n, 3)``.
+
+        Parameters
+        ----------
+        offset_m : float
+            Distance of the laser ahead of the wheel axle [m] (default 0.145).
+
+        Returns
+        -------
+        poses : ndarray, shape (n, 3)
+            ``(x_m, y_m, heading_rad)`` of the laser per scan.
+        """
         return se2_integrate(np.zeros(3), urg04lx_sensor_increments(urg04lx_odometry(self.ticks),
                                                                     offset_m=offset_m))
 
@@ -81,6 +108,16 @@ class UrgLog:
         """Scan ``k`` as a :class:`~slamlab.scans.Scan` in metres (no return: ``valid`` False, range = max range).
 
         ``odom_pose`` is the laser's pose integrated from the wheel ticks (:meth:`odometry_poses`).
+
+        Parameters
+        ----------
+        k : int
+            Scan index, negative counts from the end.
+
+        Returns
+        -------
+        Scan
+            ``ranges``, ``valid``, ``bearings``, ``odom_pose`` of that scan.
         """
         k = v.check_int(k, "k", minimum=-len(self), maximum=len(self) - 1)
         return self._scan(k, self.odometry_poses()[k])
@@ -92,7 +129,18 @@ class UrgLog:
                     time_s=self.time_s[k], odom_pose=odom_pose)
 
     def scans(self, indices=None) -> list[Scan]:
-        """Every scan (or those at ``indices``) as :class:`~slamlab.scans.Scan` objects."""
+        """Every scan (or those at ``indices``) as :class:`~slamlab.scans.Scan` objects.
+
+        Parameters
+        ----------
+        indices : iterable of int, optional
+            Scan indices to return; ``None`` = every scan.
+
+        Returns
+        -------
+        list of Scan
+            One :class:`~slamlab.scans.Scan` per index, as :meth:`scan` builds it.
+        """
         odo = self.odometry_poses()
         idx = range(len(self)) if indices is None else [
             v.check_int(int(i), "indices[k]", minimum=-len(self), maximum=len(self) - 1) for i in indices]
@@ -102,6 +150,20 @@ class UrgLog:
 def urg04lx_bearings(n_beams: int = URG04LX_N_BEAMS, fov_rad: float = URG04LX_FOV_RAD) -> np.ndarray:
     """Beam directions: ``n_beams`` evenly from ``-fov/2`` to ``+fov/2`` (counter-clockwise, 0 = ahead).
 
+    Parameters
+    ----------
+    n_beams : int
+        Number of beams, at least 2 (default 682).
+    fov_rad : float
+        Field of view [rad] (default 240°).
+
+    Returns
+    -------
+    bearings_rad : ndarray, shape (n_beams,)
+        Beam directions [rad].
+
+    Examples
+    --------
     >>> b = urg04lx_bearings()
     >>> b.size, round(float(np.degrees(b[0])), 3), round(float(np.degrees(b[1] - b[0])), 4)
     (682, -120.0, 0.3524)
@@ -186,6 +248,20 @@ def urg04lx_odometry(ticks, *, wheel_radius_m: float = 0.077, half_axle_m: float
 def urg04lx_sensor_increments(increments, *, offset_m: float = 0.145) -> np.ndarray:
     """Move body increments to a sensor mounted ``offset_m`` ahead: ``u_s = o⁻¹ ⊕ u ⊕ o``.
 
+    Parameters
+    ----------
+    increments : array_like, shape (n, 3)
+        Body-frame increments ``(dx_m, dy_m, dtheta_rad)`` of the wheel axle.
+    offset_m : float
+        Distance of the sensor ahead of the axle [m] (default 0.145).
+
+    Returns
+    -------
+    increments : ndarray, shape (n, 3)
+        The sensor's increments; the turn is kept as given (not re-wrapped).
+
+    Examples
+    --------
     >>> urg04lx_sensor_increments([[0.0, 0.0, np.pi / 2]], offset_m=1.0).round(12).tolist()
     [[-1.0, 1.0, 1.570796326795]]
     """

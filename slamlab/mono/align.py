@@ -43,6 +43,20 @@ def solve_spd(H, g) -> np.ndarray:
     The same bits on every machine (LAPACK's solvers call BLAS kernels that round by CPU).
     Returns NaNs when ``H`` is not positive definite.
 
+    Parameters
+    ----------
+    H : array_like, shape (n, n)
+        Symmetric positive definite matrix (``n`` small: the Gauss-Newton 6×6).
+    g : array_like, shape (n,)
+        Right-hand side.
+
+    Returns
+    -------
+    x : ndarray, shape (n,)
+        The solution of ``H x = g`` (NaNs when ``H`` is not positive definite).
+
+    Examples
+    --------
     >>> solve_spd(np.array([[4.0, 2.0], [2.0, 3.0]]), np.array([2.0, 1.0])).tolist()
     [0.5, 0.0]
     """
@@ -77,7 +91,20 @@ def solve_spd(H, g) -> np.ndarray:
 
 
 def build_pyramid(image, levels: int) -> list[np.ndarray]:
-    """Float32 image pyramid, level ``l`` halved ``l`` times (``cv2.pyrDown``)."""
+    """Float32 image pyramid, level ``l`` halved ``l`` times (``cv2.pyrDown``).
+
+    Parameters
+    ----------
+    image : array_like, shape (H, W)
+        Grey image.
+    levels : int
+        Number of halvings; fewer when a level's smaller side drops below 16 px.
+
+    Returns
+    -------
+    list of ndarray
+        Float32 images, ``[0]`` the full-size one.
+    """
     import cv2
 
     img = v.as_image(image, "image").astype(np.float32)
@@ -90,7 +117,20 @@ def build_pyramid(image, levels: int) -> list[np.ndarray]:
 
 
 def bilinear(img, u, v_):
-    """Bilinear samples of ``img`` at ``(u, v)`` (any shapes, clamped to the border)."""
+    """Bilinear samples of ``img`` at ``(u, v)`` (any shapes, clamped to the border).
+
+    Parameters
+    ----------
+    img : ndarray, shape (H, W)
+        Image to sample.
+    u, v_ : ndarray
+        Column and row coordinates [px], arrays of one shape.
+
+    Returns
+    -------
+    values : ndarray
+        Interpolated intensities, shape of ``u``.
+    """
     h, w = img.shape
     u = np.clip(u, 0.0, w - 1.001)
     v_ = np.clip(v_, 0.0, h - 1.001)
@@ -127,7 +167,21 @@ def _d_proj(K, X, scale):
 
 @dataclass(frozen=True)
 class AlignResult:
-    """``T_cur_ref`` 4×4, ``ok`` converged with enough points, ``n_points``, ``rms`` final photometric residual."""
+    """``T_cur_ref`` 4×4, ``ok`` converged with enough points, ``n_points``, ``rms`` final photometric residual.
+
+    Attributes
+    ----------
+    T_cur_ref : ndarray, shape (4, 4)
+        Pose of the reference camera in the current camera's frame.
+    ok : bool
+        Finite result from at least ``min_points`` points.
+    n_points : int
+        Points in front of the reference camera that were used.
+    rms : float
+        Final photometric RMS residual (grey levels).
+    iterations : int
+        Gauss-Newton steps taken over all levels.
+    """
 
     T_cur_ref: np.ndarray
     ok: bool
@@ -144,6 +198,32 @@ def sparse_align(pyr_ref, pyr_cur, K, X_ref, T_init, *, patch_px: int = 4, max_l
     taken on the reference image once per level: ``J = ∇I_ref · ∂π/∂ξ``; step
     ``δ = (JᵀJ)⁻¹ Jᵀ r`` and update ``T ← T · exp(δ)⁻¹``. A step that raises the error is
     undone and the level ends (as SVO). ``X_ref`` (N, 3) points in the reference camera frame.
+
+    Parameters
+    ----------
+    pyr_ref, pyr_cur : list of ndarray
+        Image pyramids (:func:`build_pyramid`) of the reference and current frames.
+    K : array_like, shape (3, 3)
+        Intrinsic matrix of level 0.
+    X_ref : array_like, shape (N, 3)
+        Points in the reference camera frame [m].
+    T_init : array_like, shape (4, 4)
+        Initial ``T_cur_ref`` (e.g. from a motion prior).
+    patch_px : int
+        Side of the square patch around each point [px] (default 4).
+    max_level, min_level : int
+        Coarsest and finest pyramid levels used (defaults 3 and 1).
+    max_iter : int
+        Gauss-Newton steps per level at most (default 30).
+    eps : float
+        A step with norm below ``eps`` ends the level (default 1e-6).
+    min_points : int
+        Fewest usable points; fewer returns ``ok`` False at once (default 10).
+
+    Returns
+    -------
+    AlignResult
+        ``T_cur_ref``, ``ok``, ``n_points``, ``rms``, ``iterations``.
     """
     K = np.asarray(K, dtype=np.float64)
     X_ref = np.asarray(X_ref, dtype=np.float64).reshape(-1, 3)
@@ -225,6 +305,34 @@ def refine_pose(K, X_world, uv, T_cam_world_init, *, huber_px: float = 1.0, reje
     ``(T_cam_world, residual_px (N,), ok)`` with the residuals of every point; ``ok`` is False
     (and the initial pose returned) when a run does not converge in ``max_iter`` steps or ends
     non-finite. Written without BLAS (see the module docstring): the same bits on any machine.
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    X_world : array_like, shape (N, 3)
+        Map points in the world frame [m].
+    uv : array_like, shape (N, 2)
+        Their measured pixels.
+    T_cam_world_init : array_like, shape (4, 4)
+        Initial camera pose (world to camera).
+    huber_px : float
+        Huber scale [px] (default 1).
+    reject_px : float or None
+        Error [px] above which a point is left out of the second run; ``None`` = one run only (default 3).
+    max_iter : int
+        Levenberg-Marquardt steps per run at most (default 50).
+    tol : float
+        Step-norm and relative-cost tolerance (default 1e-8).
+
+    Returns
+    -------
+    T_cam_world : ndarray, shape (4, 4)
+        Refined pose (the initial one when ``ok`` is False).
+    residual_px : ndarray, shape (N,)
+        Reprojection error of every point [px].
+    ok : bool
+        Both runs converged to a finite pose.
     """
     K = np.asarray(K, dtype=np.float64)
     X = np.asarray(X_world, dtype=np.float64).reshape(-1, 3)

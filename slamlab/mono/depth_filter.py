@@ -56,6 +56,25 @@ class Seeds:
     ``mu`` / ``sigma2`` inverse depth (1/m) mean and variance, ``a``, ``b`` the Beta
     counts, ``rho_range`` the width (1/m) of the outlier's uniform, ``ref`` the index of the
     reference keyframe, ``n_obs`` measurements taken, ``n_fail`` failed searches in a row.
+
+    Attributes
+    ----------
+    uv : ndarray, shape (N, 2)
+        Pixel in the reference keyframe.
+    f : ndarray, shape (N, 3)
+        Unit bearing in the reference keyframe.
+    mu, sigma2 : ndarray, shape (N,)
+        Inverse-depth mean [1/m] and variance [1/m²].
+    a, b : ndarray, shape (N,)
+        Beta counts (inlier, outlier).
+    rho_range : ndarray, shape (N,)
+        Width of the outlier's uniform [1/m].
+    ref : ndarray of int, shape (N,)
+        Index of the reference keyframe.
+    n_obs : ndarray of int, shape (N,)
+        Measurements taken.
+    n_fail : ndarray of int, shape (N,)
+        Failed searches in a row.
     """
 
     uv: np.ndarray
@@ -73,7 +92,18 @@ class Seeds:
         return int(self.mu.shape[0])
 
     def take(self, idx) -> Seeds:
-        """The seeds selected by an index or boolean mask."""
+        """The seeds selected by an index or boolean mask.
+
+        Parameters
+        ----------
+        idx : int array or bool mask
+            Seeds to keep.
+
+        Returns
+        -------
+        Seeds
+            The selected rows of every field.
+        """
         return Seeds(**{k: getattr(self, k)[idx] for k in self.__dataclass_fields__})
 
     @staticmethod
@@ -91,6 +121,28 @@ def init_seeds(uv, f, depth_mean_m: float, depth_min_m: float, *, ref: int = 0,
 
     ``μ = 1/depth_mean``, ``ρ_range = 1/depth_min``, ``σ² = ρ_range²/36``, ``a = a0``, ``b = b0``.
 
+    Parameters
+    ----------
+    uv : array_like, shape (N, 2)
+        Pixels of the new seeds in the reference keyframe.
+    f : array_like, shape (N, 3)
+        Their unit bearings.
+    depth_mean_m : float
+        Prior mean depth [m] (the scene's median depth).
+    depth_min_m : float
+        Smallest expected depth [m]; sets ``rho_range``.
+    ref : int
+        Index of the reference keyframe (default 0).
+    a0, b0 : float
+        Initial Beta counts (SVO: 10, 10).
+
+    Returns
+    -------
+    Seeds
+        ``N`` new seeds with ``n_obs = n_fail = 0``.
+
+    Examples
+    --------
     >>> s = init_seeds([[1.0, 2.0]], [[0.0, 0.0, 1.0]], 2.0, 0.5)
     >>> float(s.mu[0]), float(s.rho_range[0]), round(float(s.sigma2[0]), 6)
     (0.5, 2.0, 0.111111)
@@ -134,6 +186,24 @@ def update_seeds(mu, sigma2, a, b, x, tau2, rho_range):
         a' = (e − f)/(f − e/f),  b' = a' (1 − f)/f
 
     Returns ``(mu, sigma2, a, b)`` as new arrays.
+
+    Parameters
+    ----------
+    mu, sigma2 : array_like, shape (N,)
+        Prior inverse-depth mean [1/m] and variance.
+    a, b : array_like, shape (N,)
+        Prior Beta counts.
+    x : array_like, shape (N,)
+        Measured inverse depth [1/m].
+    tau2 : array_like, shape (N,)
+        Measurement variance [1/m²].
+    rho_range : array_like, shape (N,)
+        Width of the outlier's uniform [1/m].
+
+    Returns
+    -------
+    mu, sigma2, a, b : ndarray, shape (N,)
+        Posterior parameters (``sigma2`` kept above the smallest positive float).
     """
     mu, sigma2, a, b, x, tau2, rho_range = np.broadcast_arrays(
         *(np.asarray(z, dtype=np.float64) for z in (mu, sigma2, a, b, x, tau2, rho_range)))
@@ -157,7 +227,18 @@ def update_seeds(mu, sigma2, a, b, x, tau2, rho_range):
 
 
 def inlier_ratio(a, b):
-    """Mean of the Beta part, ``a / (a + b)`` (003 §4.1.1)."""
+    """Mean of the Beta part, ``a / (a + b)`` (003 §4.1.1).
+
+    Parameters
+    ----------
+    a, b : array_like
+        Beta counts.
+
+    Returns
+    -------
+    ratio : ndarray
+        ``a / (a + b)``.
+    """
     a = np.asarray(a, dtype=np.float64)
     return a / (a + np.asarray(b, dtype=np.float64))
 
@@ -170,6 +251,22 @@ def compute_tau(t_ref_cur, f, z_m, px_error_angle_rad):
     With ``a = f z − t``, ``α = ∠(f, t)``, ``β = ∠(a, −t)``, ``β⁺ = β + δ`` and
     ``g⁺ = π − α − β⁺``: ``z⁺ = |t| sin β⁺ / sin g⁺`` and ``τ = z⁺ − z``.
     ``δ = 2 atan(σ_px / (2 f_px))`` (SVO: σ_px = 1).
+
+    Parameters
+    ----------
+    t_ref_cur : array_like, shape (3,) or (N, 3)
+        Current camera centre in the reference frame [m].
+    f : array_like, shape (N, 3)
+        Unit bearings in the reference frame.
+    z_m : array_like, shape (N,)
+        Depths along ``f`` [m].
+    px_error_angle_rad : float
+        Angle ``δ`` of one pixel's error [rad].
+
+    Returns
+    -------
+    tau_m : ndarray, shape (N,)
+        Depth standard deviation [m].
     """
     t = np.broadcast_to(np.asarray(t_ref_cur, dtype=np.float64), np.shape(f))
     f = np.asarray(f, dtype=np.float64)
@@ -188,7 +285,20 @@ def compute_tau(t_ref_cur, f, z_m, px_error_angle_rad):
 
 
 def tau_inverse(z_m, tau_m):
-    """Inverse-depth std from a depth std, as SVO: ``½ (1/max(z − τ, 1e-7) − 1/(z + τ))``."""
+    """Inverse-depth std from a depth std, as SVO: ``½ (1/max(z − τ, 1e-7) − 1/(z + τ))``.
+
+    Parameters
+    ----------
+    z_m : array_like
+        Depths [m].
+    tau_m : array_like
+        Depth standard deviations [m].
+
+    Returns
+    -------
+    tau_inv : ndarray
+        Inverse-depth standard deviations [1/m].
+    """
     z = np.asarray(z_m, dtype=np.float64)
     tau = np.asarray(tau_m, dtype=np.float64)
     return 0.5 * (1.0 / np.maximum(z - tau, 1e-7) - 1.0 / (z + tau))
@@ -197,6 +307,22 @@ def tau_inverse(z_m, tau_m):
 def depth_interval(mu, sigma, n_sigma: float = 2.0, floor: float = RHO_FLOOR):
     """Depth band ``[1/(ρ + nσ), 1/max(ρ − nσ, floor)]`` searched along the epipolar line (003 §4.2).
 
+    Parameters
+    ----------
+    mu, sigma : array_like, shape (N,)
+        Inverse-depth mean and standard deviation [1/m].
+    n_sigma : float
+        Half-width of the band in standard deviations (default 2).
+    floor : float
+        Smallest inverse depth used for the far end [1/m] (default 1e-10).
+
+    Returns
+    -------
+    depth_min_m, depth_max_m : ndarray, shape (N,)
+        Near and far ends of the band [m].
+
+    Examples
+    --------
     >>> lo, hi = depth_interval(np.array([0.5]), np.array([0.3]))
     >>> round(float(lo[0]), 4), float(hi[0])
     (0.9091, 10000000000.0)
@@ -210,7 +336,21 @@ def depth_interval(mu, sigma, n_sigma: float = 2.0, floor: float = RHO_FLOOR):
 
 
 def converged_sigma(sigma2, rho_range, fraction: float = SVO_SIGMA_FRACTION):
-    """SVO's test: ``σ < fraction · ρ_range`` (SVO: fraction = 1/200)."""
+    """SVO's test: ``σ < fraction · ρ_range`` (SVO: fraction = 1/200).
+
+    Parameters
+    ----------
+    sigma2 : array_like
+        Inverse-depth variances.
+    rho_range : array_like
+        Widths of the outlier's uniform [1/m].
+    fraction : float
+        Threshold as a fraction of ``rho_range`` (default 1/200).
+
+    Returns
+    -------
+    converged : ndarray of bool
+    """
     return np.sqrt(np.asarray(sigma2, dtype=np.float64)) < fraction * np.asarray(rho_range, dtype=np.float64)
 
 
@@ -219,6 +359,20 @@ def linearity_index(mu, sigma2, d_m, cos_alpha):
 
     ``d_m`` distance from the current camera to the point, ``α`` the parallax between the
     first and the current ray (Civera, Davison & Montiel 2008, the linearity index).
+
+    Parameters
+    ----------
+    mu, sigma2 : array_like
+        Inverse-depth mean [1/m] and variance.
+    d_m : array_like
+        Distance from the current camera to the point [m].
+    cos_alpha : array_like
+        Cosine of the parallax between the first and the current ray.
+
+    Returns
+    -------
+    L : ndarray
+        The linearity index.
     """
     mu = np.asarray(mu, dtype=np.float64)
     sigma_d = np.sqrt(np.asarray(sigma2, dtype=np.float64)) / np.maximum(mu, RHO_FLOOR) ** 2
@@ -226,7 +380,19 @@ def linearity_index(mu, sigma2, d_m, cos_alpha):
 
 
 def converged_linearity(mu, sigma2, d_m, cos_alpha, L_max: float = 0.1):
-    """003's test ``L < 0.1`` (003 §4.3.2)."""
+    """003's test ``L < 0.1`` (003 §4.3.2).
+
+    Parameters
+    ----------
+    mu, sigma2, d_m, cos_alpha : array_like
+        As in :func:`linearity_index`.
+    L_max : float
+        Threshold on the index (default 0.1).
+
+    Returns
+    -------
+    converged : ndarray of bool
+    """
     return linearity_index(mu, sigma2, d_m, cos_alpha) < L_max
 
 
@@ -234,6 +400,18 @@ def seed_points(seeds: Seeds, T_world_ref) -> np.ndarray:
     """World points of seeds, ``X = R_F (f / ρ) + T_F`` (003 §4.1.2, eq. 6.4; reconstruction).
 
     ``T_world_ref`` (K, 4, 4) keyframe poses indexed by ``seeds.ref``.
+
+    Parameters
+    ----------
+    seeds : Seeds
+        The seeds.
+    T_world_ref : array_like, shape (K, 4, 4)
+        Keyframe poses (camera to world), indexed by ``seeds.ref``.
+
+    Returns
+    -------
+    X : ndarray, shape (N, 3)
+        World points [m].
     """
     T = np.asarray(T_world_ref, dtype=np.float64)[seeds.ref]
     p = seeds.f / np.maximum(seeds.mu, RHO_FLOOR)[:, None]

@@ -28,7 +28,22 @@ _FAR_DEPTH = 1e6  # depths beyond this are drawn at their vanishing point
 
 
 def extract_patches(img, uv, patch_px: int) -> np.ndarray:
-    """``(N, patch_px²)`` bilinear patches centred at ``uv`` (N, 2)."""
+    """``(N, patch_px²)`` bilinear patches centred at ``uv`` (N, 2).
+
+    Parameters
+    ----------
+    img : ndarray, shape (H, W)
+        Grey image.
+    uv : array_like, shape (N, 2)
+        Patch centres [px].
+    patch_px : int
+        Patch side [px].
+
+    Returns
+    -------
+    patches : ndarray of float32, shape (N, patch_px²)
+        Row-major patches (border pixels clamped).
+    """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     if patch_px % 2 and np.all(uv == np.rint(uv)):  # odd patch on whole pixels: plain indexing
         o = np.arange(patch_px) - patch_px // 2
@@ -51,7 +66,20 @@ def _normalise(P):
 
 
 def zncc(A, B) -> np.ndarray:
-    """ZNCC matrix ``(N, M)`` between rows of ``A`` (N, P) and ``B`` (M, P); flat patches score 0."""
+    """ZNCC matrix ``(N, M)`` between rows of ``A`` (N, P) and ``B`` (M, P); flat patches score 0.
+
+    Parameters
+    ----------
+    A : array_like, shape (N, P)
+        Patches, one per row.
+    B : array_like, shape (M, P)
+        Patches, one per row.
+
+    Returns
+    -------
+    scores : ndarray, shape (N, M)
+        Zero-mean normalised cross-correlations in ``[-1, 1]``.
+    """
     A = np.asarray(A, dtype=np.float64)
     B = np.asarray(B, dtype=np.float64)
     A = A - A.mean(axis=1, keepdims=True)
@@ -68,6 +96,26 @@ def epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma: float = 2.0):
     ``a`` is the projection of the nearest depth ``1/(ρ + nσ)``, ``b`` of the farthest
     ``1/max(ρ − nσ, 1e-10)`` (drawn at the vanishing point beyond ``1e6`` m). ``ok`` False
     when the near end is behind the current camera.
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    T_cur_ref : ndarray, shape (4, 4)
+        Reference camera pose in the current camera's frame.
+    f : array_like, shape (N, 3)
+        Unit bearings of the seeds in the reference frame.
+    mu, sigma : array_like, shape (N,)
+        Inverse-depth mean and standard deviation [1/m].
+    n_sigma : float
+        Half-width of the depth band in standard deviations (default 2).
+
+    Returns
+    -------
+    a, b : ndarray, shape (N, 2)
+        Near and far end points [px] in the current image.
+    ok : ndarray of bool, shape (N,)
+        Both ends in front of the current camera.
     """
     K = np.asarray(K, dtype=np.float64)
     R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
@@ -89,6 +137,21 @@ class EpipolarMatch:
     ``found`` (N,), ``uv`` (N, 2) matched pixel (NaN-free: zeros when not found), ``depth_m``
     (N,) triangulated depth along ``f`` in the reference frame, ``score`` (N,) best ZNCC,
     ``n_candidates`` (N,) corners tested, ``a``/``b`` segment end points.
+
+    Attributes
+    ----------
+    found : ndarray of bool, shape (N,)
+        A corner with ZNCC at least ``zncc_min`` was found and triangulated.
+    uv : ndarray, shape (N, 2)
+        Matched pixel (zeros when not found).
+    depth_m : ndarray, shape (N,)
+        Triangulated depth along ``f`` in the reference frame [m] (0 when not found).
+    score : ndarray, shape (N,)
+        Best ZNCC (-1 when no candidate).
+    n_candidates : ndarray of int, shape (N,)
+        Corners tested.
+    a, b : ndarray, shape (N, 2)
+        End points of the searched segment [px].
     """
 
     found: np.ndarray
@@ -103,7 +166,28 @@ class EpipolarMatch:
 def affine_warp(K, T_cur_ref, f, depth_m, uv_ref, *, h_px: float = 5.0) -> np.ndarray:
     """``(N, 2, 2)`` affine warp ``∂uv_cur / ∂uv_ref`` of each point at ``depth_m`` along ``f`` (SVO's
     ``getWarpMatrixAffine``): the pixel ``uv_ref`` shifted by ``h_px`` in u and in v, back-projected to the
-    same depth and projected into the current camera. Written without BLAS (einsum)."""
+    same depth and projected into the current camera. Written without BLAS (einsum).
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    T_cur_ref : ndarray, shape (4, 4)
+        Reference camera pose in the current camera's frame.
+    f : array_like, shape (N, 3)
+        Unit bearings in the reference frame (not used by the warp itself; one row per point).
+    depth_m : array_like, shape (N,)
+        Depth of each point along its ray [m].
+    uv_ref : array_like, shape (N, 2)
+        Pixels in the reference image.
+    h_px : float
+        Finite-difference step [px] (default 5).
+
+    Returns
+    -------
+    A : ndarray, shape (N, 2, 2)
+        ``∂uv_cur / ∂uv_ref`` per point.
+    """
     K = np.asarray(K, dtype=np.float64)
     R, t = T_cur_ref[:3, :3], T_cur_ref[:3, 3]
     uv_ref = np.asarray(uv_ref, dtype=np.float64).reshape(-1, 2)
@@ -124,7 +208,24 @@ def affine_warp(K, T_cur_ref, f, depth_m, uv_ref, *, h_px: float = 5.0) -> np.nd
 
 def warped_patches(img_ref, uv_ref, A, patch_px: int) -> np.ndarray:
     """``(N, patch_px²)`` reference patches resampled as the current camera sees them: pixel ``o`` of the
-    current patch is ``uv_ref + A⁻¹ o`` in the reference image (SVO's ``warpAffine``)."""
+    current patch is ``uv_ref + A⁻¹ o`` in the reference image (SVO's ``warpAffine``).
+
+    Parameters
+    ----------
+    img_ref : ndarray, shape (H, W)
+        Reference image.
+    uv_ref : ndarray, shape (N, 2)
+        Patch centres in the reference image [px].
+    A : array_like, shape (N, 2, 2)
+        Affine warps (:func:`affine_warp`).
+    patch_px : int
+        Patch side [px].
+
+    Returns
+    -------
+    patches : ndarray of float32, shape (N, patch_px²)
+        Resampled patches.
+    """
     A = np.asarray(A, dtype=np.float64)
     det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
     det = np.where(np.abs(det) > 1e-9, det, 1.0)
@@ -150,6 +251,46 @@ def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv
     ``img_ref`` and ``uv_ref`` (N, 2) given: the reference patches are warped affinely to the
     current view at the seed's mean depth (SVO's remedy for scale change, e.g. forward motion)
     instead of ``ref_patches``.
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    T_cur_ref : ndarray, shape (4, 4)
+        Reference camera pose in the current camera's frame.
+    f : array_like, shape (N, 3)
+        Unit bearings of the seeds in the reference frame.
+    mu, sigma : array_like, shape (N,)
+        Inverse-depth mean and standard deviation [1/m].
+    ref_patches : ndarray, shape (N, patch_px²)
+        The seeds' patches in their reference keyframe.
+    img_cur : ndarray, shape (H, W)
+        Current image.
+    corners_uv : array_like, shape (C, 2)
+        FAST corners of the current image [px].
+    n_sigma : float
+        Half-width of the depth band in standard deviations (default 2).
+    tol_px : float
+        Largest distance of a candidate corner from the segment [px] (default 2).
+    patch_px : int
+        Patch side [px] (default 9).
+    zncc_min : float
+        Smallest ZNCC of a match (default 0.8).
+    min_parallax_rad : float
+        Rays closer to parallel than this give no depth [rad] (default 1e-3).
+    chunk : int
+        Seeds per vectorised block (default 512).
+    cur_patches : ndarray, shape (C, patch_px²), optional
+        The corners' patches when already cut.
+    img_ref : ndarray, optional
+        Reference image; with ``uv_ref``, the reference patches are warped affinely.
+    uv_ref : array_like, shape (N, 2), optional
+        The seeds' pixels in ``img_ref``.
+
+    Returns
+    -------
+    EpipolarMatch
+        ``found``, ``uv``, ``depth_m``, ``score`` per seed.
     """
     K = np.asarray(K, dtype=np.float64)
     f = np.asarray(f, dtype=np.float64).reshape(-1, 3)

@@ -30,6 +30,18 @@ def sim3_fit(est_xyz, ref_xyz):
     """``(c, R, t)`` of the Sim(3) mapping ``est_xyz`` onto ``ref_xyz`` (Umeyama), or None when degenerate.
 
     Degenerate: fewer than 3 positions, or the estimate (or the truth) does not move.
+
+    Parameters
+    ----------
+    est_xyz : array_like, shape (N, 3)
+        Estimated positions (map units).
+    ref_xyz : array_like, shape (N, 3)
+        True positions [m].
+
+    Returns
+    -------
+    tuple or None
+        ``(c, R, t)``: scale [m per map unit], rotation (3, 3), translation (3,) [m]; ``None`` when degenerate.
     """
     from ..geometry.registration import umeyama
 
@@ -56,6 +68,25 @@ class RunScore:
     ``pos_err_m`` (N,) error of every frame after the run's Sim(3) fitted on the claimed frames
     (``inf`` everywhere when fewer than 3 frames are claimed); ``claimed`` (N,) the tracker's own
     flags; ``correct`` (N,) claimed and ``pos_err_m <= tol_m``; ``tol_m = tol_frac × path_m``.
+
+    Attributes
+    ----------
+    pos_err_m : ndarray, shape (N,)
+        Position error of every frame after the Sim(3) fit [m].
+    claimed : ndarray of bool, shape (N,)
+        The tracker's own "tracking" flags.
+    correct : ndarray of bool, shape (N,)
+        Claimed and within ``tol_m`` of the truth.
+    tol_frac : float
+        Tolerance as a fraction of the path length.
+    tol_m : float
+        ``tol_frac × path_m`` [m].
+    path_m : float
+        Length of the true path [m].
+    ate_all_m, ate_claimed_m : float
+        RMS position error over every frame and over the claimed frames [m].
+    scale_first, scale_last : float
+        Metres per map unit fitted on the first and last third of the claimed frames.
     """
 
     pos_err_m: np.ndarray = field(repr=False)

@@ -7,20 +7,18 @@ its left camera only. ``run_mono_sequence`` returns a frozen :class:`MonoRunResu
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from .. import _validate as v
 from .._progress import progress_bar
 from .._table import format_table
 from ..geometry.camera import StereoRig
-from ..geometry.se3 import se3_compose, se3_from_planar, se3_inverse
+from ..geometry.se3 import se3_compose, se3_from_planar
 from ..sim.arena import StereoArena, StereoSim
-from .evaluate import TRACK_TOL_FRAC, RunScore, score_run
+from .convergence import ConvergenceStudy, run_depth_filter_convergence
 from .params import MonoParams
-from .slam import STAGES, MonoSLAM
+from .runs import MonoRunResult, run_mono, trajectory_errors
+from .slam import STAGES
 
 __all__ = [
     "FAILURE_CASES",
@@ -66,6 +64,20 @@ def sequence_poses(name: str, n_frames: int = 60, *, step_m: float = 0.02) -> np
     yaw sway (the easy case for a monocular camera: parallax from translation across the view).
     ``"arc"``: forward on a circle of 2.5 m radius about the arena centre (parallax mostly
     along the optical axis). ``"turn"``: rotation in place (003 §5.3's pure rotation).
+
+    Parameters
+    ----------
+    name : str
+        ``"strafe"``, ``"arc"`` or ``"turn"``.
+    n_frames : int
+        Number of poses, at least 2 (default 60).
+    step_m : float
+        Distance between frames [m] (default 0.02; ``"turn"`` ignores it).
+
+    Returns
+    -------
+    poses : ndarray, shape (n_frames, 3)
+        ``(x_m, y_m, yaw_rad)`` per frame.
     """
     v.check_choice(name, "name", (*SEQUENCES, "turn"))
     n = v.check_int(n_frames, "n_frames", minimum=2)
@@ -88,6 +100,24 @@ def mono_sim(size: str = "small", *, arena: StereoArena | None = None, noise_std
     Default arena: seed 0 with the floor texture at full contrast (ours: a monocular camera
     needs points off the fence's plane; with the fence alone, a thin band of coplanar points,
     vertical translation and pitch are nearly indistinguishable).
+
+    Parameters
+    ----------
+    size : str
+        Image size: ``"tiny"`` (192×144), ``"small"`` (320×240, default) or ``"full"`` (768×576).
+    arena : StereoArena, optional
+        The scene; ``None`` = seed 0 with a full-contrast floor.
+    noise_std : float
+        Image noise [grey levels] (default 1).
+    camera_height_m : float
+        Height of the camera above the floor [m] (default 0.6).
+    rng : Generator, int or None
+        Randomness of the image noise (default 0).
+
+    Returns
+    -------
+    StereoSim
+        The simulator (its ``rig.left`` is the monocular camera).
     """
     w, h = SIZES[v.check_choice(size, "size", tuple(SIZES))]
     return StereoSim(StereoArena(seed=0, floor_contrast=1.0) if arena is None else arena,
@@ -103,6 +133,28 @@ def render_sequence(sim: StereoSim, poses, *, blur_px: float = 0.0, contrast: fl
     """Left-camera images ``(N, H, W)`` uint8 and true camera poses ``(N, 4, 4)`` (world ← camera).
 
     ``contrast`` < 1 and ``blur_px`` > 0 turn a scene into a low-texture one (ours, for 003 §5.3).
+
+    Parameters
+    ----------
+    sim : StereoSim
+        The simulator (:func:`mono_sim`).
+    poses : array_like, shape (N, 3)
+        Body poses ``(x_m, y_m, yaw_rad)`` (:func:`sequence_poses`).
+    blur_px : float
+        Gaussian blur σ [px] (default 0: none).
+    contrast : float
+        Contrast factor about mid-grey (default 1).
+    pitch_down_rad : float
+        Downward tilt of the camera [rad] (default 20°).
+    progress : bool, callable or None
+        Progress display (``slamlab._progress``).
+
+    Returns
+    -------
+    images : ndarray of uint8, shape (N, H, W)
+        Left-camera images.
+    T_wc : ndarray, shape (N, 4, 4)
+        True camera poses (camera to world).
     """
     import cv2
 
@@ -126,176 +178,36 @@ def render_sequence(sim: StereoSim, poses, *, blur_px: float = 0.0, contrast: fl
     return np.array(imgs), np.array(Ts)
 
 
-def trajectory_errors(truth, estimate, tracked):
-    """ATE (Sim(3), m) and RPE (1-frame translation, m) over the tracked frames, via :mod:`slamlab.evaluation`.
-
-    ``truth``/``estimate`` (N, 4, 4). Returns ``(ate_m, rpe_m)``; NaN-free: ``inf`` when fewer
-    than 3 frames were tracked.
-    """
-    from ..evaluation import Trajectory, ate, rpe
-
-    idx = np.flatnonzero(np.asarray(tracked, bool))
-    if idx.size < 3:
-        return float("inf"), float("inf")
-    ts = idx * 0.1
-    ref = Trajectory(truth[idx, :3, 3], truth[idx, :3, :3], ts)
-    est = Trajectory(estimate[idx, :3, 3], estimate[idx, :3, :3], ts)
-    a = float(ate(ref, est, align="sim3").rmse)
-    # RPE after the Sim(3) scale: the monocular map has no metric scale
-    from ..evaluation.metrics import align_trajectory
-
-    est_al, _ = align_trajectory(est, ref, "sim3")
-    r = float(rpe(ref, est_al, delta=1).rmse)
-    return a, r
-
-
-@dataclass(frozen=True)
-class MonoRunResult:
-    """A monocular run against ground truth (003 §5.2: ATE after alignment; ours: Sim(3), RPE, correct frames).
-
-    ``claimed`` are the tracker's own flags; ``tracked`` the **correctly tracked** frames (claimed and
-    within ``score.tol_m`` after the run's Sim(3), :func:`~slamlab.mono.evaluate.score_run`); ``ate_m``
-    is over all frames (a frame not tracked counts with the pose the tracker reports for it),
-    ``ate_claimed_m`` over the claimed ones.
-    """
-
-    name: str
-    truth: np.ndarray = field(repr=False)  # (N, 4, 4) camera poses in the first frame's camera frame
-    estimate: np.ndarray = field(repr=False)  # (N, 4, 4)
-    claimed: np.ndarray = field(repr=False)  # (N,) the tracker's own "tracked"
-    status: tuple = field(repr=False)
-    score: RunScore = field(repr=False)
-    rpe_m: float
-    n_keyframes: int
-    n_points: int
-    counts: dict = field(repr=False, compare=False)
-    stage_time_s: dict = field(repr=False, compare=False)
-    fps: float = field(compare=False)
-    points: np.ndarray = field(repr=False, compare=False, default=None)
-    seed_snapshots: dict = field(repr=False, compare=False, default=None)  # frame -> σ_ρ/ρ_range of the seeds
-
-    @property
-    def tracked(self) -> np.ndarray:
-        """(N,) correctly tracked frames (claimed and within the tolerance after Sim(3))."""
-        return self.score.correct
-
-    @property
-    def ate_m(self) -> float:
-        """ATE RMSE (m) after the run's Sim(3), over all frames."""
-        return self.score.ate_all_m
-
-    @property
-    def ate_claimed_m(self) -> float:
-        """ATE RMSE (m) after the run's Sim(3), over the frames the tracker claims."""
-        return self.score.ate_claimed_m
-
-    @property
-    def fraction_tracked(self) -> float:
-        """Share of the frames correctly tracked."""
-        return float(np.mean(self.tracked)) if len(self.tracked) else 0.0
-
-    @property
-    def fraction_claimed(self) -> float:
-        """Share of the frames the tracker claims as tracked."""
-        return float(np.mean(self.claimed)) if len(self.claimed) else 0.0
-
-    @property
-    def verdict(self) -> str:
-        """003 §5.5.1's marks on the correctly tracked share: 'X' < 30 %, '*' 30-70 %, 'ok' > 70 %."""
-        f = self.fraction_tracked
-        return "X" if f < 0.3 else ("*" if f <= 0.7 else "ok")
-
-    def __str__(self) -> str:
-        return (f"{self.name}: {len(self.tracked)} frames, correctly tracked {100 * self.fraction_tracked:.0f} % "
-                f"(claimed {100 * self.fraction_claimed:.0f} %), ATE (Sim(3), all frames) {self.ate_m:.3f} m, "
-                f"{self.n_keyframes} keyframes, {self.n_points} points")
-
-    def table(self) -> str:
-        sc = self.score
-        f3 = lambda x: f"{x:.3f}" if np.isfinite(x) else "-"
-        rows = [["frames", f"{len(self.tracked)}"],
-                ["path of the truth, m", f"{sc.path_m:.2f}"],
-                ["claimed by the tracker, %", f"{100 * self.fraction_claimed:.0f}"],
-                [f"correctly tracked (error <= {100 * sc.tol_frac:.0f} % of path = {sc.tol_m:.3f} m), %",
-                 f"{100 * self.fraction_tracked:.0f}"],
-                ["ATE RMSE after Sim(3), all frames, m", f3(self.ate_m)],
-                ["ATE RMSE after Sim(3), claimed frames, m", f3(self.ate_claimed_m)],
-                ["ATE, all frames, % of path", f"{100 * self.ate_m / sc.path_m:.1f}" if sc.path_m > 0
-                 and np.isfinite(self.ate_m) else "-"],
-                ["RPE RMSE (1 frame, Sim(3) scale), m", f3(self.rpe_m)],
-                ["scale, first / last third (m per map unit, from the truth)", f"{f3(sc.scale_first)} / {f3(sc.scale_last)}"],
-                ["scale drift (last / first)", f"{sc.scale_drift:.2f}" if np.isfinite(sc.scale_drift) else "-"],
-                ["keyframes / map points", f"{self.n_keyframes} / {self.n_points}"]]
-        return format_table(["quantity", "value"], rows,
-                            title=f"{self.name} (a frame not tracked counts at the pose the tracker reports for it)")
-
-
-def _check_frames(images) -> list:
-    """``images`` as a list of grey frames of one size, or a ValueError/TypeError naming ``images``."""
-    if isinstance(images, np.ndarray) and images.ndim == 3:
-        images = list(images)
-    try:
-        images = list(images)
-    except TypeError:
-        raise TypeError(f"`images` must be a sequence of grey images; got {type(images).__name__}") from None
-    if not images:
-        raise ValueError("`images` must hold at least one frame; got none")
-    out = [v.as_image(img, f"images[{i}]") for i, img in enumerate(images)]
-    shape0 = out[0].shape
-    for i, img in enumerate(out):
-        if img.shape != shape0:
-            raise ValueError(f"`images` must all have one size; images[0] is {shape0} (H, W) but images[{i}] is "
-                             f"{img.shape}")
-    return out
-
-
-def _check_truth(truth_T_wc, n: int) -> np.ndarray:
-    """``truth_T_wc`` as an (n, 4, 4) array, or a ValueError naming ``truth_T_wc``."""
-    T = v.as_finite_array(truth_T_wc, "truth_T_wc", ndim=3)
-    if T.shape[1:] != (4, 4):
-        raise ValueError(f"`truth_T_wc` must have shape (N, 4, 4); got {T.shape}")
-    if T.shape[0] != n:
-        raise ValueError(f"`truth_T_wc` must hold one pose per frame: {n} frames in `images`, {T.shape[0]} poses "
-                         "in `truth_T_wc`")
-    return T
-
-
-def run_mono(images, truth_T_wc, K, *, name: str = "run", params: MonoParams | None = None, progress=None,
-             snapshot_frames=(), track_tol: float = TRACK_TOL_FRAC, **overrides) -> MonoRunResult:
-    """Run :class:`MonoSLAM` on images with ground truth ``(N, 4, 4)`` and score it (003 §5.2).
-
-    ``snapshot_frames``: frames after which the seeds' ``σ_ρ / ρ_range`` are kept (for histograms).
-    ``track_tol``: a claimed frame is correctly tracked when its position error after the run's Sim(3)
-    is at most this share of the path length (ours, default 5 %). Raises ``ValueError`` naming the argument when the frames differ in size or ``truth_T_wc``
-    does not hold one pose per frame.
-    """
-    images = _check_frames(images)
-    truth_T_wc = _check_truth(truth_T_wc, len(images))
-    p = MonoParams.resolve(params, **overrides)
-    slam = MonoSLAM(K, params=p)
-    snaps = {}
-    dt = 0.0
-    for i, img in enumerate(progress_bar(images, desc=name, progress=progress)):
-        t = time.perf_counter()
-        slam.process(img)
-        dt += time.perf_counter() - t
-        if i in snapshot_frames:
-            snaps[i] = np.sqrt(slam.seeds.sigma2) / slam.seeds.rho_range
-    T0 = se3_inverse(truth_T_wc[0])
-    truth = np.einsum("ij,njk->nik", T0, truth_T_wc)
-    est = slam.trajectory
-    tr = slam.tracked
-    _, rpe_m = trajectory_errors(truth, est, tr)
-    score = score_run(truth, est, tr, tol_frac=track_tol)
-    return MonoRunResult(name, truth, est, tr, tuple(r["status"] for r in slam.records), score, rpe_m,
-                         len(slam.keyframes), len(slam.points), dict(slam.counts), slam.stage_times(),
-                         len(images) / dt if dt > 0 else float("inf"), slam.points.copy(), snaps)
-
-
 def run_mono_sequence(sequence: str = "strafe", *, n_frames: int = 60, size: str = "small", step_m: float = 0.02,
                       noise_std: float = 1.0, params: MonoParams | None = None, progress=None, rng=0,
                       **overrides) -> MonoRunResult:
-    """Render a sequence of the arena with the left camera and run the monocular pipeline on it."""
+    """Render a sequence of the arena with the left camera and run the monocular pipeline on it.
+
+    Parameters
+    ----------
+    sequence : str
+        ``"strafe"``, ``"arc"`` or ``"turn"`` (:func:`sequence_poses`; default ``"strafe"``).
+    n_frames : int
+        Number of frames (default 60).
+    size : str
+        Image size (:func:`mono_sim`; default ``"small"``).
+    step_m : float
+        Distance between frames [m] (default 0.02).
+    noise_std : float
+        Image noise [grey levels] (default 1).
+    params : MonoParams, optional
+        Settings (default values).
+    progress : bool, callable or None
+        Progress display.
+    rng : Generator, int or None
+        Randomness of the image noise (default 0).
+    **overrides
+        Fields of :class:`MonoParams` to change.
+
+    Returns
+    -------
+    MonoRunResult
+    """
     sim = mono_sim(size, noise_std=noise_std, rng=rng)
     poses = sequence_poses(sequence, n_frames, step_m=step_m)
     imgs, Ts = render_sequence(sim, poses, progress=progress)
@@ -303,81 +215,6 @@ def run_mono_sequence(sequence: str = "strafe", *, n_frames: int = 60, size: str
 
 
 STAGE_NAMES = STAGES
-
-
-# -- depth-filter convergence (003 §4.1.1, §4.3.2) ---------------------------------------------
-@dataclass(frozen=True)
-class ConvergenceStudy:
-    """Seeds of a synthetic scene updated ``n_obs`` times at several outlier rates (our experiment).
-
-    ``sigma`` (R, n_obs + 1) median σ_ρ (1/m), ``inlier`` (R, n_obs + 1) median a/(a+b),
-    ``error`` (R, n_obs + 1) median |ρ − ρ_true| (1/m), ``converged`` (R, n_obs + 1) share of seeds
-    passing SVO's σ test, ``mu`` (R, n_seeds) final means, ``rho_true`` (n_seeds,).
-    """
-
-    outlier_rates: tuple
-    sigma: np.ndarray = field(repr=False)
-    inlier: np.ndarray = field(repr=False)
-    error: np.ndarray = field(repr=False)
-    converged: np.ndarray = field(repr=False)
-    mu: np.ndarray = field(repr=False)
-    rho_true: np.ndarray = field(repr=False)
-    tau: float
-
-    def __str__(self) -> str:
-        return (f"depth filter, {self.mu.shape[1]} seeds, {self.sigma.shape[1] - 1} observations, "
-                f"outlier rates {', '.join(f'{r:.0%}' for r in self.outlier_rates)}")
-
-    def first_half(self) -> list:
-        """Observations until half of the seeds pass SVO's test, per outlier rate (None: never)."""
-        out = []
-        for row in self.converged:
-            k = np.flatnonzero(row >= 0.5)
-            out.append(int(k[0]) if k.size else None)
-        return out
-
-    def table(self, at=(0, 5, 10, 20, 40)) -> str:
-        at = [k for k in at if k < self.sigma.shape[1]]
-        rows = []
-        for i, r in enumerate(self.outlier_rates):
-            for k in at:
-                rows.append([f"{100 * r:.0f}", f"{k}", f"{self.sigma[i, k]:.4f}", f"{self.error[i, k]:.4f}",
-                             f"{self.inlier[i, k]:.2f}", f"{100 * self.converged[i, k]:.0f}"])
-        return format_table(["outliers, %", "observations", "median sigma_rho, 1/m", "median |rho - rho_true|",
-                             "median a/(a+b)", "converged (SVO), %"], rows,
-                            title=f"Depth-filter convergence (tau = {self.tau} 1/m, SVO initialisation)")
-
-
-def run_depth_filter_convergence(outlier_rates=(0.0, 0.2, 0.4, 0.6), *, n_obs: int = 40, n_seeds: int = 500,
-                                 tau: float = 0.01, depth_min_m: float = 0.5, rng=0) -> ConvergenceStudy:
-    """Gaussian × Beta seeds (SVO's start) fed inliers ``N(ρ_true, τ²)`` and outliers ``U(0, ρ_range)``."""
-    from .depth_filter import converged_sigma, init_seeds, inlier_ratio, update_seeds
-
-    rng = v.as_rng(rng)
-    n_obs = v.check_int(n_obs, "n_obs", minimum=1)
-    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
-    tau = v.check_positive(tau, "tau")
-    rates = tuple(float(r) for r in outlier_rates)
-    if not rates or any(not 0.0 <= r < 1.0 for r in rates):
-        raise ValueError(f"`outlier_rates` must be rates in [0, 1); got {outlier_rates!r}")
-    rho_true = rng.uniform(0.2, 1.0 / depth_min_m, n_seeds)
-    R = len(rates)
-    sig, inl, err, conv = (np.zeros((R, n_obs + 1)) for _ in range(4))
-    mus = np.zeros((R, n_seeds))
-    for i, r in enumerate(rates):
-        s = init_seeds(np.zeros((n_seeds, 2)), np.tile([0.0, 0.0, 1.0], (n_seeds, 1)), 1.0 / np.mean(rho_true), depth_min_m)
-        for k in range(n_obs + 1):
-            sig[i, k] = np.median(np.sqrt(s.sigma2))
-            inl[i, k] = np.median(inlier_ratio(s.a, s.b))
-            err[i, k] = np.median(np.abs(s.mu - rho_true))
-            conv[i, k] = np.mean(converged_sigma(s.sigma2, s.rho_range))
-            if k == n_obs:
-                break
-            out = rng.random(n_seeds) < r
-            x = np.where(out, rng.uniform(0.0, s.rho_range), rho_true + rng.normal(0.0, tau, n_seeds))
-            s.mu, s.sigma2, s.a, s.b = update_seeds(s.mu, s.sigma2, s.a, s.b, x, tau**2, s.rho_range)
-        mus[i] = s.mu
-    return ConvergenceStudy(rates, sig, inl, err, conv, mus, rho_true, tau)
 
 
 # -- failure cases (003 §5.3) as rendered sequences ---------------------------------------------
@@ -426,6 +263,28 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
     frame; ``pure_rotation`` 2° per frame in place; ``distant_points`` a 60×60 m arena seen from
     its middle; ``kidnap`` carried 2 m between two frames; ``bad_initial_map`` initialised after
     2 px of displacement. Returns ``{case: MonoRunResult}``.
+
+    Parameters
+    ----------
+    cases : sequence of str
+        Cases to run (default ``"normal"`` and every one of ``FAILURE_CASES``).
+    size : str
+        Image size (:func:`mono_sim`; default ``"tiny"``).
+    n_frames : int
+        Frames per case (default 30).
+    params : MonoParams, optional
+        Settings (default values).
+    progress : bool, callable or None
+        Progress display.
+    rng : Generator, int or None
+        Randomness; each case gets its own spawned stream (default 0).
+    **overrides
+        Fields of :class:`MonoParams` to change.
+
+    Returns
+    -------
+    dict
+        Case → :class:`MonoRunResult`.
     """
     out = {}
     from ..sweep import fresh_seed_sequence
@@ -438,7 +297,18 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
 
 
 def failure_table(results: dict) -> str:
-    """003 §5.5.1's table layout: the correctly tracked share with its mark (X < 30 %, * 30-70 %) and the ATE."""
+    """003 §5.5.1's table layout: the correctly tracked share with its mark (X < 30 %, * 30-70 %) and the ATE.
+
+    Parameters
+    ----------
+    results : dict
+        Case → :class:`MonoRunResult` (:func:`run_failure_cases`).
+
+    Returns
+    -------
+    str
+        The printed table.
+    """
     rows = []
     for name, r in results.items():
         ate_txt = f"{r.ate_m:.3f}" if np.isfinite(r.ate_m) else "-"

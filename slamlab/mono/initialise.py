@@ -11,19 +11,25 @@ or, as 003 also names the 5-point algorithm, from ``cv2.findEssentialMat`` +
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import _validate as v
-from ..geometry.homography import apply_homography
+from .twoview import (
+    TwoViewPose,
+    polish_homography,
+    relative_pose_essential,
+    relative_pose_homography,
+    triangulate_two_view,
+)
 
 __all__ = [
     "INIT_STATUSES",
     "InitResult",
     "Initialiser",
     "TwoViewPose",
+    "polish_homography",
     "relative_pose_essential",
     "relative_pose_homography",
     "track_lk",
@@ -35,14 +41,6 @@ INIT_STATUSES = ("first_frame", "too_few_corners", "tracking", "restart", "no_pa
                  "degenerate_homography", "done")
 
 
-def _check_uv_pair(uv0, uv1):
-    uv0 = v.as_finite_array(uv0, "uv0", ndim=2)
-    uv1 = v.as_finite_array(uv1, "uv1", ndim=2)
-    if uv0.shape[1] != 2 or uv1.shape != uv0.shape:
-        raise ValueError(f"`uv0` and `uv1` must both have shape (N, 2); got {uv0.shape} and {uv1.shape}")
-    return uv0, uv1
-
-
 def track_lk(img0, img1, uv0, *, win_px: int = 21, levels: int = 3, uv1_guess=None, max_err: float | None = None,
              fb_max_px: float | None = None):
     """Lucas-Kanade tracks of ``uv0`` from ``img0`` to ``img1`` (003 §4.3.1): ``(uv1, ok)``.
@@ -50,6 +48,30 @@ def track_lk(img0, img1, uv0, *, win_px: int = 21, levels: int = 3, uv1_guess=No
     ``cv2.calcOpticalFlowPyrLK`` with a ``win_px`` window on ``levels`` pyramid levels;
     ``ok`` also drops tracks that leave the image. ``uv1_guess`` starts from a prediction.
     ``fb_max_px`` (ours): also track back and drop tracks that do not return within it.
+
+    Parameters
+    ----------
+    img0, img1 : array_like, shape (H, W)
+        Grey images tracked from and to.
+    uv0 : array_like, shape (N, 2)
+        Pixels in ``img0``.
+    win_px : int
+        Search window side [px] (default 21).
+    levels : int
+        Pyramid levels above the image (default 3).
+    uv1_guess : array_like, shape (N, 2), optional
+        Predicted pixels in ``img1`` to start from.
+    max_err : float, optional
+        Largest OpenCV tracking error of a kept track; ``None`` = no limit.
+    fb_max_px : float, optional
+        Largest forward-backward distance [px]; ``None`` = no backward check.
+
+    Returns
+    -------
+    uv1 : ndarray, shape (N, 2)
+        Tracked pixels in ``img1``.
+    ok : ndarray of bool, shape (N,)
+        Tracks found and kept.
     """
     import cv2
 
@@ -85,200 +107,6 @@ def track_lk(img0, img1, uv0, *, win_px: int = 21, levels: int = 3, uv1_guess=No
     return uv1, ok
 
 
-@dataclass(frozen=True)
-class TwoViewPose:
-    """Relative pose of view 1 in view 0: ``X_1 = R X_0 + t`` with ``|t| = 1`` (003 §4.3.1).
-
-    ``inliers`` (N,) the RANSAC inliers; ``n_front`` points in front of both cameras for the
-    chosen solution; ``normal`` the plane normal in view 0 (homography) or None; ``ok`` False
-    when the input was degenerate (then ``R = I``, ``t = 0``); ``reason`` says why.
-    """
-
-    R: np.ndarray
-    t: np.ndarray
-    inliers: np.ndarray
-    n_front: int
-    normal: np.ndarray | None
-    ok: bool
-    reason: str = ""
-
-
-def _fail(n, reason):
-    return TwoViewPose(np.eye(3), np.zeros(3), np.zeros(n, bool), 0, None, False, reason)
-
-
-def _norm3(x) -> float:
-    """Length of a 3-vector in Python floats (``np.linalg.norm`` of a vector is a BLAS dot: its last bit varies)."""
-    x = np.asarray(x, dtype=np.float64).ravel()
-    return math.sqrt(float(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]))
-
-
-def triangulate_two_view(K, R, t, uv0, uv1):
-    """Points in view 0 from pixel pairs (linear DLT, ``cv2.triangulatePoints``): ``(X0 (N, 3), in_front)``."""
-    import cv2
-
-    K = v.as_matrix(K, "K", (3, 3))
-    P0 = np.einsum("ij,jk->ik", K, np.hstack([np.eye(3), np.zeros((3, 1))]))  # einsum: no BLAS, same bits anywhere
-    P1 = np.einsum("ij,jk->ik", K, np.hstack([np.asarray(R, float), np.asarray(t, float).reshape(3, 1)]))
-    if len(uv0) == 0:
-        return np.zeros((0, 3)), np.zeros(0, bool)
-    Xh = cv2.triangulatePoints(P0, P1, np.asarray(uv0, float).T, np.asarray(uv1, float).T)
-    w = Xh[3]
-    good = np.abs(w) > 1e-12
-    X = np.where(good[:, None], (Xh[:3] / np.where(good, w, 1.0)).T, 0.0)
-    z1 = np.einsum("nj,j->n", X, np.asarray(R, float)[2]) + float(np.asarray(t, float)[2])
-    return X, good & (X[:, 2] > 0) & (z1 > 0)
-
-
-def _hartley(uv):
-    """Similarity ``T`` (3, 3) taking pixels to zero mean and RMS distance √2 (Hartley's normalisation)."""
-    c = uv.mean(axis=0)
-    d = uv - c
-    rms = math.sqrt(float(np.mean(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])))
-    s = math.sqrt(2.0) / max(rms, 1e-12)
-    return np.array([[s, 0.0, -s * c[0]], [0.0, s, -s * c[1]], [0.0, 0.0, 1.0]])
-
-
-def _transfer(Hn, x):
-    """``(u, v, w)`` of ``π(Hn x)`` for points ``x (N, 2)``; ``w`` the homogeneous scale (for the Jacobian)."""
-    uv = apply_homography(Hn, x)
-    return uv[:, 0], uv[:, 1], Hn[2, 0] * x[:, 0] + Hn[2, 1] * x[:, 1] + Hn[2, 2]
-
-
-def polish_homography(H, uv0, uv1, *, mantissa_bits: int = 14, max_iter: int = 50) -> np.ndarray:
-    """The homography of inlier pairs, the same bits on every machine: snap OpenCV's ``H``, then re-fit it (ours).
-
-    ``cv2.findHomography`` refines its RANSAC model by Levenberg-Marquardt on OpenCV's bundled
-    OpenBLAS, and stops at a tolerance: its ``H`` differs between machines in the 7th digit, and the
-    monocular map built on it (a tracker amplifies such differences into different inlier sets) came
-    out different. Here ``H`` (in Hartley-normalised coordinates, ``h33 = 1``) is rounded to
-    ``mantissa_bits`` significant bits (relative 6e-5 for 14: far coarser than the machine
-    differences, so both machines round to the same start unless a value lies within 1e-8 of a
-    rounding boundary), then refined by Levenberg-Marquardt on the one-sided transfer error
-    ``|π(H x0) − x1|²`` written without BLAS/LAPACK (see :func:`slamlab.mono.align.solve_spd`),
-    to convergence: the result depends on the inliers, not on the machine.
-    """
-    from .align import solve_spd
-
-    uv0 = np.asarray(uv0, dtype=np.float64)
-    uv1 = np.asarray(uv1, dtype=np.float64)
-    T0, T1 = _hartley(uv0), _hartley(uv1)
-    x0 = uv0 * T0[0, 0] + T0[:2, 2]
-    x1 = uv1 * T1[0, 0] + T1[:2, 2]
-    T0_inv = np.array([[1 / T0[0, 0], 0.0, -T0[0, 2] / T0[0, 0]], [0.0, 1 / T0[1, 1], -T0[1, 2] / T0[1, 1]],
-                       [0.0, 0.0, 1.0]])
-    Hn = np.einsum("ij,jk,kl->il", T1, np.asarray(H, dtype=np.float64), T0_inv)
-    if not abs(Hn[2, 2]) > 1e-8:
-        return np.asarray(H, dtype=np.float64)
-    Hn = Hn / Hn[2, 2]
-    m, e = np.frexp(Hn)
-    Hn = np.ldexp(np.round(m * 2.0**mantissa_bits), e - mantissa_bits)
-    Hn[2, 2] = 1.0
-
-    def cost_of(Hc):
-        u, v, _ = _transfer(Hc, x0)
-        ru, rv = u - x1[:, 0], v - x1[:, 1]
-        return ru, rv, float(np.sum(ru * ru + rv * rv))
-
-    ru, rv, cost = cost_of(Hn)
-    lam = 1e-3
-    x, y = x0[:, 0], x0[:, 1]
-    for _ in range(max_iter):
-        u, v, w = _transfer(Hn, x0)
-        zero = np.zeros_like(x)
-        Ju = np.column_stack([x / w, y / w, 1 / w, zero, zero, zero, -u * x / w, -u * y / w])
-        Jv = np.column_stack([zero, zero, zero, x / w, y / w, 1 / w, -v * x / w, -v * y / w])
-        A = np.einsum("ni,nj->ij", Ju, Ju) + np.einsum("ni,nj->ij", Jv, Jv)
-        g = np.einsum("ni,n->i", Ju, ru) + np.einsum("ni,n->i", Jv, rv)
-        done = False
-        while True:
-            step = -solve_spd(A + lam * np.diag(np.diag(A)), g)
-            if not np.all(np.isfinite(step)):
-                done = True
-                break
-            H_new = Hn.copy()
-            H_new.flat[:8] += step
-            ru_n, rv_n, cost_n = cost_of(H_new)
-            if cost_n <= cost:
-                small = cost - cost_n <= 1e-15 * cost or float(np.sum(step * step)) < 1e-30
-                Hn, ru, rv, cost = H_new, ru_n, rv_n, cost_n
-                lam = max(lam / 10.0, 1e-12)
-                done = small
-                break
-            lam *= 10.0
-            if lam > 1e10:
-                done = True
-                break
-        if done:
-            break
-    T1_inv = np.array([[1 / T1[0, 0], 0.0, -T1[0, 2] / T1[0, 0]], [0.0, 1 / T1[1, 1], -T1[1, 2] / T1[1, 1]],
-                       [0.0, 0.0, 1.0]])
-    return np.einsum("ij,jk,kl->il", T1_inv, Hn, T0)
-
-
-def relative_pose_homography(uv0, uv1, K, *, ransac_px: float = 2.0, min_points: int = 8) -> TwoViewPose:
-    """Pose from a RANSAC homography and its decomposition (003 §4.3.1).
-
-    ``cv2.findHomography(RANSAC)`` then ``cv2.decomposeHomographyMat`` (up to four
-    solutions); we keep the one with most inliers triangulated in front of both views and,
-    on a tie, the plane normal most facing view 0 (our choice). ``t`` is normalised.
-    """
-    import cv2
-
-    uv0, uv1 = _check_uv_pair(uv0, uv1)
-    K = v.as_matrix(K, "K", (3, 3))
-    n = uv0.shape[0]
-    if n < max(4, min_points):
-        return _fail(n, "too_few_points")
-    cv2.setRNGSeed(0)  # OpenCV's RANSAC seeds itself today; this keeps it so if a release draws from the global RNG
-    H, mask = cv2.findHomography(uv0, uv1, cv2.RANSAC, ransac_px)
-    if H is None or not np.all(np.isfinite(H)) or abs(np.linalg.det(H)) < 1e-12:
-        return _fail(n, "degenerate_homography")
-    inl = mask.ravel().astype(bool)
-    if inl.sum() < min_points:
-        return _fail(n, "degenerate_homography")
-    H = polish_homography(H, uv0[inl], uv1[inl])
-    _, Rs, ts, normals = cv2.decomposeHomographyMat(H, K)
-    best, best_key = None, None
-    for R, tt, nn in zip(Rs, ts, normals, strict=True):
-        tt = tt.ravel()
-        tt_norm = _norm3(tt)
-        if tt_norm < 1e-9:  # a pure rotation: no translation to recover
-            continue
-        tn = tt / tt_norm
-        _, front = triangulate_two_view(K, R, tn, uv0[inl], uv1[inl])
-        key = (int(front.sum()), float(-nn.ravel()[2]))
-        if best_key is None or key > best_key:
-            best, best_key = (R, tn, nn.ravel()), key
-    if best is None:
-        return _fail(n, "no_parallax")
-    R, tn, nn = best
-    return TwoViewPose(R, tn, inl, best_key[0], nn, best_key[0] >= min_points,
-                       "" if best_key[0] >= min_points else "cheirality")
-
-
-def relative_pose_essential(uv0, uv1, K, *, ransac_px: float = 1.0, prob: float = 0.999,
-                            min_points: int = 8) -> TwoViewPose:
-    """Pose by the 5-point algorithm: ``cv2.findEssentialMat`` (RANSAC) + ``cv2.recoverPose`` (003 §4.3.1)."""
-    import cv2
-
-    uv0, uv1 = _check_uv_pair(uv0, uv1)
-    K = v.as_matrix(K, "K", (3, 3))
-    n = uv0.shape[0]
-    if n < max(5, min_points):
-        return _fail(n, "too_few_points")
-    cv2.setRNGSeed(0)  # as in relative_pose_homography
-    E, mask = cv2.findEssentialMat(uv0, uv1, K, method=cv2.RANSAC, prob=prob, threshold=ransac_px)
-    if E is None or E.shape != (3, 3):
-        return _fail(n, "degenerate_essential")
-    n_front, R, t, mask2 = cv2.recoverPose(E, uv0, uv1, K, mask=mask.copy())
-    inl = mask2.ravel().astype(bool)
-    t = t.ravel()
-    if n_front < min_points or not np.all(np.isfinite(t)):
-        return _fail(n, "cheirality")
-    return TwoViewPose(R, t / _norm3(t), inl, int(n_front), None, True)
-
-
 @dataclass
 class InitResult:
     """Output of a finished initialisation (003 §4.3.1).
@@ -287,6 +115,19 @@ class InitResult:
     tracks, ``X0`` (M, 3) their points in the first keyframe's frame scaled to a median
     depth of ``median_depth_m`` (SVO's convention; the scale of a monocular map is free),
     ``frame0``/``frame1`` the indices of the two keyframes.
+
+    Attributes
+    ----------
+    pose : TwoViewPose
+        Relative pose of the second keyframe.
+    uv0, uv1 : ndarray, shape (M, 2)
+        Inlier tracks in the two keyframes.
+    X0 : ndarray, shape (M, 3)
+        Their points in the first keyframe's frame, scaled to a median depth of ``median_depth_m``.
+    frame0, frame1 : int
+        Indices of the two keyframes.
+    scale : float
+        Factor applied to the triangulated points.
     """
 
     pose: TwoViewPose
@@ -304,6 +145,43 @@ class Initialiser:
 
     Feed frames to :meth:`add_frame`; it returns a status in :data:`INIT_STATUSES` and, once
     ``"done"``, :attr:`result` holds the map. ``counts`` tallies every status.
+
+    Attributes
+    ----------
+    K : ndarray, shape (3, 3)
+        Intrinsic matrix.
+    detect : callable
+        ``detect(image) -> (N, 2)`` corners.
+    min_corners : int
+        Fewest corners of a first frame (default 50).
+    min_disparity_px : float
+        Mean track length [px] before a pose is tried (default 15).
+    min_tracked_ratio : float
+        Share of ``min_corners`` that must survive tracking, else restart (default 0.5).
+    method : str
+        ``"homography"`` (003), ``"essential"`` or ``"auto"`` (default ``"homography"``).
+    ransac_px : float
+        RANSAC threshold [px] (default 2).
+    min_parallax_deg : float
+        Median triangulation angle needed [deg] (default 1).
+    min_point_parallax_deg : float
+        Triangulation angle a point of the first map needs [deg] (default 0).
+    plane_share : float
+        ``"auto"``: the homography when its inliers are at least this share of the 5-point's (default 0.9).
+    median_depth_m : float
+        Median depth the first map is scaled to (default 1).
+    lk_win_px : int
+        Lucas-Kanade window [px] (default 21).
+    fb_max_px : float
+        Forward-backward tolerance of the tracks [px] (default 1).
+    ref_image, ref_uv, cur_uv : ndarray or None
+        State: first keyframe, its corners and their current tracks.
+    ref_index, frame_index : int
+        State: index of the first keyframe and of the last frame.
+    result : InitResult or None
+        The map once the status is ``"done"``.
+    counts : dict
+        Status → number of frames.
     """
 
     K: np.ndarray
@@ -342,6 +220,20 @@ class Initialiser:
         return status
 
     def reset(self, image, index):
+        """Start over with ``image`` as the first keyframe (003 §4.3.1); return the status.
+
+        Parameters
+        ----------
+        image : ndarray, shape (H, W)
+            Grey image.
+        index : int
+            Its frame index.
+
+        Returns
+        -------
+        status : str
+            ``"first_frame"`` or ``"too_few_corners"``.
+        """
         uv = np.asarray(self.detect(image), float).reshape(-1, 2)
         if uv.shape[0] < self.min_corners:
             self.ref_image = None
@@ -351,7 +243,18 @@ class Initialiser:
         return self._count("first_frame")
 
     def add_frame(self, image) -> str:
-        """Process one grey image; return the status (003 §4.3.1)."""
+        """Process one grey image; return the status (003 §4.3.1).
+
+        Parameters
+        ----------
+        image : array_like, shape (H, W)
+            Next grey image.
+
+        Returns
+        -------
+        status : str
+            One of ``INIT_STATUSES``; ``"done"`` sets :attr:`result`.
+        """
         image = v.as_image(image, "image")
         self.frame_index += 1
         if self.ref_image is None:

@@ -18,7 +18,26 @@ __all__ = ["KITTI_ABLATIONS", "epipolar_demo", "load_kitti", "run_kitti_ablation
 
 
 def load_kitti(folder=None, n_frames: int | None = None):
-    """``(images, truth (N, 4, 4), K, name)`` of a KITTI odometry folder's left camera (default: the 20-frame 06 set)."""
+    """``(images, truth (N, 4, 4), K, name)`` of a KITTI odometry folder's left camera (default: the 20-frame 06 set).
+
+    Parameters
+    ----------
+    folder : str or Path, optional
+        KITTI odometry folder (``calib.txt``, ``poses.txt``, ``image_0/``); ``None`` = the bundled 06 set.
+    n_frames : int, optional
+        Read only the first ``n_frames`` (at least 2); ``None`` = all.
+
+    Returns
+    -------
+    images : list of ndarray
+        Grey uint8 left images.
+    truth : ndarray, shape (N, 4, 4)
+        Ground-truth poses (camera to world) [m].
+    K : ndarray, shape (3, 3)
+        Intrinsic matrix of camera 0.
+    name : str
+        The folder's name.
+    """
     from ..data import find_data
     from ..evaluation import read_kitti
     from ..io.kitti import read_kitti_calib, read_kitti_image
@@ -33,7 +52,26 @@ def load_kitti(folder=None, n_frames: int | None = None):
 
 def run_kitti_mono(folder=None, *, n_frames: int | None = None, params: MonoParams | None = None,
                    track_tol: float = TRACK_TOL_FRAC, **overrides) -> MonoRunResult:
-    """MonoSLAM on the left camera of a KITTI odometry folder; scored against ``poses.txt`` (Sim(3))."""
+    """MonoSLAM on the left camera of a KITTI odometry folder; scored against ``poses.txt`` (Sim(3)).
+
+    Parameters
+    ----------
+    folder : str or Path, optional
+        KITTI odometry folder; ``None`` = the bundled 06 set.
+    n_frames : int, optional
+        Use only the first ``n_frames``; ``None`` = all.
+    params : MonoParams, optional
+        Settings (default values).
+    track_tol : float
+        Tolerance of a correctly tracked frame as a fraction of the path length (default 0.05).
+    **overrides
+        Fields of :class:`MonoParams` to change.
+
+    Returns
+    -------
+    MonoRunResult
+        The run scored against ``poses.txt``.
+    """
     imgs, gt, K, name = load_kitti(folder, n_frames)
     return run_mono(imgs, gt, K, name=name, params=params, progress=False, track_tol=track_tol, **overrides)
 
@@ -89,6 +127,25 @@ def epipolar_demo(folder=None, *, frames=(0, 1, 2), n_seeds: int = 60, depth_mea
     The poses are KITTI's ground truth (the search itself is what is shown). Returns a list of
     dicts, one per searched frame: ``img_ref, img_cur, uv_ref, a, b, uv_match, found, n_candidates,
     sigma`` (σ_ρ before that search).
+
+    Parameters
+    ----------
+    folder : str or Path, optional
+        KITTI odometry folder; ``None`` = the bundled 06 set.
+    frames : tuple of int
+        Reference frame then the frames searched (default ``(0, 1, 2)``).
+    n_seeds : int
+        Seeds drawn from the reference frame's FAST corners (default 60).
+    depth_mean_m, depth_min_m : float
+        Seed prior: mean and smallest depth [m] (defaults 10 and 2).
+    fast_threshold : int
+        FAST threshold (default 30).
+
+    Returns
+    -------
+    list of dict
+        One per searched frame: ``img_ref``, ``img_cur``, ``uv_ref``, ``a``, ``b``, ``uv_match``, ``found``,
+        ``n_candidates``, ``sigma``.
     """
     from ..data import find_data
     from ..evaluation import read_kitti

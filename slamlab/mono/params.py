@@ -12,7 +12,104 @@ __all__ = ["MonoParams"]
 
 @dataclass(frozen=True)
 class MonoParams(Params):
-    """Every knob of :class:`~slamlab.mono.MonoSLAM` with the source of its default."""
+    """Every knob of :class:`~slamlab.mono.MonoSLAM` with the source of its default.
+
+    Attributes
+    ----------
+    fast_threshold : int
+        ours: FAST threshold (003 §5.3 notes its effect on the initial map)
+    min_corners : int
+        003 §4.3.1: at least 50 FAST points
+    init_disparity_px : float
+        003 §5.1.1: 10-20 px ('initial displacement')
+    init_min_tracked : float
+        ours: restart when fewer than this share of corners is still tracked
+    init_method : str
+        ours: 003 §4.3.1's homography when a dominant plane explains the matches, else the 5-point
+        method it also names ('homography', 'essential')
+    init_plane_share : float
+        ours ('auto'): the homography when its RANSAC inliers are at least this share of the 5-point
+        method's
+    init_ransac_px : float
+        ours
+    init_min_parallax_deg : float
+        ours: median triangulation angle needed
+    init_min_point_parallax_deg : float
+        ours: triangulation angle each point of the first map needs
+    convergence : str
+        003 §4.3.2: 'linearity' (L < 0.1) or SVO's 'sigma'
+    L_max : float
+        003 §4.3.2
+    sigma_fraction : float
+        SVO: sigma < rho_range / 200
+    n_sigma : float
+        003 §4.2: search over rho +- 2 sigma
+    epi_tol_px : float
+        ours: 003 §4.2 says the band around the epipolar line is tunable
+    patch_px : int
+        ours: patch side for the seed score (ZNCC; SVO scores 8x8 patches)
+    zncc_min : float
+        ours: minimum ZNCC of a seed match
+    warp_patches : bool
+        SVO: the seed's patch warped affinely to the current view at its mean depth
+    px_noise : float
+        SVO: one pixel of measurement error
+    max_seed_fail : int
+        ours: 003 §4.3.2 drops a seed not found 'for several frames'
+    min_inlier_ratio : float
+        SVO: drop seeds with a/(a+b) < 0.1
+    max_seeds_per_kf : int
+        ours
+    kf_min_frames : int
+        003 §4.3: 30 iterations between keyframes
+    kf_lost_ratio : float
+        003 §4.3: at least 10 % of points lost
+    kf_max_lost_ratio : float
+        003 §4.3 / §5.1.1 ('lost-point ratio'): > 30 % lost forces one
+    max_keyframes : int
+        003 §5.1.1: 'number of keyframes', value not given
+    motion_model : str
+        003 §4.4 step 1 ('constant_position': SVO's)
+    align_patch_px : int
+        003 §4.4.1: 4x4 patches
+    align_max_level : int
+        ours: coarsest pyramid level
+    align_min_level : int
+        003 §4.4.1: the finest levels can be skipped
+    align_iters : int
+        ours
+    align_max_points : int
+        ours: map points used by the direct alignment
+    max_matches : int
+        003 §5.1.1: 'number of matches', value not given
+    match_win_px : int
+        ours: LK window refining a projected point
+    refine_iters : int
+        ours: Levenberg-Marquardt steps of the motion-only refinement
+    reproj_inlier_deg : float
+        ours: inlier angle of a reprojection (4 px at KITTI's 707 px focal length, 1.5 px at the
+        rendered 264 px)
+    min_inliers : int
+        ours: fewer inliers = lost
+    max_coast : int
+        ours: lost frames over which the constant-velocity prior keeps moving the pose before a re-
+        initialisation (0: re-initialise at once)
+    reinit_when_lost : bool
+        ours: after coasting, a new two-view map placed at the predicted pose, scaled by the velocity
+        (constant-velocity prior only)
+    prefer_seen : bool
+        ours: among the map points in view, those matched in the previous frame first
+    min_inlier_share : float
+        ours: lost when fewer than this share of the matched points are inliers
+    max_align_rms : float
+        ours: lost when the alignment's photometric RMS (grey levels) exceeds this
+    outlier_rejection : bool
+        003 §5.1.1 item 5 (RdE); our form: a second refinement without points over 3 px and dropping
+        points that keep failing
+    refine : bool
+        003 §4.4 step 4: motion-only refinement of the reprojection error (off: the alignment's pose is
+        final)
+    """
 
     # initialisation (003 §4.3.1, §5.1.1)
     fast_threshold: int = param(20, "ours: FAST threshold (003 §5.3 notes its effect on the initial map)")

@@ -11,7 +11,20 @@ __all__ = ["plot_convergence", "plot_epipolar_pair", "plot_map_top", "plot_pinho
 
 
 def plot_convergence(study, *, axes=None):
-    """σ_ρ and the inlier ratio a/(a+b) against the number of observations, one line per outlier rate."""
+    """σ_ρ and the inlier ratio a/(a+b) against the number of observations, one line per outlier rate.
+
+    Parameters
+    ----------
+    study : ConvergenceStudy
+        Result of :func:`~slamlab.mono.convergence.run_depth_filter_convergence`.
+    axes : sequence of two Axes, optional
+        Where to draw; ``None`` = a new figure.
+
+    Returns
+    -------
+    axes : sequence of Axes
+        The two panels.
+    """
     if axes is None:
         _, axes = plt.subplots(1, 2, figsize=(11, 3.6))
     k = np.arange(study.sigma.shape[1])
@@ -26,7 +39,30 @@ def plot_convergence(study, *, axes=None):
 
 
 def plot_epipolar_pair(img_ref, img_cur, uv_ref, a, b, uv_match=None, found=None, *, axes=None, max_lines: int = 40):
-    """Seeds in the reference image and their searched epipolar segments ρ ± 2σ in the current one (003 Fig. 4.2-4.3)."""
+    """Seeds in the reference image and their searched epipolar segments ρ ± 2σ in the current one (003 Fig. 4.2-4.3).
+
+    Parameters
+    ----------
+    img_ref, img_cur : ndarray, shape (H, W)
+        Reference and current grey images.
+    uv_ref : ndarray, shape (N, 2)
+        Seeds' pixels in the reference image.
+    a, b : ndarray, shape (N, 2)
+        End points of their searched segments in the current image [px].
+    uv_match : ndarray, shape (N, 2), optional
+        Matched pixels, drawn where ``found``.
+    found : ndarray of bool, shape (N,), optional
+        Which seeds were found.
+    axes : sequence of two Axes, optional
+        Where to draw; ``None`` = a new figure.
+    max_lines : int
+        Most segments drawn (default 40).
+
+    Returns
+    -------
+    axes : sequence of Axes
+        The two panels.
+    """
     if axes is None:
         _, axes = plt.subplots(1, 2, figsize=(12, 3.4))
     n = min(len(uv_ref), max_lines)
@@ -47,7 +83,21 @@ def plot_epipolar_pair(img_ref, img_cur, uv_ref, a, b, uv_match=None, found=None
 
 
 def plot_seed_histograms(snapshots, *, ax=None, bins=40):
-    """Histograms of the seeds' σ_ρ/ρ_range at several frames: ``snapshots`` = {label: values}."""
+    """Histograms of the seeds' σ_ρ/ρ_range at several frames: ``snapshots`` = {label: values}.
+
+    Parameters
+    ----------
+    snapshots : dict
+        Label → array of the seeds' ``σ_ρ / ρ_range`` at that moment.
+    ax : Axes, optional
+        Where to draw; ``None`` = new axes.
+    bins : int
+        Number of histogram bins (default 40).
+
+    Returns
+    -------
+    ax : Axes
+    """
     ax = new_axes(ax, figsize=(6.5, 3.4), title="seeds converging", xlabel="σ_ρ / ρ_range (log)", ylabel="seeds")
     allv = np.concatenate([np.asarray(v_) for v_ in snapshots.values() if len(v_)]) if snapshots else np.ones(1)
     edges = np.logspace(np.log10(max(allv.min(), 1e-5)), np.log10(max(allv.max(), 1e-4)), bins)
@@ -64,6 +114,19 @@ def plot_map_top(result, *, ax=None, aligned=True):
 
     The Sim(3) is fitted on the frames the tracker claims; claimed frames outside the run's
     tolerance are drawn as crosses.
+
+    Parameters
+    ----------
+    result : MonoRunResult
+        A run (:func:`~slamlab.mono.runs.run_mono`).
+    ax : Axes, optional
+        Where to draw; ``None`` = new axes.
+    aligned : bool
+        Apply the Sim(3) fitted on the claimed frames (default True); False draws map units.
+
+    Returns
+    -------
+    ax : Axes
     """
     from .evaluate import sim3_fit
 
@@ -92,7 +155,23 @@ def plot_map_top(result, *, ax=None, aligned=True):
 def plot_pinhole(K, width_px: int, X_cam=(0.5, -0.2, 4.0), *, ax=None):
     """003 Fig. 2.1 redrawn from above (x right, Z forward): the centre, the image plane one focal length
     ahead (drawn at Z = 1 in units of f), the field of view and the ray of ``X_cam`` with its pixel column
-    ``u = fx X/Z + u0``."""
+    ``u = fx X/Z + u0``.
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Intrinsic matrix.
+    width_px : int
+        Image width [px].
+    X_cam : array_like, shape (3,)
+        Point in the camera frame [m] whose ray is drawn.
+    ax : Axes, optional
+        Where to draw; ``None`` = new axes.
+
+    Returns
+    -------
+    ax : Axes
+    """
     K = np.asarray(K, dtype=np.float64)
     X = np.asarray(X_cam, dtype=np.float64)
     ax = new_axes(ax, figsize=(6.5, 3.6), title="pinhole camera from above (003 §2.1)", xlabel="x [m]",

@@ -13,21 +13,14 @@ Every experiment here is ours; 003's statements are quoted beside, never its (lo
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
 from ..geometry.se3 import se3_from_planar, se3_inverse
-from .depth_filter import (
-    compute_tau,
-    converged_sigma,
-    init_seeds,
-    linearity_index,
-    tau_inverse,
-    update_seeds,
-)
+from .convergence import ConvergenceTests, run_convergence_tests
 from .experiments import (
     PITCH_DOWN_RAD,
     ConvergenceStudy,
@@ -38,11 +31,13 @@ from .experiments import (
     sequence_poses,
     trajectory_errors,
 )
+from .formulas import chapter_cameras, inverse_depth_point_table, pinhole_table, tau_table
 from .params import MonoParams
 
 __all__ = [
     "ConvergenceTests",
     "MonoVsStereo",
+    "chapter_cameras",
     "compare_init_methods",
     "inverse_depth_point_table",
     "ours_vs_source",
@@ -53,203 +48,6 @@ __all__ = [
     "source_findings_table",
     "tau_table",
 ]
-
-
-# -- 003 §2.1: the pinhole camera ----------------------------------------------------------------
-def chapter_cameras(kitti_folder=None) -> dict:
-    """``{name: (K, width_px, height_px)}``: the rendered camera (tiny size) and KITTI 06's left camera."""
-    from ..data import find_data
-    from ..io.kitti import read_kitti_calib
-    from .experiments import SIZES, mono_sim
-
-    w, h = SIZES["tiny"]
-    cams = {"rendered (tiny)": (mono_sim("tiny").rig.left.K, w, h)}
-    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if kitti_folder is None else \
-        v.as_path(kitti_folder, "kitti_folder", kind="dir")
-    cams["KITTI 06 left"] = (read_kitti_calib(d / "calib.txt")["P0"][:, :3], 1226, 370)
-    return cams
-
-
-def pinhole_table(X_cam=(0.5, -0.2, 4.0), cameras=None) -> str:
-    """003 §2.1 (eq. 2.1-2.4, lost; reconstruction): ``K = [[fx, 0, u0], [0, fy, v0], [0, 0, 1]]`` and
-    ``u = fx X/Z + u0``, ``v = fy Y/Z + v0``, for a point ``X_cam`` (m, camera frame) in each camera."""
-    X = v.as_vector(X_cam, "X_cam", 3)
-    if X[2] <= 0:
-        raise ValueError(f"`X_cam` must lie in front of the camera (Z > 0); got Z = {X[2]}")
-    cams = chapter_cameras() if cameras is None else cameras
-    rows = []
-    for name, (K, w, h) in cams.items():
-        u = K[0, 0] * X[0] / X[2] + K[0, 2]
-        v_ = K[1, 1] * X[1] / X[2] + K[1, 2]
-        hfov = np.degrees(2 * np.arctan(w / (2 * K[0, 0])))
-        rows.append([name, f"{w}x{h}", f"{K[0, 0]:.1f}", f"{K[1, 1]:.1f}", f"{K[0, 2]:.1f}", f"{K[1, 2]:.1f}",
-                     f"{hfov:.1f}", f"({u:.1f}, {v_:.1f})"])
-    return format_table(["camera", "image", "fx, px", "fy, px", "u0, px", "v0, px", "h. field of view, deg",
-                         f"pixel of X = ({X[0]:g}, {X[1]:g}, {X[2]:g}) m"], rows,
-                        title="Pinhole model (003 §2.1): K and the projection u = fx X/Z + u0, v = fy Y/Z + v0")
-
-
-# -- 003 §4.1.2, eq. 6.4 ------------------------------------------------------------------------------
-def inverse_depth_point_table(K=None, uv=(150.0, 40.0), rhos=(0.5, 0.2, 0.05, 1e-10), *, yaw_deg: float = 30.0,
-                              T_F_m=(1.0, 0.0, 2.0)) -> str:
-    """003 eq. 6.4 (lost; reconstruction): ``X = T_F + R_F · v / ρ`` for one pixel at several ρ.
-
-    ``v`` is the unit back-projection ray ``K⁻¹ [u, v, 1]ᵀ / |·|`` of the pixel in keyframe F, whose
-    pose in the world is ``R_F`` (a yaw of ``yaw_deg`` about the camera's y axis, ours) and ``T_F``.
-    Computed with :func:`~slamlab.mono.seed_points`; the last column reprojects X into F (it must give
-    the pixel back for every ρ: the depth moves the point along the ray only).
-    """
-    from ..geometry.camera import rotation_xyz
-    from .depth_filter import Seeds, seed_points
-
-    K = chapter_cameras()["rendered (tiny)"][0] if K is None else v.as_matrix(K, "K", (3, 3))
-    uv = v.as_vector(uv, "uv", 2)
-    rhos = v.as_finite_array(rhos, "rhos", ndim=1)
-    if np.any(rhos <= 0):
-        raise ValueError("`rhos` must be positive inverse depths (1/m)")
-    ray = np.array([(uv[0] - K[0, 2]) / K[0, 0], (uv[1] - K[1, 2]) / K[1, 1], 1.0])
-    f = ray / np.linalg.norm(ray)
-    n = rhos.size
-    s = init_seeds(np.tile(uv, (n, 1)), np.tile(f, (n, 1)), 1.0, 1.0)
-    s = Seeds(**{**s.__dict__, "mu": rhos.copy()})
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = rotation_xyz(0.0, np.deg2rad(yaw_deg), 0.0), v.as_vector(T_F_m, "T_F_m", 3)
-    X = seed_points(s, T[None])
-    Xc = np.einsum("ji,nj->ni", T[:3, :3], X - T[:3, 3])  # back into F
-    rows = []
-    for rho, Xi, Xci in zip(rhos, X, Xc, strict=True):
-        u = K[0, 0] * Xci[0] / Xci[2] + K[0, 2]
-        v_ = K[1, 1] * Xci[1] / Xci[2] + K[1, 2]
-        big = np.max(np.abs(Xi)) > 1e4
-        xs = ", ".join(f"{c:.3g}" if big else f"{c:.3f}" for c in Xi)
-        rows.append([f"{rho:g}", f"{1 / rho:.4g}", f"({xs})", f"({u:.2f}, {v_:.2f})"])
-    return format_table(["rho, 1/m", "range 1/rho, m", "X = T_F + R_F v / rho, m", "reprojected into F, px"], rows,
-                        title=f"Eq. 6.4: pixel ({uv[0]:g}, {uv[1]:g}) of keyframe F at T_F = "
-                              f"({', '.join(f'{c:g}' for c in T[:3, 3])}) m, yaw {yaw_deg:g} deg; "
-                              f"v = ({', '.join(f'{c:.3f}' for c in f)})")
-
-
-# -- tau: one pixel -> metres -> inverse depth ---------------------------------------------------------
-def tau_table(depths_m=(2.0, 5.0, 10.0), baselines_m=(0.02, 0.1, 0.5), *, f_px: float | None = None,
-              px_noise: float = 1.0) -> str:
-    """SVO's ``τ``: one pixel of angle pushed through the triangle (metres), then an inverse-depth std.
-
-    The point lies straight ahead of the reference camera (``f = (0, 0, 1)``), the current camera
-    ``baseline_m`` to the side. ``τ_ρ = ½ (1/(z − τ) − 1/(z + τ))`` (SVO) is printed beside its
-    first-order form ``τ / z²`` (``dρ/dz = −1/z²``).
-    """
-    f_px = float(chapter_cameras()["rendered (tiny)"][0][0, 0]) if f_px is None else v.check_positive(f_px, "f_px")
-    ang = 2 * np.arctan(px_noise / (2 * f_px))
-    rows = []
-    for z in depths_m:
-        for b in baselines_m:
-            tau = float(compute_tau(np.array([b, 0.0, 0.0]), np.array([[0.0, 0.0, 1.0]]), np.array([z]), ang)[0])
-            t_rho = float(tau_inverse(np.array([z]), np.array([tau]))[0])
-            par = np.degrees(np.arctan2(b, z))
-            rows.append([f"{z:g}", f"{b:g}", f"{par:.2f}", f"{tau:.4f}", f"{t_rho:.5f}", f"{tau / z**2:.5f}"])
-    return format_table(["depth z, m", "baseline, m", "parallax, deg", "tau, m", "tau_rho, 1/m", "tau / z^2, 1/m"],
-                        rows, title=f"tau from {px_noise:g} px of angle (f = {f_px:.1f} px: "
-                                    f"{np.degrees(ang) * 3600:.0f} arc-seconds)")
-
-
-# -- 003 §4.3.2: L < 0.1 beside SVO's σ test --------------------------------------------------------------
-@dataclass(frozen=True)
-class ConvergenceTests:
-    """Seeds seen from a camera moving sideways; when each test first declares them converged (ours).
-
-    ``conv_L`` / ``conv_svo`` (R, n_obs + 1) cumulative share converged by 003's ``L < L_max`` and by
-    SVO's ``σ < ρ_range/200``; ``err_L`` / ``err_svo`` (R,) median relative range error of the seeds
-    at the moment each test accepted them.
-    """
-
-    outlier_rates: tuple
-    step_m: float
-    L_max: float
-    conv_L: np.ndarray = field(repr=False)
-    conv_svo: np.ndarray = field(repr=False)
-    err_L: np.ndarray = field(repr=False)
-    err_svo: np.ndarray = field(repr=False)
-
-    def __str__(self) -> str:
-        return (f"convergence tests, {self.conv_L.shape[1] - 1} observations, {self.step_m} m steps, "
-                f"outliers {', '.join(f'{r:.0%}' for r in self.outlier_rates)}")
-
-    def first_half(self, which: str = "L") -> list:
-        """Observations until half of the seeds pass the test (None if never), per outlier rate."""
-        c = self.conv_L if which == "L" else self.conv_svo
-        out = []
-        for row in c:
-            k = np.flatnonzero(row >= 0.5)
-            out.append(int(k[0]) if k.size else None)
-        return out
-
-    def table(self, at=(5, 10, 20, 30)) -> str:
-        at = [k for k in at if k < self.conv_L.shape[1]]
-        rows = []
-        hL, hS = self.first_half("L"), self.first_half("svo")
-        for i, r in enumerate(self.outlier_rates):
-            rows.append([f"{100 * r:.0f}"] + [f"{100 * self.conv_L[i, k]:.0f} / {100 * self.conv_svo[i, k]:.0f}" for k in at]
-                        + ["-" if hL[i] is None else str(hL[i]), "-" if hS[i] is None else str(hS[i]),
-                           f"{100 * self.err_L[i]:.1f}", f"{100 * self.err_svo[i]:.1f}"])
-        return format_table(["outliers, %", *(f"converged after {k}, % (L / SVO)" for k in at),
-                             "half by L", "half by SVO", "range error at L, %", "range error at SVO, %"], rows,
-                            title=f"003's L < {self.L_max:g} beside SVO's sigma < range/200 "
-                                  f"(camera moving sideways {self.step_m:g} m per frame)")
-
-
-def run_convergence_tests(outlier_rates=(0.0, 0.2, 0.4), *, n_obs: int = 30, n_seeds: int = 400,
-                          step_m: float = 0.02, depth_range_m=(1.5, 6.0), f_px: float = 263.76,
-                          L_max: float = 0.1, rng=0) -> ConvergenceTests:
-    """Both convergence tests on one geometry (ours): seeds on random rays of a 40° view at
-    ``depth_range_m``, the camera moving sideways ``step_m`` per frame; observation ``k`` is the
-    true inverse range plus noise of the ``τ`` of that baseline (one pixel, :func:`compute_tau`), or
-    with probability ``r`` an outlier uniform on ``[0, ρ_range]``. A seed counts as converged from
-    the first observation at which a test passes (the pipeline then stops updating it).
-    """
-    rng = v.as_rng(rng)
-    n_obs = v.check_int(n_obs, "n_obs", minimum=1)
-    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
-    step_m = v.check_positive(step_m, "step_m")
-    L_max = v.check_positive(L_max, "L_max")
-    rates = tuple(float(r) for r in outlier_rates)
-    if not rates or any(not 0.0 <= r < 1.0 for r in rates):
-        raise ValueError(f"`outlier_rates` must be rates in [0, 1); got {outlier_rates!r}")
-    half = np.tan(np.deg2rad(20.0))
-    xy = rng.uniform(-half, half, (n_seeds, 2)) * [1.0, 0.75]
-    f = np.column_stack([xy, np.ones(n_seeds)])
-    f /= np.linalg.norm(f, axis=1, keepdims=True)
-    d_true = rng.uniform(*depth_range_m, n_seeds)
-    X = f * d_true[:, None]
-    ang = 2 * np.arctan(1.0 / (2 * f_px))
-    R = len(rates)
-    cL, cS = np.zeros((R, n_obs + 1)), np.zeros((R, n_obs + 1))
-    eL, eS = np.full(R, np.nan), np.full(R, np.nan)
-    for i, r in enumerate(rates):
-        s = init_seeds(np.zeros((n_seeds, 2)), f, float(np.mean(d_true)), depth_range_m[0])
-        at_L, at_S = np.full(n_seeds, -1), np.full(n_seeds, -1)
-        err_L, err_S = np.full(n_seeds, np.nan), np.full(n_seeds, np.nan)
-        for k in range(1, n_obs + 1):
-            c = np.array([step_m * k, 0.0, 0.0])
-            tau = compute_tau(c, f, d_true, ang)
-            t_rho = tau_inverse(d_true, tau)
-            out = rng.random(n_seeds) < r
-            x = np.where(out, rng.uniform(0.0, s.rho_range), 1.0 / d_true + rng.normal(0.0, 1.0, n_seeds) * t_rho)
-            s.mu, s.sigma2, s.a, s.b = update_seeds(s.mu, s.sigma2, s.a, s.b, x, t_rho**2, s.rho_range)
-            Xe = f / np.maximum(s.mu, 1e-10)[:, None]
-            dvec = Xe - c
-            d = np.linalg.norm(dvec, axis=1)
-            cos_a = np.sum(f * dvec, axis=1) / d
-            passL = linearity_index(s.mu, s.sigma2, d, cos_a) < L_max
-            passS = converged_sigma(s.sigma2, s.rho_range)
-            rel = np.abs(1.0 / np.maximum(s.mu, 1e-10) - d_true) / d_true
-            newL, newS = passL & (at_L < 0), passS & (at_S < 0)
-            at_L[newL], at_S[newS] = k, k
-            err_L[newL], err_S[newS] = rel[newL], rel[newS]
-            cL[i, k], cS[i, k] = np.mean(at_L >= 0), np.mean(at_S >= 0)
-        eL[i] = np.median(err_L[at_L >= 0]) if np.any(at_L >= 0) else np.nan
-        eS[i] = np.median(err_S[at_S >= 0]) if np.any(at_S >= 0) else np.nan
-    del X
-    return ConvergenceTests(rates, step_m, L_max, cL, cS, eL, eS)
 
 
 # -- 003 §5.4-5.5: its questions asked of our pipeline --------------------------------------------------
@@ -310,7 +108,19 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
 
 
 def ablation_table(results: dict, *, title: str = "003 §5.4's switches and the motion prior on our pipeline (rendered)") -> str:
-    """One row per (configuration, case): claimed and correct shares, ATE over all and claimed frames."""
+    """One row per (configuration, case): claimed and correct shares, ATE over all and claimed frames.
+
+    Parameters
+    ----------
+    results : dict
+        ``(configuration, case)`` → :class:`MonoRunResult` (:func:`run_ablation`).
+    title : str
+        Table title.
+
+    Returns
+    -------
+    str
+    """
     rows = []
     for (label, case), r in results.items():
         f3 = lambda x: f"{x:.3f}" if np.isfinite(x) else "-"
@@ -326,6 +136,18 @@ def source_findings_table(ablation: dict, failures: dict) -> str:
     ``ablation``: ``{(configuration, case): MonoRunResult}`` with at least the labels ``"defaults"``,
     ``"no outlier rejection (RdE off)"`` and ``"no refinement (alignment only)"`` for each case (the
     rendered :func:`run_ablation` and the KITTI ablation may be merged into one dict).
+
+    Parameters
+    ----------
+    ablation : dict
+        ``(configuration, case)`` → :class:`MonoRunResult`.
+    failures : dict
+        Case → :class:`MonoRunResult` (:func:`run_failure_cases`).
+
+    Returns
+    -------
+    str
+        One row per finding: 003's words beside our figures.
     """
     cases = list(dict.fromkeys(case for _, case in ablation))
     fails = {k: r for k, r in failures.items() if k != "normal"}
@@ -368,6 +190,22 @@ def compare_init_methods(*, n_points: int = 200, noise_px: float = 0.5, n_trials
 
     Synthetic views (K: f = 500 px, 640×480; a 0.4 m mostly sideways baseline with a small rotation) of a
     tilted plane 4 m ahead and of a deep scene (2.5-8 m); pixel noise ``noise_px``; ``n_trials`` draws.
+
+    Parameters
+    ----------
+    n_points : int
+        Points per scene (default 200).
+    noise_px : float
+        Pixel noise σ [px] (default 0.5).
+    n_trials : int
+        Random draws per scene (default 20).
+    rng : Generator, int or None
+        Randomness of the scenes and the noise (default 0).
+
+    Returns
+    -------
+    str
+        One row per (scene, method): median rotation and translation-direction errors [deg].
     """
     from ..geometry.camera import rotation_xyz
     from .initialise import relative_pose_essential, relative_pose_homography
@@ -411,7 +249,24 @@ def compare_init_methods(*, n_points: int = 200, noise_px: float = 0.5, n_trials
 
 def ours_vs_source(failures: dict, sequence: MonoRunResult, kitti: MonoRunResult | None = None,
                    convergence: ConvergenceStudy | None = None) -> str:
-    """003's stated figures beside ours (003 §4.3, §4.4.1, §5.1.1, §5.2, §5.4, §5.5.1), from the runs' results."""
+    """003's stated figures beside ours (003 §4.3, §4.4.1, §5.1.1, §5.2, §5.4, §5.5.1), from the runs' results.
+
+    Parameters
+    ----------
+    failures : dict
+        Case → :class:`MonoRunResult` (:func:`run_failure_cases`).
+    sequence : MonoRunResult
+        A rendered sequence run.
+    kitti : MonoRunResult, optional
+        The KITTI run, when there is one.
+    convergence : ConvergenceStudy, optional
+        The depth-filter study, when there is one.
+
+    Returns
+    -------
+    str
+        One row per figure: 003's value beside ours.
+    """
     p = MonoParams()
     n_fail_ok = sum(r.verdict == "ok" for k, r in failures.items() if k != "normal")
     n_cases = sum(k != "normal" for k in failures)
@@ -510,7 +365,17 @@ def run_mono_vs_stereo(sequence: str = "strafe", *, n_frames: int = 40, size: st
 
 @dataclass(frozen=True)
 class MonoVsStereo:
-    """The monocular run and Ch. 4's stereo pipeline on the same rendered poses."""
+    """The monocular run and Ch. 4's stereo pipeline on the same rendered poses.
+
+    Attributes
+    ----------
+    mono : MonoRunResult
+        The monocular run.
+    stereo_ate_se3_m, stereo_ate_sim3_m : float
+        ATE of the stereo pipeline after SE(3) and after Sim(3) alignment [m].
+    stereo_rpe_m : float
+        RPE of the stereo pipeline [m].
+    """
 
     mono: MonoRunResult
     stereo_ate_se3_m: float

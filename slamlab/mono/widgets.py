@@ -35,6 +35,16 @@ def explore_mono(**defaults):
     """A rendered strafe run with the slider values; prints the run and draws the map from above.
 
     Calls :func:`~slamlab.mono.run_mono`; a combination that cannot run prints its message.
+
+    Parameters
+    ----------
+    **defaults
+        Start values: ``init_disparity_px``, ``kf_min_frames``, ``kf_max_lost_ratio``, ``patch_px``,
+        ``noise_std`` (sliders), ``n_frames``, ``size``, ``rng``.
+
+    Returns
+    -------
+    ipywidgets.interactive
     """
     d = {"init_disparity_px": 15.0, "kf_min_frames": 10, "kf_max_lost_ratio": 0.3, "patch_px": 9,
          "noise_std": 1.0, "n_frames": 24, "size": "tiny", "rng": 0}
@@ -63,7 +73,17 @@ def explore_mono(**defaults):
 
 
 def explore_failure_cases(**defaults):
-    """One of 003 §5.3's failure cases (rendered) with the chosen motion prior: its table row and map."""
+    """One of 003 §5.3's failure cases (rendered) with the chosen motion prior: its table row and map.
+
+    Parameters
+    ----------
+    **defaults
+        Start values: ``case``, ``motion_model`` (menus), ``size``, ``n_frames``, ``rng``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"case": "normal", "motion_model": "constant_velocity", "size": "tiny", "n_frames": 24, "rng": 0}
     d.update(defaults)
 
@@ -85,7 +105,17 @@ def explore_failure_cases(**defaults):
 
 
 def explore_motion_prior(**defaults):
-    """003's constant velocity or SVO's constant position on a rendered sequence: the run and its map."""
+    """003's constant velocity or SVO's constant position on a rendered sequence: the run and its map.
+
+    Parameters
+    ----------
+    **defaults
+        Start values: ``sequence``, ``motion_model``, ``n_frames`` (controls), ``size``, ``rng``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"sequence": "strafe", "motion_model": "constant_velocity", "size": "tiny", "n_frames": 30, "rng": 0}
     d.update(defaults)
 
@@ -110,7 +140,17 @@ def explore_motion_prior(**defaults):
 
 
 def explore_depth_filter(**defaults):
-    """The depth filter of 003 §4.1.1 fed ``n_obs`` measurements at an outlier rate and noise τ_ρ (1/m)."""
+    """The depth filter of 003 §4.1.1 fed ``n_obs`` measurements at an outlier rate and noise τ_ρ (1/m).
+
+    Parameters
+    ----------
+    **defaults
+        Start values: ``outlier_rate``, ``tau``, ``n_obs`` (sliders), ``rng``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"outlier_rate": 0.4, "tau": 0.01, "n_obs": 40, "rng": 0}
     d.update(defaults)
 

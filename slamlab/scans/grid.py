@@ -10,7 +10,7 @@ API summary
   poses and points metres ↔ cells.
 
 Conventions (used by every 2-D module: scans, sim, correlation, hough)
---------------------------------------------------------------------
+----------------------------------------------------------------------
 In **cell units**, a world point is ``(x, y)`` with ``x`` along the columns and ``y``
 along the rows: cell ``grid[row, col]`` is the unit square centred on ``(x, y) =
 (col, row)``, i.e. covering ``[col - 0.5, col + 0.5) × [row - 0.5, row + 0.5)``. A
@@ -81,6 +81,18 @@ def world_to_cell(xy) -> np.ndarray:
 def cell_to_world(rc) -> np.ndarray:
     """Integer ``(row, col)`` → the world point ``(x, y)`` at the cell centre (inverse of :func:`world_to_cell`).
 
+    Parameters
+    ----------
+    rc : array_like, shape (..., 2)
+        Cell indices ``(row, col)``.
+
+    Returns
+    -------
+    xy : ndarray, shape (..., 2)
+        World points ``(x, y)`` in cell units.
+
+    Examples
+    --------
     >>> cell_to_world([[8, 3]]).tolist()
     [[3.0, 8.0]]
     """
@@ -93,6 +105,20 @@ def cell_to_world(rc) -> np.ndarray:
 def make_grid(n_rows: int, n_cols: int, fill: int = FREE) -> np.ndarray:
     """A new ``int8`` grid of the given size filled with one cell code (004 §7).
 
+    Parameters
+    ----------
+    n_rows, n_cols : int
+        Grid size, at least 1 each.
+    fill : int
+        Cell code to fill with: ``FREE`` (0, default), ``OBSTACLE`` (1) or ``UNEXPLORED`` (-1).
+
+    Returns
+    -------
+    grid : ndarray of int8, shape (n_rows, n_cols)
+        The new grid.
+
+    Examples
+    --------
     >>> make_grid(2, 3, UNEXPLORED)
     array([[-1, -1, -1],
            [-1, -1, -1]], dtype=int8)
@@ -107,6 +133,20 @@ def make_grid(n_rows: int, n_cols: int, fill: int = FREE) -> np.ndarray:
 def check_grid(grid, name: str = "grid") -> np.ndarray:
     """Validate an occupancy grid: 2-D, integer codes in {FREE, OBSTACLE, UNEXPLORED}; returned as ``int8``.
 
+    Parameters
+    ----------
+    grid : array_like, shape (H, W)
+        Cell codes; whole-number floats and bools are accepted.
+    name : str
+        Argument name used in the error messages (default ``"grid"``).
+
+    Returns
+    -------
+    grid : ndarray of int8, shape (H, W)
+        The validated codes.
+
+    Examples
+    --------
     >>> check_grid([[0, 1], [-1, 0]]).dtype
     dtype('int8')
     """
@@ -127,6 +167,22 @@ def check_grid(grid, name: str = "grid") -> np.ndarray:
 def grid_to_values(grid, a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0, dtype=np.float64) -> np.ndarray:
     """Map the cell codes to 004's constants: free → ``a_c``, obstacle → ``a_p``, unexplored → ``a_n`` (004 §7).
 
+    Parameters
+    ----------
+    grid : array_like, shape (H, W)
+        Cell codes (:func:`check_grid`).
+    a_c, a_p, a_n : float
+        Values of free, obstacle and unexplored cells (defaults -1, 1, 0).
+    dtype : numpy dtype
+        Output dtype (default float64).
+
+    Returns
+    -------
+    values : ndarray, shape (H, W)
+        One value per cell.
+
+    Examples
+    --------
     >>> grid_to_values([[0, 1, -1]], a_c=-1, a_p=1, a_n=0)
     array([[-1.,  1.,  0.]])
     """
@@ -143,6 +199,15 @@ def grid_to_values(grid, a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0, 
 @dataclass(frozen=True)
 class GridFrame:
     """A grid over a metric frame: cell ``(row, col)`` is centred on ``(x0_m + col·cell_m, y0_m + row·cell_m)``.
+
+    Attributes
+    ----------
+    x0_m, y0_m : float
+        World position [m] of the centre of cell ``(0, 0)``.
+    cell_m : float
+        Cell size [m], positive.
+    shape : tuple of int
+        Grid size ``(rows, cols)``.
 
     Examples
     --------
@@ -182,11 +247,33 @@ class GridFrame:
         return cls(float(lo[0]), float(lo[1]), cell, (int(n[1]), int(n[0])))
 
     def to_cells(self, poses_m) -> np.ndarray:
-        """Poses ``(x_m, y_m, heading)`` (n, 3) → cell units (heading unchanged)."""
+        """Poses ``(x_m, y_m, heading)`` (n, 3) → cell units (heading unchanged).
+
+        Parameters
+        ----------
+        poses_m : array_like, shape (n, 3)
+            Poses ``(x_m, y_m, heading_rad)``.
+
+        Returns
+        -------
+        poses_cells : ndarray, shape (n, 3)
+            ``(x, y)`` in cell units relative to the frame's origin, heading unchanged.
+        """
         P = v.as_matrix(poses_m, "poses_m", (None, 3))
         return np.column_stack([(P[:, 0] - self.x0_m) / self.cell_m, (P[:, 1] - self.y0_m) / self.cell_m, P[:, 2]])
 
     def to_metres(self, poses_cells) -> np.ndarray:
-        """Inverse of :meth:`to_cells`."""
+        """Inverse of :meth:`to_cells`.
+
+        Parameters
+        ----------
+        poses_cells : array_like, shape (n, 3)
+            Poses in cell units ``(x, y, heading_rad)``.
+
+        Returns
+        -------
+        poses_m : ndarray, shape (n, 3)
+            ``(x_m, y_m, heading_rad)``.
+        """
         P = v.as_matrix(poses_cells, "poses_cells", (None, 3))
         return np.column_stack([P[:, 0] * self.cell_m + self.x0_m, P[:, 1] * self.cell_m + self.y0_m, P[:, 2]])

@@ -37,7 +37,19 @@ RULES = ("count", "endpoints")
 
 @dataclass(frozen=True)
 class OccupancyGrid:
-    """Hit and pass counts per cell and the three-valued grid they give (cell units)."""
+    """Hit and pass counts per cell and the three-valued grid they give (cell units).
+
+    Attributes
+    ----------
+    grid : ndarray of int8, shape (H, W)
+        FREE / OBSTACLE / UNEXPLORED codes.
+    hits : ndarray of int64, shape (H, W)
+        Returns that fell in each cell.
+    passes : ndarray of int64, shape (H, W)
+        Beam samples that fell in each cell.
+    rule : str
+        The labelling rule used (``"count"`` or ``"endpoints"``).
+    """
 
     grid: np.ndarray = field(repr=False)  # int8 (H, W): FREE / OBSTACLE / UNEXPLORED
     hits: np.ndarray = field(repr=False)  # int64 (H, W): returns that fell in the cell
@@ -69,8 +81,8 @@ def occupancy_grid(scans: Sequence[Scan], poses, shape: tuple[int, int], *, rule
     ``misses_free``) and "hit" for the cell at ``range + hit_offset_cells`` (a range
     ends on the face of the obstacle cell: the offset puts the vote inside it).
 
-    Rules
-    -----
+    Rules:
+
     ``"count"``
         OBSTACLE when ``hits >= min_hits`` and ``hits >= hit_ratio·passes``, else
         FREE when passed, else UNEXPLORED (004's a_n).
@@ -86,10 +98,23 @@ def occupancy_grid(scans: Sequence[Scan], poses, shape: tuple[int, int], *, rule
         Sensor pose of each scan, in cells (``GridFrame.to_cells`` for metric poses).
     shape : (int, int)
         Grid size (rows, cols); votes outside are dropped.
+    rule : str
+        ``"count"`` or ``"endpoints"`` (above; default ``"count"``).
+    hit_ratio : float
+        Smallest ``hits / passes`` of an OBSTACLE cell under ``"count"`` (default 0.25).
+    min_hits : int
+        Fewest hits of an OBSTACLE cell (default 1).
+    step_cells : float
+        Spacing of the pass samples along a beam [cells] (default 0.5).
+    hit_offset_cells : float
+        Distance past the range at which the hit is voted [cells] (default 0.01).
+    misses_free : bool
+        A beam without return passes the cells up to its (maximum) range (default True).
 
     Returns
     -------
     OccupancyGrid
+        ``grid`` (H, W) int8 codes, ``hits`` and ``passes`` (H, W) counts, ``rule``.
 
     Examples
     --------
@@ -150,6 +175,24 @@ def label_counts(hits, passes, *, rule: str = "count", hit_ratio: float = 0.25, 
     Lets a caller subtract some scans' counts from a whole log's and label the rest
     without recounting (the leave-out maps of Ch. 5).
 
+    Parameters
+    ----------
+    hits, passes : array_like of int, shape (H, W)
+        Hit and pass counts per cell.
+    rule : str
+        ``"count"`` or ``"endpoints"`` (default ``"count"``).
+    hit_ratio : float
+        Smallest ``hits / passes`` of an OBSTACLE cell under ``"count"`` (default 0.25).
+    min_hits : int
+        Fewest hits of an OBSTACLE cell (default 1).
+
+    Returns
+    -------
+    grid : ndarray of int8, shape (H, W)
+        Cell codes.
+
+    Examples
+    --------
     >>> label_counts(np.array([[0, 1, 1]]), np.array([[0, 2, 8]])).tolist()
     [[-1, 1, 0]]
     """

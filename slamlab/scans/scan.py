@@ -122,6 +122,16 @@ class Scan:
         """World points ``(x, y)`` of the returns, seen from ``pose``.
 
         Default pose: :attr:`pose`, else :attr:`odom_pose`, else the sensor frame (origin).
+
+        Parameters
+        ----------
+        pose : array_like, shape (3,), optional
+            Sensor pose ``(x, y, heading_rad)`` in the scan's units.
+
+        Returns
+        -------
+        points : ndarray, shape (k, 2)
+            End points of the valid returns.
         """
         if pose is None:
             pose = self.pose if self.pose is not None else self.odom_pose
@@ -137,6 +147,18 @@ class Scan:
     def to_cells(self, cell_m: float) -> Scan:
         """This scan in cell units (ranges and pose positions divided by ``cell_m``); a cell scan is returned as is.
 
+        Parameters
+        ----------
+        cell_m : float
+            Cell size [m], positive.
+
+        Returns
+        -------
+        Scan
+            The scan with ``unit="cell"``.
+
+        Examples
+        --------
         >>> Scan([0.0], [0.5], [True], unit="m", max_range=4.0).to_cells(0.1).ranges.tolist()
         [5.0]
         """
@@ -144,7 +166,18 @@ class Scan:
         return self if self.unit == "cell" else self._scaled(1.0 / cell, "cell")
 
     def to_metres(self, cell_m: float) -> Scan:
-        """This scan in metres (ranges and pose positions times ``cell_m``); a metric scan is returned as is."""
+        """This scan in metres (ranges and pose positions times ``cell_m``); a metric scan is returned as is.
+
+        Parameters
+        ----------
+        cell_m : float
+            Cell size [m], positive.
+
+        Returns
+        -------
+        Scan
+            The scan with ``unit="m"``.
+        """
         cell = v.check_positive(cell_m, "cell_m")
         return self if self.unit == "m" else self._scaled(cell, "m")
 
