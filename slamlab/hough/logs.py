@@ -134,10 +134,10 @@ def log_format(path) -> str:
     -------
     str
     """
-    from ..io.carmen import _open_text  # plain text or gzip, told apart by the magic bytes
+    from ..io import open_text  # plain text or gzip, told apart by the magic bytes
 
     p = v.as_path(path, "path", kind="file")
-    with _open_text(p) as fh:
+    with open_text(p) as fh:
         for line in fh:
             tok = line.split()
             if not tok or tok[0].startswith("#"):

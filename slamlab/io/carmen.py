@@ -30,7 +30,7 @@ import numpy as np
 from .. import _validate as v
 from ..scans import Scan
 
-__all__ = ["CarmenLog", "flaser_angles", "read_carmen"]
+__all__ = ["CarmenLog", "flaser_angles", "open_text", "read_carmen"]
 
 
 def flaser_angles(n_beams: int, fov_rad: float = np.pi) -> np.ndarray:
@@ -176,7 +176,19 @@ class CarmenLog:
         return [self._scan(i, b) for i in idx]
 
 
-def _open_text(path: Path):
+def open_text(path):
+    """Open a log as text, plain or gzip, told apart by its magic bytes (not its name).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    io.TextIOBase
+        A text stream (ASCII; undecodable bytes replaced), to be closed by the caller (``with``).
+    """
     with open(path, "rb") as fh:
         gz = fh.read(2) == b"\x1f\x8b"
     return gzip.open(path, "rt", encoding="ascii", errors="replace") if gz else open(path, encoding="ascii",
@@ -225,7 +237,7 @@ def read_carmen(path, *, max_range_m: float | None = None) -> CarmenLog:
     params: dict[str, str] = {}
     skipped: dict[str, int] = {}
     n_beams = None
-    with _open_text(p) as fh:
+    with open_text(p) as fh:
         for lineno, line in enumerate(fh, start=1):
             tok = line.split()
             if not tok or tok[0].startswith("#"):

@@ -28,6 +28,8 @@ import numpy as np
 from .. import _validate as v
 
 __all__ = [
+    "CELL_CHARS",
+    "CHAR_CODES",
     "FREE",
     "OBSTACLE",
     "UNEXPLORED",
@@ -46,8 +48,10 @@ OBSTACLE = 1
 #: Unexplored space (004's a_n).
 UNEXPLORED = -1
 
-_CHARS = {FREE: ".", OBSTACLE: "#", UNEXPLORED: "~"}
-_CODES = {c: k for k, c in _CHARS.items()}
+#: Cell code → its character in a text map (``grid_from_text``/``grid_to_text`` in :mod:`slamlab.sim.grid`).
+CELL_CHARS = {FREE: ".", OBSTACLE: "#", UNEXPLORED: "~"}
+#: Character of a text map → cell code (the inverse of :data:`CELL_CHARS`).
+CHAR_CODES = {c: k for k, c in CELL_CHARS.items()}
 
 
 def world_to_cell(xy) -> np.ndarray:
@@ -125,7 +129,7 @@ def make_grid(n_rows: int, n_cols: int, fill: int = FREE) -> np.ndarray:
     """
     n_rows = v.check_int(n_rows, "n_rows", minimum=1)
     n_cols = v.check_int(n_cols, "n_cols", minimum=1)
-    if fill not in _CHARS:
+    if fill not in CELL_CHARS:
         raise ValueError(f"`fill` must be FREE (0), OBSTACLE (1) or UNEXPLORED (-1); got {fill!r}")
     return np.full((n_rows, n_cols), fill, dtype=np.int8)
 

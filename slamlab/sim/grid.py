@@ -27,7 +27,7 @@ import numpy as np
 
 from .. import _validate as v
 from ..scans.grid import (
-    _CODES,
+    CHAR_CODES,
     FREE,
     OBSTACLE,
     UNEXPLORED,
@@ -234,11 +234,11 @@ def grid_from_text(text: str) -> np.ndarray:
     widths = {len(ln) for ln in lines}
     if len(widths) != 1:
         raise ValueError(f"`text` rows must all have the same length; got lengths {sorted(widths)}")
-    bad = set("".join(lines)) - set(_CODES)
+    bad = set("".join(lines)) - set(CHAR_CODES)
     if bad:
         raise ValueError(f"`text` may hold only '.', '#' and '~'; got {sorted(bad)!r}")
     lut = np.zeros(128, dtype=np.int8)
-    for ch, code in _CODES.items():
+    for ch, code in CHAR_CODES.items():
         lut[ord(ch)] = code
     raw = np.frombuffer("".join(lines).encode("ascii"), dtype=np.uint8)
     return lut[raw].reshape(len(lines), -1)

@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from slamlab.data import find_data
-from slamlab.io import flaser_angles, read_carmen
+from slamlab.io import flaser_angles, open_text, read_carmen
 from slamlab.scans import Scan
 
 LOG = """# a comment
@@ -18,6 +18,15 @@ NEFF 15
 FLASER 3 4.0 0.0 3.0 1.0 2.0 3.0 1.0 2.0 3.0 14.0 pippo 14.0
 ROBOTLASER1 whatever
 """
+
+
+def test_open_text_tells_gzip_by_its_bytes_not_its_name(tmp_path):
+    plain, packed = tmp_path / "log.gz", tmp_path / "log.txt"  # names that lie about the content
+    plain.write_text(LOG, encoding="ascii")
+    packed.write_bytes(gzip.compress(LOG.encode("ascii")))
+    for path in (plain, packed):
+        with open_text(path) as fh:
+            assert fh.read() == LOG
 
 
 @pytest.mark.parametrize("compress", [False, True])
