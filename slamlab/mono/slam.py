@@ -207,25 +207,9 @@ class MonoSLAM(_MonoMapping):
         h, w = image.shape
         # 1. motion prior: 003's constant velocity or SVO's constant position (our default, see MonoParams)
         T_prev = self._T_cw
-        if self._T_cw_prev is None or p.motion_model == "constant_position":
-            vel1 = np.eye(4)
-        else:
-            vel1 = se3_compose(T_prev, se3_inverse(self._T_cw_prev))
-        vel = vel1  # motion from the last tracked frame: one velocity step per frame since (ours: coasting)
-        for _ in range(self._n_coast):
-            vel = se3_compose(vel1, vel)
-        T_pred = se3_compose(vel, T_prev)
+        vel1, vel, T_pred = self._motion_prior()
         # 2. sparse direct alignment to the previous frame
-        # every map point in view of the previous frame (at most align_max_points, spread; ours)
-        X_prev = transform_points(T_prev, self.points)
-        uv_prev = project(self.K, np.where(X_prev[:, 2:3] > 1e-6, X_prev, 1.0))
-        in_prev = np.flatnonzero((X_prev[:, 2] > 1e-6) & (uv_prev[:, 0] >= 0) & (uv_prev[:, 0] < w)
-                                 & (uv_prev[:, 1] >= 0) & (uv_prev[:, 1] < h))
-        if in_prev.size > p.align_max_points:
-            in_prev = self._select(in_prev, uv_prev[in_prev], w, h, p.align_max_points)
-        X_prev = X_prev[in_prev]
-        al = sparse_align(self._prev_pyr, pyr, self.K, X_prev, vel, patch_px=p.align_patch_px,
-                          max_level=p.align_max_level, min_level=p.align_min_level, max_iter=p.align_iters)
+        al = self._align(pyr, T_prev, vel, w, h)
         T_est = se3_compose(al.T_cur_ref, T_prev) if al.ok else T_pred
         if not al.ok:
             self._count("align_failed")
@@ -234,6 +218,69 @@ class MonoSLAM(_MonoMapping):
         t1 = time.perf_counter()
         times["align"] = t1 - t0
         # 3. project the map, refine each projection by LK from its keyframe
+        cand, vis, uvp, uv_m, ok_m = self._match_map(image, T_est, w, h)
+        t2 = time.perf_counter()
+        times["match"] = t2 - t1
+        # 4. motion-only refinement of the reprojection error
+        mi = cand[ok_m]
+        T_new, inl, n_inl = self._refine(T_est, mi, uv_m[ok_m])
+        t3 = time.perf_counter()
+        times["refine"] = t3 - t2
+        self.point_fail[cand] += 1
+        self.point_fail[mi[inl]] = 0
+        self._diag = {"n_matched": int(mi.size), "align_rms": float(al.rms)}
+        share_bad = n_inl < p.min_inlier_share * max(mi.size, 1)
+        if n_inl < p.min_inliers or share_bad or align_bad or not np.all(np.isfinite(T_new)):
+            return self._lost(image, idx, n_inl, share_bad, align_bad, vel1, T_prev, T_pred)
+        self._accept(image, idx, pyr, vel1, T_new, mi[inl], uv_m[ok_m][inl])
+        # mapping: the depth filter on this frame (003 §4.3.2)
+        self._update_seeds(image, times)
+        t4 = time.perf_counter()
+        # keyframe rules (003 §4.3)
+        self._since_kf += 1
+        # points lost since the last keyframe: matched now vs matched then (003 §4.3)
+        lost = 1.0 - n_inl / max(self._n_at_kf, 1)
+        if (self._since_kf >= p.kf_min_frames and lost >= p.kf_lost_ratio) or lost > p.kf_max_lost_ratio:
+            self._add_keyframe(image, idx, np.flatnonzero(vis), uvp[vis])
+            self._n_at_kf = n_inl
+        # drop points that keep failing (a simple outlier rejection, ours)
+        bad = self.point_fail > p.max_seed_fail
+        if bad.any() and p.outlier_rejection:
+            self._count("points_dropped", int(bad.sum()))
+            self._keep_points(~bad)
+        times["keyframe"] = time.perf_counter() - t4
+        return "tracked", True, n_inl
+
+    def _motion_prior(self):
+        """The last one-frame velocity ``vel1``, the velocity over the coasted frames, the predicted pose."""
+        p = self.p
+        T_prev = self._T_cw
+        if self._T_cw_prev is None or p.motion_model == "constant_position":
+            vel1 = np.eye(4)
+        else:
+            vel1 = se3_compose(T_prev, se3_inverse(self._T_cw_prev))
+        vel = vel1  # motion from the last tracked frame: one velocity step per frame since (ours: coasting)
+        for _ in range(self._n_coast):
+            vel = se3_compose(vel1, vel)
+        return vel1, vel, se3_compose(vel, T_prev)
+
+    def _align(self, pyr, T_prev, vel, w, h):
+        """Sparse direct alignment of the previous frame's visible map points to this frame (003 §4.4 step 1)."""
+        p = self.p
+        # every map point in view of the previous frame (at most align_max_points, spread; ours)
+        X_prev = transform_points(T_prev, self.points)
+        uv_prev = project(self.K, np.where(X_prev[:, 2:3] > 1e-6, X_prev, 1.0))
+        in_prev = np.flatnonzero((X_prev[:, 2] > 1e-6) & (uv_prev[:, 0] >= 0) & (uv_prev[:, 0] < w)
+                                 & (uv_prev[:, 1] >= 0) & (uv_prev[:, 1] < h))
+        if in_prev.size > p.align_max_points:
+            in_prev = self._select(in_prev, uv_prev[in_prev], w, h, p.align_max_points)
+        X_prev = X_prev[in_prev]
+        return sparse_align(self._prev_pyr, pyr, self.K, X_prev, vel, patch_px=p.align_patch_px,
+                            max_level=p.align_max_level, min_level=p.align_min_level, max_iter=p.align_iters)
+
+    def _match_map(self, image, T_est, w, h):
+        """Project the map at ``T_est``; LK-refine each projection from its source (003 §4.4 step 3)."""
+        p = self.p
         Xc = transform_points(T_est, self.points)
         front = Xc[:, 2] > 1e-6
         uvp = project(self.K, np.where(front[:, None], Xc, 1.0))
@@ -259,64 +306,66 @@ class MonoSLAM(_MonoMapping):
             u1, ok = track_lk(src_img, image, uv_src, win_px=p.match_win_px, levels=2, uv1_guess=uvp[cand[sel]])
             ok &= np.linalg.norm(u1 - uvp[cand[sel]], axis=1) < 3 * p.match_win_px
             uv_m[sel], ok_m[sel] = u1, ok
-        t2 = time.perf_counter()
-        times["match"] = t2 - t1
-        # 4. motion-only refinement of the reprojection error
-        mi = cand[ok_m]
+        return cand, vis, uvp, uv_m, ok_m
+
+    def _refine(self, T_est, mi, uv):
+        """Motion-only refinement of the reprojection error of map points ``mi`` seen at ``uv`` (003 §4.4 step 4)."""
+        p = self.p
         n_inl = 0
         T_new = T_est
         if mi.size >= p.min_inliers and p.refine:
-            T_new, err, ok = refine_pose(self.K, self.points[mi], uv_m[ok_m], T_est, huber_px=1.0, max_iter=p.refine_iters,
+            T_new, err, ok = refine_pose(self.K, self.points[mi], uv, T_est, huber_px=1.0, max_iter=p.refine_iters,
                                          reject_px=3.0 if p.outlier_rejection else None)
             inl = ok & (err < self._inlier_px) if ok else np.zeros(mi.size, bool)
             n_inl = int(inl.sum())
         elif mi.size >= p.min_inliers:  # no refinement: the alignment's pose, inliers counted there
             Xm = transform_points(T_est, self.points[mi])
             Xm[:, 2] = np.maximum(Xm[:, 2], 1e-6)
-            err = np.linalg.norm(project(self.K, Xm) - uv_m[ok_m], axis=1)
+            err = np.linalg.norm(project(self.K, Xm) - uv, axis=1)
             inl = err < self._inlier_px
             n_inl = int(inl.sum())
         else:
             inl = np.zeros(mi.size, bool)
-        t3 = time.perf_counter()
-        times["refine"] = t3 - t2
-        self.point_fail[cand] += 1
-        self.point_fail[mi[inl]] = 0
-        self._diag = {"n_matched": int(mi.size), "align_rms": float(al.rms)}
-        share_bad = n_inl < p.min_inlier_share * max(mi.size, 1)
-        if n_inl < p.min_inliers or share_bad or align_bad or not np.all(np.isfinite(T_new)):
-            self._count("lost")
-            if n_inl >= p.min_inliers:
-                self._count("lost_by_share" if share_bad else ("lost_by_photometric" if align_bad else "lost_nonfinite"))
-            if self._T_cw_prev is not None and p.motion_model == "constant_velocity" and self._n_coast < p.max_coast:
-                # coast (ours): report the predicted pose and keep the velocity for the next attempt
-                self._n_coast += 1
-                self._T_show = T_pred = orthonormalise(T_pred)
-                self._count("coasted")
-            elif p.reinit_when_lost and self._T_cw_prev is not None and p.motion_model == "constant_velocity":
-                # ours: a new two-view map, anchored at the predicted pose with the velocity's scale
-                # the step: median of the last tracked frames' steps (one velocity can be off)
-                steps = self._steps[-5:] or [float(np.sqrt(np.sum(vel1[:3, 3] ** 2)))]
-                # the new initialiser starts from the last tracked frame (its pose is known), so that this
-                # frame can already complete it
-                self._reinit = {"vel": vel1, "T_pred": {self._last_idx: T_prev, idx: T_pred},
-                                "frames": [self._last_idx, idx], "step": float(np.median(steps))}
-                self.init = self._new_initialiser()
-                self.init.add_frame(self._prev_img)
-                st = self.init.add_frame(image)
-                self.initialised = False
-                self._T_show = T_pred
-                self._count("reinit_started")
-                if st == "done":
-                    n_new = self._start_map(image, idx)
-                    if n_new is not None:
-                        return "initialised", True, n_new
-            else:
-                # keep the last pose; the next frame tries again from it (no motion prior)
-                self._T_cw_prev = None
-                self._n_coast = 0
-                self._T_show = None
-            return "lost", False, n_inl
+        return T_new, inl, n_inl
+
+    def _lost(self, image, idx, n_inl, share_bad, align_bad, vel1, T_prev, T_pred):
+        """A frame that failed the tracking tests: coast, start a new map, or wait (ours; counted)."""
+        p = self.p
+        self._count("lost")
+        if n_inl >= p.min_inliers:
+            self._count("lost_by_share" if share_bad else ("lost_by_photometric" if align_bad else "lost_nonfinite"))
+        if self._T_cw_prev is not None and p.motion_model == "constant_velocity" and self._n_coast < p.max_coast:
+            # coast (ours): report the predicted pose and keep the velocity for the next attempt
+            self._n_coast += 1
+            self._T_show = T_pred = orthonormalise(T_pred)
+            self._count("coasted")
+        elif p.reinit_when_lost and self._T_cw_prev is not None and p.motion_model == "constant_velocity":
+            # ours: a new two-view map, anchored at the predicted pose with the velocity's scale
+            # the step: median of the last tracked frames' steps (one velocity can be off)
+            steps = self._steps[-5:] or [float(np.sqrt(np.sum(vel1[:3, 3] ** 2)))]
+            # the new initialiser starts from the last tracked frame (its pose is known), so that this
+            # frame can already complete it
+            self._reinit = {"vel": vel1, "T_pred": {self._last_idx: T_prev, idx: T_pred},
+                            "frames": [self._last_idx, idx], "step": float(np.median(steps))}
+            self.init = self._new_initialiser()
+            self.init.add_frame(self._prev_img)
+            st = self.init.add_frame(image)
+            self.initialised = False
+            self._T_show = T_pred
+            self._count("reinit_started")
+            if st == "done":
+                n_new = self._start_map(image, idx)
+                if n_new is not None:
+                    return "initialised", True, n_new
+        else:
+            # keep the last pose; the next frame tries again from it (no motion prior)
+            self._T_cw_prev = None
+            self._n_coast = 0
+            self._T_show = None
+        return "lost", False, n_inl
+
+    def _accept(self, image, idx, pyr, vel1, T_new, tracked_points, tracked_uv):
+        """A tracked frame: the velocity, the step, the pose and the previous-frame state for the next frame."""
         if self._n_coast and self._T_cw_prev is not None:
             # back after coasting: keep the velocity of before (ours)
             self._T_cw_prev = se3_compose(se3_inverse(vel1), T_new)
@@ -331,23 +380,6 @@ class MonoSLAM(_MonoMapping):
         self._T_cw = orthonormalise(T_new)
         self._last_idx = idx
         self._prev_pyr = pyr
-        self._prev_vis = mi[inl]
-        self._prev_uv = uv_m[ok_m][inl]
+        self._prev_vis = tracked_points
+        self._prev_uv = tracked_uv
         self._prev_img = image
-        # mapping: the depth filter on this frame (003 §4.3.2)
-        self._update_seeds(image, times)
-        t4 = time.perf_counter()
-        # keyframe rules (003 §4.3)
-        self._since_kf += 1
-        # points lost since the last keyframe: matched now vs matched then (003 §4.3)
-        lost = 1.0 - n_inl / max(self._n_at_kf, 1)
-        if (self._since_kf >= p.kf_min_frames and lost >= p.kf_lost_ratio) or lost > p.kf_max_lost_ratio:
-            self._add_keyframe(image, idx, np.flatnonzero(vis), uvp[vis])
-            self._n_at_kf = n_inl
-        # drop points that keep failing (a simple outlier rejection, ours)
-        bad = self.point_fail > p.max_seed_fail
-        if bad.any() and p.outlier_rejection:
-            self._count("points_dropped", int(bad.sum()))
-            self._keep_points(~bad)
-        times["keyframe"] = time.perf_counter() - t4
-        return "tracked", True, n_inl
