@@ -29,7 +29,8 @@ from .stores import (
     base_rule,
     make_store,
 )
-from .tree import KDTree, SearchStats, bbf_trace, build_kdtree
+from .trace import bbf_trace
+from .tree import KDTree, SearchStats, build_kdtree
 
 _LAZY = {
     "plot_kdtree_2d": ".plot",

@@ -22,20 +22,19 @@ Speed: all queries of a batch run in lock-step with numpy arrays -- in each roun
 every unfinished query pops its best pending branch, descends to a leaf and
 evaluates that leaf's bucket. There is no Python loop over queries or points;
 the Python loops are over rounds (≤ leaves visited) and tree depth.
-:func:`bbf_trace` is the plain one-query version with ``heapq`` that the
-notebook prints step by step.
+:func:`slamlab.kdtree.bbf_trace` (in ``trace.py``) is the plain one-query version with ``heapq`` that
+the notebook prints step by step.
 """
 
 from __future__ import annotations
 
-import heapq
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _validate as v
 
-__all__ = ["KDTree", "SearchStats", "bbf_trace", "build_kdtree"]
+__all__ = ["KDTree", "SearchStats", "build_kdtree"]
 
 
 @dataclass(frozen=True)
@@ -288,6 +287,55 @@ class KDTree:
         return dist, ids
 
 
+def _merge_k_best(bd, bi, d2, cand, k):
+    """Merge a leaf's candidates (distances ``d2``, indices ``cand``: one row per query) into the sorted k best."""
+    if d2.shape[1] == 1:  # insert one candidate into the sorted k best (ties: the earlier stays first)
+        nd, ni = d2[:, 0], cand[:, 0]
+        pos = (bd <= nd[:, None]).sum(axis=1)
+        for col in range(k - 1, -1, -1):
+            take_new = pos == col
+            shift = pos < col
+            bd[:, col] = np.where(take_new, nd, np.where(shift, bd[:, col - 1] if col else nd, bd[:, col]))
+            bi[:, col] = np.where(take_new, ni, np.where(shift, bi[:, col - 1] if col else ni, bi[:, col]))
+        return bd, bi
+    all_d = np.concatenate([bd, d2], axis=1)
+    all_i = np.concatenate([bi, cand], axis=1)
+    o = np.argsort(all_d, axis=1, kind="stable")[:, :k]
+    return np.take_along_axis(all_d, o, axis=1), np.take_along_axis(all_i, o, axis=1)
+
+
+def _push_pending(pb, pn, free, width, a, far, fb):
+    """Push branch ``far`` with bound ``fb`` for queries ``a`` into the pending table (a freed slot, else a new
+    column; the table doubles when full). Returns the table and its width."""
+    slot = free[a]
+    new = slot < 0
+    if new.any():
+        if width >= pb.shape[1]:
+            M = pb.shape[0]
+            pb = np.concatenate([pb, np.full((M, pb.shape[1]), np.inf)], axis=1)
+            pn = np.concatenate([pn, np.zeros((M, pn.shape[1]), dtype=np.int64)], axis=1)
+        slot[new] = width
+        width += 1
+    pb[a, slot] = fb
+    pn[a, slot] = far
+    free[a] = -1
+    return pb, pn, width
+
+
+def _compact_pending(pb, pn, free, width):
+    """Sort the live pending branches to the front when the table is mostly holes; returns the new width."""
+    sub = pb[:, :width]
+    n_live = int(np.isfinite(sub).sum(axis=1).max())
+    if n_live < width // 2:
+        o = np.argsort(sub, axis=1, kind="stable")[:, :max(n_live, 1)]
+        pb[:, :o.shape[1]] = np.take_along_axis(sub, o, axis=1)
+        pn[:, :o.shape[1]] = np.take_along_axis(pn[:, :width], o, axis=1)
+        pb[:, o.shape[1]:width] = np.inf
+        width = o.shape[1]
+        free[:] = -1
+    return width
+
+
 def _lockstep_search(t, P, Q, k, max_leaves):
     """All queries' BBF in lock-step, one step per query per iteration (numpy over the queries).
 
@@ -333,22 +381,7 @@ def _lockstep_search(t, P, Q, k, max_leaves):
             d2[~valid] = np.inf
             leaves_v[a] += 1
             dist_v[a] += s1 - s0
-            bd, bi = best_d[a], best_i[a]
-            if leaf_size == 1:  # insert one candidate into the sorted k best (ties: the earlier stays first)
-                nd, ni = d2[:, 0], cand[:, 0]
-                pos = (bd <= nd[:, None]).sum(axis=1)
-                for col in range(k - 1, -1, -1):
-                    take_new = pos == col
-                    shift = pos < col
-                    bd[:, col] = np.where(take_new, nd, np.where(shift, bd[:, col - 1] if col else nd, bd[:, col]))
-                    bi[:, col] = np.where(take_new, ni, np.where(shift, bi[:, col - 1] if col else ni, bi[:, col]))
-                best_d[a], best_i[a] = bd, bi
-            else:
-                all_d = np.concatenate([bd, d2], axis=1)
-                all_i = np.concatenate([bi, cand], axis=1)
-                o = np.argsort(all_d, axis=1, kind="stable")[:, :k]
-                best_d[a] = np.take_along_axis(all_d, o, axis=1)
-                best_i[a] = np.take_along_axis(all_i, o, axis=1)
+            best_d[a], best_i[a] = _merge_k_best(best_d[a], best_i[a], d2, cand, k)
             cur[a] = -1
             if max_leaves is not None:
                 full = leaves_v[active] >= max_leaves
@@ -394,101 +427,10 @@ def _lockstep_search(t, P, Q, k, max_leaves):
             cur[a] = near
             keep = fb < best_d[a, k - 1]
             if keep.any():
-                a, far, fb = a[keep], far[keep], fb[keep]
-                slot = free[a]
-                new = slot < 0
-                if new.any():
-                    if width >= pb.shape[1]:
-                        pb = np.concatenate([pb, np.full((M, pb.shape[1]), np.inf)], axis=1)
-                        pn = np.concatenate([pn, np.zeros((M, pn.shape[1]), dtype=np.int64)], axis=1)
-                    slot[new] = width
-                    width += 1
-                pb[a, slot] = fb
-                pn[a, slot] = far
-                free[a] = -1
+                pb, pn, width = _push_pending(pb, pn, free, width, a[keep], far[keep], fb[keep])
         # compact the pending table when it is mostly holes (popped or pruned slots)
         it += 1
         if width > 64 and it % 32 == 0:
-            sub = pb[:, :width]
-            n_live = int(np.isfinite(sub).sum(axis=1).max())
-            if n_live < width // 2:
-                o = np.argsort(sub, axis=1, kind="stable")[:, :max(n_live, 1)]
-                pb[:, :o.shape[1]] = np.take_along_axis(sub, o, axis=1)
-                pn[:, :o.shape[1]] = np.take_along_axis(pn[:, :width], o, axis=1)
-                pb[:, o.shape[1]:width] = np.inf
-                width = o.shape[1]
-                free[:] = -1
+            width = _compact_pending(pb, pn, free, width)
     best_i[~np.isfinite(best_d)] = -1
     return best_d, best_i, SearchStats(nodes_v, leaves_v, dist_v)
-
-
-def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None):
-    """One query, step by step, with a ``heapq`` priority queue (000 §1.4.3) -- the teaching version.
-
-    Returns the neighbours and a list of events ``(kind, node, bound)`` where kind
-    is ``"pop"``, ``"push"`` or ``"leaf"``; the same search as :meth:`KDTree.query`.
-
-    Parameters
-    ----------
-    tree : KDTree
-        The tree searched.
-    q : (dim,) float
-        The query point.
-    k : int
-        Neighbours wanted.
-    max_leaves : int, optional
-        BBF leaf budget; None searches exactly.
-
-    Returns
-    -------
-    dist : (k,) float
-        Distances of the neighbours, ascending.
-    ids : (k,) int
-        Their ids.
-    events : list of (str, int, float)
-        ``(kind, node, bound)`` in search order.
-
-    Examples
-    --------
-    >>> tree = KDTree(np.array([[0.0], [1.0], [2.0], [3.0]]))
-    >>> d, ids, events = bbf_trace(tree, [2.2], k=1)
-    >>> int(ids[0]), round(float(d[0]), 6)
-    (2, 0.2)
-    """
-    if not isinstance(tree, KDTree):
-        raise TypeError(f"`tree` must be a KDTree; got {type(tree).__name__}")
-    q = v.as_vector(q, "q", tree.dim)
-    k = v.check_int(k, "k", minimum=1)
-    if max_leaves is not None:
-        max_leaves = v.check_int(max_leaves, "max_leaves", minimum=1)
-    t = tree.nodes
-    best: list[tuple[float, int]] = []  # (d2, leaf-order index), sorted
-    heap = [(0.0, 0)]
-    events = []
-    leaves = 0
-    while heap:
-        bound, node = heapq.heappop(heap)
-        kth = best[k - 1][0] if len(best) >= k else np.inf
-        if bound >= kth:
-            break
-        events.append(("pop", int(node), float(bound)))
-        while t["left"][node] >= 0:
-            d, s = t["split_dim"][node], t["split_val"][node]
-            diff = q[d] - s
-            near, far = (t["left"][node], t["right"][node]) if diff <= 0 else (t["right"][node], t["left"][node])
-            fb = max(bound, diff * diff)
-            kth = best[k - 1][0] if len(best) >= k else np.inf
-            if fb < kth:
-                heapq.heappush(heap, (fb, int(far)))
-                events.append(("push", int(far), float(fb)))
-            node = near
-        pts = np.arange(t["start"][node], t["stop"][node])
-        d2 = ((tree._P[pts].astype(np.float64) - q) ** 2).sum(axis=1)
-        best = sorted(best + list(zip(d2.tolist(), pts.tolist(), strict=True)))[:k]
-        leaves += 1
-        events.append(("leaf", int(node), float(min(d2))))
-        if max_leaves is not None and leaves >= max_leaves:
-            break
-    dist = np.array([np.sqrt(b[0]) for b in best] + [np.inf] * (k - len(best)))
-    ids = np.array([tree._ids_leaf[b[1]] for b in best] + [-1] * (k - len(best)), dtype=np.int64)
-    return dist, ids, events
