@@ -174,6 +174,16 @@ class StereoSLAM:
         if est is None:
             self._finish(rec, clock, pts_body, no_inliers)
             return rec
+        inl_mask = self._update_map(rec, est, mm, pts_body, cov_body, desc)
+        self._finish(rec, clock, pts_body, inl_mask)
+        return rec
+
+    def _update_map(self, rec, est, mm, pts_body, cov_body, desc):
+        """Take the pose ``est``; refine the re-seen landmarks, add the unmatched points (000 §3.6).
+
+        Returns the mask of the local points that were inliers of the pose.
+        """
+        p = self.params
         rec["status"] = "ok"
         self.T = est.T
         R, t = est.T[:3, :3], est.T[:3, 3]
@@ -204,8 +214,7 @@ class StereoSLAM:
         self._last_ids = np.concatenate([ids, np.arange(first_new, len(self.X))])
         inl_mask = np.zeros(len(pts_body), bool)
         inl_mask[loc] = True
-        self._finish(rec, clock, pts_body, inl_mask)
-        return rec
+        return inl_mask
 
     def _locate_window(self, rec, clock, desc, uv, pts_body, cov_body, depth):
         """The window search (``map_search='window'``, our addition): a first pose from the landmarks of the
