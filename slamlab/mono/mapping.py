@@ -277,6 +277,16 @@ class _MonoMapping:
         self._count("seed_updates", int(found_all.sum()))
         self._count("seed_misses", int(miss.sum()))
         # convergence (003 §4.3.2 or SVO) and removal
+        self._converge_seeds(c_w)
+        times["mapping"] = time.perf_counter() - t1
+
+    def _converge_seeds(self, c_w):
+        """Seeds that converged become map points, failed ones are dropped (003 §4.3.2 or SVO's test).
+
+        ``c_w`` is the current camera centre in the world frame (the linearity test's viewing angle).
+        """
+        p = self.p
+        s = self.seeds
         T_wr = {k.id: se3_inverse(k.T_cw) for k in self.keyframes}
         ids = sorted(T_wr)
         lut = np.full(max(ids) + 1, -1, np.int64)
@@ -304,4 +314,3 @@ class _MonoMapping:
         keep = ~(conv | drop)
         self.seeds = s.take(keep)
         self.seed_patches = self.seed_patches[keep]
-        times["mapping"] = time.perf_counter() - t1
