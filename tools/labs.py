@@ -11,13 +11,16 @@ Usage::
 course folder as the assignment ``labs``, runs ``nbgrader generate_assignment`` and copies the
 student versions to ``--out``. ``autograde`` takes a folder holding one sub-folder per student
 (``SUBMISSIONS/<student_id>/<NN_topic_lab>.ipynb``), runs ``nbgrader autograde`` and writes
-``grades.csv`` (``nbgrader export``) into the course folder, printing its path.
+``grades.csv`` (``nbgrader export``: one total per student) and ``grades_by_task.csv`` (the points of every
+autograded cell: ``student_id, notebook, grade_id, score, max_score``) into the course folder, printing
+the path of ``grades.csv``.
 On a JupyterHub with nbgrader's own course set-up, the same notebooks go into ``source/`` there.
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import os
 import shutil
 import subprocess
@@ -79,7 +82,38 @@ def autograde(submissions: Path, course: Path) -> Path:
             shutil.copy2(nb, dst / nb.name)
     _nbgrader(course, "autograde", ASSIGNMENT, "--force")
     _nbgrader(course, "export", "--to=grades.csv")
+    export_by_task(course)
     return course / "grades.csv"
+
+
+def export_by_task(course: Path) -> Path:
+    """Write ``grades_by_task.csv``: the autograded points of every check cell of every submission.
+
+    Parameters
+    ----------
+    course : Path
+        The nbgrader course folder (holding ``gradebook.db`` after ``nbgrader autograde``).
+
+    Returns
+    -------
+    Path
+        The written CSV, one row per student, notebook and autograded cell.
+    """
+    from nbgrader.api import Gradebook
+
+    out = course / "grades_by_task.csv"
+    rows = []
+    with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
+        for sub in gb.assignment_submissions(ASSIGNMENT):
+            for nb in sub.notebooks:
+                for grade in nb.grades:
+                    if grade.cell.cell_type == "code":  # prose cells are graded by hand
+                        rows.append((sub.student.id, nb.name, grade.name, grade.score, grade.max_score))
+    with out.open("w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(["student_id", "notebook", "grade_id", "score", "max_score"])
+        writer.writerows(sorted(rows))
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -33,7 +33,15 @@ _REGISTRY: dict[str, Task | ExplorationTask] = {}
 
 @dataclass(frozen=True)
 class Case:
-    """One call to try: a label for the report, keyword arguments, and whether it is an edge case."""
+    """One call to try: a label for the report and the keyword arguments.
+
+    Parameters
+    ----------
+    label : str
+        What the case is, as the report names it ("seeded 3", "empty input").
+    kwargs : dict
+        The keyword arguments of the call.
+    """
 
     label: str
     kwargs: dict[str, Any]
@@ -45,6 +53,23 @@ class Task:
 
     ``cases(rng)`` returns the cases (seeded random ones first, then edge cases); ``compare(expected,
     received)`` returns None when they agree, else a short description of the difference.
+
+    Parameters
+    ----------
+    task_id : str
+        Unique id, "NN.name" (NN the lab).
+    title : str
+        The task's name in every message.
+    reference : callable
+        The library's function the student's must agree with.
+    cases : callable
+        ``cases(rng) -> list[Case]``.
+    hint : str
+        Shown with a failing case: the misconception, never code.
+    compare : callable, optional
+        ``compare(expected, received) -> str | None``; default :func:`allclose`.
+    points : int
+        The task's points.
     """
 
     task_id: str
@@ -64,6 +89,19 @@ class WrongAnswer:
     computation as the accepted range); a received value within ``atol + rtol·|value|`` of it gets
     ``hint`` (which names the misconception, never the answer or code) and, from the second failed
     attempt on, ``more`` as well (still no code).
+
+    Parameters
+    ----------
+    label : str
+        The misconception's name.
+    value : callable
+        ``value() -> float``: the number the misconception gives.
+    hint : str
+        Shown for a matching answer.
+    more : str
+        Added to the hint from the second failed attempt on.
+    rtol, atol : float
+        How close a received value must be to ``value()`` to match.
     """
 
     label: str
@@ -85,6 +123,29 @@ class ExplorationTask:
     instructor, what the range is and why. ``wrong`` lists the typical wrong answers, each mapped to
     a hint naming its misconception; ``hint`` is for any other wrong value and ``more`` is added to
     it from the second failed attempt on.
+
+    Parameters
+    ----------
+    task_id : str
+        Unique id, "NN.explore.name".
+    question : str
+        The question, as every message names it.
+    expected : callable
+        ``expected() -> float``: the library's own run (the centre when ``accepted`` is None).
+    rtol, atol : float
+        Tolerance around ``expected()`` when ``accepted`` is None.
+    hint : str
+        Shown for a wrong value that matches no typical wrong answer.
+    points : int
+        The task's points.
+    accepted : callable, optional
+        ``accepted() -> (lo, hi)``: the closed range that passes, from an independent computation.
+    why : str
+        For the instructor: what the range is and why.
+    wrong : tuple of WrongAnswer
+        The typical wrong answers.
+    more : str
+        Added to ``hint`` from the second failed attempt on.
     """
 
     task_id: str
@@ -111,7 +172,18 @@ class ExplorationTask:
         return exp - tol, exp + tol
 
     def misconception(self, x: float) -> WrongAnswer | None:
-        """The typical wrong answer ``x`` matches, if any (the first in ``wrong``)."""
+        """The typical wrong answer ``x`` matches, if any (the first in ``wrong``).
+
+        Parameters
+        ----------
+        x : float
+            The received value.
+
+        Returns
+        -------
+        WrongAnswer or None
+            The first matching typical wrong answer.
+        """
         for w in self.wrong:
             v = float(w.value())
             if abs(x - v) <= w.atol + w.rtol * abs(v):
@@ -121,7 +193,17 @@ class ExplorationTask:
 
 @dataclass(frozen=True)
 class CheckResult:
-    """What a check found: ``status`` is "passed", "failed", "error" or "not done yet"."""
+    """What a check found.
+
+    Parameters
+    ----------
+    task_id : str
+        The checked task.
+    status : str
+        "passed", "failed", "error" or "not done yet".
+    message : str
+        What was printed.
+    """
 
     task_id: str
     status: str
@@ -136,7 +218,18 @@ class CheckResult:
 
 
 def register(t: Task | ExplorationTask) -> Task | ExplorationTask:
-    """Add a task to the registry (ids are unique)."""
+    """Add a task to the registry (ids are unique).
+
+    Parameters
+    ----------
+    t : Task or ExplorationTask
+        The task.
+
+    Returns
+    -------
+    Task or ExplorationTask
+        ``t``.
+    """
     if t.task_id in _REGISTRY:
         raise ValueError(f"task id {t.task_id!r} is registered twice")
     _REGISTRY[t.task_id] = t
@@ -144,8 +237,18 @@ def register(t: Task | ExplorationTask) -> Task | ExplorationTask:
 
 
 def task(task_id: str) -> Task | ExplorationTask:
-    """The registered task ``task_id``."""
-    _load_tasks()
+    """The registered task ``task_id``.
+
+    Parameters
+    ----------
+    task_id : str
+        A registered id.
+
+    Returns
+    -------
+    Task or ExplorationTask
+        The task.
+    """
     try:
         return _REGISTRY[task_id]
     except KeyError:
@@ -153,23 +256,8 @@ def task(task_id: str) -> Task | ExplorationTask:
         raise ValueError(f"`task_id` must be one of {known}; got {task_id!r}") from None
 
 
-def _load_tasks() -> None:
-    from . import (  # noqa: F401  (each registers its tasks on import)
-        tasks_correlation,
-        tasks_features,
-        tasks_filters,
-        tasks_hough,
-        tasks_localisation,
-        tasks_mono,
-        tasks_planes,
-        tasks_stereo,
-        tasks_stores,
-    )
-
-
 def all_tasks() -> dict[str, Task | ExplorationTask]:
     """Every registered task by id."""
-    _load_tasks()
     return dict(_REGISTRY)
 
 
@@ -177,7 +265,18 @@ def all_tasks() -> dict[str, Task | ExplorationTask]:
 
 
 def allclose(rtol: float = 1e-7, atol: float = 1e-9) -> Callable[[Any, Any], str | None]:
-    """Compare arrays, scalars or tuples of them elementwise with ``rtol``/``atol``."""
+    """Compare arrays, scalars or tuples of them elementwise with ``rtol``/``atol``.
+
+    Parameters
+    ----------
+    rtol, atol : float
+        Relative and absolute tolerance (as :func:`numpy.allclose`).
+
+    Returns
+    -------
+    callable
+        ``compare(expected, received) -> str | None``: None when they agree, else the difference.
+    """
 
     def compare(expected, received) -> str | None:
         if isinstance(expected, tuple):
@@ -237,7 +336,24 @@ def _finish(result: CheckResult, quiet: bool) -> CheckResult:
 
 
 def check(task_id: str, fn: Callable, *, seed: int = 0, quiet: bool = False) -> CheckResult:
-    """Run the student's ``fn`` on the task's cases; print and return pass, the first failure, or "not done yet"."""
+    """Run the student's ``fn`` on the task's cases; print and return pass, the first failure, or "not done yet".
+
+    Parameters
+    ----------
+    task_id : str
+        An implementation task's id.
+    fn : callable
+        The student's function.
+    seed : int
+        Seed of the random cases.
+    quiet : bool
+        Do not print the message.
+
+    Returns
+    -------
+    CheckResult
+        The outcome (under nbgrader a result that has not passed raises ``AssertionError`` instead).
+    """
     t = task(task_id)
     if not isinstance(t, Task):
         raise TypeError(f"{task_id!r} is answered with a number: use sl.lab.answer({task_id!r}, value)")
@@ -278,6 +394,20 @@ def answer(task_id: str, value, *, quiet: bool = False) -> CheckResult:
     task's ``accepted()`` (an independent computation), or the library's own run within the task's
     tolerance. A wrong value that matches one of the task's typical wrong answers gets the hint
     naming that misconception; from the second failed attempt at a task on, the hint says more.
+
+    Parameters
+    ----------
+    task_id : str
+        An exploration task's id.
+    value : float or callable
+        The number, or a function returning it.
+    quiet : bool
+        Do not print the message.
+
+    Returns
+    -------
+    CheckResult
+        The outcome (under nbgrader a result that has not passed raises ``AssertionError`` instead).
     """
     t = task(task_id)
     if not isinstance(t, ExplorationTask):
@@ -323,5 +453,16 @@ def _shown(x: float, tol: float) -> str:
 
 
 def tasks_of(prefix: str) -> Iterable[str]:
-    """Ids of the registered tasks starting with ``prefix`` (e.g. "01.")."""
+    """Ids of the registered tasks starting with ``prefix`` (e.g. "01.").
+
+    Parameters
+    ----------
+    prefix : str
+        Start of the ids.
+
+    Returns
+    -------
+    list of str
+        The matching ids, sorted.
+    """
     return sorted(k for k in all_tasks() if k.startswith(prefix))

@@ -141,6 +141,16 @@ def fast_threshold_opencv(*, nonmax: bool = True) -> float:
     """Exploration 1 answered with OpenCV's FAST-9 (an independent detector): the smallest grid threshold within budget.
 
     ``nonmax=False`` counts the corners before non-maximum suppression (a typical wrong reading).
+
+    Parameters
+    ----------
+    nonmax : bool
+        Count corners after OpenCV's non-maximum suppression (the question's reading).
+
+    Returns
+    -------
+    float
+        The smallest threshold of the grid whose corner count is within the budget.
     """
     import cv2
 

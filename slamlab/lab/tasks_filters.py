@@ -124,6 +124,22 @@ def cv_position_rmse_analytic(pos_std_m: float, *, n_steps: int | None = 50, acc
     2-D position error over steps ``1..n_steps`` is the mean of ``P_k[x,x] + P_k[y,y]`` (per axis
     ``[p, v]``, ``Q = σ_a² [[dt³/3, dt²/2], [dt²/2, dt]]``, ``P_0 = diag(σ_z², 1)``, 000 §1.2.1's
     predict and update). ``n_steps=None`` gives the steady state (many steps).
+
+    Parameters
+    ----------
+    pos_std_m : float
+        Standard deviation of the position measurement, in metres.
+    n_steps : int or None
+        Number of steps averaged; None for the steady state.
+    accel_std : float
+        Standard deviation of the white-noise acceleration (σ_a), in m/s².
+    dt_s : float
+        Time step, in seconds.
+
+    Returns
+    -------
+    float
+        The expected 2-D position RMSE, in metres.
     """
     F = np.array([[1.0, dt_s], [0.0, 1.0]])
     Q = accel_std**2 * np.array([[dt_s**3 / 3, dt_s**2 / 2], [dt_s**2 / 2, dt_s]])

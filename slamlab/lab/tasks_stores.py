@@ -188,6 +188,24 @@ def literal_iter_time(n1, q, *, n: float = 50000, m: float = 500, C: float = 9.0
 
     ``p = log_q(n / n1) + 1``, ``searchKd = p log n1 + C p(p-1)/2 log q``, ``addKd = n1 log n1 + m q p log n1
     + m q/2 p(p-1) log q``, ``iterTime = addKd + C searchKd`` (log = log2; 000 Appendix).
+
+    Parameters
+    ----------
+    n1 : float or array_like
+        Size of the first tree.
+    q : float or array_like
+        Growth factor between tree sizes.
+    n : float
+        Number of stored points.
+    m : float
+        Number of points matched per iteration.
+    C : float
+        Cost of a search relative to an insertion.
+
+    Returns
+    -------
+    ndarray
+        iterTime at each ``(n1, q)`` (broadcast).
     """
     n1, q = np.asarray(n1, dtype=float), np.asarray(q, dtype=float)
     p = np.log(n / n1) / np.log(q) + 1.0
@@ -215,6 +233,24 @@ def rebuilt_count(n1: float, q: float, batches, *, merges_only: bool = False, co
     After each batch the trees whose contents changed and are not empty are built again (tree 0
     and every tree that received a merge). ``merges_only`` leaves out tree 0's builds;
     ``count_emptied`` also counts tree 0 at its size before a merge emptied it (two typical wrong readings).
+
+    Parameters
+    ----------
+    n1 : float
+        Size of the first tree.
+    q : float
+        Growth factor between tree sizes.
+    batches : iterable of int
+        Numbers of points inserted per iteration.
+    merges_only : bool
+        Leave out tree 0's builds.
+    count_emptied : bool
+        Also count tree 0 at its size before a merge emptied it.
+
+    Returns
+    -------
+    int
+        Points put into newly built trees over all batches.
     """
     sizes, total = [0], 0
     for b in batches:

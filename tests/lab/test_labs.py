@@ -64,21 +64,113 @@ def course(tmp_path_factory):
     return root, students
 
 
+# --- four generated submissions per lab --------------------------------------------------------------------
+# correct: the instructor solution, each exploration answered with the instructor's number (read from the stored
+#          output of its check cell: a student may answer from any experiment, and the test need not rerun it);
+# wrong:   a plausible wrong implementation of task 1 and a typical wrong number for one exploration (the
+#          other explorations not done);
+# empty:   the student version untouched;
+# raising: the last task raises (no other task calls it); the other tasks right, the explorations not done.
+#: Task 1 of each lab made wrong the way a student might: (text in the solution, its wrong replacement).
+WRONG_TASK = {
+    "01": ("F @ P @ F.T + Q", "F @ P @ F.T"),  # the process noise forgotten
+    "02": ("II[1:, 1:] =", "II[:-1, :-1] ="),  # the zero row and column at the wrong end
+    "03": ("D = np.sqrt(", "D = ("),  # squared distances
+    "04": ("while sizes[i] > max_size(i):", "while sizes[i] >= max_size(i):"),  # a full tree merged
+    "05": ("return (p1 + p2) / 2,", "return p1,"),  # the point on the first ray, not the midpoint
+    "06": ("x + c * px - s * py, y + s * px + c * py", "x + c * px + s * py, y - s * px + c * py"),  # R transposed
+    "07": ("theta = -np.pi / 2 + delta_theta_rad", "theta = delta_theta_rad"),  # theta from 0 instead of -pi/2
+    "08": ('side="right"', 'side="left"'),  # the off-by-one at ties
+    "09": ("C2 = b / (a + b) / rho_range", "C2 = b / (a + b)"),  # the uniform density forgotten
+    "10": ("np.linalg.inv(odometry[-1]) @ odometry", "np.linalg.inv(odometry[0]) @ odometry"),  # the first line
+}
+#: The exploration answered wrong in the "wrong" submission: one whose check is quick.
+WRONG_EXPLORATION = {"01": "e2", "02": "e1", "03": "e2", "04": "e2", "05": "e2", "06": "e1", "07": "e1",
+                     "08": "e2", "09": "e2", "10": "e2"}
+SUBMISSIONS = ("correct", "wrong", "empty", "raising")
+
+
+def _replace_solution(source: str, body: str) -> str:
+    """``source`` with the lines between ``### BEGIN SOLUTION`` and ``### END SOLUTION`` replaced by ``body``."""
+    begin, end = source.index("### BEGIN SOLUTION"), source.index("### END SOLUTION")
+    indent = source[source.rindex("\n", 0, begin) + 1:begin]
+    return source[:begin] + "### BEGIN SOLUTION\n" + indent + body + "\n" + indent + source[end:]
+
+
+def _stored_answer(nb, ex: str) -> float:
+    """The number the instructor version's exploration ``ex`` passed with (its check cell's stored output)."""
+    import re
+
+    cell = next(c for c in nb.cells if c.metadata.get("nbgrader", {}).get("grade_id", "").endswith(f"_{ex}_check"))
+    text = "".join(o.get("text", "") for o in cell.outputs)
+    return float(re.search(r"— (\S+): passed\.", text).group(1))
+
+
+def _last_task(nb) -> str:
+    """The last implementation task of a lab ("t4"): the one a raising submission breaks (no later task calls it)."""
+    parts = [c.metadata["nbgrader"]["grade_id"].split("_")[1] for c in nb.cells
+             if c.metadata.get("nbgrader", {}).get("grade_id", "").endswith("_check")]
+    return max(p for p in parts if p.startswith("t"))
+
+
+def make_submission(lab: Path, kind: str):
+    """The notebook a student of kind ``kind`` ("correct", "wrong" or "raising") hands in for ``lab``."""
+    from slamlab import lab as sl_lab
+
+    nb = nbformat.read(lab, as_version=4)
+    num = lab.name[:2]
+    for c in nb.cells:
+        gid = c.metadata.get("nbgrader", {}).get("grade_id", "")
+        if not gid.endswith("_solution") or c.cell_type != "code":
+            continue
+        part = gid.split("_")[1]  # t1, t2, ..., e1, e2
+        if part.startswith("e"):
+            if kind == "correct":
+                c.source = _replace_solution(c.source, f"return {_stored_answer(nb, part)!r}")
+            elif kind == "wrong" and part == WRONG_EXPLORATION[num]:
+                check = next(d for d in nb.cells if d.metadata.get("nbgrader", {}).get("grade_id") == f"lab{num}_{part}_check")
+                task_id = check.source.split('"')[1]
+                c.source = _replace_solution(c.source, f"return {float(sl_lab.task(task_id).wrong[0].value())!r}")
+            else:
+                c.source = _replace_solution(c.source, "raise NotImplementedError()")
+        elif kind == "wrong" and part == "t1":
+            old, new = WRONG_TASK[num]
+            assert c.source.count(old) == 1, f"{lab.name}: {old!r} in\n{c.source}"
+            c.source = c.source.replace(old, new)
+        elif kind == "raising" and part == _last_task(nb):
+            c.source = _replace_solution(c.source, 'raise IndexError("index 3 is out of bounds")')
+    return nb
+
+
+def expected_points(lab: Path, kind: str) -> dict[str, float]:
+    """Points per autograded cell of ``lab`` for a submission of kind ``kind``, from the notebook's metadata."""
+    out = {}
+    for c, m in _nbgrader_cells(nbformat.read(lab, as_version=4)):
+        if not (m["grade"] and c.cell_type == "code"):
+            continue
+        part = m["grade_id"].split("_")[1]
+        lost = (kind == "empty" or (part.startswith("e") and kind == "raising")
+                or (kind == "wrong" and (part == "t1" or part.startswith("e")))
+                or (kind == "raising" and part == _last_task(nbformat.read(lab, as_version=4))))
+        out[m["grade_id"]] = 0.0 if lost else float(m["points"])
+    return out
+
+
 @pytest.fixture(scope="module")
 def autograded(course, tmp_path_factory):
-    """One ``nbgrader autograde`` of two submissions: the instructor versions and the blank student versions.
+    """One ``nbgrader autograde`` of four submissions of every lab (see ``make_submission``).
 
-    Both tests below read it: the scores, and the blank versions as nbgrader ran them (each lab's student
-    version is executed once, here, rather than once more by nbclient for the student test).
+    The tests below read it: the scores, and the empty student versions as nbgrader ran them (each lab's
+    student version is executed once, here, rather than once more by nbclient for the student test).
     """
     root, students = course
     subs = tmp_path_factory.mktemp("submissions")
-    (subs / "instructor").mkdir()
-    (subs / "blank").mkdir()
-    for lab in LABS:
-        shutil.copy2(lab, subs / "instructor" / lab.name)
-    for path in students:
-        shutil.copy2(path, subs / "blank" / path.name)
+    for kind in SUBMISSIONS:
+        (subs / kind).mkdir()
+    for lab, student in zip(LABS, students, strict=True):
+        shutil.copy2(student, subs / "empty" / student.name)
+        for kind in ("correct", "wrong", "raising"):
+            nbformat.write(make_submission(lab, kind), subs / kind / lab.name)
     return labs_tool.autograde(subs, root)
 
 
@@ -92,7 +184,7 @@ def test_student_versions_run_and_say_not_done_yet(course, autograded):
     assert [p.name for p in students] == [p.name for p in LABS]
     for path in students:
         assert "### BEGIN SOLUTION" not in path.read_text(encoding="utf-8"), path.name
-        nb = nbformat.read(root / "autograded" / "blank" / labs_tool.ASSIGNMENT / path.name, as_version=4)
+        nb = nbformat.read(root / "autograded" / "empty" / labs_tool.ASSIGNMENT / path.name, as_version=4)
         assert len([c for c in nb.cells if c.cell_type == "code"]) == len(
             [c for c in nbformat.read(path, as_version=4).cells if c.cell_type == "code"]), path.name
         for c in nb.cells:
@@ -111,13 +203,22 @@ def test_student_versions_run_and_say_not_done_yet(course, autograded):
 
 
 @pytest.mark.slow
-def test_autograde_full_points_for_solutions_zero_for_blank(autograded):
+def test_autograde_gives_each_submission_its_points_per_task(autograded):
+    """Every autograded cell of every submission scores what the notebooks' metadata says it should."""
+    with (autograded.parent / "grades_by_task.csv").open() as fh:
+        got = {(r["student_id"], r["notebook"], r["grade_id"]): float(r["score"]) for r in csv.DictReader(fh)}
+    expected = {(kind, lab.stem, gid): pts for kind in SUBMISSIONS for lab in LABS
+                for gid, pts in expected_points(lab, kind).items()}
+    wrong = {k: (v, got.get(k)) for k, v in expected.items() if got.get(k) != v}
+    assert not wrong, f"(submission, lab, cell): (expected, scored): {wrong}"
+    assert set(got) == set(expected)
     with autograded.open() as fh:
-        rows = {r["student_id"]: r for r in csv.DictReader(fh)}
-    auto_points = sum(m["points"] for lab in LABS for c, m in _nbgrader_cells(nbformat.read(lab, as_version=4))
-                      if m["grade"] and c.cell_type == "code")
-    assert float(rows["instructor"]["raw_score"]) == auto_points  # every autograded cell; prose is graded by hand
-    assert float(rows["blank"]["raw_score"]) == 0.0
+        totals = {r["student_id"]: float(r["raw_score"]) for r in csv.DictReader(fh)}
+    for kind in SUBMISSIONS:  # nbgrader's own grades.csv: the total of the autograded points (prose is by hand)
+        assert totals[kind] == sum(v for (k, _, _), v in expected.items() if k == kind), kind
+    assert totals["empty"] == 0.0
+    assert totals["correct"] == sum(m["points"] for lab in LABS for c, m in _nbgrader_cells(
+        nbformat.read(lab, as_version=4)) if m["grade"] and c.cell_type == "code")
 
 
 @pytest.mark.parametrize("lab", LABS, ids=[p.name for p in LABS])
