@@ -52,7 +52,23 @@ MAX_RANGE = 100.0
 
 @dataclass(frozen=True)
 class SimRun:
-    """One simulated run in the test room: true poses, odometry poses, scans, the kidnap step (or None)."""
+    """One simulated run in the test room: true poses, odometry poses, scans, the kidnap step (or None).
+
+    Parameters
+    ----------
+    grid : ndarray, shape (H, W)
+        The map the filters use.
+    true_poses, odom_poses : ndarray, shape (n, 3)
+        True poses and the noisy odometry (cells, rad).
+    scans : list of Scan
+        One scan per step, in cells.
+    kidnap_step : int or None
+        The step the robot is carried away before (None: no kidnap).
+    max_range : float
+        The rangefinder's maximum range (cells).
+    start : int
+        Index of the first pose on 004's path.
+    """
 
     grid: np.ndarray = field(repr=False)
     true_poses: np.ndarray = field(repr=False)  # (n, 3)
@@ -79,6 +95,31 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
     reports an ordinary step there. Noise: Gaussian range noise, odometry noise per step. ``world``:
     "map" (the scans see the map itself) or "cluttered" (they see 004's room with its unmapped clutter,
     :func:`slamlab.sim.measurement_room_200`, while the filter keeps the map).
+
+    Parameters
+    ----------
+    n_steps : int
+        Poses of the run.
+    start : int, optional
+        Index of the first pose on 004's path (random when None).
+    kidnap_step : int, optional
+        The step the robot is carried away before (None: no kidnap).
+    kidnap_to : int, optional
+        The path pose it is carried to (random, at least 40 poses away, when None).
+    n_beams : int
+        Beams per scan.
+    range_std_cells : float
+        σ of the range noise (cells).
+    odo_trans_frac, odo_rot_std_rad : float
+        Odometry noise: share of each step's length, radians per step.
+    world : {"map", "cluttered"}
+        What the scans see.
+    rng : Generator, int or None
+        Random source.
+
+    Returns
+    -------
+    SimRun
     """
     v.check_choice(world, "world", ("map", "cluttered"))
     rng = v.as_rng(rng)
@@ -121,7 +162,23 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
 
 @dataclass(frozen=True)
 class FilterRun:
-    """A filter run along a :class:`SimRun`: estimates, errors, the step records (MCL) and the time."""
+    """A filter run along a :class:`SimRun`: estimates, errors, the step records (MCL) and the time.
+
+    Parameters
+    ----------
+    est : ndarray, shape (n, 3)
+        Estimates (cells, rad).
+    err_pos : ndarray, shape (n,)
+        Position errors (cells).
+    err_heading_rad : ndarray, shape (n,)
+        Heading errors (rad).
+    records : list of StepRecord
+        MCL's step records (empty for the Markov grid).
+    snapshots : list
+        Weighted particle sets per step (when kept).
+    time_s : float
+        Wall time of the run.
+    """
 
     est: np.ndarray = field(repr=False)  # (n, 3)
     err_pos: np.ndarray = field(repr=False)  # (n,) cells
@@ -136,7 +193,17 @@ class FilterRun:
         return (self.err_pos < FAIL_POS_CELLS) & (np.degrees(self.err_heading_rad) < FAIL_DEG)
 
     def converged_at(self, after: int = 0) -> int | None:
-        """First step (≥ ``after``) from which the estimate stays within the bounds to the end; None if never."""
+        """First step (≥ ``after``) from which the estimate stays within the bounds to the end; None if never.
+
+        Parameters
+        ----------
+        after : int
+            First step to consider.
+
+        Returns
+        -------
+        int or None
+        """
         ok = self.ok
         bad = np.flatnonzero(~ok[after:])
         if bad.size == 0:
@@ -148,7 +215,29 @@ class FilterRun:
 def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params=None, rng=None,
                keep_particles: bool = False, **overrides) -> FilterRun:
     """Run MCL (``method="mcl"``) or the Markov grid (``"markov"``) along ``run`` from no prior
-    (``init="global"``) or from the true start (``"tracking"``, MCL only)."""
+    (``init="global"``) or from the true start (``"tracking"``, MCL only).
+
+    Parameters
+    ----------
+    run : SimRun
+        The simulated run.
+    method : {"mcl", "markov"}
+        The filter.
+    init : {"global", "tracking"}
+        No prior, or the true start (MCL only).
+    params : MCLParams or MarkovParams, optional
+        The filter's settings.
+    rng : Generator, int or None
+        Random source (MCL).
+    keep_particles : bool
+        Keep MCL's weighted set of every step.
+    **overrides
+        Fields of the filter's params.
+
+    Returns
+    -------
+    FilterRun
+    """
     v.check_choice(method, "method", ("mcl", "markov"))
     v.check_choice(init, "init", ("global", "tracking"))
     rng = v.as_rng(rng)
@@ -194,7 +283,15 @@ def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int, ov
 
 @dataclass(frozen=True)
 class MarkovVsMclResult:
-    """Markov grid vs MCL on the same runs: accuracy, memory and time."""
+    """Markov grid vs MCL on the same runs: accuracy, memory and time.
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (method, size, run).
+    n_runs, n_steps : int
+        Runs per method, steps per run.
+    """
 
     table_df: object = field(repr=False)
     n_runs: int = 0
@@ -299,7 +396,19 @@ AMCL_DEFAULTS = {
 
 
 def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) -> str:
-    """ROS 1 AMCL, ROS 2 Nav2 AMCL and ours side by side (ours in cells, and in metres at ``cell_m``)."""
+    """ROS 1 AMCL, ROS 2 Nav2 AMCL and ours side by side (ours in cells, and in metres at ``cell_m``).
+
+    Parameters
+    ----------
+    params : MCLParams, optional
+        Our settings (default: the defaults).
+    cell_m : float
+        Cell size [m] to express ours in metres.
+
+    Returns
+    -------
+    str
+    """
     p = MCLParams() if params is None else params
     score = {"likelihood": "p(z | x)", "geometric_mean": "geometric mean (ours)", "amcl_cubes": "1 + Σ p³"}[p.score]
     ours = {
@@ -331,7 +440,21 @@ def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) ->
 
 def ours_vs_source(global_result=None, kidnap=None, ablation=None) -> str:
     """003 §2.2 / §1.2.4 beside what this chapter does, with our figures where a run is given
-    (a :class:`~slamlab.localisation.studies.GlobalResult`, ``KidnapResult``, ``AblationResult``)."""
+    (a :class:`~slamlab.localisation.studies.GlobalResult`, ``KidnapResult``, ``AblationResult``).
+
+    Parameters
+    ----------
+    global_result : GlobalResult, optional
+        A global-localisation study.
+    kidnap : KidnapResult, optional
+        A kidnap study.
+    ablation : AblationResult, optional
+        An ablation.
+
+    Returns
+    -------
+    str
+    """
     p = MCLParams()
     rows = [
         ["three cases", "tracking, global localisation, SLAM (§1.2.4)", "tracking and global here; SLAM: Ch. 6"],
@@ -422,7 +545,17 @@ def _side_task(rng, n_steps: int, n_particles: int, delta_alpha_deg: float, over
 
 @dataclass(frozen=True)
 class SideBySideResult:
-    """MCL (global, over a run) and Ch. 5's correlation search (one scan, no prior) on the same final scans."""
+    """MCL (global, over a run) and Ch. 5's correlation search (one scan, no prior) on the same final scans.
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per run.
+    n_runs, n_steps, n_particles : int
+        Runs, MCL steps per run, MCL particles.
+    delta_alpha_deg : float
+        The correlation search's heading step [deg].
+    """
 
     table_df: object = field(repr=False)
     n_runs: int = 0

@@ -73,7 +73,43 @@ AVERAGES = ("003", "amcl", "first", "debiased")
 @dataclass(frozen=True)
 class MCLParams(ModelParams):
     """Settings of Monte Carlo localisation; lengths in cells (the map's unit). The motion and sensor
-    model's fields come first (:class:`~slamlab.localisation.models.ModelParams`)."""
+    model's fields come first (:class:`~slamlab.localisation.models.ModelParams`).
+
+    Parameters
+    ----------
+    alpha, z_hit, z_rand, sigma_hit, max_dist, max_beams, gamma : see ModelParams
+        The motion and sensor model (:class:`~slamlab.localisation.models.ModelParams`; MCL's own defaults).
+    n_particles : int
+        Particles (the most, with KLD sampling).
+    score : str
+        The score ω that eq 2.8 averages (:data:`~slamlab.localisation.models.SCORES`).
+    alpha_slow, alpha_fast : float
+        Rates of the slow and fast averages (eqs 2.9, 2.10); ``alpha_slow = 0``: no injection.
+    averages : str
+        How the averages start and restart (:data:`AVERAGES`).
+    resample_threshold : float
+        Resample when ``N_eff < resample_threshold·M`` (1: every step).
+    beam_skip : bool
+        Nav2's beam skipping, once converged.
+    beam_skip_distance, beam_skip_threshold, beam_skip_error_threshold : float
+        Its distance (cells), agreeing share of particles and share of skipped beams that turns it off.
+    jitter : tuple of 2 float
+        σ of the jitter added at every step (cells, rad).
+    update_min_d, update_min_a : float
+        Update only after moving this far (cells) or turning this far (rad).
+    converged_dist : float
+        amcl's convergence test distance (cells).
+    use_kld : bool
+        KLD sampling.
+    kld_epsilon, kld_z : float
+        KLD's ε and 1 − δ.
+    kld_bin : tuple of 3 float
+        KLD bin size (x, y cells, θ rad).
+    n_min : int
+        KLD's lower bound on the count.
+    localised_pos_std, localised_heading_std_rad : float
+        The "localised" test's bounds (cells, rad).
+    """
 
     alpha: tuple = param((0.2, 0.008, 0.2, 0.02), "ours: 4 × the Markov grid's, in cells (the ablation); PR Tables "
                                                   "5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
@@ -154,7 +190,19 @@ class MCLParams(ModelParams):
         return self.alpha_slow > 0
 
     def model(self, grid, z_max: float) -> LikelihoodFieldModel:
-        """The likelihood-field model of these settings on ``grid``."""
+        """The likelihood-field model of these settings on ``grid``.
+
+        Parameters
+        ----------
+        grid : array_like of int, shape (H, W)
+            The map.
+        z_max : float
+            The rangefinder's maximum range (cells).
+
+        Returns
+        -------
+        LikelihoodFieldModel
+        """
         return LikelihoodFieldModel(grid, z_hit=self.z_hit, z_rand=self.z_rand, sigma_hit=self.sigma_hit,
                                     z_max=z_max, max_dist=self.max_dist)
 
@@ -162,7 +210,21 @@ class MCLParams(ModelParams):
 @dataclass(frozen=True)
 class MCLState:
     """The filter's state: particles, their normalised weights, the logs of the two running averages
-    (``-inf`` = 0, 003's start) and whether the last resampled set passed amcl's convergence test."""
+    (``-inf`` = 0, 003's start) and whether the last resampled set passed amcl's convergence test.
+
+    Parameters
+    ----------
+    particles : ndarray, shape (M, 3)
+        The particle set.
+    weights : ndarray, shape (M,)
+        Normalised weights.
+    log_w_slow, log_w_fast : float
+        Logs of the running averages (eqs 2.9, 2.10); ``-inf`` = 0.
+    converged : bool
+        Whether the last resampled set passed amcl's convergence test.
+    n_updates : int
+        Updates of the averages since they last started at 0.
+    """
 
     particles: np.ndarray = field(repr=False)  # (M, 3)
     weights: np.ndarray = field(repr=False)  # (M,) summing to 1
@@ -184,7 +246,39 @@ class MCLState:
 
 @dataclass(frozen=True)
 class StepRecord:
-    """What one MCL iteration did (for the tables and the time plots)."""
+    """What one MCL iteration did (for the tables and the time plots).
+
+    Parameters
+    ----------
+    mean : ndarray, shape (3,)
+        Weighted mean pose of the set before resampling.
+    cov : ndarray, shape (3, 3)
+        Its covariance.
+    n_particles : int
+        Particles after the step.
+    n_eff : float
+        Effective sample size before resampling.
+    w_avg, w_slow, w_fast : float
+        Eq 2.8's average score and the two running averages (debiased when ``averages = "debiased"``).
+    p_inject : float
+        The injection probability ``max(0, 1 − w_fast/w_slow)``.
+    n_injected : int
+        Particles replaced at random.
+    resampled : bool
+        Whether the set was resampled.
+    localised : bool
+        The "localised" test on ``cov``.
+    weights_vanished : bool
+        Whether every weight was 0.
+    note : str
+        What happened when something unusual did.
+    converged : bool
+        amcl's convergence test on the set after the step.
+    n_beams : int
+        Beams that weighed the particles.
+    log_w_avg, log_w_slow, log_w_fast : float
+        Logs of ``w_avg``, ``w_slow``, ``w_fast``.
+    """
 
     mean: np.ndarray
     cov: np.ndarray
@@ -409,6 +503,17 @@ class MCL:
         With ``update_min_d`` / ``update_min_a`` (ROS amcl's thresholds) the filter is updated only once the
         odometry has moved that far since the last update (the motion of all the skipped steps is applied
         then); a skipped step repeats the last record (``note = "no update: moved too little"``).
+
+        Parameters
+        ----------
+        odom_prev, odom_now : array_like, shape (3,), or None
+            The odometry reading since the last step (None: no motion).
+        scan : Scan or Beams
+            The scan in cell units (or its beams).
+
+        Returns
+        -------
+        StepRecord
         """
         p = self.params
         if odom_prev is not None and odom_now is not None and (p.update_min_d > 0 or p.update_min_a > 0):

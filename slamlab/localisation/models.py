@@ -50,7 +50,20 @@ SCORES = ("likelihood", "geometric_mean", "amcl_cubes")
 
 
 def check_particles(poses, name: str = "particles") -> np.ndarray:
-    """Particles as a finite ``(N, 3)`` float array with ``N >= 1`` (a NaN pose is a ValueError)."""
+    """Particles as a finite ``(N, 3)`` float array with ``N >= 1`` (a NaN pose is a ValueError).
+
+    Parameters
+    ----------
+    poses : array_like, shape (N, 3) or (3,)
+        Poses ``(x, y, θ)``; one pose becomes ``(1, 3)``.
+    name : str
+        The argument's name in the error message.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        The poses as floats.
+    """
     P = np.asarray(poses, dtype=float)
     if P.ndim == 1 and P.shape == (3,):
         P = P[None, :]
@@ -67,7 +80,23 @@ def check_particles(poses, name: str = "particles") -> np.ndarray:
 @dataclass(frozen=True)
 class ModelParams(Params):
     """The odometry motion model and likelihood-field sensor model settings shared by :class:`MCLParams`
-    and :class:`MarkovParams` (PR Tables 5.5-5.6, 6.3); lengths in cells (the map's unit)."""
+    and :class:`MarkovParams` (PR Tables 5.5-5.6, 6.3); lengths in cells (the map's unit).
+
+    Parameters
+    ----------
+    alpha : tuple of 4 float
+        Odometry motion noise α1…α4 (PR Tables 5.5-5.6), lengths in cells.
+    z_hit, z_rand : float
+        Weights of the hit and random components of the likelihood field (PR Table 6.3).
+    sigma_hit : float
+        σ of the hit component (cells).
+    max_dist : float
+        Cap of the distance table (cells).
+    max_beams : int
+        Beams per scan that weigh a pose (evenly spaced).
+    gamma : float
+        Exponent of the likelihood (1 = PR's product over the beams).
+    """
 
     alpha: tuple = param((0.05, 0.002, 0.05, 0.005), "ours; PR Tables 5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
     z_hit: float = param(0.9, "ours; PR Table 6.3 (ROS 1: 0.95, Nav2: 0.5)")
@@ -109,6 +138,20 @@ def odometry_deltas(odom_prev, odom_now, *, min_trans: float = 1e-6):
     translation is noise; ROS AMCL does the same with 0.01 m). Works on arrays of
     poses too (``(..., 3)``).
 
+    Parameters
+    ----------
+    odom_prev, odom_now : array_like, shape (..., 3)
+        Odometry poses before and after the motion.
+    min_trans : float
+        Below this translation the first rotation is 0.
+
+    Returns
+    -------
+    tuple of (float or ndarray)
+        ``(δrot1, δtrans, δrot2)``.
+
+    Examples
+    --------
     >>> [round(float(d), 6) for d in odometry_deltas([0, 0, 0], [1, 1, np.pi / 2])]
     [0.785398, 1.414214, 0.785398]
     """
@@ -156,7 +199,24 @@ def sample_motion_odometry(poses, odom_prev, odom_now, alpha, rng=None) -> np.nd
 
 
 def motion_from_noise(P, deltas, a, e) -> np.ndarray:
-    """PR Table 5.6 lines 5-10 with given standard-normal draws ``e`` (3, N): the deterministic core."""
+    """PR Table 5.6 lines 5-10 with given standard-normal draws ``e`` (3, N): the deterministic core.
+
+    Parameters
+    ----------
+    P : ndarray, shape (N, 3)
+        Poses before the motion.
+    deltas : tuple
+        ``(δrot1, δtrans, δrot2)`` of the odometry reading (:func:`odometry_deltas`).
+    a : sequence of 4 float
+        α1…α4.
+    e : ndarray, shape (3, N)
+        Standard-normal draws for the three perturbed quantities.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+        The moved poses.
+    """
     rot1, trans, rot2 = deltas
     # PR Table 5.6 lines 5-7 (variances; errata form)
     r1 = rot1 - np.sqrt(a[0] * rot1**2 + a[1] * trans**2) * e[0]
@@ -176,6 +236,20 @@ def _normal_pdf(x, var):
 
 def motion_density_odometry(poses_now, poses_prev, odom_prev, odom_now, alpha) -> np.ndarray:
     """``p(x_t | u_t, x_{t-1})`` of the odometry model (PR Table 5.5), for arrays of pose pairs.
+
+    Parameters
+    ----------
+    poses_now, poses_prev : array_like, shape (N, 3)
+        Pose pairs ``x_t`` and ``x_{t-1}``.
+    odom_prev, odom_now : array_like, shape (3,)
+        The odometry reading.
+    alpha : sequence of 4 float
+        α1…α4.
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        The density of each pair.
 
     Examples
     --------
@@ -201,7 +275,19 @@ def motion_density_odometry(poses_now, poses_prev, odom_prev, odom_now, alpha) -
 
 @dataclass(frozen=True)
 class Beams:
-    """The beams of one scan a filter weighs with: bearings, ranges, and the body-frame end points."""
+    """The beams of one scan a filter weighs with: bearings, ranges, and the body-frame end points.
+
+    Parameters
+    ----------
+    bearings_rad : ndarray, shape (B,)
+        Beam bearings in the body frame (rad).
+    ranges : ndarray, shape (B,)
+        Ranges (cells).
+    max_range : float
+        The rangefinder's maximum range (cells).
+    end_xy : ndarray, shape (B, 2)
+        Body-frame end points (x ahead, y left).
+    """
 
     bearings_rad: np.ndarray  # (B,)
     ranges: np.ndarray  # (B,) in cells
@@ -220,6 +306,21 @@ def scan_beams(scan: Scan, max_beams: int | None = None, *, keep_max: bool = Fal
 
     Raises ``ValueError`` when the scan holds no valid beam (nothing to weigh a particle with).
 
+    Parameters
+    ----------
+    scan : Scan
+        A scan in cell units.
+    max_beams : int, optional
+        At most this many beams, evenly spaced (None: all).
+    keep_max : bool
+        Keep the beams at maximum range too.
+
+    Returns
+    -------
+    Beams
+
+    Examples
+    --------
     >>> s = Scan(np.radians([0, 90, 180, 270]), [1, 2, 3, 5], np.array([True, True, True, False]), max_range=5)
     >>> scan_beams(s, 2).ranges.tolist()
     [1.0, 2.0]
@@ -300,14 +401,38 @@ class LikelihoodFieldModel:
         self._padded_dist = D.ravel()
 
     def log_q(self, d) -> np.ndarray:
-        """``log(z_hit·N(d; 0, σ_hit²) + z_rand/z_max)`` for distances ``d`` [cells]."""
+        """``log(z_hit·N(d; 0, σ_hit²) + z_rand/z_max)`` for distances ``d`` [cells].
+
+        Parameters
+        ----------
+        d : array_like
+            Distances to the nearest obstacle (cells).
+
+        Returns
+        -------
+        ndarray
+            ``log q`` for every distance, shaped like ``d``.
+        """
         d = np.asarray(d, dtype=float)
         g = np.exp(-0.5 * (d / self.sigma_hit) ** 2) / (np.sqrt(2 * np.pi) * self.sigma_hit)
         with np.errstate(divide="ignore"):  # z_rand = 0 and a far end point: log 0 = -inf, handled by the filter
             return np.log(self.z_hit * g + self.z_rand / self.z_max)
 
     def end_points(self, poses, beams: Beams) -> tuple[np.ndarray, np.ndarray]:
-        """World end points ``(N, B)`` x and y of every beam seen from every pose."""
+        """World end points ``(N, B)`` x and y of every beam seen from every pose.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        x, y : ndarray, shape (N, B)
+            World end points (cells).
+        """
         P = np.asarray(poses, dtype=float)
         c, s = np.cos(P[:, 2])[:, None], np.sin(P[:, 2])[:, None]
         bx, by = beams.end_xy[:, 0][None, :], beams.end_xy[:, 1][None, :]
@@ -341,11 +466,33 @@ class LikelihoodFieldModel:
         return table[idx], keep
 
     def used(self, beams: Beams) -> np.ndarray:
-        """Mask of the beams that enter the likelihood: ranges below ``z_max`` (PR Table 6.3 line 3)."""
+        """Mask of the beams that enter the likelihood: ranges below ``z_max`` (PR Table 6.3 line 3).
+
+        Parameters
+        ----------
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        ndarray of bool, shape (B,)
+        """
         return beams.ranges < min(beams.max_range, self.z_max)
 
     def beam_log_q(self, poses, beams: Beams) -> np.ndarray:
-        """``log q_k`` for every pose × beam, shape ``(N, B)``, float32 (beams at ``z_max`` give 0)."""
+        """``log q_k`` for every pose × beam, shape ``(N, B)``, float32 (beams at ``z_max`` give 0).
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        ndarray of float32, shape (N, B)
+        """
         vals, keep = self._gather(self._padded, poses, beams)
         if keep.all():
             return vals
@@ -355,20 +502,70 @@ class LikelihoodFieldModel:
 
     def beam_distances(self, poses, beams: Beams) -> tuple[np.ndarray, np.ndarray]:
         """Distance ``d`` [cells] from every end point to the nearest obstacle (capped at ``max_dist``; off
-        the map ``max_dist``), shape ``(N, B_used)``, and the mask ``(B,)`` of the beams below ``z_max``."""
+        the map ``max_dist``), shape ``(N, B_used)``, and the mask ``(B,)`` of the beams below ``z_max``.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        d : ndarray, shape (N, B_used)
+            Distances to the nearest obstacle (cells).
+        keep : ndarray of bool, shape (B,)
+            The beams that enter the likelihood.
+        """
         return self._gather(self._padded_dist, poses, beams)
 
     def log_likelihood(self, poses, beams: Beams) -> np.ndarray:
-        """``log p(z | x) = Σ_k log q_k`` for every pose, shape ``(N,)``."""
+        """``log p(z | x) = Σ_k log q_k`` for every pose, shape ``(N,)``.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        ndarray, shape (N,)
+        """
         return self.beam_log_q(poses, beams).sum(axis=1, dtype=np.float64)
 
     def n_used(self, beams: Beams) -> int:
-        """Number of beams that enter the product (ranges below ``z_max``)."""
+        """Number of beams that enter the product (ranges below ``z_max``).
+
+        Parameters
+        ----------
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        int
+        """
         return int(np.count_nonzero(self.used(beams)))
 
     def score(self, log_lik, beams: Beams) -> np.ndarray:
         """The per-beam geometric mean of ``q_k / q_max``, ``exp(log p / B − log q_max)`` in [0, 1] (ours):
-        one reading of 003 §2.2's "probability between 0 and 1" per particle."""
+        one reading of 003 §2.2's "probability between 0 and 1" per particle.
+
+        Parameters
+        ----------
+        log_lik : array_like, shape (N,)
+            ``log p(z | x)`` per pose (:meth:`log_likelihood`).
+        beams : Beams
+            The scan's beams (for the number used).
+
+        Returns
+        -------
+        ndarray, shape (N,)
+            Scores in [0, 1].
+        """
         n = max(1, self.n_used(beams))
         return np.exp(np.asarray(log_lik, dtype=float) / n - self.log_q_max)
 
@@ -383,6 +580,21 @@ class LikelihoodFieldModel:
           ``LikelihoodFieldModel`` (both say it "works well" without a derivation).
 
         ``beam_mask`` (B,) keeps only some beams (beam skipping); beams at ``z_max`` never count.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+        score : str
+            One of :data:`SCORES`.
+        beam_mask : ndarray of bool, shape (B,), optional
+            Beams to use (beam skipping); None: every beam below ``z_max``.
+
+        Returns
+        -------
+        ndarray, shape (N,)
         """
         v.check_choice(score, "score", SCORES)
         if score == "amcl_cubes":
@@ -415,6 +627,28 @@ def beam_model_prob(z, z_star, *, z_max: float, z_hit: float = 0.8, z_short: flo
     ``p_short = η·λ·exp(−λz)`` on ``[0, z*]`` with ``η = 1/(1 − exp(−λz*))``,
     ``p_max = 1`` at ``z = z_max`` (a point mass) and ``p_rand = 1/z_max`` on ``[0, z_max)``.
 
+    Parameters
+    ----------
+    z : array_like
+        Measured ranges.
+    z_star : array_like
+        Expected ranges (ray cast), broadcast with ``z``.
+    z_max : float
+        Maximum range.
+    z_hit, z_short, z_max_w, z_rand : float
+        Mixture weights of the hit, short, max-range and random components.
+    sigma_hit : float
+        σ of the hit component.
+    lambda_short : float
+        Rate λ of the short component.
+
+    Returns
+    -------
+    ndarray
+        ``p(z_k | x, m)`` element-wise.
+
+    Examples
+    --------
     >>> round(float(beam_model_prob(5.0, 5.0, z_max=10.0, z_hit=1, z_short=0, z_max_w=0, z_rand=0)), 6)
     0.398942
     """

@@ -139,7 +139,17 @@ def _params_line(overrides: dict | None = None) -> str:
 @dataclass(frozen=True)
 class GlobalResult:
     """Global localisation from no prior: per particle count and step, the share of runs within the bounds,
-    and AMCL's convergence test at the last step."""
+    and AMCL's convergence test at the last step.
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (particle count, run).
+    n_runs, n_steps : int
+        Runs per count, steps per run.
+    overrides : dict
+        MCLParams fields given to every run.
+    """
 
     table_df: object = field(repr=False)
     n_runs: int = 0
@@ -148,7 +158,19 @@ class GlobalResult:
 
     def success(self, n_particles: int | None = None, step: int | None = None) -> float:
         """Share of runs within 3 cells and 5° at ``step`` (default: the last) for one count (default: the
-        largest)."""
+        largest).
+
+        Parameters
+        ----------
+        n_particles : int, optional
+            The particle count (default: the largest).
+        step : int, optional
+            The step, from 1 (default: the last).
+
+        Returns
+        -------
+        float
+        """
         df = self.table_df
         n = int(df["n_particles"].max()) if n_particles is None else int(n_particles)
         ok = _per_step(df[df["n_particles"] == n], "ok")
@@ -180,7 +202,17 @@ class GlobalResult:
                                   f"settings: {_params_line(self.overrides)}")
 
     def step_table(self, every: int = 5) -> str:
-        """Success against the step, one column per particle count."""
+        """Success against the step, one column per particle count.
+
+        Parameters
+        ----------
+        every : int
+            Show every ``every``-th step.
+
+        Returns
+        -------
+        str
+        """
         df = self.table_df
         counts = sorted(int(n) for n in df["n_particles"].unique())
         oks = {n: _per_step(df[df["n_particles"] == n], "ok").mean(axis=0) for n in counts}
@@ -259,7 +291,21 @@ def run_global_localisation(particle_counts=(500, 1000, 2500), *, n_runs: int = 
 
 @dataclass(frozen=True)
 class AblationResult:
-    """Global localisation with one factor changed at a time (the same runs for every variant)."""
+    """Global localisation with one factor changed at a time (the same runs for every variant).
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (variant, run).
+    labels : tuple of str
+        The variants, in table order.
+    n_runs, n_steps, n_particles : int
+        Runs per variant, steps per run, particles.
+    world : str
+        What the scans see ("map" or "cluttered").
+    base : dict
+        MCLParams fields under every variant's.
+    """
 
     table_df: object = field(repr=False)
     labels: tuple = ()
@@ -388,7 +434,21 @@ def _kidnap_task(rng, overrides: dict, n_particles: int, n_steps: int, kidnap_st
 
 @dataclass(frozen=True)
 class KidnapResult:
-    """Kidnapped robot: tracking from the known start, carried elsewhere at ``kidnap_step``; per variant."""
+    """Kidnapped robot: tracking from the known start, carried elsewhere at ``kidnap_step``; per variant.
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (variant, run).
+    labels : tuple of str
+        The variants, in table order.
+    n_runs, kidnap_step, n_steps, n_particles : int
+        Runs per variant, the kidnap's step, steps per run, particles.
+    world : str
+        What the scans see ("map" or "cluttered").
+    base : dict
+        MCLParams fields under every variant's.
+    """
 
     table_df: object = field(repr=False)
     labels: tuple = ()
@@ -400,7 +460,17 @@ class KidnapResult:
     base: dict = field(default_factory=dict)  # MCLParams overrides under every variant's (params=, **overrides)
 
     def recovered(self, label: str | None = None) -> float:
-        """Share of runs that recover (within the bounds from some step after the kidnap to the end)."""
+        """Share of runs that recover (within the bounds from some step after the kidnap to the end).
+
+        Parameters
+        ----------
+        label : str, optional
+            A variant (default: the first).
+
+        Returns
+        -------
+        float
+        """
         df = self.table_df
         return float(df[df["variant"] == (self.labels[-1] if label is None else label)]["recovered"].mean())
 
@@ -491,7 +561,15 @@ def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: in
 
 @dataclass(frozen=True)
 class ScoreComparison:
-    """Each observation score: global success (the ablation's runs) and kidnap recovery."""
+    """Each observation score: global success (the ablation's runs) and kidnap recovery.
+
+    Parameters
+    ----------
+    global_ : AblationResult
+        Global success per score.
+    kidnap : KidnapResult
+        Kidnap recovery per score.
+    """
 
     global_: AblationResult
     kidnap: KidnapResult
