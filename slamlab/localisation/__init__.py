@@ -5,12 +5,10 @@ from .experiments import (
     AMCL_DEFAULTS,
     FilterRun,
     MarkovVsMclResult,
-    SideBySideResult,
     SimRun,
     amcl_defaults_table,
     demo_run,
     ours_vs_source,
-    run_correlation_side_by_side,
     run_filter,
     run_markov_vs_mcl,
     simulate_run,
@@ -53,6 +51,7 @@ from .particles import (
     pose_estimate,
     uniform_free_particles,
 )
+from .side_by_side import SideBySideResult, run_correlation_side_by_side
 from .studies import (
     ABLATION,
     ABLATION_MORE,

@@ -24,6 +24,7 @@ from ..scans import Scan, cast_rays
 from ..sim.grid import measurement_room_200, test_room_200
 from ..sim.paths import path_004
 from ..sim.rangefinder import Rangefinder, simulate_odometry
+from .amcl_tables import AMCL_DEFAULTS, amcl_defaults_table, ours_vs_source
 from .markov import MarkovGrid
 from .mcl import MCL, MCLParams
 from .particles import uniform_free_particles
@@ -52,7 +53,23 @@ MAX_RANGE = 100.0
 
 @dataclass(frozen=True)
 class SimRun:
-    """One simulated run in the test room: true poses, odometry poses, scans, the kidnap step (or None)."""
+    """One simulated run in the test room: true poses, odometry poses, scans, the kidnap step (or None).
+
+    Parameters
+    ----------
+    grid : ndarray, shape (H, W)
+        The map the filters use.
+    true_poses, odom_poses : ndarray, shape (n, 3)
+        True poses and the noisy odometry (cells, rad).
+    scans : list of Scan
+        One scan per step, in cells.
+    kidnap_step : int or None
+        The step the robot is carried away before (None: no kidnap).
+    max_range : float
+        The rangefinder's maximum range (cells).
+    start : int
+        Index of the first pose on 004's path.
+    """
 
     grid: np.ndarray = field(repr=False)
     true_poses: np.ndarray = field(repr=False)  # (n, 3)
@@ -79,6 +96,31 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
     reports an ordinary step there. Noise: Gaussian range noise, odometry noise per step. ``world``:
     "map" (the scans see the map itself) or "cluttered" (they see 004's room with its unmapped clutter,
     :func:`slamlab.sim.measurement_room_200`, while the filter keeps the map).
+
+    Parameters
+    ----------
+    n_steps : int
+        Poses of the run.
+    start : int, optional
+        Index of the first pose on 004's path (random when None).
+    kidnap_step : int, optional
+        The step the robot is carried away before (None: no kidnap).
+    kidnap_to : int, optional
+        The path pose it is carried to (random, at least 40 poses away, when None).
+    n_beams : int
+        Beams per scan.
+    range_std_cells : float
+        σ of the range noise (cells).
+    odo_trans_frac, odo_rot_std_rad : float
+        Odometry noise: share of each step's length, radians per step.
+    world : {"map", "cluttered"}
+        What the scans see.
+    rng : Generator, int or None
+        Random source.
+
+    Returns
+    -------
+    SimRun
     """
     v.check_choice(world, "world", ("map", "cluttered"))
     rng = v.as_rng(rng)
@@ -121,7 +163,23 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
 
 @dataclass(frozen=True)
 class FilterRun:
-    """A filter run along a :class:`SimRun`: estimates, errors, the step records (MCL) and the time."""
+    """A filter run along a :class:`SimRun`: estimates, errors, the step records (MCL) and the time.
+
+    Parameters
+    ----------
+    est : ndarray, shape (n, 3)
+        Estimates (cells, rad).
+    err_pos : ndarray, shape (n,)
+        Position errors (cells).
+    err_heading_rad : ndarray, shape (n,)
+        Heading errors (rad).
+    records : list of StepRecord
+        MCL's step records (empty for the Markov grid).
+    snapshots : list
+        Weighted particle sets per step (when kept).
+    time_s : float
+        Wall time of the run.
+    """
 
     est: np.ndarray = field(repr=False)  # (n, 3)
     err_pos: np.ndarray = field(repr=False)  # (n,) cells
@@ -136,7 +194,17 @@ class FilterRun:
         return (self.err_pos < FAIL_POS_CELLS) & (np.degrees(self.err_heading_rad) < FAIL_DEG)
 
     def converged_at(self, after: int = 0) -> int | None:
-        """First step (≥ ``after``) from which the estimate stays within the bounds to the end; None if never."""
+        """First step (≥ ``after``) from which the estimate stays within the bounds to the end; None if never.
+
+        Parameters
+        ----------
+        after : int
+            First step to consider.
+
+        Returns
+        -------
+        int or None
+        """
         ok = self.ok
         bad = np.flatnonzero(~ok[after:])
         if bad.size == 0:
@@ -148,7 +216,29 @@ class FilterRun:
 def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params=None, rng=None,
                keep_particles: bool = False, **overrides) -> FilterRun:
     """Run MCL (``method="mcl"``) or the Markov grid (``"markov"``) along ``run`` from no prior
-    (``init="global"``) or from the true start (``"tracking"``, MCL only)."""
+    (``init="global"``) or from the true start (``"tracking"``, MCL only).
+
+    Parameters
+    ----------
+    run : SimRun
+        The simulated run.
+    method : {"mcl", "markov"}
+        The filter.
+    init : {"global", "tracking"}
+        No prior, or the true start (MCL only).
+    params : MCLParams or MarkovParams, optional
+        The filter's settings.
+    rng : Generator, int or None
+        Random source (MCL).
+    keep_particles : bool
+        Keep MCL's weighted set of every step.
+    **overrides
+        Fields of the filter's params.
+
+    Returns
+    -------
+    FilterRun
+    """
     v.check_choice(method, "method", ("mcl", "markov"))
     v.check_choice(init, "init", ("global", "tracking"))
     rng = v.as_rng(rng)
@@ -194,7 +284,15 @@ def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int, ov
 
 @dataclass(frozen=True)
 class MarkovVsMclResult:
-    """Markov grid vs MCL on the same runs: accuracy, memory and time."""
+    """Markov grid vs MCL on the same runs: accuracy, memory and time.
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (method, size, run).
+    n_runs, n_steps : int
+        Runs per method, steps per run.
+    """
 
     table_df: object = field(repr=False)
     n_runs: int = 0
@@ -272,98 +370,6 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
     return MarkovVsMclResult(df, n_runs, n_steps)
 
 
-# --- AMCL defaults and "Ours vs the source" ------------------------------------------------------------
-
-#: AMCL's defaults as declared in the node sources (read 2026-11-26 from the snapshots): ROS 1
-#: ``ros-planning/navigation`` ``amcl/src/amcl_node.cpp`` (``private_nh_.param(...)``), ``amcl/cfg/AMCL.cfg`` and
-#: ``amcl/src/amcl/pf/pf.c``, ``amcl/src/amcl/sensors/amcl_laser.cpp``; ROS 2 ``ros-navigation/navigation2``
-#: ``nav2_amcl/src/amcl_node.cpp`` (``declare_or_get_parameter``) and its ``pf/pf.c``. Lengths in metres.
-AMCL_DEFAULTS = {
-    "particles (min … max)": ("100 … 5000", "500 … 2000"),
-    "KLD ε (kld_err / pf_err)": ("0.01", "0.05"),
-    "KLD 1 − δ (kld_z / pf_z)": ("0.99", "0.99"),
-    "sensor model": ("likelihood_field", "likelihood_field"),
-    "observation weight": ("1 + Σ p³ (likelihood_field)", "1 + Σ p³ (likelihood_field)"),
-    "z_hit": ("0.95", "0.5"),
-    "z_rand": ("0.05", "0.5"),
-    "σ_hit [m]": ("0.2", "0.2"),
-    "likelihood max dist [m]": ("2.0", "2.0"),
-    "beams used": ("30", "60"),
-    "α1 … α4": ("0.2 each", "0.2 each"),
-    "α_slow / α_fast": ("0.001 / 0.1 (node; AMCL.cfg: 0 / 0)", "0.0 / 0.0 (off)"),
-    "w_slow, w_fast start": ("first w_avg; 0 again after injecting", "first w_avg; 0 again after injecting"),
-    "resampling": ("every 2nd update; selective_resampling off", "every update"),
-    "beam skipping": ("off (do_beamskip; _prob model only)", "off (do_beamskip; _prob model only)"),
-    "convergence test": ("all particles within 0.5 m of the mean", "all particles within 0.5 m of the mean"),
-}
-
-
-def amcl_defaults_table(params: MCLParams | None = None, cell_m: float = 0.1) -> str:
-    """ROS 1 AMCL, ROS 2 Nav2 AMCL and ours side by side (ours in cells, and in metres at ``cell_m``)."""
-    p = MCLParams() if params is None else params
-    score = {"likelihood": "p(z | x)", "geometric_mean": "geometric mean (ours)", "amcl_cubes": "1 + Σ p³"}[p.score]
-    ours = {
-        "particles (min … max)": f"{p.n_particles} fixed" + (f" (KLD: {p.n_min} … {p.n_particles})"
-                                                             if p.use_kld else ""),
-        "KLD ε (kld_err / pf_err)": f"{p.kld_epsilon:g} (when use_kld)",
-        "KLD 1 − δ (kld_z / pf_z)": f"{p.kld_z:g} (when use_kld)",
-        "sensor model": "likelihood_field",
-        "observation weight": f"p(z | x)^{p.gamma:g} = (Π q_k)^{p.gamma:g}; eq 2.8: {score}",
-        "z_hit": f"{p.z_hit:g}",
-        "z_rand": f"{p.z_rand:g}",
-        "σ_hit [m]": f"{p.sigma_hit:g} cells = {p.sigma_hit * cell_m:g} m at {cell_m:g} m cells",
-        "likelihood max dist [m]": f"{p.max_dist:g} cells = {p.max_dist * cell_m:g} m",
-        "beams used": f"{p.max_beams}",
-        "α1 … α4": ", ".join(f"{a:g}" for a in p.alpha),
-        "α_slow / α_fast": f"{p.alpha_slow:g} / {p.alpha_fast:g} (on)" if p.injection else "0 / 0 (off)",
-        "w_slow, w_fast start": {"003": "0 (003), never restarted", "amcl": "first w_avg; 0 after injecting",
-                                 "first": "first w_avg, never restarted",
-                                 "debiased": "0 (003), divided by 1 − (1 − α)^t"}[p.averages],
-        "resampling": "every step" if p.resample_threshold >= 1 else
-                      f"when N_eff < {p.resample_threshold:g}·M or injecting",
-        "beam skipping": "on, once converged" if p.beam_skip else "off",
-        "convergence test": f"all particles within {p.converged_dist:g} cells = {p.converged_dist * cell_m:g} m",
-    }
-    rows = [[k, a, b, ours[k]] for k, (a, b) in AMCL_DEFAULTS.items()]
-    return format_table(["setting", "ROS 1 amcl", "ROS 2 Nav2 amcl", "ours"], rows,
-                        title="AMCL defaults (node sources) beside ours")
-
-
-def ours_vs_source(global_result=None, kidnap=None, ablation=None) -> str:
-    """003 §2.2 / §1.2.4 beside what this chapter does, with our figures where a run is given
-    (a :class:`~slamlab.localisation.studies.GlobalResult`, ``KidnapResult``, ``AblationResult``)."""
-    p = MCLParams()
-    rows = [
-        ["three cases", "tracking, global localisation, SLAM (§1.2.4)", "tracking and global here; SLAM: Ch. 6"],
-        ["Markov grid", "cells summing to 1, uniform without prior", "(x, y, θ) grid, uniform on free cells"],
-        ["Markov motion", "odometry (no formula)", "shift + Gaussian blur from α1…α4 (ours)"],
-        ["Markov cost", "grows with the number of cells", "see the Markov tables"],
-        ["MCL motion", "odometry (no formula)", f"PR Table 5.6 + jitter ({p.jitter[0]:g} cell, {p.jitter[1]:g} rad; ours)"],
-        ["MCL weight", "observation model in [0, 1]", f"likelihood field p(z | x)^{p.gamma:g}; 2.8 score '{p.score}'"],
-        ["eq 2.7", "Markov property (lost image)", "p(x_t+1 | x_0..t) = p(x_t+1 | x_t) (PR)"],
-        ["eq 2.8", "mean weight (lost image)", "w_avg = Σ w_prev·ω, ω the score (PR Table 8.3)"],
-        ["eqs 2.9-2.10", "w_slow, w_fast, 'initially 0' (lost)", f"PR Table 8.3, averages '{p.averages}'"],
-        ["eq 2.11", "particles scattered at random (lost)", "M·max(0, 1 − w_fast/w_slow) expected"],
-        ["resampling", "by probability", "low-variance (PR Table 4.4), selective: N_eff < M/2 (ours)"],
-        ["particle count", "not given", "fixed, or KLD sampling (our addition)"],
-        ["results", "none survive (003's tables are lost)", "tables of this notebook"],
-    ]
-    if global_result is not None:
-        s = global_result.summary()
-        best = s["success"].idxmax()
-        rows.append(["global success", "—", (f"{s.loc[best, 'success']:.2f} with {int(best)} particles at step "
-                                            f"{global_result.n_steps} ({global_result.n_runs} runs)")])
-    if kidnap is not None:
-        rows.append(["kidnap recovery", "—", (f"{kidnap.recovered():.2f} with the defaults ({kidnap.n_runs} runs), "
-                                             f"{kidnap.recovered(kidnap.labels[0]):.2f} with 003's averages from 0")])
-    if ablation is not None and "defaults" in ablation.labels:
-        s = ablation.summary()
-        k = f"success@{ablation.n_steps}"
-        rows.append(["cause of issue 12's figures", "—", (f"{s[k].iloc[0]:.2f} before → {s.loc['defaults', k]:.2f} "
-                                                         f"with the defaults ({ablation.n_particles} particles)")])
-    return format_table(["item", "003", "ours"], rows, title="Ours vs the source (003 §1.2.4, §2.2)")
-
-
 def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: int = 60,
              params: MCLParams | None = None, rng=7, seed=None, **overrides):
     """One recorded global run (with an optional kidnap) for the plots and the time slider.
@@ -399,95 +405,3 @@ def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: 
 
 
 __all__ += ["demo_run", "uniform_free_particles"]
-
-
-# --- Ch. 5's correlation method on the same scans -----------------------------------------------------
-
-
-def _side_task(rng, n_steps: int, n_particles: int, delta_alpha_deg: float, overrides: dict):
-    from ..correlation import localise
-
-    run = simulate_run(n_steps, rng=rng)
-    r = run_filter(run, rng=rng, **{**overrides, "n_particles": n_particles})
-    t0 = time.perf_counter()
-    loc = localise(run.grid, run.scans[-1], delta_alpha_rad=float(np.radians(delta_alpha_deg)))
-    t_corr = time.perf_counter() - t0
-    true = run.true_poses[-1]
-    e = float(np.hypot(*(loc.pose[:2] - true[:2])))
-    h = float(np.degrees(abs(wrap_angle(loc.pose[2] - true[2]))))
-    return {"mcl_success": bool(r.ok[-1]), "mcl_err": float(r.err_pos[-1]),
-            "corr_success": bool(e < FAIL_POS_CELLS and h < FAIL_DEG), "corr_err": e,
-            "mcl_time_s": r.time_s, "corr_time_s": t_corr}
-
-
-@dataclass(frozen=True)
-class SideBySideResult:
-    """MCL (global, over a run) and Ch. 5's correlation search (one scan, no prior) on the same final scans."""
-
-    table_df: object = field(repr=False)
-    n_runs: int = 0
-    n_steps: int = 0
-    n_particles: int = 0
-    delta_alpha_deg: float = 5.0
-
-    def table(self) -> str:
-        df = self.table_df
-        rows = [[f"MCL, {self.n_particles} particles, {self.n_steps} steps from no prior",
-                 f"{df['mcl_success'].mean():.2f}", f"{df['mcl_err'].median():.2f}"],
-                [f"correlation (Ch. 5), last scan only, Δα = {self.delta_alpha_deg:g}°",
-                 f"{df['corr_success'].mean():.2f}", f"{df['corr_err'].median():.2f}"]]
-        return format_table(["method", "success", "median err [cells]"], rows,
-                            title=f"The same {self.n_runs} runs: pose at the last scan")
-
-    def timing_table(self) -> str:
-        df = self.table_df
-        rows = [["MCL, whole run", f"{df['mcl_time_s'].median():.3f}"],
-                ["correlation, one scan", f"{df['corr_time_s'].median():.3f}"]]
-        return format_table(["method", "median s"], rows, title="Time (wall clock)")
-
-    def __str__(self) -> str:
-        return f"MCL vs correlation on {self.n_runs} runs"
-
-
-def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_particles: int = 2000,
-                                 delta_alpha_deg: float = 5.0, params: MCLParams | None = None, rng=3,
-                                 n_jobs: int = 1, progress=None, seed=None, **overrides) -> SideBySideResult:
-    """Global MCL over each run and Ch. 5's correlation localisation of the run's last scan (on sweep).
-
-    Parameters
-    ----------
-    n_runs, n_steps : int
-        Runs, and steps per run.
-    n_particles : int
-        MCL particles (replaces ``params.n_particles``).
-    delta_alpha_deg : float
-        The correlation search's heading step.
-    params : MCLParams, optional
-        Settings of MCL (default: the defaults).
-    rng : int, SeedSequence or Generator
-        Where every run's stream is spawned from.
-    n_jobs : int
-        Parallel workers of :func:`slamlab.sweep.sweep`.
-    progress : bool, callable or None
-        See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
-    **overrides
-        :class:`MCLParams` fields.
-
-    Returns
-    -------
-    SideBySideResult
-    """
-    from ..sweep import renamed_seed, root_seed_sequence, sweep
-
-    rng = renamed_seed(rng, seed, "run_correlation_side_by_side")
-    ov = MCLParams.as_overrides(params, **overrides)
-    df = sweep(_side_task, None, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=root_seed_sequence(rng, "rng"),
-               n_jobs=n_jobs, progress=progress, on_error="raise", desc="MCL vs correlation",
-               fixed={"n_steps": n_steps, "n_particles": n_particles, "delta_alpha_deg": delta_alpha_deg,
-                      "overrides": ov})
-    return SideBySideResult(df, n_runs, n_steps, n_particles, float(delta_alpha_deg))
-
-
-__all__ += ["SideBySideResult", "run_correlation_side_by_side"]

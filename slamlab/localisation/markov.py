@@ -40,7 +40,21 @@ __all__ = ["MarkovGrid", "MarkovParams", "markov_correct", "markov_predict"]
 @dataclass(frozen=True)
 class MarkovParams(ModelParams):
     """Settings of Markov grid localisation; lengths in map cells. The motion and sensor model's
-    fields (the same as MCL's) come first (:class:`~slamlab.localisation.models.ModelParams`)."""
+    fields (the same as MCL's) come first (:class:`~slamlab.localisation.models.ModelParams`).
+
+    Parameters
+    ----------
+    alpha, z_hit, z_rand, sigma_hit, max_dist, max_beams, gamma : see ModelParams
+        The motion and sensor model (:class:`~slamlab.localisation.models.ModelParams`).
+    resolution : int
+        Map cells per belief cell.
+    n_headings : int
+        Heading bins.
+    min_blur : float
+        Gaussian σ (belief cells and heading bins) added at each motion step.
+    uniform_floor : float
+        Share of a uniform belief mixed in after each motion step.
+    """
 
     resolution: int = param(2, "ours: map cells per belief cell (003: not given)")
     n_headings: int = param(72, "ours: 5° heading bins (003: not given)")
@@ -62,6 +76,28 @@ def markov_predict(bel, odom_prev, odom_now, *, resolution: int, alpha, min_blur
                    free_mask=None) -> np.ndarray:
     """Motion update of a ``(K, h, w)`` belief by one odometry reading (our shift + blur form of PR Table 5.5).
 
+    Parameters
+    ----------
+    bel : array_like, shape (K, h, w)
+        The belief over heading bins and belief cells.
+    odom_prev, odom_now : array_like, shape (3,)
+        The odometry reading (map cells, rad).
+    resolution : int
+        Map cells per belief cell.
+    alpha : sequence of 4 float
+        α1…α4 of the odometry model.
+    min_blur : float
+        Gaussian σ added to the motion blur (belief cells and heading bins).
+    free_mask : ndarray, shape (h, w), optional
+        1 on the belief cells a robot can be in; the belief elsewhere is set to 0.
+
+    Returns
+    -------
+    ndarray, shape (K, h, w)
+        The predicted belief, normalised (all zeros when nothing is left).
+
+    Examples
+    --------
     >>> b = np.zeros((4, 5, 5)); b[0, 2, 1] = 1.0
     >>> out = markov_predict(b, [0, 0, 0], [2, 0, 0], resolution=1, alpha=(0, 0, 0, 0), min_blur=0)
     >>> np.argwhere(out > 0.99).tolist()
@@ -97,7 +133,25 @@ def markov_predict(bel, odom_prev, odom_now, *, resolution: int, alpha, min_blur
 def markov_log_likelihood(model: LikelihoodFieldModel, beams: Beams, n_headings: int, resolution: int,
                           shape: tuple[int, int]) -> np.ndarray:
     """``log p(z | x)`` for every belief cell and heading, shape ``(K, h, w)``: per (heading, beam) one
-    shifted strided slice of the log-q table (all cells at once)."""
+    shifted strided slice of the log-q table (all cells at once).
+
+    Parameters
+    ----------
+    model : LikelihoodFieldModel
+        The sensor model on the map.
+    beams : Beams
+        The scan's beams.
+    n_headings : int
+        Heading bins K.
+    resolution : int
+        Map cells per belief cell.
+    shape : tuple of int
+        ``(h, w)`` of the belief grid.
+
+    Returns
+    -------
+    ndarray, shape (K, h, w)
+    """
     K, (h, w), s = n_headings, shape, resolution
     th = 2 * np.pi * np.arange(K) / K
     c, sn = np.cos(th)[:, None], np.sin(th)[:, None]
@@ -122,6 +176,24 @@ def markov_correct(bel, L, *, gamma: float = 1.0, free_mask=None) -> tuple[np.nd
 
     When every cell with belief has probability 0 under the scan, the belief is left
     unchanged and ``False`` is returned (the caller says so; never NaN).
+
+    Parameters
+    ----------
+    bel : array_like, shape (K, h, w)
+        The predicted belief.
+    L : array_like, shape (K, h, w)
+        ``log p(z | x)`` per cell (:func:`markov_log_likelihood`).
+    gamma : float
+        Exponent of the likelihood.
+    free_mask : ndarray, shape (h, w), optional
+        1 on the cells a robot can be in.
+
+    Returns
+    -------
+    bel : ndarray, shape (K, h, w)
+        The corrected belief (the input when no mass is left).
+    kept : bool
+        Whether the belief kept any mass.
     """
     B = np.asarray(bel, dtype=float)
     Lg = gamma * np.asarray(L, dtype=float)
@@ -186,7 +258,17 @@ class MarkovGrid:
         self.last_ok = True
 
     def predict(self, odom_prev, odom_now) -> None:
-        """Motion update from one odometry reading."""
+        """Motion update from one odometry reading.
+
+        Parameters
+        ----------
+        odom_prev, odom_now : array_like, shape (3,)
+            The odometry reading (map cells, rad).
+
+        Returns
+        -------
+        None
+        """
         p = self.params
         self.belief = markov_predict(self.belief, odom_prev, odom_now, resolution=p.resolution, alpha=p.alpha,
                                      min_blur=p.min_blur, free_mask=self.free_mask)
@@ -195,14 +277,38 @@ class MarkovGrid:
             self.belief = (1 - p.uniform_floor) * self.belief + p.uniform_floor * u / u.sum()
 
     def correct(self, scan) -> bool:
-        """Sensor update from a scan (cell units) or its beams; False when the scan ruled out every cell."""
+        """Sensor update from a scan (cell units) or its beams; False when the scan ruled out every cell.
+
+        Parameters
+        ----------
+        scan : Scan or Beams
+            The scan in cell units (or its beams).
+
+        Returns
+        -------
+        bool
+            Whether the belief kept any mass.
+        """
         beams = scan if isinstance(scan, Beams) else scan_beams(scan, self.params.max_beams)
         L = markov_log_likelihood(self.model, beams, self.params.n_headings, self.params.resolution, self.shape)
         self.belief, self.last_ok = markov_correct(self.belief, L, gamma=self.params.gamma, free_mask=self.free_mask)
         return self.last_ok
 
     def step(self, odom_prev, odom_now, scan) -> np.ndarray:
-        """Predict (when odometry is given) then correct; returns the mean pose."""
+        """Predict (when odometry is given) then correct; returns the mean pose.
+
+        Parameters
+        ----------
+        odom_prev, odom_now : array_like, shape (3,), or None
+            The odometry reading (None: no motion).
+        scan : Scan or Beams
+            The scan in cell units (or its beams).
+
+        Returns
+        -------
+        ndarray, shape (3,)
+            The mean pose (map cells, rad).
+        """
         if odom_prev is not None and odom_now is not None:
             self.predict(odom_prev, odom_now)
         self.correct(scan)
@@ -250,7 +356,22 @@ class MarkovGrid:
 
     def gaussian_prior(self, pose, pos_std: float, heading_std_rad: float) -> np.ndarray:
         """A belief ``∝ exp(−½(Δx² + Δy²)/σ_pos² − ½Δθ²/σ_θ²)`` around ``pose`` (map cells, rad), on the free
-        cells: a prior for :class:`MarkovGrid` (003 §2.2.1: priors are easy on a grid)."""
+        cells: a prior for :class:`MarkovGrid` (003 §2.2.1: priors are easy on a grid).
+
+        Parameters
+        ----------
+        pose : array_like, shape (3,)
+            The prior's centre (map cells, rad).
+        pos_std : float
+            Its position σ (map cells).
+        heading_std_rad : float
+            Its heading σ (rad).
+
+        Returns
+        -------
+        ndarray, shape (K, h, w)
+            The prior, normalised.
+        """
         p = np.asarray(pose, dtype=float)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise ValueError(f"`pose` must be three finite numbers (x, y, heading); got {pose!r}")

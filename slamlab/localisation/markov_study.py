@@ -58,7 +58,23 @@ def _markov_task(rng, kind: str, offset: float, floor: float, n_steps: int, reso
 
 @dataclass(frozen=True)
 class MarkovStudyResult:
-    """A Markov-grid study: per variant, the share of runs within the bounds against the step."""
+    """A Markov-grid study: per variant, the share of runs within the bounds against the step.
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (variant, run) of :func:`slamlab.sweep.sweep`.
+    labels : tuple of str
+        The variants, in table order.
+    n_runs, n_steps : int
+        Runs per variant, steps per run.
+    resolution, n_headings : int
+        The grid's map cells per belief cell and heading bins.
+    kidnap_step : int or None
+        The step of the kidnap (None: no kidnap).
+    title : str
+        The table's title.
+    """
 
     table_df: object = field(repr=False)
     labels: tuple = ()
@@ -70,12 +86,35 @@ class MarkovStudyResult:
     title: str = ""
 
     def success(self, label: str, step: int | None = None) -> float:
-        """Share of runs of ``label`` within 3 cells and 5° at ``step`` (default: the last)."""
+        """Share of runs of ``label`` within 3 cells and 5° at ``step`` (default: the last).
+
+        Parameters
+        ----------
+        label : str
+            A variant of ``labels``.
+        step : int, optional
+            The step, from 1 (default: the last).
+
+        Returns
+        -------
+        float
+        """
         g = self.table_df[self.table_df["variant"] == label]
         k = self.n_steps if step is None else step
         return float(np.mean([s[k - 1] == "1" for s in g["ok"]]))
 
     def table(self, steps=None) -> str:
+        """The table: per variant, the success at some steps and the median final error.
+
+        Parameters
+        ----------
+        steps : sequence of int, optional
+            Steps to show (default: 1, 3, 5 and the last, or from the kidnap on).
+
+        Returns
+        -------
+        str
+        """
         ks = sorted(set(steps or ((1, 3, 5, self.n_steps) if self.kidnap_step is None else
                                   (self.kidnap_step, self.kidnap_step + 3, self.kidnap_step + 6, self.n_steps))))
         ks = [k for k in ks if 1 <= k <= self.n_steps]

@@ -41,13 +41,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .. import _validate as v
-from .._params import param
 from ..geometry import wrap_angle
+from .mcl_params import AVERAGES, MCLParams
 from .models import (
-    SCORES,
     Beams,
     LikelihoodFieldModel,
-    ModelParams,
     check_particles,
     sample_motion_odometry,
     scan_beams,
@@ -66,103 +64,25 @@ from .particles import (
 
 __all__ = ["AVERAGES", "MCL", "MCLParams", "MCLState", "StepRecord", "mcl_step"]
 
-#: How w_slow and w_fast start (and restart): see :class:`MCLParams`.
-AVERAGES = ("003", "amcl", "first", "debiased")
-
-
-@dataclass(frozen=True)
-class MCLParams(ModelParams):
-    """Settings of Monte Carlo localisation; lengths in cells (the map's unit). The motion and sensor
-    model's fields come first (:class:`~slamlab.localisation.models.ModelParams`)."""
-
-    alpha: tuple = param((0.2, 0.008, 0.2, 0.02), "ours: 4 × the Markov grid's, in cells (the ablation); PR Tables "
-                                                  "5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
-    sigma_hit: float = param(4.0, "ours, cells (the ablation); PR Table 6.3 (ROS: 0.2 m)")
-    max_dist: float = param(12.0, "ours, cells: 3 σ_hit, cap of the distance table (ROS: 2 m)")
-    gamma: float = param(0.5, "ours (the ablation): weights p(z | x)^gamma, a tempered likelihood (1 = PR's "
-                              "product of the beams as if independent)")
-    n_particles: int = param(2000, "ours (003: not given; ROS AMCL 100…5000, Nav2 500…2000)")
-    score: str = param("geometric_mean", "ours: the score ω that eq 2.8 averages (SCORES; 003: 'a probability "
-                                         "between 0 and 1'); 'likelihood' = PR Table 8.3. Weights: p(z | x)^gamma")
-    alpha_slow: float = param(0.001, "003 eq 2.9 (value not given); ROS AMCL docs suggest 0.001")
-    alpha_fast: float = param(0.1, "003 eq 2.10 (value not given); ROS AMCL docs suggest 0.1")
-    averages: str = param("debiased", "'003': w_slow, w_fast start at 0 ('initially 0'); 'debiased' (ours): from "
-                                      "0, divided by 1 − (1 − α)^t; 'amcl': at the first w_avg, and again after "
-                                      "every injection (ROS 1 amcl pf.c, Beluga); 'first' (ours): at the first "
-                                      "w_avg, never restarted")
-    resample_threshold: float = param(0.5, "ours: resample when N_eff < threshold·M (ROS 1 amcl's selective "
-                                           "resampling: 0.5); 1 = every step (003, PR Table 8.2)")
-    beam_skip: bool = param(False, "ours: Nav2/ROS 1 likelihood_field_prob's beam skipping, once converged")
-    beam_skip_distance: float = param(5.0, "cells; ROS/Nav2 beam_skip_distance 0.5 m (= 5 cells of 0.1 m)")
-    beam_skip_threshold: float = param(0.3, "ROS/Nav2 beam_skip_threshold: keep a beam when > this share of "
-                                            "the particles put its end point near an obstacle")
-    beam_skip_error_threshold: float = param(0.9, "ROS/Nav2: if this share of the beams is skipped, use all")
-    jitter: tuple = param((0.6, 0.04), "ours (the ablation): σ of a Gaussian jitter (cells, rad) added to every "
-                                       "particle at every step, moving or not (cf. the roughening of Gordon et al. "
-                                       "1993, after resampling); (0, 0) = none")
-    update_min_d: float = param(0.0, "cells; ROS amcl update_min_d (0.2 m; Nav2 0.25 m): update only after "
-                                     "moving this far (0 = every step, 003)")
-    update_min_a: float = param(0.0, "rad; ROS amcl update_min_a (π/6; Nav2 0.2): … or turning this far")
-    converged_dist: float = param(5.0, "cells; ROS 1 amcl's convergence test: every particle within 0.5 m "
-                                       "(= 5 cells of 0.1 m) of the mean in x and y")
-    use_kld: bool = param(False, "ours: KLD sampling, Fox 2003 / PR Table 8.4 (ROS AMCL does it)")
-    kld_epsilon: float = param(0.05, "Fox 2003 / PR Table 8.4 ε (ROS 1: 0.01, Nav2: 0.05)")
-    kld_z: float = param(0.99, "Fox 2003 / PR Table 8.4: 1 − δ (ROS: 0.99)")
-    kld_bin: tuple = param((2.0, 2.0, float(np.radians(10))), "ours: KLD bin (x, y cells, θ rad)")
-    n_min: int = param(100, "ours: KLD lower bound (ROS 1: 100, Nav2: 500)")
-    localised_pos_std: float = param(2.0, "ours: 'localised' when the position σ < this (cells)")
-    localised_heading_std_rad: float = param(float(np.radians(5)), "ours: … and the heading σ < this")
-
-    def check(self) -> None:
-        super().check()
-        v.check_int(self.n_particles, "n_particles", minimum=1)
-        v.check_choice(self.score, "score", SCORES)
-        v.check_choice(self.averages, "averages", AVERAGES)
-        s = v.check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
-        f = v.check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
-        if s > 1 or f > 1:
-            raise ValueError(f"`alpha_slow` and `alpha_fast` must be in [0, 1]; got {s}, {f}")
-        if s > 0 and not f > s:
-            raise ValueError(f"`alpha_fast` must be > `alpha_slow` (PR: 0 ≤ α_slow ≪ α_fast); got {f} <= {s}")
-        t = v.check_positive(self.resample_threshold, "resample_threshold", allow_zero=True)
-        if t > 1:
-            raise ValueError(f"`resample_threshold` must be in [0, 1]; got {t}")
-        for name in ("use_kld", "beam_skip"):
-            if not isinstance(getattr(self, name), (bool, np.bool_)):
-                raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
-        v.check_positive(self.beam_skip_distance, "beam_skip_distance")
-        v.check_probability(self.beam_skip_threshold, "beam_skip_threshold")
-        v.check_probability(self.beam_skip_error_threshold, "beam_skip_error_threshold")
-        v.check_positive(self.converged_dist, "converged_dist")
-        j = np.asarray(self.jitter, dtype=float) if isinstance(self.jitter, tuple) else np.full(1, np.nan)
-        if j.shape != (2,) or not np.all(np.isfinite(j)) or np.any(j < 0):
-            raise ValueError(f"`jitter` must be a tuple of two numbers >= 0 (cells, rad); got {self.jitter!r}")
-        v.check_positive(self.update_min_d, "update_min_d", allow_zero=True)
-        v.check_positive(self.update_min_a, "update_min_a", allow_zero=True)
-        v.check_positive(self.kld_epsilon, "kld_epsilon")
-        v.check_probability(self.kld_z, "kld_z")
-        b = np.asarray(self.kld_bin, dtype=float)
-        if b.shape != (3,) or np.any(b <= 0):
-            raise ValueError(f"`kld_bin` must be three sizes > 0 (x, y, θ); got {self.kld_bin!r}")
-        v.check_int(self.n_min, "n_min", minimum=1)
-        v.check_positive(self.localised_pos_std, "localised_pos_std")
-        v.check_positive(self.localised_heading_std_rad, "localised_heading_std_rad")
-
-    @property
-    def injection(self) -> bool:
-        """Whether random particles are injected (α_slow > 0)."""
-        return self.alpha_slow > 0
-
-    def model(self, grid, z_max: float) -> LikelihoodFieldModel:
-        """The likelihood-field model of these settings on ``grid``."""
-        return LikelihoodFieldModel(grid, z_hit=self.z_hit, z_rand=self.z_rand, sigma_hit=self.sigma_hit,
-                                    z_max=z_max, max_dist=self.max_dist)
-
 
 @dataclass(frozen=True)
 class MCLState:
     """The filter's state: particles, their normalised weights, the logs of the two running averages
-    (``-inf`` = 0, 003's start) and whether the last resampled set passed amcl's convergence test."""
+    (``-inf`` = 0, 003's start) and whether the last resampled set passed amcl's convergence test.
+
+    Parameters
+    ----------
+    particles : ndarray, shape (M, 3)
+        The particle set.
+    weights : ndarray, shape (M,)
+        Normalised weights.
+    log_w_slow, log_w_fast : float
+        Logs of the running averages (eqs 2.9, 2.10); ``-inf`` = 0.
+    converged : bool
+        Whether the last resampled set passed amcl's convergence test.
+    n_updates : int
+        Updates of the averages since they last started at 0.
+    """
 
     particles: np.ndarray = field(repr=False)  # (M, 3)
     weights: np.ndarray = field(repr=False)  # (M,) summing to 1
@@ -184,7 +104,39 @@ class MCLState:
 
 @dataclass(frozen=True)
 class StepRecord:
-    """What one MCL iteration did (for the tables and the time plots)."""
+    """What one MCL iteration did (for the tables and the time plots).
+
+    Parameters
+    ----------
+    mean : ndarray, shape (3,)
+        Weighted mean pose of the set before resampling.
+    cov : ndarray, shape (3, 3)
+        Its covariance.
+    n_particles : int
+        Particles after the step.
+    n_eff : float
+        Effective sample size before resampling.
+    w_avg, w_slow, w_fast : float
+        Eq 2.8's average score and the two running averages (debiased when ``averages = "debiased"``).
+    p_inject : float
+        The injection probability ``max(0, 1 − w_fast/w_slow)``.
+    n_injected : int
+        Particles replaced at random.
+    resampled : bool
+        Whether the set was resampled.
+    localised : bool
+        The "localised" test on ``cov``.
+    weights_vanished : bool
+        Whether every weight was 0.
+    note : str
+        What happened when something unusual did.
+    converged : bool
+        amcl's convergence test on the set after the step.
+    n_beams : int
+        Beams that weighed the particles.
+    log_w_avg, log_w_slow, log_w_fast : float
+        Logs of ``w_avg``, ``w_slow``, ``w_fast``.
+    """
 
     mean: np.ndarray
     cov: np.ndarray
@@ -409,6 +361,17 @@ class MCL:
         With ``update_min_d`` / ``update_min_a`` (ROS amcl's thresholds) the filter is updated only once the
         odometry has moved that far since the last update (the motion of all the skipped steps is applied
         then); a skipped step repeats the last record (``note = "no update: moved too little"``).
+
+        Parameters
+        ----------
+        odom_prev, odom_now : array_like, shape (3,), or None
+            The odometry reading since the last step (None: no motion).
+        scan : Scan or Beams
+            The scan in cell units (or its beams).
+
+        Returns
+        -------
+        StepRecord
         """
         p = self.params
         if odom_prev is not None and odom_now is not None and (p.update_min_d > 0 or p.update_min_a > 0):

@@ -2,7 +2,7 @@
 
 API summary
 -----------
-- :func:`odometry_deltas` ``(odom_prev, odom_now) -> (δrot1, δtrans, δrot2)``.
+- motion (in :mod:`slamlab.localisation.motion`, re-exported): :func:`odometry_deltas` ``(odom_prev, odom_now) -> (δrot1, δtrans, δrot2)``.
 - :func:`sample_motion_odometry` ``(poses, odom_prev, odom_now, alpha, rng) -> (N, 3)``:
   Table 5.6 (PR), vectorised over the particles.
 - :func:`motion_density_odometry` ``(poses_now, poses_prev, odom_prev, odom_now, alpha) -> (N,)``: Table 5.5.
@@ -28,8 +28,15 @@ from scipy.special import erf
 
 from .. import _validate as v
 from .._params import Params, param
-from ..geometry import wrap_angle
 from ..scans import OBSTACLE, Scan, check_grid, likelihood_field
+from .motion import (  # noqa: F401 (re-exported: moved there unchanged)
+    _check_alpha,
+    check_particles,
+    motion_density_odometry,
+    motion_from_noise,
+    odometry_deltas,
+    sample_motion_odometry,
+)
 
 __all__ = [
     "SCORES",
@@ -49,25 +56,26 @@ __all__ = [
 SCORES = ("likelihood", "geometric_mean", "amcl_cubes")
 
 
-def check_particles(poses, name: str = "particles") -> np.ndarray:
-    """Particles as a finite ``(N, 3)`` float array with ``N >= 1`` (a NaN pose is a ValueError)."""
-    P = np.asarray(poses, dtype=float)
-    if P.ndim == 1 and P.shape == (3,):
-        P = P[None, :]
-    if P.ndim != 2 or P.shape[1] != 3:
-        raise ValueError(f"`{name}` must have shape (N, 3) = (x, y, heading) rows; got shape {P.shape}")
-    if P.shape[0] == 0:
-        raise ValueError(f"`{name}` must hold at least one pose; got 0")
-    if not np.all(np.isfinite(P)):
-        raise ValueError(f"`{name}` must be finite; got {int((~np.isfinite(P)).any(axis=1).sum())} pose(s) "
-                         "with NaN or inf")
-    return P
-
-
 @dataclass(frozen=True)
 class ModelParams(Params):
     """The odometry motion model and likelihood-field sensor model settings shared by :class:`MCLParams`
-    and :class:`MarkovParams` (PR Tables 5.5-5.6, 6.3); lengths in cells (the map's unit)."""
+    and :class:`MarkovParams` (PR Tables 5.5-5.6, 6.3); lengths in cells (the map's unit).
+
+    Parameters
+    ----------
+    alpha : tuple of 4 float
+        Odometry motion noise α1…α4 (PR Tables 5.5-5.6), lengths in cells.
+    z_hit, z_rand : float
+        Weights of the hit and random components of the likelihood field (PR Table 6.3).
+    sigma_hit : float
+        σ of the hit component (cells).
+    max_dist : float
+        Cap of the distance table (cells).
+    max_beams : int
+        Beams per scan that weigh a pose (evenly spaced).
+    gamma : float
+        Exponent of the likelihood (1 = PR's product over the beams).
+    """
 
     alpha: tuple = param((0.05, 0.002, 0.05, 0.005), "ours; PR Tables 5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
     z_hit: float = param(0.9, "ours; PR Table 6.3 (ROS 1: 0.95, Nav2: 0.5)")
@@ -91,117 +99,21 @@ class ModelParams(Params):
         v.check_positive(self.gamma, "gamma")
 
 
-def _check_alpha(alpha, what: str = "alpha must be four finite numbers >= 0") -> np.ndarray:
-    try:
-        a = np.asarray(alpha, dtype=float)
-    except (TypeError, ValueError):
-        a = np.full(1, np.nan)
-    if a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a < 0):
-        name, _, rest = what.partition(" ")
-        raise ValueError(f"`{name}` {rest} (α1…α4); got {alpha!r}")
-    return a
-
-
-def odometry_deltas(odom_prev, odom_now, *, min_trans: float = 1e-6):
-    """Odometry reading ``(x̄_{t-1}, x̄_t)`` → ``(δrot1, δtrans, δrot2)`` (PR Table 5.5 lines 2-4).
-
-    Below ``min_trans`` the first rotation is taken as 0 (the heading of a tiny
-    translation is noise; ROS AMCL does the same with 0.01 m). Works on arrays of
-    poses too (``(..., 3)``).
-
-    >>> [round(float(d), 6) for d in odometry_deltas([0, 0, 0], [1, 1, np.pi / 2])]
-    [0.785398, 1.414214, 0.785398]
-    """
-    a = np.asarray(odom_prev, dtype=float)
-    b = np.asarray(odom_now, dtype=float)
-    if a.shape[-1:] != (3,) or b.shape[-1:] != (3,):
-        raise ValueError(f"odometry poses must have shape (..., 3); got {a.shape} and {b.shape}")
-    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
-        raise ValueError("odometry poses must be finite; got NaN or inf")
-    dx, dy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
-    trans = np.hypot(dx, dy)
-    rot1 = np.where(trans < min_trans, 0.0, wrap_angle(np.arctan2(dy, dx) - a[..., 2]))
-    rot2 = wrap_angle(b[..., 2] - a[..., 2] - rot1)
-    return rot1, trans, rot2
-
-
-def sample_motion_odometry(poses, odom_prev, odom_now, alpha, rng=None) -> np.ndarray:
-    """Move every particle by a noisy copy of the odometry reading (PR Table 5.6, vectorised).
-
-    ``δ̂rot1 = δrot1 − ε(α1·δrot1² + α2·δtrans²)``,
-    ``δ̂trans = δtrans − ε(α3·δtrans² + α4·δrot1² + α4·δrot2²)``,
-    ``δ̂rot2 = δrot2 − ε(α1·δrot2² + α2·δtrans²)``, with ``ε(b²)`` a zero-mean
-    normal draw of variance ``b²``; then ``x' = x + δ̂trans·cos(θ + δ̂rot1)``,
-    ``y' = y + δ̂trans·sin(θ + δ̂rot1)``, ``θ' = θ + δ̂rot1 + δ̂rot2``.
+@dataclass(frozen=True)
+class Beams:
+    """The beams of one scan a filter weighs with: bearings, ranges, and the body-frame end points.
 
     Parameters
     ----------
-    poses : array_like, shape (N, 3)
-    odom_prev, odom_now : array_like, shape (3,)
-        Two consecutive odometry poses (only their difference matters).
-    alpha : sequence of 4 floats
-        α1 (rot from rot), α2 (rot from trans), α3 (trans from trans), α4 (trans from rot).
-    rng : Generator, int or None
-
-    Examples
-    --------
-    >>> sample_motion_odometry([[0, 0, 0]], [0, 0, 0], [2, 0, 0], [0, 0, 0, 0]).tolist()
-    [[2.0, 0.0, 0.0]]
+    bearings_rad : ndarray, shape (B,)
+        Beam bearings in the body frame (rad).
+    ranges : ndarray, shape (B,)
+        Ranges (cells).
+    max_range : float
+        The rangefinder's maximum range (cells).
+    end_xy : ndarray, shape (B, 2)
+        Body-frame end points (x ahead, y left).
     """
-    P = check_particles(poses, "poses")
-    a = _check_alpha(alpha)
-    rot1, trans, rot2 = (float(d) for d in odometry_deltas(odom_prev, odom_now))
-    rng = v.as_rng(rng)
-    return motion_from_noise(P, (rot1, trans, rot2), a, rng.standard_normal((3, P.shape[0])))
-
-
-def motion_from_noise(P, deltas, a, e) -> np.ndarray:
-    """PR Table 5.6 lines 5-10 with given standard-normal draws ``e`` (3, N): the deterministic core."""
-    rot1, trans, rot2 = deltas
-    # PR Table 5.6 lines 5-7 (variances; errata form)
-    r1 = rot1 - np.sqrt(a[0] * rot1**2 + a[1] * trans**2) * e[0]
-    tr = trans - np.sqrt(a[2] * trans**2 + a[3] * (rot1**2 + rot2**2)) * e[1]
-    r2 = rot2 - np.sqrt(a[0] * rot2**2 + a[1] * trans**2) * e[2]
-    # lines 8-10
-    h = P[:, 2] + r1
-    return np.column_stack([P[:, 0] + tr * np.cos(h), P[:, 1] + tr * np.sin(h), wrap_angle(h + r2)])
-
-
-def _normal_pdf(x, var):
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = np.exp(-0.5 * x * x / var) / np.sqrt(2 * np.pi * var)
-    # a zero variance is a point mass: density 0 off it (and inf on it, which we cap at a large number)
-    return np.where(var > 0, out, np.where(x == 0, 1e300, 0.0))
-
-
-def motion_density_odometry(poses_now, poses_prev, odom_prev, odom_now, alpha) -> np.ndarray:
-    """``p(x_t | u_t, x_{t-1})`` of the odometry model (PR Table 5.5), for arrays of pose pairs.
-
-    Examples
-    --------
-    >>> p = motion_density_odometry([[1, 0, 0]], [[0, 0, 0]], [0, 0, 0], [1, 0, 0], [0.1, 0.1, 0.1, 0.1])
-    >>> round(float(p[0]), 6)  # = N(0; 0.1)·N(0; 0.1)·N(0; 0.1)
-    2.007845
-    """
-    X1 = check_particles(poses_now, "poses_now")
-    X0 = check_particles(poses_prev, "poses_prev")
-    if X1.shape != X0.shape:
-        raise ValueError(f"`poses_now` and `poses_prev` must have the same shape; got {X1.shape} and {X0.shape}")
-    a = _check_alpha(alpha)
-    rot1, trans, rot2 = odometry_deltas(odom_prev, odom_now)
-    h1, ht, h2 = odometry_deltas(X0, X1)
-    p1 = _normal_pdf(wrap_angle(rot1 - h1), a[0] * h1**2 + a[1] * ht**2)
-    p2 = _normal_pdf(trans - ht, a[2] * ht**2 + a[3] * (h1**2 + h2**2))
-    p3 = _normal_pdf(wrap_angle(rot2 - h2), a[0] * h2**2 + a[1] * ht**2)
-    return p1 * p2 * p3
-
-
-# --- the beams a filter uses ---------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Beams:
-    """The beams of one scan a filter weighs with: bearings, ranges, and the body-frame end points."""
 
     bearings_rad: np.ndarray  # (B,)
     ranges: np.ndarray  # (B,) in cells
@@ -220,6 +132,21 @@ def scan_beams(scan: Scan, max_beams: int | None = None, *, keep_max: bool = Fal
 
     Raises ``ValueError`` when the scan holds no valid beam (nothing to weigh a particle with).
 
+    Parameters
+    ----------
+    scan : Scan
+        A scan in cell units.
+    max_beams : int, optional
+        At most this many beams, evenly spaced (None: all).
+    keep_max : bool
+        Keep the beams at maximum range too.
+
+    Returns
+    -------
+    Beams
+
+    Examples
+    --------
     >>> s = Scan(np.radians([0, 90, 180, 270]), [1, 2, 3, 5], np.array([True, True, True, False]), max_range=5)
     >>> scan_beams(s, 2).ranges.tolist()
     [1.0, 2.0]
@@ -300,14 +227,38 @@ class LikelihoodFieldModel:
         self._padded_dist = D.ravel()
 
     def log_q(self, d) -> np.ndarray:
-        """``log(z_hit·N(d; 0, σ_hit²) + z_rand/z_max)`` for distances ``d`` [cells]."""
+        """``log(z_hit·N(d; 0, σ_hit²) + z_rand/z_max)`` for distances ``d`` [cells].
+
+        Parameters
+        ----------
+        d : array_like
+            Distances to the nearest obstacle (cells).
+
+        Returns
+        -------
+        ndarray
+            ``log q`` for every distance, shaped like ``d``.
+        """
         d = np.asarray(d, dtype=float)
         g = np.exp(-0.5 * (d / self.sigma_hit) ** 2) / (np.sqrt(2 * np.pi) * self.sigma_hit)
         with np.errstate(divide="ignore"):  # z_rand = 0 and a far end point: log 0 = -inf, handled by the filter
             return np.log(self.z_hit * g + self.z_rand / self.z_max)
 
     def end_points(self, poses, beams: Beams) -> tuple[np.ndarray, np.ndarray]:
-        """World end points ``(N, B)`` x and y of every beam seen from every pose."""
+        """World end points ``(N, B)`` x and y of every beam seen from every pose.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        x, y : ndarray, shape (N, B)
+            World end points (cells).
+        """
         P = np.asarray(poses, dtype=float)
         c, s = np.cos(P[:, 2])[:, None], np.sin(P[:, 2])[:, None]
         bx, by = beams.end_xy[:, 0][None, :], beams.end_xy[:, 1][None, :]
@@ -341,11 +292,33 @@ class LikelihoodFieldModel:
         return table[idx], keep
 
     def used(self, beams: Beams) -> np.ndarray:
-        """Mask of the beams that enter the likelihood: ranges below ``z_max`` (PR Table 6.3 line 3)."""
+        """Mask of the beams that enter the likelihood: ranges below ``z_max`` (PR Table 6.3 line 3).
+
+        Parameters
+        ----------
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        ndarray of bool, shape (B,)
+        """
         return beams.ranges < min(beams.max_range, self.z_max)
 
     def beam_log_q(self, poses, beams: Beams) -> np.ndarray:
-        """``log q_k`` for every pose × beam, shape ``(N, B)``, float32 (beams at ``z_max`` give 0)."""
+        """``log q_k`` for every pose × beam, shape ``(N, B)``, float32 (beams at ``z_max`` give 0).
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        ndarray of float32, shape (N, B)
+        """
         vals, keep = self._gather(self._padded, poses, beams)
         if keep.all():
             return vals
@@ -355,20 +328,70 @@ class LikelihoodFieldModel:
 
     def beam_distances(self, poses, beams: Beams) -> tuple[np.ndarray, np.ndarray]:
         """Distance ``d`` [cells] from every end point to the nearest obstacle (capped at ``max_dist``; off
-        the map ``max_dist``), shape ``(N, B_used)``, and the mask ``(B,)`` of the beams below ``z_max``."""
+        the map ``max_dist``), shape ``(N, B_used)``, and the mask ``(B,)`` of the beams below ``z_max``.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        d : ndarray, shape (N, B_used)
+            Distances to the nearest obstacle (cells).
+        keep : ndarray of bool, shape (B,)
+            The beams that enter the likelihood.
+        """
         return self._gather(self._padded_dist, poses, beams)
 
     def log_likelihood(self, poses, beams: Beams) -> np.ndarray:
-        """``log p(z | x) = Σ_k log q_k`` for every pose, shape ``(N,)``."""
+        """``log p(z | x) = Σ_k log q_k`` for every pose, shape ``(N,)``.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        ndarray, shape (N,)
+        """
         return self.beam_log_q(poses, beams).sum(axis=1, dtype=np.float64)
 
     def n_used(self, beams: Beams) -> int:
-        """Number of beams that enter the product (ranges below ``z_max``)."""
+        """Number of beams that enter the product (ranges below ``z_max``).
+
+        Parameters
+        ----------
+        beams : Beams
+            The scan's beams.
+
+        Returns
+        -------
+        int
+        """
         return int(np.count_nonzero(self.used(beams)))
 
     def score(self, log_lik, beams: Beams) -> np.ndarray:
         """The per-beam geometric mean of ``q_k / q_max``, ``exp(log p / B − log q_max)`` in [0, 1] (ours):
-        one reading of 003 §2.2's "probability between 0 and 1" per particle."""
+        one reading of 003 §2.2's "probability between 0 and 1" per particle.
+
+        Parameters
+        ----------
+        log_lik : array_like, shape (N,)
+            ``log p(z | x)`` per pose (:meth:`log_likelihood`).
+        beams : Beams
+            The scan's beams (for the number used).
+
+        Returns
+        -------
+        ndarray, shape (N,)
+            Scores in [0, 1].
+        """
         n = max(1, self.n_used(beams))
         return np.exp(np.asarray(log_lik, dtype=float) / n - self.log_q_max)
 
@@ -383,6 +406,21 @@ class LikelihoodFieldModel:
           ``LikelihoodFieldModel`` (both say it "works well" without a derivation).
 
         ``beam_mask`` (B,) keeps only some beams (beam skipping); beams at ``z_max`` never count.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 3)
+            Poses in cells and radians.
+        beams : Beams
+            The scan's beams.
+        score : str
+            One of :data:`SCORES`.
+        beam_mask : ndarray of bool, shape (B,), optional
+            Beams to use (beam skipping); None: every beam below ``z_max``.
+
+        Returns
+        -------
+        ndarray, shape (N,)
         """
         v.check_choice(score, "score", SCORES)
         if score == "amcl_cubes":
@@ -415,6 +453,28 @@ def beam_model_prob(z, z_star, *, z_max: float, z_hit: float = 0.8, z_short: flo
     ``p_short = η·λ·exp(−λz)`` on ``[0, z*]`` with ``η = 1/(1 − exp(−λz*))``,
     ``p_max = 1`` at ``z = z_max`` (a point mass) and ``p_rand = 1/z_max`` on ``[0, z_max)``.
 
+    Parameters
+    ----------
+    z : array_like
+        Measured ranges.
+    z_star : array_like
+        Expected ranges (ray cast), broadcast with ``z``.
+    z_max : float
+        Maximum range.
+    z_hit, z_short, z_max_w, z_rand : float
+        Mixture weights of the hit, short, max-range and random components.
+    sigma_hit : float
+        σ of the hit component.
+    lambda_short : float
+        Rate λ of the short component.
+
+    Returns
+    -------
+    ndarray
+        ``p(z_k | x, m)`` element-wise.
+
+    Examples
+    --------
     >>> round(float(beam_model_prob(5.0, 5.0, z_max=10.0, z_hit=1, z_short=0, z_max_w=0, z_rand=0)), 6)
     0.398942
     """

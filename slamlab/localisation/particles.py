@@ -42,6 +42,22 @@ def kld_bound(k, epsilon: float = 0.05, z_quantile: float = 0.99):
     ``z`` is the upper ``1 − δ`` quantile of the standard normal (``z_quantile = 1 − δ``);
     PR Table 8.4 line 17. One bin gives 1.
 
+    Parameters
+    ----------
+    k : int or array_like of int
+        Number of occupied bins.
+    epsilon : float
+        Bound ε on the Kullback-Leibler divergence (PR Table 8.4).
+    z_quantile : float
+        ``1 − δ``: the probability of staying within the bound.
+
+    Returns
+    -------
+    float or ndarray
+        The particle count (as floats, not rounded), shaped like ``k``.
+
+    Examples
+    --------
     >>> int(np.ceil(kld_bound(10, 0.05, 0.99)))
     217
     """
@@ -67,6 +83,24 @@ def kld_sample_count(particles, *, bin_size=(2.0, 2.0, 0.174533), epsilon: float
     Fox 2003). All of them when the bound is never met. Vectorised: bins by first occurrence, a cumsum.
 
     Default bins: 2 cells, 2 cells, 10°. Our addition (003 uses a fixed number of particles), as ROS AMCL does.
+
+    Parameters
+    ----------
+    particles : array_like, shape (N, 3)
+        The drawn set, in the order it was drawn.
+    bin_size : tuple of float
+        Bin size in x, y (cells) and heading (rad).
+    epsilon : float
+        Fox's ε (PR Table 8.4).
+    z_quantile : float
+        ``1 − δ``.
+    n_min : int
+        Lower bound on the count.
+
+    Returns
+    -------
+    int
+        The number of leading particles to keep.
     """
     P = np.asarray(particles, dtype=float)
     bs = np.asarray(bin_size, dtype=float)
@@ -85,6 +119,22 @@ def pose_estimate(particles, weights=None) -> tuple[np.ndarray, np.ndarray]:
 
     The heading residuals are wrapped around the mean before the covariance.
 
+    Parameters
+    ----------
+    particles : array_like, shape (N, 3)
+        Poses ``(x, y, θ)``.
+    weights : array_like, shape (N,), optional
+        Non-negative weights with a positive sum (normalised here); None: equal weights.
+
+    Returns
+    -------
+    mean : ndarray, shape (3,)
+        Weighted mean position and circular mean heading.
+    cov : ndarray, shape (3, 3)
+        Weighted covariance, heading residuals wrapped about the mean.
+
+    Examples
+    --------
     >>> m, C = pose_estimate([[0, 0, np.pi - 0.1], [2, 0, -np.pi + 0.1]])
     >>> m.round(6).tolist(), round(float(C[0, 0]), 6), round(float(C[2, 2]), 6)
     ([1.0, 0.0, 3.141593], 1.0, 0.01)
@@ -110,6 +160,22 @@ def is_localised(cov, *, pos_std: float = 2.0, heading_std_rad: float = 0.087266
     """The "localised" test (ours; default 2 cells and 5°): the position's largest standard deviation (√ of the largest eigenvalue
     of the x-y block) below ``pos_std`` and the heading's below ``heading_std_rad``.
 
+    Parameters
+    ----------
+    cov : array_like, shape (3, 3)
+        Covariance of the pose estimate (:func:`pose_estimate`).
+    pos_std : float
+        Largest position standard deviation allowed (cells).
+    heading_std_rad : float
+        Largest heading standard deviation allowed (rad).
+
+    Returns
+    -------
+    bool
+        Whether both standard deviations are below their bounds.
+
+    Examples
+    --------
     >>> is_localised(np.diag([1.0, 1.0, 0.001])), is_localised(np.diag([9.0, 1.0, 0.001]))
     (True, False)
     """
@@ -124,6 +190,20 @@ def amcl_converged(particles, dist: float) -> bool:
     """ROS 1 amcl's convergence test (``pf_update_converged``): every particle within ``dist`` of the
     particles' (unweighted) mean in x and in y (amcl: 0.5 m).
 
+    Parameters
+    ----------
+    particles : array_like, shape (N, 3) or (N, 2)
+        The (resampled) particle set.
+    dist : float
+        Largest distance from the mean in x and in y (cells).
+
+    Returns
+    -------
+    bool
+        Whether every particle is within ``dist`` of the mean in both coordinates.
+
+    Examples
+    --------
     >>> amcl_converged([[0, 0, 0], [1, 0, 3]], 0.6), amcl_converged([[0, 0, 0], [1, 0, 3]], 0.4)
     (True, False)
     """
@@ -135,7 +215,18 @@ def amcl_converged(particles, dist: float) -> bool:
 
 
 def free_cell_centres(grid) -> np.ndarray:
-    """``(x, y)`` centres of the FREE cells of ``grid``, shape ``(K, 2)``; ValueError when there is none."""
+    """``(x, y)`` centres of the FREE cells of ``grid``, shape ``(K, 2)``; ValueError when there is none.
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Occupancy grid with FREE / OCCUPIED / UNKNOWN cells (:mod:`slamlab.scans`).
+
+    Returns
+    -------
+    ndarray, shape (K, 2)
+        Cell centres ``(x, y)`` of the FREE cells, in cells.
+    """
     g = check_grid(grid)
     rc = np.argwhere(g == FREE)
     if rc.shape[0] == 0:
@@ -146,6 +237,24 @@ def free_cell_centres(grid) -> np.ndarray:
 def uniform_free_particles(grid, n: int, rng=None, *, centres=None) -> np.ndarray:
     """``n`` poses uniform over the FREE cells (uniform inside a cell, heading uniform in [−π, π)).
 
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Occupancy grid.
+    n : int
+        Number of poses.
+    rng : Generator, int or None
+        Random source.
+    centres : ndarray, shape (K, 2), optional
+        The free cell centres, if already computed (:func:`free_cell_centres`).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Poses ``(x, y, θ)`` in cells and radians.
+
+    Examples
+    --------
     >>> g = np.zeros((3, 3), np.int8); g[0] = 1
     >>> P = uniform_free_particles(g, 5, rng=0); bool(np.all(P[:, 1] >= 0.5))
     True

@@ -26,7 +26,21 @@ _MAP_CMAP = ListedColormap(["#dddddd", "white", "black"])  # unexplored, free, o
 
 
 def plot_map(grid, *, ax=None, extent=None):
-    """The grid map (free white, obstacle black, unexplored grey), ``origin="lower"``."""
+    """The grid map (free white, obstacle black, unexplored grey), ``origin="lower"``.
+
+    Parameters
+    ----------
+    grid : array_like, shape (H, W)
+        The map.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    extent : sequence of 4 float, optional
+        imshow's extent (default: cells).
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     ax = new_axes(ax)
     ax.set_aspect("equal", adjustable="box")  # fixed limits are set after: keep them, shape the box
     ax.imshow(np.asarray(grid) + 1, cmap=_MAP_CMAP, vmin=0, vmax=2, origin="lower", interpolation="nearest",
@@ -36,7 +50,29 @@ def plot_map(grid, *, ax=None, extent=None):
 
 def plot_particles(grid, particles, weights=None, *, true_pose=None, estimate=None, ax=None, title=None,
                    max_points: int = 3000):
-    """Particles (coloured by weight when given) over the map, with the true pose and the estimate."""
+    """Particles (coloured by weight when given) over the map, with the true pose and the estimate.
+
+    Parameters
+    ----------
+    grid : array_like, shape (H, W)
+        The map.
+    particles : array_like, shape (N, 3)
+        The particles (cells, rad).
+    weights : array_like, shape (N,), optional
+        Their weights (colour).
+    true_pose, estimate : array_like, shape (3,), optional
+        Poses to mark.
+    ax : matplotlib Axes, optional
+        Where to draw.
+    title : str, optional
+        The axes' title.
+    max_points : int
+        At most this many particles are drawn.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     ax = plot_map(grid, ax=ax)
     P = np.asarray(particles)
     step = max(1, P.shape[0] // max_points)
@@ -55,7 +91,23 @@ def plot_particles(grid, particles, weights=None, *, true_pose=None, estimate=No
 
 
 def plot_clouds(run, result, steps=(0, 3, 10, -1), *, axes=None):
-    """The weighted particle cloud at chosen steps of a recorded run (``result.snapshots``)."""
+    """The weighted particle cloud at chosen steps of a recorded run (``result.snapshots``).
+
+    Parameters
+    ----------
+    run : SimRun
+        The run.
+    result : FilterRun
+        Its recorded filter run (with snapshots).
+    steps : sequence of int
+        Steps to show (negative: from the end).
+    axes : sequence of matplotlib Axes, optional
+        One per step.
+
+    Returns
+    -------
+    sequence of matplotlib Axes
+    """
     steps = [s if s >= 0 else run.n_steps + s for s in steps]
     if axes is None:
         _fig, axes = plt.subplots(1, len(steps), figsize=(3.2 * len(steps), 3.4))
@@ -69,7 +121,23 @@ def plot_clouds(run, result, steps=(0, 3, 10, -1), *, axes=None):
 
 
 def plot_weights(weights, *, ax=None, bins: int = 50, title=None):
-    """Histogram of the normalised weights (log-scaled counts)."""
+    """Histogram of the normalised weights (log-scaled counts).
+
+    Parameters
+    ----------
+    weights : array_like, shape (N,)
+        The weights.
+    ax : matplotlib Axes, optional
+        Where to draw.
+    bins : int
+        Histogram bins.
+    title : str, optional
+        The axes' title.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     ax = new_axes(ax, xlabel="weight × M", ylabel="particles", title=title)
     w = np.asarray(weights)
     ax.hist(w * w.size, bins=bins, color="tab:blue", log=True)
@@ -77,7 +145,21 @@ def plot_weights(weights, *, ax=None, bins: int = 50, title=None):
 
 
 def plot_averages(result, *, ax=None, kidnap_step=None):
-    """log w_avg, log w_slow, log w_fast and the injected count against the step (003 eqs 2.8-2.11)."""
+    """log w_avg, log w_slow, log w_fast and the injected count against the step (003 eqs 2.8-2.11).
+
+    Parameters
+    ----------
+    result : FilterRun
+        An MCL run.
+    ax : matplotlib Axes, optional
+        Where to draw.
+    kidnap_step : int, optional
+        Marked with a vertical line.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     ax = new_axes(ax, xlabel="step", ylabel="log of the average score",
                   title="w_avg, w_slow, w_fast (log) and injected particles")
     r = result.records
@@ -97,7 +179,23 @@ def plot_averages(result, *, ax=None, kidnap_step=None):
 
 
 def plot_errors(result, *, ax=None, kidnap_step=None, label="MCL"):
-    """Position error [cells] against the step."""
+    """Position error [cells] against the step.
+
+    Parameters
+    ----------
+    result : FilterRun
+        A filter run.
+    ax : matplotlib Axes, optional
+        Where to draw.
+    kidnap_step : int, optional
+        Marked with a vertical line.
+    label : str
+        The line's label.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     ax = new_axes(ax, xlabel="step", ylabel="position error [cells]", title="Error against the truth")
     ax.semilogy(np.maximum(result.err_pos, 1e-2), label=label)
     if kidnap_step is not None:
@@ -107,7 +205,21 @@ def plot_errors(result, *, ax=None, kidnap_step=None, label="MCL"):
 
 
 def plot_belief(markov, *, true_pose=None, ax=None):
-    """The Markov belief summed over headings, over the map."""
+    """The Markov belief summed over headings, over the map.
+
+    Parameters
+    ----------
+    markov : MarkovGrid
+        The grid filter.
+    true_pose : array_like, shape (3,), optional
+        Marked on the map.
+    ax : matplotlib Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     ax = new_axes(ax, equal=True, title="Markov belief (sum over θ)")
     b = markov.belief.sum(axis=0)
     s = markov.params.resolution
@@ -121,7 +233,19 @@ def plot_belief(markov, *, true_pose=None, ax=None):
 
 
 def plot_global(result, *, ax=None):
-    """Success (solid) and amcl's convergence test (dotted) against the step, one line per particle count."""
+    """Success (solid) and amcl's convergence test (dotted) against the step, one line per particle count.
+
+    Parameters
+    ----------
+    result : GlobalResult
+        A global-localisation study.
+    ax : matplotlib Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     from .studies import _per_step
 
     ax = new_axes(ax, xlabel="step", ylabel="share of runs", title="Global localisation")
@@ -138,7 +262,19 @@ def plot_global(result, *, ax=None):
 
 
 def plot_log_run(result, *, ax=None):
-    """A CARMEN run: the map, the corrected path, odometry, tracking and global estimates (metres)."""
+    """A CARMEN run: the map, the corrected path, odometry, tracking and global estimates (metres).
+
+    Parameters
+    ----------
+    result : LogMCLResult
+        A run on a CARMEN log.
+    ax : matplotlib Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     f = result.frame
     H, W = result.grid_shape
     ext = (f.x0_m - f.cell_m / 2, f.x0_m + (W - 0.5) * f.cell_m, f.y0_m - f.cell_m / 2, f.y0_m + (H - 0.5) * f.cell_m)
@@ -158,7 +294,19 @@ def plot_log_run(result, *, ax=None):
 
 
 def mcl_figure(run, result):
-    """Last step's cloud, the error and w_slow/w_fast/injected against the step, side by side."""
+    """Last step's cloud, the error and w_slow/w_fast/injected against the step, side by side.
+
+    Parameters
+    ----------
+    run : SimRun
+        The run.
+    result : FilterRun
+        Its recorded MCL run.
+
+    Returns
+    -------
+    matplotlib Figure
+    """
     fig, ax = plt.subplots(1, 3, figsize=(13, 3.8))
     X, w = result.snapshots[-1]
     plot_particles(run.grid, X, w, true_pose=run.true_poses[-1], estimate=result.est[-1], ax=ax[0],
@@ -170,7 +318,21 @@ def mcl_figure(run, result):
 
 
 def recorded_step_figure(run, result, step: int):
-    """One step of a recorded run: the weighted cloud and the histogram of its weights."""
+    """One step of a recorded run: the weighted cloud and the histogram of its weights.
+
+    Parameters
+    ----------
+    run : SimRun
+        The run.
+    result : FilterRun
+        Its recorded MCL run (with snapshots).
+    step : int
+        The step to show.
+
+    Returns
+    -------
+    matplotlib Figure
+    """
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     X, w = result.snapshots[step]
     plot_particles(run.grid, X, w, true_pose=run.true_poses[step], estimate=result.est[step], ax=ax[0],

@@ -17,7 +17,18 @@ __all__ = ["explore_log", "explore_markov", "explore_mcl", "explore_recorded_run
 
 def explore_mcl(**defaults):
     """Particle count, α_slow/α_fast, z_hit/σ_hit, odometry noise, kidnap step → a recorded global run
-    (cloud at the end, error and w_slow/w_fast against the step). Any setting gives a result or a message."""
+    (cloud at the end, error and w_slow/w_fast against the step). Any setting gives a result or a message.
+
+    Parameters
+    ----------
+    **defaults
+        Start values of the controls: ``n_particles``, ``alpha_slow``, ``alpha_fast``, ``z_hit``, ``sigma_hit``,
+        ``odo_noise``, ``kidnap_step``, ``seed``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     from .mcl import MCLParams
 
     p0 = MCLParams()
@@ -51,7 +62,19 @@ def explore_mcl(**defaults):
 
 
 def explore_recorded_run(run, result):
-    """A time slider over a recorded run: the weighted cloud and the weights' histogram at each step."""
+    """A time slider over a recorded run: the weighted cloud and the weights' histogram at each step.
+
+    Parameters
+    ----------
+    run : SimRun
+        The run.
+    result : FilterRun
+        Its recorded MCL run (``keep_particles=True``).
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
 
     def show(step):
         w = result.snapshots[step][1]
@@ -70,7 +93,17 @@ def _log_run(name, n_scans, start, n_global):
 
 
 def explore_log(**defaults):
-    """Pick a corrected CARMEN log, the stretch of scans and the global particle count → tracking and global."""
+    """Pick a corrected CARMEN log, the stretch of scans and the global particle count → tracking and global.
+
+    Parameters
+    ----------
+    **defaults
+        Start values of the controls: ``log``, ``start``, ``n_scans``, ``n_global``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     d = {"log": "intel", "start": 0, "n_scans": 30, "n_global": 10000}
     d.update(defaults)
 
@@ -94,7 +127,18 @@ def explore_log(**defaults):
 
 def explore_markov(**defaults):
     """The Markov grid (003 §2.2.1): belief-cell size, headings, steps, the prior and an optional kidnap → the
-    belief over the map after the last step, and the error at each step."""
+    belief over the map after the last step, and the error at each step.
+
+    Parameters
+    ----------
+    **defaults
+        Start values of the controls: ``resolution``, ``n_headings``, ``n_steps``, ``prior``, ``kidnap_step``,
+        ``uniform_floor``, ``seed``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+    """
     from .experiments import simulate_run
     from .markov import MarkovGrid
 
