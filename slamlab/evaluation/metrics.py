@@ -66,6 +66,19 @@ class ErrorStats:
 
     @classmethod
     def from_errors(cls, errors, unit: str = "m") -> ErrorStats:
+        """Statistics of per-pose errors.
+
+        Parameters
+        ----------
+        errors : array_like of float
+            One error per pose pair (non-empty).
+        unit : str
+            Unit of the errors, for the tables ("m", "deg", "%").
+
+        Returns
+        -------
+        ErrorStats
+        """
         e = np.asarray(errors, dtype=float)
         if e.size == 0:
             raise ValueError("no pose pairs to evaluate (trajectory too short for this delta?)")

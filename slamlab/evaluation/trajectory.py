@@ -81,7 +81,23 @@ class Trajectory:
 
     @classmethod
     def from_poses(cls, poses, timestamps_s=None, name: str = "", frame_ids=None) -> Trajectory:
-        """From ``(N, 4, 4)`` or ``(N, 3, 4)`` pose matrices."""
+        """From ``(N, 4, 4)`` or ``(N, 3, 4)`` pose matrices.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 4, 4) or (N, 3, 4)
+            Pose matrices (rotation and position of each pose in the trajectory's frame).
+        timestamps_s : array_like of float, optional
+            One time per pose, seconds.
+        name : str
+            Label in tables and plots.
+        frame_ids : array_like of int, optional
+            One frame index per pose.
+
+        Returns
+        -------
+        Trajectory
+        """
         P = v.as_finite_array(poses, "poses", ndim=3)
         if P.shape[1:] not in ((4, 4), (3, 4)):
             raise ValueError(f"`poses` must have shape (N, 4, 4) or (N, 3, 4); got {P.shape}")

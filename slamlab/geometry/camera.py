@@ -190,7 +190,19 @@ class PinholeCamera:
 
     @classmethod
     def from_hfov(cls, width_px: int = 768, height_px: int = 576, hfov_rad: float = np.deg2rad(40.0)) -> PinholeCamera:
-        """Square pixels, principal point at the image centre, focal length from ``hfov_rad``."""
+        """Square pixels, principal point at the image centre, focal length from ``hfov_rad``.
+
+        Parameters
+        ----------
+        width_px, height_px : int
+            Image size, pixels.
+        hfov_rad : float
+            Horizontal field of view, radians.
+
+        Returns
+        -------
+        PinholeCamera
+        """
         f = focal_from_hfov(width_px, hfov_rad)
         height_px = v.check_int(height_px, "height_px", minimum=1)
         return cls(width_px, height_px, f, f, (width_px - 1) / 2.0, (height_px - 1) / 2.0)
@@ -326,7 +338,21 @@ class StereoRig:
         height_px: int = 576,
         hfov_rad: float = np.deg2rad(40.0),
     ) -> StereoRig:
-        """A rectified rig: identical cameras, parallel axes, ``baseline_m`` apart along ``x``."""
+        """A rectified rig: identical cameras, parallel axes, ``baseline_m`` apart along ``x``.
+
+        Parameters
+        ----------
+        baseline_m : float
+            Distance between the optical centres, metres (> 0).
+        width_px, height_px : int
+            Image size of both cameras, pixels.
+        hfov_rad : float
+            Horizontal field of view of both cameras, radians.
+
+        Returns
+        -------
+        StereoRig
+        """
         baseline_m = v.check_positive(baseline_m, "baseline_m")
         cam = PinholeCamera.from_hfov(width_px, height_px, hfov_rad)
         return cls(cam, cam, np.eye(3), np.array([-baseline_m, 0.0, 0.0]))

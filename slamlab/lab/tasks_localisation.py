@@ -6,7 +6,6 @@ import numpy as np
 
 from .. import _validate as v
 from ..localisation import LikelihoodFieldModel, low_variance_resample, odometry_deltas, scan_beams
-from ..localisation.mcl import _inject_probability
 from ..localisation.models import motion_from_noise
 from ..scans import Scan
 from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
@@ -92,7 +91,8 @@ def _lf_cases(rng):
 def _aug_reference(w_avg, w_slow, w_fast, alpha_slow, alpha_fast):
     s = w_slow + alpha_slow * (w_avg - w_slow)
     f = w_fast + alpha_fast * (w_avg - w_fast)
-    return np.array([s, f, _inject_probability(s, f)])
+    p_inject = max(0.0, 1.0 - f / s) if s > 0 else 0.0  # PR Table 8.3, written out: the reference stays independent
+    return np.array([s, f, p_inject])
 
 
 def _aug_cases(rng):

@@ -158,13 +158,6 @@ class StepRecord:
     log_w_fast: float = -np.inf
 
 
-def _inject_probability(w_slow: float, w_fast: float) -> float:
-    """``max(0, 1 − w_fast/w_slow)`` (PR Table 8.3); 0 while ``w_slow`` is 0."""
-    if w_slow <= 0:
-        return 0.0
-    return max(0.0, 1.0 - w_fast / w_slow)
-
-
 def _log_average(log_w: float, log_x: float, alpha: float) -> float:
     """``log(w + α·(x − w))`` from ``log w`` and ``log x`` (eqs 2.9, 2.10 in log space)."""
     if alpha <= 0:

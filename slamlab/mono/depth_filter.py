@@ -108,7 +108,17 @@ class Seeds:
 
     @staticmethod
     def concat(parts) -> Seeds:
-        """All seeds of ``parts`` in order."""
+        """All seeds of ``parts`` in order.
+
+        Parameters
+        ----------
+        parts : iterable of Seeds
+            The seed sets to join (none: an empty set).
+
+        Returns
+        -------
+        Seeds
+        """
         parts = list(parts)
         if not parts:
             return init_seeds(np.zeros((0, 2)), np.zeros((0, 3)), 1.0, 1.0)

@@ -238,6 +238,21 @@ class GridFrame:
     def around(cls, points_m, cell_m: float, margin_m: float = 1.0) -> GridFrame:
         """The smallest frame holding ``points_m`` (k, 2) plus ``margin_m`` on every side.
 
+        Parameters
+        ----------
+        points_m : array_like, shape (k, 2)
+            World points, metres.
+        cell_m : float
+            Cell side, metres.
+        margin_m : float
+            Free border around the points, metres.
+
+        Returns
+        -------
+        GridFrame
+
+        Examples
+        --------
         >>> GridFrame.around([[0.0, 0.0], [2.0, 1.0]], 0.5, margin_m=0.0)
         GridFrame(x0_m=0.0, y0_m=0.0, cell_m=0.5, shape=(3, 5))
         """

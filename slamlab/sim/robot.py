@@ -124,14 +124,37 @@ class UnicycleModel:
 
     @staticmethod
     def residual(a, b):
-        """State difference with the heading wrapped."""
+        """State difference with the heading wrapped.
+
+        Parameters
+        ----------
+        a, b : array_like, shape (..., 3)
+            States ``(x, y, θ)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``a − b`` with the heading difference wrapped to [−π, π).
+        """
         d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
         d[..., 2] = wrap_angle(d[..., 2])
         return d
 
     @staticmethod
     def mean(sigmas, weights):
-        """Weighted mean of sigma points; heading averaged in the chart around the centre point."""
+        """Weighted mean of sigma points; heading averaged in the chart around the centre point.
+
+        Parameters
+        ----------
+        sigmas : numpy.ndarray, shape (n, 3)
+            Sigma points ``(x, y, θ)``; row 0 is the centre point.
+        weights : numpy.ndarray, shape (n,)
+            Mean weights.
+
+        Returns
+        -------
+        numpy.ndarray, shape (3,)
+        """
         m = weights @ sigmas
         m[2] = angle_mean(sigmas[:, 2], weights, ref=sigmas[0, 2])
         return m
@@ -220,14 +243,37 @@ class RangeBearingSensor:
 
     @staticmethod
     def residual(a, b):
-        """Measurement difference with bearings wrapped."""
+        """Measurement difference with bearings wrapped.
+
+        Parameters
+        ----------
+        a, b : array_like, shape (..., 2k)
+            Measurements ``(r_1, φ_1, …, r_k, φ_k)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``a − b`` with every bearing difference wrapped to [−π, π).
+        """
         d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
         d[..., 1::2] = wrap_angle(d[..., 1::2])
         return d
 
     @staticmethod
     def mean(sigmas, weights):
-        """Weighted mean of sigma points; bearings averaged in the chart around the centre point."""
+        """Weighted mean of sigma points; bearings averaged in the chart around the centre point.
+
+        Parameters
+        ----------
+        sigmas : numpy.ndarray, shape (n, 2k)
+            Sigma points of the measurement ``(r_1, φ_1, …)``; row 0 is the centre point.
+        weights : numpy.ndarray, shape (n,)
+            Mean weights.
+
+        Returns
+        -------
+        numpy.ndarray, shape (2k,)
+        """
         m = weights @ sigmas
         m[1::2] = angle_mean(sigmas[:, 1::2], weights, ref=sigmas[0, 1::2])
         return m
