@@ -130,17 +130,8 @@ def build_kdtree(points, ids=None, *, leaf_size: int = 1):
             break
         s0, s1, nodes = seg_start[inner], seg_stop[inner], seg_node[inner]
         lens = s1 - s0
-        # spread per segment: balanced halving keeps a level's lengths within {L, L+1}, so the
-        # first min(lens) points of every segment form a regular (segments, L, k) block
-        lmin, lmax = int(lens.min()), int(lens.max())
-        block = X[perm[s0[:, None] + np.arange(lmin)]]
-        hi, lo = block.max(axis=1), block.min(axis=1)
-        for e in range(lmin, lmax):
-            has = np.flatnonzero(lens > e)
-            extra = X[perm[s0[has] + e]]
-            hi[has] = np.maximum(hi[has], extra)
-            lo[has] = np.minimum(lo[has], extra)
-        dim = np.argmax(hi - lo, axis=1)  # ties: the lowest coordinate index
+        dim = _widest_coordinate(X, perm, s0, lens)
+        lmax = int(lens.max())
         # sort every segment by its split coordinate (rows padded with +inf; stable: ties keep order)
         cols = np.arange(lmax)
         valid = cols < lens[:, None]
@@ -177,6 +168,22 @@ def build_kdtree(points, ids=None, *, leaf_size: int = 1):
         start[nodes], stop[nodes], depth[nodes] = s0, s1, dep
     return {"points": X, "ids": ids, "perm": perm, "split_dim": split_dim, "split_val": split_val,
             "left": left, "right": right, "start": start, "stop": stop, "depth": depth, "leaf_size": leaf_size}
+
+
+def _widest_coordinate(X, perm, s0, lens):
+    """Per segment ``perm[s0 : s0 + lens]`` of the points ``X``, the coordinate of largest spread (max − min;
+    ties: the lowest index), our reading of 000 §1.4.3's "best distribution"."""
+    # balanced halving keeps a level's lengths within {L, L+1}, so the first min(lens) points of every segment
+    # form a regular (segments, L, k) block
+    lmin, lmax = int(lens.min()), int(lens.max())
+    block = X[perm[s0[:, None] + np.arange(lmin)]]
+    hi, lo = block.max(axis=1), block.min(axis=1)
+    for e in range(lmin, lmax):
+        has = np.flatnonzero(lens > e)
+        extra = X[perm[s0[has] + e]]
+        hi[has] = np.maximum(hi[has], extra)
+        lo[has] = np.minimum(lo[has], extra)
+    return np.argmax(hi - lo, axis=1)
 
 
 class KDTree:
@@ -287,6 +294,18 @@ class KDTree:
         return dist, ids
 
 
+def _leaf_distances(P, Qa, s0, s1, lane):
+    """Squared distances from each query ``Qa[i]`` to the points ``s0[i]:s1[i]`` of its leaf (rows padded to the
+    leaf size with inf) and the candidates' leaf-order indices."""
+    cand = s0[:, None] + lane[None, :]
+    valid = cand < s1[:, None]
+    cand = np.where(valid, cand, s0[:, None])
+    diffs = P[cand] - Qa[:, None, :]
+    d2 = np.einsum("ijk,ijk->ij", diffs, diffs).astype(np.float64)
+    d2[~valid] = np.inf
+    return d2, cand
+
+
 def _merge_k_best(bd, bi, d2, cand, k):
     """Merge a leaf's candidates (distances ``d2``, indices ``cand``: one row per query) into the sorted k best."""
     if d2.shape[1] == 1:  # insert one candidate into the sorted k best (ties: the earlier stays first)
@@ -302,6 +321,22 @@ def _merge_k_best(bd, bi, d2, cand, k):
     all_i = np.concatenate([bi, cand], axis=1)
     o = np.argsort(all_d, axis=1, kind="stable")[:, :k]
     return np.take_along_axis(all_d, o, axis=1), np.take_along_axis(all_i, o, axis=1)
+
+
+def _pop_best(pb, pn, width, a, kth, cur, cur_b, free):
+    """Queries ``a`` take their best pending branch (its node into ``cur``, its bound into ``cur_b``; the slot is
+    freed for the next push) when its bound beats their k-th distance ``kth``; returns the queries that stop."""
+    sub = pb[a, :width]
+    j = np.argmin(sub, axis=1)
+    bnd = sub[np.arange(a.size), j]
+    ok = bnd < kth
+    stop_q = a[~ok]
+    a, j, bnd = a[ok], j[ok], bnd[ok]
+    cur[a] = pn[a, j]
+    cur_b[a] = bnd
+    pb[a, j] = np.inf
+    free[a] = j
+    return stop_q
 
 
 def _push_pending(pb, pn, free, width, a, far, fb):
@@ -371,14 +406,8 @@ def _lockstep_search(t, P, Q, k, max_leaves):
         at_leaf[at_leaf] = is_leaf[c[at_leaf]]
         if at_leaf.any():
             a = active[at_leaf]
-            lf = c[at_leaf]
-            s0, s1 = start[lf], stop[lf]
-            cand = s0[:, None] + lane[None, :]
-            valid = cand < s1[:, None]
-            cand = np.where(valid, cand, s0[:, None])
-            diffs = P[cand] - Q[a][:, None, :]
-            d2 = np.einsum("ijk,ijk->ij", diffs, diffs).astype(np.float64)
-            d2[~valid] = np.inf
+            s0, s1 = start[c[at_leaf]], stop[c[at_leaf]]
+            d2, cand = _leaf_distances(P, Q[a], s0, s1, lane)
             leaves_v[a] += 1
             dist_v[a] += s1 - s0
             best_d[a], best_i[a] = _merge_k_best(best_d[a], best_i[a], d2, cand, k)
@@ -398,16 +427,7 @@ def _lockstep_search(t, P, Q, k, max_leaves):
                 active = active[~need]
                 c = cur[active]
             else:
-                sub = pb[a, :width]
-                j = np.argmin(sub, axis=1)
-                bnd = sub[np.arange(a.size), j]
-                ok = bnd < best_d[a, k - 1]
-                stop_q = a[~ok]
-                a, j, bnd = a[ok], j[ok], bnd[ok]
-                cur[a] = pn[a, j]
-                cur_b[a] = bnd
-                pb[a, j] = np.inf
-                free[a] = j
+                stop_q = _pop_best(pb, pn, width, a, best_d[a, k - 1], cur, cur_b, free)
                 if stop_q.size:
                     active = np.setdiff1d(active, stop_q, assume_unique=True)
                 c = cur[active]

@@ -212,6 +212,34 @@ def mcl_step(state: MCLState, odom_prev, odom_now, scan, model: LikelihoodFieldM
     return state, rec
 
 
+def _update_averages(state, log_w_avg, params):
+    """Eqs 2.9, 2.10 in log space: the new ``(log w_slow, log w_fast)`` and the pair that sets the injection
+    probability (bias-corrected when ``params.averages == "debiased"``)."""
+    ls, lf = state.log_w_slow, state.log_w_fast
+    if params.averages in ("amcl", "first") and ls == -np.inf:  # amcl / Beluga: an average at 0 starts at w_avg
+        ls = lf = log_w_avg
+    else:
+        ls = _log_average(ls, log_w_avg, params.alpha_slow)  # 2.9
+        lf = _log_average(lf, log_w_avg, params.alpha_fast)  # 2.10
+    n_up = state.n_updates + 1
+    ls_used, lf_used = ls, lf
+    if params.averages == "debiased":  # an average started at 0, divided by 1 − (1 − α)^t (Adam's bias correction)
+        ls_used = ls - _log_bias(params.alpha_slow, n_up)
+        lf_used = lf - _log_bias(params.alpha_fast, n_up)
+    return ls, lf, ls_used, lf_used
+
+
+def _resample(X, w, params, rng):
+    """Low-variance resampling to ``params.n_particles`` (PR Table 4.4), or KLD sampling (PR Table 8.4)."""
+    if params.use_kld:
+        n_max = params.n_particles
+        idx = rng.choice(X.shape[0], size=n_max, p=w)  # PR Table 8.4 draws i.i.d.
+        m_keep = kld_sample_count(X[idx], bin_size=params.kld_bin, epsilon=params.kld_epsilon,
+                                  z_quantile=params.kld_z, n_min=min(params.n_min, n_max))
+        return X[idx[:m_keep]]
+    return X[low_variance_resample(w, params.n_particles, rng)]
+
+
 def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free_xy=None):
     """The body of :func:`mcl_step`; also returns the weighted set before resampling ``(X, w)``."""
     if not isinstance(state, MCLState):
@@ -242,17 +270,8 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     # 2.8: w_avg = Σ_m w_prev[m]·ω[m], the weighted mean of the score (PR Table 8.3 with ω = p(z | x))
     fin = np.isfinite(log_s)
     log_w_avg = float(np.logaddexp.reduce(log_wp[fin] + log_s[fin])) if fin.any() else -np.inf
-    ls, lf = state.log_w_slow, state.log_w_fast
-    if params.averages in ("amcl", "first") and ls == -np.inf:  # amcl / Beluga: an average at 0 starts at w_avg
-        ls = lf = log_w_avg
-    else:
-        ls = _log_average(ls, log_w_avg, params.alpha_slow)  # 2.9
-        lf = _log_average(lf, log_w_avg, params.alpha_fast)  # 2.10
+    ls, lf, ls_used, lf_used = _update_averages(state, log_w_avg, params)
     n_up = state.n_updates + 1
-    ls_used, lf_used = ls, lf
-    if params.averages == "debiased":  # an average started at 0, divided by 1 − (1 − α)^t (Adam's bias correction)
-        ls_used = ls - _log_bias(params.alpha_slow, n_up)
-        lf_used = lf - _log_bias(params.alpha_fast, n_up)
     log_w = log_wp + params.gamma * L  # PR Table 8.2 line 5: w = p(z | x) (tempered by gamma)
     w, ok = normalise_log_weights(log_w)
     p_inj = (max(0.0, 1.0 - float(np.exp(lf_used - ls_used))) if ls_used > -np.inf else 0.0) \
@@ -270,14 +289,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     resample = params.resample_threshold >= 1 or neff < params.resample_threshold * M or not ok
     n_inj = 0
     if resample:
-        if params.use_kld:
-            n_max = params.n_particles
-            idx = rng.choice(M, size=n_max, p=w)  # PR Table 8.4 draws i.i.d.
-            m_keep = kld_sample_count(X[idx], bin_size=params.kld_bin, epsilon=params.kld_epsilon,
-                                      z_quantile=params.kld_z, n_min=min(params.n_min, n_max))
-            X = X[idx[:m_keep]]
-        else:
-            X = X[low_variance_resample(w, params.n_particles, rng)]
+        X = _resample(X, w, params, rng)
         M = X.shape[0]
         if p_inj > 0:
             inj = rng.random(M) < p_inj  # 2.11: P_A = M·p_inj in expectation
