@@ -10,7 +10,7 @@ API summary
   poses and points metres ↔ cells.
 
 Conventions (used by every 2-D module: scans, sim, correlation, hough)
---------------------------------------------------------------------
+----------------------------------------------------------------------
 In **cell units**, a world point is ``(x, y)`` with ``x`` along the columns and ``y``
 along the rows: cell ``grid[row, col]`` is the unit square centred on ``(x, y) =
 (col, row)``, i.e. covering ``[col - 0.5, col + 0.5) × [row - 0.5, row + 0.5)``. A
