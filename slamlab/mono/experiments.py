@@ -311,7 +311,7 @@ class ConvergenceStudy:
     """Seeds of a synthetic scene updated ``n_obs`` times at several outlier rates (our experiment).
 
     ``sigma`` (R, n_obs + 1) median σ_ρ (1/m), ``inlier`` (R, n_obs + 1) median a/(a+b),
-    ``error`` (R, n_obs + 1) median |ρ − ρ_true| (1/m), ``converged`` (R, n_obs + 1) share of seeds
+    ``error`` (R, n_obs + 1) median ``|ρ − ρ_true|`` (1/m), ``converged`` (R, n_obs + 1) share of seeds
     passing SVO's σ test, ``mu`` (R, n_seeds) final means, ``rho_true`` (n_seeds,).
     """
 
