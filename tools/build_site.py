@@ -266,7 +266,7 @@ def chapter_page(src: Path, dst: Path, lab: str | None) -> dict[str, str]:
                 o.get("data", {}).pop(WIDGET_MIME, None)
         cells.append(cell)
         if widget:
-            cells.append(_md_cell(_widget_note("".join(cell["source"]), slamlab_calls(["".join(cell["source"])])),
+            cells.append(_md_cell(_widget_note("".join(cell["source"]), calls),
                                   f"site-widget-note-{len(cells)}"))
     links = ", ".join(f"{{py:obj}}`{spelled} <{name}>`" for name, spelled in sorted(calls.items(), key=lambda kv: kv[1]))
     box = "```{admonition} slamlab in this chapter\n:class: seealso\n"

@@ -43,13 +43,15 @@ nitpick_ignore_regex = [(r"py:.*", r"(?!slamlab\b).*")]
 # ---- notebooks: the stored outputs, never executed
 nb_execution_mode = "off"
 nb_output_stderr = "show"
-myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
+myst_enable_extensions = ["dollarmath", "colon_fence"]  # no amsmath: a line starting \begin{pmatrix} inside $$ would end the paragraph
+myst_dmath_double_inline = True  # $$...$$ inside a paragraph is display math, as in JupyterLab
 myst_heading_anchors = 3
 
 # ---- API reference
 autodoc_member_order = "bysource"
-autodoc_typehints = "signature"
-autodoc_preserve_defaults = True
+# Signatures without annotations: the numpydoc Parameters sections give each type with its shape and unit, and
+# thousands of annotation references (np.ndarray, float | None, ...) would each cost a search of the index.
+autodoc_typehints = "none"
 numpydoc_show_class_members = False
 numpydoc_xref_param_type = False
 numpydoc_validation_checks: set[str] = set()
@@ -68,7 +70,7 @@ html_theme_options = {
     "navigation_with_keys": False,
     "show_toc_level": 2,
     "navbar_align": "left",
-    "header_links_before_dropdown": 5,
+    "header_links_before_dropdown": 4,
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
     "secondary_sidebar_items": ["page-toc"],

@@ -174,9 +174,17 @@ _IMAGES = """async () => {
     return imgs.filter(img => img.naturalWidth === 0).map(img => img.currentSrc || img.src);
 }"""
 _MATH = """async () => {
-    if (!window.MathJax || !MathJax.startup) return {loaded: false};
-    await MathJax.startup.promise;
-    return {loaded: true, typeset: document.querySelectorAll('mjx-container').length,
+    const loaded = !!(window.MathJax && MathJax.startup);
+    if (loaded) await MathJax.startup.promise;
+    // TeX left as text in the prose (math the Markdown parser did not see as math)
+    const walker = document.createTreeWalker(document.querySelector('main') || document.body, NodeFilter.SHOW_TEXT);
+    const raw = [];
+    for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+        if (n.parentElement.closest('pre, code, script, style, mjx-container, .highlight, .output')) continue;
+        if (/\\$\\$|\\\\(mathbf|frac|hat|tilde|sigma|alpha|theta|qquad)\\b/.test(n.textContent)) raw.push(n.textContent.slice(0, 80));
+    }
+    return {loaded: loaded, raw: raw.slice(0, 3),
+            typeset: document.querySelectorAll('mjx-container').length,
             errors: document.querySelectorAll('mjx-merror').length,
             pending: document.querySelectorAll('.math:not(:has(mjx-container))').length};
 }"""
@@ -200,7 +208,7 @@ def _open(page, url: str, base: str) -> list[str]:
         broken = page.evaluate(_IMAGES)
         problems += [f"image not loaded: {src}" for src in broken]
         math = page.evaluate(_MATH)
-        if math["loaded"] and (math["errors"] or math["pending"]):
+        if math["raw"] or (math["loaded"] and (math["errors"] or math["pending"])):
             problems.append(f"equations: {math}")
     finally:
         page.remove_listener("console", on_console)
