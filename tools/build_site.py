@@ -425,8 +425,10 @@ def stage(work: Path, student_dir: Path | None = None) -> Path:
     (src / "chapters").mkdir()
     xref: dict[str, list[str]] = {}
     titles = {}
+    spelled: dict[str, dict[str, str]] = {}
     for nb in chapters:
         calls = chapter_page(nb, src / "chapters" / nb.name, lab_of.get(nb.name[:2]))
+        spelled[nb.stem] = calls
         titles[nb.stem] = _title(_read_nb(nb), nb.stem)
         for name in calls:
             xref.setdefault(name, []).append(nb.stem)
@@ -463,9 +465,28 @@ def stage(work: Path, student_dir: Path | None = None) -> Path:
         "its functions and classes, their source section (000, 002, 003, 004 and the section, or *ours*) and the "
         "chapters that call them.\n\n```{toctree}\n:maxdepth: 1\n\n"
         + "\n".join(pages) + "\n```\n", encoding="utf-8")
-    (src / "xref.json").write_text(json.dumps({"calls": xref, "titles": titles}, indent=1), encoding="utf-8")
+    (src / "xref.json").write_text(json.dumps({"calls": xref, "titles": titles, "spelled": spelled}, indent=1), encoding="utf-8")
     data_pages(src / "data")
     return src
+
+
+def link_code(out: Path, spelled: dict[str, dict[str, str]]) -> int:
+    """In each chapter's HTML, link every ``sl.pkg.name`` of the code cells to its API entry (the href that the
+    chapter's "slamlab in this chapter" box already has for it); return the number of links made."""
+    made = 0
+    for chapter, calls in spelled.items():
+        page = out / "chapters" / f"{chapter}.html"
+        html = page.read_text(encoding="utf-8")
+        for name, dotted in sorted(calls.items(), key=lambda kv: -len(kv[1])):  # longest spelling first
+            href = re.search(rf'<a class="reference internal" href="([^"]+)" title="{re.escape(name)}"', html)
+            if not href:
+                continue
+            parts = [rf'<span class="n\w*">{re.escape(p)}</span>' for p in dotted.split(".")]
+            token = re.compile(r'(?<!">)(' + r'<span class="o">\.</span>'.join(parts) + r')(?!<span class="o">\.</span>)')
+            html, n = token.subn(rf'<a class="slamlab-code-ref" href="{href.group(1)}" title="{name}">\1</a>', html)
+            made += n
+        page.write_text(html, encoding="utf-8")
+    return made
 
 
 def build(out: Path, work: Path, student_dir: Path | None = None, quiet: bool = True) -> float:
@@ -482,6 +503,7 @@ def build(out: Path, work: Path, student_dir: Path | None = None, quiet: bool = 
     done = subprocess.run(cmd, cwd=ROOT, env=env, check=False)
     if done.returncode != 0:
         raise SystemExit(f"sphinx-build failed (exit {done.returncode}): see the warnings above")
+    link_code(out, json.loads((src / "xref.json").read_text(encoding="utf-8"))["spelled"])
     return time.perf_counter() - start
 
 

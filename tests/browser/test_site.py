@@ -133,7 +133,9 @@ def test_cross_references_go_both_ways(site):
     """Chapter 01 links kf_predict to its API entry; that entry links back to chapter 01."""
     out, _ = site
     chapter = (out / "chapters" / "01_kalman_filters.html").read_text(encoding="utf-8")
-    assert "../api/filters.html#slamlab.filters.kalman.kf_predict" in chapter
+    assert "../api/filters.html#slamlab.filters.kalman.kf_predict" in chapter  # the chapter's box
+    assert re.search(r'<a class="slamlab-code-ref" href="../api/filters.html#slamlab.filters.kalman.kf_predict"[^>]*>'
+                     r'<span class="n">sl</span>', chapter), "sl.filters.kf_predict in a code cell is not linked"
     api = (out / "api" / "filters.html").read_text(encoding="utf-8")
     entry = api[api.index('id="slamlab.filters.kalman.kf_predict"'):]
     entry = entry[:entry.index('<dt class="sig sig-object py')]  # up to the next entry
@@ -190,11 +192,16 @@ _MATH = """async () => {
 }"""
 
 
+def _aborted_icon(request) -> bool:
+    """The favicon's request cut off by the next navigation (the browser fetches it lazily, after load)."""
+    return request.url.endswith("/_static/favicon.svg") and "ERR_ABORTED" in (request.failure or "")
+
+
 def _open(page, url: str, base: str) -> list[str]:
     """Open ``url``; return what went wrong: console errors, failed requests, requests leaving the site."""
     problems: list[str] = []
     on_console = lambda m: problems.append(f"console {m.type}: {m.text}") if m.type == "error" else None
-    on_failed = lambda r: problems.append(f"failed request: {r.url} ({r.failure})")
+    on_failed = lambda r: None if _aborted_icon(r) else problems.append(f"failed request: {r.url} ({r.failure})")
     on_request = lambda r: (problems.append(f"request leaving the site: {r.url}")
                             if not (r.url.startswith(base) or urlsplit(r.url).scheme in ("data", "blob")) else None)
     on_response = lambda r: problems.append(f"HTTP {r.status}: {r.url}") if r.status >= 400 else None
