@@ -10,7 +10,7 @@ PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
 	-p no:cacheprovider -n 2 --dist loadfile
 
-.PHONY: venv lab test reproducible notebooks report student autograde lint bench lock clean distclean
+.PHONY: venv lab test reproducible notebooks report student autograde docs lint bench lock clean distclean
 
 ## venv: create .venv if missing and install slamlab[test] from constraints.txt (again only when those change)
 venv: $(STAMP)
@@ -52,6 +52,11 @@ student: venv
 ## autograde: grade SUBMISSIONS=<folder of <student>/<NN_topic_lab>.ipynb>; writes build/course/grades.csv
 autograde: venv
 	$(BIN)/python tools/labs.py autograde $(SUBMISSIONS)
+
+## docs: the course site in build/site/ (open build/site/index.html): chapters with their stored outputs, the student
+## labs and instructor guide, the API reference; offline, Sphinx warnings are errors (tools/build_site.py)
+docs: venv
+	$(BIN)/python tools/build_site.py
 
 ## lint: ruff
 lint: venv

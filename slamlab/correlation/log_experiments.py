@@ -1,7 +1,7 @@
 """Ch. 5 experiments (004 §7) on real data: correlation localisation along a CARMEN log with corrected poses, and
 ours beside the source's figures (the closing table).
 
-Part of the chapter's experiments (:mod:`.experiments` holds the simulated ones and the helpers used here).
+Part of the chapter's experiments (:mod:`slamlab.correlation.experiments` holds the simulated ones and the helpers used here).
 """
 
 from __future__ import annotations

@@ -81,7 +81,7 @@ def occupancy_grid(scans: Sequence[Scan], poses, shape: tuple[int, int], *, rule
     ``misses_free``) and "hit" for the cell at ``range + hit_offset_cells`` (a range
     ends on the face of the obstacle cell: the offset puts the vote inside it).
 
-    Rules:
+    The labelling ``rule``:
 
     ``"count"``
         OBSTACLE when ``hits >= min_hits`` and ``hits >= hit_ratio·passes``, else

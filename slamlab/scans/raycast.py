@@ -7,7 +7,7 @@ API summary
   arrays, ``(N, 3)`` gives ``(N, B)``.
 
 The simulator's rangefinder (:func:`slamlab.sim.cast_rays`, one pose) and the beam model's
-expected ranges (:func:`slamlab.localisation.ray_cast`, many particles) are thin wrappers of it.
+expected ranges (:mod:`slamlab.localisation.models`, many particles) use it.
 
 Conventions are those of :mod:`slamlab.scans.grid`: cell ``(row, col)`` is the unit square
 centred on ``(x, y) = (col, row)``; a beam at angle ``α`` from pose ``(x, y, θ)`` points along

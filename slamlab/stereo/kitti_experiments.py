@@ -1,6 +1,6 @@
 """Ch. 4 experiments (000 §3) on KITTI's stereo odometry frames, and ours beside the source's figures.
 
-Part of the chapter's experiments (:mod:`.experiments` holds the simulated runs and the helpers used here).
+Part of the chapter's experiments (:mod:`slamlab.stereo.experiments` holds the simulated runs and the helpers used here).
 """
 
 from __future__ import annotations

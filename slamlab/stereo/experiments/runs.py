@@ -106,7 +106,7 @@ class StereoRunResult:
 
     @property
     def heading_error_ratio(self) -> float:
-        """Largest |heading error| / |turned angle| over frames turned at least 90° (000 §3.1: ≤ 10 %)."""
+        """Largest ``|heading error| / |turned angle|`` over frames turned at least 90° (000 §3.1: ≤ 10 %)."""
         turned = np.abs(self.truth[:, 2] - self.truth[0, 2])
         m = turned >= np.pi / 2 - 1e-9
         return float(np.max(np.abs(self.yaw_err_rad[m]) / turned[m])) if m.any() else float("nan")
