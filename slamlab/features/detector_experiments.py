@@ -1,5 +1,5 @@
 """Ch. 2 experiments on one image (000 §1.4, §3.3): every detector's keypoint count, the SURF threshold scale,
-SURF's scale on Gaussian blobs (re-exported by :mod:`.experiments`, which holds the image-pair evaluation).
+SURF's scale on Gaussian blobs (re-exported by :mod:`slamlab.features.experiments`, which holds the image-pair evaluation).
 """
 
 from __future__ import annotations

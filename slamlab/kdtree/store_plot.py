@@ -93,7 +93,7 @@ def plot_multi_tree_sizes(history, n1: int, q: float, *, ax=None, n_trees: int |
     Parameters
     ----------
     history : list of list of int
-        Tree sizes after each add (:func:`slamlab.kdtree.multi_tree_sizes`).
+        Tree sizes after each add (:func:`slamlab.kdtree.multi.multi_tree_sizes`).
     n1 : int
         Maximum size of the first tree.
     q : float

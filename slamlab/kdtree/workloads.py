@@ -139,7 +139,7 @@ def surf_like_descriptors(n: int, *, n_clusters: int = 256, sigma_cluster: float
     clustered : bool
         Draw around prototypes; False: uniform on the unit sphere (prototypes None).
     rng : numpy.random.Generator, int or None
-        Randomness (see :func:`slamlab._validate.as_rng`).
+        Randomness: a Generator, or an int seed for a new one.
     prototypes : (n_clusters, 64) float, optional
         Prototypes to reuse (from an earlier call).
 

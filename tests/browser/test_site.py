@@ -18,10 +18,8 @@ import functools
 import http.server
 import importlib
 import importlib.util
-import inspect
 import json
 import os
-import pkgutil
 import re
 import subprocess
 import sys
@@ -46,28 +44,12 @@ TIMES: dict[str, float] = {}
 
 
 def public_callables():
-    """Every public function, class and method of slamlab, as the docstring test walks them
-    (tests/test_docstrings.py, issue 23): modules without a ``_`` component, objects defined there."""
-    import slamlab
-
-    seen = set()
-    for info in pkgutil.walk_packages(slamlab.__path__, "slamlab."):
-        if any(part.startswith("_") for part in info.name.split(".")[1:]):
-            continue
-        module = importlib.import_module(info.name)
-        for attr, obj in sorted(vars(module).items()):
-            if attr.startswith("_") or not (inspect.isfunction(obj) or inspect.isclass(obj)):
-                continue
-            if getattr(obj, "__module__", None) != info.name:
-                continue
-            items = [(f"{info.name}.{attr}", obj)]
-            if inspect.isclass(obj):
-                items += [(f"{info.name}.{attr}.{a}", v) for a, v in vars(obj).items()
-                          if not a.startswith("_") and inspect.isfunction(v)]
-            for qualname, o in items:
-                if id(o) not in seen:
-                    seen.add(id(o))
-                    yield qualname, o
+    """Every public function, class and method of slamlab, exactly as the docstring test walks them
+    (``public_callables`` of tests/test_docstrings.py, issue 23: classmethods and staticmethods included)."""
+    spec = importlib.util.spec_from_file_location("_docstring_walker", ROOT / "tests" / "test_docstrings.py")
+    walker = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(walker)
+    return walker.public_callables()
 
 
 @pytest.fixture(scope="module")
