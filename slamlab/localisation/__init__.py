@@ -13,16 +13,15 @@ from .experiments import (
     run_markov_vs_mcl,
     simulate_run,
 )
+from .log_protocol import LogProtocolResult, run_log_protocol
 from .logs import (
     CARMEN_LOGS,
     LogMCLResult,
-    LogProtocolResult,
     carmen_path,
     global_log_settings,
     log_settings,
     logs_table,
     run_log_mcl,
-    run_log_protocol,
 )
 from .markov import MarkovGrid, MarkovParams, markov_correct, markov_log_likelihood, markov_predict
 from .markov_study import MARKOV_PRIORS, MarkovStudyResult, run_markov_kidnap, run_markov_prior

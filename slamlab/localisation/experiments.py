@@ -27,7 +27,7 @@ from ..sim.rangefinder import Rangefinder, simulate_odometry
 from .amcl_tables import AMCL_DEFAULTS, amcl_defaults_table, ours_vs_source
 from .markov import MarkovGrid
 from .mcl import MCL, MCLParams
-from .particles import uniform_free_particles
+from .particles import FAIL_DEG, FAIL_POS_CELLS, uniform_free_particles
 
 __all__ = [
     "AMCL_DEFAULTS",
@@ -43,10 +43,6 @@ __all__ = [
     "simulate_run",
 ]
 
-#: Success: final position error below this (cells) ...
-FAIL_POS_CELLS = 3.0
-#: ... and heading error below this (degrees) (ours).
-FAIL_DEG = 5.0
 #: The simulated sensor's range limit (cells).
 MAX_RANGE = 100.0
 

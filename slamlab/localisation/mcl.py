@@ -52,6 +52,7 @@ from .models import (
 )
 from .particles import (
     amcl_converged,
+    best_cluster_estimate,
     free_cell_centres,
     is_localised,
     kld_sample_count,
@@ -283,7 +284,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
         else:
             note = "all weights vanished: no injection (α_slow = 0), particles kept with uniform weights"
     weighted = (X, w)
-    mean, cov = pose_estimate(X, w)
+    mean, cov = pose_estimate(X, w) if params.estimate == "mean" else best_cluster_estimate(X, w, params.kld_bin)
     neff = n_eff(w)
     M = X.shape[0]
     resample = params.resample_threshold >= 1 or neff < params.resample_threshold * M or not ok

@@ -13,11 +13,13 @@ from .. import _validate as v
 from .._params import param
 from .models import SCORES, LikelihoodFieldModel, ModelParams
 
-__all__ = ["AVERAGES", "MCLParams"]
+__all__ = ["AVERAGES", "ESTIMATES", "MCLParams"]
 
 
 #: How w_slow and w_fast start (and restart): see :class:`MCLParams`.
 AVERAGES = ("003", "amcl", "first", "debiased")
+#: The pose a step reports: see :class:`MCLParams`.
+ESTIMATES = ("mean", "best_cluster")
 
 
 @dataclass(frozen=True)
@@ -59,6 +61,8 @@ class MCLParams(ModelParams):
         KLD's lower bound on the count.
     localised_pos_std, localised_heading_std_rad : float
         The "localised" test's bounds (cells, rad).
+    estimate : str
+        The pose a step reports (:data:`ESTIMATES`).
     """
 
     alpha: tuple = param((0.2, 0.008, 0.2, 0.02), "ours: 4 × the Markov grid's, in cells (the ablation); PR Tables "
@@ -98,12 +102,16 @@ class MCLParams(ModelParams):
     n_min: int = param(100, "ours: KLD lower bound (ROS 1: 100, Nav2: 500)")
     localised_pos_std: float = param(2.0, "ours: 'localised' when the position σ < this (cells)")
     localised_heading_std_rad: float = param(float(np.radians(5)), "ours: … and the heading σ < this")
+    estimate: str = param("mean", "'mean': the weighted mean of the whole set (003: the set is the estimate); "
+                                  "'best_cluster': the mean of the heaviest cluster of kld_bin bins, the pose "
+                                  "ROS 1 amcl publishes")
 
     def check(self) -> None:
         super().check()
         v.check_int(self.n_particles, "n_particles", minimum=1)
         v.check_choice(self.score, "score", SCORES)
         v.check_choice(self.averages, "averages", AVERAGES)
+        v.check_choice(self.estimate, "estimate", ESTIMATES)
         s = v.check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
         f = v.check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
         if s > 1 or f > 1:

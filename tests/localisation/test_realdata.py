@@ -51,13 +51,28 @@ def test_log_by_path_and_bad_path(tmp_path):
 
 
 def test_protocol_runs_on_a_log_by_path(shared_data):
-    """The protocol on any CARMEN log by path: one row per stretch and count, the same stretches for every count.
-    (Issue 27's goal, success >= 0.8 over 10 stretches of 30 scans per log with 20 000 particles, does not hold:
-    0.74 with the global settings of issue 27's real-log ablation (0.68 before), measured on 2026-11-26 with
-    ``rng=0``, so it is not pinned.)"""
+    """The protocol on any CARMEN log by path: one row per stretch and count, the same stretches for every count,
+    and a stretch's run does not depend on what else shares the call (its streams are keyed by log, stretch and
+    count)."""
     path = shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz"
     res = L.run_log_protocol(path, (300, 600), n_runs=2, n_scans=4, rng=0, progress=False)
     df = res.table_df
     assert len(df) == 4
     assert df.groupby("n_particles")["start"].apply(list).tolist() == [[0, df["start"].max()]] * 2
     assert "seattle-corrected" in res.table()
+    assert df["track_success"].notna().sum() == 2  # the ceiling: once per stretch, with the largest count
+    alone = L.run_log_protocol(path, (600,), n_runs=2, n_scans=4, rng=0, progress=False, track_particles=0)
+    both = df[df["n_particles"] == 600].reset_index(drop=True)
+    np.testing.assert_array_equal(alone.table_df["final_err_m"].to_numpy(), both["final_err_m"].to_numpy())
+
+
+@pytest.mark.slow
+def test_global_success_on_the_five_logs_is_at_least_08():
+    """Issue 27's goal: global localisation from no prior succeeds in >= 0.8 of 10 stretches of 30 scans per log
+    over the five shared logs with 20 000 particles (success: within 3 cells = 0.3 m and 5° at the last scan, the
+    chapter's criterion). Measured 2026-11-26: 0.84 / 0.88 / 0.92 with rng 0 / 1 / 2 (within 0.2 m and 2°:
+    0.76 / 0.74 / 0.88; tracking from the corrected start pose: 0.94 / 0.98 / 1.00)."""
+    res = L.run_log_protocol(L.CARMEN_LOGS, (20000,), n_runs=10, n_scans=30, rng=0, progress=False,
+                             track_particles=0)
+    assert len(res.table_df) == 50
+    assert res.success() >= 0.8, res.table()
