@@ -31,6 +31,16 @@ _PKG_DIR = str(Path(__file__).resolve().parent.parent)
 _REGISTRY: dict[str, Task | ExplorationTask] = {}
 
 
+def _load_nothing(chapter: str | None) -> None:
+    """The default loader: no task module (``slamlab.lab`` installs its own on import)."""
+
+
+#: Imports the task modules of one chapter ("01") or, for None or an unknown chapter, of every chapter, so that
+#: their tasks are registered; installed by :mod:`slamlab.lab` (``core`` itself imports no task module). A lab's
+#: kernel then imports only its own chapter's tasks and packages.
+_loader: Callable[[str | None], None] = _load_nothing
+
+
 @dataclass(frozen=True)
 class Case:
     """One call to try: a label for the report and the keyword arguments.
@@ -249,15 +259,19 @@ def task(task_id: str) -> Task | ExplorationTask:
     Task or ExplorationTask
         The task.
     """
+    if task_id not in _REGISTRY:
+        _loader(str(task_id)[:2])
     try:
         return _REGISTRY[task_id]
     except KeyError:
+        _loader(None)
         known = ", ".join(sorted(_REGISTRY))
         raise ValueError(f"`task_id` must be one of {known}; got {task_id!r}") from None
 
 
 def all_tasks() -> dict[str, Task | ExplorationTask]:
-    """Every registered task by id."""
+    """Every task of every chapter by id."""
+    _loader(None)
     return dict(_REGISTRY)
 
 
@@ -465,4 +479,5 @@ def tasks_of(prefix: str) -> Iterable[str]:
     list of str
         The matching ids, sorted.
     """
-    return sorted(k for k in all_tasks() if k.startswith(prefix))
+    _loader(prefix[:2] if len(prefix) >= 2 else None)
+    return sorted(k for k in _REGISTRY if k.startswith(prefix))
