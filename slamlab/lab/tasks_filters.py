@@ -232,7 +232,7 @@ def _q_single_run_interval() -> float:
 
 
 def _rmse_quarter_metre() -> float:
-    from ..filters.experiments import run_cv_target
+    from ..filters import run_cv_target
 
     return run_cv_target(n_runs=50, n_steps=50, accel_std=0.2, pos_std_m=0.25, rng=2010,
                          progress=False).rmse_pos_m
