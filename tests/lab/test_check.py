@@ -108,14 +108,37 @@ def test_autograder_mode_raises_on_anything_but_a_pass(monkeypatch):
         lab.check("01.kf_predict", lambda x, P, F, Q: (_ for _ in ()).throw(NotImplementedError), quiet=True)
 
 
-def test_exploration_answers():
-    from slamlab.filters.experiments import run_stabilising_noise
+def test_q_scale_range_is_filterpys_ekf_and_equals_the_library_run():
+    import inspect
 
-    res = run_stabilising_noise(scales=(1.0, 2.0, 4.0, 8.0, 16.0), n_runs=30, n_steps=60, rng=2010, progress=False)
-    lo, hi = res.nees_bounds
-    smallest = res.scales[(res.mean_nees >= lo) & (res.mean_nees <= hi)].min()
-    assert lab.answer("01.explore.q_scale", smallest, quiet=True).passed
-    assert lab.answer("01.explore.q_scale", smallest / 2, quiet=True).status == "failed"
+    from scipy.stats import chi2
+
+    from slamlab.filters import default_landmarks, run_stabilising_noise, run_unicycle_comparison
+    from slamlab.lab import tasks_filters as tf
+
+    d = {k: p.default for k, p in inspect.signature(run_unicycle_comparison).parameters.items()}
+    assert (d["dt_s"], d["speed_mps"], d["turn_rate_degps"], d["v_std_mps"], d["omega_std_degps"], d["range_std_m"],
+            d["bearing_std_deg"], d["init_pos_std_m"], d["init_heading_std_deg"]) == (
+        0.5, 1.0, 11.46, 0.2, 10.0, 0.5, 10.0, 1.0, 90.0)  # the scenario tasks_filters simulates for filterpy
+    np.testing.assert_array_equal(default_landmarks(), [[0.0, 5.0], [4.0, 8.0], [-4.0, 2.0]])
+    mean, (lo, hi) = tf.q_scale_study_filterpy()
+    res = run_stabilising_noise(scales=tf.EXPLORE_Q_SCALES, n_runs=30, n_steps=60, rng=2010, progress=False)
+    np.testing.assert_allclose(mean, res.mean_nees, rtol=1e-8)  # filterpy's EKF == the library's, run for run
+    np.testing.assert_allclose((lo, hi), res.nees_bounds, rtol=1e-12)
+    inside = [s for s, m in zip(tf.EXPLORE_Q_SCALES, mean, strict=True) if lo <= m <= hi]
+    t = lab.task("01.explore.q_scale")
+    assert t.accepted_range() == (min(inside), min(inside))
+    assert lab.answer("01.explore.q_scale", res.scales[(res.mean_nees >= lo) & (res.mean_nees <= hi)].min(),
+                      quiet=True).passed
+    below = max(s for s in tf.EXPLORE_Q_SCALES if s < min(inside))
+    assert mean[tf.EXPLORE_Q_SCALES.index(below)] > hi  # the grid step below is over-confident
+    for value, words in ((below, "last one that fails"), (tf.EXPLORE_Q_SCALES[int(np.argmin(abs(mean - 3)))],
+                                                           "nearest the state dimension"),
+                         (min(s for s, m in zip(tf.EXPLORE_Q_SCALES, mean, strict=True)
+                              if chi2.ppf(0.025, 3) <= m <= chi2.ppf(0.975, 3)), "one run's NEES")):
+        res_w = lab.answer("01.explore.q_scale", value, quiet=True)
+        assert res_w.status == "failed"
+        assert words in res_w.message
     assert lab.answer("01.explore.q_scale", None, quiet=True).status == "not done yet"
     assert lab.answer("01.explore.q_scale", "eight", quiet=True).status == "failed"
 

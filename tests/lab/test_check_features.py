@@ -110,6 +110,32 @@ def test_lab02_uint8_overflow_case_alone():
     assert "I_p + t overflows uint8" in lab.check("02.fast_mask", uint8_only_when_bright, quiet=True).message
 
 
+def _hint_of(task_id, value):
+    res = lab.answer(task_id, value, quiet=True)
+    assert res.status == "failed"
+    return res.message
+
+
+@pytest.mark.realdata
+def test_lab02_wall_range_is_a_brute_force_count_equal_to_the_library(shared_data):
+    import slamlab as sl
+    from slamlab.lab.features_checks import wall_repeatability_brute_force
+
+    names, rep = wall_repeatability_brute_force()
+    ev = sl.features.run_pair_evaluation(("wall",), (2, 3, 4, 5, 6), scale=0.5, n_points=500, progress=False)
+    assert names == ev.detectors
+    np.testing.assert_allclose(rep, ev.rep[0], rtol=0, atol=1e-12)  # kd-tree count == all pairwise distances
+    means = rep.mean(axis=0)
+    best = float(means.max())
+    assert lab.task("02.explore.wall_repeatability").accepted_range() == pytest.approx((best - 0.005, best + 0.005))
+    for k in range(len(names)):  # any detector's mean to two decimals: only the best one's passes
+        assert lab.answer("02.explore.wall_repeatability", round(float(means[k]), 2), quiet=True).passed == (
+            means[k] == best)
+    assert "percent" in _hint_of("02.explore.wall_repeatability", 100 * round(best, 2))
+    assert "one pair's" in _hint_of("02.explore.wall_repeatability", round(float(rep.max()), 2))
+    assert "averages the detectors" in _hint_of("02.explore.wall_repeatability", float(rep.mean()))
+
+
 @pytest.mark.realdata
 @pytest.mark.slow
 def test_lab02_exploration_answers(shared_data):
@@ -120,10 +146,6 @@ def test_lab02_exploration_answers(shared_data):
     assert lab.answer("02.explore.fast_threshold", t, quiet=True).passed
     assert lab.answer("02.explore.fast_threshold", t - 5, quiet=True).status == "failed"
 
-    ev = sl.features.run_pair_evaluation(("wall",), (2, 3, 4, 5, 6), scale=0.5, n_points=500)
-    best = max(float(np.mean(ev.rep[0, :, k])) for k in range(len(ev.detectors)))
-    assert lab.answer("02.explore.wall_repeatability", round(best, 2), quiet=True).passed
-    assert lab.answer("02.explore.wall_repeatability", best - 0.02, quiet=True).status == "failed"
 
 
 # --- lab 03: independent solutions ------------------------------------------------------------------
@@ -216,17 +238,43 @@ def test_lab03_mistakes():
 
 
 @pytest.mark.realdata
-@pytest.mark.slow
-def test_lab03_exploration_answers(shared_data):
+def test_lab03_budget_range_from_exact_neighbours_over_three_query_sets(shared_data):
     import slamlab as sl
-    from slamlab.lab.tasks_features import EXPLORE_BUDGETS, EXPLORE_RATIOS
+    from slamlab.lab.tasks_features import EXPLORE_BUDGETS, bbf_recall_exact_truth
 
-    c = sl.features.run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200)
-    budget = next(int(b) for b, r in zip(c.budgets, c.recall_bbf, strict=True) if r >= 0.9)
-    assert lab.answer("03.explore.bbf_budget", budget, quiet=True).passed
-    assert lab.answer("03.explore.bbf_budget", 200, quiet=True).status == "failed"
+    curves = bbf_recall_exact_truth(EXPLORE_BUDGETS)
+    lib = sl.features.run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200, progress=False)
+    np.testing.assert_array_equal(curves["ranks 0-199"], lib.recall_bbf)  # SciPy's truth == the library's
+    firsts = {next(b for b, r in zip(EXPLORE_BUDGETS, c, strict=True) if r >= 0.9) for c in curves.values()}
+    lo, hi = lab.task("03.explore.bbf_budget").accepted_range()
+    assert (lo, hi) == (min(firsts), max(firsts))
+    assert lab.answer("03.explore.bbf_budget", float(lib.budgets[lib.recall_bbf >= 0.9].min()), quiet=True).passed
+    k = EXPLORE_BUDGETS.index(int(lo))
+    assert all(c[k - 1] < 0.9 for c in curves.values())  # the budget below fails for every query set
+    assert "last budget that fails" in _hint_of("03.explore.bbf_budget", EXPLORE_BUDGETS[k - 1])
+    assert "smallest budget that already" in _hint_of("03.explore.bbf_budget", EXPLORE_BUDGETS[-1])
 
-    tr = sl.features.run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
-    best = max(r for r, p in zip(tr.ratios, tr.precision, strict=True) if p >= 0.9)
-    assert lab.answer("03.explore.precise_ratio", best, quiet=True).passed
-    assert lab.answer("03.explore.precise_ratio", best + 0.05, quiet=True).status == "failed"
+
+@pytest.mark.realdata
+def test_lab03_ratio_range_from_a_brute_force_matcher(shared_data):
+    import slamlab as sl
+    from slamlab.lab.tasks_features import EXPLORE_RATIOS, ratio_precision_independent
+
+    img1, img2, H = sl.features.load_oxford_pair("boat", 2, scale=0.5)
+    f1, f2 = (sl.features.detect(i, "surf", max_points=1000, threshold=1e-4) for i in (img1, img2))
+    dist, idx = two_nn(f1.descriptors, f2.descriptors)  # this file's brute-force 2-NN
+    p = np.c_[f1.uv, np.ones(len(f1))] @ H.T
+    ok = np.hypot(*(p[:, :2] / p[:, 2:] - f2.uv[idx[:, 0]]).T) < 2.5
+    prec = np.array([ok[dist[:, 0] < r * dist[:, 1]].mean() for r in EXPLORE_RATIOS])
+    np.testing.assert_allclose(prec, ratio_precision_independent(EXPLORE_RATIOS))
+    lib = sl.features.run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
+    np.testing.assert_allclose(prec, lib.precision)
+    holds = [r for r, q in zip(EXPLORE_RATIOS, prec, strict=True) if q >= 0.9]
+    lo, hi = lab.task("03.explore.precise_ratio").accepted_range()
+    assert (lo, hi) == pytest.approx((max(holds) - 0.005, max(holds) + 0.005))
+    assert lab.answer("03.explore.precise_ratio", 0.3 + 0.05 * EXPLORE_RATIOS.index(max(holds)), quiet=True).passed
+    first_fail = next(r for r, q in zip(EXPLORE_RATIOS, prec, strict=True) if q < 0.9)
+    assert first_fail < max(holds)  # precision is not monotonic: a search stopping at the first failure is wrong
+    assert "stopped at the first ratio" in _hint_of("03.explore.precise_ratio", round(first_fail - 0.05, 2))
+    assert "first ratio that fails" in _hint_of("03.explore.precise_ratio", round(max(holds) + 0.05, 2))
+    assert "strictest" in _hint_of("03.explore.precise_ratio", min(holds))
