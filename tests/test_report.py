@@ -65,10 +65,14 @@ def test_parse_params_reads_literals_and_words():
 @pytest.mark.slow
 @pytest.mark.realdata
 def test_report_runs_notebook_06_with_fewer_poses(tmp_path, shared_data):
-    params = report.parse_params(["TABLE1_POSES=3", "MC_SIZE=4", "CONSTANTS_POSES=2"])
+    params = report.parse_params(["TABLE1_POSES=3", "MC_SIZE=4", "CONSTANTS_POSES=2", "LOG_EVERY=300",
+                                  "LOG_JOINED=(1, 3)"])
     out = report.run_report("06", params, tmp_path)
-    assert out.name == "06_correlation_localisation-TABLE1_POSES=3-MC_SIZE=4-CONSTANTS_POSES=2.ipynb"
+    assert out.name == ("06_correlation_localisation-TABLE1_POSES=3-MC_SIZE=4-CONSTANTS_POSES=2-LOG_EVERY=300-"
+                        "LOG_JOINED=(1,3).ipynb")
     text = _outputs(nbformat.read(out, as_version=4))
+    assert "every 300th from 300 to 900" in text
+    assert "every 100th" not in text
     # the stored notebook says 10 / 12 / 6 poses
     assert "Table 1, 3 poses" in text
     assert "Monte Carlo, 4 poses" in text

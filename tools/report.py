@@ -52,7 +52,18 @@ def parse_params(items: list[str]) -> dict[str, object]:
 def run_report(number: str, params: dict[str, object], out_dir: Path = REPORT_DIR) -> Path:
     """Execute notebook ``number`` with ``params``; return the path of the executed copy."""
     import papermill as pm
+    from papermill.translators import PythonTranslator, papermill_translators
 
+    class TupleTranslator(PythonTranslator):
+        """papermill's Python translator writes a tuple as its str in quotes; this one writes a tuple."""
+
+        @classmethod
+        def translate(cls, val):
+            if isinstance(val, tuple):
+                return "(" + "".join(f"{cls.translate(x)}, " for x in val) + ")"
+            return super().translate(val)
+
+    papermill_translators.register("python", TupleTranslator)
     src = find_notebook(number)
     suffix = "".join(f"-{k}={v}" for k, v in params.items()).replace("/", "_").replace(" ", "")
     out_dir.mkdir(parents=True, exist_ok=True)
