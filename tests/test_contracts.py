@@ -25,7 +25,7 @@ _NO_PIPELINE = ("no pipeline Params dataclass: a textbook experiment whose every
 #: function (module.name) -> {missing parameter: why it makes no sense there}
 ALLOWED: dict[str, dict[str, str]] = {
     # correlation: the constructed corridor is built without noise; its settings are LocaliseParams (params=)
-    "slamlab.correlation.experiments.corridor.run_corridor_tie": {"rng": _NO_RANDOMNESS + " (a noise-free corridor)"},
+    "slamlab.correlation.experiments.run_corridor_tie": {"rng": _NO_RANDOMNESS + " (a noise-free corridor)"},
     # features: detectors and matchers on the Oxford images; their settings are the detectors' own arguments
     "slamlab.features.experiments.run_pair_evaluation": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.detector_experiments.run_detector_summary": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
@@ -36,12 +36,12 @@ ALLOWED: dict[str, dict[str, str]] = {
     "slamlab.features.matching_experiments.run_ratio_tradeoff": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     "slamlab.features.detector_experiments.run_blob_scale": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     # filters: each experiment is one model (F, Q, H, R from its keywords) run through the filters
-    "slamlab.filters.experiments.linear.run_cv_target": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.linear.run_joseph_vs_short": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.unicycle.run_unicycle_comparison": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.unicycle.run_stabilising_noise": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.linear.run_sigma_alpha_study": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.landmarks.run_landmark_filter": {"params": _NO_PIPELINE},
+    "slamlab.filters.experiments.run_cv_target": {"params": _NO_PIPELINE},
+    "slamlab.filters.studies.run_joseph_vs_short": {"params": _NO_PIPELINE},
+    "slamlab.filters.experiments.run_unicycle_comparison": {"params": _NO_PIPELINE},
+    "slamlab.filters.experiments.run_stabilising_noise": {"params": _NO_PIPELINE},
+    "slamlab.filters.experiments.run_sigma_alpha_study": {"params": _NO_PIPELINE},
+    "slamlab.filters.studies.run_landmark_filter": {"params": _NO_PIPELINE},
     # hough
     "slamlab.hough.example.run_example_line": {
         "params": "004's worked example: one line, both transforms at 004's resolutions (no Hough SLAM run)",

@@ -108,27 +108,10 @@ def test_import_graph_has_no_cycle_across_subpackages():
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles)
 
 
-def _may_import_sim(module: str) -> bool:
-    """An experiments/widgets/plot module, a package's ``__init__``, or a family module of an ``experiments``
-    package (CONVENTIONS: experiments.py split by experiment family into ``<pkg>/experiments/<family>.py``)."""
-    parts = module.split(".")
-    return parts[-1] in SIM_USERS or (len(parts) > 2 and parts[-2] == "experiments") or module == "slamlab"
-
-
-def test_only_experiment_modules_may_import_sim():
-    assert _may_import_sim("slamlab.filters.experiments")
-    assert _may_import_sim("slamlab.filters.experiments.unicycle")
-    assert _may_import_sim("slamlab.stereo.widgets")
-    # an algorithm module elsewhere still may not, whatever its name says
-    assert not _may_import_sim("slamlab.filters.unicycle")
-    assert not _may_import_sim("slamlab.filters.unicycle_experiments")
-    assert not _may_import_sim("slamlab.filters.experiments_helpers.unicycle")
-    assert not _may_import_sim("slamlab.filters.linear.experiments_family")
-
-
 def test_algorithm_modules_never_import_sim():
     bad = [f"{m} -> {t}" for m, targets in _graph().items() for t in targets
-           if _subpackage(t) == "sim" and _subpackage(m) != "sim" and not _may_import_sim(m)]
+           if _subpackage(t) == "sim" and _subpackage(m) != "sim" and m.split(".")[-1] not in SIM_USERS
+           and m != "slamlab"]
     assert not bad, "algorithm modules import slamlab.sim: " + ", ".join(sorted(bad))
 
 

@@ -36,7 +36,7 @@ from .experiments import (
     Table1Result,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
-from .experiments.common import _errors
+from .studies import _errors
 
 __all__ = [
     "DEFAULT_CARMEN_LOG",

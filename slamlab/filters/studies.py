@@ -1,57 +1,63 @@
-"""Ch. 1 experiment on the static-landmark filter (000 §3.6): error vs number of sightings."""
+"""Ch. 1 studies that need no simulated world (000 §1.2.1, §3.6): the Joseph form against the short form, the
+static-landmark filter, and the landmark layout of the unicycle scenario."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ... import _validate as v
-from ..._table import format_table
+from .. import _validate as v
+from .kalman import kf_update
+from .results import JosephResult, LandmarkDemoResult
 
-# --- the static-landmark filter of 000 §3.6 ---------------------------------------------------------
 
+def run_joseph_vs_short(gain_scales=(0.0, 0.5, 0.8, 1.0, 1.2, 1.5, 2.0), *, n_samples: int = 100_000,
+                        rng=2010) -> JosephResult:
+    """Scale the optimal gain and compare both covariance updates with the sampled error variance.
 
-@dataclass(frozen=True)
-class LandmarkDemoResult:
-    """Static landmarks refined by the §3.6 filter: error vs number of sightings.
+    One position/velocity prior, a position measurement; the true posterior
+    error is sampled ``n_samples`` times per gain.
 
-    Attributes
+    Parameters
     ----------
-    sightings : numpy.ndarray of int, shape (S,)
-        Sighting counts reported.
-    rmse_filtered_m : numpy.ndarray, shape (S,)
-        RMSE per coordinate of the filtered landmarks after that many sightings [m].
-    rmse_single_m : numpy.ndarray, shape (S,)
-        RMSE of the latest single sighting [m].
-    predicted_std_m : numpy.ndarray, shape (S,)
-        RMS of the filter's predicted std per coordinate [m].
-    n_landmarks : int
-        Landmarks observed.
+    gain_scales : sequence of float
+        Multiples of the optimal gain to try.
+    n_samples : int, default 100000
+        Sampled prior states and measurements (at least 100).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator of the samples.
+
+    Returns
+    -------
+    JosephResult
     """
+    g = v.as_rng(rng)
+    n_samples = v.check_int(n_samples, "n_samples", minimum=100)
+    scales = v.as_vector(gain_scales, "gain_scales")
+    P = np.array([[4.0, 1.0], [1.0, 1.0]])
+    H, R = np.array([[1.0, 0.0]]), np.array([[1.0]])
+    x = np.zeros(2)
+    K_opt = kf_update(x, P, [0.0], H, R).K
+    x_true = g.multivariate_normal(x, P, size=n_samples)
+    z = x_true @ H.T + g.normal(size=(n_samples, 1))
+    vs, vj, vm = [], [], []
+    for s in scales:
+        K = s * K_opt
+        vs.append(kf_update(x, P, [0.0], H, R, form="short", K=K).P[0, 0])
+        vj.append(kf_update(x, P, [0.0], H, R, form="joseph", K=K).P[0, 0])
+        err = x_true - (x + (z - x @ H.T) @ K.T)
+        vm.append(np.mean(err[:, 0] ** 2))
+    return JosephResult(scales, np.array(vs), np.array(vj), np.array(vm), n_samples)
 
-    sightings: np.ndarray
-    rmse_filtered_m: np.ndarray
-    rmse_single_m: np.ndarray
-    predicted_std_m: np.ndarray
-    n_landmarks: int
 
-    def __str__(self) -> str:
-        return (f"{self.n_landmarks} landmarks: RMSE {self.rmse_single_m[-1]:.4f} m from one sighting, "
-                f"{self.rmse_filtered_m[-1]:.4f} m after {self.sightings[-1]} sightings")
+def default_landmarks() -> np.ndarray:
+    """Three landmarks near the circular path (start at the origin heading +x, radius 5 m).
 
-    def table(self) -> str:
-        """Table: one row per reported sighting count, with the ``1/sqrt(n)`` reference.
-
-        Returns
-        -------
-        str
-        """
-        rows = [[f"{n}", f"{f:.4f}", f"{p:.4f}", f"{s:.4f}", f"{s / np.sqrt(n):.4f}"]
-                for n, f, p, s in zip(self.sightings, self.rmse_filtered_m, self.predicted_std_m,
-                                      self.rmse_single_m, strict=True)]
-        return format_table(["sightings", "filtered RMSE [m]", "predicted [m]", "one sighting [m]",
-                             "one / sqrt(n) [m]"], rows)
+    Returns
+    -------
+    numpy.ndarray, shape (3, 2)
+        Landmark positions [m].
+    """
+    return np.array([[0.0, 5.0], [4.0, 8.0], [-4.0, 2.0]])
 
 
 def run_landmark_filter(n_landmarks: int = 500, n_sightings: int = 20, *, obs_std_m: float = 0.05,
@@ -81,7 +87,7 @@ def run_landmark_filter(n_landmarks: int = 500, n_sightings: int = 20, *, obs_st
     -------
     LandmarkDemoResult
     """
-    from ..landmark import LandmarkFilter
+    from .landmark import LandmarkFilter
 
     g = v.as_rng(rng)
     n_landmarks = v.check_int(n_landmarks, "n_landmarks", minimum=1)

@@ -1,16 +1,18 @@
-"""Ch. 1's closing table (000 §1.2, §3.6): the source's claims beside the seeded results of the experiment families."""
+"""Ch. 1's closing table (000 §1.2, §3.6): the source's claims beside the seeded results of the experiments."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..._table import format_table
-from ._common import _nanmean
-from .landmarks import LandmarkDemoResult
-from .linear import CVTargetResult, JosephResult
-from .unicycle import StabilisingNoiseResult, UnicycleResult
-
-# --- Ours vs the source ---------------------------------------------------------------------------
+from .._table import format_table
+from .results import (
+    CVTargetResult,
+    JosephResult,
+    LandmarkDemoResult,
+    StabilisingNoiseResult,
+    UnicycleResult,
+    _nanmean,
+)
 
 
 def _filter_row(res: UnicycleResult, name: str) -> int:

@@ -1,115 +1,174 @@
-"""Ch. 1 experiments on the range-bearing unicycle (000 §1.2.2, §1.2.3): where LKF, EKF and UKF differ; stabilising noise."""
+"""Ch. 1 experiments (000 §1.2): seeded Monte Carlo runs returning printable results.
+
+Each ``run_*`` returns a frozen dataclass: ``str(result)`` is a one-line summary,
+``result.table()`` a fixed-precision text table (what the notebook prints and
+nbval compares); arrays for plotting are kept in fields.
+
+This module builds the simulated worlds and runs the experiments on them (constant-velocity target,
+sigma-point weight, unicycle filter comparison, stabilising noise); the result dataclasses and the Monte
+Carlo loop live in :mod:`.results`, the sim-free studies in :mod:`.studies`, the closing table in
+:mod:`.source_table` (all re-exported here).
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
-from ... import _validate as v
-from ..._table import format_table
-from ...sim import RangeBearingSensor, UnicycleModel, simulate_unicycle
-from ..consistency import chi2_interval, nees
-from ..ekf import ExtendedKalmanFilter
-from ..kalman import _predict, _update
-from ..ukf import UnscentedKalmanFilter
-from ._common import DIVERGED_RMSE_M, FILTER_NAMES, _monte_carlo, _nanmean
+from .. import _validate as v
+from ..sim import (
+    RangeBearingSensor,
+    UnicycleModel,
+    constant_velocity_model,
+    simulate_linear,
+    simulate_unicycle,
+)
+from .consistency import chi2_interval, nees
+from .ekf import ExtendedKalmanFilter
+from .kalman import KalmanFilter, _predict, _update
+from .results import (
+    DIVERGED_RMSE_M,
+    FILTER_NAMES,
+    CVTargetResult,
+    JosephResult,
+    LandmarkDemoResult,
+    SigmaAlphaResult,
+    StabilisingNoiseResult,
+    UnicycleResult,
+    _monte_carlo,
+    _nanmean,
+)
+from .source_table import ours_vs_source
+from .studies import default_landmarks, run_joseph_vs_short, run_landmark_filter
+from .ukf import UnscentedKalmanFilter, sigma_weights, ukf_predict, ukf_update
 
-# --- unicycle with range-bearing landmarks: where the filters differ -----------------------------
+__all__ = [
+    "DIVERGED_RMSE_M",
+    "FILTER_NAMES",
+    "CVTargetResult",
+    "JosephResult",
+    "LandmarkDemoResult",
+    "SigmaAlphaResult",
+    "StabilisingNoiseResult",
+    "UnicycleResult",
+    "default_landmarks",
+    "ours_vs_source",
+    "run_cv_target",
+    "run_joseph_vs_short",
+    "run_landmark_filter",
+    "run_sigma_alpha_study",
+    "run_stabilising_noise",
+    "run_unicycle_comparison",
+]
 
 
-def default_landmarks() -> np.ndarray:
-    """Three landmarks near the circular path (start at the origin heading +x, radius 5 m).
+def _cv_run(*, F, Q, H, R, P0, n_steps: int, rng: np.random.Generator) -> dict:
+    """One Monte Carlo run of the constant-velocity target: squared errors, NEES and NIS per step."""
+    x_true0 = rng.multivariate_normal(np.array([0.0, 1.0, 0.0, 0.5]), P0)
+    X, Z = simulate_linear(F, Q, H, R, x_true0, n_steps, rng=rng)
+    kf = KalmanFilter(np.array([0.0, 1.0, 0.0, 0.5]), P0, F, Q, H, R)
+    est = np.empty_like(X)
+    nees_k, nis_k = np.empty(n_steps), np.empty(n_steps)
+    var_pred = 0.0
+    for k in range(n_steps):
+        kf.predict()
+        kf.update(Z[k])
+        est[k] = kf.x
+        nees_k[k] = nees(X[k] - kf.x, kf.P)
+        nis_k[k] = nees(kf.y, kf.S)
+        var_pred += kf.P[0, 0] + kf.P[2, 2]
+    return {"se_pos": float(np.sum((est[:, [0, 2]] - X[:, [0, 2]]) ** 2)),
+            "se_meas": float(np.sum((Z - X[:, [0, 2]]) ** 2)), "var_pred": var_pred,
+            "nees": nees_k, "nis": nis_k, "example": (X, Z, est)}
+
+
+def run_cv_target(n_runs: int = 50, n_steps: int = 50, *, dt_s: float = 1.0, accel_std: float = 0.2,
+                  pos_std_m: float = 1.0, rng=2010, n_jobs: int = 1, progress: bool | None = None) -> CVTargetResult:
+    """Track a 2-D constant-velocity target with the KF over seeded Monte Carlo runs (on :func:`~slamlab.sweep.sweep`).
+
+    Parameters
+    ----------
+    n_runs : int, default 50
+        Monte Carlo runs.
+    n_steps : int, default 50
+        Steps per run.
+    dt_s : float, default 1.0
+        Time step [s].
+    accel_std : float, default 0.2
+        Std of the white acceleration noise [m/s²].
+    pos_std_m : float, default 1.0
+        Std of each position measurement coordinate [m]; also the prior position std.
+    rng : int, numpy.random.Generator or SeedSequence, default 2010
+        Seed or generator; run ``r`` draws from child ``r`` of its seed sequence.
+    n_jobs : int, default 1
+        Worker processes for the runs.
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
 
     Returns
     -------
-    numpy.ndarray, shape (3, 2)
-        Landmark positions [m].
+    CVTargetResult
     """
-    return np.array([[0.0, 5.0], [4.0, 8.0], [-4.0, 2.0]])
+    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
+    n_steps = v.check_int(n_steps, "n_steps", minimum=1)
+    F, Q, H, R = constant_velocity_model(dt_s, accel_std, pos_std_m, dims=2)
+    P0 = np.diag([pos_std_m**2, 1.0, pos_std_m**2, 1.0])
+    runs = _monte_carlo(_cv_run, n_runs, rng, n_jobs, progress, F=F, Q=Q, H=H, R=R, P0=P0, n_steps=n_steps)
+    n = n_runs * n_steps
+    return CVTargetResult(
+        n_runs, n_steps, float(np.sqrt(runs["se_pos"].sum() / n)), float(np.sqrt(runs["se_meas"].sum() / n)),
+        float(np.sqrt(runs["var_pred"].sum() / n)), np.stack(runs["nees"]).mean(axis=0),
+        np.stack(runs["nis"]).mean(axis=0), chi2_interval(4, n_runs), chi2_interval(2, n_runs), *runs["example"][0],
+    )
 
 
-@dataclass(frozen=True)
-class UnicycleResult:
-    """KF/EKF/UKF on the range-bearing unicycle: RMSE and NEES over Monte Carlo runs.
+def run_sigma_alpha_study(alphas=(1e-5, 1e-4, 1e-3, 1e-2, 0.1, 1.0), n_steps: int = 30, *,
+                          form: str = "additive", rng=2010) -> SigmaAlphaResult:
+    """Run the UKF on a linear CV model (where it must equal the KF) for several ``alpha``.
 
-    Attributes
+    The centre weight is ``W_s^0 = 1 - 1/alpha^2`` for ``kappa = 0``: about
+    ``-10^6`` at 000's default ``alpha = 1e-3``. The mean is then a difference of
+    numbers ~10^6 times larger than itself, so rounding errors are amplified.
+
+    Parameters
     ----------
-    filters : tuple of str
-        Filter names, in row order (from ``FILTER_NAMES``).
-    n_runs, n_steps : int
-        Monte Carlo runs and steps per run.
-    params : dict
-        The noise and sigma-point settings of the run.
-    rmse_pos_m : numpy.ndarray, shape (n_filters,)
-        Position RMSE over the runs that did not fail [m].
-    rmse_heading_rad : numpy.ndarray, shape (n_filters,)
-        Heading RMSE [rad].
-    anees : numpy.ndarray, shape (n_filters, n_steps)
-        NEES averaged over runs (dim 3).
-    failures : numpy.ndarray, shape (n_filters,)
-        Runs with a numerical failure (excluded from the averages).
-    run_rmse_pos_m : numpy.ndarray, shape (n_filters, n_runs)
-        Per-run position RMSE, NaN for a failed run [m].
-    nees_bounds : tuple of float
-        95 % chi-square interval of the run-averaged NEES.
-    example_truth : numpy.ndarray, shape (n_steps, 3)
-        First run's true poses ``(x_m, y_m, theta_rad)``.
-    example_est : numpy.ndarray, shape (n_filters, n_steps, 3)
-        First run's estimates.
-    example_P : numpy.ndarray, shape (n_filters, n_steps, 3, 3)
-        First run's covariances.
-    landmarks_m : numpy.ndarray, shape (L, 2)
-        Landmark positions [m].
+    alphas : sequence of float
+        Values of ``alpha`` to try (``kappa = 0``, ``beta = 2``).
+    n_steps : int, default 30
+        Steps of the 1-D constant-velocity run.
+    form : str, default "additive"
+        Not used: the study always runs the additive UKF (the model is linear with additive noise).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator of the simulated measurements.
+
+    Returns
+    -------
+    SigmaAlphaResult
     """
-
-    filters: tuple[str, ...]
-    n_runs: int
-    n_steps: int
-    params: dict
-    rmse_pos_m: np.ndarray      # (n_filters,)
-    rmse_heading_rad: np.ndarray
-    anees: np.ndarray           # (n_filters, n_steps) NEES averaged over runs
-    failures: np.ndarray        # (n_filters,) runs with a numerical failure (then excluded)
-    run_rmse_pos_m: np.ndarray  # (n_filters, n_runs) per-run position RMSE (NaN for a failed run)
-    nees_bounds: tuple[float, float]
-    example_truth: np.ndarray = field(repr=False)
-    example_est: np.ndarray = field(repr=False)     # (n_filters, n_steps, 3)
-    example_P: np.ndarray = field(repr=False)       # (n_filters, n_steps, 3, 3)
-    landmarks_m: np.ndarray = field(repr=False)
-
-    def __str__(self) -> str:
-        finite = np.where(np.isfinite(self.rmse_pos_m), self.rmse_pos_m, np.inf)
-        best = self.filters[int(np.argmin(finite))]
-        return (f"Unicycle, {self.n_runs} runs x {self.n_steps} steps: lowest position RMSE {best}; "
-                + ", ".join(f"{f} {r:.3f} m" for f, r in zip(self.filters, self.rmse_pos_m, strict=True)))
-
-    @property
-    def diverged(self) -> np.ndarray:
-        """Runs per filter whose position RMSE exceeds ``DIVERGED_RMSE_M`` (failed runs not included)."""
-        return np.sum(np.nan_to_num(self.run_rmse_pos_m, nan=0.0) > DIVERGED_RMSE_M, axis=1)
-
-    def table(self) -> str:
-        """Fixed-precision table: one row per filter (RMSEs, NEES, diverged and failed runs).
-
-        Returns
-        -------
-        str
-        """
-        lo, hi = self.nees_bounds
-        rows = []
-        for i, name in enumerate(self.filters):
-            a = self.anees[i]
-            ok = np.isfinite(self.run_rmse_pos_m[i])
-            med = np.median(self.run_rmse_pos_m[i, ok]) if ok.any() else np.nan
-            rows.append([name, f"{self.rmse_pos_m[i]:.3f}", f"{med:.3f}",
-                         f"{np.rad2deg(self.rmse_heading_rad[i]):.2f}", f"{_nanmean(a):.2f}",
-                         f"{_nanmean(np.where(np.isfinite(a), (a >= lo) & (a <= hi), np.nan)):.0%}",
-                         f"{int(self.diverged[i])}",
-                         f"{int(self.failures[i])}"])
-        return format_table(["filter", "pos RMSE [m]", "median run [m]", "heading RMSE [deg]", "mean NEES (3)",
-                             f"NEES in [{lo:.2f}, {hi:.2f}]", f"diverged (>{DIVERGED_RMSE_M:g} m)", "failed"],
-                            rows)
+    alphas = v.as_vector(alphas, "alphas")
+    F, Q, H, R = constant_velocity_model(1.0, 0.5, 1.0, dims=1)
+    _, Z = simulate_linear(F, Q, H, R, [100.0, 1.0], n_steps, rng=rng)
+    w0, eP, ex = [], [], []
+    for a in alphas:
+        w0.append(sigma_weights(2, float(a))[0][0])
+        xk, Pk = np.array([100.0, 1.0]), 10 * np.eye(2)
+        xu, Pu = xk.copy(), Pk.copy()
+        worst_P = worst_x = 0.0
+        try:
+            for z in Z:
+                xk, Pk = _predict(xk, Pk, F, Q)
+                xu, Pu = ukf_predict(xu, Pu, lambda x, u: x @ F.T, Q, form="additive", alpha=float(a),
+                                     vectorized=True)
+                upk = _update(xk, Pk, z - H @ xk, H, R)
+                upu = ukf_update(xu, Pu, z, lambda x: x @ H.T, R, form="additive", alpha=float(a),
+                                 vectorized=True)
+                xk, Pk, xu, Pu = upk.x, upk.P, upu.x, upu.P
+                worst_P = max(worst_P, np.max(np.abs(Pu - Pk)) / np.max(np.abs(Pk)))
+                worst_x = max(worst_x, np.max(np.abs(xu - xk)) / np.max(np.abs(xk)))
+        except np.linalg.LinAlgError:
+            worst_P = worst_x = np.inf
+        eP.append(worst_P)
+        ex.append(worst_x)
+    return SigmaAlphaResult(alphas, np.array(w0), np.array(eP), np.array(ex), n_steps)
 
 
 def _make_filters(names, x0, P0, model, sensor, u0, alpha, beta, kappa, q_scale):
@@ -286,51 +345,6 @@ def run_unicycle_comparison(n_runs: int = 30, n_steps: int = 60, *, filters=FILT
     ok_runs = max(1, int(n_runs - failures.max()))
     return UnicycleResult(filters, n_runs, n_steps, params, rmse_pos, rmse_head, anees, failures, run_rmse,
                           chi2_interval(3, ok_runs), ex_truth, ex_est, ex_P, sensor.landmarks_m)
-
-
-# --- 000's "stabilising noise" for the EKF ----------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class StabilisingNoiseResult:
-    """EKF consistency as the assumed process noise is inflated.
-
-    Attributes
-    ----------
-    scales : numpy.ndarray, shape (S,)
-        Process-noise factors tried.
-    rmse_pos_m : numpy.ndarray, shape (S,)
-        EKF position RMSE per factor [m].
-    mean_nees : numpy.ndarray, shape (S,)
-        EKF NEES averaged over runs and steps per factor (consistent: 3).
-    nees_bounds : tuple of float
-        95 % chi-square interval of the run-averaged NEES.
-    n_runs : int
-        Monte Carlo runs per factor.
-    """
-
-    scales: np.ndarray
-    rmse_pos_m: np.ndarray
-    mean_nees: np.ndarray
-    nees_bounds: tuple[float, float]
-    n_runs: int
-
-    def __str__(self) -> str:
-        return (f"EKF mean NEES {self.mean_nees[0]:.1f} without stabilising noise, "
-                f"{self.mean_nees[-1]:.1f} with x{self.scales[-1]:g} process noise (consistent: 3)")
-
-    def table(self) -> str:
-        """Table: one row per Q scale, RMSE, mean NEES and whether it lies in the bounds.
-
-        Returns
-        -------
-        str
-        """
-        lo, hi = self.nees_bounds
-        rows = [[f"{s:g}", f"{r:.3f}", f"{n:.2f}", "yes" if lo <= n <= hi else ("over-confident" if n > hi else
-                                                                                   "pessimistic")]
-                for s, r, n in zip(self.scales, self.rmse_pos_m, self.mean_nees, strict=True)]
-        return format_table(["Q scale", "pos RMSE [m]", "mean NEES (3)", f"in [{lo:.2f}, {hi:.2f}]?"], rows)
 
 
 def run_stabilising_noise(scales=(1.0, 2.0, 4.0, 8.0), n_runs: int = 30, n_steps: int = 60, *, rng=2010,

@@ -1,69 +1,25 @@
-"""What the ch. 5 experiment families share (004 §7): the test room, its clutter and the rangefinder,
-the failure thresholds, the localisations on :func:`slamlab.sweep.sweep` and their errors.
-"""
+"""Ch. 5 study helpers that need no simulated world (004 §7): the failure thresholds, localising a batch of scans on
+:func:`slamlab.sweep.sweep` with their errors and margins, 004's Table 1, the constructed corridor and the timing of
+:func:`~slamlab.correlation.localise` (the simulated runs live in :mod:`.experiments`)."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
-from ... import _validate as v
-from ...scans import grid_to_values
-from ...sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
-from ...sim.rangefinder import Rangefinder
-from ..algorithm import _localise, _scan_beams, heading_candidates, heading_error
-
-__all__ = ["FAIL_CELLS", "FAIL_DEG", "random_clutter"]
-
+from ..scans import FREE, OBSTACLE, UNEXPLORED, grid_to_values
+from .algorithm import (
+    _localise,
+    _scan_beams,
+    heading_candidates,
+    heading_error,
+    localise,
+)
 
 FAIL_CELLS = 2.0  # a localisation farther than this from the truth (or > FAIL_DEG off) is a failure
+
 FAIL_DEG = 5.0
-
-
-def _sensor(n_beams, max_range_cells, range_std_cells, quantum_cells=0.1) -> Rangefinder:
-    return Rangefinder(n_beams=n_beams, fov_rad=2 * np.pi, max_range_cells=max_range_cells,
-                       range_std_cells=range_std_cells, quantum_cells=quantum_cells)
-
-
-def _worlds(clutter: bool, extra_clutter: int, rng):
-    M = test_room_200()
-    W = measurement_room_200() if clutter else M.copy()
-    if extra_clutter:
-        W = add_clutter(W, random_clutter(W, extra_clutter, rng=rng))
-    return M, W
-
-
-def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int = 3, rng=None) -> list[tuple]:
-    """``n`` extra unmapped discs ("people's legs", bins) on free cells of ``grid`` (our addition).
-
-    Parameters
-    ----------
-    grid : array_like of int, shape (H, W)
-        Cell codes; discs are centred on free cells.
-    n : int
-        Number of discs.
-    radius_cells : float, default 1.5
-        Disc radius [cells].
-    margin_cells : int, default 3
-        Centres keep this many cells from obstacles (see :func:`slamlab.sim.grid.free_cells`).
-    rng : int or numpy.random.Generator, optional
-        Seed or generator of the centres.
-
-    Returns
-    -------
-    list of tuple
-        ``("disc", col, row, radius_cells)`` shapes for :func:`slamlab.sim.grid.add_clutter`.
-
-    Examples
-    --------
-    >>> len(random_clutter(test_room_200(), 5, rng=0))
-    5
-    """
-    n = v.check_int(n, "n", minimum=0)
-    r = v.check_positive(radius_cells, "radius_cells")
-    rng = v.as_rng(rng)
-    cells = free_cells(grid, margin_cells)
-    pick = cells[rng.integers(0, cells.shape[0], n)]
-    return [("disc", int(c), int(rw), r) for rw, c in pick]
 
 
 def _localise_one(*, beams, choice: int, Mvs, settings, headings, margins: bool = False, pose_index: int = 0) -> dict:
@@ -84,7 +40,7 @@ def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 
     ``pose_index``, ``x``, ``y``, ``heading_rad`` and with ``margins`` ``half_max_area``,
     ``heading_margin``), setting-major.
     """
-    from ...sweep import sweep
+    from ..sweep import sweep
 
     beams = [_scan_beams(s) for s in scans]
     settings = tuple(q.replace(ambiguity=False) for q in settings)  # these runs report no ambiguity: no rival search
@@ -120,3 +76,64 @@ def _margins(loc, heading_window=3):
     bmed = float(np.median(b))
     head = (loc.score - b[far].max()) / max(loc.score - bmed, 1e-12)
     return area, head
+
+
+#: 004 Table 1: α0, α0 est [rad], X, X est, Y, Y est [cells].
+SOURCE_TABLE1 = np.array([
+    [1.8812, 1.885, 187, 187, 15, 15],
+    [0.5225, 0.5236, 30, 30, 175, 175],
+    [3.1297, 3.1241, 173, 173, 94, 94],
+    [1.0738, 1.0821, 69, 69, 58, 58],
+    [5.1389, 5.1487, 181, 181, 188, 188],
+    [3.4681, 3.4732, 167, 167, 103, 102],
+    [0.5715, 0.576, 162, 162, 93, 93],
+    [5.5558, 5.5501, 63, 63, 81, 81],
+    [2.1229, 2.1293, 30, 30, 171, 171],
+    [5.2929, 5.2883, 105, 105, 45, 45],
+])
+
+
+def corridor_grid() -> np.ndarray:
+    """A straight corridor (rows 20..30 free, walls at rows 19 and 31) open at the map's left edge, with a dead
+    end at column 150 (52×160 cells; our test case): symmetric under a half turn wherever a 25-cell scan sees
+    neither end.
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (52, 160)
+        Cell codes.
+
+    Examples
+    --------
+    >>> g = corridor_grid(); g.shape, int(g[25, 150]), int(g[25, 149])
+    ((52, 160), 1, 0)
+    """
+    g = np.full((52, 160), UNEXPLORED, dtype=np.int8)
+    g[19:32, :151] = OBSTACLE
+    g[20:31, :150] = FREE
+    return g
+
+
+def time_localise(grid, scan, *, dtypes=("float64", "float32")) -> dict:
+    """Wall time in seconds of one full 360° :func:`localise` per dtype (volatile: print only in ignored cells).
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Map as cell codes.
+    scan : Scan
+        Scan in cell units.
+    dtypes : sequence of str or dtype
+        FFT precisions to time.
+
+    Returns
+    -------
+    dict
+        dtype name -> seconds.
+    """
+    out = {}
+    for dt in dtypes:
+        t0 = time.perf_counter()
+        localise(grid, scan, dtype=np.dtype(dt).name)
+        out[np.dtype(dt).name] = time.perf_counter() - t0
+    return out

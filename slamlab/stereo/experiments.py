@@ -1,159 +1,53 @@
-"""Stereo SLAM on rendered arena runs (000 §3.7): the result, the runner, 000's turn in place and closed loop."""
+"""Ch. 4 experiments (000 §3.7): the stereo SLAM loop on rendered arena runs, against ground truth (KITTI and the
+closing table: :mod:`.kitti_experiments`).
+
+``run_turn_in_place`` (000 §3.7.1) and ``run_closed_loop`` (000 §3.7.2) return a
+frozen :class:`StereoRunResult`; ``str(result)`` is a one-line summary and
+``result.table()`` prints our figures beside 000's. Timings live in ``stage_time_s``
+and ``fps`` only, never in the table.
+
+This module renders the arena and runs the pipeline on it (the runner, the turn in place, the closed loop,
+the comparison, the drift study, the recorded store calls, the disparity check); the result dataclasses and
+tables live in :mod:`.run_results`, the disparity error table in :mod:`.disparity_check` (re-exported here).
+"""
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
-from ..._progress import progress_bar
-from ..._table import format_table
-from ...geometry import wrap_angle
-from ...geometry.camera import StereoRig
-from ...geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
-from ...kdtree.stores import LandmarkStore
-from ...sim.arena import StereoArena, StereoSim
-from ...sim.stereo_paths import rectangular_loop, turn_in_place
-from ..params import RenderParams, StereoParams
-from ..slam import STAGES, StereoSLAM
+from .. import _validate as v
+from .._progress import progress_bar
+from ..geometry import wrap_angle
+from ..geometry.camera import StereoRig
+from ..geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
+from ..kdtree.stores import ExactStore, LandmarkStore
+from ..kdtree.workloads import RecordingStore, Workload
+from ..sim.arena import StereoArena, StereoSim
+from ..sim.stereo_paths import rectangular_loop, turn_in_place
+from .disparity_check import disparity_error_table
+from .params import RenderParams, StereoParams
+from .run_results import COMPARISON, SIZES, DriftStudy, StereoRunResult, _first, comparison_table
+from .slam import StereoSLAM
 
-#: frame steps per size: (turn step deg, loop step m, loop turn step deg)
-SIZES = {"small": (10.0, 0.5, 20.0), "full": (5.0, 0.25, 15.0)}
-
-
-@dataclass(frozen=True)
-class StereoRunResult:
-    """One stereo SLAM run on a rendered trajectory, errors against the ground truth (000 §3.7).
-
-    Attributes
-    ----------
-    name : str
-        Run label.
-    params : StereoParams
-        Pipeline settings.
-    n_frames : int
-        Frames processed.
-    truth, estimate : numpy.ndarray, shape (N, 3)
-        ``(x_m, y_m, yaw_rad)`` in the map frame (yaw unwrapped).
-    pos_err_m : numpy.ndarray, shape (N,)
-        Position errors [m].
-    yaw_err_rad : numpy.ndarray, shape (N,)
-        Wrapped yaw errors, estimate minus truth [rad].
-    counts : dict
-        Per-frame counts of :meth:`StereoSLAM.process` (``n_inliers``, ``n_new``...), as arrays (:meth:`StereoSLAM.counts`).
-    landmarks_xy : numpy.ndarray, shape (K, 2)
-        Base landmarks in the map frame [m].
-    degenerate : numpy.ndarray of int
-        Frames that kept the last pose.
-    stage_time_s : dict
-        Per-frame stage times [s] (not compared).
-    fps : float
-        SLAM frames per second, rendering excluded (not compared).
-    """
-
-    name: str
-    params: StereoParams = field(repr=False)
-    n_frames: int
-    truth: np.ndarray = field(repr=False)  # (N, 3) x, y, yaw (unwrapped) in the map frame
-    estimate: np.ndarray = field(repr=False)  # (N, 3)
-    pos_err_m: np.ndarray = field(repr=False)  # (N,)
-    yaw_err_rad: np.ndarray = field(repr=False)  # (N,) wrapped estimate - truth
-    counts: dict = field(repr=False)
-    landmarks_xy: np.ndarray = field(repr=False)  # (K, 2) base landmarks in the map frame
-    degenerate: np.ndarray = field(repr=False)  # indices of frames that kept the last pose
-    stage_time_s: dict = field(repr=False, compare=False)  # per-frame stage times
-    fps: float = field(compare=False)  # SLAM frames per second (rendering excluded)
-
-    @property
-    def detector(self) -> str:
-        return self.params.detector
-
-    @property
-    def policy(self) -> str:
-        return self.params.policy
-
-    def __str__(self) -> str:
-        return (
-            f"{self.name}: {self.n_frames} frames, {self.detector}/{self.policy}, max position error "
-            f"{self.pos_err_m.max():.2f} m, max heading error {np.rad2deg(np.abs(self.yaw_err_rad).max()):.1f} deg, "
-            f"{len(self.degenerate)} degenerate frames"
-        )
-
-    # -- figures of 000 §3.7 -------------------------------------------------------------------------
-    def frame_at_turn(self, angle_rad: float) -> int:
-        """First frame whose true turned angle reaches ``angle_rad``.
-
-        Parameters
-        ----------
-        angle_rad : float
-            Turned angle [rad].
-
-        Returns
-        -------
-        int
-            Frame index (the last frame when the angle is never reached).
-        """
-        turned = np.abs(self.truth[:, 2] - self.truth[0, 2])
-        return int(np.argmax(turned >= angle_rad - 1e-9)) if np.any(turned >= angle_rad - 1e-9) else len(turned) - 1
-
-    @property
-    def position_spread_m(self) -> float:
-        """Largest distance between two estimated positions (000 §3.7.1: ~20 cm in the turn)."""
-        p = self.estimate[:, :2]
-        return float(np.max(np.linalg.norm(p[:, None] - p[None], axis=2)))
-
-    @property
-    def heading_error_ratio(self) -> float:
-        """Largest ``|heading error| / |turned angle|`` over frames turned at least 90° (000 §3.1: ≤ 10 %)."""
-        turned = np.abs(self.truth[:, 2] - self.truth[0, 2])
-        m = turned >= np.pi / 2 - 1e-9
-        return float(np.max(np.abs(self.yaw_err_rad[m]) / turned[m])) if m.any() else float("nan")
-
-    @property
-    def revisit_difference(self) -> tuple[float, float]:
-        """Estimated pose at the last frame minus at the first (same true place and heading): (m, rad)."""
-        d = self.estimate[-1] - self.estimate[0]
-        return float(np.hypot(d[0], d[1])), float(wrap_angle(d[2]))
-
-    def table(self) -> str:
-        """Our errors beside 000's figures and requirements (fixed precision).
-
-        Returns
-        -------
-        str
-        """
-        deg = np.rad2deg
-        rows = [
-            ["frames (degenerate)", f"{self.n_frames} ({len(self.degenerate)})", ""],
-            ["max position error, m", f"{self.pos_err_m.max():.2f}", "<= 0.5 (req.)" if self.name == "closed loop" else "<= 0.15"],
-        ]
-        if self.name == "turn in place":
-            rows.append(["spread of positions, m", f"{self.position_spread_m:.2f}", "~0.20"])
-            i180 = self.frame_at_turn(np.pi)
-            rows.append(["heading error at 180 deg, deg", f"{deg(abs(self.yaw_err_rad[i180])):.1f}", "<= 5"])
-            rows.append(["heading error back at 0 deg, deg", f"{deg(abs(self.yaw_err_rad[-1])):.1f}", "2-3"])
-        else:
-            rows.append(["max heading error / turned angle, %", f"{100 * self.heading_error_ratio:.1f}", "<= 10 (req.; 000: 10)"])
-            dp, dyaw = self.revisit_difference
-            rows.append(["revisit: pose change, m", f"{dp:.2f}", "same pose (req.)"])
-            rows.append(["revisit: heading change, deg", f"{deg(abs(dyaw)):.1f}", "same pose (req.)"])
-        c = self.counts
-        rows.append(["stereo matches per frame (median)", f"{np.median(c['n_stereo']):.0f}", "~500 (<100 bad)"])
-        rows.append(["RANSAC inliers per frame (median)", f"{np.median(c['n_inliers'][1:]):.0f}", ""])
-        return format_table(["quantity", "ours", "000"], rows, title=f"{self.name} ({self.detector}, policy {self.policy})")
-
-    def timing_table(self) -> str:
-        """Mean time per stage in ms and frames per second (volatile: not for nbval).
-
-        Returns
-        -------
-        str
-        """
-        rows = [[s, f"{1000 * np.mean(self.stage_time_s[s]):.1f}"] for s in STAGES]
-        rows.append(["frames/s", f"{self.fps:.2f}"])
-        return format_table(["stage", "ms/frame"], rows)
+__all__ = [
+    "COMPARISON",
+    "SIZES",
+    "DriftStudy",
+    "StereoRunResult",
+    "comparison_table",
+    "disparity_error_table",
+    "disparity_errors",
+    "experiment_poses",
+    "record_stereo_stream",
+    "run_closed_loop",
+    "run_comparison",
+    "run_drift_study",
+    "run_stereo_slam",
+    "run_stereo_slam_variants",
+    "run_turn_in_place",
+]
 
 
 def run_stereo_slam(poses, *, name: str = "run", params: StereoParams | None = None, store=None,
@@ -271,7 +165,7 @@ def run_stereo_slam_variants(
         raise ValueError("a `store` instance serves one run; give a factory for several variants")
     bar = progress_bar(total=len(poses), desc=f"stereo SLAM: {name}", progress=progress)
     render = RenderParams.resolve(render)
-    from ...sweep import fresh_seed_sequence
+    from ..sweep import fresh_seed_sequence
 
     r_sim, r_slam = fresh_seed_sequence(rng).spawn(2)  # an int seed: SeedSequence(seed)'s children as before
     arena = StereoArena(seed=render.arena_seed) if arena is None else arena
@@ -301,10 +195,6 @@ def run_stereo_slam_variants(
             stage_time_s=slam.stage_times(), fps=len(poses) / t_slam[k],
         )  # fmt: skip
     return out
-
-
-def _first(poses, n_frames):
-    return poses if n_frames is None else poses[: v.check_int(n_frames, "n_frames", minimum=2)]
 
 
 def experiment_poses(experiment: str, size: str = "small") -> np.ndarray:
@@ -402,3 +292,207 @@ def run_closed_loop(size: str = "small", *, n_frames: int | None = None, params:
     poses = _first(experiment_poses("closed loop", size), n_frames)
     return run_stereo_slam(poses, name="closed loop", params=params, store=store, render=render, progress=progress, rng=rng,
                            **overrides)
+
+
+def run_comparison(
+    experiment: str = "closed loop", size: str = "small", variants: dict | None = None, *, n_frames: int | None = None,
+    params: StereoParams | None = None, render: RenderParams | None = None, progress=None, rng=0,
+) -> dict:
+    """The turn or the loop once per pipeline setting, on the same rendered frames (000 §3.5, §3.7).
+
+    ``variants`` maps a label to a :class:`StereoParams` or to overrides of ``params`` (default
+    :data:`COMPARISON`); ``render``: :class:`RenderParams` (``noise_std``, ``drift_std_rad``, ...).
+    Returns label -> :class:`StereoRunResult`; :func:`comparison_table` prints them side by side.
+
+    Parameters
+    ----------
+    experiment : {"closed loop", "turn in place"}
+        The trajectory.
+    size : {"small", "full"}
+        Frame step.
+    variants : dict, optional
+        Label -> :class:`StereoParams` or overrides of ``params`` (default ``COMPARISON``).
+    n_frames : int, optional
+        Keep only the first frames.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    progress : bool, None or callable
+        A bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``), or ``progress(i)`` after frame ``i``.
+    rng : int or numpy.random.Generator, default 0
+        Seed of the RANSAC stream (and the image noise).
+
+    Returns
+    -------
+    dict
+        Label -> :class:`StereoRunResult`.
+    """
+    v.check_choice(size, "size", SIZES)
+    v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
+    poses = _first(experiment_poses(experiment, size), n_frames)
+    return run_stereo_slam_variants(poses, COMPARISON if variants is None else variants, name=experiment,
+                                    params=params, render=render, progress=progress, rng=rng)
+
+_RUNNERS = {"turn in place": "run_turn_in_place", "closed loop": "run_closed_loop"}
+
+
+def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, params: StereoParams,
+                render: RenderParams, seed) -> dict:
+    """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``seed``).
+
+    Parameters
+    ----------
+    drift_std_rad : float
+        Drift level [rad per axis and frame].
+    experiment : {"turn in place", "closed loop"}
+        The run.
+    size : {"small", "full"}
+        Frame step.
+    n_frames : int or None
+        Keep only the first frames.
+    params : StereoParams
+        Pipeline settings.
+    render : RenderParams
+        Renderer settings (its ``drift_std_rad`` is replaced).
+    seed : int or SeedSequence
+        The run's seed, the same for every level.
+
+    Returns
+    -------
+    dict
+        ``{"run": StereoRunResult}``.
+    """
+    runner = globals()[_RUNNERS[experiment]]
+    return {"run": runner(size, n_frames=n_frames, params=params, render=render.replace(drift_std_rad=drift_std_rad),
+                          progress=False, rng=seed)}
+
+
+def run_drift_study(
+    drift_std_rad=(0.0, 0.5e-3, 1e-3, 2e-3), experiment: str = "turn in place", size: str = "small", *,
+    n_frames: int | None = None, params: StereoParams | None = None, render: RenderParams | None = None, rng=0,
+    n_jobs: int = 1, progress: bool | None = None, **overrides,
+) -> DriftStudy:
+    """The same run at several calibration-drift levels (our experiment for 000 §3.2), on :func:`slamlab.sweep.sweep`.
+
+    The right camera's orientation takes a random-walk step of ``drift_std_rad`` per axis and
+    frame while the pipeline keeps the nominal calibration; ``params`` + ``overrides`` set the
+    pipeline (``detector``, ``policy``, ...), ``render`` the rest of the renderer. Every level uses
+    the same seed ``rng`` (common random numbers: the level is the only change), so each task is
+    deterministic and the sweep gives it no stream of its own (``rng_arg=None``); the study is
+    the same for any ``n_jobs``. ``progress``: a bar over the levels (default: on unless
+    ``$SLAMLAB_PROGRESS=0``).
+
+    Parameters
+    ----------
+    drift_std_rad : sequence of float
+        Drift levels [rad per axis and frame], ≥ 0.
+    experiment : {"turn in place", "closed loop"}
+        The run.
+    size : {"small", "full"}
+        Frame step.
+    n_frames : int, optional
+        Keep only the first frames.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    render : RenderParams, optional
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+    rng : int, numpy.random.Generator or SeedSequence, default 0
+        Seed shared by every level.
+    n_jobs : int, default 1
+        Worker processes.
+    progress : bool or None
+        A bar over the levels.
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    DriftStudy
+    """
+    from ..sweep import fresh_seed_sequence, sweep
+
+    v.check_choice(experiment, "experiment", _RUNNERS)
+    v.check_choice(size, "size", SIZES)
+    levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
+    if min(levels) < 0:
+        raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
+    seed = fresh_seed_sequence(rng)  # every level's run from the same (fresh) SeedSequence
+    p = StereoParams.resolve(params, **overrides)
+    render = RenderParams.resolve(render)
+    table = sweep(drift_level, {"drift_std_rad": levels}, rng_arg=None, n_jobs=n_jobs, progress=progress,
+                  on_error="raise", desc=f"calibration drift study ({experiment})",
+                  fixed={"experiment": experiment, "size": size, "n_frames": n_frames, "params": p, "render": render,
+                         "seed": seed})
+    return DriftStudy(experiment, levels, tuple(table["run"]))
+
+
+def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift", rng: int = 0,
+                         progress: bool | None = None) -> Workload:
+    """Record the landmark-store calls of the stereo pipeline on 000's closed loop (our addition).
+
+    Runs the closed loop (small size: 57 frames; ``n_frames`` keeps the first frames only) with an
+    :class:`~slamlab.kdtree.ExactStore` wrapped in a :class:`~slamlab.kdtree.workloads.RecordingStore`,
+    and returns the recorded :class:`~slamlab.kdtree.workloads.Workload` for
+    :func:`slamlab.kdtree.experiments.run_store_comparison`. ``detector="sift"`` gives 128-d float
+    descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. The map search is 000's
+    global one for every detector (ORB's window search would leave the store almost no queries).
+    ``progress``: a bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    Parameters
+    ----------
+    n_frames : int, optional
+        Keep only the first frames.
+    detector : str, default "sift"
+        Detector of the run ("sift", "surf").
+    rng : int, default 0
+        RANSAC seed.
+    progress : bool or None
+        A bar over the frames.
+
+    Returns
+    -------
+    Workload
+    """
+    p = StereoParams(detector=detector, map_search="global")
+    rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
+    run_closed_loop("small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
+    n = len(rec.iterations)
+    return rec.workload(f"stereo closed loop, {n} frames ({detector.upper()}, recorded)",
+                        base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
+
+
+def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, params: StereoParams | None = None,
+                     rng=0, **overrides) -> str:
+    """Stereo disparity errors against the renderer's depth, per ORB pyramid level, before and after
+    :func:`~slamlab.stereo.subpixel_disparity` (our addition to 000 §3.3).
+
+    One rendered pair at ``pose`` in ``arena`` (default the 6×8 m arena): keypoints (``params`` +
+    ``overrides``, default ORB), stereo matches, and for each match the disparity minus the true one
+    ``f b / z`` (``z``: the renderer's depth at the left keypoint's pixel). Returns a table of the
+    median absolute error and the share above 1 px per level.
+
+    Parameters
+    ----------
+    pose : array_like, shape (3,)
+        Body pose ``(x_m, y_m, yaw_rad)``.
+    arena : StereoArena, optional
+        Scene (default the 6×8 m arena, seed 0).
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    rng : int or numpy.random.Generator, default 0
+        Seed of the simulator.
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    str
+    """
+    p = StereoParams.resolve(params, **({"detector": "orb"} | overrides))
+    arena = StereoArena(seed=0) if arena is None else arena
+    sim = StereoSim(arena, rng=rng)
+    pose = v.as_vector(pose, "pose", 3)
+    left, right = sim.render_pair(pose)
+    _, depth, _ = arena.cast(sim.rig.left, se3_from_planar(*pose) @ sim.T_body_left)
+    return disparity_error_table(left, right, depth, sim.rig.F, sim.rig.left.fx * sim.rig.baseline_m, params=p)
