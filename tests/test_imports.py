@@ -115,6 +115,19 @@ def test_algorithm_modules_never_import_sim():
     assert not bad, "algorithm modules import slamlab.sim: " + ", ".join(sorted(bad))
 
 
+#: the sim-free helpers of an experiments.py (issue 23): results, tables, loops; the dependency is one way
+EXPERIMENT_HELPERS = ("slamlab.filters.results", "slamlab.filters.studies", "slamlab.filters.source_table",
+                      "slamlab.correlation.studies", "slamlab.correlation.study_results",
+                      "slamlab.stereo.run_results", "slamlab.stereo.disparity_check")
+
+
+def test_experiment_helpers_import_neither_sim_nor_experiments():
+    graph = _graph()
+    bad = [f"{m} -> {t}" for m in EXPERIMENT_HELPERS for t in graph[m]
+           if _subpackage(t) == "sim" or t.split(".")[-1] == "experiments"]
+    assert not bad, "experiment helpers import the simulator or an experiments module: " + ", ".join(sorted(bad))
+
+
 SUBPACKAGES = ["slamlab", "slamlab.geometry", "slamlab.scans", "slamlab.io", "slamlab.sim", "slamlab.filters",
                "slamlab.features", "slamlab.kdtree", "slamlab.stereo", "slamlab.correlation", "slamlab.hough",
                "slamlab.planes", "slamlab.evaluation", "slamlab.lab", "slamlab.sweep", "slamlab.mono", "slamlab.localisation"]

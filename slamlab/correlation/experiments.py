@@ -1,5 +1,5 @@
 """Ch. 5 experiments (004 §7): Table 1, a Monte Carlo study, the constants a_c/a_p, the corridor tie (the real
-CARMEN log and the closing table: :mod:`.log_experiments`).
+CARMEN log and the closing table: :mod:`~slamlab.correlation.log_experiments`).
 
 Every ``run_*`` takes ``params=`` (a :class:`~slamlab.correlation.LocaliseParams`, the
 same settings and defaults as :func:`~slamlab.correlation.localise`) plus overrides
@@ -11,8 +11,8 @@ nbval compares); arrays for plotting live in fields, timings in ``time_s``
 (never in the table).
 
 This module builds the simulated worlds (the test room, its clutter, the rangefinder) and runs the
-experiments on them; the result dataclasses live in :mod:`.study_results`, the sim-free helpers (the sweep of
-localisations, errors, margins, Table 1's source values, the corridor, the timing) in :mod:`.studies` (all
+experiments on them; the result dataclasses live in :mod:`~slamlab.correlation.study_results`, the sim-free helpers (the sweep of
+localisations, errors, margins, Table 1's source values, the corridor, the timing) in :mod:`~slamlab.correlation.studies` (all
 re-exported here).
 """
 

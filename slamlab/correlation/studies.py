@@ -1,6 +1,6 @@
 """Ch. 5 study helpers that need no simulated world (004 §7): the failure thresholds, localising a batch of scans on
 :func:`slamlab.sweep.sweep` with their errors and margins, 004's Table 1, the constructed corridor and the timing of
-:func:`~slamlab.correlation.localise` (the simulated runs live in :mod:`.experiments`)."""
+:func:`~slamlab.correlation.localise` (the simulated runs live in :mod:`~slamlab.correlation.experiments`)."""
 
 from __future__ import annotations
 

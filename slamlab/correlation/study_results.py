@@ -1,5 +1,5 @@
 """Ch. 5 experiment results (004 §7): the printable result dataclasses of Table 1, the Monte Carlo study, the constants
-a_c/a_p and the corridor tie, with their tables (no simulator here: the runs live in :mod:`.experiments`)."""
+a_c/a_p and the corridor tie, with their tables (no simulator here: the runs live in :mod:`~slamlab.correlation.experiments`)."""
 
 from __future__ import annotations
 

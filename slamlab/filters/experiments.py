@@ -6,8 +6,8 @@ nbval compares); arrays for plotting are kept in fields.
 
 This module builds the simulated worlds and runs the experiments on them (constant-velocity target,
 sigma-point weight, unicycle filter comparison, stabilising noise); the result dataclasses and the Monte
-Carlo loop live in :mod:`.results`, the sim-free studies in :mod:`.studies`, the closing table in
-:mod:`.source_table` (all re-exported here).
+Carlo loop live in :mod:`~slamlab.filters.results`, the sim-free studies in :mod:`~slamlab.filters.studies`, the closing table in
+:mod:`~slamlab.filters.source_table` (all re-exported here).
 """
 
 from __future__ import annotations

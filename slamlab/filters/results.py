@@ -1,5 +1,5 @@
 """Ch. 1 experiment results (000 §1.2, §3.6): the printable result dataclasses with their tables, the filter names,
-the divergence threshold and the seeded Monte Carlo loop (no simulator here: the runs live in :mod:`.experiments`)."""
+the divergence threshold and the seeded Monte Carlo loop (no simulator here: the runs live in :mod:`~slamlab.filters.experiments`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Ch. 4 experiments (000 §3.7): the stereo SLAM loop on rendered arena runs, against ground truth (KITTI and the
-closing table: :mod:`.kitti_experiments`).
+closing table: :mod:`~slamlab.stereo.kitti_experiments`).
 
 ``run_turn_in_place`` (000 §3.7.1) and ``run_closed_loop`` (000 §3.7.2) return a
 frozen :class:`StereoRunResult`; ``str(result)`` is a one-line summary and
@@ -8,7 +8,7 @@ and ``fps`` only, never in the table.
 
 This module renders the arena and runs the pipeline on it (the runner, the turn in place, the closed loop,
 the comparison, the drift study, the recorded store calls, the disparity check); the result dataclasses and
-tables live in :mod:`.run_results`, the disparity error table in :mod:`.disparity_check` (re-exported here).
+tables live in :mod:`~slamlab.stereo.run_results`, the disparity error table in :mod:`~slamlab.stereo.disparity_check` (re-exported here).
 """
 
 from __future__ import annotations

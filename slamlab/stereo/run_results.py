@@ -1,5 +1,5 @@
 """Ch. 4 run results (000 §3.7): the frame steps per size, :class:`StereoRunResult` with its tables, the default
-comparison and its table, and the calibration-drift study (no simulator here: the runs live in :mod:`.experiments`)."""
+comparison and its table, and the calibration-drift study (no simulator here: the runs live in :mod:`~slamlab.stereo.experiments`)."""
 
 from __future__ import annotations
 
