@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from ..correlation import rasterise_scan, score_maps
@@ -155,18 +157,109 @@ def _monte_carlo_failures() -> float:
     return float(mc.failed.sum())
 
 
+def brute_force_headings(grid, bearings_rad, ranges, valid, headings_deg) -> tuple[np.ndarray, np.ndarray]:
+    """Best score and its cell for each heading, every map cell scored with plain numpy (no correlation code).
+
+    The template follows 004 §7: free marks ``a_c = -1`` every half cell along each valid beam, then
+    the obstacle marks ``a_p = +1`` just beyond the hit; the map's free / occupied / unknown cells
+    count -1 / +1 / 0. Every shift is scored at once by a zero-padded FFT cross-correlation
+    (the independent check of Exploration 1).
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        The map's cell codes (0 free, 1 occupied, -1 unknown).
+    bearings_rad, ranges : array_like, shape (n,)
+        The scan's beam angles [rad] relative to the robot and ranges [cells].
+    valid : array_like of bool, shape (n,)
+        Beams with a return.
+    headings_deg : array_like of int
+        The headings tried [deg].
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(best, cell)``: shapes ``(k,)`` and ``(k, 2)``, the best score per heading and its ``(row, col)``.
+    """
+    g = np.asarray(grid)
+    M = np.where(g == 1, 1.0, np.where(g == 0, -1.0, 0.0))
+    H, W = M.shape
+    valid = np.asarray(valid, bool)
+    b, r = np.asarray(bearings_rad, float)[valid], np.asarray(ranges, float)[valid]
+    o = int(np.ceil(r.max())) + 3
+    P = (H + 2 * o, W + 2 * o)  # no wrap-around: the map sits o cells inside a zero frame
+    Mp = np.zeros(P)
+    Mp[o:o + H, o:o + W] = M
+    FM = np.fft.rfft2(Mp)
+    free = np.arange(0.0, 1.0, 0.5 / r.max())[None, :] * r[:, None]
+    hit = r[:, None] + np.array([[0.01, 0.5]])
+    best, cell = [], []
+    for k in np.asarray(headings_deg):
+        ang = np.radians(float(k)) + b[:, None]
+        T = np.zeros(P)
+        for t, val in ((free, -1.0), (hit, 1.0)):  # obstacle marks last: they win a shared cell
+            rows, cols = np.floor(t * np.sin(ang) + 0.5).astype(int), np.floor(t * np.cos(ang) + 0.5).astype(int)
+            T[rows % P[0], cols % P[1]] = val
+        D = np.fft.irfft2(FM * np.conj(np.fft.rfft2(T)), s=P)[o:o + H, o:o + W]
+        i = int(np.argmax(D))
+        best.append(D.flat[i])
+        cell.append(divmod(i, W))
+    return np.array(best), np.array(cell)
+
+
+@lru_cache(maxsize=1)
+def brute_force_first_failing_step() -> float:
+    """Exploration 1 by brute force: the first whole-degree Δα whose best candidate is over 2 cells away.
+
+    With the candidates ``n·Δα`` (004 §7) the search at step Δα picks, among the 1° headings scored by
+    :func:`brute_force_headings`, the best of those that are multiples of Δα.
+
+    Returns
+    -------
+    float
+        The first failing step [deg], or nan if none in ``EXPLORE_STEPS_DEG`` fails.
+    """
+    from .experiments import localisation_scene
+
+    M, scan = localisation_scene(EXPLORE_POSE, rng=2010)
+    best, cell = brute_force_headings(M, scan.bearings_rad, scan.ranges, scan.valid, np.arange(360))
+    for d in EXPLORE_STEPS_DEG:
+        ks = np.arange(0, 360, d)
+        row, col = cell[ks[np.argmax(best[ks])]]
+        if np.hypot(col - EXPLORE_POSE[0], row - EXPLORE_POSE[1]) > 2.0:
+            return float(d)
+    return float("nan")
+
+
+def _heading_miss_deg(step_deg: float) -> float:
+    """How far the multiple of ``step_deg`` nearest the true heading is from it [deg]."""
+    true = float(np.degrees(EXPLORE_POSE[2]))
+    return float(abs(true - step_deg * np.round(true / step_deg)))
+
+
 register(ExplorationTask(
     "06.explore.heading_step",
     "Exploration 1: the smallest whole-degree step Δα at which localisation at (60, 40, 37°) fails",
     _first_failing_step,
-    why="exactly the library's value: one seeded scan (rng=SEED) localised with whole-degree steps; the search is "
-        "deterministic given the scan; no independent localiser yet.",
+    accepted=lambda: (brute_force_first_failing_step(),) * 2,
+    why="one whole-degree value from an independent brute-force localiser in plain numpy (every cell × every "
+        "1° heading of the map scored by an FFT cross-correlation of 004 §7's template, then for each Δα the "
+        "best of the headings n·Δα): it fails first at the same Δα as the library. The reason is geometric: the "
+        "best candidate heading is the multiple of Δα nearest 37°, and the first step whose nearest multiple is "
+        "5° off (28° and 42° for 14°) is where the peak jumps elsewhere; a 4° miss (11°) still succeeds. The answer "
+        "is the chapter's localiser's: a coarser template (free marks every cell, one obstacle mark) already fails "
+        "at the 4° miss, 11° (tests/lab/test_check_correlation.py).",
     hint="failure means a position error above 2 cells against the true pose; the question asks for the first "
          "step size at which that happens, with the scan and map the question names.",
     more="The coarser the heading search, the further its best heading can be from the true one.",
-    wrong=(WrongAnswer("the last step that succeeds", lambda: _first_failing_step() - 1.0,
+    wrong=(WrongAnswer("the last step that succeeds", lambda: brute_force_first_failing_step() - 1.0,
                        hint="at that step the localisation still succeeds: the question asks for the first step "
-                            "that fails."),)))
+                            "that fails."),
+           WrongAnswer("radians", lambda: float(np.radians(brute_force_first_failing_step())), atol=1e-3,
+                       hint="check the unit: the question asks for a whole number of degrees."),
+           WrongAnswer("the heading error", lambda: _heading_miss_deg(brute_force_first_failing_step()),
+                       hint="that looks like how far the best candidate heading is from the true one: the "
+                            "question asks for the step Δα itself."))))
 register(ExplorationTask(
     "06.explore.failures",
     "Exploration 2: failures of 12 random poses with σ = 2 cells and 120 extra clutter discs",
