@@ -150,11 +150,39 @@ def _first_failing_step() -> float:
     return float("nan")
 
 
-def _monte_carlo_failures() -> float:
+#: Exploration 2: the seeds whose runs span the accepted range of failures.
+FAILURE_SEEDS = (2010, 2011, 2012, 2013)
+
+
+@lru_cache(maxsize=1)
+def failure_runs() -> tuple:
+    """Exploration 2's 12-pose Monte Carlo run (σ = 2 cells, 120 clutter discs, Δα = 2°) for each seed.
+
+    Returns
+    -------
+    tuple of MonteCarloResult
+        One run per seed of :data:`FAILURE_SEEDS`.
+    """
     from ..correlation import run_monte_carlo
 
-    mc = run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, delta_alpha_rad=np.radians(2.0), rng=2010)
-    return float(mc.failed.sum())
+    return tuple(run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, delta_alpha_rad=np.radians(2.0),
+                                 rng=seed, progress=False) for seed in FAILURE_SEEDS)
+
+
+def _monte_carlo_failures() -> float:
+    return float(failure_runs()[0].failed.sum())
+
+
+def failures_over_seeds() -> tuple[float, float]:
+    """Exploration 2's range: fewest and most failures of the runs of :func:`failure_runs`.
+
+    Returns
+    -------
+    tuple of float
+        ``(lo, hi)`` failures.
+    """
+    n = [int(mc.failed.sum()) for mc in failure_runs()]
+    return float(min(n)), float(max(n))
 
 
 def brute_force_headings(grid, bearings_rad, ranges, valid, headings_deg) -> tuple[np.ndarray, np.ndarray]:
@@ -263,11 +291,16 @@ register(ExplorationTask(
 register(ExplorationTask(
     "06.explore.failures",
     "Exploration 2: failures of 12 random poses with σ = 2 cells and 120 extra clutter discs",
-    _monte_carlo_failures,
-    why="exactly the library's seeded Monte Carlo (rng=SEED): the poses, noise and clutter are random, so the "
-        "question fixes the seed; no independent localiser yet.",
+    _monte_carlo_failures, accepted=failures_over_seeds,
+    why="the fewest to the most failures of the same 12-pose run over four seeds (2010-2013): poses, noise and "
+        "clutter are random, so a run with another seed (or the question's) lands in this range; the seed's "
+        "effect dwarfs the localiser's details. Not independent of the library's localiser: an independent "
+        "brute-force localiser (as in Exploration 1) over 12 poses × 180 headings per seed is too slow for the "
+        "notebook; the failure rule itself (> 2 cells or > 5°) is recomputed from the errors in the tests.",
     hint="a localisation fails when its position error is above 2 cells or its heading error above 5°; count "
          "failures, with the noise, clutter and heading step the question names.",
     more="Both error criteria count: a pose can be close in position and still wrong in heading.",
     wrong=(WrongAnswer("successes", lambda: 12.0 - _monte_carlo_failures(),
-                       hint="that is the number of successes: the question asks how many fail."),)))
+                       hint="that is the number of successes: the question asks how many fail."),
+           WrongAnswer("a fraction", lambda: _monte_carlo_failures() / 12.0, atol=0.01,
+                       hint="that looks like a fraction of the poses: the question asks for a count."))))
