@@ -164,3 +164,19 @@ def test_exploration_answers():
     assert 0 < res.slam.lost.sum() < 120
     assert lab.answer("07.explore.lost_steps", int(res.slam.lost.sum()), quiet=True).passed
     assert lab.answer("07.explore.lost_steps", 0, quiet=True).status == "failed"
+
+
+def test_lost_steps_exploration_range():
+    """The accepted range is the spread of lost steps over seeds; the wrong answers stay outside it."""
+    from slamlab.lab.tasks_hough import LOST_SEEDS, lost_runs
+
+    counts = [int(lost[1:].sum()) for lost in lost_runs()]  # the first pose is the start, never lost
+    assert len(counts) == len(LOST_SEEDS)
+    lo, hi = min(counts), max(counts)
+    assert 0 < lo < hi < 120
+    assert lab.task("07.explore.lost_steps").accepted_range() == (lo, hi)
+    for wrong, hint in ((lo - 1, "Hint"), (hi + 1, "Hint"), (120 - counts[0], "pose from lines"),
+                        (counts[0] / 120, "fraction")):
+        res = lab.answer("07.explore.lost_steps", wrong, quiet=True)
+        assert res.status == "failed"
+        assert hint in res.message
