@@ -125,20 +125,58 @@ def test_transform_and_pose_mistakes():
         lab.check("07.pose_from_two_lines", no_angle_check, quiet=True).message
 
 
-def test_exploration_answers():
+def test_h_min_exploration_independent():
+    """OpenCV's point-set Hough transform: the third distinct line's votes + 1 is the accepted H_min."""
+    import cv2
+
     import slamlab as sl
+    from slamlab.lab.tasks_hough import independent_h_min
 
     rf = sl.sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.1)
     scan = rf.scan(sl.sim.test_room_200(), sl.sim.path_004()[20], rng=2010)
-    acc = sl.hough.hough_polar(scan.bearings_rad[scan.valid], scan.ranges[scan.valid], delta_rho=1.0,
-                               delta_theta_rad=np.radians(1.0))
-    votes = sl.hough.find_peaks(acc, H_min=1).votes  # strongest first: line 3 is lost one vote above its count
-    h = int(votes[2]) + 1
+    b, r = scan.bearings_rad[scan.valid], scan.ranges[scan.valid]
+    pts = np.column_stack([r * np.cos(b), r * np.sin(b)]).astype(np.float32).reshape(-1, 1, 2)
+    R = float(np.ceil(r.max()))
+    found = cv2.HoughLinesPointSet(pts, 20, 1, -R, R, 1.0, 0.0, np.pi, np.radians(1.0)).reshape(-1, 3)
+    lines = []  # (votes, rho, θ [deg] in [0, 180)), strongest first; a peak within 3 cells / 3° (also across
+    for votes, rho, th in found:  # θ = 0/180°, where rho changes sign) of a stronger one is the same line
+        t = np.degrees(th)
+        if not any((abs(t - u) <= 3 and abs(rho - q) <= 3) or (abs(abs(t - u) - 180) <= 3 and abs(rho + q) <= 3)
+                   for _, q, u in lines):
+            lines.append((int(votes), rho, t))
+    h = lines[2][0] + 1  # a peak needs H >= H_min: the third line goes one vote above its count
+    assert h == independent_h_min()
+    acc = sl.hough.hough_polar(b, r, delta_rho=1.0, delta_theta_rad=np.radians(1.0))
     assert len(sl.hough.find_peaks(acc, H_min=h)) == 2
+    assert len(sl.hough.find_peaks(acc, H_min=h - 1)) == 3
     assert lab.answer("07.explore.h_min", h, quiet=True).passed
-    assert lab.answer("07.explore.h_min", h - 1, quiet=True).status == "failed"
+    raw = int(found[2, 0]) + 1  # the third raw maximum is the second line again
+    for wrong, hint in ((h - 1, "still found"), (raw, "two local maxima")):
+        res = lab.answer("07.explore.h_min", wrong, quiet=True)
+        assert res.status == "failed"
+        assert hint in res.message
+
+
+def test_exploration_answers():
+    import slamlab as sl
 
     res = sl.hough.run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=2010)
     assert 0 < res.slam.lost.sum() < 120
     assert lab.answer("07.explore.lost_steps", int(res.slam.lost.sum()), quiet=True).passed
     assert lab.answer("07.explore.lost_steps", 0, quiet=True).status == "failed"
+
+
+def test_lost_steps_exploration_range():
+    """The accepted range is the spread of lost steps over seeds; the wrong answers stay outside it."""
+    from slamlab.lab.tasks_hough import LOST_SEEDS, lost_runs
+
+    counts = [int(lost[1:].sum()) for lost in lost_runs()]  # the first pose is the start, never lost
+    assert len(counts) == len(LOST_SEEDS)
+    lo, hi = min(counts), max(counts)
+    assert 0 < lo < hi < 120
+    assert lab.task("07.explore.lost_steps").accepted_range() == (lo, hi)
+    for wrong, hint in ((lo - 1, "Hint"), (hi + 1, "Hint"), (120 - counts[0], "pose from lines"),
+                        (counts[0] / 120, "fraction")):
+        res = lab.answer("07.explore.lost_steps", wrong, quiet=True)
+        assert res.status == "failed"
+        assert hint in res.message

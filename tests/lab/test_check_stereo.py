@@ -149,4 +149,10 @@ def test_drift_exploration():
     err = float(np.max(np.hypot(*(res.estimate[:, :2] - res.truth[:, :2]).T)))
     assert err > 0.5  # a few milliradians of drift cost metres
     assert lab.answer("05.explore.drift", err, quiet=True).passed
-    assert lab.answer("05.explore.drift", 0.05, quiet=True).status == "failed"  # the error without drift
+    no_drift = sl.stereo.run_turn_in_place("small", n_frames=5, detector="orb", rng=2010, progress=False)
+    assert no_drift.pos_err_m.max() < 0.01  # without drift the same turn is tracked to millimetres
+    errs = np.hypot(*(res.estimate[:, :2] - res.truth[:, :2]).T)
+    for wrong, hint in ((float(errs.mean()), "mean"), (1000 * err, "unit"), (float(no_drift.pos_err_m.max()), "without calibration drift")):
+        r = lab.answer("05.explore.drift", wrong, quiet=True)
+        assert r.status == "failed"
+        assert hint in r.message
