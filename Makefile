@@ -24,7 +24,13 @@ $(STAMP): pyproject.toml constraints.txt
 ## lab: start JupyterLab on notebooks/ (as root too, as the Jupyter Docker stacks do: containers and lab VMs)
 LAB_ARGS ?=
 ROOT_ARGS := $(if $(filter 0,$(shell id -u)),--allow-root,)
+# Widget messages go to the kernel's main thread, not to subshells (JupyterLab >= 4.4 with ipykernel >= 7 handles
+# them on threads of their own, so a widget's figure could be drawn while a cell draws another: matplotlib is not
+# thread-safe, and its shared mathtext parser breaks, a ParseException): an overrides.json in the venv's lab settings.
+LAB_OVERRIDES := $(VENV)/share/jupyter/lab/settings/overrides.json
 lab: venv
+	mkdir -p $(dir $(LAB_OVERRIDES))
+	$(BIN)/python -c "import json, pathlib; p = pathlib.Path('$(LAB_OVERRIDES)'); d = json.loads(p.read_text()) if p.exists() else {}; d.setdefault('@jupyterlab/apputils-extension:kernels-settings', {})['commsOverSubshells'] = 'disabled'; p.write_text(json.dumps(d, indent=2))"
 	$(BIN)/jupyter lab $(ROOT_ARGS) $(LAB_ARGS) notebooks/
 
 ## test: the whole suite in one pytest run: unit tests, doctests, every notebook under nbval

@@ -361,6 +361,17 @@ def _shut_down_sessions(base: str, token: str, path: str) -> None:
             urllib.request.urlopen(request, timeout=30).close()
 
 
+def test_make_lab_sends_widget_messages_to_the_main_thread(lab_server):
+    """`make lab` turns JupyterLab's comms over kernel subshells off: with them, a widget's callback runs on a
+    thread of its own and can draw while a cell draws, and matplotlib's shared mathtext parser then fails (seen
+    here: a ParseException after moving notebook 08's first slider)."""
+    base, token = lab_server
+    url = f"{base}/lab/api/settings/@jupyterlab/apputils-extension:kernels-settings?token={token}"
+    with urllib.request.urlopen(url, timeout=30) as r:
+        schema = json.load(r)["schema"]
+    assert schema["properties"]["commsOverSubshells"]["default"] == "disabled"
+
+
 @pytest.mark.parametrize("notebook", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
 def test_notebook_runs_in_jupyterlab(lab_server, browser, notebook):
     """The notebook runs in JupyterLab: every cell, no error, every widget view, one control moved."""
