@@ -10,12 +10,8 @@ import functools
 
 import numpy as np
 
+from ..geometry.homography import apply_homography
 from ..kdtree import KDTree
-
-
-def _project(H, uv):
-    p = np.c_[uv, np.ones(len(uv))] @ H.T  # homogeneous image-1 pixels through H
-    return p[:, :2] / p[:, 2:]
 
 
 @functools.lru_cache(maxsize=1)
@@ -42,7 +38,7 @@ def wall_repeatability_brute_force() -> tuple[tuple[str, ...], np.ndarray]:
         for k, name in enumerate(names):
             method, params = EVAL_DETECTORS[name]  # ORB's n_features (3000) already exceeds 2 x 500
             f1, f2 = (detect(img, method, max_points=500, **params) for img in (a, b))
-            p1, p2 = _project(H, f1.uv), _project(np.linalg.inv(H), f2.uv)
+            p1, p2 = apply_homography(H, f1.uv), apply_homography(np.linalg.inv(H), f2.uv)
             in1 = (p1 >= 0).all(axis=1) & (p1[:, 0] <= b.shape[1] - 1) & (p1[:, 1] <= b.shape[0] - 1)
             in2 = (p2 >= 0).all(axis=1) & (p2[:, 0] <= a.shape[1] - 1) & (p2[:, 1] <= a.shape[0] - 1)
             D = np.linalg.norm(p1[in1][:, None, :] - f2.uv[in2][None, :, :], axis=2)
@@ -113,6 +109,6 @@ def ratio_precision_independent(ratios: tuple[float, ...]) -> np.ndarray:
     img1, img2, H = load_oxford_pair("boat", 2, scale=0.5)
     f1, f2 = (detect(img, "surf", max_points=1000, threshold=1e-4) for img in (img1, img2))
     d, i = cKDTree(f2.descriptors).query(f1.descriptors, k=2)
-    ok = np.linalg.norm(_project(H, f1.uv) - f2.uv[i[:, 0]], axis=1) < 2.5
+    ok = np.linalg.norm(apply_homography(H, f1.uv) - f2.uv[i[:, 0]], axis=1) < 2.5
     keep = [d[:, 0] < r * d[:, 1] for r in ratios]
     return np.array([ok[k].mean() if k.any() else np.nan for k in keep])
