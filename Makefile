@@ -6,9 +6,10 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
 # -n 2 --dist loadfile: two pytest-xdist workers (both cores); each file, so each notebook's cells, stays in one
+# --durations=30: the log ends with the 30 slowest tests (CI has a 20-minute goal)
 PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
-	-p no:cacheprovider -n 2 --dist loadfile
+	-p no:cacheprovider -n 2 --dist loadfile --durations=30
 
 .PHONY: venv lab test reproducible notebooks report student autograde docs lint bench lock clean distclean
 
