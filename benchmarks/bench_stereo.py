@@ -12,6 +12,8 @@ query vs ``cv2.BFMatcher.knnMatch``.
     python benchmarks/bench_stereo.py --drift            # + calibration drift on the loop (SURF, ~2 min)
     python benchmarks/bench_stereo.py --long             # + the ~80 m run of 000 §4.2 (slow)
     python benchmarks/bench_stereo.py --kitti            # + the 20 KITTI frames, issue 17's changes off (before) and on (after)
+    python benchmarks/bench_stereo.py --kitti51          # + the 51-frame KITTI 06 set, issue 25's changes off and on
+    python benchmarks/bench_stereo.py --highway --seeds 8  # + the scale ablation on the simulated highway (51 frames)
 
 Every run uses the pipeline's defaults (oldest-landmark policy; store: multi kd-tree for SURF/SIFT,
 exact Hamming brute force for ORB; the two images detected in two threads).
@@ -59,6 +61,10 @@ def main(argv=None):
     ap.add_argument("--drift", action="store_true", help="also run the calibration-drift study on the small loop")
     ap.add_argument("--long", action="store_true", help="also run the ~80 m path in the 10x12 m room")
     ap.add_argument("--kitti", action="store_true", help="also run the 20 KITTI frames with issue 17's changes off (before) and on (after)")
+    ap.add_argument("--kitti51", action="store_true", help="also run the 51-frame KITTI 06 set, issue 25's changes off and on")
+    ap.add_argument("--highway", action="store_true", help="also run the scale ablation on the simulated highway scene")
+    ap.add_argument("--seeds", type=int, default=8, help="scenes per setting of --highway")
+    ap.add_argument("--highway-frames", type=int, default=51, help="frames per run of --highway")
     ap.add_argument("--markdown", default=None, help="write the tables to this file")
     args = ap.parse_args(argv)
 
@@ -149,6 +155,28 @@ def main(argv=None):
                 say(f"| {det}, {label} | {k.ate_m:.3f} | {k.ate_se3_m:.3f} | {k.final_error_m:.3f} | "
                     f"{k.length_ratio:.4f} | {k.end_distance_ratio:.4f} | {st.mean():.4f} ± "
                     f"{st.std(ddof=1) / np.sqrt(st.size):.4f} | {st.std(ddof=1):.4f} |")
+    if args.kitti51:
+        say()
+        folder = sl.data.find_data("kitti-odometry-06-stereo-51/calib.txt").parent
+        for det in args.detectors.split(","):
+            t0 = time.perf_counter()
+            variants = {"before (issue 25: global search, measured-depth weights)": {
+                "detector": det, "map_search": "global", "weight_depth": "measured", "update_cov_depth": "measured"},
+                "after (KITTI_PARAMS)": {"detector": det}}
+            say("```")
+            say(sl.stereo.kitti_comparison(variants, folder))
+            say("```")
+            say(f"  ({det}: {time.perf_counter() - t0:.0f} s for both runs; load average "
+                f"{' '.join(f'{x:.2f}' for x in os.getloadavg())})")
+    if args.highway:
+        say()
+        t0 = time.perf_counter()
+        abl = sl.stereo.run_scale_ablation(lambda rng: sl.sim.HighwayScene(rng=rng), sl.sim.highway_path(args.highway_frames),
+                                           n_seeds=args.seeds, rng=0)
+        say("```")
+        say(abl.table())
+        say("```")
+        say(f"  ({time.perf_counter() - t0:.0f} s; load average {' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     say(f"load average at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     if args.markdown:
         with open(args.markdown, "w") as f:

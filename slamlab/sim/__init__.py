@@ -82,6 +82,7 @@ __all__ += [
 
 # --- stereo arena, procedural lunar textures, stereo trajectories (000 §3.2, §3.7; Ch. 4) ---
 from .arena import R_BODY_CAM, StereoArena, StereoSim
+from .highway import HighwayScene, highway_path
 from .stereo_paths import (
     LONG_PATH_WAYPOINTS,
     LOOP_WAYPOINTS,
@@ -96,10 +97,12 @@ __all__ += [
     "LONG_PATH_WAYPOINTS",
     "LOOP_WAYPOINTS",
     "R_BODY_CAM",
+    "HighwayScene",
     "StereoArena",
     "StereoSim",
     "crater_heightfield",
     "fractal_noise",
+    "highway_path",
     "long_path",
     "lunar_texture",
     "rectangular_loop",

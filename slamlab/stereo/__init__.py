@@ -24,6 +24,7 @@ from .experiments import (
 )
 from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
+from .scale_ablation import SCALE_ABLATION, ScaleAblation, run_scale_ablation
 from .slam import STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
     LocalCloud,
@@ -37,6 +38,7 @@ from .stages import (
     pose_std,
     select_oldest,
     stereo_match,
+    stereo_point_cov,
     subpixel_disparity,
     triangulate_local,
 )
@@ -51,6 +53,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [
     "COMPARISON",
     "KITTI_PARAMS",
+    "SCALE_ABLATION",
     "SIZES",
     "STAGES",
     "STEREO_DETECTORS",
@@ -61,6 +64,7 @@ __all__ = [
     "MapMatches",
     "PoseEstimate",
     "RenderParams",
+    "ScaleAblation",
     "StereoMatches",
     "StereoParams",
     "StereoRunResult",
@@ -81,11 +85,13 @@ __all__ = [
     "run_comparison",
     "run_drift_study",
     "run_kitti",
+    "run_scale_ablation",
     "run_stereo_slam",
     "run_stereo_slam_variants",
     "run_turn_in_place",
     "select_oldest",
     "stereo_match",
+    "stereo_point_cov",
     "subpixel_disparity",
     "triangulate_local",
 ]

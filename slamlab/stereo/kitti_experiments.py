@@ -118,10 +118,13 @@ class KittiRunResult:
 #: metres (the arena's default, 10 m, would drop most of it); ``orb_levels = 1`` (ORB only): at 10 Hz a
 #: feature's scale changes by a few per cent per frame, and ORB's coarse levels doubled the spread of its
 #: per-frame step lengths (sd 5.2 % -> 2.8 % of the true step over frames 0-19, issue 17);
-#: ``map_search = "global"``: 20 frames leave a small map, so ORB keeps 000's search over every landmark
-#: (the window search is for long runs; on these frames it gave ATE 0.19 against 0.18 m); everything else
-#: as :class:`StereoParams`
-KITTI_PARAMS = StereoParams(max_depth_m=40.0, orb_levels=1, map_search="global")
+#: ``weight_depth = update_cov_depth = "map"`` (issue 25): a match's weight in the pose and an observation's
+#: covariance in the landmark filter come from the landmark's depth, not from the depth this frame measured,
+#: so no weight depends on its own measurement's error (on the simulated highway each measured-depth weight
+#: biases the scale by about 2 %, in opposite directions: :func:`run_scale_ablation`); the map search as
+#: :class:`StereoParams` (ORB: the window search; on the 51-frame set 000's global search left ORB's heading
+#: drifting, ATE 1.3 % of the path against 0.7 %); everything else as :class:`StereoParams`
+KITTI_PARAMS = StereoParams(max_depth_m=40.0, orb_levels=1, weight_depth="map", update_cov_depth="map")
 
 
 def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams | None = None, rng=0,

@@ -25,6 +25,7 @@ __all__ = [
     "epipolar_pairs",
     "is_rectified",
     "stereo_match",
+    "stereo_point_cov",
     "subpixel_disparity",
     "triangulate_local",
 ]
@@ -430,11 +431,40 @@ def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixe
     P = tri.points
     ok = tri.valid & (P[:, 2] >= min_depth_m) & (P[:, 2] <= max_depth_m)
     P = P[ok]
-    f = rig.left.fx
+    return LocalCloud(P, stereo_point_cov(P, rig.left.fx, rig.baseline_m, pixel_std), li[ok], tri.gap_m[ok])
+
+
+def stereo_point_cov(points, f_px: float, baseline_m: float, pixel_std: float) -> np.ndarray:
+    """Covariances of stereo points in the left-camera frame from a pixel error (our addition to 000 §3.3).
+
+    Lateral variance ``(z σ / f)²``, depth variance ``(z² √2 σ / (f b))²`` along the viewing ray.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (K, 3)
+        Points in the left-camera frame (``z`` > 0) [m].
+    f_px : float
+        Focal length [px].
+    baseline_m : float
+        Stereo baseline [m].
+    pixel_std : float
+        Pixel error per coordinate [px].
+
+    Returns
+    -------
+    numpy.ndarray, shape (K, 3, 3)
+        Covariances [m²].
+
+    Examples
+    --------
+    >>> C = stereo_point_cov(np.array([[0.0, 0.0, 10.0]]), 500.0, 0.5, 0.5)
+    >>> np.round(np.sqrt(np.diag(C[0])), 3).tolist()
+    [0.01, 0.01, 0.283]
+    """
+    P = np.asarray(points, dtype=float)
     z = P[:, 2]
-    lat = (z * pixel_std / f) ** 2
-    dep = (z**2 * np.sqrt(2.0) * pixel_std / (f * rig.baseline_m)) ** 2
+    lat = (z * pixel_std / f_px) ** 2
+    dep = (z**2 * np.sqrt(2.0) * pixel_std / (f_px * baseline_m)) ** 2
     # covariance = lat I + (dep - lat) r r^T with r the unit viewing ray
     r = P / np.linalg.norm(P, axis=1, keepdims=True)
-    cov = lat[:, None, None] * np.eye(3) + (dep - lat)[:, None, None] * (r[:, :, None] * r[:, None, :])
-    return LocalCloud(P, cov, li[ok], tri.gap_m[ok])
+    return lat[:, None, None] * np.eye(3) + (dep - lat)[:, None, None] * (r[:, :, None] * r[:, None, :])

@@ -23,6 +23,7 @@ __all__ = ["STEREO_DETECTORS", "RenderParams", "StereoParams"]
 STEREO_DETECTORS = ("surf", "sift", "orb")
 POLICIES = ("oldest", "all")
 MAP_SEARCHES = ("global", "window")
+DEPTH_SOURCES = ("measured", "map")
 
 
 def _fraction(value, name):
@@ -103,6 +104,8 @@ class StereoParams(Params):
         ours: the threshold grows as (depth / depth_ref_m)^2 beyond it
     min_inliers : int
         ours: RANSAC inliers needed for a valid pose
+    weight_depth : str
+        ours: depth behind a match's RANSAC threshold and weight: 'measured' (this frame's point) or 'map' (the landmark seen from the last pose; issue 25)
     n_oldest : int
         ours: 000 §3.5 says 'sufficiently large'
     oldest_fraction : float
@@ -129,6 +132,8 @@ class StereoParams(Params):
         ours: pose uncertainty added to an observation
     update_gate : float or None
         ours: chi^2_3 at 99.9 % (None: always update)
+    update_cov_depth : str
+        ours: depth behind an observation's covariance in the landmark filter: 'measured' or 'map' (the landmark seen from the new pose; issue 25)
 
     Examples
     --------
@@ -182,6 +187,8 @@ class StereoParams(Params):
     threshold_m: float = param(0.1, "ours: RANSAC inlier distance at depth_ref_m")
     depth_ref_m: float = param(3.0, "ours: the threshold grows as (depth / depth_ref_m)^2 beyond it")
     min_inliers: int = param(10, "ours")
+    weight_depth: str = param("measured", "ours: depth behind a match's RANSAC threshold and weight: 'm"
+                                          "easured' (this frame's point) or 'map' (the landmark seen from the last pose; issue 25)")
     n_oldest: int = param(40, "ours: 000 §3.5 says 'sufficiently large'")
     oldest_fraction: float = param(0.5, "ours")
     keep_fraction: float = param(0.5, "ours: share of the oldest set that must agree")
@@ -196,6 +203,8 @@ class StereoParams(Params):
     pose_std_m: float = param(0.02, "ours: pose uncertainty added to an observation")
     pose_std_rad: float = param(float(np.deg2rad(0.5)), "ours: pose uncertainty added to an observation")
     update_gate: float | None = param(16.27, "ours: chi^2_3 at 99.9 % (None: always update)")
+    update_cov_depth: str = param("measured", "ours: depth behind an observation's covariance in the landma"
+                                              "rk filter: 'measured' or 'map' (the landmark seen from the new pose; issue 25)")
 
     def check(self) -> None:
         v.check_choice(self.detector, "detector", STEREO_DETECTORS)
@@ -232,6 +241,8 @@ class StereoParams(Params):
         v.check_positive(self.threshold_m, "threshold_m")
         v.check_positive(self.depth_ref_m, "depth_ref_m")
         v.check_int(self.min_inliers, "min_inliers", minimum=3)
+        v.check_choice(self.weight_depth, "weight_depth", DEPTH_SOURCES)
+        v.check_choice(self.update_cov_depth, "update_cov_depth", DEPTH_SOURCES)
         v.check_int(self.n_oldest, "n_oldest", minimum=3)
         if v.check_positive(self.oldest_fraction, "oldest_fraction") > 1:
             raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {self.oldest_fraction}")

@@ -21,7 +21,7 @@ from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore, base_rule
 from .frame import STAGES, FrameRecord, _detect_pair, _StageClock, default_store
-from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified
+from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
 from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
 from .params import StereoParams
 
@@ -124,13 +124,36 @@ class StereoSLAM:
         p = self.params
         clock = _StageClock()
         fl, fr = _detect_pair(left, right, p.detector, self._detect_kwargs, p.parallel_detect)
+        return self._process(fl, fr, left, right, clock)
+
+    def process_features(self, left_features, right_features) -> FrameRecord:
+        """Run the stages after detection on the features of one stereo pair (000 §3.3-3.6).
+
+        For features that come from elsewhere than :func:`slamlab.features.detect` (a point-level
+        simulation, say): no images, so no sub-pixel disparity refinement.
+
+        Parameters
+        ----------
+        left_features, right_features : Features
+            Keypoints and descriptors of the left and right images.
+
+        Returns
+        -------
+        FrameRecord
+            Counts per stage, ``status``, the pose.
+        """
+        return self._process(left_features, right_features, None, None, _StageClock())
+
+    def _process(self, fl, fr, left, right, clock) -> FrameRecord:
+        """The stages after detection; ``left``/``right`` images (None: no disparity refinement)."""
+        p = self.params
         _check_features(fl, "left features")
         _check_features(fr, "right features")
         clock.lap("detect")
         sm = _stereo_match(fl, fr, self.rig.F, p.ratio, p.epi_tol_px)
         clock.lap("stereo")
         refine = None
-        if self._refine:
+        if self._refine and left is not None:
             refine = (to_gray_uint8(left, "left", channel_order=p.channel_order),
                       to_gray_uint8(right, "right", channel_order=p.channel_order), p.subpixel_half_px, p.subpixel_search_px)
         cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m, p.pixel_std, refine)
@@ -192,7 +215,17 @@ class StereoSLAM:
         loc = mm.local[est.inliers]
         Z = pts_body[loc] @ R.T + t
         pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
-        Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
+        if p.update_cov_depth == "map":
+            # the observation's covariance at the landmark's position seen from the new pose, not at the
+            # measured one: a measurement's weight then does not depend on its own error (issue 25)
+            T_wc = est.T @ self.T_body_left
+            Xc = (self.X[ids] - T_wc[:3, 3]) @ T_wc[:3, :3]
+            Xc[:, 2] = np.maximum(Xc[:, 2], p.min_depth_m)
+            Rwc = T_wc[:3, :3]
+            Rz = Rwc @ stereo_point_cov(Xc, self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rwc.T
+            Rz += pose_var[:, None, None] * np.eye(3)
+        else:
+            Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
         rec["n_gated"] = int((~self.refine_landmarks(ids, Z, Rz)).sum())
         self.n_seen[ids] += 1
         self.store.observe(ids)
@@ -266,7 +299,12 @@ class StereoSLAM:
         if len(mm.local) < max(3, p.min_inliers):
             rec["status"] = "too_few_matches"
             return mm, None
-        est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], depth[mm.local],
+        d_use = depth[mm.local]
+        if p.weight_depth == "map":
+            # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
+            T_wc = self.T @ self.T_body_left
+            d_use = np.maximum(((self.X[mm.ids] - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], p.min_depth_m)
+        est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], d_use,
                              cov_body[mm.local], p, self.rng)
         rec["n_used"] = est.n_used
         if not est.converged:

@@ -20,6 +20,7 @@ from .local_stages import (
     epipolar_pairs,
     is_rectified,
     stereo_match,
+    stereo_point_cov,
     subpixel_disparity,
     triangulate_local,
 )
@@ -45,6 +46,7 @@ __all__ = [
     "pose_std",
     "select_oldest",
     "stereo_match",
+    "stereo_point_cov",
     "subpixel_disparity",
     "triangulate_local",
 ]

@@ -1,0 +1,175 @@
+"""Where the stereo scale bias comes from: an ablation on a simulated scene (issue 25; ours).
+
+:func:`run_scale_ablation` runs :class:`~slamlab.stereo.StereoSLAM` on keypoints observed in a
+simulated scene (such as :class:`slamlab.sim.highway.HighwayScene`, passed in: this module does not
+import the simulator) once per setting and seed, and tabulates the path-length ratio, the per-frame
+step ratios (mean ± standard error) and the ATE. Each setting changes one thing against
+:data:`~slamlab.stereo.KITTI_PARAMS`: the pixel noise of the keypoints, which depth sets a match's
+weight in the pose and an observation's covariance in the landmark filter, the depth cut, the RANSAC
+threshold's growth with depth, the oldest-landmark policy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as v
+from .._table import format_table
+from .kitti_experiments import KITTI_PARAMS
+from .params import StereoParams
+from .slam import StereoSLAM
+
+__all__ = ["SCALE_ABLATION", "ScaleAblation", "run_scale_ablation"]
+
+#: the settings of the ablation: label -> overrides of KITTI_PARAMS (``pixel_std_obs``: the scene's keypoint noise);
+#: 'measured' / 'map': the depth behind a match's weight in the pose (``weight_depth``) and an observation's
+#: covariance in the landmark filter (``update_cov_depth``)
+SCALE_ABLATION = {
+    "KITTI_PARAMS (both at the landmark's depth)": {},
+    "no keypoint noise": {"pixel_std_obs": 0.0},
+    "both at the measured depth (before issue 25)": {"weight_depth": "measured", "update_cov_depth": "measured"},
+    "pose weight at the measured depth only": {"weight_depth": "measured"},
+    "filter covariance at the measured depth only": {"update_cov_depth": "measured"},
+    "depth cut 80 m": {"max_depth_m": 80.0},
+    "depth cut 80 m, both at the measured depth": {"max_depth_m": 80.0, "weight_depth": "measured",
+                                                   "update_cov_depth": "measured"},
+    "RANSAC threshold 0.5 m at every depth, equal weights": {"depth_ref_m": 1000.0, "threshold_m": 0.5},
+    "pose from all inliers": {"policy": "all"},
+}
+
+
+@dataclass(frozen=True)
+class ScaleAblation:
+    """Scale figures of each setting of :func:`run_scale_ablation` (issue 25).
+
+    Attributes
+    ----------
+    labels : tuple of str
+        The settings.
+    path_ratio : numpy.ndarray, shape (S, n_seeds)
+        Estimated over true path length, per setting and seed.
+    step_ratios : numpy.ndarray, shape (S, n_seeds, n_frames - 1)
+        Estimated over true length of every frame-to-frame step.
+    ate_m : numpy.ndarray, shape (S, n_seeds)
+        ATE RMSE (no alignment: both start at frame 0) [m].
+    path_length_m : float
+        True path length [m].
+    pixel_std : float
+        Keypoint noise of the scene [px] (settings may override it).
+    n_degenerate : numpy.ndarray, shape (S, n_seeds)
+        Frames that kept the last pose.
+    """
+
+    labels: tuple
+    path_ratio: np.ndarray = field(repr=False)
+    step_ratios: np.ndarray = field(repr=False)
+    ate_m: np.ndarray = field(repr=False)
+    path_length_m: float
+    pixel_std: float
+    n_degenerate: np.ndarray = field(repr=False)
+
+    def __str__(self) -> str:
+        i = int(np.argmax(np.abs(self.path_ratio.mean(axis=1) - 1)))
+        return (f"scale ablation, {len(self.labels)} settings x {self.path_ratio.shape[1]} seeds over "
+                f"{self.path_length_m:.1f} m: largest bias {self.path_ratio[i].mean():.3f} ({self.labels[i]})")
+
+    def step_mean_se(self) -> np.ndarray:
+        """Mean of the step ratios over every seed and step, and its standard error, per setting: ``(S, 2)``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (S, 2)
+        """
+        s = self.step_ratios.reshape(len(self.labels), -1)
+        return np.column_stack([s.mean(axis=1), s.std(axis=1, ddof=1) / np.sqrt(s.shape[1])])
+
+    def table(self) -> str:
+        """Per setting: path ratio (mean over seeds), step ratio mean ± s.e., ATE in % of the path (fixed precision).
+
+        Returns
+        -------
+        str
+        """
+        ms = self.step_mean_se()
+        rows = [[lab, f"{self.path_ratio[i].mean():.3f}", f"{ms[i, 0]:.3f} ± {ms[i, 1]:.3f}",
+                 f"{100 * self.ate_m[i].mean() / self.path_length_m:.2f}", f"{int(self.n_degenerate[i].sum())}"]
+                for i, lab in enumerate(self.labels)]
+        n_seeds, n_steps = self.step_ratios.shape[1:]
+        return format_table(["setting", "path est./true", "step est./true: mean ± s.e.", "ATE, % of path", "degenerate"],
+                            rows, title=(f"scale ablation: {n_seeds} seeds x {n_steps + 1} frames, {self.path_length_m:.1f} m, "
+                                         f"keypoint noise {self.pixel_std:g} px (simulated)"))
+
+
+def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, params: StereoParams | None = None,
+                       n_seeds: int = 3, pixel_std: float = 0.5, rng=0) -> ScaleAblation:
+    """StereoSLAM on a simulated scene's keypoints once per setting and seed: the scale bias and its causes (issue 25).
+
+    Every setting sees the same scenes and the same keypoints for a given seed (the noise streams are
+    spawned per seed, not per setting), so differences between rows come from the setting alone.
+
+    Parameters
+    ----------
+    scene_factory : callable
+        ``scene_factory(rng)`` returns a scene with ``rig``, ``T_body_left``,
+        ``ground_truth_se3(pose)`` and ``observe(pose, pixel_std=, rng=) -> (left, right)`` features
+        (:class:`slamlab.sim.highway.HighwayScene`).
+    poses : array_like, shape (N, 3)
+        Body poses ``(x_m, y_m, yaw_rad)``, N ≥ 3 (:func:`slamlab.sim.highway.highway_path`).
+    variants : dict, optional
+        Label -> overrides of ``params`` (default :data:`SCALE_ABLATION`); the key ``pixel_std_obs``
+        sets the keypoint noise instead.
+    params : StereoParams, optional
+        Base settings (default :data:`~slamlab.stereo.KITTI_PARAMS`).
+    n_seeds : int, default 3
+        Scenes (layouts and noise) per setting.
+    pixel_std : float, default 0.5
+        Keypoint noise [px] of the scene's observations.
+    rng : int or numpy.random.Generator, default 0
+        Root of the seeds.
+
+    Returns
+    -------
+    ScaleAblation
+    """
+    if not callable(scene_factory):
+        raise TypeError(f"`scene_factory` must be callable (rng -> scene); got {type(scene_factory).__name__}")
+    P = v.as_finite_array(poses, "poses", ndim=2)
+    if P.shape[1] != 3 or P.shape[0] < 3:
+        raise ValueError(f"`poses` must have shape (N, 3) with N >= 3; got {P.shape}")
+    variants = SCALE_ABLATION if variants is None else variants
+    if not isinstance(variants, dict) or not variants:
+        raise TypeError("`variants` must be a non-empty dict of label -> dict of overrides")
+    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
+    sigma = v.check_positive(pixel_std, "pixel_std", allow_zero=True)
+    base = KITTI_PARAMS if params is None else StereoParams.resolve(params)
+    resolved = {}
+    for label, over in variants.items():
+        over = dict(over)
+        noise = v.check_positive(over.pop("pixel_std_obs", sigma), "pixel_std_obs", allow_zero=True)
+        resolved[label] = (StereoParams.resolve(base, **over), noise)
+    seeds = np.random.SeedSequence(int(v.as_rng(rng).integers(2**32))).spawn(n_seeds)
+    S, n = len(variants), len(P)
+    path_ratio, ate_m, n_deg = np.empty((S, n_seeds)), np.empty((S, n_seeds)), np.zeros((S, n_seeds), int)
+    steps = np.empty((S, n_seeds, n - 1))
+    path_len = 0.0
+    for j, ss in enumerate(seeds):
+        s_scene, s_noise, s_slam = ss.spawn(3)
+        scene = scene_factory(np.random.default_rng(s_scene))
+        T0inv = np.linalg.inv(scene.ground_truth_se3(P[0]))
+        truth = np.array([(T0inv @ scene.ground_truth_se3(p))[:3, 3] for p in P])
+        true_steps = np.linalg.norm(np.diff(truth, axis=0), axis=1)
+        path_len = float(true_steps.sum())
+        for i, (p, noise) in enumerate(resolved.values()):
+            g = np.random.default_rng(s_noise)  # the same keypoints for every setting
+            slam = StereoSLAM(scene.rig, scene.T_body_left, params=p, rng=np.random.default_rng(s_slam))
+            for pose in P:
+                slam.process_features(*scene.observe(pose, pixel_std=noise, rng=g))
+            est = slam.trajectory[:, :3, 3]
+            est_steps = np.linalg.norm(np.diff(est, axis=0), axis=1)
+            steps[i, j] = est_steps / true_steps
+            path_ratio[i, j] = est_steps.sum() / path_len
+            ate_m[i, j] = np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1)))
+            n_deg[i, j] = len(slam.degenerate_frames)
+    return ScaleAblation(tuple(variants), path_ratio, steps, ate_m, path_len, sigma, n_deg)
