@@ -151,8 +151,9 @@ def _first_failing_step() -> float:
     return float("nan")
 
 
-#: Exploration 2: the seeds whose runs span the accepted range of failures.
-FAILURE_SEEDS = (2010, 2011, 2012, 2013)
+#: Exploration 2: the seeds whose runs span the accepted range of failures (the question's 2010 is held out:
+#: tests/lab/test_check_correlation.py checks that it lands inside).
+FAILURE_SEEDS = (2011, 2012, 2013)
 
 
 @lru_cache(maxsize=1)
@@ -214,9 +215,9 @@ def failures_over_seeds() -> tuple[float, float]:
     return float(min(n)), float(max(n))
 
 
-def _seeded_failures() -> float:
-    """The brute-force count for the question's seed (the first of :data:`FAILURE_SEEDS`)."""
-    return float(sum(brute_force_failures()[0]))
+def _mid_failures() -> float:
+    """The middle of the accepted range: the typical wrong answers are matched around it, for any seed."""
+    return float(np.mean(failures_over_seeds()))
 
 
 def brute_force_headings(grid, bearings_rad, ranges, valid, headings_deg) -> tuple[np.ndarray, np.ndarray]:
@@ -334,17 +335,18 @@ register(ExplorationTask(
     "06.explore.failures",
     "Exploration 2: failures of 12 random poses with σ = 2 cells and 120 extra clutter discs",
     _monte_carlo_failures, accepted=failures_over_seeds,
-    why="the fewest to the most failures over four seeds (2010-2013) of an independent brute-force localiser "
+    why="the fewest to the most failures over three seeds (2011-2013) of an independent brute-force localiser "
         "with no slamlab.correlation code (the run's own poses and scans; every map cell × every heading n·2° "
         "scored by an FFT cross-correlation of 004 §7's template; a failure is > 2 cells or > 5° off): 2-5, as "
-        "the library's runs. Poses, noise and clutter are random, so another seed lands in this range. Per seed "
+        "the library's runs. Poses, noise and clutter are random, so another seed lands in this range (the "
+        "question's 2010 gives 4, by both). Per seed "
         "the two localisers agree to one pose: in this much noise and clutter the winning peak beats the best "
         "candidate near the truth by a few points in scores of thousands, so a detail of the template (the "
         "rounding of a mark to its cell) can decide a pose, while the spread over seeds is larger.",
     hint="a localisation fails when its position error is above 2 cells or its heading error above 5°; count "
          "failures, with the noise, clutter and heading step the question names.",
     more="Both error criteria count: a pose can be close in position and still wrong in heading.",
-    wrong=(WrongAnswer("successes", lambda: 12.0 - _seeded_failures(),
+    wrong=(WrongAnswer("successes", lambda: 12.0 - _mid_failures(), atol=1.5,  # 12 minus any seed's failures
                        hint="that is the number of successes: the question asks how many fail."),
-           WrongAnswer("a fraction", lambda: _seeded_failures() / 12.0, atol=0.01,
+           WrongAnswer("a fraction", lambda: _mid_failures() / 12.0, atol=0.15,  # any seed's failures / 12
                        hint="that looks like a fraction of the poses: the question asks for a count."))))
