@@ -221,7 +221,7 @@ def _mid_failures() -> float:
 
 
 def brute_force_headings(grid, bearings_rad, ranges, valid, headings_deg) -> tuple[np.ndarray, np.ndarray]:
-    """Best score and its cell for each heading, every map cell scored with plain numpy (no correlation code).
+    """Best score and its cell for each heading, every map cell scored (numpy, scipy.fft; no correlation code).
 
     The template follows 004 §7 (as Task 2's stamp): free marks ``a_c = -1`` every half cell from
     the robot along each valid beam, short of its hit, then the obstacle marks ``a_p = +1`` just beyond the hit; the map's free / occupied / unknown cells
@@ -313,7 +313,7 @@ register(ExplorationTask(
     "Exploration 1: the smallest whole-degree step Δα at which localisation at (60, 40, 37°) fails",
     _first_failing_step,
     accepted=lambda: (brute_force_first_failing_step(),) * 2,
-    why="one whole-degree value from an independent brute-force localiser in plain numpy (every cell × every "
+    why="one whole-degree value from an independent brute-force localiser in numpy and scipy.fft (every cell × every "
         "1° heading of the map scored by an FFT cross-correlation of 004 §7's template, then for each Δα the "
         "best of the headings n·Δα): it fails first at the same Δα as the library. The reason is geometric: the "
         "best candidate heading is the multiple of Δα nearest 37°, and the first step whose nearest multiple is "
@@ -340,9 +340,10 @@ register(ExplorationTask(
         "scored by an FFT cross-correlation of 004 §7's template; a failure is > 2 cells or > 5° off): 2-5, as "
         "the library's runs. Poses, noise and clutter are random, so another seed lands in this range (the "
         "question's 2010 gives 4, by both). Per seed "
-        "the two localisers agree to one pose: in this much noise and clutter the winning peak beats the best "
-        "candidate near the truth by a few points in scores of thousands, so a detail of the template (the "
-        "rounding of a mark to its cell) can decide a pose, while the spread over seeds is larger.",
+        "the two localisers agree to one pose: their scores of one candidate differ by a few points in thousands "
+        "(a few marks rounded to other cells), and in this much noise and clutter a far candidate often beats "
+        "the true pose by only tens of points, so such a detail can decide a pose; the spread over seeds is "
+        "larger.",
     hint="a localisation fails when its position error is above 2 cells or its heading error above 5°; count "
          "failures, with the noise, clutter and heading step the question names.",
     more="Both error criteria count: a pose can be close in position and still wrong in heading.",

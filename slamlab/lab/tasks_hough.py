@@ -229,7 +229,8 @@ def _seeded_lost() -> float:
     return float(independent_lost_counts()[0][1])
 
 
-def independent_line_votes(bearings_rad, ranges, *, window: int = 3, H_min: int = 1) -> np.ndarray:
+def independent_line_votes(bearings_rad, ranges, *, window: int = 3, H_min: int = 1,
+                           n_lines: int | None = None) -> np.ndarray:
     """Votes of the scan's lines, strongest first, from a plain numpy accumulator (no slamlab.hough code).
 
     Every point ``(x, y)`` votes once per 1° θ in [-90°, 90°) for ``rho = x cos θ + y sin θ``
@@ -248,6 +249,8 @@ def independent_line_votes(bearings_rad, ranges, *, window: int = 3, H_min: int 
         Suppression window, in rho cells and degrees.
     H_min : int
         Fewest votes of a returned line.
+    n_lines : int, optional
+        Stop after the ``n_lines`` strongest lines (exact too: a line depends only on stronger ones).
 
     Returns
     -------
@@ -273,6 +276,8 @@ def independent_line_votes(bearings_rad, ranges, *, window: int = 3, H_min: int 
         if not any((abs(t - u) <= window and abs(p - q) <= window)
                    or (abs(abs(t - u) - 180) <= window and abs(p + q) <= window) for q, u, _ in kept):
             kept.append((p, t, int(H[i, j])))
+            if n_lines is not None and len(kept) >= n_lines:
+                break
     return np.array([v for _, _, v in kept], dtype=int)
 
 
@@ -288,7 +293,8 @@ def independent_h_min() -> float:
     from .experiments import hough_scene_scan
 
     scan = hough_scene_scan(EXPLORE_POSE_INDEX, rng=2010)
-    return float(independent_line_votes(scan.bearings_rad[scan.valid], scan.ranges[scan.valid])[EXPLORE_LINE] + 1)
+    return float(independent_line_votes(scan.bearings_rad[scan.valid], scan.ranges[scan.valid],
+                                        n_lines=EXPLORE_LINE + 1)[EXPLORE_LINE] + 1)
 
 
 def _raw_third_peak_h_min() -> float:
@@ -296,7 +302,8 @@ def _raw_third_peak_h_min() -> float:
     from .experiments import hough_scene_scan
 
     scan = hough_scene_scan(EXPLORE_POSE_INDEX, rng=2010)
-    votes = independent_line_votes(scan.bearings_rad[scan.valid], scan.ranges[scan.valid], window=0)
+    votes = independent_line_votes(scan.bearings_rad[scan.valid], scan.ranges[scan.valid], window=0,
+                                   n_lines=EXPLORE_LINE + 1)
     return float(votes[EXPLORE_LINE] + 1)
 
 
