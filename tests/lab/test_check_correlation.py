@@ -193,10 +193,9 @@ def test_exploration_answers():
 
 def test_failures_exploration_range():
     """The accepted range is the spread over seeds of a brute-force localiser's failures (no slamlab.correlation
-    code); the question's seed, held out, fails at the same poses by the brute force and the library, inside the
-    range; the wrong answers of any seed in the range stay outside it."""
-    from slamlab.lab.experiments import monte_carlo_scene
-    from slamlab.lab.tasks_correlation import FAILURE_SEEDS, brute_force_failures, brute_force_headings
+    code); the library fails at the same poses of the first seed (the same scene, an agreeing localiser), its run
+    for the question's seed (held out of the range) lands inside, and any seed's wrong answers stay outside."""
+    from slamlab.lab.tasks_correlation import FAILURE_SEEDS, brute_force_failures
 
     runs = brute_force_failures()
     assert [len(f) for f in runs] == [12] * len(FAILURE_SEEDS)
@@ -204,20 +203,19 @@ def test_failures_exploration_range():
     lo, hi = min(counts), max(counts)
     assert 0 < lo < hi < 12  # the seed matters: one seed's count is not the answer
     assert lab.task("06.explore.failures").accepted_range() == (lo, hi)
-    grid, poses, scans = monte_carlo_scene(12, range_std_cells=2.0, extra_clutter=120, rng=2010)
-    held_out = []
-    for (x, y, th), scan in zip(poses, scans, strict=True):  # the question's seed, by the brute force
-        best, cell = brute_force_headings(grid, scan.bearings_rad, scan.ranges, scan.valid, np.arange(0, 360, 2))
-        k = int(np.argmax(best))
-        held_out.append(int(np.hypot(cell[k, 1] - x, cell[k, 0] - y) > 2
-                            or abs((2 * k - np.degrees(th) + 180) % 360 - 180) > 5))
-    mc = sl.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, delta_alpha_rad=np.radians(2.0),
-                                        rng=2010, progress=False)
-    assert mc.failed.astype(int).tolist() == held_out  # the same poses fail: the same scene, an agreeing localiser
-    assert lo <= sum(held_out) <= hi
+
+    def library(seed):
+        return sl.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120,
+                                              delta_alpha_rad=np.radians(2.0), rng=seed, progress=False).failed
+
+    assert library(FAILURE_SEEDS[0]).astype(int).tolist() == list(runs[0])
+    held_out = int(library(2010).sum())
+    assert 2010 not in FAILURE_SEEDS
+    assert lo <= held_out <= hi
     for n in range(lo, hi + 1):
         assert lab.answer("06.explore.failures", n, quiet=True).passed
-    for wrong, hint in ((lo - 1, "fails when"), (hi + 1, "fails when"), *((12 - n, "successes") for n in range(lo, hi + 1)),
+    for wrong, hint in ((lo - 1, "fails when"), (hi + 1, "fails when"),
+                        *((12 - n, "successes") for n in range(lo, hi + 1)),
                         *((n / 12, "fraction") for n in range(lo, hi + 1))):
         res = lab.answer("06.explore.failures", wrong, quiet=True)
         assert res.status == "failed"
