@@ -5,6 +5,7 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
+import scipy.fft as sfft
 
 from ..correlation import rasterise_scan, score_maps
 from ..scans import Scan, scan_to_points
@@ -150,8 +151,9 @@ def _first_failing_step() -> float:
     return float("nan")
 
 
-#: Exploration 2: the seeds whose runs span the accepted range of failures.
-FAILURE_SEEDS = (2010, 2011, 2012, 2013)
+#: Exploration 2: the seeds whose runs span the accepted range of failures (the question's 2010 is held out:
+#: tests/lab/test_check_correlation.py checks that it lands inside).
+FAILURE_SEEDS = (2011, 2012, 2013)
 
 
 @lru_cache(maxsize=1)
@@ -173,25 +175,59 @@ def _monte_carlo_failures() -> float:
     return float(failure_runs()[0].failed.sum())
 
 
+@lru_cache(maxsize=1)
+def brute_force_failures() -> tuple[tuple[int, ...], ...]:
+    """Exploration 2 by brute force: each seed's failed poses, localised with no slamlab.correlation code.
+
+    The run's own poses and scans (:func:`~slamlab.lab.experiments.monte_carlo_scene`), each
+    localised by :func:`brute_force_headings` over every map cell and the headings ``n·2°``; a pose
+    fails when the best candidate is over 2 cells or 5° from the truth (the question's rule).
+
+    Returns
+    -------
+    tuple of tuple of int
+        Per seed of :data:`FAILURE_SEEDS`, 1 for each failed pose and 0 for each success.
+    """
+    from .experiments import monte_carlo_scene
+
+    out = []
+    for seed in FAILURE_SEEDS:
+        grid, poses, scans = monte_carlo_scene(12, range_std_cells=2.0, extra_clutter=120, rng=seed)
+        failed = []
+        for (x, y, th), scan in zip(poses, scans, strict=True):
+            best, cell = brute_force_headings(grid, scan.bearings_rad, scan.ranges, scan.valid, np.arange(0, 360, 2))
+            k = int(np.argmax(best))
+            miss_deg = abs((2.0 * k - np.degrees(th) + 180.0) % 360.0 - 180.0)
+            failed.append(int(np.hypot(cell[k, 1] - x, cell[k, 0] - y) > 2.0 or miss_deg > 5.0))
+        out.append(tuple(failed))
+    return tuple(out)
+
+
 def failures_over_seeds() -> tuple[float, float]:
-    """Exploration 2's range: fewest and most failures of the runs of :func:`failure_runs`.
+    """Exploration 2's range: fewest and most failures over :data:`FAILURE_SEEDS` by :func:`brute_force_failures`.
 
     Returns
     -------
     tuple of float
         ``(lo, hi)`` failures.
     """
-    n = [int(mc.failed.sum()) for mc in failure_runs()]
+    n = [sum(f) for f in brute_force_failures()]
     return float(min(n)), float(max(n))
 
 
-def brute_force_headings(grid, bearings_rad, ranges, valid, headings_deg) -> tuple[np.ndarray, np.ndarray]:
-    """Best score and its cell for each heading, every map cell scored with plain numpy (no correlation code).
+def _mid_failures() -> float:
+    """The middle of the accepted range: the typical wrong answers are matched around it, for any seed."""
+    return float(np.mean(failures_over_seeds()))
 
-    The template follows 004 §7: free marks ``a_c = -1`` every half cell along each valid beam, then
-    the obstacle marks ``a_p = +1`` just beyond the hit; the map's free / occupied / unknown cells
+
+def brute_force_headings(grid, bearings_rad, ranges, valid, headings_deg) -> tuple[np.ndarray, np.ndarray]:
+    """Best score and its cell for each heading, every map cell scored (numpy, scipy.fft; no correlation code).
+
+    The template follows 004 §7 (as Task 2's stamp): free marks ``a_c = -1`` every half cell from
+    the robot along each valid beam, short of its hit, then the obstacle marks ``a_p = +1`` just beyond the hit; the map's free / occupied / unknown cells
     count -1 / +1 / 0. Every shift is scored at once by a zero-padded FFT cross-correlation
-    (the independent check of Exploration 1).
+    (scipy.fft; the scores are integers, so they are rounded and ties go to the first cell);
+    the independent check of Explorations 1 and 2.
 
     Parameters
     ----------
@@ -215,20 +251,27 @@ def brute_force_headings(grid, bearings_rad, ranges, valid, headings_deg) -> tup
     valid = np.asarray(valid, bool)
     b, r = np.asarray(bearings_rad, float)[valid], np.asarray(ranges, float)[valid]
     o = int(np.ceil(r.max())) + 3
-    P = (H + 2 * o, W + 2 * o)  # no wrap-around: the map sits o cells inside a zero frame
-    Mp = np.zeros(P)
-    Mp[o:o + H, o:o + W] = M
-    FM = np.fft.rfft2(Mp)
-    free = np.arange(0.0, 1.0, 0.5 / r.max())[None, :] * r[:, None]
-    hit = r[:, None] + np.array([[0.01, 0.5]])
+    # circular correlation with the map in the corner of a zero frame of >= o cells: a shift of up to
+    # ±o from a map cell wraps into zeros only (no wrap-around), at a fast FFT length
+    P = tuple(sfft.next_fast_len(n + o + 1, real=True) for n in (H, W))
+    Mp = np.zeros(P, np.float32)  # float32: integer scores of a few thousand, rounded below (errors << 0.5)
+    Mp[:H, :W] = M
+    FM = sfft.rfft2(Mp)
+    T = np.zeros(P, np.float32)
+    t_free = np.arange(0.0, r.max(), 0.5)[None, :]  # every half cell from the robot, short of the hit
+    beam, step = np.nonzero(t_free < r[:, None])
+    hit_t = (r[:, None] + np.array([[0.01, 0.5]])).ravel()
+    # each mark at heading 0 as (x, y); a heading turns them: the marks' points, not their cells
+    marks = [(t_free[0, step] * np.cos(b[beam]), t_free[0, step] * np.sin(b[beam]), -1.0),
+             (hit_t * np.cos(np.repeat(b, 2)), hit_t * np.sin(np.repeat(b, 2)), 1.0)]
     best, cell = [], []
     for k in np.asarray(headings_deg):
-        ang = np.radians(float(k)) + b[:, None]
-        T = np.zeros(P)
-        for t, val in ((free, -1.0), (hit, 1.0)):  # obstacle marks last: they win a shared cell
-            rows, cols = np.floor(t * np.sin(ang) + 0.5).astype(int), np.floor(t * np.cos(ang) + 0.5).astype(int)
+        T[:] = 0.0
+        c, s = np.cos(np.radians(float(k))), np.sin(np.radians(float(k)))
+        for x, y, val in marks:  # obstacle marks last: they win a shared cell
+            rows, cols = np.floor(s * x + c * y + 0.5).astype(int), np.floor(c * x - s * y + 0.5).astype(int)
             T[rows % P[0], cols % P[1]] = val
-        D = np.fft.irfft2(FM * np.conj(np.fft.rfft2(T)), s=P)[o:o + H, o:o + W]
+        D = np.rint(sfft.irfft2(FM * np.conj(sfft.rfft2(T)), s=P)[:H, :W])
         i = int(np.argmax(D))
         best.append(D.flat[i])
         cell.append(divmod(i, W))
@@ -270,7 +313,7 @@ register(ExplorationTask(
     "Exploration 1: the smallest whole-degree step Δα at which localisation at (60, 40, 37°) fails",
     _first_failing_step,
     accepted=lambda: (brute_force_first_failing_step(),) * 2,
-    why="one whole-degree value from an independent brute-force localiser in plain numpy (every cell × every "
+    why="one whole-degree value from an independent brute-force localiser in numpy and scipy.fft (every cell × every "
         "1° heading of the map scored by an FFT cross-correlation of 004 §7's template, then for each Δα the "
         "best of the headings n·Δα): it fails first at the same Δα as the library. The reason is geometric: the "
         "best candidate heading is the multiple of Δα nearest 37°, and the first step whose nearest multiple is "
@@ -292,15 +335,19 @@ register(ExplorationTask(
     "06.explore.failures",
     "Exploration 2: failures of 12 random poses with σ = 2 cells and 120 extra clutter discs",
     _monte_carlo_failures, accepted=failures_over_seeds,
-    why="the fewest to the most failures of the same 12-pose run over four seeds (2010-2013): poses, noise and "
-        "clutter are random, so a run with another seed (or the question's) lands in this range; the seed's "
-        "effect dwarfs the localiser's details. Not independent of the library's localiser: an independent "
-        "brute-force localiser (as in Exploration 1) over 12 poses × 180 headings per seed is too slow for the "
-        "notebook; the failure rule itself (> 2 cells or > 5°) is recomputed from the errors in the tests.",
+    why="the fewest to the most failures over three seeds (2011-2013) of an independent brute-force localiser "
+        "with no slamlab.correlation code (the run's own poses and scans; every map cell × every heading n·2° "
+        "scored by an FFT cross-correlation of 004 §7's template; a failure is > 2 cells or > 5° off): 2-5, as "
+        "the library's runs. Poses, noise and clutter are random, so another seed lands in this range (the "
+        "question's 2010 gives 4, by both). Per seed "
+        "the two localisers agree to one pose: their scores of one candidate differ by a few points in thousands "
+        "(a few marks rounded to other cells), and in this much noise and clutter a far candidate often beats "
+        "the true pose by only tens of points, so such a detail can decide a pose; the spread over seeds is "
+        "larger.",
     hint="a localisation fails when its position error is above 2 cells or its heading error above 5°; count "
          "failures, with the noise, clutter and heading step the question names.",
     more="Both error criteria count: a pose can be close in position and still wrong in heading.",
-    wrong=(WrongAnswer("successes", lambda: 12.0 - _monte_carlo_failures(),
+    wrong=(WrongAnswer("successes", lambda: 12.0 - _mid_failures(), atol=1.5,  # 12 minus any seed's failures
                        hint="that is the number of successes: the question asks how many fail."),
-           WrongAnswer("a fraction", lambda: _monte_carlo_failures() / 12.0, atol=0.01,
+           WrongAnswer("a fraction", lambda: _mid_failures() / 12.0, atol=0.15,  # any seed's failures / 12
                        hint="that looks like a fraction of the poses: the question asks for a count."))))

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
 from ..geometry import umeyama
@@ -11,8 +9,9 @@ from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
 from ..geometry.triangulation import triangulate_midpoint, triangulate_stereo
 from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
-#: Exploration 1: the right camera's calibration drift per frame [rad] and the frames of the turn in place.
-EXPLORE_DRIFT_RAD, EXPLORE_FRAMES = 2e-3, 5
+#: Exploration 1: the right camera's turn about its vertical axis [rad] (one step of the simulator's drift) and
+#: the depth [m] of the point straight ahead.
+EXPLORE_TURN_RAD, EXPLORE_TURN_DEPTH_M = 2e-3, 8.0
 #: Exploration 2: depth [m] of the point and the disparity error [px].
 EXPLORE_DEPTH_M, EXPLORE_DISPARITY_ERR_PX = 8.0, 0.5
 
@@ -202,29 +201,64 @@ register(Task("05.umeyama", "Task 4, Umeyama alignment (rotation, translation, s
               "scale estimation the scale is 1.", compare=_umeyama_compare, points=3))
 
 
-@lru_cache(maxsize=2)
-def drift_errors(drift_std_rad: float = EXPLORE_DRIFT_RAD) -> tuple[float, ...]:
-    """Exploration 1's seeded run (rng=2010): the position error [m] of each frame.
+def _turned_depth_errors() -> tuple[float, float]:
+    """Exploration 1 by the library: depth error [m] of the point for the right camera turned by ``±EXPLORE_TURN_RAD``.
 
-    Parameters
-    ----------
-    drift_std_rad : float
-        Calibration drift per frame [rad] (0 gives the run without drift).
+    The drifted rig (the simulator's drift: ``R_rl`` turned about the camera's vertical axis) projects
+    the point; the calibrated rig triangulates it.
+    """
+    from .experiments import stereo_rig
+
+    rig = stereo_rig(arena_seed=0, rng=2010)
+    out = []
+    for turn in (EXPLORE_TURN_RAD, -EXPLORE_TURN_RAD):
+        drifted = StereoRig(rig.left, rig.right, rotation_xyz(0.0, turn, 0.0) @ rig.R_rl, rig.t_rl)
+        uvl, uvr = drifted.project(np.array([[0.0, 0.0, EXPLORE_TURN_DEPTH_M]]))
+        out.append(float(triangulate_stereo(rig, uvl, uvr).points[0, 2] - EXPLORE_TURN_DEPTH_M))
+    return out[0], out[1]
+
+
+def _drift_depth_error() -> float:
+    return max(abs(e) for e in _turned_depth_errors())
+
+
+def turned_depth_formulas() -> tuple[float, float, float]:
+    """Exploration 1's closed forms from the baseline alone: ``(first order, exact, exact the other way)`` [m].
+
+    A point at depth Z straight ahead of the left camera; the right camera turned by δ about its
+    vertical axis sees it at ``x_r = (Z sin δ - B, 0, Z cos δ)``, so the disparity becomes
+    ``f (B - Z sin δ) / (Z cos δ)`` and the calibrated rig triangulates ``Z' = B Z cos δ / (B - Z sin δ)``
+    (f cancels); first order ``Z² δ / B`` (000 §3.3 with ``δd = f δ``). The turn the other way
+    (``-δ``) gives ``B Z cos δ / (B + Z sin δ)``, a smaller error. No triangulation code involved
+    (the independent check of Exploration 1).
 
     Returns
     -------
     tuple of float
-        One error per frame.
+        ``(Z² δ / B, Z' - Z, Z - Z'_other)``, all positive.
     """
-    from ..stereo import RenderParams, run_turn_in_place
+    from .experiments import stereo_rig
 
-    res = run_turn_in_place("small", n_frames=EXPLORE_FRAMES, detector="orb",
-                            render=RenderParams(drift_std_rad=drift_std_rad), rng=2010, progress=False)
-    return tuple(float(e) for e in res.pos_err_m)
+    B = stereo_rig(arena_seed=0, rng=2010).baseline_m
+    Z, d = EXPLORE_TURN_DEPTH_M, EXPLORE_TURN_RAD
+    return (float(Z**2 * d / B), float(B * Z * np.cos(d) / (B - Z * np.sin(d)) - Z),
+            float(Z - B * Z * np.cos(d) / (B + Z * np.sin(d))))
 
 
-def _drift_max_error() -> float:
-    return max(drift_errors())
+def _drift_accepted() -> tuple[float, float]:
+    first, exact, _ = turned_depth_formulas()
+    return 0.97 * first, 1.03 * exact
+
+
+def _drift_exact() -> float:
+    return turned_depth_formulas()[1]
+
+
+def _rig_fx() -> float:
+    """The simulator's focal length [px] (the pixel shift of a turn is about ``f δ``)."""
+    from .experiments import stereo_rig
+
+    return float(stereo_rig(arena_seed=0, rng=2010).left.fx)
 
 
 def _depth_error() -> float:
@@ -261,24 +295,35 @@ def _depth_mid() -> float:
 
 register(ExplorationTask(
     "05.explore.drift",
-    "Exploration 1: max position error [m] of 5 turn-in-place frames (ORB) with 2 mrad calibration drift per frame",
-    _drift_max_error, atol=0.005,
-    why="the library's seeded run (rng=SEED) ± 5 mm; no independent computation: the drift is a random walk "
-        "whose draw decides the answer (seeds 2010-2015 give 0.91, 0.88, 0.00, 0.73, 0.21 and 0.56 m), so a range "
-        "over seeds would accept nearly anything, and no second stereo pipeline exists to rerun the seed. The "
-        "tests check what is independent of the number: the error without drift is millimetres, the drift's is "
-        "tenths of a metre, and the wrong answers (mean over frames, millimetres, no drift) are rejected.",
-    hint="the drift perturbs the right camera's calibration while the pipeline still assumes the nominal rig; the "
-         "question asks for the worst position error over the frames, in metres, with everything else as in the "
-         "chapter.",
-    more="The worst error is the maximum over frames, not the last frame's or the mean.",
-    wrong=(WrongAnswer("the mean over frames", lambda: float(np.mean(drift_errors())), atol=0.005,
-                       hint="that looks like the mean over the frames: the question asks for the worst frame."),
-           WrongAnswer("millimetres", lambda: 1000.0 * _drift_max_error(), atol=5.0,
+    "Exploration 1: the larger depth error [m] at 8 m when the right camera has turned by 2 mrad (either way)",
+    _drift_depth_error, accepted=_drift_accepted,
+    why="from the baseline, the depth and the turn alone (f cancels; no triangulation code): 0.97 × the first-order "
+        "Z² δ / B to 1.03 × the exact B Z cos δ / (B − Z sin δ) − Z, the turn that shrinks the disparity. "
+        "Triangulating with the calibrated rig and the first-order formula both pass; the other direction "
+        "(the disparity grows) gives the smaller error and is rejected. The question used to ask for the worst "
+        "position error of a seeded SLAM run with a random-walk drift, which no independent computation can "
+        "check: over seeds 2010-2015 it ranged from 0.00 m (seed 2012: tracking is lost from the second frame, "
+        "the pose stays at the start and a turn in place has no translation to get wrong) to 0.91 m. The run is "
+        "now the question's open follow-up.",
+    hint="the drifted right camera sees the point where the turned camera would; the calibrated rig then "
+         "triangulates it. The question asks for the larger of the two depth errors (turn one way or the other), "
+         "in metres, for the point 8 m ahead.",
+    more="A turn of the right camera moves every right pixel sideways by about f times the angle: a disparity error.",
+    wrong=(WrongAnswer("the other direction", lambda: turned_depth_formulas()[2], rtol=0.01,
+                       hint="that is the error of the turn that makes the disparity larger (the point comes closer): "
+                            "the other direction gives the larger error."),
+           WrongAnswer("the other direction, signed", lambda: -turned_depth_formulas()[2], rtol=0.01,
+                       hint="that is the error of the turn that makes the disparity larger (the point comes closer): "
+                            "the other direction gives the larger error."),
+           WrongAnswer("millimetres", lambda: 1000.0 * _drift_exact(), rtol=0.06,
                        hint="check the unit: the answer is in metres."),
-           WrongAnswer("no drift", lambda: max(drift_errors(0.0)), atol=0.005,
-                       hint="that is about the error without calibration drift: check that the drift is applied to "
-                            "the right camera."))))
+           WrongAnswer("the pixel shift", lambda: float(_rig_fx() * EXPLORE_TURN_RAD), rtol=0.02,
+                       hint="that looks like the disparity error in pixels: the question asks for the depth error "
+                            "in metres."),
+           WrongAnswer("relative error", lambda: _drift_exact() / EXPLORE_TURN_DEPTH_M, rtol=0.06,
+                       hint="that looks like the error divided by the depth: the question asks for metres."),
+           WrongAnswer("the depth itself", lambda: EXPLORE_TURN_DEPTH_M + _drift_exact(), rtol=0.01,
+                       hint="that is the depth itself: the error is its difference from the true 8 m."))))
 register(ExplorationTask(
     "05.explore.depth_error",
     "Exploration 2: depth error [m] at 8 m from a 0.5 px disparity error (the simulator's rig)",

@@ -158,25 +158,32 @@ def test_h_min_exploration_independent():
 
 
 def test_exploration_answers():
+    """The library's run for the question's seed: its lost steps are the independent count, and accepted."""
     import slamlab as sl
+    from slamlab.lab.tasks_hough import independent_lost_counts
 
     res = sl.hough.run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=2010)
-    assert 0 < res.slam.lost.sum() < 120
+    assert int(res.slam.lost.sum()) == independent_lost_counts()[0][1]
     assert lab.answer("07.explore.lost_steps", int(res.slam.lost.sum()), quiet=True).passed
     assert lab.answer("07.explore.lost_steps", 0, quiet=True).status == "failed"
 
 
 def test_lost_steps_exploration_range():
-    """The accepted range is the spread of lost steps over seeds; the wrong answers stay outside it."""
-    from slamlab.lab.tasks_hough import LOST_SEEDS, lost_runs
+    """The accepted range: per seed, the steps whose scan or the previous one has fewer than two lines of >= 40
+    votes by Exploration 1's plain-numpy line finder (no slamlab.hough code); the wrong answers stay outside."""
+    from slamlab.lab.tasks_hough import LOST_SEEDS, independent_lost_counts
 
-    counts = [int(lost[1:].sum()) for lost in lost_runs()]  # the first pose is the start, never lost
+    counts = independent_lost_counts()
     assert len(counts) == len(LOST_SEEDS)
-    lo, hi = min(counts), max(counts)
-    assert 0 < lo < hi < 120
+    assert all(0 < few < lost < 120 for few, lost in counts)  # the step after a scan without two lines is lost too
+    lo, hi = min(n for _, n in counts), max(n for _, n in counts)
+    assert lo < hi  # the seed matters: one seed's count is not the answer
     assert lab.task("07.explore.lost_steps").accepted_range() == (lo, hi)
-    for wrong, hint in ((lo - 1, "Hint"), (hi + 1, "Hint"), (120 - counts[0], "pose from lines"),
-                        (counts[0] / 120, "fraction")):
+    for n in range(lo, hi + 1):
+        assert lab.answer("07.explore.lost_steps", n, quiet=True).passed
+    few, lost = counts[0]
+    for wrong, hint in ((lo - 1, "Hint"), (hi + 1, "Hint"), (120 - lost, "pose from lines"),
+                        (lost / 120, "fraction"), (few, "fewer than two lines")):
         res = lab.answer("07.explore.lost_steps", wrong, quiet=True)
         assert res.status == "failed"
         assert hint in res.message

@@ -140,19 +140,28 @@ def test_depth_error_exploration():
     assert lab.answer("05.explore.depth_error", 2 * err, quiet=True).status == "failed"
 
 
-@pytest.mark.slow
 def test_drift_exploration():
+    """The drifted right camera's pixel and the depth from the disparity, written here: the range's ends are the
+    first-order and exact errors of the turn that shrinks the disparity; the library's answer and the typical
+    wrong ones fall where they should."""
     import slamlab as sl
 
-    res = sl.stereo.run_turn_in_place("small", n_frames=5, detector="orb",
-                                      render=sl.stereo.RenderParams(drift_std_rad=2e-3), rng=2010)
-    err = float(np.max(np.hypot(*(res.estimate[:, :2] - res.truth[:, :2]).T)))
-    assert err > 0.5  # a few milliradians of drift cost metres
-    assert lab.answer("05.explore.drift", err, quiet=True).passed
-    no_drift = sl.stereo.run_turn_in_place("small", n_frames=5, detector="orb", rng=2010, progress=False)
-    assert no_drift.pos_err_m.max() < 0.01  # without drift the same turn is tracked to millimetres
-    errs = np.hypot(*(res.estimate[:, :2] - res.truth[:, :2]).T)
-    for wrong, hint in ((float(errs.mean()), "mean"), (1000 * err, "unit"), (float(no_drift.pos_err_m.max()), "without calibration drift")):
+    rig = sl.sim.StereoSim(sl.sim.StereoArena(seed=0), rng=2010).rig
+    f, cx, B, Z, turn = rig.left.fx, rig.left.cx, rig.baseline_m, 8.0, 2e-3
+    errors = []
+    for a in (turn, -turn):  # the right camera turned about its vertical axis, x_r = R_y(a) x_l + (-B, 0, 0)
+        x, z = Z * np.sin(a) - B, Z * np.cos(a)
+        d = cx - (f * x / z + cx)  # the left pixel is cx: the point is straight ahead
+        errors.append(f * B / d - Z)  # the calibrated rig's depth from the disparity
+    worst, other = max(errors, key=abs), min(errors, key=abs)
+    assert worst > 0 > other  # the shrinking disparity pushes the point away, and further than the other pulls it
+    lo, hi = lab.task("05.explore.drift").accepted_range()
+    assert (lo, hi) == pytest.approx((0.97 * Z**2 * turn / B, 1.03 * worst), rel=1e-9)
+    assert lo < Z**2 * turn / B < worst < hi  # first order and exact both pass
+    assert lab.answer("05.explore.drift", lab.task("05.explore.drift").expected(), quiet=True).passed
+    assert lab.task("05.explore.drift").expected() == pytest.approx(worst, rel=1e-6)
+    for wrong, hint in ((abs(other), "disparity larger"), (other, "disparity larger"), (1000 * worst, "unit"),
+                        (f * turn, "pixels"), (worst / Z, "divided by the depth"), (Z + worst, "depth itself")):
         r = lab.answer("05.explore.drift", wrong, quiet=True)
         assert r.status == "failed"
         assert hint in r.message
