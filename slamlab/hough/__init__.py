@@ -37,7 +37,7 @@ from .lines import (
 )
 from .mapping import map_agreement
 from .pose import PoseChange, pose_from_lines, pose_from_two_lines, select_line_pair
-from .slam import HoughSlamParams, HoughSlamResult, detect_lines, hough_slam
+from .slam import STEP_CAUSES, HoughSlamParams, HoughSlamResult, detect_lines, hough_slam
 from .transform import (
     HoughAccumulator,
     hough_classic,
@@ -66,6 +66,7 @@ __all__ = [
     "LOG_PARAMS",
     "ODOMETRY_NOISE",
     "SHARED_LOGS",
+    "STEP_CAUSES",
     "ExampleLineResult",
     "HoughAccumulator",
     "HoughSlamParams",

@@ -34,7 +34,21 @@ from .lines import Lines, _find_peaks, _merge_duplicates, _refine_lines, _transf
 from .pose import _pose_from_lines
 from .transform import _hough_polar, theta_axis
 
-__all__ = ["HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
+__all__ = ["STEP_CAUSES", "HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
+
+#: How each step's pose was obtained (ours): the code stored in :attr:`HoughSlamResult.cause`.
+#: Codes 0 and 1 use the lines; every other code means the step fell back on odometry, for that cause.
+STEP_CAUSES = {
+    "lines": "pose from non-parallel lines common with a reference scan",
+    "partial": "only parallel lines: rotation and move across them from the lines, along them from odometry",
+    "few_returns": "fewer returns than H_min: no line can reach the vote threshold",
+    "no_lines": "no line found in the scan",
+    "not_associated": "lines found, none associated with the previous scan's",
+    "one_line": "one line associated, the parallel-line step rejected it (its votes, heading or residual)",
+    "pose_rejected": "two or more lines associated, the pose solution rejected them (angle change or residual)",
+    "gate": "a pose was found but lay beyond the gate around odometry's",
+}
+_CODE = {name: k for k, name in enumerate(STEP_CAUSES)}
 
 
 def _optional_positive(value, name):
@@ -163,6 +177,8 @@ class HoughSlamResult:
         The settings of the run.
     partial : numpy.ndarray of bool, shape (n,) or None
         Pose from parallel lines plus odometry.
+    cause : numpy.ndarray of int, shape (n,) or None
+        How each step's pose was obtained: an index into :data:`STEP_CAUSES` (ours).
     """
 
     poses: np.ndarray = field(repr=False)  # (n, 3) estimated (x, y, φ), φ unwrapped
@@ -172,6 +188,20 @@ class HoughSlamResult:
     history: LineHistory = field(repr=False)
     params: HoughSlamParams = field(default_factory=HoughSlamParams)
     partial: np.ndarray | None = field(default=None, repr=False)  # (n,) bool: parallel lines + odometry
+    cause: np.ndarray | None = field(default=None, repr=False)  # (n,) index into STEP_CAUSES
+
+    def cause_counts(self) -> dict:
+        """Steps (scan 0 excluded) per entry of :data:`STEP_CAUSES` (ours).
+
+        Returns
+        -------
+        dict
+            ``{cause name: number of steps}`` in the order of :data:`STEP_CAUSES`.
+        """
+        if self.cause is None:
+            raise ValueError("this result carries no per-step `cause` (made without it)")
+        counts = np.bincount(self.cause[1:], minlength=len(STEP_CAUSES))
+        return {name: int(c) for name, c in zip(STEP_CAUSES, counts, strict=True)}
 
     def __str__(self) -> str:
         n_part = 0 if self.partial is None else int(self.partial.sum())
@@ -279,6 +309,19 @@ def _partial(history, n1, n2, prior, params):
     return np.array([t[0], t[1], ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())])
 
 
+def _fallback_cause(n_returns, n_lines, most_common, rejected, gated, H_min) -> str:
+    """The :data:`STEP_CAUSES` name of a step that fell back on odometry (the first that applies)."""
+    if n_returns < H_min:
+        return "few_returns"
+    if n_lines == 0:
+        return "no_lines"
+    if gated:
+        return "gate"
+    if rejected:
+        return "pose_rejected"
+    return "not_associated" if most_common == 0 else "one_line"
+
+
 def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
                params: HoughSlamParams | None = None, *, progress: bool | None = None,
                **overrides) -> HoughSlamResult:
@@ -323,6 +366,7 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     partial = np.zeros(n, dtype=bool)
     ref = np.full(n, -1, dtype=np.int64)
     n_lines = np.zeros(n, dtype=np.int64)
+    cause = np.zeros(n, dtype=np.int64)
     history = LineHistory()
     keyframe = 0
     for k in progress_bar(range(n), desc="Hough SLAM", progress=progress):
@@ -341,14 +385,18 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
         history.add_scan(lines, ids)
         guess = se2_compose(poses[k - 1], U[k - 1])
         pose = None
+        most_common, rejected, gated = 0, False, False  # why no pose: for the cause code
         for n1 in dict.fromkeys((keyframe, k - 1)):
-            delta, _ = _relative(history, n1, k, params)
+            delta, n_common = _relative(history, n1, k, params)
+            most_common = max(most_common, n_common)
             if delta is None:
+                rejected |= n_common >= 2
                 continue
             cand = se2_compose(poses[n1], delta)
             if params.gate is not None and odometry is not None and (
                     math.hypot(*(cand[:2] - guess[:2])) > params.gate
                     or abs(float(wrap_angle(cand[2] - guess[2]))) > params.gate_theta_rad):
+                gated = True
                 continue
             pose, ref[k] = cand, n1
             break
@@ -356,12 +404,15 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
             delta = _partial(history, k - 1, k, U[k - 1], params)
             if delta is not None:
                 pose, ref[k], partial[k] = se2_compose(poses[k - 1], delta), k - 1, True
+                cause[k] = _CODE["partial"]
         if pose is None:
             pose, lost[k], ref[k] = guess, True, k - 1
+            cause[k] = _CODE[_fallback_cause(returns[k][1].size, len(lines), most_common, rejected, gated,
+                                             params.H_min)]
         poses[k] = pose
         _, n_common = _relative(history, keyframe, k, params) if ref[k] == keyframe else (None, 0)
         if lost[k] or ref[k] != keyframe or n_common < params.min_common:
             keyframe = k
     # headings unwrapped along the run, starting at the given start heading
     poses[:, 2] = np.unwrap(poses[:, 2]) + (poses[0, 2] - np.unwrap(poses[:, 2])[0])
-    return HoughSlamResult(poses, lost, n_lines, ref, history, params, partial)
+    return HoughSlamResult(poses, lost, n_lines, ref, history, params, partial, cause)

@@ -133,8 +133,15 @@ def test_partial_update_in_a_corridor():
     err = E.pose_errors(res.poses, truth)
     assert np.abs(err[:, 1]).max() < 1e-6  # across: from the walls, exact
     assert np.abs(err[:, 2]).max() < 1e-6
+    assert res.cause_counts() == {**dict.fromkeys(h.STEP_CAUSES, 0), "partial": 2}
     off = h.hough_slam(scans, truth[0], odo_biased, delta_rho=0.1, H_min=20, partial=False)
     assert off.lost[1:].all()
+    # two parallel lines associated, no pose from them: the fallback's cause
+    assert off.cause_counts()["pose_rejected"] == 2
+    few = h.hough_slam([scans[0], Scan(phi[:5], np.ones(5), np.ones(5, bool), max_range=30.0)], truth[0], odo[:1],
+                       delta_rho=0.1, H_min=20)
+    assert few.cause_counts()["few_returns"] == 1
+    assert few.lost[1]
     assert np.abs(E.pose_errors(off.poses, truth)[-1, 1]) > 0.15
 
 
