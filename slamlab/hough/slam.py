@@ -41,6 +41,7 @@ __all__ = ["STEP_CAUSES", "HoughSlamParams", "HoughSlamResult", "detect_lines", 
 STEP_CAUSES = {
     "lines": "pose from non-parallel lines common with a reference scan",
     "partial": "only parallel lines: rotation and move across them from the lines, along them from odometry",
+    "heading": "lines associated but no pose from them: heading from the lines, translation from odometry",
     "few_returns": "fewer returns than H_min: no line can reach the vote threshold",
     "no_lines": "no line found in the scan",
     "not_associated": "lines found, none associated with the previous scan's",
@@ -107,6 +108,9 @@ class HoughSlamParams(Params):
         Heading gate [rad].
     partial : bool
         With only parallel lines, move along them from odometry.
+    heading : bool
+        When lines are associated but give no pose, take the heading change from them and the
+        translation from odometry (ours; off in simulation, on in :func:`~slamlab.hough.run_real_log`).
     """
 
     delta_rho: float = param(1.0, "004 §Hough SLAM: Δrho = 1 cell")
@@ -132,6 +136,7 @@ class HoughSlamParams(Params):
     gate: float | None = param(None, "ours: reject a pose farther than this from odometry's (None: off)")
     gate_theta_rad: float = param(math.radians(10.0), "ours: heading gate")
     partial: bool = param(True, "ours: only parallel lines → move along them from odometry")
+    heading: bool = param(False, "ours: no pose from the lines → their heading change, odometry's translation")
 
     def check(self) -> None:
         v.check_positive(self.delta_rho, "delta_rho")
@@ -140,7 +145,7 @@ class HoughSlamParams(Params):
             _optional_positive(getattr(self, name), name)
         v.check_int(self.H_min, "H_min", minimum=1)
         v.check_int(self.max_lines, "max_lines", minimum=2)
-        for name in ("refine", "partial"):
+        for name in ("refine", "partial", "heading"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
         v.check_positive(self.a, "a")
@@ -322,6 +327,29 @@ def _fallback_cause(n_returns, n_lines, most_common, rejected, gated, H_min) -> 
     return "not_associated" if most_common == 0 else "one_line"
 
 
+def _heading(history, n1, n2, prior, params):
+    """Last step before odometry alone (our addition): Δφ from the common lines, (Δx, Δy) from ``prior``.
+
+    The heading change is the vote-weighted mean of θ_{n1} - θ_{n2} over the lines within
+    ``angle_tol_rad`` of its weighted median; it needs ``H_min`` votes and must lie within
+    ``gate_theta_rad`` of odometry's.
+    """
+    ids1, l1 = history.scan(n1)
+    ids2, l2 = history.scan(n2)
+    common, i1, i2 = np.intersect1d(ids1, ids2, return_indices=True)
+    if common.size < 1:
+        return None
+    dphi_all = l1.theta_rad[i1] - l2.theta_rad[i2]
+    w = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
+    order = np.argsort(dphi_all)
+    cw = np.cumsum(w[order])
+    ref = dphi_all[order][np.searchsorted(cw, 0.5 * cw[-1])]
+    use = np.abs(wrap_angle(dphi_all - ref)) <= params.angle_tol_rad
+    if w[use].sum() < params.H_min or abs(float(wrap_angle(ref - prior[2]))) > params.gate_theta_rad:
+        return None
+    return np.array([prior[0], prior[1], ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())])
+
+
 def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
                params: HoughSlamParams | None = None, *, progress: bool | None = None,
                **overrides) -> HoughSlamResult:
@@ -405,6 +433,10 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
             if delta is not None:
                 pose, ref[k], partial[k] = se2_compose(poses[k - 1], delta), k - 1, True
                 cause[k] = _CODE["partial"]
+        if pose is None and params.heading and odometry is not None:
+            delta = _heading(history, k - 1, k, U[k - 1], params)
+            if delta is not None:
+                pose, ref[k], cause[k] = se2_compose(poses[k - 1], delta), k - 1, _CODE["heading"]
         if pose is None:
             pose, lost[k], ref[k] = guess, True, k - 1
             cause[k] = _CODE[_fallback_cause(returns[k][1].size, len(lines), most_common, rejected, gated,

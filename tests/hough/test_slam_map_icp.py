@@ -211,6 +211,25 @@ def test_real_urg_log_runs_with_raw_odometry():
 
 
 @pytest.mark.realdata
+@pytest.mark.parametrize("key", ["urg04lx", "mbicp"])
+def test_real_logs_meet_the_issue_25_goals_with_one_set_of_defaults(shared_data, key):
+    # bounds from issue 25's goal: on both shared logs, with run_real_log's defaults, the map is >= 10 %
+    # sharper than odometry's and <= 5 % of the steps fall back on odometry alone
+    res = E.run_real_log(shared_data / E.SHARED_LOGS[key], progress=False)
+    assert res.sharper_than_odometry() >= 0.10
+    assert res.slam.lost[1:].mean() <= 0.05
+    counts = res.slam.cause_counts()
+    assert sum(counts.values()) == res.odometry.shape[0] - 1
+    fallback = sum(c for name, c in counts.items() if name not in ("lines", "partial", "heading"))
+    assert fallback == res.slam.lost[1:].sum()
+    table = h.real_log_cause_table([res])
+    assert "odometry alone: all causes" in table
+    assert "sharper than odometry" in table
+    with pytest.raises(TypeError, match="`results` must be a non-empty sequence of RealLogResult"):
+        h.real_log_cause_table([res.slam])
+
+
+@pytest.mark.realdata
 @pytest.mark.parametrize(("key", "new_name", "label"), [("urg04lx", "hallway_run.dat", "URG-04LX"),
                                                         ("mbicp", "office.clf", "CARMEN")])
 def test_real_log_takes_any_path_and_labels_from_it(shared_data, tmp_path, key, new_name, label):
@@ -232,7 +251,7 @@ def test_hough_slam_params_check_every_field():
            "suppress_rho": -1.0, "suppress_theta_rad": 0.0, "refine": "yes", "band": -0.1, "max_gap": 0.0,
            "a": 0.0, "b": -1.0, "a_theta_rad": 0.0, "parallel_tol_rad": -0.1, "p_min": 1.5, "method": "svd",
            "angle_tol_rad": -1.0, "rho_tol": 0.0, "min_angle_rad": 2.0, "min_common": 1, "gate": 0.0,
-           "gate_theta_rad": 0.0, "partial": None}
+           "gate_theta_rad": 0.0, "partial": None, "heading": 1}
     assert set(bad) == set(h.HoughSlamParams.field_names())  # every field has a failing value
     for name, value in bad.items():
         with pytest.raises((TypeError, ValueError), match=f"`{name}`"):
