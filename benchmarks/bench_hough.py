@@ -99,7 +99,7 @@ def real_log_ablation():
 
     paths = {key: find_data(rel) for key, rel in h.SHARED_LOGS.items()}
     print(f"{'setting':52s} {'log':8s} {'alone':>7s} {'parallel':>9s} {'heading':>8s} {'cells S/O':>11s} "
-          f"{'sharper':>8s} {'s':>5s}")
+          f"{'sharper':>8s} {'s':>5s}  causes of the steps on odometry alone")
     for label, over in ABLATION:
         for key, path in paths.items():
             kw = over.get(key, {}) if over and isinstance(next(iter(over.values())), dict) else over
@@ -108,7 +108,8 @@ def real_log_ablation():
             c, n = r.slam.cause_counts(), r.odometry.shape[0] - 1
             print(f"{label:52s} {key:8s} {r.slam.lost[1:].sum() / n:7.1%} {c['partial'] / n:9.1%} "
                   f"{c['heading'] / n:8.1%} {r.sharpness('slam'):5.2f}/{r.sharpness('odometry'):5.2f} "
-                  f"{r.sharper_than_odometry():8.1%} {time.perf_counter() - t0:5.1f}")
+                  f"{r.sharper_than_odometry():8.1%} {time.perf_counter() - t0:5.1f}  "
+                  + ", ".join(f"{k} {v}" for k, v in c.items() if v and k not in ("lines", "partial", "heading")))
 
 
 def main(argv=None):
