@@ -77,12 +77,15 @@ def measure(phi, r, d_rho, d_theta, r_max, repeat):
 
 
 #: The ablation of ``--real-logs``: label → overrides of :data:`slamlab.hough.REAL_LOG_PARAMS` (per log key
-#: when a dict of dicts). The first row is the settings before issue 25 (per-format max_gap, no heading step).
+#: when a dict of dicts). The first row is the settings before issue 25 (per-format max_gap, no heading step,
+#: no second line search at ``H_min_retry``).
 ABLATION = (
     ("before issue 25: per-format max_gap, no heading step",
-     {"urg04lx": {"heading": False}, "mbicp": {"heading": False, "max_gap": 0.3}}),
-    ("one set (max_gap 0.2 m), no heading step", {"heading": False}),
-    ("defaults: one set + heading step", {}),
+     {"urg04lx": {"heading": False, "H_min_retry": None},
+      "mbicp": {"heading": False, "H_min_retry": None, "max_gap": 0.3}}),
+    ("one set (max_gap 0.2 m), no heading step, no retry", {"heading": False, "H_min_retry": None}),
+    ("one set + heading step, no retry", {"H_min_retry": None}),
+    ("defaults: one set + heading step + H_min retry 10", {}),
     ("defaults, partial step off", {"partial": False}),
     ("defaults, max_gap 0.3 m", {"max_gap": 0.3}),
     ("defaults, H_min 10", {"H_min": 10}),
@@ -98,7 +101,7 @@ def real_log_ablation():
     from slamlab.data import find_data
 
     paths = {key: find_data(rel) for key, rel in h.SHARED_LOGS.items()}
-    print(f"{'setting':52s} {'log':8s} {'alone':>7s} {'parallel':>9s} {'heading':>8s} {'cells S/O':>11s} "
+    print(f"{'setting':56s} {'log':8s} {'alone':>7s} {'parallel':>9s} {'heading':>8s} {'cells S/O':>11s} "
           f"{'sharper':>8s} {'s':>5s}  causes of the steps on odometry alone")
     for label, over in ABLATION:
         for key, path in paths.items():
@@ -106,7 +109,7 @@ def real_log_ablation():
             t0 = time.perf_counter()
             r = h.run_real_log(path, progress=False, **kw)
             c, n = r.slam.cause_counts(), r.odometry.shape[0] - 1
-            print(f"{label:52s} {key:8s} {r.slam.lost[1:].sum() / n:7.1%} {c['partial'] / n:9.1%} "
+            print(f"{label:56s} {key:8s} {r.slam.lost[1:].sum() / n:7.1%} {c['partial'] / n:9.1%} "
                   f"{c['heading'] / n:8.1%} {r.sharpness('slam'):5.2f}/{r.sharpness('odometry'):5.2f} "
                   f"{r.sharper_than_odometry():8.1%} {time.perf_counter() - t0:5.1f}  "
                   + ", ".join(f"{k} {v}" for k, v in c.items() if v and k not in ("lines", "partial", "heading")))

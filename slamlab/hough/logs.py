@@ -167,9 +167,10 @@ def real_log_cause_table(results) -> str:
 
 #: Real-log settings (ours), one set for every log and format: rho resolution and thresholds in metres
 #: (``r_max`` = the log's range limit); ``heading``: a step whose lines give no pose takes its heading change
-#: from them and its translation from odometry. Tuned on exp2 (URG-04LX) and the MbICP log together.
-REAL_LOG_PARAMS = {"delta_rho": 0.02, "H_min": 15, "a": 0.15, "max_gap": 0.2, "rho_tol": 0.05, "band": 0.03,
-                   "heading": True}
+#: from them and its translation from odometry; ``H_min_retry``: a scan with fewer than two lines is searched
+#: again at 10 votes. Tuned on exp2 (URG-04LX) and the MbICP log together.
+REAL_LOG_PARAMS = {"delta_rho": 0.02, "H_min": 15, "H_min_retry": 10, "a": 0.15, "max_gap": 0.2, "rho_tol": 0.05,
+                   "band": 0.03, "heading": True}
 #: The settings per format (kept for old callers): both formats use :data:`REAL_LOG_PARAMS`.
 LOG_PARAMS = {"urg04lx": REAL_LOG_PARAMS, "carmen": REAL_LOG_PARAMS}
 _FORMAT_NAMES = {"urg04lx": "URG-04LX", "carmen": "CARMEN"}

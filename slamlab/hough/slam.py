@@ -74,6 +74,9 @@ class HoughSlamParams(Params):
         Longest range used (None: each scan's longest).
     H_min : int
         Fewest votes of a line (004 leaves the value open).
+    H_min_retry : int or None
+        A scan with fewer than two lines at ``H_min`` is searched again with this threshold
+        (ours; None: not).
     max_lines : int
         Strongest lines kept per scan.
     suppress_rho, suppress_theta_rad : float or None
@@ -117,6 +120,7 @@ class HoughSlamParams(Params):
     delta_theta_rad: float = param(math.pi / 180, "004 §Hough SLAM: Δθ = 1°")
     r_max: float | None = param(None, "ours: longest range used (None: each scan's longest)")
     H_min: int = param(15, "004 §Hough SLAM: a parameter, value not given")
+    H_min_retry: int | None = param(None, "ours: a scan with < 2 lines is searched again at this threshold")
     max_lines: int = param(12, "ours: strongest lines kept per scan")
     suppress_rho: float | None = param(None, "ours: false-neighbour window (None: 3 Δrho)")
     suppress_theta_rad: float | None = param(None, "ours: false-neighbour window (None: 3 Δθ)")
@@ -144,6 +148,8 @@ class HoughSlamParams(Params):
         for name in ("r_max", "suppress_rho", "suppress_theta_rad", "band", "max_gap", "b", "rho_tol", "gate"):
             _optional_positive(getattr(self, name), name)
         v.check_int(self.H_min, "H_min", minimum=1)
+        if self.H_min_retry is not None:
+            v.check_int(self.H_min_retry, "H_min_retry", minimum=1)
         v.check_int(self.max_lines, "max_lines", minimum=2)
         for name in ("refine", "partial", "heading"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
@@ -397,8 +403,11 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     cause = np.zeros(n, dtype=np.int64)
     history = LineHistory()
     keyframe = 0
+    retry = None if params.H_min_retry is None else params.replace(H_min=params.H_min_retry)
     for k in progress_bar(range(n), desc="Hough SLAM", progress=progress):
         lines = _detect(*returns[k], params, theta)
+        if len(lines) < 2 and retry is not None:  # ours: a sparse scan, searched again at a lower threshold
+            lines = _detect(*returns[k], retry, theta)
         n_lines[k] = len(lines)
         if k == 0:
             history.add_scan(lines, np.full(len(lines), -1))

@@ -251,7 +251,7 @@ def test_hough_slam_params_check_every_field():
            "suppress_rho": -1.0, "suppress_theta_rad": 0.0, "refine": "yes", "band": -0.1, "max_gap": 0.0,
            "a": 0.0, "b": -1.0, "a_theta_rad": 0.0, "parallel_tol_rad": -0.1, "p_min": 1.5, "method": "svd",
            "angle_tol_rad": -1.0, "rho_tol": 0.0, "min_angle_rad": 2.0, "min_common": 1, "gate": 0.0,
-           "gate_theta_rad": 0.0, "partial": None, "heading": 1}
+           "gate_theta_rad": 0.0, "partial": None, "heading": 1, "H_min_retry": 0}
     assert set(bad) == set(h.HoughSlamParams.field_names())  # every field has a failing value
     for name, value in bad.items():
         with pytest.raises((TypeError, ValueError), match=f"`{name}`"):
