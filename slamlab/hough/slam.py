@@ -76,7 +76,7 @@ class HoughSlamParams(Params):
         Fewest votes of a line (004 leaves the value open).
     H_min_retry : int or None
         A scan with fewer than two lines at ``H_min`` is searched again with this threshold
-        (ours; None: not).
+        (ours; None, or not below ``H_min``: not).
     max_lines : int
         Strongest lines kept per scan.
     suppress_rho, suppress_theta_rad : float or None
@@ -403,7 +403,8 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     cause = np.zeros(n, dtype=np.int64)
     history = LineHistory()
     keyframe = 0
-    retry = None if params.H_min_retry is None else params.replace(H_min=params.H_min_retry)
+    low = params.H_min_retry is not None and params.H_min_retry < params.H_min  # a retry only below H_min
+    retry = params.replace(H_min=params.H_min_retry) if low else None
     for k in progress_bar(range(n), desc="Hough SLAM", progress=progress):
         lines = _detect(*returns[k], params, theta)
         if len(lines) < 2 and retry is not None:  # ours: a sparse scan, searched again at a lower threshold

@@ -138,6 +138,16 @@ def test_partial_update_in_a_corridor():
     assert off.lost[1:].all()
     # two parallel lines associated, no pose from them: the fallback's cause
     assert off.cause_counts()["pose_rejected"] == 2
+    # no line reaches H_min = 350 (each wall has ~340 votes): "no lines"; a second search at H_min_retry finds
+    # them, and the heading step (both ours) takes the heading from them, the translation from odometry
+    odo_turn = odo_biased.copy()
+    odo_turn[:, 2] += 0.02  # odometry's heading wrong too
+    none = h.hough_slam(scans, truth[0], odo_turn, delta_rho=0.1, H_min=350)
+    assert none.cause_counts()["no_lines"] == 2
+    assert np.abs(E.pose_errors(none.poses, truth)[-1, 2]) > 0.039
+    again = h.hough_slam(scans, truth[0], odo_turn, delta_rho=0.1, H_min=350, H_min_retry=20, heading=True)
+    assert again.cause_counts()["heading"] == 2
+    assert np.abs(E.pose_errors(again.poses, truth)[:, 2]).max() < 1e-6
     few = h.hough_slam([scans[0], Scan(phi[:5], np.ones(5), np.ones(5, bool), max_range=30.0)], truth[0], odo[:1],
                        delta_rho=0.1, H_min=20)
     assert few.cause_counts()["few_returns"] == 1
