@@ -289,26 +289,42 @@ def _relative(history, n1, n2, params):
     return (pc.pose if pc.ok else None), common.size
 
 
-def _partial(history, n1, n2, prior, params):
-    """Degenerate case (our addition): the common lines are all parallel (a corridor).
+def _common_heading(history, n1, n2, prior, params, min_votes):
+    """Lines common to scans n1 and n2 and their heading change (ours; shared by the partial and heading steps).
 
-    Δφ and the move across the lines come from the lines (vote-weighted means), the move
-    along them from the odometry ``prior``.
+    The heading change is the vote-weighted mean of θ_{n1} - θ_{n2} over the lines within
+    ``angle_tol_rad`` of its weighted median; None when those lines hold fewer than
+    ``min_votes`` votes or the change is farther than ``gate_theta_rad`` from ``prior``'s.
+    Else ``(l1, i1, l2, i2, w, use, dphi)``: both scans' lines, the common ones' indices,
+    their weights and which agree.
     """
     ids1, l1 = history.scan(n1)
     ids2, l2 = history.scan(n2)
     common, i1, i2 = np.intersect1d(ids1, ids2, return_indices=True)
     if common.size < 1:
         return None
-    ti, tj = l1.theta_rad[i1], l2.theta_rad[i2]
+    dphi_all = l1.theta_rad[i1] - l2.theta_rad[i2]
     w = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
-    dphi_all = ti - tj
     order = np.argsort(dphi_all)
     cw = np.cumsum(w[order])
     ref = dphi_all[order][np.searchsorted(cw, 0.5 * cw[-1])]
     use = np.abs(wrap_angle(dphi_all - ref)) <= params.angle_tol_rad
-    if w[use].sum() < 2 * params.H_min or abs(float(wrap_angle(ref - prior[2]))) > params.gate_theta_rad:
+    if w[use].sum() < min_votes or abs(float(wrap_angle(ref - prior[2]))) > params.gate_theta_rad:
         return None
+    return l1, i1, l2, i2, w, use, ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())
+
+
+def _partial(history, n1, n2, prior, params):
+    """Degenerate case (our addition): the common lines are all parallel (a corridor).
+
+    Δφ and the move across the lines come from the lines (vote-weighted means), the move
+    along them from the odometry ``prior``.
+    """
+    found = _common_heading(history, n1, n2, prior, params, 2 * params.H_min)
+    if found is None:
+        return None
+    l1, i1, l2, i2, w, use, dphi = found
+    ti = l1.theta_rad[i1]
     ww = w[use] / w[use].sum()
     normal_angle = float(np.sum(ww * ti[use]))  # the lines are parallel: one normal
     nrm = np.array([math.cos(normal_angle), math.sin(normal_angle)])
@@ -317,8 +333,7 @@ def _partial(history, n1, n2, prior, params):
     resid = np.abs(np.column_stack([np.cos(ti[use]), np.sin(ti[use])]) @ t - d)
     if params.rho_tol is not None and resid.max() > params.rho_tol:
         return None
-    return np.array([t[0], t[1], ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())])
-
+    return np.array([t[0], t[1], dphi])
 
 def _fallback_cause(n_returns, n_lines, most_common, rejected, gated, H_min) -> str:
     """The :data:`STEP_CAUSES` name of a step that fell back on odometry (the first that applies)."""
@@ -336,24 +351,10 @@ def _fallback_cause(n_returns, n_lines, most_common, rejected, gated, H_min) -> 
 def _heading(history, n1, n2, prior, params):
     """Last step before odometry alone (our addition): Δφ from the common lines, (Δx, Δy) from ``prior``.
 
-    The heading change is the vote-weighted mean of θ_{n1} - θ_{n2} over the lines within
-    ``angle_tol_rad`` of its weighted median; it needs ``H_min`` votes and must lie within
-    ``gate_theta_rad`` of odometry's.
+    The heading change as in the partial step (:func:`_common_heading`, needing ``H_min`` votes).
     """
-    ids1, l1 = history.scan(n1)
-    ids2, l2 = history.scan(n2)
-    common, i1, i2 = np.intersect1d(ids1, ids2, return_indices=True)
-    if common.size < 1:
-        return None
-    dphi_all = l1.theta_rad[i1] - l2.theta_rad[i2]
-    w = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
-    order = np.argsort(dphi_all)
-    cw = np.cumsum(w[order])
-    ref = dphi_all[order][np.searchsorted(cw, 0.5 * cw[-1])]
-    use = np.abs(wrap_angle(dphi_all - ref)) <= params.angle_tol_rad
-    if w[use].sum() < params.H_min or abs(float(wrap_angle(ref - prior[2]))) > params.gate_theta_rad:
-        return None
-    return np.array([prior[0], prior[1], ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())])
+    found = _common_heading(history, n1, n2, prior, params, params.H_min)
+    return None if found is None else np.array([prior[0], prior[1], found[-1]])
 
 
 def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
