@@ -10,7 +10,11 @@ ours and the reference measured in the same process, and their ratio (reference 
 * ``polar transform + find_peaks`` vs ``rasterise + cv2.HoughLines`` (scan in, lines out);
 * the classic transform of 004 (ours, numpy) vs OpenCV on the same image.
 
-Usage: ``python benchmarks/bench_hough.py [--repeat N]``.
+With ``--real-logs`` it runs instead the ablation of Hough SLAM on the two shared real logs (issue 25):
+per setting and log, the steps on odometry alone (fell back), the partial steps (parallel lines; heading from
+lines) and the sharpness 1 - (obstacle cells per 100 returns, Hough SLAM map) / (the same, odometry map).
+
+Usage: ``python benchmarks/bench_hough.py [--repeat N] [--real-logs]``.
 """
 
 from __future__ import annotations
@@ -72,10 +76,56 @@ def measure(phi, r, d_rho, d_theta, r_max, repeat):
     }
 
 
+#: The ablation of ``--real-logs``: label → overrides of :data:`slamlab.hough.REAL_LOG_PARAMS` (per log key
+#: when a dict of dicts). The first row is the settings before issue 25 (per-format max_gap, no heading step,
+#: no second line search at ``H_min_retry``).
+ABLATION = (
+    ("before issue 25: per-format max_gap, no heading step",
+     {"urg04lx": {"heading": False, "H_min_retry": None},
+      "mbicp": {"heading": False, "H_min_retry": None, "max_gap": 0.3}}),
+    ("one set (max_gap 0.2 m), no heading step, no retry", {"heading": False, "H_min_retry": None}),
+    ("one set + heading step, no retry", {"H_min_retry": None}),
+    ("defaults: one set + heading step + H_min retry 10", {}),
+    ("defaults, partial step off", {"partial": False}),
+    ("defaults, max_gap 0.3 m", {"max_gap": 0.3}),
+    ("defaults, H_min 10", {"H_min": 10}),
+    ("defaults, refit band 5 cm", {"band": 0.05}),
+    ("defaults, H_min 10 + band 5 cm", {"H_min": 10, "band": 0.05}),
+    ("defaults, angle_tol 1°", {"angle_tol_rad": math.radians(1.0)}),
+    ("defaults, rho_tol 10 cm", {"rho_tol": 0.1}),
+)
+
+
+def real_log_ablation():
+    """Print the ``--real-logs`` table: each setting of :data:`ABLATION` on both shared logs."""
+    from slamlab.data import find_data
+
+    paths = {key: find_data(rel) for key, rel in h.SHARED_LOGS.items()}
+    print(f"{'setting':56s} {'log':8s} {'alone':>7s} {'parallel':>9s} {'heading':>8s} {'cells S/O':>11s} "
+          f"{'sharper':>8s} {'s':>5s}  causes of the steps on odometry alone")
+    for label, over in ABLATION:
+        for key, path in paths.items():
+            kw = over.get(key, {}) if over and isinstance(next(iter(over.values())), dict) else over
+            t0 = time.perf_counter()
+            r = h.run_real_log(path, progress=False, **kw)
+            c, n = r.slam.cause_counts(), r.odometry.shape[0] - 1
+            print(f"{label:56s} {key:8s} {r.slam.lost[1:].sum() / n:7.1%} {c['partial'] / n:9.1%} "
+                  f"{c['heading'] / n:8.1%} {r.sharpness('slam'):5.2f}/{r.sharpness('odometry'):5.2f} "
+                  f"{r.sharper_than_odometry():8.1%} {time.perf_counter() - t0:5.1f}  "
+                  + ", ".join(f"{k} {v}" for k, v in c.items() if v and k not in ("lines", "partial", "heading")))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=30)
+    ap.add_argument("--real-logs", action="store_true", help="Hough SLAM ablation on the shared real logs")
     args = ap.parse_args(argv)
+    if args.real_logs:
+        print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+              f"numpy {np.__version__}, load average {os.getloadavg()[0]:.2f}")
+        real_log_ablation()
+        print(f"load average {os.getloadavg()[0]:.2f}")
+        return
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numpy {np.__version__}, opencv {cv2.__version__}, load average {os.getloadavg()[0]:.2f}")
     rows = []

@@ -35,9 +35,10 @@ from .lines import (
     refine_lines,
     transform_lines,
 )
+from .logs import REAL_LOG_PARAMS, real_log_cause_table
 from .mapping import map_agreement
 from .pose import PoseChange, pose_from_lines, pose_from_two_lines, select_line_pair
-from .slam import HoughSlamParams, HoughSlamResult, detect_lines, hough_slam
+from .slam import STEP_CAUSES, HoughSlamParams, HoughSlamResult, detect_lines, hough_slam
 from .transform import (
     HoughAccumulator,
     hough_classic,
@@ -65,7 +66,9 @@ __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), 
 __all__ = [
     "LOG_PARAMS",
     "ODOMETRY_NOISE",
+    "REAL_LOG_PARAMS",
     "SHARED_LOGS",
+    "STEP_CAUSES",
     "ExampleLineResult",
     "HoughAccumulator",
     "HoughSlamParams",
@@ -101,6 +104,7 @@ __all__ = [
     "pose_from_lines",
     "pose_from_two_lines",
     "rasterise_scan",
+    "real_log_cause_table",
     "refine_lines",
     "rigid_fit_2d",
     "run_example_line",

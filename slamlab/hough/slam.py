@@ -34,7 +34,22 @@ from .lines import Lines, _find_peaks, _merge_duplicates, _refine_lines, _transf
 from .pose import _pose_from_lines
 from .transform import _hough_polar, theta_axis
 
-__all__ = ["HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
+__all__ = ["STEP_CAUSES", "HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
+
+#: How each step's pose was obtained (ours): the code stored in :attr:`HoughSlamResult.cause`.
+#: Codes 0 and 1 use the lines; every other code means the step fell back on odometry, for that cause.
+STEP_CAUSES = {
+    "lines": "pose from non-parallel lines common with a reference scan",
+    "partial": "only parallel lines: rotation and move across them from the lines, along them from odometry",
+    "heading": "lines associated but no pose from them: heading from the lines, translation from odometry",
+    "few_returns": "fewer returns than H_min: no line can reach the vote threshold",
+    "no_lines": "no line found in the scan",
+    "not_associated": "lines found, none associated with the previous scan's",
+    "one_line": "one line associated, the parallel-line step rejected it (its votes, heading or residual)",
+    "pose_rejected": "two or more lines associated, the pose solution rejected them (angle change or residual)",
+    "gate": "a pose was found but lay beyond the gate around odometry's",
+}
+_CODE = {name: k for k, name in enumerate(STEP_CAUSES)}
 
 
 def _optional_positive(value, name):
@@ -59,6 +74,9 @@ class HoughSlamParams(Params):
         Longest range used (None: each scan's longest).
     H_min : int
         Fewest votes of a line (004 leaves the value open).
+    H_min_retry : int or None
+        A scan with fewer than two lines at ``H_min`` is searched again with this threshold
+        (ours; None, or not below ``H_min``: not).
     max_lines : int
         Strongest lines kept per scan.
     suppress_rho, suppress_theta_rad : float or None
@@ -93,12 +111,16 @@ class HoughSlamParams(Params):
         Heading gate [rad].
     partial : bool
         With only parallel lines, move along them from odometry.
+    heading : bool
+        When lines are associated but give no pose, take the heading change from them and the
+        translation from odometry (ours; off in simulation, on in :func:`~slamlab.hough.run_real_log`).
     """
 
     delta_rho: float = param(1.0, "004 §Hough SLAM: Δrho = 1 cell")
     delta_theta_rad: float = param(math.pi / 180, "004 §Hough SLAM: Δθ = 1°")
     r_max: float | None = param(None, "ours: longest range used (None: each scan's longest)")
     H_min: int = param(15, "004 §Hough SLAM: a parameter, value not given")
+    H_min_retry: int | None = param(None, "ours: a scan with < 2 lines is searched again at this threshold")
     max_lines: int = param(12, "ours: strongest lines kept per scan")
     suppress_rho: float | None = param(None, "ours: false-neighbour window (None: 3 Δrho)")
     suppress_theta_rad: float | None = param(None, "ours: false-neighbour window (None: 3 Δθ)")
@@ -118,6 +140,7 @@ class HoughSlamParams(Params):
     gate: float | None = param(None, "ours: reject a pose farther than this from odometry's (None: off)")
     gate_theta_rad: float = param(math.radians(10.0), "ours: heading gate")
     partial: bool = param(True, "ours: only parallel lines → move along them from odometry")
+    heading: bool = param(False, "ours: no pose from the lines → their heading change, odometry's translation")
 
     def check(self) -> None:
         v.check_positive(self.delta_rho, "delta_rho")
@@ -125,8 +148,10 @@ class HoughSlamParams(Params):
         for name in ("r_max", "suppress_rho", "suppress_theta_rad", "band", "max_gap", "b", "rho_tol", "gate"):
             _optional_positive(getattr(self, name), name)
         v.check_int(self.H_min, "H_min", minimum=1)
+        if self.H_min_retry is not None:
+            v.check_int(self.H_min_retry, "H_min_retry", minimum=1)
         v.check_int(self.max_lines, "max_lines", minimum=2)
-        for name in ("refine", "partial"):
+        for name in ("refine", "partial", "heading"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
         v.check_positive(self.a, "a")
@@ -163,6 +188,8 @@ class HoughSlamResult:
         The settings of the run.
     partial : numpy.ndarray of bool, shape (n,) or None
         Pose from parallel lines plus odometry.
+    cause : numpy.ndarray of int, shape (n,) or None
+        How each step's pose was obtained: an index into :data:`STEP_CAUSES` (ours).
     """
 
     poses: np.ndarray = field(repr=False)  # (n, 3) estimated (x, y, φ), φ unwrapped
@@ -172,6 +199,20 @@ class HoughSlamResult:
     history: LineHistory = field(repr=False)
     params: HoughSlamParams = field(default_factory=HoughSlamParams)
     partial: np.ndarray | None = field(default=None, repr=False)  # (n,) bool: parallel lines + odometry
+    cause: np.ndarray | None = field(default=None, repr=False)  # (n,) index into STEP_CAUSES
+
+    def cause_counts(self) -> dict:
+        """Steps (scan 0 excluded) per entry of :data:`STEP_CAUSES` (ours).
+
+        Returns
+        -------
+        dict
+            ``{cause name: number of steps}`` in the order of :data:`STEP_CAUSES`.
+        """
+        if self.cause is None:
+            raise ValueError("this result carries no per-step `cause` (made without it)")
+        counts = np.bincount(self.cause[1:], minlength=len(STEP_CAUSES))
+        return {name: int(c) for name, c in zip(STEP_CAUSES, counts, strict=True)}
 
     def __str__(self) -> str:
         n_part = 0 if self.partial is None else int(self.partial.sum())
@@ -248,26 +289,42 @@ def _relative(history, n1, n2, params):
     return (pc.pose if pc.ok else None), common.size
 
 
-def _partial(history, n1, n2, prior, params):
-    """Degenerate case (our addition): the common lines are all parallel (a corridor).
+def _common_heading(history, n1, n2, prior, params, min_votes):
+    """Lines common to scans n1 and n2 and their heading change (ours; shared by the partial and heading steps).
 
-    Δφ and the move across the lines come from the lines (vote-weighted means), the move
-    along them from the odometry ``prior``.
+    The heading change is the vote-weighted mean of θ_{n1} - θ_{n2} over the lines within
+    ``angle_tol_rad`` of its weighted median; None when those lines hold fewer than
+    ``min_votes`` votes or the change is farther than ``gate_theta_rad`` from ``prior``'s.
+    Else ``(l1, i1, l2, i2, w, use, dphi)``: both scans' lines, the common ones' indices,
+    their weights and which agree.
     """
     ids1, l1 = history.scan(n1)
     ids2, l2 = history.scan(n2)
     common, i1, i2 = np.intersect1d(ids1, ids2, return_indices=True)
     if common.size < 1:
         return None
-    ti, tj = l1.theta_rad[i1], l2.theta_rad[i2]
+    dphi_all = l1.theta_rad[i1] - l2.theta_rad[i2]
     w = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
-    dphi_all = ti - tj
     order = np.argsort(dphi_all)
     cw = np.cumsum(w[order])
     ref = dphi_all[order][np.searchsorted(cw, 0.5 * cw[-1])]
     use = np.abs(wrap_angle(dphi_all - ref)) <= params.angle_tol_rad
-    if w[use].sum() < 2 * params.H_min or abs(float(wrap_angle(ref - prior[2]))) > params.gate_theta_rad:
+    if w[use].sum() < min_votes or abs(float(wrap_angle(ref - prior[2]))) > params.gate_theta_rad:
         return None
+    return l1, i1, l2, i2, w, use, ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())
+
+
+def _partial(history, n1, n2, prior, params):
+    """Degenerate case (our addition): the common lines are all parallel (a corridor).
+
+    Δφ and the move across the lines come from the lines (vote-weighted means), the move
+    along them from the odometry ``prior``.
+    """
+    found = _common_heading(history, n1, n2, prior, params, 2 * params.H_min)
+    if found is None:
+        return None
+    l1, i1, l2, i2, w, use, dphi = found
+    ti = l1.theta_rad[i1]
     ww = w[use] / w[use].sum()
     normal_angle = float(np.sum(ww * ti[use]))  # the lines are parallel: one normal
     nrm = np.array([math.cos(normal_angle), math.sin(normal_angle)])
@@ -276,7 +333,28 @@ def _partial(history, n1, n2, prior, params):
     resid = np.abs(np.column_stack([np.cos(ti[use]), np.sin(ti[use])]) @ t - d)
     if params.rho_tol is not None and resid.max() > params.rho_tol:
         return None
-    return np.array([t[0], t[1], ref + float(np.sum(w[use] * wrap_angle(dphi_all[use] - ref)) / w[use].sum())])
+    return np.array([t[0], t[1], dphi])
+
+def _fallback_cause(n_returns, n_lines, most_common, rejected, gated, H_min) -> str:
+    """The :data:`STEP_CAUSES` name of a step that fell back on odometry (the first that applies)."""
+    if n_returns < H_min:
+        return "few_returns"
+    if n_lines == 0:
+        return "no_lines"
+    if gated:
+        return "gate"
+    if rejected:
+        return "pose_rejected"
+    return "not_associated" if most_common == 0 else "one_line"
+
+
+def _heading(history, n1, n2, prior, params):
+    """Last step before odometry alone (our addition): Δφ from the common lines, (Δx, Δy) from ``prior``.
+
+    The heading change as in the partial step (:func:`_common_heading`, needing ``H_min`` votes).
+    """
+    found = _common_heading(history, n1, n2, prior, params, params.H_min)
+    return None if found is None else np.array([prior[0], prior[1], found[-1]])
 
 
 def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
@@ -323,10 +401,15 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     partial = np.zeros(n, dtype=bool)
     ref = np.full(n, -1, dtype=np.int64)
     n_lines = np.zeros(n, dtype=np.int64)
+    cause = np.zeros(n, dtype=np.int64)
     history = LineHistory()
     keyframe = 0
+    low = params.H_min_retry is not None and params.H_min_retry < params.H_min  # a retry only below H_min
+    retry = params.replace(H_min=params.H_min_retry) if low else None
     for k in progress_bar(range(n), desc="Hough SLAM", progress=progress):
         lines = _detect(*returns[k], params, theta)
+        if len(lines) < 2 and retry is not None:  # ours: a sparse scan, searched again at a lower threshold
+            lines = _detect(*returns[k], retry, theta)
         n_lines[k] = len(lines)
         if k == 0:
             history.add_scan(lines, np.full(len(lines), -1))
@@ -341,14 +424,18 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
         history.add_scan(lines, ids)
         guess = se2_compose(poses[k - 1], U[k - 1])
         pose = None
+        most_common, rejected, gated = 0, False, False  # why no pose: for the cause code
         for n1 in dict.fromkeys((keyframe, k - 1)):
-            delta, _ = _relative(history, n1, k, params)
+            delta, n_common = _relative(history, n1, k, params)
+            most_common = max(most_common, n_common)
             if delta is None:
+                rejected |= n_common >= 2
                 continue
             cand = se2_compose(poses[n1], delta)
             if params.gate is not None and odometry is not None and (
                     math.hypot(*(cand[:2] - guess[:2])) > params.gate
                     or abs(float(wrap_angle(cand[2] - guess[2]))) > params.gate_theta_rad):
+                gated = True
                 continue
             pose, ref[k] = cand, n1
             break
@@ -356,12 +443,19 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
             delta = _partial(history, k - 1, k, U[k - 1], params)
             if delta is not None:
                 pose, ref[k], partial[k] = se2_compose(poses[k - 1], delta), k - 1, True
+                cause[k] = _CODE["partial"]
+        if pose is None and params.heading and odometry is not None:
+            delta = _heading(history, k - 1, k, U[k - 1], params)
+            if delta is not None:
+                pose, ref[k], cause[k] = se2_compose(poses[k - 1], delta), k - 1, _CODE["heading"]
         if pose is None:
             pose, lost[k], ref[k] = guess, True, k - 1
+            cause[k] = _CODE[_fallback_cause(returns[k][1].size, len(lines), most_common, rejected, gated,
+                                             params.H_min)]
         poses[k] = pose
         _, n_common = _relative(history, keyframe, k, params) if ref[k] == keyframe else (None, 0)
         if lost[k] or ref[k] != keyframe or n_common < params.min_common:
             keyframe = k
     # headings unwrapped along the run, starting at the given start heading
     poses[:, 2] = np.unwrap(poses[:, 2]) + (poses[0, 2] - np.unwrap(poses[:, 2])[0])
-    return HoughSlamResult(poses, lost, n_lines, ref, history, params, partial)
+    return HoughSlamResult(poses, lost, n_lines, ref, history, params, partial, cause)

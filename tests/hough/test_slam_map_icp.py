@@ -133,8 +133,25 @@ def test_partial_update_in_a_corridor():
     err = E.pose_errors(res.poses, truth)
     assert np.abs(err[:, 1]).max() < 1e-6  # across: from the walls, exact
     assert np.abs(err[:, 2]).max() < 1e-6
+    assert res.cause_counts() == {**dict.fromkeys(h.STEP_CAUSES, 0), "partial": 2}
     off = h.hough_slam(scans, truth[0], odo_biased, delta_rho=0.1, H_min=20, partial=False)
     assert off.lost[1:].all()
+    # two parallel lines associated, no pose from them: the fallback's cause
+    assert off.cause_counts()["pose_rejected"] == 2
+    # no line reaches H_min = 350 (each wall has ~340 votes): "no lines"; a second search at H_min_retry finds
+    # them, and the heading step (both ours) takes the heading from them, the translation from odometry
+    odo_turn = odo_biased.copy()
+    odo_turn[:, 2] += 0.02  # odometry's heading wrong too
+    none = h.hough_slam(scans, truth[0], odo_turn, delta_rho=0.1, H_min=350)
+    assert none.cause_counts()["no_lines"] == 2
+    assert np.abs(E.pose_errors(none.poses, truth)[-1, 2]) > 0.039
+    again = h.hough_slam(scans, truth[0], odo_turn, delta_rho=0.1, H_min=350, H_min_retry=20, heading=True)
+    assert again.cause_counts()["heading"] == 2
+    assert np.abs(E.pose_errors(again.poses, truth)[:, 2]).max() < 1e-6
+    few = h.hough_slam([scans[0], Scan(phi[:5], np.ones(5), np.ones(5, bool), max_range=30.0)], truth[0], odo[:1],
+                       delta_rho=0.1, H_min=20)
+    assert few.cause_counts()["few_returns"] == 1
+    assert few.lost[1]
     assert np.abs(E.pose_errors(off.poses, truth)[-1, 1]) > 0.15
 
 
@@ -204,6 +221,25 @@ def test_real_urg_log_runs_with_raw_odometry():
 
 
 @pytest.mark.realdata
+@pytest.mark.parametrize("key", ["urg04lx", "mbicp"])
+def test_real_logs_meet_the_issue_25_goals_with_one_set_of_defaults(shared_data, key):
+    # bounds from issue 25's goal: on both shared logs, with run_real_log's defaults, the map is >= 10 %
+    # sharper than odometry's and <= 5 % of the steps fall back on odometry alone
+    res = E.run_real_log(shared_data / E.SHARED_LOGS[key], progress=False)
+    assert res.sharper_than_odometry() >= 0.10
+    assert res.slam.lost[1:].mean() <= 0.05
+    counts = res.slam.cause_counts()
+    assert sum(counts.values()) == res.odometry.shape[0] - 1
+    fallback = sum(c for name, c in counts.items() if name not in ("lines", "partial", "heading"))
+    assert fallback == res.slam.lost[1:].sum()
+    table = h.real_log_cause_table([res])
+    assert "odometry alone: all causes" in table
+    assert "sharper than odometry" in table
+    with pytest.raises(TypeError, match="`results` must be a non-empty sequence of RealLogResult"):
+        h.real_log_cause_table([res.slam])
+
+
+@pytest.mark.realdata
 @pytest.mark.parametrize(("key", "new_name", "label"), [("urg04lx", "hallway_run.dat", "URG-04LX"),
                                                         ("mbicp", "office.clf", "CARMEN")])
 def test_real_log_takes_any_path_and_labels_from_it(shared_data, tmp_path, key, new_name, label):
@@ -225,7 +261,7 @@ def test_hough_slam_params_check_every_field():
            "suppress_rho": -1.0, "suppress_theta_rad": 0.0, "refine": "yes", "band": -0.1, "max_gap": 0.0,
            "a": 0.0, "b": -1.0, "a_theta_rad": 0.0, "parallel_tol_rad": -0.1, "p_min": 1.5, "method": "svd",
            "angle_tol_rad": -1.0, "rho_tol": 0.0, "min_angle_rad": 2.0, "min_common": 1, "gate": 0.0,
-           "gate_theta_rad": 0.0, "partial": None}
+           "gate_theta_rad": 0.0, "partial": None, "heading": 1, "H_min_retry": 0}
     assert set(bad) == set(h.HoughSlamParams.field_names())  # every field has a failing value
     for name, value in bad.items():
         with pytest.raises((TypeError, ValueError), match=f"`{name}`"):
