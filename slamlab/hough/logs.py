@@ -31,6 +31,21 @@ SHARED_LOGS = {"urg04lx": "mines-urg04lx-odometry/exp2.dat", "mbicp": "mbicp-las
 # --- real laser logs ---------------------------------------------------------------------------
 
 
+def _steps(n: int) -> str:
+    """``"1 step"`` / ``"n steps"``.
+
+    Parameters
+    ----------
+    n : int
+        The count.
+
+    Returns
+    -------
+    str
+    """
+    return f"{n} step" if n == 1 else f"{n} steps"
+
+
 @dataclass(frozen=True)
 class RealLogResult:
     """Hough SLAM on a real log beside integrated odometry (no ground truth in these logs).
@@ -97,7 +112,7 @@ class RealLogResult:
 
     def __str__(self) -> str:
         return (f"{self.name}: {self.odometry.shape[0]} scans, {self.path_length_m:.1f} m of odometry path; "
-                f"{int(self.slam.lost.sum())} steps fell back on odometry, {int(self.slam.partial.sum())} in part")
+                f"{_steps(int(self.slam.lost.sum()))} fell back on odometry, {int(self.slam.partial.sum())} in part")
 
     def table(self) -> str:
         """Hough SLAM against integrated odometry on the log (fixed precision).
