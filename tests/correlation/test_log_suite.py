@@ -1,0 +1,40 @@
+"""Ch. 5 on every shared CARMEN log (issue 25): run_log_suite and its per-log tables."""
+
+import numpy as np
+import pytest
+
+from slamlab import correlation as C
+from slamlab.io import read_carmen
+
+
+def test_log_suite_bad_input(tmp_path):
+    with pytest.raises(TypeError, match="`paths` must be a list or tuple of logs"):
+        C.run_log_suite("intel-corrected.log.gz")
+    with pytest.raises(ValueError, match="`paths` must hold at least one log"):
+        C.run_log_suite([])
+    with pytest.raises(TypeError, match=r"`paths` must hold str, os\.PathLike or CarmenLog"):
+        C.run_log_suite([3])
+    with pytest.raises(ValueError, match="`every`"):
+        C.run_log_suite([str(tmp_path / "x.log")], every=2)
+    with pytest.raises(TypeError, match="`every`"):
+        C.run_log_suite([str(tmp_path / "x.log")], every=2.5)
+    with pytest.raises(FileNotFoundError, match=r"no file at .*missing.log"):
+        C.run_log_suite([str(tmp_path / "missing.log")])
+    assert len(C.SHARED_CARMEN_LOGS) == 5
+
+
+@pytest.mark.realdata
+def test_log_suite_tables_and_bad_threshold(shared_data):
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    with pytest.raises(ValueError, match=r"`every` \(950\) leaves no scan of intel-corrected.log.gz"):
+        C.run_log_suite([log], every=950)
+    r = C.run_log_suite([log], every=500, joined=(1,), delta_alpha_rad=np.radians(5.0))
+    assert r.names == ("intel",)
+    assert r.rates().shape == (1, 1)
+    assert r.results[0].scan_indices.tolist() == [500]
+    assert "Every 500th scan of each log" in r.table()
+    assert "intel      1     1/1" in r.table()
+    assert "failures flagged (>= 0.8)" in r.ambiguity_table(0.8)
+    assert "intel 1/1" in str(r)
+    with pytest.raises(ValueError, match=r"`threshold` must lie in \[0, 1\]"):
+        r.ambiguity_table(threshold=1.5)
