@@ -109,6 +109,9 @@ def main():
     ap.add_argument("--logs", action="store_true",
                     help="also localise every --every-th scan of each shared CARMEN log (run_log_suite's defaults)")
     ap.add_argument("--every", type=int, default=25, help="scan step of the --logs run (default 25)")
+    ap.add_argument("--exclude", type=int, default=None,
+                    help="scans left out on either side of each --logs scan (default: run_log_localisation's, 2)")
+    ap.add_argument("--max-range", type=float, default=None, help="range limit [m] of the --logs run (default 10)")
     ap.add_argument("--only", default=None, help="comma-separated short log names for --logs (default all five)")
     ap.add_argument("--jobs", type=int, default=1, help="sweep workers of the --intel/--logs runs (same result for any)")
     args = ap.parse_args()
@@ -176,20 +179,24 @@ def main():
     if args.intel:
         intel(args.jobs)
     if args.logs:
-        logs(args.every, args.only, args.jobs)
+        settings = {k: val for k, val in (("exclude", args.exclude), ("max_range_m", args.max_range)) if val is not None}
+        logs(args.every, args.only, args.jobs, settings)
 
 
-def logs(every: int, only: str | None, n_jobs: int) -> None:
+def logs(every: int, only: str | None, n_jobs: int, settings: dict) -> None:
     """Issue 25: every ``every``-th scan of each shared CARMEN log, modes 1/2/3, with the real-log defaults."""
     from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
 
     paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
-    print(f"\nShared CARMEN logs, every {every}th scan, load average {os.getloadavg()[0]:.1f}")
+    print(f"\nShared CARMEN logs, every {every}th scan, settings {settings or 'defaults'}, "
+          f"load average {os.getloadavg()[0]:.1f}")
     t0 = time.perf_counter()
-    r = sl.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs, progress=False)
+    r = sl.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs, progress=False,
+                                     **settings)
     print(f"took {time.perf_counter() - t0:.1f} s wall ({n_jobs} job(s)); load average now {os.getloadavg()[0]:.1f}")
     print(r.table())
-    print(r.ambiguity_table())
+    for t in (0.75, 0.8, 0.85, 0.9):
+        print(r.ambiguity_table(t))
     for res in r.results:
         print(res.table())
 

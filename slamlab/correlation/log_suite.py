@@ -89,7 +89,8 @@ class LogSuiteResult:
         return format_table(head, rows, title=title)
 
     def ambiguity_table(self, threshold: float = 0.75) -> str:
-        """Per log and mode: failures flagged (ambiguity ≥ ``threshold``) and successes flagged (false alarms).
+        """Per log and mode, then pooled over the logs: failures flagged (ambiguity ≥ ``threshold``) and
+        successes flagged (false alarms).
 
         Parameters
         ----------
@@ -110,6 +111,12 @@ class LogSuiteResult:
                 rows.append([name, r._mode(k), f"{np.sum(a[~ok] >= t)}/{np.sum(~ok)}", f"{np.sum(a[ok] >= t)}/{ok.sum()}",
                              f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-",
                              f"{np.median(a[ok]):.2f}" if ok.any() else "-"])
+        for m, k in enumerate(self.results[0].joined):  # pooled over the logs
+            a = np.concatenate([r.ambiguity[m] for r in self.results])
+            ok = np.concatenate([r.success[m] for r in self.results])
+            rows.append(["all", self.results[0]._mode(k), f"{np.sum(a[~ok] >= t)}/{np.sum(~ok)}",
+                         f"{np.sum(a[ok] >= t)}/{ok.sum()}", f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-",
+                         f"{np.median(a[ok]):.2f}" if ok.any() else "-"])
         return format_table(["log", "mode", f"failures flagged (>= {t:g})", "successes flagged",
                              "median amb. (failures)", "median amb. (successes)"], rows,
                             title=f"Ambiguity as a failure flag, threshold {t:g}")

@@ -35,6 +35,9 @@ def test_log_suite_tables_and_bad_threshold(shared_data):
     assert "Every 500th scan of each log" in r.table()
     assert "intel      1     1/1" in r.table()
     assert "failures flagged (>= 0.8)" in r.ambiguity_table(0.8)
+    assert r.ambiguity_table().splitlines()[-1].split()[:2] == ["all", "1"]
     assert "intel 1/1" in str(r)
     with pytest.raises(ValueError, match=r"`threshold` must lie in \[0, 1\]"):
         r.ambiguity_table(threshold=1.5)
+    with pytest.raises(ValueError, match=r"`hit_ratio` must lie in \[0, 1\]"):
+        C.run_log_localisation(log, (500,), hit_ratio=1.5)
