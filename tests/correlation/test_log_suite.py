@@ -41,3 +41,18 @@ def test_log_suite_tables_and_bad_threshold(shared_data):
         r.ambiguity_table(threshold=1.5)
     with pytest.raises(ValueError, match=r"`hit_ratio` must lie in \[0, 1\]"):
         C.run_log_localisation(log, (500,), hit_ratio=1.5)
+
+
+@pytest.mark.realdata
+def test_intel_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
+    """Issue 25's goal on the Intel log at the goal's size (every 25th scan, 36 scans) with the real-log defaults.
+
+    csail and fhw meet the goal too (docs/benchmarks.md) but cost 60-85 s each; orebro and seattle do not yet.
+    """
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    r = C.run_log_suite([log], 25, joined=(1, 3))
+    ok = r.results[0].success
+    assert ok.shape == (2, 36)
+    # the goal: >= 75 % from a single scan, >= 90 % with 3 joined scans
+    assert ok[0].mean() >= 0.75
+    assert ok[1].mean() >= 0.90
