@@ -17,6 +17,7 @@ from .. import _validate as v
 from .._table import format_table
 from .experiments import FAIL_CELLS, FAIL_DEG
 from .log_experiments import LogLocalisationResult, run_log_localisation
+from .settings import LocaliseParams
 
 __all__ = ["SHARED_CARMEN_LOGS", "LogSuiteResult", "run_log_suite"]
 
@@ -127,8 +128,8 @@ class LogSuiteResult:
         return f"{len(self.results)} logs, every {self.every}th scan, localised per mode: {rates}"
 
 
-def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), n_jobs: int = 1, progress: bool | None = None,
-                  **settings) -> LogSuiteResult:
+def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: LocaliseParams | None = None, rng=2017,
+                  n_jobs: int = 1, progress: bool | None = None, **settings) -> LogSuiteResult:
     """Localise every ``every``-th scan of each CARMEN log with the same settings (ours, issue 25; 004 §7).
 
     Each log runs through :func:`~slamlab.correlation.run_log_localisation` with its defaults (the real-log
@@ -143,13 +144,19 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), n_jobs: int 
         Localise every ``every``-th scan (at least 3, so the joined scans come before).
     joined : sequence of int in {1, 2, 3}
         The modes (scans joined by odometry), as in :func:`~slamlab.correlation.run_log_localisation`.
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`'s; its fields can also be given in
+        ``settings``).
+    rng : int or numpy.random.Generator, default 2017
+        Seed or generator of the joined modes' odometry noise; each log gets the same seed (an int), or draws
+        from the one generator in turn.
     n_jobs : int, default 1
         Sweep workers per log (same result for any).
     progress : bool, optional
         Progress bars (default: unless ``$SLAMLAB_PROGRESS=0``).
     **settings
         Any other argument of :func:`~slamlab.correlation.run_log_localisation` (``cell_m``, ``max_range_m``,
-        ``exclude``, ``odom_std``, ``params``, ``rng``, :class:`LocaliseParams` fields).
+        ``exclude``, ``odom_std``, ``hit_ratio``, :class:`LocaliseParams` fields).
 
     Returns
     -------
@@ -174,5 +181,6 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), n_jobs: int 
         idx = np.arange(ev, log.n_scans, ev)
         if idx.size == 0:
             raise ValueError(f"`every` ({ev}) leaves no scan of {log.name} ({log.n_scans} scans)")
-        results.append(run_log_localisation(log, idx, joined=joined, n_jobs=n_jobs, progress=progress, **settings))
+        results.append(run_log_localisation(log, idx, joined=joined, params=params, rng=rng, n_jobs=n_jobs,
+                                            progress=progress, **settings))
     return LogSuiteResult(tuple(results), ev)
