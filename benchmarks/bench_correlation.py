@@ -8,6 +8,8 @@ definition on a small case; every pair must give the identical peak.
     python benchmarks/bench_correlation.py            # timings
     python benchmarks/bench_correlation.py --monte-carlo   # + the 200-pose Monte Carlo of the notebook
     python benchmarks/bench_correlation.py --intel         # + every 25th Intel scan: 1 scan vs 2, 3 joined
+    python benchmarks/bench_correlation.py --logs          # + every 25th scan of each shared CARMEN log, per-log table
+    python benchmarks/bench_correlation.py --logs --every 100 --only intel,seattle   # smaller / fewer logs
 """
 
 from __future__ import annotations
@@ -104,7 +106,14 @@ def main():
     ap.add_argument("--monte-carlo", action="store_true", help="also run the 200-pose Monte Carlo")
     ap.add_argument("--intel", action="store_true",
                     help="also localise every 25th scan of the Intel log, one scan vs 2 and 3 joined by odometry")
-    ap.add_argument("--jobs", type=int, default=1, help="sweep workers of the --intel run (same result for any)")
+    ap.add_argument("--logs", action="store_true",
+                    help="also localise every --every-th scan of each shared CARMEN log (run_log_suite's defaults)")
+    ap.add_argument("--every", type=int, default=25, help="scan step of the --logs run (default 25)")
+    ap.add_argument("--exclude", type=int, default=None,
+                    help="scans left out on either side of each --logs scan (default: run_log_localisation's, 2)")
+    ap.add_argument("--max-range", type=float, default=None, help="range limit [m] of the --logs run (default 10)")
+    ap.add_argument("--only", default=None, help="comma-separated short log names for --logs (default all five)")
+    ap.add_argument("--jobs", type=int, default=1, help="sweep workers of the --intel/--logs runs (same result for any)")
     args = ap.parse_args()
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs; numpy {np.__version__}, "
           f"scipy {scipy.__version__}; load average {os.getloadavg()[0]:.1f}")
@@ -169,6 +178,27 @@ def main():
 
     if args.intel:
         intel(args.jobs)
+    if args.logs:
+        settings = {k: val for k, val in (("exclude", args.exclude), ("max_range_m", args.max_range)) if val is not None}
+        logs(args.every, args.only, args.jobs, settings)
+
+
+def logs(every: int, only: str | None, n_jobs: int, settings: dict) -> None:
+    """Issue 25: every ``every``-th scan of each shared CARMEN log, modes 1/2/3, with the real-log defaults."""
+    from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
+
+    paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
+    print(f"\nShared CARMEN logs, every {every}th scan, settings {settings or 'defaults'}, "
+          f"load average {os.getloadavg()[0]:.1f}")
+    t0 = time.perf_counter()
+    r = sl.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs, progress=False,
+                                     **settings)
+    print(f"took {time.perf_counter() - t0:.1f} s wall ({n_jobs} job(s)); load average now {os.getloadavg()[0]:.1f}")
+    print(r.table())
+    for t in (0.75, 0.8, 0.85, 0.9):
+        print(r.ambiguity_table(t))
+    for res in r.results:
+        print(res.table())
 
 
 def intel(n_jobs: int) -> None:
@@ -177,14 +207,15 @@ def intel(n_jobs: int) -> None:
     idx = range(25, log.n_scans, 25)
     print(f"\nIntel log, every 25th scan ({len(idx)} scans), load average {os.getloadavg()[0]:.1f}")
     t0 = time.perf_counter()
-    r = sl.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), n_jobs=n_jobs)
+    r = sl.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), exclude=10, n_jobs=n_jobs)  # issue 17's
     t = time.perf_counter() - t0
     print(f"took {t:.1f} s wall ({t / len(idx):.2f} s per scan for the three modes, {n_jobs} job(s)); "
           f"load average now {os.getloadavg()[0]:.1f}")
     print(r.summary_table())
     print(r.ambiguity_table())
     print(r.table())
-    r0 = sl.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), odom_std=(0.0, 0.0), n_jobs=n_jobs)
+    r0 = sl.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), exclude=10, odom_std=(0.0, 0.0),
+                                             n_jobs=n_jobs)
     print("\nthe same without odometry noise (the logged relative poses):")
     print(r0.summary_table())
     # cost of the ambiguity: the peak search alone vs the peak plus its rival, on one scan

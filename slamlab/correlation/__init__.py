@@ -28,6 +28,7 @@ from .experiments import (
     time_localise,
 )
 from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, ours_vs_source, run_log_localisation
+from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, run_log_suite
 
 _PLOT = (
     "constants_figure",
@@ -48,12 +49,14 @@ __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), 
 
 __all__ = [
     "DEFAULT_CARMEN_LOG",
+    "SHARED_CARMEN_LOGS",
     "SOURCE_TABLE1",
     "ConstantsResult",
     "CorridorResult",
     "Localisation",
     "LocaliseParams",
     "LogLocalisationResult",
+    "LogSuiteResult",
     "MonteCarloResult",
     "Table1Result",
     "check_constants",
@@ -69,6 +72,7 @@ __all__ = [
     "run_constants_study",
     "run_corridor_tie",
     "run_log_localisation",
+    "run_log_suite",
     "run_monte_carlo",
     "run_table1",
     "score_maps",

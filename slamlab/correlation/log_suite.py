@@ -1,0 +1,186 @@
+"""Ch. 5 on every shared CARMEN log (issue 25, ours): correlation localisation of every ``every``-th scan of each
+corrected Radish log with one set of real-log defaults, and the per-log tables.
+
+:func:`run_log_suite` runs :func:`~slamlab.correlation.run_log_localisation` on each log with the same settings;
+:class:`LogSuiteResult` prints the per-log success rates (:meth:`~LogSuiteResult.table`) and how well the
+ambiguity separates failures from successes (:meth:`~LogSuiteResult.ambiguity_table`).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate as v
+from .._table import format_table
+from .experiments import FAIL_CELLS, FAIL_DEG
+from .log_experiments import LogLocalisationResult, run_log_localisation
+from .settings import LocaliseParams
+
+__all__ = ["SHARED_CARMEN_LOGS", "LogSuiteResult", "run_log_suite"]
+
+#: The five corrected Radish logs of the shared data (found by :func:`slamlab.data.find_data`).
+SHARED_CARMEN_LOGS = tuple(f"carmen-radish-corrected/{n}-corrected.log.gz"
+                           for n in ("csail", "fhw", "intel", "orebro", "seattle"))
+
+
+def _short(name: str) -> str:
+    return name.removesuffix(".gz").removesuffix(".log").removesuffix("-corrected")
+
+
+@dataclass(frozen=True)
+class LogSuiteResult:
+    """Correlation localisation on several CARMEN logs with the same settings (ours, issue 25).
+
+    Attributes
+    ----------
+    results : tuple of LogLocalisationResult
+        One result per log, in the order run.
+    every : int
+        Every ``every``-th scan was localised (from scan ``every``).
+    """
+
+    results: tuple[LogLocalisationResult, ...]
+    every: int
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Short log names (``"intel"`` for ``intel-corrected.log.gz``)."""
+        return tuple(_short(r.name) for r in self.results)
+
+    def rates(self) -> np.ndarray:
+        """``(logs, modes)`` success rates (success: within 2 cells and 5° of the logged pose).
+
+        Returns
+        -------
+        numpy.ndarray
+        """
+        return np.array([r.success.mean(axis=1) for r in self.results])
+
+    def table(self) -> str:
+        """One row per log: scans, then per mode the scans localised, the rate and the successes' median errors.
+
+        Returns
+        -------
+        str
+        """
+        r0 = self.results[0]
+        head = ["log", "scans"]
+        for k in r0.joined:
+            head += [f"{r0._mode(k)}", "rate", "median err [m] / [°]"]
+        rows = []
+        for name, r in zip(self.names, self.results, strict=True):
+            ok = r.success
+            row = [name, str(ok.shape[1])]
+            for m in range(len(r.joined)):
+                s = ok[m]
+                med = (f"{np.median(r.err_pos_m[m][s]):.3f} / {np.median(np.degrees(r.err_heading_rad[m][s])):.2f}"
+                       if s.any() else "-")
+                row += [f"{s.sum()}/{s.size}", f"{s.mean():.1%}", med]
+            rows.append(row)
+        tot = np.concatenate([r.success for r in self.results], axis=1)
+        rows.append(["all", str(tot.shape[1])]
+                    + [c for m in range(tot.shape[0]) for c in (f"{tot[m].sum()}/{tot.shape[1]}",
+                                                                 f"{tot[m].mean():.1%}", "")])
+        title = (f"Every {self.every}th scan of each log from no prior; success = within {FAIL_CELLS:g} cells "
+                 f"({FAIL_CELLS * r0.cell_m:.1f} m) and {FAIL_DEG:g}° of the logged pose; cells {r0.cell_m:g} m, "
+                 f"ranges < {r0.max_range_m:g} m, ±{r0.exclude} scans left out of each grid")
+        return format_table(head, rows, title=title)
+
+    def ambiguity_table(self, threshold: float = 0.75) -> str:
+        """Per log and mode, then pooled over the logs: failures flagged (ambiguity ≥ ``threshold``) and
+        successes flagged (false alarms).
+
+        Parameters
+        ----------
+        threshold : float, default 0.75
+            Ambiguity at or above which a localisation is flagged, in [0, 1].
+
+        Returns
+        -------
+        str
+        """
+        t = v.check_positive(threshold, "threshold", allow_zero=True)
+        if t > 1:
+            raise ValueError(f"`threshold` must lie in [0, 1]; got {t}")
+        rows = []
+        for name, r in zip(self.names, self.results, strict=True):
+            for m, k in enumerate(r.joined):
+                a, ok = r.ambiguity[m], r.success[m]
+                rows.append([name, r._mode(k), f"{np.sum(a[~ok] >= t)}/{np.sum(~ok)}", f"{np.sum(a[ok] >= t)}/{ok.sum()}",
+                             f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-",
+                             f"{np.median(a[ok]):.2f}" if ok.any() else "-"])
+        for m, k in enumerate(self.results[0].joined):  # pooled over the logs
+            a = np.concatenate([r.ambiguity[m] for r in self.results])
+            ok = np.concatenate([r.success[m] for r in self.results])
+            rows.append(["all", self.results[0]._mode(k), f"{np.sum(a[~ok] >= t)}/{np.sum(~ok)}",
+                         f"{np.sum(a[ok] >= t)}/{ok.sum()}", f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-",
+                         f"{np.median(a[ok]):.2f}" if ok.any() else "-"])
+        return format_table(["log", "mode", f"failures flagged (>= {t:g})", "successes flagged",
+                             "median amb. (failures)", "median amb. (successes)"], rows,
+                            title=f"Ambiguity as a failure flag, threshold {t:g}")
+
+    def __str__(self) -> str:
+        rates = "; ".join(f"{n} " + ", ".join(f"{ok.sum()}/{ok.size}" for ok in r.success)
+                          for n, r in zip(self.names, self.results, strict=True))
+        return f"{len(self.results)} logs, every {self.every}th scan, localised per mode: {rates}"
+
+
+def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: LocaliseParams | None = None, rng=2017,
+                  n_jobs: int = 1, progress: bool | None = None, **settings) -> LogSuiteResult:
+    """Localise every ``every``-th scan of each CARMEN log with the same settings (ours, issue 25; 004 §7).
+
+    Each log runs through :func:`~slamlab.correlation.run_log_localisation` with its defaults (the real-log
+    defaults) unless ``settings`` change them, for scans ``every, 2·every, …`` below the log's length.
+
+    Parameters
+    ----------
+    paths : sequence of (str, os.PathLike or CarmenLog), optional
+        The logs; default :data:`SHARED_CARMEN_LOGS` (the five corrected Radish logs, found by
+        :func:`slamlab.data.find_data`).
+    every : int, default 25
+        Localise every ``every``-th scan (at least 3, so the joined scans come before).
+    joined : sequence of int in {1, 2, 3}
+        The modes (scans joined by odometry), as in :func:`~slamlab.correlation.run_log_localisation`.
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`'s; its fields can also be given in
+        ``settings``).
+    rng : int or numpy.random.Generator, default 2017
+        Seed or generator of the joined modes' odometry noise; each log gets the same seed (an int), or draws
+        from the one generator in turn.
+    n_jobs : int, default 1
+        Sweep workers per log (same result for any).
+    progress : bool, optional
+        Progress bars (default: unless ``$SLAMLAB_PROGRESS=0``).
+    **settings
+        Any other argument of :func:`~slamlab.correlation.run_log_localisation` (``cell_m``, ``max_range_m``,
+        ``exclude``, ``odom_std``, ``hit_ratio``, :class:`LocaliseParams` fields).
+
+    Returns
+    -------
+    LogSuiteResult
+        One :class:`LogLocalisationResult` per log; :meth:`LogSuiteResult.table` prints the per-log rates.
+    """
+    from ..data import find_data
+    from ..io import CarmenLog, read_carmen
+
+    if paths is None:
+        paths = [find_data(p) for p in SHARED_CARMEN_LOGS]
+    elif isinstance(paths, (str, os.PathLike, CarmenLog)) or not isinstance(paths, (list, tuple)):
+        raise TypeError(f"`paths` must be a list or tuple of logs (paths or CarmenLog); got {type(paths).__name__}")
+    if len(paths) == 0:
+        raise ValueError("`paths` must hold at least one log; got 0")
+    ev = v.check_int(every, "every", minimum=3)
+    results = []
+    for p in paths:
+        if isinstance(p, bool) or not isinstance(p, (str, os.PathLike, CarmenLog)):
+            raise TypeError(f"`paths` must hold str, os.PathLike or CarmenLog; got {type(p).__name__}")
+        log = p if isinstance(p, CarmenLog) else read_carmen(p)
+        idx = np.arange(ev, log.n_scans, ev)
+        if idx.size == 0:
+            raise ValueError(f"`every` ({ev}) leaves no scan of {log.name} ({log.n_scans} scans)")
+        results.append(run_log_localisation(log, idx, joined=joined, params=params, rng=rng, n_jobs=n_jobs,
+                                            progress=progress, **settings))
+    return LogSuiteResult(tuple(results), ev)

@@ -1,0 +1,58 @@
+"""Ch. 5 on every shared CARMEN log (issue 25): run_log_suite and its per-log tables."""
+
+import numpy as np
+import pytest
+
+from slamlab import correlation as C
+from slamlab.io import read_carmen
+
+
+def test_log_suite_bad_input(tmp_path):
+    with pytest.raises(TypeError, match="`paths` must be a list or tuple of logs"):
+        C.run_log_suite("intel-corrected.log.gz")
+    with pytest.raises(ValueError, match="`paths` must hold at least one log"):
+        C.run_log_suite([])
+    with pytest.raises(TypeError, match=r"`paths` must hold str, os\.PathLike or CarmenLog"):
+        C.run_log_suite([3])
+    with pytest.raises(ValueError, match="`every`"):
+        C.run_log_suite([str(tmp_path / "x.log")], every=2)
+    with pytest.raises(TypeError, match="`every`"):
+        C.run_log_suite([str(tmp_path / "x.log")], every=2.5)
+    with pytest.raises(FileNotFoundError, match=r"no file at .*missing.log"):
+        C.run_log_suite([str(tmp_path / "missing.log")])
+    assert len(C.SHARED_CARMEN_LOGS) == 5
+
+
+@pytest.mark.realdata
+def test_log_suite_tables_and_bad_threshold(shared_data):
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    with pytest.raises(ValueError, match=r"`every` \(950\) leaves no scan of intel-corrected.log.gz"):
+        C.run_log_suite([log], every=950)
+    r = C.run_log_suite([log], every=500, joined=(1,), delta_alpha_rad=np.radians(5.0))
+    assert r.names == ("intel",)
+    assert r.rates().shape == (1, 1)
+    assert r.results[0].scan_indices.tolist() == [500]
+    assert "Every 500th scan of each log" in r.table()
+    assert "intel      1     1/1" in r.table()
+    assert "failures flagged (>= 0.8)" in r.ambiguity_table(0.8)
+    assert r.ambiguity_table().splitlines()[-1].split()[:2] == ["all", "1"]
+    assert "intel 1/1" in str(r)
+    with pytest.raises(ValueError, match=r"`threshold` must lie in \[0, 1\]"):
+        r.ambiguity_table(threshold=1.5)
+    with pytest.raises(ValueError, match=r"`hit_ratio` must lie in \[0, 1\]"):
+        C.run_log_localisation(log, (500,), hit_ratio=1.5)
+
+
+@pytest.mark.realdata
+def test_intel_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
+    """Issue 25's goal on the Intel log at the goal's size (every 25th scan, 36 scans) with the real-log defaults.
+
+    csail and fhw meet the goal too (docs/benchmarks.md) but cost 60-85 s each; orebro and seattle do not yet.
+    """
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    r = C.run_log_suite([log], 25, joined=(1, 3))
+    ok = r.results[0].success
+    assert ok.shape == (2, 36)
+    # the goal: >= 75 % from a single scan, >= 90 % with 3 joined scans
+    assert ok[0].mean() >= 0.75
+    assert ok[1].mean() >= 0.90
