@@ -15,6 +15,7 @@ definition on a small case; every pair must give the identical peak.
 from __future__ import annotations
 
 import argparse
+import ast
 import os
 import platform
 import time
@@ -112,6 +113,9 @@ def main():
     ap.add_argument("--exclude", type=int, default=None,
                     help="scans left out on either side of each --logs scan (default: run_log_localisation's, 2)")
     ap.add_argument("--max-range", type=float, default=None, help="range limit [m] of the --logs run (default 10)")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="any other setting of the --logs run (run_log_localisation's arguments, LocaliseParams "
+                         "fields), a Python literal: --set 'odom_std=(0, 0)' --set a_p=4 --set hit_ratio=0.1")
     ap.add_argument("--only", default=None, help="comma-separated short log names for --logs (default all five)")
     ap.add_argument("--jobs", type=int, default=1, help="sweep workers of the --intel/--logs runs (same result for any)")
     args = ap.parse_args()
@@ -180,6 +184,11 @@ def main():
         intel(args.jobs)
     if args.logs:
         settings = {k: val for k, val in (("exclude", args.exclude), ("max_range_m", args.max_range)) if val is not None}
+        for item in args.set:
+            name, sep, value = item.partition("=")
+            if not sep:
+                ap.error(f"--set takes NAME=VALUE; got {item!r}")
+            settings[name.strip()] = ast.literal_eval(value.strip())
         logs(args.every, args.only, args.jobs, settings)
 
 
