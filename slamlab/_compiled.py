@@ -1,0 +1,72 @@
+"""One place for compiled kernels (our addition, speed; issue 25).
+
+The teaching implementations stay in numpy; where numpy cannot reach a measured speed bound, a kernel
+compiled with numba sits beside the numpy version and is tested against it. Every kernel is compiled
+through :func:`kernel` so that all share the same settings:
+
+- ``cache=True``: the machine code is written next to the module (``__pycache__``) on the first call,
+  so only the first process on a machine pays the compile time;
+- ``nogil=True``: a kernel can run in :mod:`slamlab._threads`' shared pool;
+- no ``fastmath``: floating-point operations keep numpy's order and rounding (no reassociation, no
+  fused multiply-add contraction), so a kernel gives the same numbers on every CPU of our kind,
+  whether it has AVX2 or AVX-512.
+
+``SLAMLAB_NO_NUMBA=1`` makes :func:`numba_enabled` false: callers then take the numpy path (a way to
+compare the two, and a fallback where numba cannot be installed).
+"""
+
+from __future__ import annotations
+
+import os
+
+__all__ = ["kernel", "numba_enabled"]
+
+
+def numba_enabled() -> bool:
+    """Whether compiled kernels are used: numba is importable and ``SLAMLAB_NO_NUMBA`` is not set.
+
+    Returns
+    -------
+    bool
+        True when the numba path should be taken.
+    """
+    if os.environ.get("SLAMLAB_NO_NUMBA", "") not in ("", "0"):
+        return False
+    try:
+        import numba  # noqa: F401
+    except ImportError:  # pragma: no cover - numba is a dependency; this is the fallback
+        return False
+    return True
+
+
+def kernel(fn):
+    """Compile ``fn`` with numba under the project's settings (see the module docstring), lazily.
+
+    The function is compiled on its first call, not at import, so ``import slamlab`` stays light.
+
+    Parameters
+    ----------
+    fn : callable
+        A function written in the numba-supported subset of Python and numpy.
+
+    Returns
+    -------
+    callable
+        The compiled dispatcher (``numba.njit(cache=True, nogil=True)(fn)``), created on first use.
+    """
+    compiled = None
+
+    def call(*args):
+        nonlocal compiled
+        if compiled is None:
+            import numba
+
+            compiled = numba.njit(cache=True, nogil=True)(fn)
+        return compiled(*args)
+
+    call.__name__ = fn.__name__
+    call.__qualname__ = fn.__qualname__
+    call.__doc__ = fn.__doc__
+    call.__wrapped__ = fn
+    call.py_func = fn
+    return call

@@ -1,0 +1,43 @@
+"""slamlab._compiled: the one place that compiles kernels (issue 25)."""
+
+import subprocess
+import sys
+
+import numpy as np
+
+from slamlab._compiled import kernel, numba_enabled
+
+
+def _sum_of_products(x, y):
+    total = 0.0
+    for i in range(x.shape[0]):
+        total += x[i] * y[i]
+    return total
+
+
+def test_a_kernel_gives_the_python_functions_result_bit_for_bit():
+    # no fastmath: the same sequential sum and the same roundings as the plain Python loop
+    rng = np.random.default_rng(0)
+    x, y = rng.standard_normal(1001), rng.standard_normal(1001)
+    compiled = kernel(_sum_of_products)
+    assert compiled(x, y) == _sum_of_products(x, y)
+    assert compiled.py_func is _sum_of_products
+
+
+def test_numba_is_used_unless_switched_off(monkeypatch):
+    assert numba_enabled()
+    monkeypatch.setenv("SLAMLAB_NO_NUMBA", "1")
+    assert not numba_enabled()
+    monkeypatch.setenv("SLAMLAB_NO_NUMBA", "0")
+    assert numba_enabled()
+
+
+def test_defining_a_kernel_does_not_import_numba(tmp_path):
+    # compiling happens on the first call, so modules that define kernels keep `import slamlab` light
+    (tmp_path / "mod.py").write_text("from slamlab._compiled import kernel\n@kernel\ndef f(x):\n    return x + 1\n")
+    code = (
+        "import sys, mod\n"
+        "assert 'numba' not in sys.modules, 'imported at definition'\n"
+        "assert mod.f(1) == 2 and 'numba' in sys.modules\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=tmp_path)
