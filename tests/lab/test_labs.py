@@ -67,10 +67,11 @@ def course(tmp_path_factory):
 # --- four generated submissions per lab --------------------------------------------------------------------
 # correct: the instructor solution, each exploration answered with the instructor's number (read from the stored
 #          output of its check cell: a student may answer from any experiment, and the test need not rerun it);
-# wrong:   a plausible wrong implementation of task 1 and a typical wrong number for one exploration (the
-#          other explorations not done);
-# empty:   the student version untouched;
-# raising: the last task raises (no other task calls it); the other tasks right, the explorations not done.
+# wrong:   a plausible wrong implementation of task 1, the last task raising (no other task calls it; an
+#          exception must cost that task only), a typical wrong number for one exploration, the other
+#          explorations not done; the other tasks right. (Wrong and raising were two submissions until issue 25:
+#          one submission runs the lab once less, ~5 s of CI per lab, and tests the same cells.)
+# empty:   the student version untouched.
 #: Task 1 of each lab made wrong the way a student might: (text in the solution, its wrong replacement).
 WRONG_TASK = {
     "01": ("F @ P @ F.T + Q", "F @ P @ F.T"),  # the process noise forgotten
@@ -87,7 +88,7 @@ WRONG_TASK = {
 #: The exploration answered wrong in the "wrong" submission: one whose check is quick.
 WRONG_EXPLORATION = {"01": "e2", "02": "e1", "03": "e2", "04": "e2", "05": "e2", "06": "e1", "07": "e1",
                      "08": "e2", "09": "e2", "10": "e2"}
-SUBMISSIONS = ("correct", "wrong", "empty", "raising")
+SUBMISSIONS = ("correct", "wrong", "empty")
 
 
 def _replace_solution(source: str, body: str) -> str:
@@ -107,18 +108,19 @@ def _stored_answer(nb, ex: str) -> float:
 
 
 def _last_task(nb) -> str:
-    """The last implementation task of a lab ("t4"): the one a raising submission breaks (no later task calls it)."""
+    """The last implementation task of a lab ("t4"): the one the wrong submission makes raise (no later task calls it)."""
     parts = [c.metadata["nbgrader"]["grade_id"].split("_")[1] for c in nb.cells
              if c.metadata.get("nbgrader", {}).get("grade_id", "").endswith("_check")]
     return max(p for p in parts if p.startswith("t"))
 
 
 def make_submission(lab: Path, kind: str):
-    """The notebook a student of kind ``kind`` ("correct", "wrong" or "raising") hands in for ``lab``."""
+    """The notebook a student of kind ``kind`` ("correct" or "wrong") hands in for ``lab``."""
     from slamlab import lab as sl_lab
 
     nb = nbformat.read(lab, as_version=4)
     num = lab.name[:2]
+    assert _last_task(nb) != "t1", f"{lab.name}: the wrong submission needs task 1 and the last task apart"
     for c in nb.cells:
         gid = c.metadata.get("nbgrader", {}).get("grade_id", "")
         if not gid.endswith("_solution") or c.cell_type != "code":
@@ -137,7 +139,7 @@ def make_submission(lab: Path, kind: str):
             old, new = WRONG_TASK[num]
             assert c.source.count(old) == 1, f"{lab.name}: {old!r} in\n{c.source}"
             c.source = c.source.replace(old, new)
-        elif kind == "raising" and part == _last_task(nb):
+        elif kind == "wrong" and part == _last_task(nb):
             c.source = _replace_solution(c.source, 'raise IndexError("index 3 is out of bounds")')
     return nb
 
@@ -149,9 +151,9 @@ def expected_points(lab: Path, kind: str) -> dict[str, float]:
         if not (m["grade"] and c.cell_type == "code"):
             continue
         part = m["grade_id"].split("_")[1]
-        lost = (kind == "empty" or (part.startswith("e") and kind == "raising")
-                or (kind == "wrong" and (part == "t1" or part.startswith("e")))
-                or (kind == "raising" and part == _last_task(nbformat.read(lab, as_version=4))))
+        lost = (kind == "empty"
+                or (kind == "wrong" and (part in ("t1", _last_task(nbformat.read(lab, as_version=4)))
+                                         or part.startswith("e"))))
         out[m["grade_id"]] = 0.0 if lost else float(m["points"])
     return out
 
@@ -169,7 +171,7 @@ def autograded(course, tmp_path_factory):
         (subs / kind).mkdir()
     for lab, student in zip(LABS, students, strict=True):
         shutil.copy2(student, subs / "empty" / student.name)
-        for kind in ("correct", "wrong", "raising"):
+        for kind in ("correct", "wrong"):
             nbformat.write(make_submission(lab, kind), subs / kind / lab.name)
     return labs_tool.autograde(subs, root)
 
