@@ -78,13 +78,12 @@ def _vote_polar(x, y, w, rows, n_rho):
     return counts
 
 
-def _peak_groups(Ht, H_min, max_candidates):
-    """Local maxima ≥ ``H_min`` and their flat tops (steps 1 of ``_find_peaks``, compiled; 004 §Hough SLAM).
+def _local_maxima(Ht, H_min):
+    """Cells with at least ``H_min`` votes and no fewer than their 8 neighbours (``_peak_groups`` step 1, compiled).
 
-    Same rules as the numpy path: a candidate is ≥ its 8 neighbours (rho clipped at the axis ends, θ
-    wrapping to ``(-rho, θ ± π)``); at most ``max_candidates`` (the most votes, ties by position); adjacent
-    candidates (also across the θ wrap) form one group, whose centre is the mean of its cells, the cells
-    of a group across the wrap moved to one side.
+    As the numpy path: rho is clipped at the axis ends (edge cells compare with themselves), θ wraps to
+    ``(-rho, θ ± π)``. Cells are visited in (rho, θ) row-major order, the numpy path's candidate order
+    (θ inner: the few cache lines of one rho block of ``Ht`` serve 8 consecutive rho rows).
 
     Parameters
     ----------
@@ -92,55 +91,65 @@ def _peak_groups(Ht, H_min, max_candidates):
         Votes, θ-major (``acc.H.T``).
     H_min : int
         Smallest vote count.
-    max_candidates : int
-        Cap on the candidates grouped.
 
     Returns
     -------
-    sum_i, sum_k : numpy.ndarray of float, shape (G,)
-        Sums of the (moved) row and column indices of each group's cells, in cell order.
-    count, votes, first : numpy.ndarray of int64, shape (G,)
-        Cells, votes and smallest flat index ``i·n_theta + k`` of each group; groups in the order of
-        their first cell.
+    numpy.ndarray of int64
+        Flat indices ``i·n_theta + k`` of the local maxima, ascending.
     """
     n_theta, n_rho = Ht.shape
-    # 1. candidates: cells >= H_min that are >= their 8 neighbours
-    flat = np.empty(0, dtype=np.int64)
-    found = []
-    for k in range(n_theta):
-        for i in range(n_rho):
+    flat = np.empty(n_theta * n_rho, dtype=np.int64)
+    m = 0
+    for i in range(n_rho):
+        for k in range(n_theta):
             value = Ht[k, i]
             if value < H_min:
                 continue
             is_max = True
             for dk in (-1, 0, 1):
                 for di in (-1, 0, 1):
-                    if di == 0 and dk == 0:
-                        continue
                     ii = min(max(i + di, 0), n_rho - 1)
                     kk = k + dk
                     if kk < 0 or kk >= n_theta:  # across the θ wrap: rho flips
                         ii, kk = n_rho - 1 - ii, kk % n_theta
-                    if value < Ht[kk, ii]:
-                        is_max = False
+                    is_max = is_max and value >= Ht[kk, ii]
             if is_max:
-                found.append(i * n_theta + k)
-    flat = np.sort(np.array(found, dtype=np.int64)) if found else flat
-    i_c, k_c = flat // n_theta, flat % n_theta
-    value = np.empty(flat.size, dtype=np.int64)
-    for m in range(flat.size):
-        value[m] = Ht[k_c[m], i_c[m]]
-    if flat.size > max_candidates:  # the most votes, ties by position (a stable sort)
-        top = np.sort(np.argsort(-value, kind="mergesort")[:max_candidates])
-        i_c, k_c, value = i_c[top], k_c[top], value[top]
-    # 2. groups of adjacent candidates (union-find; labels = smallest member)
-    m_c = i_c.size
-    parent = np.arange(m_c)
+                flat[m] = i * n_theta + k
+                m += 1
+    return flat[:m].copy()
+
+
+def _group_peaks(i, k, value, n_rho, n_theta):
+    """Flat tops: groups of adjacent candidates and their centres (``_peak_groups`` step 2, compiled).
+
+    As the numpy path: candidates adjacent in (rho, θ), or across the θ wrap where ``(rho, -90°)``
+    continues as ``(-rho, 90°)``, form one group; a group's centre is the mean of its cells, the cells
+    of a group that spans the wrap moved to the side of θ = -90°.
+
+    Parameters
+    ----------
+    i, k : numpy.ndarray of int64, shape (M,)
+        Rows and columns of the candidates, in (rho, θ) row-major order.
+    value : numpy.ndarray of int64, shape (M,)
+        Their votes.
+    n_rho, n_theta : int
+        Accumulator shape.
+
+    Returns
+    -------
+    sum_i, sum_k : numpy.ndarray of float, shape (G,)
+        Sums of the (moved) row and column indices of each group's cells, added in cell order.
+    count, votes, first : numpy.ndarray of int64, shape (G,)
+        Cells, votes and smallest flat index ``i·n_theta + k`` of each group; groups in the order of
+        their first cell.
+    """
+    m_c = i.size
+    parent = np.arange(m_c)  # union-find; a root is its group's first cell
     for a in range(m_c):
         for b in range(a + 1, m_c):
-            near = abs(i_c[a] - i_c[b]) <= 1 and abs(k_c[a] - k_c[b]) <= 1
-            near = near or (k_c[a] == 0 and k_c[b] == n_theta - 1 and abs(i_c[a] - (n_rho - 1 - i_c[b])) <= 1)
-            near = near or (k_c[b] == 0 and k_c[a] == n_theta - 1 and abs(i_c[b] - (n_rho - 1 - i_c[a])) <= 1)
+            near = abs(i[a] - i[b]) <= 1 and abs(k[a] - k[b]) <= 1
+            near = near or (k[a] == 0 and k[b] == n_theta - 1 and abs(i[a] - (n_rho - 1 - i[b])) <= 1)
+            near = near or (k[b] == 0 and k[a] == n_theta - 1 and abs(i[b] - (n_rho - 1 - i[a])) <= 1)
             if near:
                 ra, rb = a, b
                 while parent[ra] != ra:
@@ -159,7 +168,6 @@ def _peak_groups(Ht, H_min, max_candidates):
             n_groups += 1
         else:
             label[a] = label[root]
-    # 3. per group: cells, votes, first cell, and the index sums (cells across the wrap moved to one side)
     count = np.zeros(n_groups, dtype=np.int64)
     votes = np.zeros(n_groups, dtype=np.int64)
     first = np.full(n_groups, n_theta * n_rho, dtype=np.int64)
@@ -169,20 +177,50 @@ def _peak_groups(Ht, H_min, max_candidates):
         g = label[a]
         count[g] += 1
         votes[g] = value[a]
-        first[g] = min(first[g], i_c[a] * n_theta + k_c[a])
-        at_start[g] |= k_c[a] == 0
-        at_end[g] |= k_c[a] == n_theta - 1
+        first[g] = min(first[g], i[a] * n_theta + k[a])
+        at_start[g] |= k[a] == 0
+        at_end[g] |= k[a] == n_theta - 1
     sum_i = np.zeros(n_groups)
     sum_k = np.zeros(n_groups)
     for a in range(m_c):
         g = label[a]
-        if at_start[g] and at_end[g] and k_c[a] >= n_theta / 2:
-            sum_i[g] += float(n_rho - 1 - i_c[a])
-            sum_k[g] += float(k_c[a] - n_theta)
+        if at_start[g] and at_end[g] and k[a] >= n_theta / 2:  # across the wrap: to the -90° side
+            sum_i[g] += float(n_rho - 1 - i[a])
+            sum_k[g] += float(k[a] - n_theta)
         else:
-            sum_i[g] += float(i_c[a])
-            sum_k[g] += float(k_c[a])
+            sum_i[g] += float(i[a])
+            sum_k[g] += float(k[a])
     return sum_i, sum_k, count, votes, first
+
+
+def peak_groups(H, H_min, max_candidates):
+    """``lines._peak_groups`` with its two loops compiled: the same centres, votes and first cells.
+
+    Parameters
+    ----------
+    H : numpy.ndarray of intp, shape (n_rho, n_theta)
+        Votes.
+    H_min : int
+        Smallest vote count.
+    max_candidates : int
+        Cap on the candidates grouped (``lines._MAX_CANDIDATES``).
+
+    Returns
+    -------
+    centre : numpy.ndarray, shape (G, 2)
+        Mean (rho index, θ index) of each group of adjacent local maxima.
+    votes, first : numpy.ndarray of int64, shape (G,)
+        Its votes and smallest flat index ``i·n_theta + k``.
+    """
+    n_rho, n_theta = H.shape
+    flat = local_maxima(H.T, H_min)
+    i, k = flat // n_theta, flat % n_theta
+    value = H[i, k]
+    if i.size > max_candidates:  # the most votes, ties by position (as lines._peak_groups)
+        top = np.sort(np.argsort(-value, kind="stable")[:max_candidates])
+        i, k, value = i[top], k[top], value[top]
+    sum_i, sum_k, count, votes, first = group_peaks(i, k, value, n_rho, n_theta)
+    return np.column_stack([sum_i / count, sum_k / count]), votes, first
 
 
 def _greedy_keep(rho, theta, s_rho, s_theta):
@@ -218,5 +256,6 @@ def _greedy_keep(rho, theta, s_rho, s_theta):
 
 
 vote_polar = kernel(_vote_polar)
-peak_groups = kernel(_peak_groups)
+local_maxima = kernel(_local_maxima)
+group_peaks = kernel(_group_peaks)
 greedy_keep = kernel(_greedy_keep)

@@ -199,8 +199,7 @@ def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float,
     if numba_enabled() and H.dtype == np.intp:  # the same groups, compiled (_kernels.peak_groups; issue 25)
         from ._kernels import peak_groups
 
-        sum_i, sum_k, count, votes, first = peak_groups(H.T, H_min, _MAX_CANDIDATES)
-        centre = np.column_stack([sum_i / count, sum_k / count])
+        centre, votes, first = peak_groups(H, H_min, _MAX_CANDIDATES)
     else:
         centre, votes, first = _peak_groups(H, H_min)
     if votes.size == 0:
