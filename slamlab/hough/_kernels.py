@@ -82,8 +82,8 @@ def _local_maxima(Ht, H_min):
     """Cells with at least ``H_min`` votes and no fewer than their 8 neighbours (``_peak_groups`` step 1, compiled).
 
     As the numpy path: rho is clipped at the axis ends (edge cells compare with themselves), θ wraps to
-    ``(-rho, θ ± π)``. Cells are visited in (rho, θ) row-major order, the numpy path's candidate order
-    (θ inner: the few cache lines of one rho block of ``Ht`` serve 8 consecutive rho rows).
+    ``(-rho, θ ± π)``. ``Ht`` is scanned in its memory order (θ-major); a counting sort by rho row then
+    gives the numpy path's candidate order, (rho, θ) row-major.
 
     Parameters
     ----------
@@ -98,10 +98,11 @@ def _local_maxima(Ht, H_min):
         Flat indices ``i·n_theta + k`` of the local maxima, ascending.
     """
     n_theta, n_rho = Ht.shape
-    flat = np.empty(n_theta * n_rho, dtype=np.int64)
+    found = np.empty(n_theta * n_rho, dtype=np.int64)  # θ-major flat indices k·n_rho + i
+    per_row = np.zeros(n_rho + 1, dtype=np.int64)
     m = 0
-    for i in range(n_rho):
-        for k in range(n_theta):
+    for k in range(n_theta):
+        for i in range(n_rho):
             value = Ht[k, i]
             if value < H_min:
                 continue
@@ -114,9 +115,16 @@ def _local_maxima(Ht, H_min):
                         ii, kk = n_rho - 1 - ii, kk % n_theta
                     is_max = is_max and value >= Ht[kk, ii]
             if is_max:
-                flat[m] = i * n_theta + k
+                found[m] = k * n_rho + i
+                per_row[i + 1] += 1
                 m += 1
-    return flat[:m].copy()
+    start = np.cumsum(per_row)  # counting sort by rho row; within a row θ stays ascending
+    flat = np.empty(m, dtype=np.int64)
+    for j in range(m):
+        k, i = found[j] // n_rho, found[j] % n_rho
+        flat[start[i]] = i * n_theta + k
+        start[i] += 1
+    return flat
 
 
 def _group_peaks(i, k, value, n_rho, n_theta):
