@@ -8,6 +8,8 @@ ours and the reference measured in the same process, and their ratio (reference 
 
 * ``polar transform`` vs ``cv2.HoughLines`` alone (OpenCV also finds and sorts peaks);
 * ``polar transform + find_peaks`` vs ``rasterise + cv2.HoughLines`` (scan in, lines out);
+* both of ours on the numpy path (``SLAMLAB_NO_NUMBA=1``) and with the compiled kernels (issue 25), and
+  once the first-call time of the kernels in a new process, compiling and loaded from the cache;
 * the classic transform of 004 (ours, numpy) vs OpenCV on the same image.
 
 With ``--real-logs`` it runs instead the ablation of Hough SLAM on the two shared real logs (issue 25):
@@ -56,13 +58,31 @@ def make_scans(n_scans=5, n_beams=1081, cell_m=0.05, max_range_m=30.0, rng=0):
     return out
 
 
+def numpy_path(on):
+    """Switch slamlab's compiled kernels off (``on=True``: SLAMLAB_NO_NUMBA=1) or back on."""
+    if on:
+        os.environ["SLAMLAB_NO_NUMBA"] = "1"
+    else:
+        os.environ.pop("SLAMLAB_NO_NUMBA", None)
+
+
+def compiled_pair(phi, r, d_rho, r_max, repeat):
+    """Median times of the compiled transform and transform + find_peaks (issue 25)."""
+    numpy_path(False)
+    return {
+        "nb": best_time(lambda: h.hough_polar(phi, r, delta_rho=d_rho, r_max=r_max), repeat),
+        "nb_pk": best_time(lambda: h.find_peaks(h.hough_polar(phi, r, delta_rho=d_rho, r_max=r_max), 30), repeat),
+    }
+
+
 def measure(phi, r, d_rho, d_theta, r_max, repeat):
-    """Median times of each case on one scan."""
+    """Median times of each case on one scan: ours on the numpy path and compiled, OpenCV."""
     img, _ = h.rasterise_scan(phi, r, cell=d_rho, r_max=r_max)
     # the floor of any numpy vote count: np.bincount alone on the N·180 vote indices (GIL held, one pass)
     acc = h.hough_polar(phi, r, delta_rho=d_rho, r_max=r_max)
     n_cells = acc.H.size
     votes = np.repeat(np.arange(n_cells), acc.H.T.ravel())
+    numpy_path(True)
     return {
         "ours": best_time(lambda: h.hough_polar(phi, r, delta_rho=d_rho, r_max=r_max), repeat),
         "cv2": best_time(lambda: cv2.HoughLines(img, 1, d_theta, 30), repeat),
@@ -71,6 +91,7 @@ def measure(phi, r, d_rho, d_theta, r_max, repeat):
                                                      d_theta, 30), repeat),
         "classic": best_time(lambda: h.hough_classic(img), max(3, repeat // 10)),
         "bincount": best_time(lambda: np.bincount(votes, minlength=n_cells), repeat),
+        **compiled_pair(phi, r, d_rho, r_max, repeat),
         # votes per θ: ours one per beam (004's transform), OpenCV one per occupied pixel
         "beams": float(acc.H[:, 0].sum()), "pixels": float(np.count_nonzero(img)),
     }
@@ -115,6 +136,31 @@ def real_log_ablation():
                   + ", ".join(f"{k} {v}" for k, v in c.items() if v and k not in ("lines", "partial", "heading")))
 
 
+_FIRST_CALL = """
+import time, numpy as np, slamlab.hough as h
+phi = np.linspace(-2.0, 2.0, 1081); r = 5.0 / np.maximum(np.abs(np.cos(phi)), np.abs(np.sin(phi)))
+t0 = time.perf_counter(); h.find_peaks(h.hough_polar(phi, r, delta_rho=0.05, r_max=30.0), 30)
+print(time.perf_counter() - t0)
+"""
+
+
+def first_call_times():
+    """First call of hough_polar + find_peaks in a fresh process: compiling (empty cache), then from the cache.
+
+    The kernels are cached in a temporary ``NUMBA_CACHE_DIR`` so the project's own cache is not touched.
+    """
+    import subprocess
+    import sys
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as cache:
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+        env.pop("SLAMLAB_NO_NUMBA", None)
+        run = [sys.executable, "-c", _FIRST_CALL]
+        return tuple(float(subprocess.run(run, env=env, check=True, capture_output=True, text=True).stdout)
+                     for _ in range(2))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=30)
@@ -132,11 +178,10 @@ def main(argv=None):
     for d_rho, r_max in ((0.05, 30.0), (0.02, 30.0), (0.05, 10.0)):
         scans = make_scans()
         d_theta = math.radians(1.0)
-        res = {"ours": [], "cv2": [], "ours_pk": [], "cv2_full": [], "classic": [], "bincount": [], "beams": [],
-               "pixels": []}
+        res = {}
         for phi, r in scans:
             for key, t in measure(phi, r, d_rho, d_theta, r_max, args.repeat).items():
-                res[key].append(t)
+                res.setdefault(key, []).append(t)
         m = {k: float(np.median(v)) for k, v in res.items()}
         n_pts = int(np.median([p.size for p, _ in scans]))
         side = 2 * math.ceil(r_max / d_rho) + 1
@@ -147,11 +192,17 @@ def main(argv=None):
     rows.append(("square room (notebook 07), Δrho 5 cm, r_max 30 m", measure(phi_sq, r_sq, 0.05, math.radians(1.0),
                                                                           30.0, args.repeat)))
     print(f"load average {os.getloadavg()[0]:.2f}")
+    compile_s, cached_s = first_call_times()
+    print(f"first call of hough_polar + find_peaks in a new process (compiled kernels): {compile_s:.2f} s "
+          f"compiling (empty cache), {cached_s:.2f} s loading them from the cache")
     print()
     print(f"{'case':58s} {'ours [ms]':>10s} {'OpenCV [ms]':>12s} {'ratio':>7s}")
     for label, m in rows:
-        for name, ours, ref in (("polar transform vs cv2.HoughLines", m["ours"], m["cv2"]),
-                                ("polar + find_peaks vs rasterise + cv2.HoughLines", m["ours_pk"], m["cv2_full"]),
+        for name, ours, ref in (("polar transform (numpy) vs cv2.HoughLines", m["ours"], m["cv2"]),
+                                ("polar transform (compiled) vs cv2.HoughLines", m["nb"], m["cv2"]),
+                                ("polar + find_peaks (numpy) vs rasterise + HoughLines", m["ours_pk"], m["cv2_full"]),
+                                ("polar + find_peaks (compiled) vs rasterise + HoughLines", m["nb_pk"],
+                                 m["cv2_full"]),
                                 ("classic (numpy) vs cv2.HoughLines", m["classic"], m["cv2"]),
                                 ("np.bincount of the votes alone vs cv2.HoughLines", m["bincount"], m["cv2"])):
             print(f"{label}\n  {name:56s} {ours * 1e3:10.3f} {ref * 1e3:12.3f} {ref / ours:7.2f}")

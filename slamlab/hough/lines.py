@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from .._compiled import numba_enabled
 from .transform import HoughAccumulator
 
 _MAX_CANDIDATES = 600
@@ -195,8 +196,41 @@ _NB_DK = np.array([-1, 0, 1, -1, 1, -1, 0, 1])[:, None]
 def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float, max_lines: int | None) -> Lines:
     """:func:`find_peaks` on checked arguments (suppression windows resolved)."""
     H = acc.H
+    if numba_enabled() and H.dtype == np.intp:  # the same groups, compiled (_kernels.peak_groups; issue 25)
+        from ._kernels import peak_groups
+
+        centre, votes, first = peak_groups(H, H_min, _MAX_CANDIDATES)
+    else:
+        centre, votes, first = _peak_groups(H, H_min)
+    if votes.size == 0:
+        return Lines(np.empty(0), np.empty(0), np.empty(0, dtype=np.int64))
+    order = np.lexsort((first, -votes))  # by votes, ties by position: deterministic
+    centre, votes = centre[order], votes[order]
+    rho, theta = canonical_lines(acc.rho[0] + centre[:, 0] * acc.delta_rho,
+                                 acc.theta_rad[0] + centre[:, 1] * acc.delta_theta_rad)
+    keep = _greedy_keep(rho, theta, s_rho, s_theta)[:max_lines]
+    return Lines(rho[keep].astype(float), theta[keep].astype(float), votes[keep].astype(np.int64))
+
+
+def _peak_groups(H, H_min: int):
+    """Step 1 of :func:`find_peaks` (numpy): the flat tops' centres ``(i, k)``, votes and first flat index.
+
+    Parameters
+    ----------
+    H : numpy.ndarray, shape (n_rho, n_theta)
+        Votes.
+    H_min : int
+        Smallest vote count.
+
+    Returns
+    -------
+    centre : numpy.ndarray, shape (G, 2)
+        Mean (rho index, θ index) of each group of adjacent local maxima.
+    votes, first : numpy.ndarray of int, shape (G,)
+        Its votes and smallest flat index ``i·n_theta + k``.
+    """
     n_theta = H.shape[1]
-    empty = Lines(np.empty(0), np.empty(0), np.empty(0, dtype=np.int64))
+    empty = np.empty((0, 2)), np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
     n_rho = H.shape[0]
     # candidates in (rho, θ) row-major order; found on the θ-major counts, which are contiguous for
     # hough_polar (a 2-D nonzero on the transposed view cost more than the rest of the search)
@@ -234,12 +268,7 @@ def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float,
     votes[label] = value
     first = np.full(count.size, H.size)
     np.minimum.at(first, label, i * n_theta + k)
-    order = np.lexsort((first, -votes))  # by votes, ties by position: deterministic
-    centre, votes = centre[order], votes[order]
-    rho, theta = canonical_lines(acc.rho[0] + centre[:, 0] * acc.delta_rho,
-                                 acc.theta_rad[0] + centre[:, 1] * acc.delta_theta_rad)
-    keep = _greedy_keep(rho, theta, s_rho, s_theta)[:max_lines]
-    return Lines(rho[keep].astype(float), theta[keep].astype(float), votes[keep].astype(np.int64))
+    return centre, votes, first
 
 
 def _components(adjacent):
@@ -261,7 +290,24 @@ def _components(adjacent):
 
 
 def _greedy_keep(rho, theta, s_rho, s_theta):
-    """Indices kept when going down the (sorted) lines and dropping those close to a kept one."""
+    """Indices kept when going down the (sorted) lines and dropping those close to a kept one.
+
+    Parameters
+    ----------
+    rho, theta : numpy.ndarray, shape (L,)
+        Lines, strongest first.
+    s_rho, s_theta : float
+        Suppression windows (rho unit, rad).
+
+    Returns
+    -------
+    numpy.ndarray of intp
+        Indices of the lines kept, ascending.
+    """
+    if numba_enabled():  # the same loop, compiled (_kernels.greedy_keep; issue 25)
+        from ._kernels import greedy_keep
+
+        return greedy_keep(np.asarray(rho, dtype=float), np.asarray(theta, dtype=float), float(s_rho), float(s_theta))
     d_rho, d_theta = line_difference(rho[:, None], theta[:, None], rho[None, :], theta[None, :])
     close = (np.abs(d_rho) <= s_rho + 1e-9) & (np.abs(d_theta) <= s_theta + 1e-9)
     keep = np.ones(rho.size, dtype=bool)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _validate as v
+from .._compiled import numba_enabled
 
 __all__ = [
     "HoughAccumulator",
@@ -190,12 +191,17 @@ def _hough_polar(phi, r, d_rho, theta, delta_theta_rad, r_max) -> HoughAccumulat
     pts[1] = (r[keep] * np.sin(phi[keep])) / d_rho
     pts[2] = 1.0
     rows = max(1, min(n_theta, _VOTE_BLOCK // max(n, 1)))
-    # votes in a (θ, rho) layout so that the row offset j·n_rho (j = θ row within its block) folds
-    # into the float sum: rho/Δrho + n_half + 0.5 + j·n_rho >= 0.5, so truncation = rounding to the
-    # nearest bin (|rho| <= r <= r_max keeps every vote inside its θ row)
     w = np.empty((n_theta, 3))
     w[:, 0], w[:, 1] = np.cos(theta), np.sin(theta)
     w[:, 2] = (n_half + 0.5) + n_rho * (np.arange(n_theta) % rows)
+    if numba_enabled():  # the same votes, compiled (slamlab.hough._kernels.vote_polar; issue 25)
+        from ._kernels import vote_polar
+
+        counts = vote_polar(pts[0], pts[1], w, rows, n_rho)
+        return HoughAccumulator(counts.T, rho_axis, theta, d_rho, delta_theta_rad)
+    # votes in a (θ, rho) layout so that the row offset j·n_rho (j = θ row within its block) folds
+    # into the float sum: rho/Δrho + n_half + 0.5 + j·n_rho >= 0.5, so truncation = rounding to the
+    # nearest bin (|rho| <= r <= r_max keeps every vote inside its θ row)
     counts = np.empty((n_theta, n_rho), dtype=np.intp)
     fbuf, ibuf = np.empty((rows, n)), np.empty((rows, n), dtype=np.intp)
     for k0 in range(0, n_theta, rows):
