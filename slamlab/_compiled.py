@@ -7,9 +7,10 @@ through :func:`kernel` so that all share the same settings:
 - ``cache=True``: the machine code is written next to the module (``__pycache__``) on the first call,
   so only the first process on a machine pays the compile time;
 - ``nogil=True``: a kernel can run in :mod:`slamlab._threads`' shared pool;
-- no ``fastmath``: floating-point operations keep numpy's order and rounding (no reassociation, no
-  fused multiply-add contraction), so a kernel gives the same numbers on every CPU of our kind,
-  whether it has AVX2 or AVX-512.
+- no ``fastmath``: floating-point operations keep the order and rounding written in the kernel (no
+  reassociation, no implicit fused multiply-add contraction), so a kernel gives the same numbers on
+  every CPU of our kind, whether it has AVX2 or AVX-512. Where a kernel reproduces a BLAS product that
+  rounds a multiply-add once, it says so with an explicit ``fma`` (``slamlab.hough._kernels``).
 
 ``SLAMLAB_NO_NUMBA=1`` makes :func:`numba_enabled` false: callers then take the numpy path (a way to
 compare the two, and a fallback where numba cannot be installed).
