@@ -277,6 +277,13 @@ def _query_rows(Q):
     return Qa
 
 
+def _in_pool():
+    """Whether this thread is one of :mod:`slamlab._threads`' workers (whose tasks must not submit tasks)."""
+    import threading
+
+    return threading.current_thread().name.startswith("slamlab-worker")
+
+
 def _final_k(Q, X, best_idx, k):
     """The candidates' distances recomputed directly in float64, sorted (ties by index), the best ``k`` kept."""
     diff = Q[:, None, :].astype(np.float64) - X[best_idx].astype(np.float64)
@@ -285,7 +292,7 @@ def _final_k(Q, X, best_idx, k):
     return np.take_along_axis(d, o, axis=1), np.take_along_axis(best_idx, o, axis=1)
 
 
-def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1, Xa=None):
+def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1, Xa=None, workers: int = 0):
     """:func:`_exact_knn_float` with the selection compiled: the same BLAS blocks, one pass per block.
 
     After each block's product, :func:`~slamlab.kdtree._brute_kernel.update_top_c` merges the block's keys
@@ -294,8 +301,10 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     are the product's own (the numpy path recomputes them with ``einsum``), so the two candidate lists
     can differ only where float32 rounding reorders near-equal keys; the final ``k`` come from the same
     float64 recomputation and order, hence the same results whenever both lists hold the true ``k``
-    nearest (the numpy path's own condition for exactness).
+    nearest (the numpy path's own condition for exactness). With ``workers`` = 2 (0: 2 for blocks of
+    at least 2^18 keys) the two halves of the queries are selected in :mod:`slamlab._threads`' pool.
     """
+    from .._threads import run_tasks
     from ._brute_kernel import update_top_c
 
     M, N = Q.shape[0], X.shape[0]
@@ -307,11 +316,15 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     buf = np.empty(M * min(block, N), dtype=np.float32)
     best_key = np.full((M, c), np.inf, dtype=np.float32)
     best_idx = np.full((M, c), -1, dtype=np.int64)
+    # large blocks: two halves of the queries in the shared pool (never from inside one of its tasks)
+    workers = workers or (2 if M * min(block, N) >= 1 << 18 and not _in_pool() else 1)
+    halves = [(0, M // 2), (M // 2, M)] if workers > 1 and M > 1 else [(0, M)]
     for s0 in range(0, N, block):
         s1 = min(s0 + block, N)
         G = buf[: M * (s1 - s0)].reshape(M, s1 - s0)  # contiguous rows, also for the last block
         np.matmul(Qa, Xa[s0:s1].T, out=G)  # (M, b) ranking keys |x|²/2 - q·x
-        update_top_c(G, s0, best_key, best_idx, 0, M)
+        run_tasks([lambda G=G, s0=s0, r0=r0, r1=r1: update_top_c(G, s0, best_key, best_idx, r0, r1)
+                   for r0, r1 in halves], len(halves))
     # a key that never beat inf (an overflowing product) leaves a slot empty: rank those queries in numpy
     bad = np.flatnonzero(best_idx[:, -1] < 0)
     if bad.size:
