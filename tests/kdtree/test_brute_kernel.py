@@ -95,3 +95,12 @@ def test_numpy_path_under_no_numba(monkeypatch):
     d0, i0 = knn.exact_knn(Q, X, 2)
     np.testing.assert_array_equal(i1, i0)
     np.testing.assert_array_equal(d1, d0)
+
+
+def test_overflowing_keys_fall_back_to_numpy():
+    X = np.array([[0.0, 0.0], [1.0, 0.0], [3e19, 0.0]], np.float32)  # |x|²/2 overflows float32: key inf
+    Q = np.array([[0.5, 0.0], [2e19, 0.0]], np.float32)
+    with np.errstate(over="ignore", invalid="ignore"):  # the overflow itself (both paths)
+        (d0, i0), (d1, i1) = _both(Q, X, 2)
+    np.testing.assert_array_equal(i1, i0)
+    np.testing.assert_array_equal(d1, d0)
