@@ -2,7 +2,8 @@
 
 - :func:`exact_knn` — exact k-NN by brute force: Hamming distance for binary ``uint8``
   descriptors (ORB; OpenCV's ``batchDistance``), Euclidean for float ones (BLAS on
-  query blocks, the kept distances recomputed directly in float64);
+  query blocks, the kept distances recomputed directly in float64; the selection from
+  each block compiled in :mod:`slamlab.kdtree._brute_kernel` unless ``SLAMLAB_NO_NUMBA=1``);
 - :func:`pad_knn` — the one "pad to k" rule: fewer than ``k`` candidates give ``inf``
   distances and id ``-1``;
 - :func:`merge_knn` — k-NN lists of several trees merged into one (000 §4: a query
@@ -301,8 +302,30 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     are the product's own (the numpy path recomputes them with ``einsum``), so the two candidate lists
     can differ only where float32 rounding reorders near-equal keys; the final ``k`` come from the same
     float64 recomputation and order, hence the same results whenever both lists hold the true ``k``
-    nearest (the numpy path's own condition for exactness). With ``workers`` = 2 (0: 2 for blocks of
-    at least 2^18 keys) the two halves of the queries are selected in :mod:`slamlab._threads`' pool.
+    nearest (the numpy path's own condition for exactness).
+
+    Parameters
+    ----------
+    Q, X : (M, d), (N, d) float
+        Queries and database rows.
+    k : int
+        Neighbours per query (``k <= N``).
+    block : int, optional
+        Database rows per BLAS product (default: :func:`_block_rows`).
+    margin : int
+        Candidates kept beyond ``k`` for the float64 re-ranking.
+    Xa : (N, d + 1) float32, optional
+        ``augment_rows(X)``, when the caller keeps it.
+    workers : int
+        2: the two halves of the queries are selected in :mod:`slamlab._threads`' pool; 1: in this
+        thread; 0: 2 for blocks of at least 2^18 keys.
+
+    Returns
+    -------
+    dist : (M, k) float64
+        Ascending, ties by index.
+    idx : (M, k) int64
+        Row indices into ``X``.
     """
     from .._threads import run_tasks
     from ._brute_kernel import update_top_c

@@ -16,7 +16,8 @@ def _both(Q, X, k, block=None):
 
 def _reference(Q, X, k):
     """Full float64 distance matrix, sorted by (distance, index)."""
-    D = np.sqrt(((Q[:, None, :].astype(np.float64) - X[None].astype(np.float64)) ** 2).sum(-1))
+    X64 = X.astype(np.float64)
+    D = np.array([np.sqrt(((q - X64) ** 2).sum(-1)) for q in Q.astype(np.float64)])  # one query at a time
     o = np.lexsort((np.broadcast_to(np.arange(X.shape[0]), D.shape), D), axis=1)[:, :k]
     return np.take_along_axis(D, o, axis=1), o
 
