@@ -293,6 +293,9 @@ def _final_k(Q, X, best_idx, k):
     return np.take_along_axis(d, o, axis=1), np.take_along_axis(best_idx, o, axis=1)
 
 
+_POOL_MIN_KEYS = 1 << 18  # blocks from which the compiled selection splits the queries over two threads
+
+
 def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1, Xa=None, workers: int = 0):
     """:func:`_exact_knn_float` with the selection compiled: the same BLAS blocks, one pass per block.
 
@@ -317,8 +320,8 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     Xa : (N, d + 1) float32, optional
         ``augment_rows(X)``, when the caller keeps it.
     workers : int
-        2: the two halves of the queries are selected in :mod:`slamlab._threads`' pool; 1: in this
-        thread; 0: 2 for blocks of at least 2^18 keys.
+        2: the second half of the queries is selected in a worker of :mod:`slamlab._threads`' pool
+        while this thread selects the first; 1: all in this thread; 0: 2 for blocks of at least 2^18 keys.
 
     Returns
     -------
@@ -327,7 +330,7 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     idx : (M, k) int64
         Row indices into ``X``.
     """
-    from .._threads import run_tasks
+    from .._threads import shared_pool
     from ._brute_kernel import update_top_c
 
     M, N = Q.shape[0], X.shape[0]
@@ -340,14 +343,17 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     best_key = np.full((M, c), np.inf, dtype=np.float32)
     best_idx = np.full((M, c), -1, dtype=np.int64)
     # large blocks: two halves of the queries in the shared pool (never from inside one of its tasks)
-    workers = workers or (2 if M * min(block, N) >= 1 << 18 and not _in_pool() else 1)
+    workers = workers or (2 if M * min(block, N) >= _POOL_MIN_KEYS and not _in_pool() else 1)
     halves = [(0, M // 2), (M // 2, M)] if workers > 1 and M > 1 else [(0, M)]
     for s0 in range(0, N, block):
         s1 = min(s0 + block, N)
         G = buf[: M * (s1 - s0)].reshape(M, s1 - s0)  # contiguous rows, also for the last block
         np.matmul(Qa, Xa[s0:s1].T, out=G)  # (M, b) ranking keys |x|²/2 - q·x
-        run_tasks([lambda G=G, s0=s0, r0=r0, r1=r1: update_top_c(G, s0, best_key, best_idx, r0, r1)
-                   for r0, r1 in halves], len(halves))
+        # the second half in a pool worker while this thread selects the first
+        later = [shared_pool().submit(update_top_c, G, s0, best_key, best_idx, r0, r1) for r0, r1 in halves[1:]]
+        update_top_c(G, s0, best_key, best_idx, *halves[0])
+        for f in later:
+            f.result()
     # a key that never beat inf (an overflowing product) leaves a slot empty: rank those queries in numpy
     bad = np.flatnonzero(best_idx[:, -1] < 0)
     if bad.size:
