@@ -293,7 +293,9 @@ def _final_k(Q, X, best_idx, k):
     return np.take_along_axis(d, o, axis=1), np.take_along_axis(best_idx, o, axis=1)
 
 
-_POOL_MIN_KEYS = 1 << 18  # blocks from which the compiled selection splits the queries over two threads
+# whether blocks of >= 2^18 keys split their selection over two threads (the shared pool); off: on our loaded
+# 2-core runs the split cost more CPU than it saved wall time (bench_stores.py --brute-only prints both; issue 25)
+_POOL_SELECTION = False
 
 
 def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1, Xa=None, workers: int = 0):
@@ -321,7 +323,8 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
         ``augment_rows(X)``, when the caller keeps it.
     workers : int
         2: the second half of the queries is selected in a worker of :mod:`slamlab._threads`' pool
-        while this thread selects the first; 1: all in this thread; 0: 2 for blocks of at least 2^18 keys.
+        while this thread selects the first; 1: all in this thread; 0: 2 for blocks of at least 2^18 keys
+        when ``_POOL_SELECTION`` is set, else 1.
 
     Returns
     -------
@@ -343,7 +346,7 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     best_key = np.full((M, c), np.inf, dtype=np.float32)
     best_idx = np.full((M, c), -1, dtype=np.int64)
     # large blocks: two halves of the queries in the shared pool (never from inside one of its tasks)
-    workers = workers or (2 if M * min(block, N) >= _POOL_MIN_KEYS and not _in_pool() else 1)
+    workers = workers or (2 if _POOL_SELECTION and M * min(block, N) >= 1 << 18 and not _in_pool() else 1)
     halves = [(0, M // 2), (M // 2, M)] if workers > 1 and M > 1 else [(0, M)]
     for s0 in range(0, N, block):
         s1 = min(s0 + block, N)

@@ -105,3 +105,16 @@ def test_overflowing_keys_fall_back_to_numpy():
         (d0, i0), (d1, i1) = _both(Q, X, 2)
     np.testing.assert_array_equal(i1, i0)
     np.testing.assert_array_equal(d1, d0)
+
+
+def test_selection_split_over_two_threads_gives_the_same():
+    rng = np.random.default_rng(11)
+    X = rng.standard_normal((3000, 16)).astype(np.float32)
+    Q = rng.standard_normal((101, 16)).astype(np.float32)  # odd: halves of 50 and 51 queries
+    d1, i1 = knn._exact_knn_float_compiled(Q, X, 2, workers=1)
+    d2, i2 = knn._exact_knn_float_compiled(Q, X, 2, workers=2)
+    d0, i0 = knn._exact_knn_float(Q, X, 2)
+    np.testing.assert_array_equal(i2, i1)
+    np.testing.assert_array_equal(d2, d1)
+    np.testing.assert_array_equal(i1, i0)
+    np.testing.assert_array_equal(d1, d0)
