@@ -2,7 +2,8 @@
 
 - :func:`exact_knn` — exact k-NN by brute force: Hamming distance for binary ``uint8``
   descriptors (ORB; OpenCV's ``batchDistance``), Euclidean for float ones (BLAS on
-  query blocks, the kept distances recomputed directly in float64);
+  query blocks, the kept distances recomputed directly in float64; the selection from
+  each block compiled in :mod:`slamlab.kdtree._brute_kernel` unless ``SLAMLAB_NO_NUMBA=1``);
 - :func:`pad_knn` — the one "pad to k" rule: fewer than ``k`` candidates give ``inf``
   distances and id ``-1``;
 - :func:`merge_knn` — k-NN lists of several trees merged into one (000 §4: a query
@@ -17,6 +18,8 @@ The features chapter's matching (:func:`slamlab.features.knn2`), the landmark st
 from __future__ import annotations
 
 import numpy as np
+
+from .._compiled import numba_enabled
 
 __all__ = ["augment_rows", "exact_knn", "flann_index", "hamming_distances", "merge_knn", "pad_knn"]
 
@@ -180,6 +183,8 @@ def exact_knn(Q, X, k: int = 2, ids=None, *, augmented=None):
                                    normType=cv2.NORM_HAMMING, K=kk)
         idx = idx.astype(np.int64)
         d = np.where(idx >= 0, d, np.inf).astype(np.float64)
+    elif numba_enabled():  # the same blocks, the selection compiled (issue 25)
+        d, idx = _exact_knn_float_compiled(Q, X, kk, Xa=augmented)
     else:
         d, idx = _exact_knn_float(Q, X, kk, Xa=augmented)
     if ids is not None:
@@ -229,12 +234,8 @@ def _exact_knn_float(Q, X, k, block: int | None = None, margin: int = 1, Xa=None
     # augmented rows: [x, |x|²/2] · [-q, 1] = |x|²/2 - q·x, one GEMM per block writes the key directly
     if Xa is None:
         Xa = augment_rows(X)
-    # blocks of ~2^21 keys (8 MB): the GEMM's output and the passes over it stay in L3 with few GEMM calls
-    # (8192-row blocks of 500 queries wrote and re-read 16 MB per block three times; issue 17)
-    block = block or max(512, min(8192, (1 << 21) // max(M, 1)))
-    Qa = np.empty((M, Q.shape[1] + 1), dtype=np.float32)
-    Qa[:, :-1] = -Q
-    Qa[:, -1] = 1.0
+    block = block or _block_rows(M)
+    Qa = _query_rows(Q)
     buf = np.empty((M, min(block, N)), dtype=np.float32)
     best_key = np.full((M, 0), np.inf, dtype=np.float32)
     best_idx = np.empty((M, 0), dtype=np.int64)
@@ -259,11 +260,108 @@ def _exact_knn_float(Q, X, k, block: int | None = None, margin: int = 1, Xa=None
             best_key, best_idx = key, idx
         else:
             best_key[rows], best_idx[rows] = key, idx
-    # the candidates' distances recomputed directly in float64, sorted, the best k kept
+    return _final_k(Q, X, best_idx, k)
+
+
+def _block_rows(M):
+    """Database rows per block for ``M`` queries."""
+    # blocks of ~2^21 keys (8 MB): the GEMM's output and the passes over it stay in L3 with few GEMM calls
+    # (8192-row blocks of 500 queries wrote and re-read 16 MB per block three times; issue 17)
+    return max(512, min(8192, (1 << 21) // max(M, 1)))
+
+
+def _query_rows(Q):
+    """``[-q, 1]`` float32 rows (the query side of the ranking GEMM)."""
+    Qa = np.empty((Q.shape[0], Q.shape[1] + 1), dtype=np.float32)
+    Qa[:, :-1] = -Q
+    Qa[:, -1] = 1.0
+    return Qa
+
+
+def _in_pool():
+    """Whether this thread is one of :mod:`slamlab._threads`' workers (whose tasks must not submit tasks)."""
+    import threading
+
+    return threading.current_thread().name.startswith("slamlab-worker")
+
+
+def _final_k(Q, X, best_idx, k):
+    """The candidates' distances recomputed directly in float64, sorted (ties by index), the best ``k`` kept."""
     diff = Q[:, None, :].astype(np.float64) - X[best_idx].astype(np.float64)
     d = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
     o = _order(d, best_idx)[:, :k]
     return np.take_along_axis(d, o, axis=1), np.take_along_axis(best_idx, o, axis=1)
+
+
+# whether blocks of >= 2^18 keys split their selection over two threads (the shared pool); off: on our loaded
+# 2-core runs the split cost more CPU than it saved wall time (bench_stores.py --brute-only prints both; issue 25)
+_POOL_SELECTION = False
+
+
+def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1, Xa=None, workers: int = 0):
+    """:func:`_exact_knn_float` with the selection compiled: the same BLAS blocks, one pass per block.
+
+    After each block's product, :func:`~slamlab.kdtree._brute_kernel.update_top_c` merges the block's keys
+    into the running ``k + margin`` best of every query in one pass over the block (no ``min`` pass, no
+    ``argmin`` passes, no gathers; a query that cannot improve costs one compare per key). The kept keys
+    are the product's own (the numpy path recomputes them with ``einsum``), so the two candidate lists
+    can differ only where float32 rounding reorders near-equal keys; the final ``k`` come from the same
+    float64 recomputation and order, hence the same results whenever both lists hold the true ``k``
+    nearest (the numpy path's own condition for exactness).
+
+    Parameters
+    ----------
+    Q, X : (M, d), (N, d) float
+        Queries and database rows.
+    k : int
+        Neighbours per query (``k <= N``).
+    block : int, optional
+        Database rows per BLAS product (default: :func:`_block_rows`).
+    margin : int
+        Candidates kept beyond ``k`` for the float64 re-ranking.
+    Xa : (N, d + 1) float32, optional
+        ``augment_rows(X)``, when the caller keeps it.
+    workers : int
+        2: the second half of the queries is selected in a worker of :mod:`slamlab._threads`' pool
+        while this thread selects the first; 1: all in this thread; 0: 2 for blocks of at least 2^18 keys
+        when ``_POOL_SELECTION`` is set, else 1.
+
+    Returns
+    -------
+    dist : (M, k) float64
+        Ascending, ties by index.
+    idx : (M, k) int64
+        Row indices into ``X``.
+    """
+    from .._threads import shared_pool
+    from ._brute_kernel import update_top_c
+
+    M, N = Q.shape[0], X.shape[0]
+    c = min(k + margin, N)
+    if Xa is None:
+        Xa = augment_rows(X)
+    block = block or _block_rows(M)
+    Qa = _query_rows(Q)
+    buf = np.empty(M * min(block, N), dtype=np.float32)
+    best_key = np.full((M, c), np.inf, dtype=np.float32)
+    best_idx = np.full((M, c), -1, dtype=np.int64)
+    # large blocks: two halves of the queries in the shared pool (never from inside one of its tasks)
+    workers = workers or (2 if _POOL_SELECTION and M * min(block, N) >= 1 << 18 and not _in_pool() else 1)
+    halves = [(0, M // 2), (M // 2, M)] if workers > 1 and M > 1 else [(0, M)]
+    for s0 in range(0, N, block):
+        s1 = min(s0 + block, N)
+        G = buf[: M * (s1 - s0)].reshape(M, s1 - s0)  # contiguous rows, also for the last block
+        np.matmul(Qa, Xa[s0:s1].T, out=G)  # (M, b) ranking keys |x|²/2 - q·x
+        # the second half in a pool worker while this thread selects the first
+        later = [shared_pool().submit(update_top_c, G, s0, best_key, best_idx, r0, r1) for r0, r1 in halves[1:]]
+        update_top_c(G, s0, best_key, best_idx, *halves[0])
+        for f in later:
+            f.result()
+    # a key that never beat inf (an overflowing product) leaves a slot empty: rank those queries in numpy
+    bad = np.flatnonzero(best_idx[:, -1] < 0)
+    if bad.size:
+        best_idx[bad] = _exact_knn_float(Q[bad], X, c, block, 0, Xa)[1]
+    return _final_k(Q, X, best_idx, k)
 
 
 def _keys(Qa, Xa, idx):
