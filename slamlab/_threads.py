@@ -1,8 +1,9 @@
 """Two shared worker threads for numpy work that releases the GIL (our addition, speed; issue 17).
 
 One pool per process, shared by every caller (SURF's response maps, orientations and descriptors;
-the exact k-NN's numpy selection passes, and its compiled selection when ``knn._POOL_SELECTION`` is on), so that concurrent callers — e.g. the stereo pipeline's two
-images — still run at most two threads of such work. Tasks never submit tasks (no nesting).
+the exact k-NN's numpy selection passes, and its compiled selection when ``knn._POOL_SELECTION`` is
+on), so that concurrent callers — e.g. the stereo pipeline's two images — still run at most two
+threads of such work. Tasks never submit tasks (no nesting).
 """
 
 from __future__ import annotations
