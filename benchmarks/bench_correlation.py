@@ -10,6 +10,7 @@ definition on a small case; every pair must give the identical peak.
     python benchmarks/bench_correlation.py --intel         # + every 25th Intel scan: 1 scan vs 2, 3 joined
     python benchmarks/bench_correlation.py --logs          # + every 25th scan of each shared CARMEN log, per-log table
     python benchmarks/bench_correlation.py --logs --every 100 --only intel,seattle   # smaller / fewer logs
+    python benchmarks/bench_correlation.py --logs --map-check   # + is each log's beam layout read right? (issue 25)
 """
 
 from __future__ import annotations
@@ -116,6 +117,8 @@ def main():
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="any other setting of the --logs run (run_log_localisation's arguments, LocaliseParams "
                          "fields), a Python literal: --set 'odom_std=(0, 0)' --set a_p=4 --set hit_ratio=0.1")
+    ap.add_argument("--map-check", action="store_true",
+                    help="with --logs: first print the end points on the other scans' walls per beam layout and log")
     ap.add_argument("--only", default=None, help="comma-separated short log names for --logs (default all five)")
     ap.add_argument("--jobs", type=int, default=1, help="sweep workers of the --intel/--logs runs (same result for any)")
     args = ap.parse_args()
@@ -189,14 +192,20 @@ def main():
             if not sep:
                 ap.error(f"--set takes NAME=VALUE; got {item!r}")
             settings[name.strip()] = ast.literal_eval(value.strip())
-        logs(args.every, args.only, args.jobs, settings)
+        logs(args.every, args.only, args.jobs, settings, args.map_check)
 
 
-def logs(every: int, only: str | None, n_jobs: int, settings: dict) -> None:
+def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: bool = False) -> None:
     """Issue 25: every ``every``-th scan of each shared CARMEN log, modes 1/2/3, with the real-log defaults."""
     from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
 
     paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
+    if map_check:
+        t0 = time.perf_counter()
+        print(f"\nBeam layout check (every 5th scan, ±2 scans left out, 0.2 m cells, ranges < 10 m), load average "
+              f"{os.getloadavg()[0]:.1f}")
+        print(sl.correlation.map_check([sl.data.find_data(p) for p in paths]))
+        print(f"took {time.perf_counter() - t0:.1f} s wall")
     print(f"\nShared CARMEN logs, every {every}th scan, settings {settings or 'defaults'}, "
           f"load average {os.getloadavg()[0]:.1f}")
     t0 = time.perf_counter()

@@ -29,6 +29,7 @@ from .experiments import (
 )
 from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, ours_vs_source, run_log_localisation
 from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, run_log_suite
+from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
 
 _PLOT = (
     "constants_figure",
@@ -49,6 +50,7 @@ __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), 
 
 __all__ = [
     "DEFAULT_CARMEN_LOG",
+    "MAP_CHECK_LAYOUTS",
     "SHARED_CARMEN_LOGS",
     "SOURCE_TABLE1",
     "ConstantsResult",
@@ -61,11 +63,13 @@ __all__ = [
     "Table1Result",
     "check_constants",
     "corridor_grid",
+    "endpoint_agreement",
     "heading_candidates",
     "heading_error",
     "localise",
     "localise_joined",
     "log_grid",
+    "map_check",
     "ours_vs_source",
     "random_clutter",
     "rasterise_scan",

@@ -242,16 +242,48 @@ def _localise(Mv, a, r, h, headings, p: LocaliseParams, *, tracking: bool) -> Lo
     """The search itself, on checked arguments: ``Mv`` the map in 004's values (called per scan by the runs)."""
     free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
                               step_cells=p.step_cells, use_misses=p.use_misses)
-    return _localise_samples(Mv, free, obs, int(np.ceil(_reach(r, h, p))) + 2, headings, p, tracking=tracking)
+    return _localise_samples(Mv, free, obs, int(np.ceil(_reach(r, h, p))) + 2, headings, p, tracking=tracking,
+                             obs_weights=_wall_weights([(a, r, h)], np.zeros((1, 3)), p) if p.wall_balance else None)
 
 
-def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking: bool, n_scans: int = 1):
-    """Rasterise the robot-frame samples ``free`` / ``obs`` (stamp half-size ``o``), search the peak and its rival."""
+def _wall_weights(beams, rel_poses, p: LocaliseParams, n_bins: int = 12) -> np.ndarray:
+    """Weight of each obstacle sample of :func:`_joined_samples`: the rarer its wall direction, the larger (ours).
+
+    In a corridor most returns lie on its two long walls, which fix the pose across the corridor but not along
+    it; the few returns on door frames, corners and the corridor's end fix it along. Each return's wall direction
+    is that of the line through its neighbours' end points (in beam order), modulo π, in ``n_bins`` bins over
+    all joined scans; a return's weight is ``count(bin)^(-1/2)``, scaled to a mean of 1 over the returns and
+    capped at 4 (issue 25, ours; :attr:`LocaliseParams.wall_balance`). Same order as the obstacle samples.
+    """
+    lo, hi = -p.delta_l_cells + 0.01, p.delta_l_cells + p.hit_offset_cells
+    n_obs = max(int(np.ceil((hi - lo) / p.step_cells)) + 1, 1) if hi > lo else 1  # marks per beam, as sampled
+    dirs = []
+    for (a, r, h), q in zip(beams, rel_poses, strict=True):
+        use = h | p.use_misses
+        hit = h[use]
+        ah, rh = a[use][hit], r[use][hit]
+        x, y = rh * np.cos(ah), rh * np.sin(ah)
+        d = np.arctan2(np.gradient(y), np.gradient(x)) if x.size >= 2 else np.zeros(x.size)
+        dirs.append(d + q[2])
+    d = np.mod(np.concatenate(dirs), np.pi)
+    b = np.minimum((d / (np.pi / n_bins)).astype(np.int64), n_bins - 1)
+    w = np.bincount(b, minlength=n_bins)[b] ** -0.5 if b.size else np.ones(0)
+    w = np.minimum(w * (w.size / max(w.sum(), 1e-12)), 4.0)
+    return np.repeat(w, n_obs)
+
+
+def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking: bool, n_scans: int = 1,
+                      obs_weights=None):
+    """Rasterise the robot-frame samples ``free`` / ``obs`` (stamp half-size ``o``), search the peak and its rival.
+
+    ``obs_weights`` (one per obstacle sample, optional) multiply ``a_p`` in the stamps (:func:`_wall_weights`).
+    """
     dtype = np.dtype(p.dtype)
     S = 2 * o
-    stamps = _Stamps(free, obs, headings, p.a_c, p.a_p, p.a_n, o, dtype)
+    a_p = p.a_p if obs_weights is None else p.a_p * np.asarray(obs_weights, dtype=float)
+    stamps = _Stamps(free, obs, headings, p.a_c, a_p, p.a_n, o, dtype)
     n_marks = max(1, free.shape[0] + obs.shape[0])
-    amax = max(abs(p.a_c), abs(p.a_p), abs(p.a_n))
+    amax = max(abs(p.a_c), float(np.max(np.abs(a_p), initial=0.0)), abs(p.a_n))
     tol = (1e-9 if dtype == np.float64 else 2e-5) * amax * amax * n_marks
     specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=p.workers)
     best_val, best_idx, best_map, best, arg = _peak_search(Mv, stamps, headings, S, o, dtype=dtype,
@@ -340,9 +372,11 @@ def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = 
     if prior_heading_rad is None and window_rad is not None:
         raise ValueError("`window_rad` needs `prior_heading_rad` (tracking mode)")
     headings = heading_candidates(p.delta_alpha_rad, center_rad=prior_heading_rad, window_rad=window_rad)
-    free, obs, o = _joined_samples(beams, se2_relative(P[0], P), p)
+    rel = se2_relative(P[0], P)
+    free, obs, o = _joined_samples(beams, rel, p)
     return _localise_samples(grid_to_values(g, p.a_c, p.a_p, p.a_n), free, obs, o, headings, p,
-                             tracking=prior_heading_rad is not None, n_scans=len(scans))
+                             tracking=prior_heading_rad is not None, n_scans=len(scans),
+                             obs_weights=_wall_weights(beams, rel, p) if p.wall_balance else None)
 
 
 def heading_error(est_rad, true_rad):

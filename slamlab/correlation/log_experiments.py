@@ -25,6 +25,7 @@ from .algorithm import (
     _joined_samples,
     _localise_samples,
     _scan_beams,
+    _wall_weights,
     heading_candidates,
     heading_error,
 )
@@ -264,7 +265,8 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
     row = {}
     for k in joined:
         free, obs, o = _joined_samples(beams[:k], rel[:k], p)
-        loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k)
+        loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k,
+                                obs_weights=_wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None)
         row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity})
     return row
 

@@ -80,7 +80,8 @@ def _stamp(T: np.ndarray, headings: np.ndarray, free: np.ndarray, obs: np.ndarra
             y *= S
             y += x
             y += base[k0:k0 + chunk] - 0.5 * (S + 1)
-            flat[y.astype(np.int64).ravel()] = val
+            # val: a scalar, or one value per point (obstacle weights, ours): the same for every heading
+            flat[y.astype(np.int64).ravel()] = val if np.ndim(val) == 0 else np.broadcast_to(val, y.shape).ravel()
 
 
 def _fast_len(n: int) -> int:

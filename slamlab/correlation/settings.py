@@ -139,6 +139,9 @@ class LocaliseParams(Params):
         A rival lies farther than this from the peak [cells] ...
     rival_heading_rad : float
         ... or its heading differs by more than this [rad], below π.
+    wall_balance : bool
+        Weigh each obstacle mark of the scan(s) by the rarity of its wall direction (ours, issue 25): returns
+        on a corridor's long walls count less, those on door frames and corners more.
     """
 
     delta_alpha_rad: float = param(float(np.radians(1.0)), "004 §7: Δα = 1°")
@@ -155,6 +158,7 @@ class LocaliseParams(Params):
     ambiguity: bool = param(True, "ours: also find the best rival pose (re-scores the headings near the peak)")
     rival_radius_cells: float = param(5.0, "ours: a rival is farther than this from the peak (1 m at 0.2 m)")
     rival_heading_rad: float = param(float(np.radians(30.0)), "ours: ... or its heading is more than 30° off")
+    wall_balance: bool = param(False, "ours (issue 25): a_p × count(wall-direction bin)^(-1/2), mean 1, cap 4")
 
     def __post_init__(self) -> None:
         with contextlib.suppress(TypeError):  # accept numpy dtypes (np.float32) too; check() names a bad one
@@ -180,6 +184,8 @@ class LocaliseParams(Params):
         if not isinstance(self.ambiguity, (bool, np.bool_)):
             raise TypeError(f"`ambiguity` must be a bool; got {type(self.ambiguity).__name__}")
         v.check_positive(self.rival_radius_cells, "rival_radius_cells", allow_zero=True)
+        if not isinstance(self.wall_balance, (bool, np.bool_)):
+            raise TypeError(f"`wall_balance` must be a bool; got {type(self.wall_balance).__name__}")
         h = v.check_positive(self.rival_heading_rad, "rival_heading_rad", allow_zero=True)
         if h >= np.pi:
             raise ValueError(f"`rival_heading_rad` must be < π (else no heading is far enough); got {h}")

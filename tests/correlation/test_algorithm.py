@@ -219,3 +219,32 @@ def test_localise_params_object_equals_overrides():
     a = C.localise(M, s, params=p)
     b = C.localise(M, s, delta_alpha_rad=np.radians(5.0), a_c=0.0)
     assert (a.row, a.col, a.heading_index, a.score) == (b.row, b.col, b.heading_index, b.score)
+
+
+def test_wall_balance_weights_corridor_walls_less():
+    """Issue 25 (ours): returns on a corridor's long walls weigh less than those on its end wall; mean 1, cap 4."""
+    from slamlab.correlation.algorithm import _wall_weights
+    from slamlab.correlation.scoring import _stamp
+
+    p = C.LocaliseParams(wall_balance=True)
+    a = np.radians(np.arange(-90.0, 91.0))  # a corridor 4 cells wide along x, its end wall at x = 30
+    r = np.minimum(np.abs(2.0 / np.where(np.sin(a) == 0, 1e-9, np.sin(a))), 30.0 / np.maximum(np.cos(a), 1e-9))
+    h = np.ones(a.size, bool)
+    w = _wall_weights([(a, r, h)], np.zeros((1, 3)), p)
+    n_obs = w.size // a.size
+    wb = w[::n_obs]
+    end = np.abs(r * np.cos(a) - 30.0) < 1e-6
+    assert w.size == n_obs * a.size
+    assert wb[end].mean() > 2 * wb[~end].mean()
+    assert np.isclose(wb.mean(), 1.0) or wb.max() == 4.0
+    assert wb.max() <= 4.0
+    # per-point values equal to a scalar stamp the same image, bit for bit
+    pts = np.column_stack([r * np.cos(a), r * np.sin(a)])
+    T1 = np.zeros((3, 80, 80), np.float32)
+    T2 = np.zeros((3, 80, 80), np.float32)
+    hd = np.radians([0.0, 10.0, 45.0])
+    _stamp(T1, hd, pts[:0], pts, -1.0, 1.0, 40)
+    _stamp(T2, hd, pts[:0], pts, -1.0, np.ones(a.size), 40)
+    assert np.array_equal(T1, T2)
+    with pytest.raises(TypeError, match="`wall_balance` must be a bool"):
+        C.LocaliseParams(wall_balance=1)
