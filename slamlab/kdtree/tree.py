@@ -21,7 +21,8 @@ leaves equals exact search by construction (and the tests check it against
 Speed: all queries of a batch run in lock-step with numpy arrays -- in each round
 every unfinished query pops its best pending branch, descends to a leaf and
 evaluates that leaf's bucket. There is no Python loop over queries or points;
-the Python loops are over rounds (≤ leaves visited) and tree depth.
+the Python loops are over rounds (≤ leaves visited) and tree depth. Where numba is enabled the same rounds run
+compiled (``_kernels.py``, issue 25): the same neighbours, distances and counts, without the per-round cost.
 :func:`slamlab.kdtree.bbf_trace` (in ``trace.py``) is the plain one-query version with ``heapq`` that
 the notebook prints step by step.
 """
@@ -33,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
+from .._compiled import numba_enabled
 
 __all__ = ["KDTree", "SearchStats", "build_kdtree"]
 
@@ -285,7 +287,13 @@ class KDTree:
         if max_leaves is not None:
             max_leaves = v.check_int(max_leaves, "max_leaves", minimum=1)
         Q = Q.astype(self._P.dtype, copy=False)
-        d2, idx, stats = _lockstep_search(self._t, self._P, Q, k, max_leaves)
+        if numba_enabled():  # the compiled search: the same results as the numpy one (issue 25)
+            from ._kernels import bbf_search
+
+            d2, idx, *counts = bbf_search(self._t, self._P, Q, k, max_leaves)
+            stats = SearchStats(*counts)
+        else:
+            d2, idx, stats = _lockstep_search(self._t, self._P, Q, k, max_leaves)
         self.last_stats = stats
         dist = np.sqrt(np.maximum(d2, 0.0))
         ids = np.where(idx >= 0, self._ids_leaf[np.maximum(idx, 0)], -1)
