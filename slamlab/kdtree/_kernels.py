@@ -137,6 +137,31 @@ def _compact(hb, hs, hn, hsize, tb, ts, tn):
             hb[q, r], hs[q, r], hn[q, r] = tb[r], r, tn[r]
 
 
+def _eval_leaf(P, Q, q, s0, s1, best_d, best_i, acc):
+    """Query ``q`` evaluates the leaf bucket ``P[s0:s1]``: each point goes into the sorted k best after any
+    equal distance (numpy's stable merge)."""
+    k = best_d.shape[1]
+    for i in range(s0, s1):
+        d2 = _sq_dist(P, i, Q, q, acc)
+        pos = k
+        while pos > 0 and best_d[q, pos - 1] > d2:
+            pos -= 1
+        if pos < k:
+            for j in range(k - 1, pos, -1):
+                best_d[q, j], best_i[q, j] = best_d[q, j - 1], best_i[q, j - 1]
+            best_d[q, pos], best_i[q, pos] = d2, i
+
+
+def _grow(hb, hs, hn):
+    """The heaps' arrays with twice the columns (the first ones copied)."""
+    M, cap = hb.shape
+    nb, ns, nn = np.empty((M, 2 * cap)), np.empty((M, 2 * cap), np.int64), np.empty((M, 2 * cap), np.int64)
+    for q in range(M):
+        for j in range(cap):
+            nb[q, j], ns[q, j], nn[q, j] = hb[q, j], hs[q, j], hn[q, j]
+    return nb, ns, nn
+
+
 def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_leaves, acc):
     """The rounds of ``tree._lockstep_search``, one query after the other inside a round (see the module doc).
 
@@ -172,15 +197,7 @@ def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_l
             # 1. on a leaf: evaluate its bucket, insert each point after any equal distance
             c = cur[q]
             if left[c] < 0:
-                for i in range(start[c], stop[c]):
-                    d2 = _sq_dist(P, i, Q, q, acc)
-                    pos = k
-                    while pos > 0 and best_d[q, pos - 1] > d2:
-                        pos -= 1
-                    if pos < k:
-                        for j in range(k - 1, pos, -1):
-                            best_d[q, j], best_i[q, j] = best_d[q, j - 1], best_i[q, j - 1]
-                        best_d[q, pos], best_i[q, pos] = d2, i
+                _eval_leaf(P, Q, q, start[c], stop[c], best_d, best_i, acc)
                 leaves_v[q] += 1
                 dist_v[q] += stop[c] - start[c]
                 kth = best_d[q, k - 1]
@@ -208,10 +225,7 @@ def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_l
                         s = w0
                         opened = True
                     if hsize[q] == hb.shape[1]:  # grow every row's heap (numpy doubles its table)
-                        cap = 2 * hb.shape[1]
-                        nb, ns, nn = np.empty((M, cap)), np.empty((M, cap), np.int64), np.empty((M, cap), np.int64)
-                        nb[:, :hb.shape[1]], ns[:, :hb.shape[1]], nn[:, :hb.shape[1]] = hb, hs, hn
-                        hb, hs, hn = nb, ns, nn
+                        hb, hs, hn = _grow(hb, hs, hn)
                     _heap_push(hb, hs, hn, q, hsize[q], fb, s, far)
                     hsize[q] += 1
                     free[q] = -1
@@ -243,4 +257,6 @@ _key_less = register_jitable(_key_less)
 _heap_push = register_jitable(_heap_push)
 _heap_pop = register_jitable(_heap_pop)
 _compact = register_jitable(_compact)
+_eval_leaf = register_jitable(_eval_leaf)
+_grow = register_jitable(_grow)
 _bbf_lockstep = kernel(_bbf_lockstep)
