@@ -31,7 +31,7 @@ from .._compiled import kernel
 __all__ = ["bbf_search"]
 
 
-def bbf_search(t, P, Q, k, max_leaves):
+def bbf_search(t, P, Q, k, max_leaves, bound="max"):
     """All queries' BBF, compiled; the same results as ``tree._lockstep_search`` (000 §1.4.3).
 
     Parameters
@@ -46,6 +46,9 @@ def bbf_search(t, P, Q, k, max_leaves):
         Neighbours per query.
     max_leaves : int or None
         Leaf budget per query; None = exact search.
+    bound : {'max', 'incremental', 'sum'}
+        Lower bound of a pending branch (``tree.BBF_BOUNDS``); ``t`` holds ``cell_lo``/``cell_hi`` for
+        ``"incremental"``.
 
     Returns
     -------
@@ -57,9 +60,11 @@ def bbf_search(t, P, Q, k, max_leaves):
         Internal nodes passed, leaves evaluated, distances computed per query.
     """
     lanes = np.zeros(16 // P.dtype.itemsize, dtype=P.dtype)  # one 128-bit register of accumulators
+    mode = ("max", "incremental", "sum").index(bound)
+    lo, hi = (t["cell_lo"], t["cell_hi"]) if mode == 1 else (t["split_val"], t["split_val"])
     return _bbf_lockstep(t["split_dim"], t["split_val"], t["left"], t["right"], t["start"], t["stop"],
                          np.ascontiguousarray(P), np.ascontiguousarray(Q), int(k),
-                         0 if max_leaves is None else int(max_leaves), lanes)
+                         0 if max_leaves is None else int(max_leaves), lanes, mode, lo, hi)
 
 
 def _sq_dist(P, i, Q, q, acc):
@@ -162,13 +167,15 @@ def _grow(hb, hs, hn):
     return nb, ns, nn
 
 
-def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_leaves, acc):
+def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_leaves, acc, mode, lo, hi):
     """The rounds of ``tree._lockstep_search``, one query after the other inside a round (see the module doc).
 
     In each round every unfinished query: evaluates the leaf it stands on (and stops at ``max_leaves``);
     without a node, pops its best pending branch, or stops when that bound is no better than its k-th
     distance; on an inner node, descends one level and pushes the far child with the bound
-    max(parent bound, (q[d] - split)²) (000 §1.4.3, our bound) when it beats the k-th distance."""
+    max(parent bound, (q[d] - split)²) (000 §1.4.3, our bound; ``mode`` 0), Arya & Mount's incremental
+    distance to the far cell (1: the parent bound with coordinate d's offset from ``[lo, hi]`` replaced) or
+    FLANN's sum (2), when it beats the k-th distance."""
     M = Q.shape[0]
     best_d = np.full((M, k), np.inf)
     best_i = np.full((M, k), -1, dtype=np.int64)
@@ -216,7 +223,14 @@ def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_l
             if left[c] >= 0:
                 diff = Q[q, split_dim[c]] - split_val[c]  # float64, as numpy promotes it
                 near, far = (left[c], right[c]) if diff <= 0 else (right[c], left[c])
-                fb = max(cur_b[q], diff * diff)
+                if mode == 0:
+                    fb = max(cur_b[q], diff * diff)
+                elif mode == 2:
+                    fb = cur_b[q] + diff * diff
+                else:
+                    qd = np.float64(Q[q, split_dim[c]])
+                    off = max(max(lo[c] - qd, qd - hi[c]), 0.0)
+                    fb = max(cur_b[q], cur_b[q] - off * off + diff * diff)
                 nodes_v[q] += 1
                 cur[q] = near
                 if fb < kth:

@@ -36,7 +36,14 @@ import numpy as np
 from .. import _validate as v
 from .._compiled import numba_enabled
 
-__all__ = ["KDTree", "SearchStats", "build_kdtree"]
+__all__ = ["BBF_BOUNDS", "KDTree", "SearchStats", "build_kdtree"]
+
+#: lower bound of a pending branch (issue 25): ``"max"`` max(parent bound, (q[d] - split)²), ours, the default;
+#: ``"incremental"`` Arya & Mount's incremental distance from the query to the branch's cell (ANN's priority
+#: search): the parent's bound with coordinate d's offset replaced, a tighter bound that keeps exact search exact;
+#: ``"sum"`` parent bound + (q[d] - split)², FLANN's randomised kd-tree (not a lower bound when a coordinate is
+#: split twice on the path: unlimited search is then not guaranteed exact)
+BBF_BOUNDS = ("max", "incremental", "sum")
 
 
 @dataclass(frozen=True)
@@ -257,7 +264,7 @@ class KDTree:
     def __repr__(self) -> str:
         return f"KDTree(n={self.n}, k={self.dim}, leaf_size={self.leaf_size}, height={self.height})"
 
-    def query(self, Q, k: int = 2, *, max_leaves: int | None = None):
+    def query(self, Q, k: int = 2, *, max_leaves: int | None = None, bound: str = "max"):
         """k nearest neighbours of every row of ``Q``: exact, or BBF after ``max_leaves`` leaves (000 §1.4.3).
 
         Parameters
@@ -269,6 +276,8 @@ class KDTree:
         max_leaves : int or None
             None = exact search; otherwise stop each query after that many leaves
             (000: about 200).
+        bound : {'max', 'incremental', 'sum'}
+            Lower bound that orders the pending branches (:data:`BBF_BOUNDS`; default ``"max"``).
 
         Returns
         -------
@@ -286,20 +295,73 @@ class KDTree:
         k = v.check_int(k, "k", minimum=1)
         if max_leaves is not None:
             max_leaves = v.check_int(max_leaves, "max_leaves", minimum=1)
+        if bound not in BBF_BOUNDS:
+            raise ValueError(f"`bound` must be one of {BBF_BOUNDS}; got {bound!r}")
+        if bound == "incremental" and "cell_lo" not in self._t:
+            self._t["cell_lo"], self._t["cell_hi"] = _cell_bounds(self._t)
         Q = Q.astype(self._P.dtype, copy=False)
         if numba_enabled():  # the compiled search: the same results as the numpy one (issue 25)
             from ._kernels import bbf_search
 
-            d2, idx, *counts = bbf_search(self._t, self._P, Q, k, max_leaves)
+            d2, idx, *counts = bbf_search(self._t, self._P, Q, k, max_leaves, bound)
             stats = SearchStats(*counts)
         else:
-            d2, idx, stats = _lockstep_search(self._t, self._P, Q, k, max_leaves)
+            d2, idx, stats = _lockstep_search(self._t, self._P, Q, k, max_leaves, bound)
         self.last_stats = stats
         dist = np.sqrt(np.maximum(d2, 0.0))
         ids = np.where(idx >= 0, self._ids_leaf[np.maximum(idx, 0)], -1)
         if single:
             return dist[0], ids[0]
         return dist, ids
+
+
+def _cell_bounds(t):
+    """Per inner node, its cell's interval ``[lo, hi]`` along its own split coordinate (±inf where no ancestor
+    splits on it): the nearest ancestor on each side that splits on the same coordinate bounds it.
+
+    Parameters
+    ----------
+    t : dict of arrays
+        The node arrays of :func:`build_kdtree`.
+
+    Returns
+    -------
+    lo, hi : (n_nodes,) float64
+        The interval per node (leaves: ±inf).
+    """
+    left, right, dim, val = t["left"], t["right"], t["split_dim"], t["split_val"]
+    n = left.size
+    inner = np.flatnonzero(left >= 0)
+    parent = np.full(n, -1, dtype=np.int64)
+    parent[left[inner]] = inner
+    parent[right[inner]] = inner
+    is_right = np.zeros(n, dtype=bool)
+    is_right[right[inner]] = True
+    lo, hi = np.full(n, -np.inf), np.full(n, np.inf)
+    cur = np.arange(n)
+    for _ in range(int(t["depth"].max())):  # walk every node's path up to the root
+        up = np.flatnonzero(parent[cur] >= 0)
+        p = parent[cur[up]]
+        same = dim[p] == dim[up]
+        r = up[same & is_right[cur[up]]]  # a right child holds values >= split: a lower end
+        lo[r] = np.maximum(lo[r], val[parent[cur[r]]])
+        lf = up[same & ~is_right[cur[up]]]
+        hi[lf] = np.minimum(hi[lf], val[parent[cur[lf]]])
+        cur[up] = p
+    return lo, hi
+
+
+def _far_bound(bound, cur_b, diff, qd, lo, hi):
+    """Lower bound of the far child (see :data:`BBF_BOUNDS`) from the node's bound ``cur_b``, the query's
+    signed distance ``diff`` to the splitting plane, its coordinate ``qd`` and the cell's interval ``[lo, hi]``
+    along the split coordinate."""
+    d2 = diff.astype(np.float64) ** 2
+    if bound == "max":
+        return np.maximum(cur_b, d2)
+    if bound == "sum":
+        return cur_b + d2
+    off = np.maximum(np.maximum(lo - qd, qd - hi), 0.0)  # the query's offset from the node's cell along d
+    return np.maximum(cur_b, cur_b - off * off + d2)
 
 
 def _leaf_distances(P, Qa, s0, s1, lane):
@@ -379,7 +441,7 @@ def _compact_pending(pb, pn, free, width):
     return width
 
 
-def _lockstep_search(t, P, Q, k, max_leaves):
+def _lockstep_search(t, P, Q, k, max_leaves, bound="max"):
     """All queries' BBF in lock-step, one step per query per iteration (numpy over the queries).
 
     Each iteration, every unfinished query does one of: evaluate the leaf it stands on,
@@ -450,7 +512,11 @@ def _lockstep_search(t, P, Q, k, max_leaves):
             go_left = diff <= 0
             near = np.where(go_left, left[cn], right[cn])
             far = np.where(go_left, right[cn], left[cn])
-            fb = np.maximum(cur_b[a], diff.astype(np.float64) ** 2)
+            if bound == "incremental":
+                fb = _far_bound(bound, cur_b[a], diff, Q[a, split_dim[cn]].astype(np.float64),
+                                t["cell_lo"][cn], t["cell_hi"][cn])
+            else:
+                fb = _far_bound(bound, cur_b[a], diff, None, None, None)
             nodes_v[a] += 1
             cur[a] = near
             keep = fb < best_d[a, k - 1]

@@ -84,3 +84,39 @@ def test_query_takes_the_kernel_unless_disabled(monkeypatch):
     np.testing.assert_array_equal(i_c, i_np)
     np.testing.assert_array_equal(leaves_c, tree.last_stats.leaves_visited)
     assert i_c.min() >= 100
+
+
+@pytest.mark.parametrize("bound", ["incremental", "sum"])
+def test_kernel_equals_numpy_with_the_other_bounds(bound):
+    rng = np.random.default_rng(6)
+    X, Q = _clustered(rng, 2000, 12, np.float32), _clustered(rng, 150, 12, np.float32)
+    tree = KDTree(X, leaf_size=2)
+    tree.query(Q[:1], bound=bound)  # computes the cells' intervals
+    for m in (5, 60, None):
+        d_np, i_np, st = tree_mod._lockstep_search(tree._t, tree._P, Q, 2, m, bound)
+        d_c, i_c, _, leaves, _ = bbf_search(tree._t, tree._P, Q, 2, m, bound)
+        np.testing.assert_array_equal(d_c, d_np)
+        np.testing.assert_array_equal(i_c, i_np)
+        np.testing.assert_array_equal(leaves, st.leaves_visited)
+
+
+def test_incremental_bound_is_exact_unlimited_and_recalls_at_least_the_default():
+    rng = np.random.default_rng(7)
+    X, Q = _clustered(rng, 6000, 16, np.float32), _clustered(rng, 400, 16, np.float32)
+    tree = KDTree(X)
+    _, i_ref = cKDTree(X.astype(np.float64)).query(Q.astype(np.float64), k=2)
+    _, i = tree.query(Q, k=2, bound="incremental")  # a valid lower bound: unlimited search stays exact
+    np.testing.assert_array_equal(i, i_ref)
+    leaves_exact = tree.last_stats.mean_leaves
+    tree.query(Q, k=2)
+    assert leaves_exact <= tree.last_stats.mean_leaves  # a tighter bound prunes more
+    for m in (20, 50, 100):
+        rec = {b: np.mean(tree.query(Q, k=2, max_leaves=m, bound=b)[1][:, 0] == i_ref[:, 0])
+               for b in ("max", "incremental")}
+        assert rec["incremental"] >= rec["max"], (m, rec)
+
+
+def test_bound_is_checked():
+    tree = KDTree(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="`bound` must be one of"):
+        tree.query(np.zeros(2), bound="mean")
