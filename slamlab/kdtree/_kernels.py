@@ -70,7 +70,24 @@ def bbf_search(t, P, Q, k, max_leaves, bound="max"):
 def _sq_dist(P, i, Q, q, acc):
     """Squared distance from point ``P[i]`` to query ``Q[q]`` summed as numpy's einsum does (see module doc).
 
-    ``acc`` is a scratch array of L = 16 / itemsize lanes in the points' dtype."""
+    Parameters
+    ----------
+    P : (N, dim) float array
+        Points in leaf order.
+    i : int
+        Row of ``P``.
+    Q : (M, dim) array of ``P``'s dtype
+        Queries.
+    q : int
+        Row of ``Q``.
+    acc : (L,) array of ``P``'s dtype
+        Scratch accumulators, L = 16 / itemsize lanes (one 128-bit register).
+
+    Returns
+    -------
+    float
+        The squared distance, summed in ``P``'s dtype, as float64.
+    """
     L = acc.size
     dim = P.shape[1]
     for l in range(L):
@@ -96,12 +113,41 @@ def _sq_dist(P, i, Q, q, acc):
 
 
 def _key_less(b1, s1, b2, s2):
-    """Heap order: smaller bound first, ties to the lower slot (numpy's argmin over the slots)."""
+    """Heap order: smaller bound first, ties to the lower slot (numpy's argmin over the slots).
+
+    Parameters
+    ----------
+    b1, s1 : float, int
+        Bound and slot of the first entry.
+    b2, s2 : float, int
+        Bound and slot of the second entry.
+
+    Returns
+    -------
+    bool
+        True when the first entry is popped before the second.
+    """
     return b1 < b2 or (b1 == b2 and s1 < s2)
 
 
 def _heap_push(hb, hs, hn, q, n, b, s, node):
-    """Push (bound ``b``, slot ``s``, ``node``) onto query ``q``'s heap of ``n`` entries (sift up)."""
+    """Push (bound ``b``, slot ``s``, ``node``) onto query ``q``'s heap of ``n`` entries (sift up).
+
+    Parameters
+    ----------
+    hb, hs, hn : (M, C) arrays
+        Bounds, slots and nodes of every query's heap (row ``q``, first ``n`` entries), changed in place.
+    q : int
+        The query.
+    n : int
+        Entries in its heap before the push (< C).
+    b : float
+        Bound of the new entry.
+    s : int
+        Its slot (numpy's pending-table column).
+    node : int
+        The branch's node.
+    """
     i = n
     while i > 0:
         p = (i - 1) // 2
@@ -113,7 +159,17 @@ def _heap_push(hb, hs, hn, q, n, b, s, node):
 
 
 def _heap_pop(hb, hs, hn, q, n):
-    """Remove the root of query ``q``'s heap of ``n`` entries (sift the last entry down)."""
+    """Remove the root of query ``q``'s heap of ``n`` entries (sift the last entry down).
+
+    Parameters
+    ----------
+    hb, hs, hn : (M, C) arrays
+        Bounds, slots and nodes of every query's heap, changed in place.
+    q : int
+        The query.
+    n : int
+        Entries in its heap before the pop (>= 1).
+    """
     n -= 1
     b, s, node = hb[q, n], hs[q, n], hn[q, n]
     i = 0
@@ -132,7 +188,17 @@ def _heap_pop(hb, hs, hn, q, n):
 
 def _compact(hb, hs, hn, hsize, tb, ts, tn):
     """numpy's ``_compact_pending``: every query's live entries sorted by (bound, slot), slots renumbered
-    0, 1, ... (a sorted array is a heap, so the heaps stay valid)."""
+    0, 1, ... (a sorted array is a heap, so the heaps stay valid).
+
+    Parameters
+    ----------
+    hb, hs, hn : (M, C) arrays
+        Bounds, slots and nodes of every query's heap, changed in place.
+    hsize : (M,) int array
+        Entries per heap.
+    tb, ts, tn : (>= max(hsize),) arrays
+        Scratch rows.
+    """
     for q in range(hsize.size):
         n = hsize[q]
         for r in range(n):  # heap sort into the scratch row
@@ -144,7 +210,23 @@ def _compact(hb, hs, hn, hsize, tb, ts, tn):
 
 def _eval_leaf(P, Q, q, s0, s1, best_d, best_i, acc):
     """Query ``q`` evaluates the leaf bucket ``P[s0:s1]``: each point goes into the sorted k best after any
-    equal distance (numpy's stable merge)."""
+    equal distance (numpy's stable merge).
+
+    Parameters
+    ----------
+    P : (N, dim) float array
+        Points in leaf order.
+    Q : (M, dim) array of ``P``'s dtype
+        Queries.
+    q : int
+        The query.
+    s0, s1 : int
+        The leaf's bucket ``P[s0:s1]``.
+    best_d, best_i : (M, k) arrays
+        Sorted squared distances and leaf-order indices of every query's k best, changed in place.
+    acc : (L,) array of ``P``'s dtype
+        Scratch accumulators for :func:`_sq_dist`.
+    """
     k = best_d.shape[1]
     for i in range(s0, s1):
         d2 = _sq_dist(P, i, Q, q, acc)
@@ -158,7 +240,18 @@ def _eval_leaf(P, Q, q, s0, s1, best_d, best_i, acc):
 
 
 def _grow(hb, hs, hn):
-    """The heaps' arrays with twice the columns (the first ones copied)."""
+    """The heaps' arrays with twice the columns (the first ones copied).
+
+    Parameters
+    ----------
+    hb, hs, hn : (M, C) arrays
+        Bounds, slots and nodes of every query's heap.
+
+    Returns
+    -------
+    hb, hs, hn : (M, 2 C) arrays
+        The same heaps with room for C more entries each.
+    """
     M, cap = hb.shape
     nb, ns, nn = np.empty((M, 2 * cap)), np.empty((M, 2 * cap), np.int64), np.empty((M, 2 * cap), np.int64)
     for q in range(M):
@@ -175,7 +268,32 @@ def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_l
     distance; on an inner node, descends one level and pushes the far child with the bound
     max(parent bound, (q[d] - split)²) (000 §1.4.3, our bound; ``mode`` 0), Arya & Mount's incremental
     distance to the far cell (1: the parent bound with coordinate d's offset from ``[lo, hi]`` replaced) or
-    FLANN's sum (2), when it beats the k-th distance."""
+    FLANN's sum (2), when it beats the k-th distance.
+
+    Parameters
+    ----------
+    split_dim, split_val, left, right, start, stop : (n_nodes,) arrays
+        The tree's node arrays (:func:`slamlab.kdtree.build_kdtree`).
+    P : (N, dim) float array
+        Points in leaf order.
+    Q : (M, dim) array of ``P``'s dtype
+        Queries.
+    k : int
+        Neighbours per query.
+    max_leaves : int
+        Leaf budget per query; 0 = none (exact search).
+    acc : (L,) array of ``P``'s dtype
+        Scratch accumulators for :func:`_sq_dist`.
+    mode : int
+        0 max bound, 1 incremental, 2 sum.
+    lo, hi : (n_nodes,) float64
+        Each node's cell interval along its split coordinate (used by mode 1).
+
+    Returns
+    -------
+    best_d, best_i, nodes_v, leaves_v, dist_v
+        As :func:`bbf_search`.
+    """
     M = Q.shape[0]
     best_d = np.full((M, k), np.inf)
     best_i = np.full((M, k), -1, dtype=np.int64)

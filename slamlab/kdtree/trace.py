@@ -7,7 +7,8 @@ import heapq
 import numpy as np
 
 from .. import _validate as v
-from .tree import BBF_BOUNDS, KDTree, _cell_bounds
+from ._bounds import BBF_BOUNDS, _cell_bounds
+from .tree import KDTree
 
 __all__ = ["bbf_trace"]
 

@@ -35,15 +35,9 @@ import numpy as np
 
 from .. import _validate as v
 from .._compiled import numba_enabled
+from ._bounds import BBF_BOUNDS, _cell_bounds, _far_bound
 
 __all__ = ["BBF_BOUNDS", "KDTree", "SearchStats", "build_kdtree"]
-
-#: lower bound of a pending branch (issue 25): ``"max"`` max(parent bound, (q[d] - split)²), ours, the default;
-#: ``"incremental"`` Arya & Mount's incremental distance from the query to the branch's cell (ANN's priority
-#: search): the parent's bound with coordinate d's offset replaced, a tighter bound that keeps exact search exact;
-#: ``"sum"`` parent bound + (q[d] - split)², FLANN's randomised kd-tree (not a lower bound when a coordinate is
-#: split twice on the path: unlimited search is then not guaranteed exact)
-BBF_BOUNDS = ("max", "incremental", "sum")
 
 
 @dataclass(frozen=True)
@@ -313,55 +307,6 @@ class KDTree:
         if single:
             return dist[0], ids[0]
         return dist, ids
-
-
-def _cell_bounds(t):
-    """Per inner node, its cell's interval ``[lo, hi]`` along its own split coordinate (±inf where no ancestor
-    splits on it): the nearest ancestor on each side that splits on the same coordinate bounds it.
-
-    Parameters
-    ----------
-    t : dict of arrays
-        The node arrays of :func:`build_kdtree`.
-
-    Returns
-    -------
-    lo, hi : (n_nodes,) float64
-        The interval per node (leaves: ±inf).
-    """
-    left, right, dim, val = t["left"], t["right"], t["split_dim"], t["split_val"]
-    n = left.size
-    inner = np.flatnonzero(left >= 0)
-    parent = np.full(n, -1, dtype=np.int64)
-    parent[left[inner]] = inner
-    parent[right[inner]] = inner
-    is_right = np.zeros(n, dtype=bool)
-    is_right[right[inner]] = True
-    lo, hi = np.full(n, -np.inf), np.full(n, np.inf)
-    cur = np.arange(n)
-    for _ in range(int(t["depth"].max())):  # walk every node's path up to the root
-        up = np.flatnonzero(parent[cur] >= 0)
-        p = parent[cur[up]]
-        same = dim[p] == dim[up]
-        r = up[same & is_right[cur[up]]]  # a right child holds values >= split: a lower end
-        lo[r] = np.maximum(lo[r], val[parent[cur[r]]])
-        lf = up[same & ~is_right[cur[up]]]
-        hi[lf] = np.minimum(hi[lf], val[parent[cur[lf]]])
-        cur[up] = p
-    return lo, hi
-
-
-def _far_bound(bound, cur_b, diff, qd, lo, hi):
-    """Lower bound of the far child (see :data:`BBF_BOUNDS`) from the node's bound ``cur_b``, the query's
-    signed distance ``diff`` to the splitting plane, its coordinate ``qd`` and the cell's interval ``[lo, hi]``
-    along the split coordinate."""
-    d2 = diff.astype(np.float64) ** 2
-    if bound == "max":
-        return np.maximum(cur_b, d2)
-    if bound == "sum":
-        return cur_b + d2
-    off = np.maximum(np.maximum(lo - qd, qd - hi), 0.0)  # the query's offset from the node's cell along d
-    return np.maximum(cur_b, cur_b - off * off + d2)
 
 
 def _leaf_distances(P, Qa, s0, s1, lane):
