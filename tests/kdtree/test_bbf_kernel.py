@@ -27,8 +27,8 @@ def _assert_same(tree, Q, k, max_leaves):
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
-@pytest.mark.parametrize(("kind", "n", "dim", "leaf_size"), [("random", 1500, 5, 1), ("random", 1200, 64, 8),
-                                                            ("clustered", 2000, 16, 3), ("ties", 800, 3, 1)])
+@pytest.mark.parametrize(("kind", "n", "dim", "leaf_size"), [("random", 1000, 5, 1), ("random", 600, 64, 8),
+                                                            ("clustered", 1500, 16, 3), ("ties", 800, 3, 1)])
 def test_kernel_equals_numpy_lockstep(dtype, kind, n, dim, leaf_size):
     rng = np.random.default_rng(11)
     if kind == "clustered":
