@@ -7,12 +7,13 @@ import heapq
 import numpy as np
 
 from .. import _validate as v
+from ._bounds import BBF_BOUNDS, _cell_bounds
 from .tree import KDTree
 
 __all__ = ["bbf_trace"]
 
 
-def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None):
+def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None, bound: str = "max"):
     """One query, step by step, with a ``heapq`` priority queue (000 §1.4.3) -- the teaching version.
 
     Returns the neighbours and a list of events ``(kind, node, bound)`` where kind
@@ -28,6 +29,8 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None):
         Neighbours wanted.
     max_leaves : int, optional
         BBF leaf budget; None searches exactly.
+    bound : {'max', 'incremental', 'sum'}
+        Lower bound of a pending branch (:data:`slamlab.kdtree.tree.BBF_BOUNDS`).
 
     Returns
     -------
@@ -51,7 +54,12 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None):
     k = v.check_int(k, "k", minimum=1)
     if max_leaves is not None:
         max_leaves = v.check_int(max_leaves, "max_leaves", minimum=1)
+    if bound not in BBF_BOUNDS:
+        raise ValueError(f"`bound` must be one of {BBF_BOUNDS}; got {bound!r}")
+    bound_rule = bound  # `bound` below is the popped branch's bound
     t = tree.nodes
+    if bound == "incremental" and "cell_lo" not in t:
+        t["cell_lo"], t["cell_hi"] = _cell_bounds(t)
     best: list[tuple[float, int]] = []  # (d2, leaf-order index), sorted
     heap = [(0.0, 0)]
     events = []
@@ -66,7 +74,13 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None):
             d, s = t["split_dim"][node], t["split_val"][node]
             diff = q[d] - s
             near, far = (t["left"][node], t["right"][node]) if diff <= 0 else (t["right"][node], t["left"][node])
-            fb = max(bound, diff * diff)
+            if bound_rule == "max":  # our bound: the farthest single plane so far
+                fb = max(bound, diff * diff)
+            elif bound_rule == "sum":  # FLANN's: the planes' squared distances added up
+                fb = bound + diff * diff
+            else:  # Arya & Mount: coordinate d's old offset from the cell replaced by the plane's distance
+                off = max(t["cell_lo"][node] - q[d], q[d] - t["cell_hi"][node], 0.0)
+                fb = max(bound, bound - off * off + diff * diff)
             kth = best[k - 1][0] if len(best) >= k else np.inf
             if fb < kth:
                 heapq.heappush(heap, (fb, int(far)))

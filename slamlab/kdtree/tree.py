@@ -21,7 +21,8 @@ leaves equals exact search by construction (and the tests check it against
 Speed: all queries of a batch run in lock-step with numpy arrays -- in each round
 every unfinished query pops its best pending branch, descends to a leaf and
 evaluates that leaf's bucket. There is no Python loop over queries or points;
-the Python loops are over rounds (≤ leaves visited) and tree depth.
+the Python loops are over rounds (≤ leaves visited) and tree depth. Where numba is enabled the same rounds run
+compiled (``_kernels.py``, issue 25): the same neighbours, distances and counts, without the per-round cost.
 :func:`slamlab.kdtree.bbf_trace` (in ``trace.py``) is the plain one-query version with ``heapq`` that
 the notebook prints step by step.
 """
@@ -33,8 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as v
+from .._compiled import numba_enabled
+from ._bounds import BBF_BOUNDS, _cell_bounds, _far_bound
 
-__all__ = ["KDTree", "SearchStats", "build_kdtree"]
+__all__ = ["BBF_BOUNDS", "KDTree", "SearchStats", "build_kdtree"]
 
 
 @dataclass(frozen=True)
@@ -255,7 +258,7 @@ class KDTree:
     def __repr__(self) -> str:
         return f"KDTree(n={self.n}, k={self.dim}, leaf_size={self.leaf_size}, height={self.height})"
 
-    def query(self, Q, k: int = 2, *, max_leaves: int | None = None):
+    def query(self, Q, k: int = 2, *, max_leaves: int | None = None, bound: str = "max"):
         """k nearest neighbours of every row of ``Q``: exact, or BBF after ``max_leaves`` leaves (000 §1.4.3).
 
         Parameters
@@ -267,6 +270,8 @@ class KDTree:
         max_leaves : int or None
             None = exact search; otherwise stop each query after that many leaves
             (000: about 200).
+        bound : {'max', 'incremental', 'sum'}
+            Lower bound that orders the pending branches (:data:`BBF_BOUNDS`; default ``"max"``).
 
         Returns
         -------
@@ -284,8 +289,18 @@ class KDTree:
         k = v.check_int(k, "k", minimum=1)
         if max_leaves is not None:
             max_leaves = v.check_int(max_leaves, "max_leaves", minimum=1)
+        if bound not in BBF_BOUNDS:
+            raise ValueError(f"`bound` must be one of {BBF_BOUNDS}; got {bound!r}")
+        if bound == "incremental" and "cell_lo" not in self._t:
+            self._t["cell_lo"], self._t["cell_hi"] = _cell_bounds(self._t)
         Q = Q.astype(self._P.dtype, copy=False)
-        d2, idx, stats = _lockstep_search(self._t, self._P, Q, k, max_leaves)
+        if numba_enabled():  # the compiled search: the same results as the numpy one (issue 25)
+            from ._kernels import bbf_search
+
+            d2, idx, *counts = bbf_search(self._t, self._P, Q, k, max_leaves, bound)
+            stats = SearchStats(*counts)
+        else:
+            d2, idx, stats = _lockstep_search(self._t, self._P, Q, k, max_leaves, bound)
         self.last_stats = stats
         dist = np.sqrt(np.maximum(d2, 0.0))
         ids = np.where(idx >= 0, self._ids_leaf[np.maximum(idx, 0)], -1)
@@ -371,7 +386,7 @@ def _compact_pending(pb, pn, free, width):
     return width
 
 
-def _lockstep_search(t, P, Q, k, max_leaves):
+def _lockstep_search(t, P, Q, k, max_leaves, bound="max"):
     """All queries' BBF in lock-step, one step per query per iteration (numpy over the queries).
 
     Each iteration, every unfinished query does one of: evaluate the leaf it stands on,
@@ -442,7 +457,11 @@ def _lockstep_search(t, P, Q, k, max_leaves):
             go_left = diff <= 0
             near = np.where(go_left, left[cn], right[cn])
             far = np.where(go_left, right[cn], left[cn])
-            fb = np.maximum(cur_b[a], diff.astype(np.float64) ** 2)
+            if bound == "incremental":
+                fb = _far_bound(bound, cur_b[a], diff, Q[a, split_dim[cn]].astype(np.float64),
+                                t["cell_lo"][cn], t["cell_hi"][cn])
+            else:
+                fb = _far_bound(bound, cur_b[a], diff, None, None, None)
             nodes_v[a] += 1
             cur[a] = near
             keep = fb < best_d[a, k - 1]
