@@ -8,6 +8,11 @@ processes side by side to use both cores.
 
     python benchmarks/ablate_stereo_long.py 'before={"detector": "orb", "subpixel_stereo": false}' \\
         'after={"detector": "orb"}'
+    python benchmarks/ablate_stereo_long.py --heading-frames 5 'orb={"detector": "orb"}' \\
+        'orb, constant velocity={"detector": "orb", "degenerate_pose": "constant_velocity"}'
+
+``--heading-frames DEG`` prints, per variant, the frames whose heading error exceeds DEG with what the
+pipeline did on them (:func:`slamlab.stereo.heading_frames`).
 """
 
 from __future__ import annotations
@@ -48,6 +53,8 @@ def main(argv=None):
     ap.add_argument("variants", nargs="+", help="label=JSON overrides of StereoParams")
     ap.add_argument("--frames", type=int, default=None, help="first frames only (default: all 401)")
     ap.add_argument("--cache", type=Path, default=Path("/tmp/slamlab-stereo-long"))
+    ap.add_argument("--heading-frames", type=float, default=None, metavar="DEG",
+                    help="list the frames whose heading error exceeds DEG and what the pipeline did on them")
     args = ap.parse_args(argv)
     path, sim, L, R, r_slam = load(args.frames, args.cache)
     T0_inv = se3_inverse(se3_from_planar(*path[0]))
@@ -81,6 +88,8 @@ def main(argv=None):
             + f"; landmarks searched {c['n_searched'][1:].mean():.0f} per frame (mean), "
               f"{int(c['gate_fallback'].sum())} whole-map fallbacks, {int(c['window_fallback'].sum())} window "
               f"fallbacks, {c['n_compared'][1:].mean() / 1e6:.2f} M descriptor distances per frame (mean)", flush=True)
+        if args.heading_frames is not None:
+            print(sl.stereo.heading_frames(slam, truth, args.heading_frames), flush=True)
 
 
 if __name__ == "__main__":
