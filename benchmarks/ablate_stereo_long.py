@@ -11,6 +11,8 @@ processes side by side to use both cores.
     python benchmarks/ablate_stereo_long.py --heading-frames 5 'orb={"detector": "orb"}' \\
         'orb, constant velocity={"detector": "orb", "degenerate_pose": "constant_velocity"}'
 
+The key ``"numba": false`` in a variant's JSON runs it without the compiled kernels (the numpy path), e.g.
+``'numpy={"detector": "orb", "numba": false}' 'compiled={"detector": "orb"}'``.
 ``--heading-frames DEG`` prints, per variant, the frames whose heading error exceeds DEG with what the
 pipeline did on them (:func:`slamlab.stereo.heading_frames`).
 """
@@ -61,9 +63,13 @@ def main(argv=None):
     truth = np.array([planar_from_se3(T0_inv @ se3_from_planar(*p)) for p in path])
     truth[:, 2] = path[:, 2] - path[0, 2]
     length_m = float(np.sum(np.hypot(*np.diff(path[:, :2], axis=0).T)))
+    no_numba = os.environ.get("SLAMLAB_NO_NUMBA", "")
     for arg in args.variants:
         label, _, js = arg.partition("=")
-        p = StereoParams(**(json.loads(js) if js else {}))
+        over = json.loads(js) if js else {}
+        # "numba": false runs this variant on the numpy path (SLAMLAB_NO_NUMBA=1), for a row beside the compiled one
+        os.environ["SLAMLAB_NO_NUMBA"] = no_numba if over.pop("numba", True) else "1"
+        p = StereoParams(**over)
         slam = StereoSLAM(sim.rig, sim.T_body_left, params=p, rng=np.random.default_rng(r_slam))
         load0 = os.getloadavg()[0]
         wall = cpu = 0.0
