@@ -8,6 +8,13 @@ processes side by side to use both cores.
 
     python benchmarks/ablate_stereo_long.py 'before={"detector": "orb", "subpixel_stereo": false}' \\
         'after={"detector": "orb"}'
+    python benchmarks/ablate_stereo_long.py --heading-frames 5 'orb={"detector": "orb"}' \\
+        'orb, constant velocity={"detector": "orb", "degenerate_pose": "constant_velocity"}'
+
+The key ``"numba": false`` in a variant's JSON runs it without the compiled kernels (the numpy path), e.g.
+``'numpy={"detector": "orb", "numba": false}' 'compiled={"detector": "orb"}'``.
+``--heading-frames DEG`` prints, per variant, the frames whose heading error exceeds DEG with what the
+pipeline did on them (:func:`slamlab.stereo.heading_frames`).
 """
 
 from __future__ import annotations
@@ -48,15 +55,21 @@ def main(argv=None):
     ap.add_argument("variants", nargs="+", help="label=JSON overrides of StereoParams")
     ap.add_argument("--frames", type=int, default=None, help="first frames only (default: all 401)")
     ap.add_argument("--cache", type=Path, default=Path("/tmp/slamlab-stereo-long"))
+    ap.add_argument("--heading-frames", type=float, default=None, metavar="DEG",
+                    help="list the frames whose heading error exceeds DEG and what the pipeline did on them")
     args = ap.parse_args(argv)
     path, sim, L, R, r_slam = load(args.frames, args.cache)
     T0_inv = se3_inverse(se3_from_planar(*path[0]))
     truth = np.array([planar_from_se3(T0_inv @ se3_from_planar(*p)) for p in path])
     truth[:, 2] = path[:, 2] - path[0, 2]
     length_m = float(np.sum(np.hypot(*np.diff(path[:, :2], axis=0).T)))
+    no_numba = os.environ.get("SLAMLAB_NO_NUMBA", "")
     for arg in args.variants:
         label, _, js = arg.partition("=")
-        p = StereoParams(**(json.loads(js) if js else {}))
+        over = json.loads(js) if js else {}
+        # "numba": false runs this variant on the numpy path (SLAMLAB_NO_NUMBA=1), for a row beside the compiled one
+        os.environ["SLAMLAB_NO_NUMBA"] = no_numba if over.pop("numba", True) else "1"
+        p = StereoParams(**over)
         slam = StereoSLAM(sim.rig, sim.T_body_left, params=p, rng=np.random.default_rng(r_slam))
         load0 = os.getloadavg()[0]
         wall = cpu = 0.0
@@ -81,6 +94,8 @@ def main(argv=None):
             + f"; landmarks searched {c['n_searched'][1:].mean():.0f} per frame (mean), "
               f"{int(c['gate_fallback'].sum())} whole-map fallbacks, {int(c['window_fallback'].sum())} window "
               f"fallbacks, {c['n_compared'][1:].mean() / 1e6:.2f} M descriptor distances per frame (mean)", flush=True)
+        if args.heading_frames is not None:
+            print(sl.stereo.heading_frames(slam, truth, args.heading_frames), flush=True)
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@ from .experiments import (
     run_stereo_slam_variants,
     run_turn_in_place,
 )
+from .heading import heading_frames
 from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
 from .scale_ablation import SCALE_ABLATION, ScaleAblation, run_scale_ablation
@@ -75,6 +76,7 @@ __all__ = [
     "disparity_errors",
     "estimate_pose",
     "experiment_poses",
+    "heading_frames",
     "is_rectified",
     "kitti_comparison",
     "match_to_map",

@@ -11,6 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import _validate as v
+from .._compiled import numba_enabled
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.ransac import ransac
 from ..geometry.registration import RigidTransform, umeyama
@@ -18,6 +19,7 @@ from ..geometry.so3 import hat
 from ..kdtree.stores import LandmarkStore
 from .local_stages import _pair_distances, _two_nearest
 from .params import StereoParams
+from .window_kernel import window_hamming_2nn
 
 __all__ = [
     "MapMatches",
@@ -151,9 +153,9 @@ def _matches_from_knn(dist, ids, ratio, positions=None, same_point_m=None, max_d
     return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed), ids[:, 0])
 
 
-def _radius_pairs(uv_q, uv_t, radius):
-    """All pairs ``(query, target)`` of 2-D points at most ``radius`` apart, grouped by ascending query
-    index: targets bucketed in a grid of ``radius`` cells, each query looks in its 3 x 3 cells."""
+def _radius_cells(uv_q, uv_t, radius):
+    """Targets bucketed in a grid of ``radius`` cells: ``(order, lo, hi)``, the targets sorted by cell and, for
+    query ``i`` and column offset ``c`` (-1, 0, 1), its 3 cells of that column as the range ``order[lo[i, c]:hi[i, c]]``."""
     lo_xy = np.minimum(uv_q.min(axis=0), uv_t.min(axis=0))
     cq = np.floor((uv_q - lo_xy) / radius).astype(np.int64)
     ct = np.floor((uv_t - lo_xy) / radius).astype(np.int64)
@@ -163,8 +165,13 @@ def _radius_pairs(uv_q, uv_t, radius):
     keys = key_t[order]
     # the 3 cells of a column are consecutive keys: one range per column offset
     base = (cq[:, 0:1] + 1 + np.arange(-1, 2)) * ny + cq[:, 1:2] + 1  # (k, 3) middle cell of each column
-    lo = np.searchsorted(keys, base - 1, side="left")
-    hi = np.searchsorted(keys, base + 1, side="right")
+    return order, np.searchsorted(keys, base - 1, side="left"), np.searchsorted(keys, base + 1, side="right")
+
+
+def _radius_pairs(uv_q, uv_t, radius):
+    """All pairs ``(query, target)`` of 2-D points at most ``radius`` apart, grouped by ascending query
+    index: targets bucketed in a grid of ``radius`` cells, each query looks in its 3 x 3 cells."""
+    order, lo, hi = _radius_cells(uv_q, uv_t, radius)
     cnt = (hi - lo).ravel()
     qi = np.repeat(np.arange(len(uv_q)), 3)
     qi = np.repeat(qi, cnt)
@@ -172,6 +179,23 @@ def _radius_pairs(uv_q, uv_t, radius):
     d = uv_q[qi] - uv_t[ti]
     keep = np.einsum("ij,ij->i", d, d) <= radius * radius
     return qi[keep], ti[keep]
+
+
+def _window_two_nearest(D, uv, desc_lm, uv_lm, radius_px):
+    """Nearest and second-nearest landmark by descriptor among those within ``radius_px`` of each keypoint:
+    ``(query, nearest, d1, d2, second)`` as :func:`_two_nearest`, and the number of pairs compared. Binary
+    descriptors take the compiled kernel when numba is enabled (same result, tested), otherwise numpy."""
+    if D.dtype == np.uint8 and D.shape[1] % 8 == 0 and numba_enabled():
+        order, lo, hi = _radius_cells(uv, uv_lm, radius_px)
+        r1, d1, d2, r2, n_pairs = window_hamming_2nn(D.view(np.uint64), desc_lm.view(np.uint64), uv, uv_lm,
+                                                     order, lo, hi, float(radius_px))
+        q = np.flatnonzero(r1 >= 0)
+        return q, r1[q], d1[q], d2[q], r2[q], int(n_pairs)
+    qi, rows = _radius_pairs(uv, uv_lm, radius_px)
+    if qi.size == 0:
+        return qi, qi, np.empty(0), np.empty(0), qi, 0
+    d = _pair_distances(D, desc_lm, qi, rows)
+    return (*_two_nearest(qi, rows, d), int(qi.size))
 
 
 def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance, positions=None,
@@ -186,11 +210,9 @@ def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance,
     none = MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
     if k == 0 or len(ids_lm) == 0:
         return none, 0
-    qi, rows = _radius_pairs(uv, uv_lm, radius_px)
-    if qi.size == 0:
+    q, r1, d1, d2, r2, n_pairs = _window_two_nearest(D, uv, desc_lm, uv_lm, radius_px)
+    if n_pairs == 0:
         return none, 0
-    d = _pair_distances(D, desc_lm, qi, rows)
-    q, r1, d1, d2, r2 = _two_nearest(qi, rows, d)
     ok = ratio_rule(d1, d2, ratio)
     _accept_twins(ok, ids_lm[r1], np.where(r2 >= 0, ids_lm[r2], -1), positions, same_point_m)
     ok &= d1 <= max_distance
@@ -200,7 +222,7 @@ def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance,
     sel = best_per_target(lid, dd)
     claimed = np.zeros(k, dtype=bool)
     claimed[loc] = True
-    return MapMatches(loc[sel], lid[sel], dd[sel], np.flatnonzero(~claimed), nearest), int(qi.size)
+    return MapMatches(loc[sel], lid[sel], dd[sel], np.flatnonzero(~claimed), nearest), n_pairs
 
 
 # --- pose: absolute orientation inside RANSAC, oldest landmarks first (000 §3.5) -----------------
@@ -433,9 +455,12 @@ def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> Po
             cum = np.cumsum(info[order], axis=0)
             ends = np.flatnonzero(np.r_[fs[1:] != fs[:-1], True])  # last candidate of each sighting time
             ends = ends[fs[ends] >= first_seen[old].max()]
-            std = _std_from_information(cum[ends])
-            good = np.all(std <= max_std_factor * _std_from_information(cum[-1]), axis=1)
-            cut = ends[np.argmax(good)] if good.any() else len(order) - 1
+            bound, cut = max_std_factor * _std_from_information(cum[-1]), len(order) - 1
+            for e in np.array_split(ends, np.arange(16, ends.size, 16)):  # 16 at a time: the first good one is enough
+                good = np.all(_std_from_information(cum[e]) <= bound, axis=1)
+                if good.any():
+                    cut = e[np.argmax(good)]
+                    break
             old = loose[np.sort(order[: cut + 1])]
         if old.size >= 3:
             r_old = ransac((src[old], dst[old], w[old]), _fit, _residuals, 3, threshold_m, max_iters=max_iters, rng=rng)

@@ -124,6 +124,8 @@ class StereoParams(Params):
         ours: bound on the oldest set's correction (None: none)
     max_rot_std_rad : float or None
         ours: reject a pose whose rotation std exceeds this (None: off)
+    degenerate_pose : str
+        ours: pose of a frame that gives none: 'last' (keep the last pose) or 'constant_velocity' (the last frame's motion once more)
     state_var : float
         000 §3.6: static landmarks; ours: a small process variance, m^2
     pose_std_m : float
@@ -198,6 +200,8 @@ class StereoParams(Params):
     max_correction_rad: float | None = param(None, "ours: bound on the oldest set's correction (None: none)")
     max_correction_m: float | None = param(None, "ours: bound on the oldest set's correction (None: none)")
     max_rot_std_rad: float | None = param(0.01, "ours: reject a pose whose rotation std exceeds this (None: off)")
+    degenerate_pose: str = param("last", "ours: pose of a frame that gives none: 'last' (keep the last pose) or "
+                                         "'constant_velocity' (the last frame's motion once more)")
     # -- landmark filter (000 §3.6) --------------------------------------------------------------------
     state_var: float = param(1e-6, "000 §3.6: static landmarks; ours: a small process variance, m^2")
     pose_std_m: float = param(0.02, "ours: pose uncertainty added to an observation")
@@ -253,6 +257,7 @@ class StereoParams(Params):
         _optional_positive(self.max_correction_rad, "max_correction_rad", allow_zero=True)
         _optional_positive(self.max_correction_m, "max_correction_m", allow_zero=True)
         _optional_positive(self.max_rot_std_rad, "max_rot_std_rad")
+        v.check_choice(self.degenerate_pose, "degenerate_pose", ("last", "constant_velocity"))
         v.check_positive(self.state_var, "state_var", allow_zero=True)
         v.check_positive(self.pose_std_m, "pose_std_m", allow_zero=True)
         v.check_positive(self.pose_std_rad, "pose_std_rad", allow_zero=True)

@@ -165,7 +165,8 @@ class StereoSLAM:
         rec = FrameRecord(
             frame=self.frame, n_left=len(fl.uv), n_right=len(fr.uv), n_stereo=len(sm.left),
             n_local=len(pts_body), n_searched=0, n_map_matches=0, n_inliers=0, n_used=0, n_gated=0, n_new=0,
-            n_compared=0, n_duplicates=0, window_fallback=False, gate_fallback=False, status="ok",
+            n_compared=0, n_duplicates=0, window_fallback=False, gate_fallback=False, rot_std_rad=np.nan, status="ok",
+            trail="",
         )  # fmt: skip
         no_inliers = np.zeros(len(pts_body), bool)
         if len(self.X) == 0:
@@ -195,6 +196,9 @@ class StereoSLAM:
             rec["gate_fallback"] = True
             mm, est = self._locate(rec, clock, desc, pts_body, cov_body, cloud.points[:, 2], None)
         if est is None:
+            if p.degenerate_pose == "constant_velocity" and len(self.poses) >= 2:
+                # our option: the last frame's motion once more, not the last pose (a turn goes on; issue 25)
+                self.T = self.T @ (np.linalg.inv(self.poses[-2]) @ self.poses[-1])
             self._finish(rec, clock, pts_body, no_inliers)
             return rec
         inl_mask = self._update_map(rec, est, mm, pts_body, cov_body, desc)
@@ -261,7 +265,7 @@ class StereoSLAM:
         clock.lap("map_match")
         rec["n_searched"] += len(last)
         rec["n_compared"] += len(last) * len(desc)
-        mm, est = self._pose(rec, clock, mm, pts_body, cov_body, depth)
+        mm, est = self._pose(rec, clock, mm, pts_body, cov_body, depth, "last")
         if est is None:
             return mm, None
         T_wc = est.T @ self.T_body_left
@@ -278,8 +282,9 @@ class StereoSLAM:
         rec["n_compared"] += n_pairs
         if len(mm.local) < p.window_min_share * len(desc):
             rec["status"] = "too_few_matches"
+            rec["trail"] += f"window {len(mm.local)} too_few_matches; "
             return mm, None
-        return self._pose(rec, clock, mm, pts_body, cov_body, depth)
+        return self._pose(rec, clock, mm, pts_body, cov_body, depth, "window")
 
     def _locate(self, rec, clock, desc, pts_body, cov_body, depth, cand):
         """Match to the map (the landmarks ``cand``, or all) and estimate the pose (000 §3.4-3.5);
@@ -290,36 +295,34 @@ class StereoSLAM:
         n = len(self.store) if cand is None else len(cand)
         rec["n_searched"] += n
         rec["n_compared"] += n * len(desc)
-        return self._pose(rec, clock, mm, pts_body, cov_body, depth)
+        return self._pose(rec, clock, mm, pts_body, cov_body, depth, "global" if cand is None else "in view")
 
-    def _pose(self, rec, clock, mm, pts_body, cov_body, depth):
-        """The pose of map matches ``mm`` (000 §3.5) with our checks; ``(mm, estimate or None)``."""
+    def _pose(self, rec, clock, mm, pts_body, cov_body, depth, search):
+        """The pose of map matches ``mm`` (000 §3.5) with our checks; ``(mm, estimate or None)``, ``rec.status``
+        saying why when None. Each attempt goes to ``rec["trail"]``: "search matches outcome" (``search``: which)."""
         p = self.params
-        rec["n_map_matches"] = len(mm.local)
+        rec["n_map_matches"], rec["rot_std_rad"], est = len(mm.local), np.nan, None
         if len(mm.local) < max(3, p.min_inliers):
             rec["status"] = "too_few_matches"
-            return mm, None
-        d_use = depth[mm.local]
-        if p.weight_depth == "map":
-            # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
-            T_wc = self.T @ self.T_body_left
-            d_use = np.maximum(((self.X[mm.ids] - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], p.min_depth_m)
-        est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], d_use,
-                             cov_body[mm.local], p, self.rng)
-        rec["n_used"] = est.n_used
-        if not est.converged:
+        else:
+            d_use = depth[mm.local]
+            if p.weight_depth == "map":
+                # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
+                T_wc = self.T @ self.T_body_left
+                d_use = np.maximum(((self.X[mm.ids] - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], p.min_depth_m)
+            est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], d_use,
+                                 cov_body[mm.local], p, self.rng)
+            rec["n_used"] = est.n_used
+            if not est.converged:
+                rec["status"], est = "ransac_failed", None
+            elif p.max_rot_std_rad is not None:
+                R, inl = est.T[:3, :3], mm.local[est.inliers]
+                rec["rot_std_rad"] = float(np.max(pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)[:3]))
+                if not rec["rot_std_rad"] <= p.max_rot_std_rad:
+                    rec["status"], est = "ill_conditioned", None
             clock.lap("pose")
-            rec["status"] = "ransac_failed"
-            return mm, None
-        if p.max_rot_std_rad is not None:
-            R = est.T[:3, :3]
-            inl = mm.local[est.inliers]
-            std = pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)
-            if not np.max(std[:3]) <= p.max_rot_std_rad:
-                clock.lap("pose")
-                rec["status"] = "ill_conditioned"
-                return mm, None
-        clock.lap("pose")
+        std = "" if np.isnan(rec["rot_std_rad"]) else f" (rot std {np.rad2deg(rec['rot_std_rad']):.2f} deg)"
+        rec["trail"] += f"{search} {len(mm.local)} {rec['status'] if est is None else 'ok'}{std}; "
         return mm, est
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
@@ -456,7 +459,7 @@ class StereoSLAM:
         dict
             Count name -> numpy.ndarray over the frames.
         """
-        keys = [k for k in self.records[0] if k != "status"] if self.records else []
+        keys = [k for k in self.records[0] if k not in ("status", "trail")] if self.records else []
         return {k: np.array([r[k] for r in self.records]) for k in keys}
 
     def stage_times(self, cpu: bool = False) -> dict:

@@ -1,0 +1,78 @@
+"""Compiled kernel of the window search for binary descriptors (our addition to 000 §3.4; speed, issue 25).
+
+The teaching version is numpy, in :mod:`slamlab.stereo.map_stages` (``_radius_pairs``, then
+``_pair_distances`` and ``_two_nearest``): it builds every (keypoint, landmark) pair within the
+window as arrays, then their Hamming distances, then the two nearest per keypoint. This kernel walks
+the same pairs in the same order and keeps only the two nearest, so nothing of size "pairs" is
+allocated; the result is the same, bit for bit (tested against the numpy version).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._compiled import kernel
+
+__all__ = ["window_hamming_2nn"]
+
+
+def _window_hamming_2nn(Dq, Dt, uv_q, uv_t, order, lo, hi, radius):  # pragma: no cover - compiled
+    """For each query ``i``: the targets ``order[lo[i, c]:hi[i, c]]`` (c = 0, 1, 2: its 3 x 3 grid cells, in
+    the numpy version's order) within ``radius`` px, their Hamming distances (descriptors as uint64 words)
+    and the nearest / second nearest, each the first in that order among equals."""
+    k = Dq.shape[0]
+    r1 = np.full(k, -1, np.int64)
+    r2 = np.full(k, -1, np.int64)
+    d1 = np.full(k, np.inf)
+    d2 = np.full(k, np.inf)
+    r2_lim = radius * radius
+    n_pairs = 0
+    for i in range(k):
+        for c in range(3):
+            for j in range(lo[i, c], hi[i, c]):
+                t = order[j]
+                dx, dy = uv_q[i, 0] - uv_t[t, 0], uv_q[i, 1] - uv_t[t, 1]
+                if dx * dx + dy * dy > r2_lim:  # outside the window
+                    continue
+                n_pairs += 1
+                bits = np.uint64(0)
+                for w in range(Dq.shape[1]):
+                    # bits set in a 64-bit word: the "SWAR" count (Hacker's Delight §5-1)
+                    x = Dq[i, w] ^ Dt[t, w]
+                    x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+                    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+                    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+                    bits += (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+                d = float(bits)
+                if d < d1[i]:  # a new nearest: the old one becomes the second
+                    d2[i], r2[i] = d1[i], r1[i]
+                    d1[i], r1[i] = d, t
+                elif d < d2[i]:
+                    d2[i], r2[i] = d, t
+    return r1, d1, d2, r2, n_pairs
+
+
+window_hamming_2nn = kernel(_window_hamming_2nn)
+window_hamming_2nn.__doc__ = """Two nearest landmarks by Hamming distance within the window of each keypoint (compiled).
+
+Parameters
+----------
+Dq : numpy.ndarray of uint64, shape (K, W)
+    Keypoint descriptors as 64-bit words.
+Dt : numpy.ndarray of uint64, shape (L, W)
+    Landmark descriptors as 64-bit words.
+uv_q : numpy.ndarray, shape (K, 2)
+    Keypoint pixels.
+uv_t : numpy.ndarray, shape (L, 2)
+    Projected landmark pixels.
+order, lo, hi : numpy.ndarray of int
+    The grid of ``_radius_cells`` (targets sorted by cell; per query and column, a range of ``order``).
+radius : float
+    Window radius [px].
+
+Returns
+-------
+tuple
+    ``r1, d1, d2, r2`` per keypoint (``r1 = -1``: no landmark in the window; ``r2 = -1``, ``d2 = inf``: one)
+    and the number of pairs within the windows.
+"""
