@@ -3,7 +3,7 @@
 - :func:`exact_knn` — exact k-NN by brute force: Hamming distance for binary ``uint8``
   descriptors (ORB; OpenCV's ``batchDistance``), Euclidean for float ones (BLAS on
   query blocks, the kept distances recomputed directly in float64; the selection from
-  each block compiled in :mod:`slamlab.kdtree._brute_kernel` unless ``SLAMLAB_NO_NUMBA=1``);
+  each block compiled in ``slamlab.kdtree._brute_kernel`` unless ``SLAMLAB_NO_NUMBA=1``);
 - :func:`pad_knn` — the one "pad to k" rule: fewer than ``k`` candidates give ``inf``
   distances and id ``-1``;
 - :func:`merge_knn` — k-NN lists of several trees merged into one (000 §4: a query
@@ -301,7 +301,7 @@ _POOL_SELECTION = False
 def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1, Xa=None, workers: int = 0):
     """:func:`_exact_knn_float` with the selection compiled: the same BLAS blocks, one pass per block.
 
-    After each block's product, :func:`~slamlab.kdtree._brute_kernel.update_top_c` merges the block's keys
+    After each block's product, ``_brute_kernel.update_top_c`` merges the block's keys
     into the running ``k + margin`` best of every query in one pass over the block (no ``min`` pass, no
     ``argmin`` passes, no gathers; a query that cannot improve costs one compare per key). The kept keys
     are the product's own (the numpy path recomputes them with ``einsum``), so the two candidate lists
