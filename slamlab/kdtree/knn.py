@@ -218,6 +218,37 @@ def augment_rows(X, out=None) -> np.ndarray:
     return Xa
 
 
+def _block_setup(Q, X, k, margin, block, Xa):
+    """What both blocked k-NN paths (numpy and compiled) start from: ``(M, N, c, Xa, block, Qa)``.
+
+    ``c = min(k + margin, N)`` candidates kept per query; the augmented rows ``[x, |x|²/2]`` (``Xa``, made
+    here unless the caller keeps them) and query rows ``[-q, 1]`` make one GEMM per block write the ranking
+    key ``|x|²/2 - q·x`` directly; ``block`` database rows per GEMM (default ``_block_rows(M)``).
+
+    Parameters
+    ----------
+    Q : (M, d) float32
+        Queries.
+    X : (N, d) float32
+        Database.
+    k : int
+        Neighbours per query.
+    margin : int
+        Candidates kept beyond ``k``.
+    block : int or None
+        Database rows per block.
+    Xa : (N, d + 1) float32 or None
+        ``augment_rows(X)``, when the caller keeps it.
+
+    Returns
+    -------
+    tuple
+        ``(M, N, c, Xa, block, Qa)``.
+    """
+    M, N = Q.shape[0], X.shape[0]
+    return M, N, min(k + margin, N), augment_rows(X) if Xa is None else Xa, block or _block_rows(M), _query_rows(Q)
+
+
 def _exact_knn_float(Q, X, k, block: int | None = None, margin: int = 1, Xa=None):
     """Exact Euclidean k-NN (k <= N): float32 BLAS ranks, float64 decides.
 
@@ -229,13 +260,7 @@ def _exact_knn_float(Q, X, k, block: int | None = None, margin: int = 1, Xa=None
     float64 and sorted, so float32 rounding can only matter if it pushed a true neighbour behind
     ``margin`` others. The full distance matrix is never written.
     """
-    M, N = Q.shape[0], X.shape[0]
-    c = min(k + margin, N)
-    # augmented rows: [x, |x|²/2] · [-q, 1] = |x|²/2 - q·x, one GEMM per block writes the key directly
-    if Xa is None:
-        Xa = augment_rows(X)
-    block = block or _block_rows(M)
-    Qa = _query_rows(Q)
+    M, N, c, Xa, block, Qa = _block_setup(Q, X, k, margin, block, Xa)
     buf = np.empty((M, min(block, N)), dtype=np.float32)
     best_key = np.full((M, 0), np.inf, dtype=np.float32)
     best_idx = np.empty((M, 0), dtype=np.int64)
@@ -336,12 +361,7 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     from .._threads import shared_pool
     from ._brute_kernel import update_top_c
 
-    M, N = Q.shape[0], X.shape[0]
-    c = min(k + margin, N)
-    if Xa is None:
-        Xa = augment_rows(X)
-    block = block or _block_rows(M)
-    Qa = _query_rows(Q)
+    M, N, c, Xa, block, Qa = _block_setup(Q, X, k, margin, block, Xa)
     buf = np.empty(M * min(block, N), dtype=np.float32)
     best_key = np.full((M, c), np.inf, dtype=np.float32)
     best_idx = np.full((M, c), -1, dtype=np.int64)
