@@ -10,13 +10,23 @@ so far, sorted, and compares every key with the ``c``-th smallest (a vectorisabl
 
 Ties keep the lowest database index first (a key equal to the ``c``-th best does not enter; an entering
 key goes behind the equal ones already kept), as the numpy path's ``argmin`` does.
+
+:func:`top_c_blocks` drives it over the blocks: in the calling thread (each product split over two
+threads by BLAS, the selection on one), or, for large problems, on two workers that each take the next
+free block, multiply it (BLAS on one thread) and select from it while its keys are still in L2, so that
+both cores multiply and select; the two workers' lists are then merged by (key, index).
 """
 
 from __future__ import annotations
 
-from slamlab._compiled import kernel
+import threading
 
-__all__ = ["update_top_c"]
+import numpy as np
+
+from slamlab._compiled import kernel
+from slamlab._threads import blas_one_thread, shared_pool
+
+__all__ = ["top_c_blocks", "update_top_c"]
 
 _CHUNK = 64  # keys per vectorised test (256 bytes of one row)
 
@@ -65,3 +75,56 @@ def update_top_c(G, s0, best_key, best_idx, r0, r1):
                     best_key[i, p] = g
                     best_idx[i, p] = s0 + j
                     worst = best_key[i, c - 1]
+
+
+def top_c_blocks(Qa, Xa, c, block, workers=1):
+    """Indices of the ``c`` smallest ranking keys ``Qa @ Xa.T`` of every query, block by block (ties: lowest index).
+
+    Parameters
+    ----------
+    Qa : (M, d + 1) float32
+        Query rows ``[-q, 1]``.
+    Xa : (N, d + 1) float32
+        Database rows ``[x, |x|²/2]``.
+    c : int
+        Candidates kept per query (``c <= N``).
+    block : int
+        Database rows per product.
+    workers : int
+        1: every block in the calling thread; 2: the calling thread and a worker of
+        :mod:`slamlab._threads`' pool each take the next free block, BLAS held to one thread meanwhile
+        (:func:`slamlab._threads.blas_one_thread`).
+
+    Returns
+    -------
+    (M, c) int64
+        Database rows by ascending key, ties by index; ``-1`` where no finite key was seen.
+    """
+    M, N = Qa.shape[0], Xa.shape[0]
+    starts, lock = iter(range(0, N, block)), threading.Lock()  # the blocks not taken yet
+
+    def worker():  # products and selection of the next free block (in increasing order) until none is left
+        best_key, best_idx = np.full((M, c), np.inf, dtype=np.float32), np.full((M, c), -1, dtype=np.int64)
+        buf = np.empty(M * min(block, N), dtype=np.float32)
+        while True:
+            with lock:
+                s0 = next(starts, None)
+            if s0 is None:
+                return best_key, best_idx
+            s1 = min(s0 + block, N)
+            G = buf[: M * (s1 - s0)].reshape(M, s1 - s0)  # contiguous rows, also for the last block
+            np.matmul(Qa, Xa[s0:s1].T, out=G)  # (M, b) ranking keys |x|²/2 - q·x
+            update_top_c(G, s0, best_key, best_idx, 0, M)
+
+    if workers <= 1:
+        return worker()[1]
+    with blas_one_thread():
+        other = shared_pool().submit(worker)
+        try:
+            parts = [worker()]
+        finally:  # not started (the pool busy with other work): no block left for it; else wait for it
+            if not other.cancel():
+                parts.append(other.result())
+    key, idx = (np.concatenate([p[j] for p in parts], axis=1) for j in (0, 1))
+    o = np.lexsort((idx, key), axis=1)[:, :c]  # the c best of both lists by key, ties by the lower index
+    return np.take_along_axis(idx, o, axis=1)

@@ -3,7 +3,8 @@
 - :func:`exact_knn` — exact k-NN by brute force: Hamming distance for binary ``uint8``
   descriptors (ORB; OpenCV's ``batchDistance``), Euclidean for float ones (BLAS on
   query blocks, the kept distances recomputed directly in float64; the selection from
-  each block compiled in ``slamlab.kdtree._brute_kernel`` unless ``SLAMLAB_NO_NUMBA=1``);
+  each block compiled in ``slamlab.kdtree._brute_kernel`` unless ``SLAMLAB_NO_NUMBA=1``,
+  large problems on two workers);
 - :func:`pad_knn` — the one "pad to k" rule: fewer than ``k`` candidates give ``inf``
   distances and id ``-1``;
 - :func:`merge_knn` — k-NN lists of several trees merged into one (000 §4: a query
@@ -318,11 +319,6 @@ def _final_k(Q, X, best_idx, k):
     return np.take_along_axis(d, o, axis=1), np.take_along_axis(best_idx, o, axis=1)
 
 
-# whether blocks of >= 2^18 keys split their selection over two threads (the shared pool); off: on our loaded
-# 2-core runs the split cost more CPU than it saved wall time (bench_stores.py --brute-only prints both; issue 25)
-_POOL_SELECTION = False
-
-
 def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1, Xa=None, workers: int = 0):
     """:func:`_exact_knn_float` with the selection compiled: the same BLAS blocks, one pass per block.
 
@@ -332,7 +328,8 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     are the product's own (the numpy path recomputes them with ``einsum``), so the two candidate lists
     can differ only where float32 rounding reorders near-equal keys; the final ``k`` come from the same
     float64 recomputation and order, hence the same results whenever both lists hold the true ``k``
-    nearest (the numpy path's own condition for exactness).
+    nearest (the numpy path's own condition for exactness). Large problems run on two workers, each
+    multiplying (BLAS on one thread) and selecting its own blocks (``_brute_kernel.top_c_blocks``).
 
     Parameters
     ----------
@@ -341,15 +338,14 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     k : int
         Neighbours per query (``k <= N``).
     block : int, optional
-        Database rows per BLAS product (default: :func:`_block_rows`).
+        Database rows per BLAS product (default: :func:`_block_rows` on one worker, :func:`_split_rows` on two).
     margin : int
         Candidates kept beyond ``k`` for the float64 re-ranking.
     Xa : (N, d + 1) float32, optional
         ``augment_rows(X)``, when the caller keeps it.
     workers : int
-        2: the second half of the queries is selected in a worker of :mod:`slamlab._threads`' pool
-        while this thread selects the first; 1: all in this thread; 0: 2 for blocks of at least 2^18 keys
-        when ``_POOL_SELECTION`` is set, else 1.
+        1: products (BLAS threaded as configured) and selection in this thread; 2: this thread and a worker
+        of :mod:`slamlab._threads`' pool; 0: 2 where :func:`_use_two_workers` says so, else 1.
 
     Returns
     -------
@@ -358,30 +354,57 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     idx : (M, k) int64
         Row indices into ``X``.
     """
-    from .._threads import shared_pool
-    from ._brute_kernel import update_top_c
+    from ._brute_kernel import top_c_blocks
 
-    M, N, c, Xa, block, Qa = _block_setup(Q, X, k, margin, block, Xa)
-    buf = np.empty(M * min(block, N), dtype=np.float32)
-    best_key = np.full((M, c), np.inf, dtype=np.float32)
-    best_idx = np.full((M, c), -1, dtype=np.int64)
-    # large blocks: two halves of the queries in the shared pool (never from inside one of its tasks)
-    workers = workers or (2 if _POOL_SELECTION and M * min(block, N) >= 1 << 18 and not _in_pool() else 1)
-    halves = [(0, M // 2), (M // 2, M)] if workers > 1 and M > 1 else [(0, M)]
-    for s0 in range(0, N, block):
-        s1 = min(s0 + block, N)
-        G = buf[: M * (s1 - s0)].reshape(M, s1 - s0)  # contiguous rows, also for the last block
-        np.matmul(Qa, Xa[s0:s1].T, out=G)  # (M, b) ranking keys |x|²/2 - q·x
-        # the second half in a pool worker while this thread selects the first
-        later = [shared_pool().submit(update_top_c, G, s0, best_key, best_idx, r0, r1) for r0, r1 in halves[1:]]
-        update_top_c(G, s0, best_key, best_idx, *halves[0])
-        for f in later:
-            f.result()
+    M, N = Q.shape[0], X.shape[0]
+    workers = workers or (2 if _use_two_workers(M, N) else 1)
+    _M, _N, c, Xa, block, Qa = _block_setup(Q, X, k, margin, block or (_split_rows(M) if workers > 1 else None), Xa)
+    best_idx = top_c_blocks(Qa, Xa, c, block, workers)
     # a key that never beat inf (an overflowing product) leaves a slot empty: rank those queries in numpy
     bad = np.flatnonzero(best_idx[:, -1] < 0)
     if bad.size:
         best_idx[bad] = _exact_knn_float(Q[bad], X, c, block, 0, Xa)[1]
     return _final_k(Q, X, best_idx, k)
+
+
+# two workers from this many keys (queries x rows) on: below, a product is too short to share (issue 25)
+_TWO_WORKERS_MIN_KEYS = 1 << 20
+
+
+def _use_two_workers(M, N):
+    """Whether the compiled path runs on two workers: a large problem, not from inside the shared pool.
+
+    Parameters
+    ----------
+    M, N : int
+        Queries and database rows.
+
+    Returns
+    -------
+    bool
+        True where the problem has at least ``_TWO_WORKERS_MIN_KEYS`` keys and two blocks, and numpy's BLAS
+        can be held to one thread per worker (:func:`slamlab._threads.blas_threads_settable`).
+    """
+    from .._threads import blas_threads_settable
+
+    return M * N >= _TWO_WORKERS_MIN_KEYS and 2 * _split_rows(M) <= N and not _in_pool() and blas_threads_settable()
+
+
+def _split_rows(M):
+    """Database rows per block on two workers: a block's keys (``M`` x rows, float32) stay in L2.
+
+    Parameters
+    ----------
+    M : int
+        Queries.
+
+    Returns
+    -------
+    int
+    """
+    # 2^17 keys = 512 KB of the 1 MiB L2 per core: 256-row blocks of 500 queries beat 64-128 (more calls)
+    # and 512-4096 (keys read back from L3) in bench_stores.py --brute-only (issue 25)
+    return max(128, min(4096, (1 << 17) // max(M, 1)))
 
 
 def _keys(Qa, Xa, idx):

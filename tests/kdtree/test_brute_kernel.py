@@ -3,8 +3,11 @@
 import numpy as np
 import pytest
 
+from slamlab import _threads
+from slamlab._threads import blas_one_thread, blas_threads_settable
+from slamlab.kdtree import _brute_kernel as _brute
 from slamlab.kdtree import knn
-from slamlab.kdtree._brute_kernel import update_top_c
+from slamlab.kdtree._brute_kernel import top_c_blocks, update_top_c
 from slamlab.kdtree.stores import BruteForceStore
 
 
@@ -107,14 +110,57 @@ def test_overflowing_keys_fall_back_to_numpy():
     np.testing.assert_array_equal(d1, d0)
 
 
-def test_selection_split_over_two_threads_gives_the_same():
-    rng = np.random.default_rng(11)
-    X = rng.standard_normal((3000, 16)).astype(np.float32)
-    Q = rng.standard_normal((101, 16)).astype(np.float32)  # odd: halves of 50 and 51 queries
-    d1, i1 = knn._exact_knn_float_compiled(Q, X, 2, workers=1)
-    d2, i2 = knn._exact_knn_float_compiled(Q, X, 2, workers=2)
+@pytest.mark.parametrize("block", [128, 300])
+def test_two_workers_equal_one_worker_and_numpy(block):
+    rng = np.random.default_rng(block)
+    X = rng.standard_normal((5000, 16)).astype(np.float32)
+    Q = rng.standard_normal((101, 16)).astype(np.float32)
+    d2, i2 = knn._exact_knn_float_compiled(Q, X, 2, block=block, workers=2)
+    d1, i1 = knn._exact_knn_float_compiled(Q, X, 2, block=block, workers=1)
     d0, i0 = knn._exact_knn_float(Q, X, 2)
     np.testing.assert_array_equal(i2, i1)
     np.testing.assert_array_equal(d2, d1)
-    np.testing.assert_array_equal(i1, i0)
-    np.testing.assert_array_equal(d1, d0)
+    np.testing.assert_array_equal(i2, i0)
+    np.testing.assert_array_equal(d2, d0)
+
+
+def test_two_workers_ties_across_blocks_keep_the_lowest_index():
+    # integer coordinates: every key is exact in float32 whatever the product's order, so the candidate lists
+    # of one and two workers must agree entry for entry; every point recurs in many blocks of both workers
+    rng = np.random.default_rng(5)
+    base = rng.integers(0, 3, (40, 4)).astype(np.float32)
+    X = base[rng.integers(0, 40, 6000)]
+    Q = np.vstack([X[:60], rng.integers(0, 3, (40, 4)).astype(np.float32) + 0.5])
+    Qa, Xa = knn._query_rows(Q), knn.augment_rows(X)
+    for _ in range(3):  # which worker takes which block varies from run to run; the result must not
+        np.testing.assert_array_equal(_brute.top_c_blocks(Qa, Xa, 3, 128, 2), _brute.top_c_blocks(Qa, Xa, 3, 128, 1))
+    _d_ref, i_ref = _reference(Q, X, 2)
+    np.testing.assert_array_equal(knn._exact_knn_float_compiled(Q, X, 2, block=128, workers=2)[1], i_ref)
+
+
+def test_store_takes_two_workers_for_large_problems(monkeypatch):
+    rng = np.random.default_rng(9)
+    X = rng.standard_normal((3000, 8)).astype(np.float32)  # 900 000 keys: one worker by default
+    Q = rng.standard_normal((300, 8)).astype(np.float32)
+    s = BruteForceStore()
+    s.add(X, np.arange(3000) + 7)
+    calls = []
+    monkeypatch.setattr(_brute, "top_c_blocks", lambda *a: calls.append(a[-1]) or top_c_blocks(*a))
+    d1, i1 = s.query(Q, 2)
+    monkeypatch.setattr(knn, "_TWO_WORKERS_MIN_KEYS", 1000)
+    d2, i2 = s.query(Q, 2)
+    assert calls == [1, 2 if blas_threads_settable() else 1]
+    np.testing.assert_array_equal(i2, i1)
+    np.testing.assert_array_equal(d2, d1)
+
+
+@pytest.mark.skipif(not blas_threads_settable(), reason="numpy's BLAS thread count cannot be set here")
+def test_blas_one_thread_nests_and_restores():
+    get = _threads._openblas_threads()[0]
+    before = get()
+    with blas_one_thread():
+        assert get() == 1
+        with blas_one_thread():
+            assert get() == 1
+        assert get() == 1
+    assert get() == before
