@@ -5,8 +5,9 @@ Run: ``.venv/bin/python benchmarks/bench_stores.py [--quick] [--markdown FILE]``
 Prints, measured in the same process:
 
 1. the machine's float32 GEMM rate and the GEMM bound for 500 x 64 x 65000
-   multiply-adds, our blocked brute-force store (numpy selection and compiled
-   selection, side by side, and the kernel's compile time) and faiss
+   multiply-adds, our blocked brute-force store (numpy selection, compiled
+   selection on one worker and on two workers — the store's default — with each
+   path's products alone, and the kernel's compile time) and faiss
    ``IndexFlatL2`` on the same 500 queries against 65000 points, and their ratios;
 2. 000's Table 1 and Table 2 workloads and a 200000-point workload through the
    rebuilt kd-tree, buffer + multi kd-tree, FLANN and brute force: mean and max
