@@ -367,8 +367,9 @@ def _exact_knn_float_compiled(Q, X, k, block: int | None = None, margin: int = 1
     return _final_k(Q, X, best_idx, k)
 
 
-# two workers from this many keys (queries x rows) on: below, a product is too short to share (issue 25)
-_TWO_WORKERS_MIN_KEYS = 1 << 20
+# two workers from this many keys (queries x rows) on: below, a product is too short to share (issue 25; at load
+# 10, 2^17-2^20 keys took 0.04-0.54x the one-worker time, the one worker's two-thread BLAS waiting for a core)
+_TWO_WORKERS_MIN_KEYS = 1 << 18
 
 
 def _use_two_workers(M, N):
@@ -402,8 +403,8 @@ def _split_rows(M):
     -------
     int
     """
-    # 2^17 keys = 512 KB of the 1 MiB L2 per core: 256-row blocks of 500 queries beat 64-128 (more calls)
-    # and 512-4096 (keys read back from L3) in bench_stores.py --brute-only (issue 25)
+    # 2^17 keys = 512 KB of the 1 MiB L2 per core. Scratch sweeps of 500 queries x 65 000 rows at load 5-10 had
+    # 256-384 rows at or near the best of 64-4194 in three of four (issue 25); to be re-measured quietly
     return max(128, min(4096, (1 << 17) // max(M, 1)))
 
 

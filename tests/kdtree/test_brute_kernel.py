@@ -140,14 +140,15 @@ def test_two_workers_ties_across_blocks_keep_the_lowest_index():
 
 def test_store_takes_two_workers_for_large_problems(monkeypatch):
     rng = np.random.default_rng(9)
-    X = rng.standard_normal((3000, 8)).astype(np.float32)  # 900 000 keys: one worker by default
-    Q = rng.standard_normal((300, 8)).astype(np.float32)
+    X = rng.standard_normal((3000, 8)).astype(np.float32)
+    Q = rng.standard_normal((300, 8)).astype(np.float32)  # 900 000 keys: two workers by default
     s = BruteForceStore()
     s.add(X, np.arange(3000) + 7)
     calls = []
     monkeypatch.setattr(_brute, "top_c_blocks", lambda *a: calls.append(a[-1]) or top_c_blocks(*a))
-    d1, i1 = s.query(Q, 2)
-    monkeypatch.setattr(knn, "_TWO_WORKERS_MIN_KEYS", 1000)
+    with monkeypatch.context() as m:
+        m.setattr(knn, "_TWO_WORKERS_MIN_KEYS", 1 << 62)
+        d1, i1 = s.query(Q, 2)
     d2, i2 = s.query(Q, 2)
     assert calls == [1, 2 if blas_threads_settable() else 1]
     np.testing.assert_array_equal(i2, i1)
