@@ -64,7 +64,7 @@ def _timed(fn, repeats):
 #: the library options that recall most at 200 leaves (issue 25; ``--bbf-ablation``): split at the midrange of the
 #: coordinate of largest variance, the split gaps kept, Arya & Mount's incremental bound
 BEST_SPLIT, BEST_GAP, BEST_BOUND = "variance-midrange", True, "incremental"
-BEST_LABEL = f"BBF 200, library options (split={BEST_SPLIT!r}, gap={BEST_GAP}, bound={BEST_BOUND!r})"
+BEST_LABEL = f"BBF 200, library options ({BEST_SPLIT}, gap, {BEST_BOUND})"
 
 
 def _methods(Q, train, tree, tree_opt, ck, fl, n):
@@ -103,7 +103,7 @@ def bench_matching(sizes, n_queries=500, repeats=3):
                          "numpy lock-step") + "; leaves of 1 point, so 200 leaves = 200 points examined, as "
           "FLANN's checks=200 (1 randomised tree)")
     KDTree(np.ones((2, 64), np.float32)).query(np.ones((1, 64), np.float32), 2, max_leaves=1)  # compile first
-    print(f"{'stored':>7s} {'method':75s} {'time [ms]':>10s} {'/ brute':>8s} {'NN recall':>10s}")
+    print(f"{'stored':>7s} {'method':60s} {'time [ms]':>10s} {'/ brute':>8s} {'NN recall':>10s}")
     rows, goal = [], []
     for n in sizes:
         _, q, train, _ = _matching_workload(n, n_queries, "graf", 2, 0.5 if n <= 13000 else 1.0, 5e-5)
@@ -117,7 +117,7 @@ def bench_matching(sizes, n_queries=500, repeats=3):
         t_brute, (_, i_ref) = results["brute (BLAS)"]
         for k, (t, (_, idx)) in results.items():
             rec = np.mean(idx[:, 0] == i_ref[:, 0])
-            print(f"{n:7d} {k:75s} {1000 * t:10.1f} {t / t_brute:8.2f} {rec:10.3f}")
+            print(f"{n:7d} {k:60s} {1000 * t:10.1f} {t / t_brute:8.2f} {rec:10.3f}")
             rows.append((n, k, t, t / t_brute, rec))
         fl_rec = _flann_recalls(Q, train, i_ref)
         ours = rows[[r[1] for r in rows].index(BEST_LABEL, len(rows) - len(results))][4]
