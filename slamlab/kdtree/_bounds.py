@@ -19,7 +19,8 @@ BBF_BOUNDS = ("max", "incremental", "sum")
 
 def _cell_bounds(t):
     """Per inner node, its cell's interval ``[lo, hi]`` along its own split coordinate (±inf where no ancestor
-    splits on it): the nearest ancestor on each side that splits on the same coordinate bounds it.
+    splits on it): the nearest ancestor on each side that splits on the same coordinate bounds it (at its
+    ``split_hi`` for a right descendant, ``split_lo`` for a left one).
 
     Parameters
     ----------
@@ -31,7 +32,8 @@ def _cell_bounds(t):
     lo, hi : (n_nodes,) float64
         The interval per node (leaves: ±inf).
     """
-    left, right, dim, val = t["left"], t["right"], t["split_dim"], t["split_val"]
+    left, right, dim = t["left"], t["right"], t["split_dim"]
+    split_lo, split_hi = t["split_lo"], t["split_hi"]  # the halves' nearest values (both split_val without gaps)
     n = left.size
     inner = np.flatnonzero(left >= 0)
     parent = np.full(n, -1, dtype=np.int64)
@@ -45,10 +47,10 @@ def _cell_bounds(t):
         up = np.flatnonzero(parent[cur] >= 0)
         p = parent[cur[up]]
         same = dim[p] == dim[up]
-        r = up[same & is_right[cur[up]]]  # a right child holds values >= split: a lower end
-        lo[r] = np.maximum(lo[r], val[parent[cur[r]]])
+        r = up[same & is_right[cur[up]]]  # a right child holds values >= split_hi: a lower end
+        lo[r] = np.maximum(lo[r], split_hi[parent[cur[r]]])
         lf = up[same & ~is_right[cur[up]]]
-        hi[lf] = np.minimum(hi[lf], val[parent[cur[lf]]])
+        hi[lf] = np.minimum(hi[lf], split_lo[parent[cur[lf]]])
         cur[up] = p
     return lo, hi
 
@@ -63,7 +65,8 @@ def _far_bound(bound, cur_b, diff, qd, lo, hi):
     cur_b : (A,) float64
         Bounds of the nodes being descended.
     diff : (A,) float
-        The queries' signed distances to the splitting planes.
+        The queries' distances to the far halves along the split coordinate (to the splitting planes when the
+        tree keeps no gaps; the sign does not matter).
     qd : (A,) float64 or None
         The queries' split coordinates (``"incremental"`` only).
     lo, hi : (A,) float64 or None

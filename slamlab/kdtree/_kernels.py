@@ -62,8 +62,8 @@ def bbf_search(t, P, Q, k, max_leaves, bound="max"):
     lanes = np.zeros(16 // P.dtype.itemsize, dtype=P.dtype)  # one 128-bit register of accumulators
     mode = ("max", "incremental", "sum").index(bound)
     lo, hi = (t["cell_lo"], t["cell_hi"]) if mode == 1 else (t["split_val"], t["split_val"])
-    return _bbf_lockstep(t["split_dim"], t["split_val"], t["left"], t["right"], t["start"], t["stop"],
-                         np.ascontiguousarray(P), np.ascontiguousarray(Q), int(k),
+    return _bbf_lockstep(t["split_dim"], t["split_val"], t["split_lo"], t["split_hi"], t["left"], t["right"],
+                         t["start"], t["stop"], np.ascontiguousarray(P), np.ascontiguousarray(Q), int(k),
                          0 if max_leaves is None else int(max_leaves), lanes, mode, lo, hi)
 
 
@@ -260,19 +260,22 @@ def _grow(hb, hs, hn):
     return nb, ns, nn
 
 
-def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_leaves, acc, mode, lo, hi):
+def _bbf_lockstep(split_dim, split_val, split_lo, split_hi, left, right, start, stop, P, Q, k, max_leaves, acc,
+                  mode, lo, hi):
     """The rounds of ``tree._lockstep_search``, one query after the other inside a round (see the module doc).
 
     In each round every unfinished query: evaluates the leaf it stands on (and stops at ``max_leaves``);
     without a node, pops its best pending branch, or stops when that bound is no better than its k-th
-    distance; on an inner node, descends one level and pushes the far child with the bound
-    max(parent bound, (q[d] - split)²) (000 §1.4.3, our bound; ``mode`` 0), Arya & Mount's incremental
+    distance; on an inner node, descends one level (the side of ``split_val``) and pushes the far child with
+    the bound max(parent bound, e²), e = the distance from q[d] to the far half's nearest value ``split_hi`` /
+    ``split_lo`` (the plane unless the tree keeps gaps; 000 §1.4.3, our bound; ``mode`` 0), Arya & Mount's
+    incremental
     distance to the far cell (1: the parent bound with coordinate d's offset from ``[lo, hi]`` replaced) or
     FLANN's sum (2), when it beats the k-th distance.
 
     Parameters
     ----------
-    split_dim, split_val, left, right, start, stop : (n_nodes,) arrays
+    split_dim, split_val, split_lo, split_hi, left, right, start, stop : (n_nodes,) arrays
         The tree's node arrays (:func:`slamlab.kdtree.build_kdtree`).
     P : (N, dim) float array
         Points in leaf order.
@@ -339,14 +342,16 @@ def _bbf_lockstep(split_dim, split_val, left, right, start, stop, P, Q, k, max_l
             # 3. on an inner node: descend one level, push the far child
             c = cur[q]
             if left[c] >= 0:
-                diff = Q[q, split_dim[c]] - split_val[c]  # float64, as numpy promotes it
-                near, far = (left[c], right[c]) if diff <= 0 else (right[c], left[c])
+                qd = np.float64(Q[q, split_dim[c]])  # float64, as numpy promotes it
+                if qd - split_val[c] <= 0:  # e to the far half's nearest value (the plane without gaps)
+                    near, far, diff = left[c], right[c], split_hi[c] - qd
+                else:
+                    near, far, diff = right[c], left[c], qd - split_lo[c]
                 if mode == 0:
                     fb = max(cur_b[q], diff * diff)
                 elif mode == 2:
                     fb = cur_b[q] + diff * diff
                 else:
-                    qd = np.float64(Q[q, split_dim[c]])
                     off = max(max(lo[c] - qd, qd - hi[c]), 0.0)
                     fb = max(cur_b[q], cur_b[q] - off * off + diff * diff)
                 nodes_v[q] += 1

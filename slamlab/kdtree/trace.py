@@ -72,8 +72,10 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None, bou
         events.append(("pop", int(node), float(bound)))
         while t["left"][node] >= 0:
             d, s = t["split_dim"][node], t["split_val"][node]
-            diff = q[d] - s
-            near, far = (t["left"][node], t["right"][node]) if diff <= 0 else (t["right"][node], t["left"][node])
+            if q[d] - s <= 0:  # the far half's nearest value: split_hi / split_lo (= s unless the tree keeps gaps)
+                near, far, diff = t["left"][node], t["right"][node], t["split_hi"][node] - q[d]
+            else:
+                near, far, diff = t["right"][node], t["left"][node], q[d] - t["split_lo"][node]
             if bound_rule == "max":  # our bound: the farthest single plane so far
                 fb = max(bound, diff * diff)
             elif bound_rule == "sum":  # FLANN's: the planes' squared distances added up

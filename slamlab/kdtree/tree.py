@@ -7,6 +7,8 @@ distribution" (000 is silent on it): the coordinate of **largest spread**
 (max - min); the median split is by *position* in the sorted order, so points
 equal to the split value may sit on either side (ties handled explicitly: left
 holds values ``<= split``, right ``>= split``; both lower bounds stay valid).
+Other split rules (FLANN's variance and mean, the midrange; unbalanced trees) and the
+split gaps: ``KDTree(..., split=, gap=)``, built in ``build.py`` (issue 25).
 
 Search (Beis & Lowe's Best-Bin-First, which 000 cites): descend to the leaf of
 the query, remember every branch not taken with its lower bound -- the squared
@@ -36,8 +38,9 @@ import numpy as np
 from .. import _validate as v
 from .._compiled import numba_enabled
 from ._bounds import BBF_BOUNDS, _cell_bounds, _far_bound
+from .build import SPLIT_RULES, build_kdtree
 
-__all__ = ["BBF_BOUNDS", "KDTree", "SearchStats", "build_kdtree"]
+__all__ = ["BBF_BOUNDS", "SPLIT_RULES", "KDTree", "SearchStats", "build_kdtree"]
 
 
 @dataclass(frozen=True)
@@ -72,123 +75,6 @@ class SearchStats:
                 f"{self.mean_leaves:.1f} leaves, {self.mean_distance_evals:.1f} distance evaluations per query")
 
 
-def build_kdtree(points, ids=None, *, leaf_size: int = 1):
-    """Median split on the coordinate of largest spread, level by level (000 §1.4.3).
-
-    Parameters
-    ----------
-    points : (N, k) array
-        The k-dimensional points (descriptors).
-    ids : (N,) int array, optional
-        Identifiers returned by queries; ``arange(N)`` by default.
-    leaf_size : int
-        A node with at most this many points is a leaf (bucket). 1 = one point per
-        leaf, as in Beis & Lowe's BBF where "200 leaves" means 200 points examined.
-
-    Returns
-    -------
-    dict of arrays
-        ``perm`` (points in leaf order), ``split_dim``, ``split_val``, ``left``,
-        ``right`` (-1 for leaves), ``start``, ``stop`` (leaf bucket ranges in
-        ``perm``), ``depth``. Node 0 is the root; nodes are numbered level by level.
-
-    Examples
-    --------
-    >>> t = build_kdtree(np.array([[0.0, 0], [1, 0], [2, 0], [3, 5]]))
-    >>> int(t["split_dim"][0]), float(t["split_val"][0])
-    (1, 0.0)
-    """
-    keep32 = isinstance(points, np.ndarray) and points.dtype == np.float32
-    X = v.as_finite_array(points, "points", ndim=2, dtype=np.float32 if keep32 else np.float64)
-    n, k = X.shape
-    if n == 0 or k == 0:
-        raise ValueError(f"`points` must hold at least one point of dimension >= 1; got shape {X.shape}")
-    leaf_size = v.check_int(leaf_size, "leaf_size", minimum=1)
-    if ids is None:
-        ids = np.arange(n, dtype=np.int64)
-    else:
-        ids = np.asarray(ids)
-        if not np.issubdtype(ids.dtype, np.integer):
-            raise TypeError(f"`ids` must be an integer array; got dtype {ids.dtype}")
-        if ids.shape != (n,):
-            raise ValueError(f"`ids` must have shape ({n},) to match `points`; got shape {ids.shape}")
-        ids = ids.astype(np.int64)
-
-    perm = np.arange(n, dtype=np.int64)
-    # current level: segments [s0, s1) of perm, with their node numbers
-    seg_start = np.array([0], dtype=np.int64)
-    seg_stop = np.array([n], dtype=np.int64)
-    seg_node = np.array([0], dtype=np.int64)
-    n_nodes, level = 1, 0
-    node_rows = []  # (node ids, dims, vals, left, right, start, stop, depth) per level
-    while seg_start.size:
-        size = seg_stop - seg_start
-        is_leaf = size <= leaf_size
-        inner = ~is_leaf
-        # leaves of this level
-        lf = np.flatnonzero(is_leaf)
-        node_rows.append((seg_node[lf], np.full(lf.size, -1), np.zeros(lf.size), np.full(lf.size, -1),
-                          np.full(lf.size, -1), seg_start[lf], seg_stop[lf], np.full(lf.size, level)))
-        if not inner.any():
-            break
-        s0, s1, nodes = seg_start[inner], seg_stop[inner], seg_node[inner]
-        lens = s1 - s0
-        dim = _widest_coordinate(X, perm, s0, lens)
-        lmax = int(lens.max())
-        # sort every segment by its split coordinate (rows padded with +inf; stable: ties keep order)
-        cols = np.arange(lmax)
-        valid = cols < lens[:, None]
-        idx = np.where(valid, s0[:, None] + cols, s0[:, None])
-        key = np.where(valid, X[perm[idx], dim[:, None]], np.inf)
-        o = np.argsort(key, axis=1, kind="stable")
-        key = np.take_along_axis(key, o, axis=1)
-        perm[idx[valid]] = perm[np.take_along_axis(idx, o, axis=1)][valid]
-        half = lens // 2  # left gets floor(n/2) points, right the rest
-        mid = s0 + half
-        # split value: the largest value on the left (left <= split <= right)
-        val = key[np.arange(s0.size), half - 1].astype(np.float64)
-        lnode = n_nodes + 2 * np.arange(s0.size)
-        rnode = lnode + 1
-        n_nodes += 2 * s0.size
-        node_rows.append((nodes, dim, val, lnode, rnode, np.full(s0.size, -1), np.full(s0.size, -1),
-                          np.full(s0.size, level)))
-        seg_start = np.concatenate([s0, mid])
-        seg_stop = np.concatenate([mid, s1])
-        seg_node = np.concatenate([lnode, rnode])
-        srt = np.argsort(seg_node)
-        seg_start, seg_stop, seg_node = seg_start[srt], seg_stop[srt], seg_node[srt]
-        level += 1
-
-    split_dim = np.empty(n_nodes, dtype=np.int64)
-    split_val = np.empty(n_nodes, dtype=np.float64)
-    left = np.empty(n_nodes, dtype=np.int64)
-    right = np.empty(n_nodes, dtype=np.int64)
-    start = np.empty(n_nodes, dtype=np.int64)
-    stop = np.empty(n_nodes, dtype=np.int64)
-    depth = np.empty(n_nodes, dtype=np.int64)
-    for nodes, d, val, lft, rgt, s0, s1, dep in node_rows:
-        split_dim[nodes], split_val[nodes], left[nodes], right[nodes] = d, val, lft, rgt
-        start[nodes], stop[nodes], depth[nodes] = s0, s1, dep
-    return {"points": X, "ids": ids, "perm": perm, "split_dim": split_dim, "split_val": split_val,
-            "left": left, "right": right, "start": start, "stop": stop, "depth": depth, "leaf_size": leaf_size}
-
-
-def _widest_coordinate(X, perm, s0, lens):
-    """Per segment ``perm[s0 : s0 + lens]`` of the points ``X``, the coordinate of largest spread (max − min;
-    ties: the lowest index), our reading of 000 §1.4.3's "best distribution"."""
-    # balanced halving keeps a level's lengths within {L, L+1}, so the first min(lens) points of every segment
-    # form a regular (segments, L, k) block
-    lmin, lmax = int(lens.min()), int(lens.max())
-    block = X[perm[s0[:, None] + np.arange(lmin)]]
-    hi, lo = block.max(axis=1), block.min(axis=1)
-    for e in range(lmin, lmax):
-        has = np.flatnonzero(lens > e)
-        extra = X[perm[s0[has] + e]]
-        hi[has] = np.maximum(hi[has], extra)
-        lo[has] = np.minimum(lo[has], extra)
-    return np.argmax(hi - lo, axis=1)
-
-
 class KDTree:
     """Static balanced kd-tree with exact and Best-Bin-First k-NN queries (000 §1.4.3).
 
@@ -200,6 +86,12 @@ class KDTree:
         Identifiers returned by :meth:`query` (default ``arange(N)``).
     leaf_size : int
         Bucket size of a leaf (default 1: a leaf is a point, as in BBF's "200 leaves").
+    split : str
+        Split rule (:data:`SPLIT_RULES`): ``"spread-median"`` (default, balanced, 000 §1.4.3) or e.g.
+        ``"variance-mean"`` (FLANN's) -- see :func:`build_kdtree`.
+    gap : bool
+        Keep both ends of every split's gap (nanoflann's divlow/divhigh; default False) -- see
+        :func:`build_kdtree`.
 
     Examples
     --------
@@ -213,8 +105,8 @@ class KDTree:
     (2,)
     """
 
-    def __init__(self, points, ids=None, *, leaf_size: int = 1):
-        t = build_kdtree(points, ids, leaf_size=leaf_size)
+    def __init__(self, points, ids=None, *, leaf_size: int = 1, split: str = "spread-median", gap: bool = False):
+        t = build_kdtree(points, ids, leaf_size=leaf_size, split=split, gap=gap)
         self.points = t["points"]
         self.ids = t["ids"]
         self.leaf_size = t["leaf_size"]
@@ -256,7 +148,9 @@ class KDTree:
         return self.n
 
     def __repr__(self) -> str:
-        return f"KDTree(n={self.n}, k={self.dim}, leaf_size={self.leaf_size}, height={self.height})"
+        opts = "" if self._t["split"] == "spread-median" and not self._t["gap"] else \
+            f", split={self._t['split']!r}, gap={self._t['gap']}"
+        return f"KDTree(n={self.n}, k={self.dim}, leaf_size={self.leaf_size}{opts}, height={self.height})"
 
     def query(self, Q, k: int = 2, *, max_leaves: int | None = None, bound: str = "max"):
         """k nearest neighbours of every row of ``Q``: exact, or BBF after ``max_leaves`` leaves (000 §1.4.3).
@@ -394,6 +288,7 @@ def _lockstep_search(t, P, Q, k, max_leaves, bound="max"):
     neighbour, or ``max_leaves`` reached), descend one level pushing the far child.
     """
     split_dim, split_val, left, right = t["split_dim"], t["split_val"], t["left"], t["right"]
+    split_lo, split_hi = t["split_lo"], t["split_hi"]
     start, stop = t["start"], t["stop"]
     leaf_size = t["leaf_size"]
     M = Q.shape[0]
@@ -453,13 +348,14 @@ def _lockstep_search(t, P, Q, k, max_leaves, bound="max"):
         if inner.any():
             a = active[inner]
             cn = c[inner]
-            diff = Q[a, split_dim[cn]] - split_val[cn]
-            go_left = diff <= 0
+            qd = Q[a, split_dim[cn]].astype(np.float64)
+            go_left = qd - split_val[cn] <= 0
             near = np.where(go_left, left[cn], right[cn])
             far = np.where(go_left, right[cn], left[cn])
+            # distance to the far half: its nearest value (= split_val unless the tree keeps the gaps)
+            diff = np.where(go_left, split_hi[cn] - qd, qd - split_lo[cn])
             if bound == "incremental":
-                fb = _far_bound(bound, cur_b[a], diff, Q[a, split_dim[cn]].astype(np.float64),
-                                t["cell_lo"][cn], t["cell_hi"][cn])
+                fb = _far_bound(bound, cur_b[a], diff, qd, t["cell_lo"][cn], t["cell_hi"][cn])
             else:
                 fb = _far_bound(bound, cur_b[a], diff, None, None, None)
             nodes_v[a] += 1
