@@ -215,6 +215,8 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
     print(r.table())
     for t in (0.75, 0.8, 0.85, 0.9):
         print(r.ambiguity_table(t))
+    for t in (1.0, 1.2, 1.3):  # issue 25: the margin, threshold 1.2 tuned on csail, orebro and seattle
+        print(r.margin_table(t))
     for res in r.results:
         print(res.table())
 
