@@ -311,8 +311,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         grid; the issue-17 runs left out ±10 (≈ ±10 m of path on the shared logs, whose scans are
         ≈ 1 m apart), which removed the map of places the robot passed once (csail, orebro:
         ``docs/benchmarks.md``, correlation section, the ablation table).
-    joined : sequence of int in {1, 2, 3}
-        The modes to run on the same scans.
+    joined : sequence of int in {1, ..., 5}
+        The modes to run on the same scans (4 and 5: an issue-25 experiment, a longer baseline).
     odom_std : tuple of float
         ``(σ_xy [m], σ_θ [rad])`` of the noise added to each logged step (default ``ODOM_STD``, 0.05 m and 1°).
     hit_ratio : float, default 0.25
@@ -338,8 +338,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     rmax = v.check_positive(max_range_m, "max_range_m")
     ex = v.check_int(exclude, "exclude", minimum=0)
     modes = tuple(int(k) for k in np.atleast_1d(np.asarray(joined)))
-    if not modes or any(k not in (1, 2, 3) for k in modes) or len(set(modes)) != len(modes):
-        raise ValueError(f"`joined` must be distinct numbers of scans from {{1, 2, 3}}; got {joined!r}")
+    if not modes or any(k not in (1, 2, 3, 4, 5) for k in modes) or len(set(modes)) != len(modes):
+        raise ValueError(f"`joined` must be distinct numbers of scans from {{1, ..., 5}}; got {joined!r}")
     kmax = max(modes)
     if ex < kmax - 1:
         raise ValueError(f"`exclude` must be >= {kmax - 1} so the joined scans are not in the map; got {ex}")

@@ -163,7 +163,7 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: Loca
         :func:`slamlab.data.find_data`).
     every : int, default 25
         Localise every ``every``-th scan (at least 3, so the joined scans come before).
-    joined : sequence of int in {1, 2, 3}
+    joined : sequence of int in {1, ..., 5}
         The modes (scans joined by odometry), as in :func:`~slamlab.correlation.run_log_localisation`.
     params : LocaliseParams, optional
         Settings of every localisation (default :class:`LocaliseParams`'s; its fields can also be given in
