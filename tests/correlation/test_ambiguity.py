@@ -139,3 +139,14 @@ def test_corridor_tie_run_reports_both_modes():
     assert str(r).startswith("corridor: one scan 180° off")
     with pytest.raises(ValueError, match="`step_cells` must be"):
         C.run_corridor_tie(step_cells=-1.0)
+
+
+def test_margin_edge_cases():
+    """The margin's sentinels: no rival pose (inf), a peak no better than the median heading (0), not searched (NaN)."""
+    kw = {"pose": np.zeros(3), "row": 0, "col": 0, "heading_index": 0, "score": 9.0,
+          "headings_rad": np.zeros(3), "best_per_heading": np.array([9.0, 5.0, 1.0]), "score_map": np.zeros((1, 1))}
+    assert C.Localisation(**kw, rival_score=-np.inf).margin == np.inf
+    assert np.isnan(C.Localisation(**kw).margin)
+    assert C.Localisation(**kw, rival_score=8.0).margin == pytest.approx(0.5)  # (9 - 8) / sqrt(9 - 5)
+    flat = {**kw, "best_per_heading": np.array([9.0, 9.0, 9.0])}
+    assert C.Localisation(**flat, rival_score=8.0).margin == 0.0
