@@ -215,8 +215,25 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
     print(r.table())
     for t in (0.75, 0.8, 0.85, 0.9):
         print(r.ambiguity_table(t))
+    for t in (1.0, 1.2, 1.3):  # issue 25: the margin, threshold 1.2 tuned on csail, orebro and seattle
+        print(r.margin_table(t))
+    if 1 in r.results[0].joined and 3 in r.results[0].joined:
+        more_confident(r)
     for res in r.results:
         print(res.table())
+
+
+def more_confident(r) -> None:
+    """Issue 25 (ours, an experiment): per scan, the 1-scan or the 3-scan answer, whichever has the larger margin."""
+    print("\nPer scan the answer of the mode with the larger margin (1 scan or 3 joined), localised per log:")
+    tot = [0, 0, 0]
+    for name, res in zip(r.names, r.results, strict=True):
+        m1, m3 = res.joined.index(1), res.joined.index(3)
+        pick = np.where(res.margin[m1] > res.margin[m3], res.success[m1], res.success[m3])
+        n = pick.size
+        tot = [tot[0] + res.success[m3].sum(), tot[1] + pick.sum(), tot[2] + n]
+        print(f"{name:>8}: 3 scans {res.success[m3].sum()}/{n}, more confident of 1 and 3: {pick.sum()}/{n}")
+    print(f"{'all':>8}: 3 scans {tot[0]}/{tot[2]}, more confident of 1 and 3: {tot[1]}/{tot[2]}")
 
 
 def intel(n_jobs: int) -> None:

@@ -97,6 +97,8 @@ class LogLocalisationResult:
         Wrapped heading errors [rad].
     ambiguity : numpy.ndarray, shape (modes, n)
         :attr:`Localisation.ambiguity` of each localisation.
+    margin : numpy.ndarray, shape (modes, n), optional
+        :attr:`Localisation.margin` of each localisation (None: not recorded).
     cell_m : float
         Grid cell size [m].
     max_range_m : float
@@ -136,6 +138,7 @@ class LogLocalisationResult:
     example_points_m: np.ndarray = field(default=None, repr=False)  # the first scan drawn at its estimate (mode 0)
     params: LocaliseParams = field(default_factory=LocaliseParams, repr=False)
     time_s: float = field(default=0.0, compare=False)
+    margin: np.ndarray | None = field(default=None, repr=False)  # (modes, n) Localisation.margin
 
     @property
     def success(self) -> np.ndarray:
@@ -267,7 +270,8 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
         free, obs, o = _joined_samples(beams[:k], rel[:k], p)
         loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k,
                                 obs_weights=_wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None)
-        row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity})
+        row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity,
+                    f"mar{k}": loc.margin})
     return row
 
 
@@ -307,8 +311,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         grid; the issue-17 runs left out ±10 (≈ ±10 m of path on the shared logs, whose scans are
         ≈ 1 m apart), which removed the map of places the robot passed once (csail, orebro:
         ``docs/benchmarks.md``, correlation section, the ablation table).
-    joined : sequence of int in {1, 2, 3}
-        The modes to run on the same scans.
+    joined : sequence of int in {1, ..., 5}
+        The modes to run on the same scans (4 and 5: an issue-25 experiment, a longer baseline).
     odom_std : tuple of float
         ``(σ_xy [m], σ_θ [rad])`` of the noise added to each logged step (default ``ODOM_STD``, 0.05 m and 1°).
     hit_ratio : float, default 0.25
@@ -334,8 +338,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     rmax = v.check_positive(max_range_m, "max_range_m")
     ex = v.check_int(exclude, "exclude", minimum=0)
     modes = tuple(int(k) for k in np.atleast_1d(np.asarray(joined)))
-    if not modes or any(k not in (1, 2, 3) for k in modes) or len(set(modes)) != len(modes):
-        raise ValueError(f"`joined` must be distinct numbers of scans from {{1, 2, 3}}; got {joined!r}")
+    if not modes or any(k not in (1, 2, 3, 4, 5) for k in modes) or len(set(modes)) != len(modes):
+        raise ValueError(f"`joined` must be distinct numbers of scans from {{1, ..., 5}}; got {joined!r}")
     kmax = max(modes)
     if ex < kmax - 1:
         raise ValueError(f"`exclude` must be >= {kmax - 1} so the joined scans are not in the map; got {ex}")
@@ -370,9 +374,11 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     err_p = np.hypot(est_m[..., 0] - true_m[:, 0], est_m[..., 1] - true_m[:, 1])
     err_a = heading_error(est_m[..., 2], true_m[:, 2])
     amb = np.stack([table[f"amb{k}"].to_numpy(dtype=float) for k in modes])
+    margin = np.stack([table[f"mar{k}"].to_numpy(dtype=float) for k in modes])
     example = log.scan(int(idx[0])).points(est_m[0, 0])
     return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, amb, cell, rmax, ex, full.grid, frame,
-                                 modes, (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0)
+                                 modes, (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0,
+                                 margin)
 
 
 def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = None,

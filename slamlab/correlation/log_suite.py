@@ -105,22 +105,43 @@ class LogSuiteResult:
         t = v.check_positive(threshold, "threshold", allow_zero=True)
         if t > 1:
             raise ValueError(f"`threshold` must lie in [0, 1]; got {t}")
-        rows = []
-        for name, r in zip(self.names, self.results, strict=True):
-            for m, k in enumerate(r.joined):
-                a, ok = r.ambiguity[m], r.success[m]
-                rows.append([name, r._mode(k), f"{np.sum(a[~ok] >= t)}/{np.sum(~ok)}", f"{np.sum(a[ok] >= t)}/{ok.sum()}",
-                             f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-",
-                             f"{np.median(a[ok]):.2f}" if ok.any() else "-"])
+        return self._flag_table([r.ambiguity for r in self.results], lambda a: a >= t, f">= {t:g}", "amb.",
+                                f"Ambiguity as a failure flag, threshold {t:g}")
+
+    def margin_table(self, threshold: float = 1.2) -> str:
+        """Per log and mode, then pooled over the logs: failures flagged (margin ≤ ``threshold``) and successes
+        flagged (false alarms), with :attr:`~slamlab.correlation.Localisation.margin` (ours, issue 25).
+
+        Parameters
+        ----------
+        threshold : float, default 1.2
+            Margin at or below which a localisation is flagged, at least 0 (1.2: tuned on csail, orebro and
+            seattle, ``docs/benchmarks.md``).
+
+        Returns
+        -------
+        str
+        """
+        t = v.check_positive(threshold, "threshold", allow_zero=True)
+        if any(r.margin is None for r in self.results):
+            raise ValueError("every result must carry its margins (run by run_log_localisation)")
+        return self._flag_table([r.margin for r in self.results], lambda a: a <= t, f"<= {t:g}", "margin",
+                                f"Margin (best - rival) / sqrt(best - base) as a failure flag, threshold {t:g}")
+
+    def _flag_table(self, values, flag, rule: str, short: str, title: str) -> str:
+        """Rows per log and mode, then pooled: failures and successes ``flag``-ged, and their median ``values``."""
+        def row(name, mode, a, ok):
+            f = flag(a)
+            return [name, mode, f"{np.sum(f[~ok])}/{np.sum(~ok)}", f"{np.sum(f[ok])}/{ok.sum()}",
+                    f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-", f"{np.median(a[ok]):.2f}" if ok.any() else "-"]
+
+        rows = [row(name, r._mode(k), a[m], r.success[m])
+                for name, r, a in zip(self.names, self.results, values, strict=True) for m, k in enumerate(r.joined)]
         for m, k in enumerate(self.results[0].joined):  # pooled over the logs
-            a = np.concatenate([r.ambiguity[m] for r in self.results])
-            ok = np.concatenate([r.success[m] for r in self.results])
-            rows.append(["all", self.results[0]._mode(k), f"{np.sum(a[~ok] >= t)}/{np.sum(~ok)}",
-                         f"{np.sum(a[ok] >= t)}/{ok.sum()}", f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-",
-                         f"{np.median(a[ok]):.2f}" if ok.any() else "-"])
-        return format_table(["log", "mode", f"failures flagged (>= {t:g})", "successes flagged",
-                             "median amb. (failures)", "median amb. (successes)"], rows,
-                            title=f"Ambiguity as a failure flag, threshold {t:g}")
+            rows.append(row("all", self.results[0]._mode(k), np.concatenate([a[m] for a in values]),
+                            np.concatenate([r.success[m] for r in self.results])))
+        return format_table(["log", "mode", f"failures flagged ({rule})", "successes flagged",
+                             f"median {short} (failures)", f"median {short} (successes)"], rows, title=title)
 
     def __str__(self) -> str:
         rates = "; ".join(f"{n} " + ", ".join(f"{ok.sum()}/{ok.size}" for ok in r.success)
@@ -142,7 +163,7 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: Loca
         :func:`slamlab.data.find_data`).
     every : int, default 25
         Localise every ``every``-th scan (at least 3, so the joined scans come before).
-    joined : sequence of int in {1, 2, 3}
+    joined : sequence of int in {1, ..., 5}
         The modes (scans joined by odometry), as in :func:`~slamlab.correlation.run_log_localisation`.
     params : LocaliseParams, optional
         Settings of every localisation (default :class:`LocaliseParams`'s; its fields can also be given in

@@ -101,6 +101,27 @@ class Localisation:
             return 1.0
         return float(np.clip((self.rival_score - base) / (self.score - base), 0.0, 1.0))
 
+    @property
+    def margin(self) -> float:
+        """How far the peak stands above its best rival, in units of the peak's own counting noise (ours, issue 25).
+
+        ``(score − rival) / √(score − base)`` with ``rival`` and ``base`` as in :attr:`ambiguity`. The score
+        above ``base`` counts the marks of the scan that match the map better than at a wrong heading; if
+        matches came at random, two poses' counts would differ by about its square root, so a margin below
+        about 1 means the peak could as well be its rival. Small = doubtful (the opposite sense of
+        :attr:`ambiguity`); ``docs/benchmarks.md`` (correlation section) gives its threshold as a failure
+        flag (1.2) and how well it separates on the five shared CARMEN logs. NaN when the rival was not
+        searched; ``inf`` when no pose lies outside the rival window; 0 when the peak is no better than ``base``.
+        """
+        if np.isnan(self.rival_score):
+            return float("nan")
+        if self.rival_score == -np.inf:
+            return float("inf")
+        above = self.score - float(np.median(self.best_per_heading))
+        if above <= 0:
+            return 0.0
+        return float(max(self.score - self.rival_score, 0.0) / np.sqrt(above))
+
     def __str__(self) -> str:
         amb = f", ambiguity {self.ambiguity:.3f}" if np.isfinite(self.ambiguity) else ""
         return (f"pose x={self.pose[0]:.0f}, y={self.pose[1]:.0f} cells, heading "

@@ -44,6 +44,7 @@ def test_corridor_reads_as_ambiguous():
     assert loc.rival_score == pytest.approx(loc.score, rel=1e-12)
     assert loc.ambiguity == pytest.approx(1.0, abs=1e-12)
     assert "ambiguity 1.000" in str(loc)
+    assert loc.margin == pytest.approx(0.0, abs=1e-9)  # a tie: no margin
 
 
 def test_unique_corner_reads_as_unambiguous():
@@ -65,6 +66,10 @@ def test_unique_corner_reads_as_unambiguous():
     # a tie reads 1 (the corridor); the corner's best rival, a quarter turn that lays one wall along the
     # other, gets clearly less than the peak above the wrong headings' median
     assert loc.ambiguity < 0.9
+    # the margin by its definition: (best - rival) / sqrt(best - median of the headings' best scores)
+    base = np.median(loc.best_per_heading)
+    assert loc.margin == pytest.approx((best - rival) / np.sqrt(best - base), rel=1e-9)
+    assert loc.margin > 1.2  # not flagged at the threshold of docs/benchmarks.md
 
 
 def test_rival_window_parameters_and_switch():
@@ -78,6 +83,7 @@ def test_rival_window_parameters_and_switch():
     assert loc.rival_score >= wide.rival_score
     off = C.localise(g, scan, **EXACT, ambiguity=False)
     assert np.isnan(off.ambiguity)
+    assert np.isnan(off.margin)
     assert off.rival_pose is None
     assert (off.row, off.col, off.heading_index) == (wide.row, wide.col, wide.heading_index)
 
@@ -133,3 +139,14 @@ def test_corridor_tie_run_reports_both_modes():
     assert str(r).startswith("corridor: one scan 180° off")
     with pytest.raises(ValueError, match="`step_cells` must be"):
         C.run_corridor_tie(step_cells=-1.0)
+
+
+def test_margin_edge_cases():
+    """The margin's sentinels: no rival pose (inf), a peak no better than the median heading (0), not searched (NaN)."""
+    kw = {"pose": np.zeros(3), "row": 0, "col": 0, "heading_index": 0, "score": 9.0,
+          "headings_rad": np.zeros(3), "best_per_heading": np.array([9.0, 5.0, 1.0]), "score_map": np.zeros((1, 1))}
+    assert C.Localisation(**kw, rival_score=-np.inf).margin == np.inf
+    assert np.isnan(C.Localisation(**kw).margin)
+    assert C.Localisation(**kw, rival_score=8.0).margin == pytest.approx(0.5)  # (9 - 8) / sqrt(9 - 5)
+    flat = {**kw, "best_per_heading": np.array([9.0, 9.0, 9.0])}
+    assert C.Localisation(**flat, rival_score=8.0).margin == 0.0

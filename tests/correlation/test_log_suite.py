@@ -39,6 +39,10 @@ def test_log_suite_tables_and_bad_threshold(shared_data):
     assert "intel 1/1" in str(r)
     with pytest.raises(ValueError, match=r"`threshold` must lie in \[0, 1\]"):
         r.ambiguity_table(threshold=1.5)
+    assert "failures flagged (<= 1.2)" in r.margin_table()
+    assert r.results[0].margin.shape == (1, 1)
+    with pytest.raises(ValueError, match="`threshold`"):
+        r.margin_table(threshold=-1.0)
     with pytest.raises(ValueError, match=r"`hit_ratio` must lie in \[0, 1\]"):
         C.run_log_localisation(log, (500,), hit_ratio=1.5)
 
