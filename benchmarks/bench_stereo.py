@@ -66,6 +66,7 @@ def main(argv=None):
     ap.add_argument("--highway", action="store_true", help="also run the scale ablation on the simulated highway scene")
     ap.add_argument("--seeds", type=int, default=8, help="scenes per setting of --highway")
     ap.add_argument("--highway-frames", type=int, default=51, help="frames per run of --highway")
+    ap.add_argument("--highway-noise", type=float, default=0.5, help="keypoint noise [px] of --highway's scene")
     ap.add_argument("--conditions", action="store_true",
                     help="also run the highway scene's conditions (noise, pyramid, disparity, vehicles, aliasing) x "
                          "{old defaults, KITTI_PARAMS}, --seeds scenes each")
@@ -176,9 +177,9 @@ def main(argv=None):
         say()
         t0 = time.perf_counter()
         abl = sl.stereo.run_scale_ablation(lambda rng: sl.sim.HighwayScene(rng=rng), sl.sim.highway_path(args.highway_frames),
-                                           n_seeds=args.seeds, rng=0)
+                                           n_seeds=args.seeds, pixel_std=args.highway_noise, rng=0)
         say("```")
-        say(abl.table())
+        say(abl.table(end=True))
         say("```")
         say(f"  ({time.perf_counter() - t0:.0f} s; load average {' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     if args.conditions:

@@ -67,6 +67,9 @@ class ScaleAblation:
         Keypoint noise of the scene [px] (settings may override it).
     n_degenerate : numpy.ndarray, shape (S, n_seeds)
         Frames that kept the last pose.
+    end_ratio : numpy.ndarray or None, shape (S, n_seeds)
+        The estimated end position projected on the true one, over the true one's length: the scale
+        of the displacement, which pose jitter does not lengthen (the path length grows with it).
     """
 
     labels: tuple
@@ -76,6 +79,7 @@ class ScaleAblation:
     path_length_m: float
     pixel_std: float
     n_degenerate: np.ndarray = field(repr=False)
+    end_ratio: np.ndarray | None = field(default=None, repr=False)
 
     def __str__(self) -> str:
         i = int(np.argmax(np.abs(self.path_ratio.mean(axis=1) - 1)))
@@ -92,8 +96,13 @@ class ScaleAblation:
         s = self.step_ratios.reshape(len(self.labels), -1)
         return np.column_stack([s.mean(axis=1), s.std(axis=1, ddof=1) / np.sqrt(s.shape[1])])
 
-    def table(self) -> str:
+    def table(self, end: bool = False) -> str:
         """Per setting: path ratio (mean over seeds), step ratio mean ± s.e., ATE in % of the path (fixed precision).
+
+        Parameters
+        ----------
+        end : bool, default False
+            Add the end ratio (mean over seeds) after the path ratio.
 
         Returns
         -------
@@ -103,8 +112,13 @@ class ScaleAblation:
         rows = [[lab, f"{self.path_ratio[i].mean():.3f}", f"{ms[i, 0]:.3f} ± {ms[i, 1]:.3f}",
                  f"{100 * self.ate_m[i].mean() / self.path_length_m:.2f}", f"{int(self.n_degenerate[i].sum())}"]
                 for i, lab in enumerate(self.labels)]
+        head = ["setting", "path est./true", "step est./true: mean ± s.e.", "ATE, % of path", "degenerate"]
+        if end and self.end_ratio is not None:
+            head.insert(2, "end est./true")
+            for i, row in enumerate(rows):
+                row.insert(2, f"{self.end_ratio[i].mean():.3f}")
         n_seeds, n_steps = self.step_ratios.shape[1:]
-        return format_table(["setting", "path est./true", "step est./true: mean ± s.e.", "ATE, % of path", "degenerate"],
+        return format_table(head,
                             rows, title=(f"scale ablation: {n_seeds} seeds x {n_steps + 1} frames, {self.path_length_m:.1f} m, "
                                          f"keypoint noise {self.pixel_std:g} px (simulated)"))
 
@@ -159,6 +173,7 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
     seeds = np.random.SeedSequence(int(v.as_rng(rng).integers(2**32))).spawn(n_seeds)
     S, n = len(variants), len(P)
     path_ratio, ate_m, n_deg = np.empty((S, n_seeds)), np.empty((S, n_seeds)), np.zeros((S, n_seeds), int)
+    end_ratio = np.empty((S, n_seeds))
     steps = np.empty((S, n_seeds, n - 1))
     path_len = 0.0
     for j, ss in enumerate(seeds):
@@ -177,9 +192,10 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
             est_steps = np.linalg.norm(np.diff(est, axis=0), axis=1)
             steps[i, j] = est_steps / true_steps
             path_ratio[i, j] = est_steps.sum() / path_len
+            end_ratio[i, j] = est[-1] @ truth[-1] / (truth[-1] @ truth[-1])
             ate_m[i, j] = np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1)))
             n_deg[i, j] = len(slam.degenerate_frames)
-    return ScaleAblation(tuple(variants), path_ratio, steps, ate_m, path_len, sigma, n_deg)
+    return ScaleAblation(tuple(variants), path_ratio, steps, ate_m, path_len, sigma, n_deg, end_ratio)
 
 
 @dataclass(frozen=True)
@@ -210,12 +226,14 @@ class ConditionAblation:
         rows = []
         for cond, a in zip(self.conditions, self.results, strict=True):
             ms = a.step_mean_se()
-            rows += [[cond, lab, f"{a.pixel_std:g}", f"{a.path_ratio[i].mean():.3f}", f"{ms[i, 0]:.3f} ± {ms[i, 1]:.3f}",
+            rows += [[cond, lab, f"{a.pixel_std:g}", f"{a.path_ratio[i].mean():.3f}", f"{a.end_ratio[i].mean():.3f}",
+                      f"{ms[i, 0]:.3f} ± {ms[i, 1]:.3f}",
                       f"{100 * a.ate_m[i].mean() / a.path_length_m:.2f}", f"{int(a.n_degenerate[i].sum())}"]
                      for i, lab in enumerate(a.labels)]
         a = self.results[0]
         n_seeds, n_steps = a.step_ratios.shape[1:]
-        return format_table(["scene condition", "setting", "noise px", "path est./true", "step est./true: mean ± s.e.",
+        return format_table(["scene condition", "setting", "noise px", "path est./true", "end est./true",
+                             "step est./true: mean ± s.e.",
                              "ATE, % of path", "degenerate"], rows,
                             title=f"scene conditions: {n_seeds} seeds x {n_steps + 1} frames, {a.path_length_m:.1f} m (simulated)")
 
