@@ -261,7 +261,8 @@ class HighwayScene:
         pose : array_like, shape (3,)
             Body pose ``(x_m, y_m, yaw_rad)``.
         pixel_std : float, default 0.3
-            Keypoint position noise per coordinate [px].
+            Keypoint position noise per coordinate [px] at pyramid level 0 (the scene's options add
+            pyramid levels, disparity locking and bias, moving vehicles).
         detect_prob : float, default 0.9
             Chance that a visible landmark gives a keypoint in one image.
         descriptor_noise : float, default 0.05
