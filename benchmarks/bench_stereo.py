@@ -14,6 +14,7 @@ query vs ``cv2.BFMatcher.knnMatch``.
     python benchmarks/bench_stereo.py --kitti            # + the 20 KITTI frames, issue 17's changes off (before) and on (after)
     python benchmarks/bench_stereo.py --kitti51          # + the 51-frame KITTI 06 set, issue 25's changes off and on
     python benchmarks/bench_stereo.py --highway --seeds 8  # + the scale ablation on the simulated highway (51 frames)
+    python benchmarks/bench_stereo.py --detectors orb --frames 2 --conditions --seeds 3  # + the highway's scene conditions
 
 Every run uses the pipeline's defaults (oldest-landmark policy; store: multi kd-tree for SURF/SIFT,
 exact Hamming brute force for ORB; the two images detected in two threads).
@@ -65,6 +66,10 @@ def main(argv=None):
     ap.add_argument("--highway", action="store_true", help="also run the scale ablation on the simulated highway scene")
     ap.add_argument("--seeds", type=int, default=8, help="scenes per setting of --highway")
     ap.add_argument("--highway-frames", type=int, default=51, help="frames per run of --highway")
+    ap.add_argument("--highway-noise", type=float, default=0.5, help="keypoint noise [px] of --highway's scene")
+    ap.add_argument("--conditions", action="store_true",
+                    help="also run the highway scene's conditions (noise, pyramid, disparity, vehicles, aliasing) x "
+                         "{old defaults, KITTI_PARAMS}, --seeds scenes each")
     ap.add_argument("--markdown", default=None, help="write the tables to this file")
     args = ap.parse_args(argv)
 
@@ -172,9 +177,22 @@ def main(argv=None):
         say()
         t0 = time.perf_counter()
         abl = sl.stereo.run_scale_ablation(lambda rng: sl.sim.HighwayScene(rng=rng), sl.sim.highway_path(args.highway_frames),
-                                           n_seeds=args.seeds, rng=0)
+                                           n_seeds=args.seeds, pixel_std=args.highway_noise, rng=0)
         say("```")
-        say(abl.table())
+        say(abl.table(end=True))
+        say("```")
+        say(f"  ({time.perf_counter() - t0:.0f} s; load average {' '.join(f'{x:.2f}' for x in os.getloadavg())})")
+    if args.conditions:
+        from slamlab.sim.highway import HIGHWAY_CONDITIONS
+        from slamlab.stereo.scale_ablation import run_condition_ablation
+
+        say()
+        t0 = time.perf_counter()
+        conds = {lab: ((lambda rng, kw=kw: sl.sim.HighwayScene(rng=rng, **kw)), sigma)
+                 for lab, (kw, sigma) in HIGHWAY_CONDITIONS.items()}
+        res = run_condition_ablation(conds, sl.sim.highway_path(args.highway_frames), n_seeds=args.seeds, rng=0)
+        say("```")
+        say(res.table())
         say("```")
         say(f"  ({time.perf_counter() - t0:.0f} s; load average {' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     say(f"load average at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")

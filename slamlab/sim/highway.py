@@ -24,7 +24,22 @@ from ..geometry.camera import PinholeCamera, StereoRig
 from ..geometry.se3 import se3_from_planar
 from .arena import R_BODY_CAM
 
-__all__ = ["HighwayScene", "highway_path"]
+__all__ = ["HIGHWAY_CONDITIONS", "HighwayScene", "highway_path"]
+
+#: realistic conditions tried alone on the highway scene (issue 25; ours): label -> (scene options of
+#: :class:`HighwayScene`, keypoint noise ``pixel_std`` [px] of :meth:`HighwayScene.observe`)
+HIGHWAY_CONDITIONS = {
+    "plain scene (0.5 px)": ({}, 0.5),
+    "keypoint noise 1 px": ({}, 1.0),
+    "keypoint noise 2 px": ({}, 2.0),
+    "ORB pyramid 8 x 1.2, ORB's level shares": ({"pyramid_levels": 8}, 0.5),
+    "ORB pyramid 8 x 1.2, level grows beyond 10 m": ({"pyramid_levels": 8, "level_ref_m": 10.0}, 0.5),
+    "disparity locked halfway to integers": ({"disparity_locking": 0.5}, 0.5),
+    "disparity bias -0.2 px": ({"disparity_bias_px": -0.2}, 0.5),
+    "6 oncoming vehicles": ({"n_oncoming": 6}, 0.5),
+    "4 vehicles ahead, our speed": ({"n_ahead": 4}, 0.5),
+    "posts share 1 look (stereo aliasing)": ({"n_post_looks": 1}, 0.5),
+}
 
 
 def highway_path(n_frames: int = 51, *, step_m: float = 1.0, curvature_per_m: float = 0.002) -> np.ndarray:
@@ -78,6 +93,32 @@ class HighwayScene:
         Scattered near points (road marks, signs) 5-20 m from the road.
     n_post_looks : int, default 3
         Distinct descriptors among the posts (the rest repeat them: repeated structure).
+    pyramid_levels : int, default 1
+        Scene option (issue 25; ours): keypoints come from a detector pyramid of this many levels,
+        ``pyramid_scale`` apart, and a keypoint of level ``l`` has noise ``pixel_std * pyramid_scale**l``
+        (ORB: 8 levels x 1.2). 1: every keypoint at level 0 (the plain scene).
+    pyramid_scale : float, default 1.2
+        Scale between pyramid levels (> 1).
+    level_ref_m : float or None, default None
+        None: each observation's level is drawn with ORB's share per level (proportional to
+        ``pyramid_scale**(-2 l)``), the same in both images; a depth [m]: the level grows with the
+        landmark's depth, ``floor(log(z / level_ref_m) / log(pyramid_scale))`` clipped to the pyramid
+        (far keypoints from coarse levels).
+    disparity_locking : float, default 0.0
+        Scene option (issue 25; ours): share in [0, 1] by which each measured disparity is pulled toward
+        the nearest integer (sub-pixel "pixel locking"; 1: integer disparities).
+    disparity_bias_px : float, default 0.0
+        Scene option (issue 25; ours): added to every measured disparity [px] (a systematic bias; it
+        matters most on small, far disparities).
+    n_oncoming : int, default 0
+        Scene option (issue 25; ours): vehicles in the oncoming lane (3.5 m left of ours), coming toward
+        us at ``vehicle_speed`` times our speed; their points are not static.
+    n_ahead : int, default 0
+        Scene option (issue 25; ours): vehicles ahead in our lane and the one to its right, moving with
+        us at ``vehicle_speed`` times our speed.
+    vehicle_speed : float, default 1.0
+        Speed of the vehicles as a share of ours (the scene has no clock: a vehicle moves
+        ``vehicle_speed`` metres along the road per metre we travel, ``pose[0]``).
     rng : int or numpy.random.Generator, optional
         Seed of the scene's layout and descriptors.
 
@@ -90,7 +131,9 @@ class HighwayScene:
     points_m : numpy.ndarray, shape (K, 3)
         Landmarks in the world frame.
     kind : numpy.ndarray of str, shape (K,)
-        'post', 'far' or 'near'.
+        'post', 'far', 'near' or 'vehicle'.
+    velocity : numpy.ndarray, shape (K,)
+        Motion of each landmark along the world ``x`` axis per metre we travel (0: static).
     descriptors : numpy.ndarray of float32, shape (K, 64)
         Unit-norm descriptor of each landmark.
 
@@ -103,13 +146,30 @@ class HighwayScene:
     """
 
     def __init__(self, length_m: float = 60.0, *, post_spacing_m: float = 2.0, rail_offsets_m=(4.0, -6.0),
-                 n_far: int = 1500, n_near: int = 30, n_post_looks: int = 3, rng=None):
+                 n_far: int = 1500, n_near: int = 30, n_post_looks: int = 3, pyramid_levels: int = 1,
+                 pyramid_scale: float = 1.2, level_ref_m: float | None = None, disparity_locking: float = 0.0,
+                 disparity_bias_px: float = 0.0, n_oncoming: int = 0, n_ahead: int = 0, vehicle_speed: float = 1.0,
+                 rng=None):
         length = v.check_positive(length_m, "length_m")
         spacing = v.check_positive(post_spacing_m, "post_spacing_m")
         rails = v.as_finite_array(rail_offsets_m, "rail_offsets_m", ndim=1)
         n_far = v.check_int(n_far, "n_far", minimum=0)
         n_near = v.check_int(n_near, "n_near", minimum=0)
         n_looks = v.check_int(n_post_looks, "n_post_looks", minimum=1)
+        self.pyramid_levels = v.check_int(pyramid_levels, "pyramid_levels", minimum=1)
+        self.pyramid_scale = v.check_positive(pyramid_scale, "pyramid_scale")
+        if self.pyramid_scale <= 1:
+            raise ValueError(f"`pyramid_scale` must exceed 1; got {pyramid_scale}")
+        self.level_ref_m = None if level_ref_m is None else v.check_positive(level_ref_m, "level_ref_m")
+        self.disparity_locking = v.check_positive(disparity_locking, "disparity_locking", allow_zero=True)
+        if self.disparity_locking > 1:
+            raise ValueError(f"`disparity_locking` must be in [0, 1]; got {disparity_locking}")
+        self.disparity_bias_px = float(disparity_bias_px)
+        if not np.isfinite(self.disparity_bias_px):
+            raise ValueError(f"`disparity_bias_px` must be finite; got {disparity_bias_px}")
+        n_oncoming = v.check_int(n_oncoming, "n_oncoming", minimum=0)
+        n_ahead = v.check_int(n_ahead, "n_ahead", minimum=0)
+        speed = v.check_positive(vehicle_speed, "vehicle_speed", allow_zero=True)
         g = v.as_rng(rng)
         f, b, h = 718.856, 0.537, 1.65
         cam = PinholeCamera(1226, 370, f, f, 607.19, 185.22)
@@ -136,7 +196,42 @@ class HighwayScene:
         self.points_m = np.concatenate([posts, far, near])
         self.kind = np.array(["post"] * len(posts) + ["far"] * n_far + ["near"] * n_near)
         desc = np.concatenate([post_desc, g.standard_normal((n_far + n_near, 64))]).astype(np.float32)
+        self.velocity = np.zeros(len(self.points_m))
+        if n_oncoming + n_ahead:  # drawn after the static scene: without vehicles the scene is unchanged
+            cars, vel = _vehicles(g, n_oncoming, n_ahead, speed, length)
+            self.points_m = np.concatenate([self.points_m, cars])
+            self.kind = np.concatenate([self.kind, ["vehicle"] * len(cars)])
+            self.velocity = np.concatenate([self.velocity, vel])
+            desc = np.concatenate([desc, g.standard_normal((len(cars), 64)).astype(np.float32)])
         self.descriptors = desc / np.linalg.norm(desc, axis=1, keepdims=True)
+
+    def points_at(self, pose) -> np.ndarray:
+        """Landmarks in the world frame when we are at ``pose`` (vehicles moved along the road; issue 25).
+
+        Parameters
+        ----------
+        pose : array_like, shape (3,)
+            Body pose ``(x_m, y_m, yaw_rad)``; the vehicles have moved ``velocity * x_m`` along ``x``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (K, 3)
+        """
+        x = v.as_vector(pose, "pose", 3)[0]
+        if not self.velocity.any():
+            return self.points_m
+        out = self.points_m.copy()
+        out[:, 0] += self.velocity * x
+        return out
+
+    def _levels(self, depth_m, g) -> np.ndarray:
+        """Pyramid level of each landmark's keypoint (see ``pyramid_levels``; both images share it)."""
+        L, s = self.pyramid_levels, self.pyramid_scale
+        if self.level_ref_m is None:  # ORB's share of features per level: proportional to s^(-2 l)
+            w = s ** (-2.0 * np.arange(L))
+            return g.choice(L, size=len(depth_m), p=w / w.sum())
+        lev = np.floor(np.log(np.maximum(depth_m, 1e-9) / self.level_ref_m) / np.log(s))
+        return np.clip(lev, 0, L - 1).astype(int)
 
     def ground_truth_se3(self, pose) -> np.ndarray:
         """Body pose ``(x_m, y_m, yaw_rad)`` as a (4, 4) transform (body to world).
@@ -166,7 +261,8 @@ class HighwayScene:
         pose : array_like, shape (3,)
             Body pose ``(x_m, y_m, yaw_rad)``.
         pixel_std : float, default 0.3
-            Keypoint position noise per coordinate [px].
+            Keypoint position noise per coordinate [px] at pyramid level 0 (the scene's options add
+            pyramid levels, disparity locking and bias, moving vehicles).
         detect_prob : float, default 0.9
             Chance that a visible landmark gives a keypoint in one image.
         descriptor_noise : float, default 0.05
@@ -185,20 +281,65 @@ class HighwayScene:
         d_noise = v.check_positive(descriptor_noise, "descriptor_noise", allow_zero=True)
         g = v.as_rng(rng)
         T_wl = self.ground_truth_se3(pose) @ self.T_body_left
-        out = []
+        points = self.points_at(pose)
+        level = np.zeros(len(points), int)
+        if self.pyramid_levels > 1:  # noise grows with the keypoint's pyramid level
+            level = self._levels((points - T_wl[:3, 3]) @ T_wl[:3, 2], g)
+            sigma = sigma * self.pyramid_scale ** level[:, None]
+        out, uv_left = [], None
         for cam, t_cam in ((self.rig.left, np.zeros(3)), (self.rig.right, self.rig.t_rl)):
-            Xc = (self.points_m - T_wl[:3, 3]) @ T_wl[:3, :3] + t_cam
+            Xc = (points - T_wl[:3, 3]) @ T_wl[:3, :3] + t_cam
             z = Xc[:, 2]
             front = z > 0.5
             uv = np.full((len(Xc), 2), -1.0)
             uv[front] = Xc[front, :2] / z[front, None] * [cam.fx, cam.fy] + [cam.cx, cam.cy]
             uv += sigma * g.standard_normal(uv.shape)
+            if uv_left is None:
+                uv_left = uv
+            elif self.disparity_locking or self.disparity_bias_px:  # the measured disparity, locked and biased
+                d = uv_left[:, 0] - uv[:, 0]
+                d = d + self.disparity_locking * (np.rint(d) - d) + self.disparity_bias_px
+                uv[:, 0] = np.where(front, uv_left[:, 0] - d, uv[:, 0])
             keep = front & (uv[:, 0] >= 0) & (uv[:, 0] < cam.width_px) & (uv[:, 1] >= 0) & (uv[:, 1] < cam.height_px)
             keep &= g.random(len(Xc)) < p_det
             idx = g.permutation(np.flatnonzero(keep))
             d = self.descriptors[idx] + d_noise * g.standard_normal((idx.size, 64)).astype(np.float32)
             d /= np.linalg.norm(d, axis=1, keepdims=True)
             n = idx.size
-            out.append(Features(uv[idx], np.full(n, 2.0), np.zeros(n), np.ones(n), np.zeros(n, int),
+            out.append(Features(uv[idx], 2.0 * self.pyramid_scale ** level[idx], np.zeros(n), np.ones(n), level[idx],
                                 d.astype(np.float32), "highway-sim"))
         return out[0], out[1]
+
+
+def _vehicles(g, n_oncoming, n_ahead, speed, length_m):
+    """Points of vehicles on the road and their motion per metre we travel (issue 25; ours).
+
+    Each vehicle is 8 points on the corners of its visible face, 1.8 m wide, 0.3-1.5 m high, 0.5 m deep.
+    Oncoming vehicles drive 3.5 m left of our lane toward us (velocity ``-speed``), starting 20 m to
+    ``2 length_m`` ahead so that they pass us during the run; vehicles ahead keep 12-40 m in our lane or
+    the one to its right (``+speed``).
+
+    Parameters
+    ----------
+    g : numpy.random.Generator
+        Layout source.
+    n_oncoming, n_ahead : int
+        Vehicles of each kind.
+    speed : float
+        Their speed as a share of ours.
+    length_m : float
+        Road length of the scene [m].
+
+    Returns
+    -------
+    points : numpy.ndarray, shape (8 (n_oncoming + n_ahead), 3)
+        Positions when we are at ``x = 0``.
+    velocity : numpy.ndarray, shape (8 (n_oncoming + n_ahead),)
+        Motion along ``x`` per metre we travel.
+    """
+    x0 = np.concatenate([g.uniform(20.0, 2.0 * length_m + 20.0, n_oncoming), g.uniform(12.0, 40.0, n_ahead)])
+    lane = np.concatenate([np.full(n_oncoming, 3.5), np.where(g.random(n_ahead) < 0.5, 0.0, -3.5)])
+    corner = np.array([[dx, dy, dz] for dx in (0.0, 0.5) for dy in (-0.9, 0.9) for dz in (0.3, 1.5)])
+    pts = (np.column_stack([x0, lane, np.zeros(len(x0))])[:, None, :] + corner[None]).reshape(-1, 3)
+    vel = np.repeat(np.concatenate([np.full(n_oncoming, -speed), np.full(n_ahead, speed)]), len(corner))
+    return pts, vel

@@ -21,7 +21,8 @@ from .kitti_experiments import KITTI_PARAMS
 from .params import StereoParams
 from .slam import StereoSLAM
 
-__all__ = ["SCALE_ABLATION", "ScaleAblation", "run_scale_ablation"]
+__all__ = ["CONDITION_SETTINGS", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
+           "run_scale_ablation"]
 
 #: the settings of the ablation: label -> overrides of KITTI_PARAMS (``pixel_std_obs``: the scene's keypoint noise);
 #: 'measured' / 'map': the depth behind a match's weight in the pose (``weight_depth``) and an observation's
@@ -37,6 +38,12 @@ SCALE_ABLATION = {
                                                    "update_cov_depth": "measured"},
     "RANSAC threshold 0.5 m at every depth, equal weights": {"depth_ref_m": 1000.0, "threshold_m": 0.5},
     "pose from all inliers": {"policy": "all"},
+}
+
+#: the two settings of :func:`run_condition_ablation`: the defaults before issue 25 and today's KITTI_PARAMS
+CONDITION_SETTINGS = {
+    "old defaults (measured depth)": {"weight_depth": "measured", "update_cov_depth": "measured"},
+    "KITTI_PARAMS": {},
 }
 
 
@@ -60,6 +67,9 @@ class ScaleAblation:
         Keypoint noise of the scene [px] (settings may override it).
     n_degenerate : numpy.ndarray, shape (S, n_seeds)
         Frames that kept the last pose.
+    end_ratio : numpy.ndarray or None, shape (S, n_seeds)
+        The estimated end position projected on the true one, over the true one's length: the scale
+        of the displacement, which pose jitter does not lengthen (the path length grows with it).
     """
 
     labels: tuple
@@ -69,6 +79,7 @@ class ScaleAblation:
     path_length_m: float
     pixel_std: float
     n_degenerate: np.ndarray = field(repr=False)
+    end_ratio: np.ndarray | None = field(default=None, repr=False)
 
     def __str__(self) -> str:
         i = int(np.argmax(np.abs(self.path_ratio.mean(axis=1) - 1)))
@@ -85,8 +96,13 @@ class ScaleAblation:
         s = self.step_ratios.reshape(len(self.labels), -1)
         return np.column_stack([s.mean(axis=1), s.std(axis=1, ddof=1) / np.sqrt(s.shape[1])])
 
-    def table(self) -> str:
+    def table(self, end: bool = False) -> str:
         """Per setting: path ratio (mean over seeds), step ratio mean ± s.e., ATE in % of the path (fixed precision).
+
+        Parameters
+        ----------
+        end : bool, default False
+            Add the end ratio (mean over seeds) after the path ratio.
 
         Returns
         -------
@@ -96,8 +112,13 @@ class ScaleAblation:
         rows = [[lab, f"{self.path_ratio[i].mean():.3f}", f"{ms[i, 0]:.3f} ± {ms[i, 1]:.3f}",
                  f"{100 * self.ate_m[i].mean() / self.path_length_m:.2f}", f"{int(self.n_degenerate[i].sum())}"]
                 for i, lab in enumerate(self.labels)]
+        head = ["setting", "path est./true", "step est./true: mean ± s.e.", "ATE, % of path", "degenerate"]
+        if end and self.end_ratio is not None:
+            head.insert(2, "end est./true")
+            for i, row in enumerate(rows):
+                row.insert(2, f"{self.end_ratio[i].mean():.3f}")
         n_seeds, n_steps = self.step_ratios.shape[1:]
-        return format_table(["setting", "path est./true", "step est./true: mean ± s.e.", "ATE, % of path", "degenerate"],
+        return format_table(head,
                             rows, title=(f"scale ablation: {n_seeds} seeds x {n_steps + 1} frames, {self.path_length_m:.1f} m, "
                                          f"keypoint noise {self.pixel_std:g} px (simulated)"))
 
@@ -152,6 +173,7 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
     seeds = np.random.SeedSequence(int(v.as_rng(rng).integers(2**32))).spawn(n_seeds)
     S, n = len(variants), len(P)
     path_ratio, ate_m, n_deg = np.empty((S, n_seeds)), np.empty((S, n_seeds)), np.zeros((S, n_seeds), int)
+    end_ratio = np.empty((S, n_seeds))
     steps = np.empty((S, n_seeds, n - 1))
     path_len = 0.0
     for j, ss in enumerate(seeds):
@@ -170,6 +192,87 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
             est_steps = np.linalg.norm(np.diff(est, axis=0), axis=1)
             steps[i, j] = est_steps / true_steps
             path_ratio[i, j] = est_steps.sum() / path_len
+            end_ratio[i, j] = est[-1] @ truth[-1] / (truth[-1] @ truth[-1])
             ate_m[i, j] = np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1)))
             n_deg[i, j] = len(slam.degenerate_frames)
-    return ScaleAblation(tuple(variants), path_ratio, steps, ate_m, path_len, sigma, n_deg)
+    return ScaleAblation(tuple(variants), path_ratio, steps, ate_m, path_len, sigma, n_deg, end_ratio)
+
+
+@dataclass(frozen=True)
+class ConditionAblation:
+    """Scale figures per scene condition and setting of :func:`run_condition_ablation` (issue 25).
+
+    Attributes
+    ----------
+    conditions : tuple of str
+        The scene conditions.
+    results : tuple of ScaleAblation
+        One per condition (its rows: the settings).
+    """
+
+    conditions: tuple
+    results: tuple = field(repr=False)
+
+    def __str__(self) -> str:
+        return f"condition ablation, {len(self.conditions)} conditions x {len(self.results[0].labels)} settings"
+
+    def table(self) -> str:
+        """Rows condition x setting: path ratio (mean over seeds), step ratio mean ± s.e., ATE % of path, degenerate.
+
+        Returns
+        -------
+        str
+        """
+        rows = []
+        for cond, a in zip(self.conditions, self.results, strict=True):
+            ms = a.step_mean_se()
+            rows += [[cond, lab, f"{a.pixel_std:g}", f"{a.path_ratio[i].mean():.3f}", f"{a.end_ratio[i].mean():.3f}",
+                      f"{ms[i, 0]:.3f} ± {ms[i, 1]:.3f}",
+                      f"{100 * a.ate_m[i].mean() / a.path_length_m:.2f}", f"{int(a.n_degenerate[i].sum())}"]
+                     for i, lab in enumerate(a.labels)]
+        a = self.results[0]
+        n_seeds, n_steps = a.step_ratios.shape[1:]
+        return format_table(["scene condition", "setting", "noise px", "path est./true", "end est./true",
+                             "step est./true: mean ± s.e.",
+                             "ATE, % of path", "degenerate"], rows,
+                            title=f"scene conditions: {n_seeds} seeds x {n_steps + 1} frames, {a.path_length_m:.1f} m (simulated)")
+
+
+def run_condition_ablation(conditions: dict, poses, variants: dict | None = None, *, params: StereoParams | None = None,
+                           n_seeds: int = 3, rng=0) -> ConditionAblation:
+    """:func:`run_scale_ablation` once per scene condition: which realistic condition biases the scale (issue 25).
+
+    Every condition sees the same seeds, so a row differs from the plain scene's by its condition
+    (and by the layout draws a condition adds, such as vehicles).
+
+    Parameters
+    ----------
+    conditions : dict
+        Label -> ``(scene_factory, pixel_std)``: a factory as in :func:`run_scale_ablation` and the
+        keypoint noise [px] (:data:`slamlab.sim.highway.HIGHWAY_CONDITIONS` gives the scene options).
+    poses : array_like, shape (N, 3)
+        Body poses, N ≥ 3.
+    variants : dict, optional
+        Settings (default :data:`CONDITION_SETTINGS`).
+    params : StereoParams, optional
+        Base settings (default :data:`~slamlab.stereo.KITTI_PARAMS`).
+    n_seeds : int, default 3
+        Scenes per condition and setting.
+    rng : int or numpy.random.Generator, default 0
+        Root of the seeds, the same for every condition.
+
+    Returns
+    -------
+    ConditionAblation
+    """
+    if not isinstance(conditions, dict) or not conditions:
+        raise TypeError("`conditions` must be a non-empty dict of label -> (scene_factory, pixel_std)")
+    for label, c in conditions.items():
+        if not isinstance(c, tuple) or len(c) != 2:
+            raise TypeError(f"`conditions`[{label!r}] must be a pair (scene_factory, pixel_std); got {c!r}")
+    variants = CONDITION_SETTINGS if variants is None else variants
+    # an int seed goes to every condition as it is (the plain scene's rows then equal run_scale_ablation's)
+    root = int(rng) if isinstance(rng, (int, np.integer)) else int(v.as_rng(rng).integers(2**32))
+    results = tuple(run_scale_ablation(f, poses, variants, params=params, n_seeds=n_seeds, pixel_std=sigma, rng=root)
+                    for f, sigma in conditions.values())
+    return ConditionAblation(tuple(conditions), results)

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from slamlab.sim.highway import HighwayScene, highway_path
+from slamlab.sim.highway import HIGHWAY_CONDITIONS, HighwayScene, highway_path
 from slamlab.stereo import KITTI_PARAMS, StereoSLAM, run_scale_ablation
+from slamlab.stereo.scale_ablation import run_condition_ablation
 
 
 def _scene(rng):
@@ -58,3 +59,27 @@ def test_scale_ablation_arguments_are_checked():
         run_scale_ablation(_scene, highway_path(3), {"x": {"pixel_std_obs": -1.0}})
     with pytest.raises(ValueError, match="weight_depth"):
         run_scale_ablation(_scene, highway_path(3), {"x": {"weight_depth": "guess"}})
+
+
+def test_moving_vehicles_bias_the_scale_with_the_expected_signs():
+    """Oncoming vehicles make us seem faster, vehicles moving with us slower (issue 25's scene conditions).
+
+    One seed, 21 frames, KITTI_PARAMS; the same seed for every condition.
+    """
+    labels = ("plain scene (0.5 px)", "6 oncoming vehicles", "4 vehicles ahead, our speed")
+    conds = {lab: ((lambda rng, kw=HIGHWAY_CONDITIONS[lab][0]: HighwayScene(rng=rng, **kw)), HIGHWAY_CONDITIONS[lab][1])
+             for lab in labels}
+    res = run_condition_ablation(conds, highway_path(21), {"KITTI_PARAMS": {}}, n_seeds=1, rng=0)
+    plain, oncoming, ahead = (a.path_ratio[0, 0] for a in res.results)
+    assert oncoming > plain + 0.005
+    assert ahead < plain - 0.005
+    assert "6 oncoming vehicles" in res.table()
+    assert "end est./true" in res.table()
+    assert "end est./true" in res.results[0].table(end=True)
+    assert "end est./true" not in res.results[0].table()  # notebook 05 prints the table without it
+    assert res.results[0].end_ratio[0, 0] == pytest.approx(plain, abs=0.05)  # no jitter to speak of at 0.5 px
+    assert "3 conditions" in str(res)
+    with pytest.raises(TypeError, match="conditions"):
+        run_condition_ablation({}, highway_path(3))
+    with pytest.raises(TypeError, match="conditions"):
+        run_condition_ablation({"x": _scene}, highway_path(3))
