@@ -1,12 +1,14 @@
-"""The compiled window search for binary descriptors against its numpy version (our addition to 000 §3.4;
-issue 25): same nearest / second nearest, distances and pair counts, bit for bit, ties included."""
+"""The compiled two-nearest kernels for binary descriptors against their numpy versions (issue 25): the window
+search (our addition to 000 §3.4), the stereo matching's epipolar pairs (000 §3.3) and the brute-force search of
+the last frame's landmarks; same nearest / second nearest, distances and pair counts, bit for bit, ties included."""
 
 import numpy as np
 import pytest
 
 from slamlab._compiled import numba_enabled
-from slamlab.stereo.local_stages import _pair_distances, _two_nearest
-from slamlab.stereo.map_stages import _radius_pairs, _window_two_nearest
+from slamlab.kdtree.knn import exact_knn
+from slamlab.stereo.local_stages import _pair_distances, _pairs_two_nearest, _two_nearest, epipolar_pairs
+from slamlab.stereo.map_stages import _knn2, _radius_pairs, _window_two_nearest
 
 
 @pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
@@ -40,3 +42,51 @@ def test_window_numpy_path_without_numba(monkeypatch):
     q, r1, d1, d2, r2, n_pairs = _window_two_nearest(D, uv, Dt, np.array([[12.0, 10.0], [11.0, 11.0]]), 15.0)
     assert q.tolist() == [0]
     assert (r1.tolist(), d1.tolist(), d2.tolist(), r2.tolist(), n_pairs) == ([0], [0.0], [3.0], [1], 2)
+
+
+def _random_descriptors(rng, k, n, trial):
+    D = rng.integers(0, 256, (k, 32), dtype=np.uint8)
+    Dt = rng.integers(0, 256, (n, 32), dtype=np.uint8)
+    if trial % 3 == 0 and n:  # many equal distances: the first in the numpy order must win both ranks
+        Dt[: n // 2] = Dt[0]
+        D[: k // 2] = D[0]
+    return D, Dt
+
+
+@pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
+@pytest.mark.parametrize("trial", range(6))
+def test_stereo_kernel_matches_numpy(trial):
+    """The stereo matching's two nearest over the epipolar pairs (000 §3.3): kernel = numpy, ties included."""
+    rng = np.random.default_rng(100 + trial)
+    k, n = int(rng.integers(1, 1500)), int(rng.integers(1, 1500))
+    D, Dt = _random_descriptors(rng, k, n, trial)
+    uv_l = rng.uniform(0, 576, (k, 2))
+    uv_r = np.round(rng.uniform(0, 576, (n, 2))) if trial % 2 else rng.uniform(0, 576, (n, 2))
+    F = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # rectified: the epipolar lines are rows
+    qi, ti = epipolar_pairs(uv_l, uv_r, F, 2.0)
+    ref = _two_nearest(qi, ti, _pair_distances(D, Dt, qi, ti))
+    for a, b in zip(ref, _pairs_two_nearest(D, Dt, qi, ti), strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
+@pytest.mark.parametrize("n", [0, 1, 2, 900])
+def test_brute_force_kernel_matches_exact_knn(n):
+    """The search of the last frame's landmarks: kernel = exact_knn (OpenCV's batchDistance), ties included."""
+    rng = np.random.default_rng(n)
+    D, Dt = _random_descriptors(rng, 700, n, 0)
+    ids = rng.permutation(5 * n + 1)[:n] + 3
+    for a, b in zip(exact_knn(D, Dt, 2, ids), _knn2(D, Dt, ids), strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_numpy_paths_without_numba(monkeypatch):
+    monkeypatch.setenv("SLAMLAB_NO_NUMBA", "1")
+    D = np.zeros((2, 32), np.uint8)
+    Dt = np.zeros((3, 32), np.uint8)
+    Dt[1, 0] = 0b111
+    q, r1, d1, d2, r2 = _pairs_two_nearest(D, Dt, np.array([1, 1]), np.array([1, 2]))
+    assert (q.tolist(), r1.tolist(), d1.tolist(), d2.tolist(), r2.tolist()) == ([1], [2], [0.0], [3.0], [1])
+    dist, ids = _knn2(D, Dt, np.array([5, 6, 7]))
+    assert dist.tolist() == [[0.0, 0.0]] * 2
+    assert ids.tolist() == [[5, 7]] * 2
