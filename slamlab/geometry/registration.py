@@ -74,6 +74,26 @@ def umeyama(src, dst, *, with_scale: bool = False, weights=None) -> RigidTransfo
         if np.any(w < 0) or w.sum() <= 0:
             raise ValueError("`weights` must be non-negative with a positive sum")
         w = w / w.sum()
+    return _umeyama(src, dst, w, with_scale)
+
+
+def _umeyama(src, dst, w, with_scale: bool = False) -> RigidTransform:
+    """:func:`umeyama` without its argument checks, for inner loops (a RANSAC's hypotheses, 000 §3.5).
+
+    Parameters
+    ----------
+    src, dst : numpy.ndarray of float64, shape (N, d)
+        Corresponding finite points, ``d`` = 2 or 3, ``N >= d``.
+    w : numpy.ndarray of float64, shape (N,)
+        Non-negative weights summing to 1.
+    with_scale : bool, default False
+        Also estimate a scale.
+
+    Returns
+    -------
+    RigidTransform
+    """
+    d = src.shape[1]
     mu_s, mu_d = w @ src, w @ dst
     xs, xd = src - mu_s, dst - mu_d
     # cross-covariance Sigma = sum w (dst - mu_d)(src - mu_s)^T

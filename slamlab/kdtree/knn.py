@@ -177,7 +177,16 @@ def exact_knn(Q, X, k: int = 2, ids=None, *, augmented=None):
     kk = min(k, N)
     if M == 0 or kk == 0:
         return pad_knn(np.empty((M, 0)), np.empty((M, 0), dtype=np.int64), k)
-    if Q.dtype == np.uint8:
+    if Q.dtype == np.uint8 and kk == 2 and Q.shape[1] % 8 == 0 and numba_enabled():
+        # the same search compiled: each query keeps its two nearest while it walks X in order, ties to the
+        # first, as batchDistance (issue 25; no (M, N) distance matrix)
+        from ._hamming_kernel import ranges_hamming_2nn
+
+        r1, d1, d2, r2 = ranges_hamming_2nn(np.ascontiguousarray(Q).view(np.uint64),
+                                            np.ascontiguousarray(X).view(np.uint64), np.arange(N),
+                                            np.zeros(M, np.int64), np.full(M, N, np.int64))
+        d, idx = np.column_stack([d1, d2]), np.column_stack([r1, r2])
+    elif Q.dtype == np.uint8:
         import cv2  # OpenCV's popcount: several times faster than numpy's for Hamming
 
         d, idx = cv2.batchDistance(np.ascontiguousarray(Q), np.ascontiguousarray(X), cv2.CV_32S,

@@ -14,13 +14,12 @@ from .. import _validate as v
 from .._compiled import numba_enabled
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.ransac import ransac
-from ..geometry.registration import RigidTransform, umeyama
+from ..geometry.registration import RigidTransform, _umeyama
 from ..geometry.so3 import hat
-from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore
 from .local_stages import _pair_distances, _two_nearest
 from .params import StereoParams
-from .window_kernel import ranges_hamming_2nn, window_hamming_2nn
+from .window_kernel import window_hamming_2nn
 
 __all__ = [
     "MapMatches",
@@ -152,19 +151,6 @@ def _matches_from_knn(dist, ids, ratio, positions=None, same_point_m=None, max_d
     claimed = np.zeros(k, dtype=bool)
     claimed[loc] = True  # ratio-passing points that lost a duplicate are neither matches nor new
     return MapMatches(loc[sel], lid[sel], d[sel], np.flatnonzero(~claimed), ids[:, 0])
-
-
-def _knn2(D, Dt, ids):
-    """The two nearest rows of ``Dt`` (ids ``ids``) to each row of ``D`` by brute force, as
-    :func:`~slamlab.kdtree.knn.exact_knn` ``(D, Dt, 2, ids)``: ``(dist, ids)``, each (K, 2). Binary
-    descriptors take the compiled kernel when numba is enabled (same result and ties, tested)."""
-    if D.dtype == np.uint8 and D.shape[1] % 8 == 0 and len(Dt) and numba_enabled():
-        k, n = D.shape[0], Dt.shape[0]
-        r1, d1, d2, r2 = ranges_hamming_2nn(D.view(np.uint64), np.ascontiguousarray(Dt).view(np.uint64),
-                                            np.arange(n), np.zeros(k, np.int64), np.full(k, n, np.int64))
-        idx = np.column_stack([r1, r2])
-        return np.column_stack([d1, d2]), np.where(idx >= 0, np.asarray(ids, np.int64)[np.maximum(idx, 0)], -1)
-    return exact_knn(D, Dt, 2, ids)
 
 
 def _radius_cells(uv_q, uv_t, radius):
@@ -359,7 +345,8 @@ class PoseEstimate(NamedTuple):
 
 
 def _fit(src, dst, w):
-    return umeyama(src, dst, weights=w)
+    # a RANSAC hypothesis or refit: umeyama's arithmetic without its argument checks (the rows are checked once)
+    return _umeyama(np.asarray(src, dtype=float), np.asarray(dst, dtype=float), w / w.sum())
 
 
 def _residuals(T: RigidTransform, src, dst, w):

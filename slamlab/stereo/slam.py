@@ -18,10 +18,11 @@ from ..features.base import to_gray_uint8
 from ..filters.landmark import landmark_predict, landmark_update
 from ..geometry.camera import StereoRig, project_points
 from ..geometry.se3 import planar_from_se3
+from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore, base_rule
 from .frame import STAGES, FrameRecord, _detect_pair, _StageClock, default_store
 from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
-from .map_stages import _estimate_pose, _knn2, _match_to_map, _matches_from_knn, _window_match, pose_std
+from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
 from .params import StereoParams
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
@@ -259,7 +260,7 @@ class StereoSLAM:
         the pose of those matches is the frame's. ``(matches, estimate)`` as :meth:`_locate`."""
         p = self.params
         last = self._last_ids[self.alive[self._last_ids]]
-        dist, ids = _knn2(desc, self.desc[last], last)
+        dist, ids = exact_knn(desc, self.desc[last], 2, last)
         mm = _matches_from_knn(dist, ids, p.map_ratio, self.X, p.twin_gap_m)
         clock.lap("map_match")
         rec["n_searched"] += len(last)

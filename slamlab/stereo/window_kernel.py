@@ -7,10 +7,10 @@ allocated; the results are the same, bit for bit (tested against the numpy versi
 
 - :func:`window_hamming_2nn`: the window search of the map matching (our addition to 000 §3.4), the
   pairs of ``_radius_pairs`` in :mod:`slamlab.stereo.map_stages`;
-- :func:`ranges_hamming_2nn`: candidates given as a range of an index list per query — the
-  epipolar pairs of the stereo matching (000 §3.3, :func:`slamlab.stereo.epipolar_pairs`), and the
-  brute-force search of the last frame's landmarks (every landmark a candidate; numpy:
-  :func:`slamlab.kdtree.knn.exact_knn`, OpenCV's ``batchDistance``, whose order and ties it keeps).
+- ``ranges_hamming_2nn`` (in :mod:`slamlab.kdtree`, re-exported here): candidates given as a range of an
+  index list per query — the epipolar pairs of the stereo matching (000 §3.3,
+  :func:`slamlab.stereo.epipolar_pairs`); :func:`slamlab.kdtree.knn.exact_knn` takes it for binary 2-NN (the
+  brute-force search of the last frame's landmarks), keeping OpenCV's ``batchDistance`` order and ties.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._compiled import kernel
+from ..kdtree._hamming_kernel import ranges_hamming_2nn  # re-exported: the stereo matching's user
 
 __all__ = ["ranges_hamming_2nn", "window_hamming_2nn"]
 
@@ -84,60 +85,3 @@ tuple
 """
 
 
-def _ranges_hamming_2nn(Dq, Dt, order, lo, hi):  # pragma: no cover - compiled
-    """For each query ``i``: the targets ``order[lo[i]:hi[i]]`` in that order, their Hamming distances
-    (descriptors as uint64 words) and the nearest / second nearest, each the first in that order among equals."""
-    k = Dq.shape[0]
-    r1 = np.full(k, -1, np.int64)
-    r2 = np.full(k, -1, np.int64)
-    d1 = np.full(k, np.inf)
-    d2 = np.full(k, np.inf)
-    n_max = 0
-    for i in range(k):
-        n_max = max(n_max, hi[i] - lo[i])
-    bits = np.empty(max(n_max, 1), np.int64)  # the distances of one query's candidates
-    for i in range(k):
-        n = hi[i] - lo[i]
-        # first the distances, in a loop without branches (the compiler vectorises it) ...
-        for j in range(n):
-            t = order[lo[i] + j]
-            b = np.uint64(0)
-            for w in range(Dq.shape[1]):
-                # bits set in a 64-bit word: the "SWAR" count (Hacker's Delight §5-1)
-                x = Dq[i, w] ^ Dt[t, w]
-                x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
-                x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
-                x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
-                b += (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
-            bits[j] = b
-        # ... then the two smallest, as in the window kernel
-        for j in range(n):
-            d = float(bits[j])
-            if d < d1[i]:  # a new nearest: the old one becomes the second
-                d2[i], r2[i] = d1[i], r1[i]
-                d1[i], r1[i] = d, order[lo[i] + j]
-            elif d < d2[i]:
-                d2[i], r2[i] = d, order[lo[i] + j]
-    return r1, d1, d2, r2
-
-
-ranges_hamming_2nn = kernel(_ranges_hamming_2nn)
-ranges_hamming_2nn.__doc__ = """Two nearest targets by Hamming distance among each query's candidate range (compiled).
-
-Parameters
-----------
-Dq : numpy.ndarray of uint64, shape (K, W)
-    Query descriptors as 64-bit words.
-Dt : numpy.ndarray of uint64, shape (N, W)
-    Target descriptors as 64-bit words.
-order : numpy.ndarray of int, shape (P,)
-    Target indices; query ``i``'s candidates are ``order[lo[i]:hi[i]]``, in that order.
-lo, hi : numpy.ndarray of int, shape (K,)
-    Each query's range of ``order``.
-
-Returns
--------
-tuple
-    ``r1, d1, d2, r2`` per query (``r1 = -1``, ``d1 = inf``: no candidate; ``r2 = -1``, ``d2 = inf``: one);
-    among equal distances the first in ``order`` wins.
-"""

@@ -8,7 +8,7 @@ import pytest
 from slamlab._compiled import numba_enabled
 from slamlab.kdtree.knn import exact_knn
 from slamlab.stereo.local_stages import _pair_distances, _pairs_two_nearest, _two_nearest, epipolar_pairs
-from slamlab.stereo.map_stages import _knn2, _radius_pairs, _window_two_nearest
+from slamlab.stereo.map_stages import _radius_pairs, _window_two_nearest
 
 
 @pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
@@ -71,12 +71,15 @@ def test_stereo_kernel_matches_numpy(trial):
 
 @pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
 @pytest.mark.parametrize("n", [0, 1, 2, 900])
-def test_brute_force_kernel_matches_exact_knn(n):
-    """The search of the last frame's landmarks: kernel = exact_knn (OpenCV's batchDistance), ties included."""
+def test_brute_force_kernel_matches_exact_knn(n, monkeypatch):
+    """exact_knn's binary 2-NN (the search of the last frame's landmarks, the ORB stores): the kernel = OpenCV's
+    batchDistance (the numpy path), ties included."""
     rng = np.random.default_rng(n)
     D, Dt = _random_descriptors(rng, 700, n, 0)
     ids = rng.permutation(5 * n + 1)[:n] + 3
-    for a, b in zip(exact_knn(D, Dt, 2, ids), _knn2(D, Dt, ids), strict=True):
+    compiled = exact_knn(D, Dt, 2, ids)
+    monkeypatch.setenv("SLAMLAB_NO_NUMBA", "1")
+    for a, b in zip(exact_knn(D, Dt, 2, ids), compiled, strict=True):
         np.testing.assert_array_equal(a, b)
 
 
@@ -87,6 +90,6 @@ def test_numpy_paths_without_numba(monkeypatch):
     Dt[1, 0] = 0b111
     q, r1, d1, d2, r2 = _pairs_two_nearest(D, Dt, np.array([1, 1]), np.array([1, 2]))
     assert (q.tolist(), r1.tolist(), d1.tolist(), d2.tolist(), r2.tolist()) == ([1], [2], [0.0], [3.0], [1])
-    dist, ids = _knn2(D, Dt, np.array([5, 6, 7]))
+    dist, ids = exact_knn(D, Dt, 2, np.array([5, 6, 7]))
     assert dist.tolist() == [[0.0, 0.0]] * 2
     assert ids.tolist() == [[5, 7]] * 2
