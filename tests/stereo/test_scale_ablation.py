@@ -76,7 +76,7 @@ def test_moving_vehicles_bias_the_scale_with_the_expected_signs():
     assert "6 oncoming vehicles" in res.table()
     assert "end est./true" in res.table()
     assert "end est./true" in res.results[0].table(end=True)
-    assert "end est./true" not in res.results[0].table()  # notebook 05 prints the table without it
+    assert "end est./true" not in res.results[0].table()  # the default table keeps its columns; end=True adds one
     assert res.results[0].end_ratio[0, 0] == pytest.approx(plain, abs=0.05)  # no jitter to speak of at 0.5 px
     assert "3 conditions" in str(res)
     with pytest.raises(TypeError, match="conditions"):
