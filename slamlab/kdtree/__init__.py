@@ -3,7 +3,9 @@
 The generic layer under the features and stereo chapters (it imports neither):
 
 - ``KDTree(points, ids, leaf_size=1)`` builds a balanced static tree (median split on the
-  coordinate of largest spread); ``tree.query(Q, k=2, max_leaves=None)`` returns the k
+  coordinate of largest spread; ``split=`` and ``gap=`` choose other split rules, such as FLANN's
+  variance-mean, and keep each split's gap: :func:`build_kdtree`, our addition, issue 25);
+  ``tree.query(Q, k=2, max_leaves=None)`` returns the k
   nearest neighbours exactly, or by Best-Bin-First after ``max_leaves`` leaves;
   ``tree.last_stats`` counts the work. :func:`bbf_trace` is the one-query teaching version.
 - :func:`exact_knn` (brute force, Hamming or Euclidean), :func:`pad_knn`, :func:`merge_knn`
