@@ -282,3 +282,62 @@ def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.fl
         a0 = S - 1 - o  # robot row = a + o - (S - 1)
         out[n] = full[a0:a0 + H, a0:a0 + W]
     return out
+
+
+def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p, poses) -> np.ndarray:
+    """The correlation Σ T·M of the robot-frame samples at any poses, by the definition (ours, issue 25).
+
+    ``poses`` ``(m, 3)``: ``(x = col, y = row, heading)`` in cells and radians, not necessarily on the search's
+    grid. At a grid pose (integer cell) the samples are rasterised exactly as :class:`_Stamps` does (the
+    heading modulo 90° in float32, then the quarter turn on integer offsets), so the value equals the search's
+    ``D[n, row, col]`` up to its FFT rounding; off the grid the fractional part of the position is added before
+    rounding. Free samples are written first, obstacle samples (``a_p``: a scalar or one value per sample) over
+    them, each cell counted once; the map is 0 outside (``a_n = 0``). Returns ``(m,)`` float64 scores.
+    """
+    H, W = Mv.shape
+    pts = np.vstack([free.reshape(-1, 2), obs.reshape(-1, 2)])
+    n_free = free.shape[0]
+    vals = np.concatenate([np.full(n_free, float(a_c)), np.broadcast_to(np.asarray(a_p, dtype=float),
+                                                                         (obs.shape[0],))])
+    P = np.asarray(poses, dtype=float).reshape(-1, 3)
+    reach = float(np.sqrt(np.max(np.sum(pts ** 2, axis=1)))) if pts.size else 0.0
+    pad = int(np.ceil(reach)) + 3
+    Mp = np.zeros((H + 2 * pad, W + 2 * pad))
+    Mp[pad:pad + H, pad:pad + W] = Mv
+    flat, Wp = Mp.ravel(), W + 2 * pad
+    seen = np.full(Mp.size, -1, dtype=np.int64)
+    order = np.arange(pts.shape[0])
+    px, py = pts[:, 0].astype(np.float32), pts[:, 1].astype(np.float32)
+    out = np.empty(P.shape[0])
+    for m, (x, y, h) in enumerate(P):
+        if not (np.isfinite(x) and np.isfinite(y)) or abs(x) > 4 * (H + W) or abs(y) > 4 * (H + W):
+            out[m] = np.nan
+            continue
+        q = int(np.floor(np.mod(h, 2 * np.pi) / (np.pi / 2) + 1e-9)) % 4
+        b = float(np.mod(h, np.pi / 2))
+        b = 0.0 if b > np.pi / 2 - 1e-9 else round(b, 12)
+        c, s = np.float32(np.cos(b)), np.float32(np.sin(b))
+        xr = c * px
+        xr -= s * py
+        yr = s * px
+        yr += c * py
+        tx, ty = np.floor(x + 0.5), np.floor(y + 0.5)
+        fx, fy = x - tx, y - ty
+        for _ in range(q):  # the fractional offset in the base heading's frame: R_q⁻¹ (x, y) = (y, -x)
+            fx, fy = fy, -fx
+        if fx == 0.0 and fy == 0.0:  # a grid pose: float32 rounding, as _stamp
+            i = np.floor(xr + np.float32(0.5)).astype(np.int64)
+            j = np.floor(yr + np.float32(0.5)).astype(np.int64)
+        else:
+            i = np.floor(xr.astype(np.float64) + (fx + 0.5)).astype(np.int64)
+            j = np.floor(yr.astype(np.float64) + (fy + 0.5)).astype(np.int64)
+        for _ in range(q):  # quarter turns on the integer offsets: (i, j) -> (-j, i)
+            i, j = -j, i
+        col, row = i + int(tx), j + int(ty)
+        inside = (row >= -pad) & (row < H + pad) & (col >= -pad) & (col < W + pad)
+        idx = np.where(inside, (row + pad) * Wp + (col + pad), 0)
+        seen[idx] = order  # the last write of a cell wins, as in the stamp
+        last = (seen[idx] == order) & inside
+        out[m] = float(np.dot(vals[last], flat[idx[last]]))
+        seen[idx] = -1
+    return out
