@@ -154,19 +154,24 @@ def _iter_scores(specs, stamps, sel, S, chunk):
             yield heads, D
 
 
-def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None):
+def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None, n_peaks: int = 0):
     """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
 
     Returns ``(best_val, (n, row, col), best_map, best_per_heading, argmax_per_heading)``; ties within
     ``tol`` go to the smallest heading index, then the first row and column. ``argmax_per_heading``
-    holds the flat cell index of each heading's maximum.
+    holds the flat cell index of each heading's maximum. With ``n_peaks`` > 0 a sixth item: the
+    ``(value, n, row, col)`` of up to ``4·n_peaks`` largest local maxima (5×5 cells) per chunk of
+    headings, for :func:`_distinct_peaks` (ours, issue 25).
     """
     if specs is None:
         specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=workers)
     best_per = np.full(headings.size, -np.inf)
     arg_per = np.zeros(headings.size, dtype=np.int64)
     best_val, best_idx, best_map = -np.inf, None, None
+    peaks = []
     for heads, D in _iter_scores(specs, stamps, np.arange(headings.size), S, chunk):
+        if n_peaks:
+            peaks.append(_local_peaks(D, heads, 4 * n_peaks))
         flat_D = D.reshape(D.shape[0], -1)
         am = flat_D.argmax(axis=1)
         per = flat_D[np.arange(am.size), am]
@@ -180,7 +185,35 @@ def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, spec
                 best_val = max(m, best_val)
                 best_idx = (int(heads[k]), *np.unravel_index(flat, D.shape[1:]))
                 best_map = np.ascontiguousarray(D[k])
+    if n_peaks:
+        return best_val, best_idx, best_map, best_per, arg_per, np.vstack(peaks)
     return best_val, best_idx, best_map, best_per, arg_per
+
+
+def _local_peaks(D: np.ndarray, heads: np.ndarray, k: int) -> np.ndarray:
+    """``(value, n, row, col)`` rows of the ``k`` largest local maxima (over 5×5 cells) of the maps ``D``."""
+    from scipy.ndimage import maximum_filter
+
+    is_peak = maximum_filter(D, size=(1, 5, 5), mode="constant", cval=-np.inf) <= D
+    n, r, c = np.nonzero(is_peak)
+    val = D[n, r, c].astype(np.float64)
+    if val.size > k:
+        sel = np.argpartition(-val, k - 1)[:k]
+        n, r, c, val = n[sel], r[sel], c[sel], val[sel]
+    return np.column_stack([val, heads[n], r, c])
+
+
+def _distinct_peaks(peaks: np.ndarray, headings: np.ndarray, k: int, radius_cells: float, heading_rad: float):
+    """The ``k`` best of ``peaks`` (rows ``(value, n, row, col)``) that lie more than ``radius_cells`` or
+    ``heading_rad`` from every better one kept (greedy non-maximum suppression)."""
+    kept = []
+    for val, n, r, c in peaks[np.argsort(-peaks[:, 0], kind="stable")]:
+        if all(np.hypot(r - r2, c - c2) > radius_cells or abs(wrap_angle(headings[int(n)] - headings[int(n2)]))
+               > heading_rad for _v, n2, r2, c2 in kept):
+            kept.append((val, n, r, c))
+            if len(kept) == k:
+                break
+    return np.array(kept).reshape(-1, 4)
 
 
 def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, radius_cells, heading_rad, chunk):
