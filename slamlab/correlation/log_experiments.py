@@ -325,7 +325,8 @@ def _check_unit(x, name: str) -> float:
 
 
 def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, headings, joined,
-                       hit_ratio: float = 0.25, truth_check: bool = False, refine: int = 0) -> dict:
+                       hit_ratio: float = 0.25, truth_check: bool = False, refine: int = 0,
+                       refine_heading_rad: float = float(np.radians(1.0))) -> dict:
     """One sweep task: the leave-out grid of scan ``index`` and its localisation in every mode (deterministic);
     with ``truth_check`` also :func:`_truth_check`'s columns per mode."""
     if hit_ratio == 0.25:  # occupancy_grid's default rule: leave_out_grid labels the counts
@@ -339,7 +340,7 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
         free, obs, o = _joined_samples(beams[:k], rel[:k], p)
         loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k,
                                 obs_weights=_wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None,
-                                refine=refine)
+                                refine=refine, refine_heading_rad=refine_heading_rad)
         row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity,
                     f"mar{k}": loc.margin})
         if truth_check:
@@ -427,7 +428,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                          cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int = 2, joined=(1,),
                          odom_std=ODOM_STD, hit_ratio: float = 0.25, params: LocaliseParams | None = None, rng=2017,
                          n_jobs: int = 1, progress: bool | None = None, truth_check: bool = False,
-                         refine: int = 0, **overrides) -> LogLocalisationResult:
+                         refine: int = 0, refine_heading_rad: float = float(np.radians(1.0)), **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
 
     Each test scan is localised on the grid (``cell_m`` cells, 004's three values) of every
@@ -483,6 +484,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         search (more than 2 cells or 3° apart) again every 0.5 cell within 1 cell and every 0.5° within 1°,
         by the definition, and keep the best pose (against failures where the truth's neighbourhood scores
         higher than the estimate's only off the grid; ``docs/benchmarks.md``).
+    refine_heading_rad : float, default 1°
+        Half-width of the refinement's headings around each peak [rad].
 
     Returns
     -------
@@ -505,6 +508,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     if not isinstance(truth_check, (bool, np.bool_)):
         raise TypeError(f"`truth_check` must be a bool; got {type(truth_check).__name__}")
     rf = v.check_int(refine, "refine", minimum=0)
+    rfh = v.check_positive(refine_heading_rad, "refine_heading_rad", allow_zero=True)
     if (truth_check or rf) and p.a_n != 0:
         raise ValueError(f"`truth_check` and `refine` score by the definition with a_n = 0 (004's value); got a_n = "
                          f"{p.a_n}")
@@ -531,7 +535,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                        "rel": np.array(rel)})
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes, "hit_ratio": hr, "truth_check": bool(truth_check),
-             "refine": rf}
+             "refine": rf, "refine_heading_rad": rfh}
     table = sweep(_localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed,
                   on_error="raise", desc="localise log scans")
     true_m = log.poses[idx]

@@ -58,3 +58,38 @@ def test_truth_check_on_csail_scans(shared_data):
         C.run_log_localisation(log, (100,), truth_check=True, a_n=0.5)
     with pytest.raises(ValueError, match="this result has no truth check"):
         C.run_log_localisation(log, (100,), ambiguity=False, delta_alpha_rad=np.radians(10.0)).truth_check()
+
+
+def test_distinct_peaks_keeps_the_best_apart():
+    from slamlab.correlation.scoring import _distinct_peaks
+
+    hs = np.radians(np.arange(360.0))
+    peaks = np.array([[10.0, 0, 5, 5], [9.0, 1, 5, 6], [8.0, 0, 20, 5], [7.0, 90, 5, 5], [6.0, 359, 5, 5]])
+    # (9, 1°, one cell away) and (6, 359°, same cell) lie within 2 cells and 3° of the best: dropped
+    assert _distinct_peaks(peaks, hs, 5, 2.0, np.radians(3.0))[:, 0].tolist() == [10.0, 8.0, 7.0]
+    assert _distinct_peaks(peaks, hs, 2, 2.0, np.radians(3.0))[:, 0].tolist() == [10.0, 8.0]
+
+
+def test_refine_scores_at_least_the_grid_peak_and_the_truth():
+    from slamlab.correlation.algorithm import _localise_samples
+    from slamlab.correlation.settings import LocaliseParams
+
+    M = S.test_room_200()
+    Mv = S.grid_to_values(M)
+    truth = np.array([60.5, 40.5, np.radians(30.5)])  # half a cell and half a degree off the search's grid
+    scan = S.Rangefinder(n_beams=360, max_range_cells=60.0).scan(M, truth)
+    free, obs = _beam_samples(scan.bearings_rad, scan.ranges, scan.valid, delta_l_cells=0.0, hit_offset_cells=0.5,
+                              step_cells=0.5, use_misses=False)
+    p = LocaliseParams(ambiguity=False)
+    hs = C.heading_candidates(p.delta_alpha_rad)
+    o = int(np.ceil(np.sqrt(np.max(np.sum(np.vstack([free, obs]) ** 2, axis=1))))) + 2
+    grid = _localise_samples(Mv, free, obs, o, hs, p, tracking=False)
+    fine = _localise_samples(Mv, free, obs, o, hs, p, tracking=False, refine=3)
+    s_grid, s_fine = _pose_scores(Mv, free, obs, -1.0, 1.0, np.vstack([grid.pose, fine.pose]))
+    assert s_fine >= s_grid  # the refinement lattice holds the grid peak itself
+    # the truth is within 1 cell and 1° of the grid peak, on the lattice: the refined pose scores at least as high
+    assert np.hypot(*(grid.pose[:2] - truth[:2])) <= 1.0
+    assert s_fine >= _pose_scores(Mv, free, obs, -1.0, 1.0, truth[None])[0]
+    assert np.hypot(*(fine.pose[:2] - truth[:2])) <= 1.0
+    assert abs(np.degrees(fine.pose[2] - truth[2])) <= 1.0 + 1e-9
+    assert fine.score == grid.score  # the score and the rival stay the grid search's
