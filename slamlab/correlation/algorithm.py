@@ -273,7 +273,7 @@ def _wall_weights(beams, rel_poses, p: LocaliseParams, n_bins: int = 12) -> np.n
 
 
 def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking: bool, n_scans: int = 1,
-                      obs_weights=None, refine: int = 0, refine_heading_rad: float = float(np.radians(1.0))):
+                      obs_weights=None, refine: int = 0, refine_heading_rad: float = float(np.radians(3.0))):
     """Rasterise the robot-frame samples ``free`` / ``obs`` (stamp half-size ``o``), search the peak and its rival.
 
     ``obs_weights`` (one per obstacle sample, optional) multiply ``a_p`` in the stamps (:func:`_wall_weights`).
@@ -316,7 +316,7 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
 
 
 def _refine_peaks(Mv, free, obs, a_c, a_p, headings, peaks, k: int,
-                  heading_rad: float = float(np.radians(1.0))) -> np.ndarray:
+                  heading_rad: float = float(np.radians(3.0))) -> np.ndarray:
     """The best pose off the grid near the ``k`` best distinct grid peaks (ours, issue 25).
 
     Each peak of :func:`~slamlab.correlation.scoring._distinct_peaks` (more than 2 cells or 3° apart) is

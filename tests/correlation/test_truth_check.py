@@ -56,6 +56,12 @@ def test_truth_check_on_csail_scans(shared_data):
         C.run_log_localisation(log, (100,), truth_check="yes")
     with pytest.raises(ValueError, match="`truth_check` and `refine` score by the definition with a_n = 0"):
         C.run_log_localisation(log, (100,), truth_check=True, a_n=0.5)
+    with pytest.raises(ValueError, match="`refine`"):
+        C.run_log_localisation(log, (100,), refine=-1)
+    with pytest.raises(TypeError, match="`refine`"):
+        C.run_log_localisation(log, (100,), refine=2.5)
+    with pytest.raises(ValueError, match="`refine_heading_rad`"):
+        C.run_log_localisation(log, (100,), refine=3, refine_heading_rad=-0.1)
     with pytest.raises(ValueError, match="this result has no truth check"):
         C.run_log_localisation(log, (100,), ambiguity=False, delta_alpha_rad=np.radians(10.0)).truth_check()
 
