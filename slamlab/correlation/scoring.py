@@ -161,7 +161,7 @@ def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, spec
     ``tol`` go to the smallest heading index, then the first row and column. ``argmax_per_heading``
     holds the flat cell index of each heading's maximum. With ``n_peaks`` > 0 a sixth item: the
     ``(value, n, row, col)`` of up to ``4·n_peaks`` largest local maxima (5×5 cells) per chunk of
-    headings, for :func:`_distinct_peaks` (ours, issue 25).
+    headings (:func:`_local_peaks`), for :func:`_distinct_peaks` (ours, issue 25).
     """
     if specs is None:
         specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=workers)
@@ -191,12 +191,24 @@ def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, spec
 
 
 def _local_peaks(D: np.ndarray, heads: np.ndarray, k: int) -> np.ndarray:
-    """``(value, n, row, col)`` rows of the ``k`` largest local maxima (over 5×5 cells) of the maps ``D``."""
-    from scipy.ndimage import maximum_filter
-
-    is_peak = maximum_filter(D, size=(1, 5, 5), mode="constant", cval=-np.inf) <= D
-    n, r, c = np.nonzero(is_peak)
-    val = D[n, r, c].astype(np.float64)
+    """``(value, n, row, col)`` rows of the ``k`` largest local maxima (over 5×5 cells) among the ``64·k``
+    largest cells of the maps ``D`` (a cell is a local maximum when no cell within 2 rows and columns of its
+    map is larger)."""
+    _n, H, W = D.shape
+    flat = D.reshape(-1)
+    m = min(64 * k, flat.size)
+    top = np.argpartition(flat, flat.size - m)[flat.size - m:]
+    n, rc = np.divmod(top, H * W)
+    r, c = np.divmod(rc, W)
+    val = flat[top]
+    is_peak = np.ones(top.size, dtype=bool)
+    for dr in range(-2, 3):
+        for dc in range(-2, 3):
+            rr, cc = r + dr, c + dc
+            inside = (rr >= 0) & (rr < H) & (cc >= 0) & (cc < W)
+            nb = D[n[inside], rr[inside], cc[inside]]
+            is_peak[np.nonzero(inside)[0][nb > val[inside]]] = False
+    n, r, c, val = n[is_peak], r[is_peak], c[is_peak], val[is_peak].astype(np.float64)
     if val.size > k:
         sel = np.argpartition(-val, k - 1)[:k]
         n, r, c, val = n[sel], r[sel], c[sel], val[sel]
@@ -342,18 +354,21 @@ def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, 
     order = np.arange(pts.shape[0])
     px, py = pts[:, 0].astype(np.float32), pts[:, 1].astype(np.float32)
     out = np.empty(P.shape[0])
+    last_h = None
     for m, (x, y, h) in enumerate(P):
         if not (np.isfinite(x) and np.isfinite(y)) or abs(x) > 4 * (H + W) or abs(y) > 4 * (H + W):
             out[m] = np.nan
             continue
-        q = int(np.floor(np.mod(h, 2 * np.pi) / (np.pi / 2) + 1e-9)) % 4
-        b = float(np.mod(h, np.pi / 2))
-        b = 0.0 if b > np.pi / 2 - 1e-9 else round(b, 12)
-        c, s = np.float32(np.cos(b)), np.float32(np.sin(b))
-        xr = c * px
-        xr -= s * py
-        yr = s * px
-        yr += c * py
+        if h != last_h:  # the samples turned by the heading's base (mod 90°), once per run of equal headings
+            q = int(np.floor(np.mod(h, 2 * np.pi) / (np.pi / 2) + 1e-9)) % 4
+            b = float(np.mod(h, np.pi / 2))
+            b = 0.0 if b > np.pi / 2 - 1e-9 else round(b, 12)
+            c, s = np.float32(np.cos(b)), np.float32(np.sin(b))
+            xr = c * px
+            xr -= s * py
+            yr = s * px
+            yr += c * py
+            xr64, yr64, last_h = xr.astype(np.float64), yr.astype(np.float64), h
         tx, ty = np.floor(x + 0.5), np.floor(y + 0.5)
         fx, fy = x - tx, y - ty
         for _ in range(q):  # the fractional offset in the base heading's frame: R_q⁻¹ (x, y) = (y, -x)
@@ -362,8 +377,8 @@ def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, 
             i = np.floor(xr + np.float32(0.5)).astype(np.int64)
             j = np.floor(yr + np.float32(0.5)).astype(np.int64)
         else:
-            i = np.floor(xr.astype(np.float64) + (fx + 0.5)).astype(np.int64)
-            j = np.floor(yr.astype(np.float64) + (fy + 0.5)).astype(np.int64)
+            i = np.floor(xr64 + (fx + 0.5)).astype(np.int64)
+            j = np.floor(yr64 + (fy + 0.5)).astype(np.int64)
         for _ in range(q):  # quarter turns on the integer offsets: (i, j) -> (-j, i)
             i, j = -j, i
         col, row = i + int(tx), j + int(ty)
