@@ -246,11 +246,11 @@ def refine_cost(repeat: int = 2) -> None:
           f"(alternating), load average {os.getloadavg()[0]:.1f}")
     times = {0: [], 10: []}
     for _ in range(repeat):
-        for k in times:
+        for k, ts in times.items():
             t0 = time.process_time()
             r = sl.correlation.run_log_localisation(log, idx, joined=(1, 3), refine=k, progress=False)
-            times[k].append(time.process_time() - t0)
-            print(f"  refine={k}: {times[k][-1]:.1f} s CPU, localised {r.success.sum(axis=1).tolist()} (1 / 3 scans)")
+            ts.append(time.process_time() - t0)
+            print(f"  refine={k}: {ts[-1]:.1f} s CPU, localised {r.success.sum(axis=1).tolist()} (1 / 3 scans)")
     t0, t10 = min(times[0]), min(times[10])
     print(f"best: defaults {t0:.1f} s, refine=10 {t10:.1f} s, ratio {t10 / t0:.2f}; load average now "
           f"{os.getloadavg()[0]:.1f}")
