@@ -321,8 +321,8 @@ def _refine_peaks(Mv, free, obs, a_c, a_p, headings, peaks, k: int,
 
     Each peak of :func:`~slamlab.correlation.scoring._distinct_peaks` (more than 2 cells or 3° apart) is
     scored by the definition (:func:`~slamlab.correlation.scoring._pose_scores`) at the poses every 0.5 cell
-    within 1 cell and every 0.5° within ``heading_rad`` of it; the pose ``(x = col, y = row, heading)`` with the highest
-    score wins (first on ties, the peaks taken best first).
+    within 1 cell and every 0.5° within ``heading_rad`` of it; the pose ``(x = col, y = row, heading)`` with the
+    highest score wins (first on ties, the peaks taken best first).
     """
     from .scoring import _distinct_peaks, _pose_scores
 

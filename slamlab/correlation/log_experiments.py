@@ -101,7 +101,7 @@ class LogLocalisationResult:
         :attr:`Localisation.margin` of each localisation (None: not recorded).
     truth : dict of str to numpy.ndarray, shape (modes, n), optional
         The truth check's scores and wall fractions (``run_log_localisation(truth_check=True)``; None: not run);
-        :meth:`truth_check` tabulates them.
+        :meth:`~slamlab.correlation.LogLocalisationResult.truth_check` tabulates them.
     cell_m : float
         Grid cell size [m].
     max_range_m : float
@@ -198,7 +198,8 @@ class LogLocalisationResult:
         return pd.DataFrame(rows)
 
     def failure_table(self) -> str:
-        """The failures of :meth:`truth_check`: errors, scores at the estimate and near the truth, wall fractions.
+        """The failures of :meth:`~slamlab.correlation.LogLocalisationResult.truth_check`: errors, scores at the
+        estimate and near the truth, wall fractions.
 
         Returns
         -------
@@ -360,7 +361,8 @@ def _tolerance_poses(center, headings, radius_cells: float, heading_rad: float) 
     ``center`` (cells, rad): the search's poses that count as a success there."""
     x, y, th = center
     r = int(np.ceil(radius_cells)) + 1
-    cx, cy = np.meshgrid(np.arange(np.floor(x) - r, np.floor(x) + r + 2), np.arange(np.floor(y) - r, np.floor(y) + r + 2))
+    cx, cy = np.meshgrid(np.arange(np.floor(x) - r, np.floor(x) + r + 2),
+                         np.arange(np.floor(y) - r, np.floor(y) + r + 2))
     near = np.hypot(cx - x, cy - y) <= radius_cells + 1e-9
     hs = headings[heading_error(headings, th) <= heading_rad + 1e-9]
     cells = np.column_stack([cx[near], cy[near]])
@@ -479,7 +481,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     truth_check : bool, default False
         Also score each scan near its logged pose with the search's own score (ours, issue 25): is a failure a
         score failure (the truth scores lower than the estimate) or a search failure?
-        :meth:`LogLocalisationResult.truth_check` tabulates it. Needs ``a_n = 0`` (004's value).
+        :meth:`~slamlab.correlation.LogLocalisationResult.truth_check` tabulates it. Needs ``a_n = 0`` (004's
+        value).
     refine : int, default 0
         Off by default. ``refine`` > 0 (ours, issue 25): score the ``refine`` best distinct peaks of the grid
         search (more than 2 cells or 3° apart) again every 0.5 cell within 1 cell and every 0.5° within

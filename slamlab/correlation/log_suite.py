@@ -144,9 +144,9 @@ class LogSuiteResult:
                              f"median {short} (failures)", f"median {short} (successes)"], rows, title=title)
 
     def failure_table(self) -> str:
-        """Per log and mode: the failures by kind of :meth:`LogLocalisationResult.truth_check` (score failure,
-        search failure, off the grid) and the score failures' fraction of end points on walls at the truth
-        (ours, issue 25; needs ``truth_check=True``).
+        """Per log and mode: the failures by kind of :meth:`~slamlab.correlation.LogLocalisationResult.truth_check`
+        (score failure, search failure, off the grid) and the score failures' fraction of end points on walls at
+        the truth (ours, issue 25; needs ``truth_check=True``).
 
         Returns
         -------
