@@ -11,6 +11,8 @@ definition on a small case; every pair must give the identical peak.
     python benchmarks/bench_correlation.py --logs          # + every 25th scan of each shared CARMEN log, per-log table
     python benchmarks/bench_correlation.py --logs --every 100 --only intel,seattle   # smaller / fewer logs
     python benchmarks/bench_correlation.py --logs --map-check   # + is each log's beam layout read right? (issue 25)
+    python benchmarks/bench_correlation.py --logs --failures    # + each failure: score failure or search failure?
+    python benchmarks/bench_correlation.py --refine-cost        # + CPU time of refine=10 (issue 25)
 """
 
 from __future__ import annotations
@@ -119,6 +121,12 @@ def main():
                          "fields), a Python literal: --set 'odom_std=(0, 0)' --set a_p=4 --set hit_ratio=0.1")
     ap.add_argument("--map-check", action="store_true",
                     help="with --logs: first print the end points on the other scans' walls per beam layout and log")
+    ap.add_argument("--failures", action="store_true",
+                    help="with --logs: score each scan near its logged pose too and print the failures by kind "
+                         "(score failure or search failure, issue 25)")
+    ap.add_argument("--refine-cost", action="store_true",
+                    help="CPU time of run_log_localisation with refine=10 vs without, every 25th csail scan, modes "
+                         "1 and 3 (issue 25)")
     ap.add_argument("--only", default=None, help="comma-separated short log names for --logs (default all five)")
     ap.add_argument("--jobs", type=int, default=1, help="sweep workers of the --intel/--logs runs (same result for any)")
     args = ap.parse_args()
@@ -185,6 +193,8 @@ def main():
 
     if args.intel:
         intel(args.jobs)
+    if args.refine_cost:
+        refine_cost()
     if args.logs:
         settings = {k: val for k, val in (("exclude", args.exclude), ("max_range_m", args.max_range)) if val is not None}
         for item in args.set:
@@ -192,10 +202,11 @@ def main():
             if not sep:
                 ap.error(f"--set takes NAME=VALUE; got {item!r}")
             settings[name.strip()] = ast.literal_eval(value.strip())
-        logs(args.every, args.only, args.jobs, settings, args.map_check)
+        logs(args.every, args.only, args.jobs, settings, args.map_check, args.failures)
 
 
-def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: bool = False) -> None:
+def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: bool = False,
+         failures: bool = False) -> None:
     """Issue 25: every ``every``-th scan of each shared CARMEN log, modes 1/2/3, with the real-log defaults."""
     from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
 
@@ -210,9 +221,13 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
           f"load average {os.getloadavg()[0]:.1f}")
     t0 = time.perf_counter()
     r = sl.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs, progress=False,
-                                     **settings)
+                                     **settings, **({"truth_check": True} if failures else {}))
     print(f"took {time.perf_counter() - t0:.1f} s wall ({n_jobs} job(s)); load average now {os.getloadavg()[0]:.1f}")
     print(r.table())
+    if failures:
+        print(r.failure_table())
+        for res in r.results:
+            print(res.failure_table())
     for t in (0.75, 0.8, 0.85, 0.9):
         print(r.ambiguity_table(t))
     for t in (1.0, 1.2, 1.3):  # issue 25: the margin, threshold 1.2 tuned on csail, orebro and seattle
@@ -221,6 +236,24 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
         more_confident(r)
     for res in r.results:
         print(res.table())
+
+
+def refine_cost(repeat: int = 2) -> None:
+    """Issue 25: CPU time of ``run_log_localisation(refine=10)`` against the defaults, every 25th csail scan."""
+    log = sl.io.read_carmen(sl.data.find_data("carmen-radish-corrected/csail-corrected.log.gz"))
+    idx = range(25, log.n_scans, 25)
+    print(f"\nrefine cost: csail, every 25th scan ({len(idx)} scans), modes 1 and 3, best CPU time of {repeat} "
+          f"(alternating), load average {os.getloadavg()[0]:.1f}")
+    times = {0: [], 10: []}
+    for _ in range(repeat):
+        for k, ts in times.items():
+            t0 = time.process_time()
+            r = sl.correlation.run_log_localisation(log, idx, joined=(1, 3), refine=k, progress=False)
+            ts.append(time.process_time() - t0)
+            print(f"  refine={k}: {ts[-1]:.1f} s CPU, localised {r.success.sum(axis=1).tolist()} (1 / 3 scans)")
+    t0, t10 = min(times[0]), min(times[10])
+    print(f"best: defaults {t0:.1f} s, refine=10 {t10:.1f} s, ratio {t10 / t0:.2f}; load average now "
+          f"{os.getloadavg()[0]:.1f}")
 
 
 def more_confident(r) -> None:

@@ -273,10 +273,14 @@ def _wall_weights(beams, rel_poses, p: LocaliseParams, n_bins: int = 12) -> np.n
 
 
 def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking: bool, n_scans: int = 1,
-                      obs_weights=None):
+                      obs_weights=None, refine: int = 0, refine_heading_rad: float = float(np.radians(3.0))):
     """Rasterise the robot-frame samples ``free`` / ``obs`` (stamp half-size ``o``), search the peak and its rival.
 
     ``obs_weights`` (one per obstacle sample, optional) multiply ``a_p`` in the stamps (:func:`_wall_weights`).
+    ``refine`` > 0 (ours, issue 25; off by default): the ``refine`` best distinct peaks of the grid search
+    (more than 2 cells or 3° apart) are scored again off the grid, every 0.5 cell within 1 cell and every
+    0.5° within ``refine_heading_rad`` (:func:`_refine_peaks`), and the pose is the best of those (``score``
+    and the rival stay the grid search's).
     """
     dtype = np.dtype(p.dtype)
     S = 2 * o
@@ -286,8 +290,9 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
     amax = max(abs(p.a_c), float(np.max(np.abs(a_p), initial=0.0)), abs(p.a_n))
     tol = (1e-9 if dtype == np.float64 else 2e-5) * amax * amax * n_marks
     specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=p.workers)
-    best_val, best_idx, best_map, best, arg = _peak_search(Mv, stamps, headings, S, o, dtype=dtype,
-                                                           workers=p.workers, chunk=p.chunk, tol=tol, specs=specs)
+    found = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=p.workers, chunk=p.chunk, tol=tol,
+                         specs=specs, n_peaks=refine)
+    best_val, best_idx, best_map, best, arg = found[:5]
     n, row, col = (int(i) for i in best_idx)
 
     def pose_of(k, rw, cl):
@@ -300,9 +305,37 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
                                         radius_cells=p.rival_radius_cells, heading_rad=p.rival_heading_rad,
                                         chunk=p.chunk)
         rival_pose = None if ridx is None else pose_of(*ridx)
-    return Localisation(pose=pose_of(n, row, col), row=row, col=col, heading_index=n, score=best_val,
+    pose = pose_of(n, row, col)
+    if refine:
+        pose = _refine_peaks(Mv, free, obs, p.a_c, a_p, headings, found[5], refine, refine_heading_rad)
+        if not tracking:
+            pose[2] = float(np.mod(pose[2], 2 * np.pi))
+    return Localisation(pose=pose, row=row, col=col, heading_index=n, score=best_val,
                         headings_rad=headings, best_per_heading=best, score_map=best_map, rival_score=rival_val,
                         rival_pose=rival_pose, n_scans=n_scans)
+
+
+def _refine_peaks(Mv, free, obs, a_c, a_p, headings, peaks, k: int,
+                  heading_rad: float = float(np.radians(3.0))) -> np.ndarray:
+    """The best pose off the grid near the ``k`` best distinct grid peaks (ours, issue 25).
+
+    Each peak of :func:`~slamlab.correlation.scoring._distinct_peaks` (more than 2 cells or 3° apart) is
+    scored by the definition (:func:`~slamlab.correlation.scoring._pose_scores`) at the poses every 0.5 cell
+    within 1 cell and every 0.5° within ``heading_rad`` of it; the pose ``(x = col, y = row, heading)`` with the
+    highest score wins (first on ties, the peaks taken best first).
+    """
+    from .scoring import _distinct_peaks, _pose_scores
+
+    cand = _distinct_peaks(peaks, headings, k, 2.0, float(np.radians(3.0)))
+    d = 0.5 * np.arange(-2, 3)
+    dx, dy = np.meshgrid(d, d)
+    near = np.hypot(dx, dy) <= 1.0 + 1e-9
+    m = int(np.floor(heading_rad / np.radians(0.5) + 1e-9))
+    dh = np.radians(0.5) * np.arange(-m, m + 1)
+    offs = np.array([[a, b, h] for h in dh for a, b in zip(dx[near], dy[near], strict=True)])
+    poses = np.vstack([offs + np.array([c, r, headings[int(n)]]) for _v, n, r, c in cand])
+    sc = _pose_scores(Mv, free, obs, a_c, a_p, poses)
+    return poses[int(np.argmax(sc))].copy()
 
 
 def _joined_samples(beams, rel_poses, p: LocaliseParams):

@@ -143,6 +143,35 @@ class LogSuiteResult:
         return format_table(["log", "mode", f"failures flagged ({rule})", "successes flagged",
                              f"median {short} (failures)", f"median {short} (successes)"], rows, title=title)
 
+    def failure_table(self) -> str:
+        """Per log and mode: the failures by kind of :meth:`~slamlab.correlation.LogLocalisationResult.truth_check`
+        (score failure, search failure, off the grid) and the score failures' fraction of end points on walls at
+        the truth (ours, issue 25; needs ``truth_check=True``).
+
+        Returns
+        -------
+        str
+        """
+        rows = []
+        for name, r in zip(self.names, self.results, strict=True):
+            d = r.truth_check()
+            for k in r.joined:
+                dk = d[d["joined"] == k]
+                fail = dk[~dk["ok"]]
+                sc = fail[fail["kind"] == "score"]
+                rows.append([name, r._mode(k), f"{len(fail)}/{len(dk)}", str(int((fail["kind"] == "score").sum())),
+                             str(int((fail["kind"] == "search").sum())), str(int((fail["kind"] == "grid").sum())),
+                             ", ".join(f"{s}: {w:.2f}" for s, w in zip(sc["scan"], sc["walls_truth"], strict=True))
+                             or "-",
+                             f"{np.median(dk[dk['ok']]['walls_truth']):.2f}" if dk["ok"].any() else "-"])
+        return format_table(["log", "mode", "failures", "score", "search", "grid", "score failures: walls at truth",
+                             "successes: median walls"], rows,
+                            title=("Failures by kind: score = the logged pose's neighbourhood (2 cells, 5°) scores "
+                                   "lower than the estimate on the grid and off it (0.5 cell, 0.5°); search = a grid "
+                                   "pose near the truth scores at least as high; grid = only off the grid; walls = "
+                                   "fraction of end points at the logged poses on obstacle cells of the leave-out "
+                                   "grid"))
+
     def __str__(self) -> str:
         rates = "; ".join(f"{n} " + ", ".join(f"{ok.sum()}/{ok.size}" for ok in r.success)
                           for n, r in zip(self.names, self.results, strict=True))

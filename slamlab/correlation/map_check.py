@@ -126,21 +126,25 @@ def endpoint_agreement(log, *, fov_rad: float = np.pi, reverse: bool = False, of
     ev = v.check_int(every, "every", minimum=1)
     view = _LaidOut(log, fov, bool(reverse), off, dx, k)
     _frame, sc, Pc, full = log_counts(view, cell_m=cell_m, max_range_m=max_range_m)
-    H, W = full.grid.shape
     on = seen = total = 0
     for i in range(ev, view.n_scans, ev):
         g = leave_out_grid(full, sc, Pc, range(max(0, i - ex), min(view.n_scans, i + ex + 1)))
-        s = sc[i]
-        th = Pc[i, 2] + s.bearings_rad[s.valid]
-        r = s.ranges[s.valid] + 0.01  # the hit cell, as occupancy_grid votes it
-        col = np.floor(Pc[i, 0] + r * np.cos(th) + 0.5).astype(np.int64)
-        row = np.floor(Pc[i, 1] + r * np.sin(th) + 0.5).astype(np.int64)
-        inside = (row >= 0) & (row < H) & (col >= 0) & (col < W)
-        code = g[row[inside], col[inside]]
-        on += int(np.sum(code == OBSTACLE))
-        seen += int(np.sum(code != UNEXPLORED))
-        total += int(s.valid.sum())
+        o, sn, t = _endpoints_on_walls(g, sc[i], Pc[i])
+        on, seen, total = on + o, seen + sn, total + t
     return on / max(total, 1), on / max(seen, 1)
+
+
+def _endpoints_on_walls(grid, scan, pose) -> tuple[int, int, int]:
+    """End points of a cell-unit ``scan`` at ``pose`` (cells, rad): on obstacle cells of ``grid``, on seen cells
+    (obstacle or free), and in all (its returns; outside the grid counts as unseen)."""
+    H, W = grid.shape
+    th = pose[2] + scan.bearings_rad[scan.valid]
+    r = scan.ranges[scan.valid] + 0.01  # the hit cell, as occupancy_grid votes it
+    col = np.floor(pose[0] + r * np.cos(th) + 0.5).astype(np.int64)
+    row = np.floor(pose[1] + r * np.sin(th) + 0.5).astype(np.int64)
+    inside = (row >= 0) & (row < H) & (col >= 0) & (col < W)
+    code = grid[row[inside], col[inside]]
+    return int(np.sum(code == OBSTACLE)), int(np.sum(code != UNEXPLORED)), int(scan.valid.sum())
 
 
 def map_check(paths=None, layouts=MAP_CHECK_LAYOUTS, **settings) -> str:

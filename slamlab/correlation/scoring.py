@@ -154,19 +154,24 @@ def _iter_scores(specs, stamps, sel, S, chunk):
             yield heads, D
 
 
-def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None):
+def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None, n_peaks: int = 0):
     """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
 
     Returns ``(best_val, (n, row, col), best_map, best_per_heading, argmax_per_heading)``; ties within
     ``tol`` go to the smallest heading index, then the first row and column. ``argmax_per_heading``
-    holds the flat cell index of each heading's maximum.
+    holds the flat cell index of each heading's maximum. With ``n_peaks`` > 0 a sixth item: the
+    ``(value, n, row, col)`` of up to ``4·n_peaks`` largest local maxima (5×5 cells) per chunk of
+    headings (:func:`_local_peaks`), for :func:`_distinct_peaks` (ours, issue 25).
     """
     if specs is None:
         specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=workers)
     best_per = np.full(headings.size, -np.inf)
     arg_per = np.zeros(headings.size, dtype=np.int64)
     best_val, best_idx, best_map = -np.inf, None, None
+    peaks = []
     for heads, D in _iter_scores(specs, stamps, np.arange(headings.size), S, chunk):
+        if n_peaks:
+            peaks.append(_local_peaks(D, heads, 4 * n_peaks))
         flat_D = D.reshape(D.shape[0], -1)
         am = flat_D.argmax(axis=1)
         per = flat_D[np.arange(am.size), am]
@@ -180,7 +185,47 @@ def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, spec
                 best_val = max(m, best_val)
                 best_idx = (int(heads[k]), *np.unravel_index(flat, D.shape[1:]))
                 best_map = np.ascontiguousarray(D[k])
+    if n_peaks:
+        return best_val, best_idx, best_map, best_per, arg_per, np.vstack(peaks)
     return best_val, best_idx, best_map, best_per, arg_per
+
+
+def _local_peaks(D: np.ndarray, heads: np.ndarray, k: int) -> np.ndarray:
+    """``(value, n, row, col)`` rows of the ``k`` largest local maxima (over 5×5 cells) among the ``64·k``
+    largest cells of the maps ``D`` (a cell is a local maximum when no cell within 2 rows and columns of its
+    map is larger)."""
+    _n, H, W = D.shape
+    flat = D.reshape(-1)
+    m = min(64 * k, flat.size)
+    top = np.argpartition(flat, flat.size - m)[flat.size - m:]
+    n, rc = np.divmod(top, H * W)
+    r, c = np.divmod(rc, W)
+    val = flat[top]
+    is_peak = np.ones(top.size, dtype=bool)
+    for dr in range(-2, 3):
+        for dc in range(-2, 3):
+            rr, cc = r + dr, c + dc
+            inside = (rr >= 0) & (rr < H) & (cc >= 0) & (cc < W)
+            nb = D[n[inside], rr[inside], cc[inside]]
+            is_peak[np.nonzero(inside)[0][nb > val[inside]]] = False
+    n, r, c, val = n[is_peak], r[is_peak], c[is_peak], val[is_peak].astype(np.float64)
+    if val.size > k:
+        sel = np.argpartition(-val, k - 1)[:k]
+        n, r, c, val = n[sel], r[sel], c[sel], val[sel]
+    return np.column_stack([val, heads[n], r, c])
+
+
+def _distinct_peaks(peaks: np.ndarray, headings: np.ndarray, k: int, radius_cells: float, heading_rad: float):
+    """The ``k`` best of ``peaks`` (rows ``(value, n, row, col)``) that lie more than ``radius_cells`` or
+    ``heading_rad`` from every better one kept (greedy non-maximum suppression)."""
+    kept = []
+    for val, n, r, c in peaks[np.argsort(-peaks[:, 0], kind="stable")]:
+        if all(np.hypot(r - r2, c - c2) > radius_cells or abs(wrap_angle(headings[int(n)] - headings[int(n2)]))
+               > heading_rad for _v, n2, r2, c2 in kept):
+            kept.append((val, n, r, c))
+            if len(kept) == k:
+                break
+    return np.array(kept).reshape(-1, 4)
 
 
 def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, radius_cells, heading_rad, chunk):
@@ -281,4 +326,66 @@ def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.fl
         full = fftconvolve(Mv, T[n, ::-1, ::-1], mode="full")  # = correlation of M with T_n
         a0 = S - 1 - o  # robot row = a + o - (S - 1)
         out[n] = full[a0:a0 + H, a0:a0 + W]
+    return out
+
+
+def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p, poses) -> np.ndarray:
+    """The correlation Σ T·M of the robot-frame samples at any poses, by the definition (ours, issue 25).
+
+    ``poses`` ``(m, 3)``: ``(x = col, y = row, heading)`` in cells and radians, not necessarily on the search's
+    grid. At a grid pose (integer cell) the samples are rasterised exactly as :class:`_Stamps` does (the
+    heading modulo 90° in float32, then the quarter turn on integer offsets), so the value equals the search's
+    ``D[n, row, col]`` up to its FFT rounding; off the grid the fractional part of the position is added before
+    rounding. Free samples are written first, obstacle samples (``a_p``: a scalar or one value per sample) over
+    them, each cell counted once; the map is 0 outside (``a_n = 0``). Returns ``(m,)`` float64 scores.
+    """
+    H, W = Mv.shape
+    pts = np.vstack([free.reshape(-1, 2), obs.reshape(-1, 2)])
+    n_free = free.shape[0]
+    vals = np.concatenate([np.full(n_free, float(a_c)), np.broadcast_to(np.asarray(a_p, dtype=float),
+                                                                         (obs.shape[0],))])
+    P = np.asarray(poses, dtype=float).reshape(-1, 3)
+    reach = float(np.sqrt(np.max(np.sum(pts ** 2, axis=1)))) if pts.size else 0.0
+    pad = int(np.ceil(reach)) + 3
+    Mp = np.zeros((H + 2 * pad, W + 2 * pad))
+    Mp[pad:pad + H, pad:pad + W] = Mv
+    flat, Wp = Mp.ravel(), W + 2 * pad
+    seen = np.full(Mp.size, -1, dtype=np.int64)
+    order = np.arange(pts.shape[0])
+    px, py = pts[:, 0].astype(np.float32), pts[:, 1].astype(np.float32)
+    out = np.empty(P.shape[0])
+    last_h = None
+    for m, (x, y, h) in enumerate(P):
+        if not (np.isfinite(x) and np.isfinite(y)) or abs(x) > 4 * (H + W) or abs(y) > 4 * (H + W):
+            out[m] = np.nan
+            continue
+        if h != last_h:  # the samples turned by the heading's base (mod 90°), once per run of equal headings
+            q = int(np.floor(np.mod(h, 2 * np.pi) / (np.pi / 2) + 1e-9)) % 4
+            b = float(np.mod(h, np.pi / 2))
+            b = 0.0 if b > np.pi / 2 - 1e-9 else round(b, 12)
+            c, s = np.float32(np.cos(b)), np.float32(np.sin(b))
+            xr = c * px
+            xr -= s * py
+            yr = s * px
+            yr += c * py
+            xr64, yr64, last_h = xr.astype(np.float64), yr.astype(np.float64), h
+        tx, ty = np.floor(x + 0.5), np.floor(y + 0.5)
+        fx, fy = x - tx, y - ty
+        for _ in range(q):  # the fractional offset in the base heading's frame: R_q⁻¹ (x, y) = (y, -x)
+            fx, fy = fy, -fx
+        if fx == 0.0 and fy == 0.0:  # a grid pose: float32 rounding, as _stamp
+            i = np.floor(xr + np.float32(0.5)).astype(np.int64)
+            j = np.floor(yr + np.float32(0.5)).astype(np.int64)
+        else:
+            i = np.floor(xr64 + (fx + 0.5)).astype(np.int64)
+            j = np.floor(yr64 + (fy + 0.5)).astype(np.int64)
+        for _ in range(q):  # quarter turns on the integer offsets: (i, j) -> (-j, i)
+            i, j = -j, i
+        col, row = i + int(tx), j + int(ty)
+        inside = (row >= -pad) & (row < H + pad) & (col >= -pad) & (col < W + pad)
+        idx = np.where(inside, (row + pad) * Wp + (col + pad), 0)
+        seen[idx] = order  # the last write of a cell wins, as in the stamp
+        last = (seen[idx] == order) & inside
+        out[m] = float(np.dot(vals[last], flat[idx[last]]))
+        seen[idx] = -1
     return out

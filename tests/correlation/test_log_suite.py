@@ -60,3 +60,49 @@ def test_intel_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
     # the goal: >= 75 % from a single scan, >= 90 % with 3 joined scans
     assert ok[0].mean() >= 0.75
     assert ok[1].mean() >= 0.90
+
+
+def _goal_rates(shared_data, name: str, every: int):
+    """Single-scan and 3-scan success rates of every ``every``-th scan of a shared log with the real-log defaults.
+
+    ``ambiguity=False``: the rival search only scores the estimate's rivals, it never moves the estimate (the
+    peak search runs before it), so the success counts are the defaults' at about 3/4 of the time.
+    """
+    log = read_carmen(shared_data / "carmen-radish-corrected" / f"{name}-corrected.log.gz")
+    ok = C.run_log_suite([log], every, joined=(1, 3), ambiguity=False).results[0].success
+    return ok.mean(axis=1)
+
+
+@pytest.mark.realdata
+def test_csail_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
+    """Issue 25's goal on csail at the goal's size (every 25th scan, 16 scans): >= 75 % single, >= 90 % with 3."""
+    single, three = _goal_rates(shared_data, "csail", 25)
+    assert single >= 0.75
+    assert three >= 0.90
+
+
+@pytest.mark.realdata
+def test_fhw_meets_the_issue_25_goals_at_every_50th_scan(shared_data):
+    """Issue 25's goal on fhw on a cheaper subset: every 50th scan (9 scans, half of the goal's every 25th; the
+    whole set costs about 30 s). Bounds from the goal: >= 75 % single, >= 90 % with 3 joined scans."""
+    single, three = _goal_rates(shared_data, "fhw", 50)
+    assert single >= 0.75
+    assert three >= 0.90
+
+
+@pytest.mark.realdata
+@pytest.mark.xfail(strict=True, reason="issue 25: orebro misses the goal (4/9 single, 7/9 with 3 scans; orebro 50 "
+                                       "and 200 are score failures, docs/benchmarks.md): passes the day it is met")
+def test_orebro_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
+    single, three = _goal_rates(shared_data, "orebro", 25)
+    assert single >= 0.75
+    assert three >= 0.90
+
+
+@pytest.mark.realdata
+@pytest.mark.xfail(strict=True, reason="issue 25: seattle misses the 3-scan goal (7/9 with 3 scans; seattle 75 is "
+                                       "a score failure, docs/benchmarks.md): passes the day it is met")
+def test_seattle_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
+    single, three = _goal_rates(shared_data, "seattle", 25)
+    assert single >= 0.75
+    assert three >= 0.90

@@ -1,0 +1,101 @@
+"""Issue 25: score failure or search failure? The search's score at any pose, and the truth check of the log runs."""
+
+import numpy as np
+import pytest
+
+from slamlab import correlation as C
+from slamlab import sim as S
+from slamlab.correlation.algorithm import _beam_samples
+from slamlab.correlation.scoring import _pose_scores
+from slamlab.io import read_carmen
+
+
+def test_pose_scores_equal_the_definition_at_grid_poses():
+    # score_maps(method="direct") is the correlation's definition on the stamps T_n; _pose_scores rasterises the
+    # samples at each pose itself: at grid poses (integer cells, candidate headings incl. quarter turns) they agree
+    M = S.test_room_200()[20:100, 0:90]
+    Mv = S.grid_to_values(M)
+    scan = S.Rangefinder(n_beams=90, max_range_cells=25.0, range_std_cells=0.3).scan(
+        M, [40.0, 30.0, np.radians(33.0)], rng=3)
+    hs = C.heading_candidates(np.radians(7.5))
+    T, o = C.rasterise_scan(scan, hs, dtype="float64")
+    D = C.score_maps(Mv, T, o, method="direct")
+    free, obs = _beam_samples(scan.bearings_rad, scan.ranges, scan.valid, delta_l_cells=0.0, hit_offset_cells=0.5,
+                              step_cells=0.5, use_misses=False)
+    rng = np.random.default_rng(0)
+    n, r, c = rng.integers(0, hs.size, 300), rng.integers(0, M.shape[0], 300), rng.integers(0, M.shape[1], 300)
+    got = _pose_scores(Mv, free, obs, -1.0, 1.0, np.column_stack([c, r, hs[n]]))
+    np.testing.assert_array_equal(got, D[n, r, c])
+    # off the grid, a sample is counted in the cell it falls in: one obstacle sample 3.4 cells ahead on a map with
+    # one obstacle cell, robot at (10.3, 5.0) heading 0 -> the sample at x = 13.7 lies in column 14 (centre 14)
+    M1 = np.zeros((11, 21))
+    M1[5, 14] = 1.0
+    one = _pose_scores(M1, np.zeros((0, 2)), np.array([[3.4, 0.0]]), -1.0, 1.0,
+                       [[10.3, 5.0, 0.0], [10.0, 5.0, 0.0], [10.3, 5.0, np.pi]])
+    assert one.tolist() == [1.0, 0.0, 0.0]
+
+
+@pytest.mark.realdata
+def test_truth_check_on_csail_scans(shared_data):
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "csail-corrected.log.gz")
+    r = C.run_log_localisation(log, (100, 150), joined=(1,), truth_check=True, ambiguity=False)
+    d = r.truth_check()
+    assert list(d["scan"]) == [100, 150]
+    assert set(d["kind"]) <= {"ok", "score", "search", "grid"}
+    assert (d["kind"] == "ok").tolist() == r.success[0].tolist()
+    # the search scored every grid pose: the best near the truth is never above its estimate; for a success the
+    # estimate lies near the truth, so the two are the same score
+    assert np.all(d["score_truth"] <= d["score_est"])
+    assert np.all(d.loc[d["ok"], "score_truth"] == d.loc[d["ok"], "score_est"])
+    assert d.loc[d["ok"], "score_truth_fine"].isna().all()
+    assert d.loc[~d["ok"], "score_truth_fine"].notna().all()
+    assert d["walls_truth"].between(0, 1).all()
+    assert d["walls_est"].between(0, 1).all()
+    assert "kind" in r.failure_table()
+    with pytest.raises(TypeError, match="`truth_check` must be a bool"):
+        C.run_log_localisation(log, (100,), truth_check="yes")
+    with pytest.raises(ValueError, match="`truth_check` and `refine` score by the definition with a_n = 0"):
+        C.run_log_localisation(log, (100,), truth_check=True, a_n=0.5)
+    with pytest.raises(ValueError, match="`refine`"):
+        C.run_log_localisation(log, (100,), refine=-1)
+    with pytest.raises(TypeError, match="`refine`"):
+        C.run_log_localisation(log, (100,), refine=2.5)
+    with pytest.raises(ValueError, match="`refine_heading_rad`"):
+        C.run_log_localisation(log, (100,), refine=3, refine_heading_rad=-0.1)
+    with pytest.raises(ValueError, match="this result has no truth check"):
+        C.run_log_localisation(log, (100,), ambiguity=False, delta_alpha_rad=np.radians(10.0)).truth_check()
+
+
+def test_distinct_peaks_keeps_the_best_apart():
+    from slamlab.correlation.scoring import _distinct_peaks
+
+    hs = np.radians(np.arange(360.0))
+    peaks = np.array([[10.0, 0, 5, 5], [9.0, 1, 5, 6], [8.0, 0, 20, 5], [7.0, 90, 5, 5], [6.0, 359, 5, 5]])
+    # (9, 1°, one cell away) and (6, 359°, same cell) lie within 2 cells and 3° of the best: dropped
+    assert _distinct_peaks(peaks, hs, 5, 2.0, np.radians(3.0))[:, 0].tolist() == [10.0, 8.0, 7.0]
+    assert _distinct_peaks(peaks, hs, 2, 2.0, np.radians(3.0))[:, 0].tolist() == [10.0, 8.0]
+
+
+def test_refine_scores_at_least_the_grid_peak_and_the_truth():
+    from slamlab.correlation.algorithm import _localise_samples
+    from slamlab.correlation.settings import LocaliseParams
+
+    M = S.test_room_200()
+    Mv = S.grid_to_values(M)
+    truth = np.array([60.5, 40.5, np.radians(30.5)])  # half a cell and half a degree off the search's grid
+    scan = S.Rangefinder(n_beams=360, max_range_cells=60.0).scan(M, truth)
+    free, obs = _beam_samples(scan.bearings_rad, scan.ranges, scan.valid, delta_l_cells=0.0, hit_offset_cells=0.5,
+                              step_cells=0.5, use_misses=False)
+    p = LocaliseParams(ambiguity=False)
+    hs = C.heading_candidates(p.delta_alpha_rad)
+    o = int(np.ceil(np.sqrt(np.max(np.sum(np.vstack([free, obs]) ** 2, axis=1))))) + 2
+    grid = _localise_samples(Mv, free, obs, o, hs, p, tracking=False)
+    fine = _localise_samples(Mv, free, obs, o, hs, p, tracking=False, refine=3)
+    s_grid, s_fine = _pose_scores(Mv, free, obs, -1.0, 1.0, np.vstack([grid.pose, fine.pose]))
+    assert s_fine >= s_grid  # the refinement lattice holds the grid peak itself
+    # the truth is within 1 cell and 1° of the grid peak, on the lattice: the refined pose scores at least as high
+    assert np.hypot(*(grid.pose[:2] - truth[:2])) <= 1.0
+    assert s_fine >= _pose_scores(Mv, free, obs, -1.0, 1.0, truth[None])[0]
+    assert np.hypot(*(fine.pose[:2] - truth[:2])) <= 1.0
+    assert abs(np.degrees(fine.pose[2] - truth[2])) <= 1.0 + 1e-9
+    assert fine.score == grid.score  # the score and the rival stay the grid search's
