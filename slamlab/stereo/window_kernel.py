@@ -9,8 +9,9 @@ allocated; the results are the same, bit for bit (tested against the numpy versi
   pairs of ``_radius_pairs`` in :mod:`slamlab.stereo.map_stages`;
 - ``ranges_hamming_2nn`` (in :mod:`slamlab.kdtree`, re-exported here): candidates given as a range of an
   index list per query — the epipolar pairs of the stereo matching (000 §3.3,
-  ``slamlab.stereo.local_stages.epipolar_pairs``); :func:`slamlab.kdtree.knn.exact_knn` takes it for binary 2-NN (the
-  brute-force search of the last frame's landmarks), keeping OpenCV's ``batchDistance`` order and ties.
+  ``slamlab.stereo.local_stages.epipolar_pairs``). The brute-force search of the last frame's landmarks
+  (:func:`slamlab.kdtree.knn.exact_knn`, binary 2-NN) has its own kernel beside it, keeping OpenCV's
+  ``batchDistance`` order and ties.
 """
 
 from __future__ import annotations

@@ -44,9 +44,9 @@ def test_window_numpy_path_without_numba(monkeypatch):
     assert (r1.tolist(), d1.tolist(), d2.tolist(), r2.tolist(), n_pairs) == ([0], [0.0], [3.0], [1], 2)
 
 
-def _random_descriptors(rng, k, n, trial):
-    D = rng.integers(0, 256, (k, 32), dtype=np.uint8)
-    Dt = rng.integers(0, 256, (n, 32), dtype=np.uint8)
+def _random_descriptors(rng, k, n, trial, n_bytes=32):
+    D = rng.integers(0, 256, (k, n_bytes), dtype=np.uint8)
+    Dt = rng.integers(0, 256, (n, n_bytes), dtype=np.uint8)
     if trial % 3 == 0 and n:  # many equal distances: the first in the numpy order must win both ranks
         Dt[: n // 2] = Dt[0]
         D[: k // 2] = D[0]
@@ -70,12 +70,12 @@ def test_stereo_kernel_matches_numpy(trial):
 
 
 @pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
-@pytest.mark.parametrize("n", [0, 1, 2, 900])
-def test_brute_force_kernel_matches_exact_knn(n, monkeypatch):
+@pytest.mark.parametrize(("n", "n_bytes"), [(0, 32), (1, 32), (2, 32), (900, 32), (900, 8), (333, 64)])
+def test_brute_force_kernel_matches_exact_knn(n, n_bytes, monkeypatch):
     """exact_knn's binary 2-NN (the search of the last frame's landmarks, the ORB stores): the kernel = OpenCV's
-    batchDistance (the numpy path), ties included."""
+    batchDistance (the numpy path), ties included, for descriptors of 1, 4 and 8 words."""
     rng = np.random.default_rng(n)
-    D, Dt = _random_descriptors(rng, 700, n, 0)
+    D, Dt = _random_descriptors(rng, 700, n, 0, n_bytes)
     ids = rng.permutation(5 * n + 1)[:n] + 3
     compiled = exact_knn(D, Dt, 2, ids)
     monkeypatch.setenv("SLAMLAB_NO_NUMBA", "1")
