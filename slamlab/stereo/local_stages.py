@@ -18,7 +18,7 @@ from ..features.matching import best_per_target, ratio_rule
 from ..geometry.camera import StereoRig
 from ..geometry.triangulation import triangulate_stereo
 from .params import StereoParams
-from .window_kernel import ranges_hamming_2nn
+from .window_kernel import epipolar_hamming_2nn, ranges_hamming_2nn
 
 __all__ = [
     "LocalCloud",
@@ -136,10 +136,9 @@ def _stereo_match(left, right, F, ratio, epi_tol_px, max_distance=None) -> Stere
     empty = StereoMatches(np.empty(0, np.intp), np.empty(0, np.intp), np.empty(0))
     if len(left.uv) == 0 or len(right.uv) == 0:
         return empty
-    li, ri = epipolar_pairs(left.uv, right.uv, F, epi_tol_px)
+    li, ri, d1, d2, _ = _epipolar_two_nearest(left.descriptors, right.descriptors, left.uv, right.uv, F, epi_tol_px)
     if li.size == 0:
         return empty
-    li, ri, d1, d2, _ = _pairs_two_nearest(left.descriptors, right.descriptors, li, ri)
     keep = ratio_rule(d1, d2, ratio)
     if max_distance is not None:
         keep &= d1 <= max_distance
@@ -202,19 +201,9 @@ def epipolar_pairs(uv_left, uv_right, F, tol_px):
     left, right : ndarray of int
         Indices of the pairs, grouped by left index (ascending).
     """
-    xl = np.column_stack([uv_left, np.ones(len(uv_left))])
-    lines = xl @ F.T
-    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
-    a, b, c = lines.T
+    a, b, c, order, lo, hi = _epipolar_ranges(uv_left, uv_right, F, tol_px)
     n = len(uv_left)
-    if np.all(np.abs(b) > 0.5):
-        order = np.argsort(uv_right[:, 1], kind="stable")
-        ys = uv_right[order, 1]
-        x_lo, x_hi = uv_right[:, 0].min(), uv_right[:, 0].max()
-        y_lo, y_hi = -(a * x_lo + c) / b, -(a * x_hi + c) / b
-        pad = tol_px / np.abs(b) + 1e-9  # |a x + b y + c| <= tol  <=>  |y - y_line(x)| <= tol / |b|
-        lo = np.searchsorted(ys, np.minimum(y_lo, y_hi) - pad, side="left")
-        hi = np.searchsorted(ys, np.maximum(y_lo, y_hi) + pad, side="right")
+    if order is not None:
         cnt = hi - lo
         li = np.repeat(np.arange(n), cnt)
         ri = order[np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt - lo, cnt)]
@@ -223,6 +212,45 @@ def epipolar_pairs(uv_left, uv_right, F, tol_px):
     dist = np.abs(a[li] * uv_right[ri, 0] + b[li] * uv_right[ri, 1] + c[li])
     keep = dist <= tol_px
     return li[keep], ri[keep]
+
+
+def _epipolar_ranges(uv_left, uv_right, F, tol_px):
+    """The left keypoints' epipolar lines ``l = F x_l`` scaled to a unit normal, ``(a, b, c)``, and when every
+    line is nearly horizontal their candidates for :func:`epipolar_pairs` before the distance test: left
+    keypoint ``i``'s are ``order[lo[i]:hi[i]]`` (right keypoints sorted by row). ``(a, b, c, order, lo, hi)``,
+    the last three None when some line is steep (then every pair is a candidate)."""
+    xl = np.column_stack([uv_left, np.ones(len(uv_left))])
+    lines = xl @ F.T
+    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
+    a, b, c = lines.T
+    if not np.all(np.abs(b) > 0.5):
+        return a, b, c, None, None, None
+    order = np.argsort(uv_right[:, 1], kind="stable")
+    ys = uv_right[order, 1]
+    x_lo, x_hi = uv_right[:, 0].min(), uv_right[:, 0].max()
+    y_lo, y_hi = -(a * x_lo + c) / b, -(a * x_hi + c) / b
+    pad = tol_px / np.abs(b) + 1e-9  # |a x + b y + c| <= tol  <=>  |y - y_line(x)| <= tol / |b|
+    lo = np.searchsorted(ys, np.minimum(y_lo, y_hi) - pad, side="left")
+    hi = np.searchsorted(ys, np.maximum(y_lo, y_hi) + pad, side="right")
+    return a, b, c, order, lo, hi
+
+
+def _epipolar_two_nearest(A, B, uv_left, uv_right, F, tol_px):
+    """:func:`epipolar_pairs` and then :func:`_pairs_two_nearest` on them: ``(query, nearest, d1, d2, second)``.
+    Binary descriptors on a nearly rectified rig take one compiled kernel for both when numba is enabled (the
+    same pairs in the same order, the same distance test; same result, tested), otherwise numpy."""
+    if A.dtype == np.uint8 and A.shape[1] % 8 == 0 and len(uv_right) and numba_enabled():
+        a, b, c, order, lo, hi = _epipolar_ranges(uv_left, uv_right, F, tol_px)
+        if order is not None:
+            r1, d1, d2, r2 = epipolar_hamming_2nn(A.view(np.uint64), B.view(np.uint64), a, b, c,
+                                                  np.ascontiguousarray(uv_right, dtype=np.float64), order, lo, hi,
+                                                  float(tol_px))
+            q = np.flatnonzero(r1 >= 0)
+            return q, r1[q], d1[q], d2[q], r2[q]
+    li, ri = epipolar_pairs(uv_left, uv_right, F, tol_px)
+    if li.size == 0:
+        return li, ri, np.empty(0), np.empty(0), ri
+    return _pairs_two_nearest(A, B, li, ri)
 
 
 def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:

@@ -7,7 +7,13 @@ import pytest
 
 from slamlab._compiled import numba_enabled
 from slamlab.kdtree.knn import exact_knn
-from slamlab.stereo.local_stages import _pair_distances, _pairs_two_nearest, _two_nearest, epipolar_pairs
+from slamlab.stereo.local_stages import (
+    _epipolar_two_nearest,
+    _pair_distances,
+    _pairs_two_nearest,
+    _two_nearest,
+    epipolar_pairs,
+)
 from slamlab.stereo.map_stages import _radius_pairs, _window_two_nearest
 
 
@@ -67,6 +73,46 @@ def test_stereo_kernel_matches_numpy(trial):
     ref = _two_nearest(qi, ti, _pair_distances(D, Dt, qi, ti))
     for a, b in zip(ref, _pairs_two_nearest(D, Dt, qi, ti), strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
+@pytest.mark.parametrize("trial", range(8))
+def test_fused_epipolar_kernel_matches_numpy(trial):
+    """The stereo matching in one pass (epipolar test + two nearest, 000 §3.3) = epipolar_pairs, then the
+    numpy two nearest of their Hamming distances: same queries, nearest, second and distances, ties included;
+    on a rectified rig, a slightly rotated one (lines not quite rows: the distance test decides) and, for the
+    numpy path, steep lines."""
+    rng = np.random.default_rng(200 + trial)
+    k, n = int(rng.integers(1, 1500)), int(rng.integers(1, 1500))
+    D, Dt = _random_descriptors(rng, k, n, trial)
+    uv_l = rng.uniform(0, 576, (k, 2))
+    uv_r = np.round(rng.uniform(0, 576, (n, 2))) if trial % 2 else rng.uniform(0, 576, (n, 2))
+    if trial % 4 == 3:  # whole-pixel rows on both sides: distances exactly at the tolerance
+        uv_l = np.round(uv_l)
+    F = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # rectified: the epipolar lines are rows
+    if trial >= 4:  # a small rotation about the optical axis: tilted lines
+        e = 0.01 * (trial - 3)
+        F = F @ np.array([[np.cos(e), -np.sin(e), 0.0], [np.sin(e), np.cos(e), 0.0], [0.0, 0.0, 1.0]])
+    qi, ti = epipolar_pairs(uv_l, uv_r, F, 2.0)
+    ref = _two_nearest(qi, ti, _pair_distances(D, Dt, qi, ti))
+    for a, b in zip(ref, _epipolar_two_nearest(D, Dt, uv_l, uv_r, F, 2.0), strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_fused_epipolar_numpy_paths(monkeypatch):
+    """Steep epipolar lines (every pair a candidate) and numba off: epipolar_pairs + the two nearest."""
+    D = np.zeros((2, 32), np.uint8)
+    Dt = np.zeros((3, 32), np.uint8)
+    Dt[1, 0] = 0b111
+    uv_l = np.array([[5.0, 10.0], [50.0, 20.0]])
+    uv_r = np.array([[4.0, 300.0], [5.0, 100.0], [90.0, 20.0]])
+    F_cols = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])  # lines are columns: u_r = u_l
+    out = _epipolar_two_nearest(D, Dt, uv_l, uv_r, F_cols, 1.5)  # left 0: right 0 (1 px off, Hamming 0) and 1 (3)
+    assert [x.tolist() for x in out] == [[0], [0], [0.0], [3.0], [1]]
+    monkeypatch.setenv("SLAMLAB_NO_NUMBA", "1")
+    F_rows = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+    out = _epipolar_two_nearest(D, Dt, uv_l, uv_r, F_rows, 1.5)  # left 1: right 2 on its row, alone
+    assert [x.tolist() for x in out] == [[1], [2], [0.0], [np.inf], [-1]]
 
 
 @pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
