@@ -17,6 +17,7 @@ from ..features.detect import detect
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.camera import StereoRig
 from ..geometry.triangulation import triangulate_stereo
+from ._sad_kernel import MAX_SAD_TERMS, sad_costs
 from .params import StereoParams
 from .window_kernel import epipolar_hamming_2nn, ranges_hamming_2nn
 
@@ -361,13 +362,16 @@ def _subpixel_disparity(IL, IR, uvl, uvr, h, s):
     if idx.size == 0:
         return uvl.copy(), out_r, ok
     P = 2 * h + 1
-    lp = sliding_window_view(IL, (P, P))[r[idx] - h, c[idx] - h].astype(np.float32)
-    strip = sliding_window_view(IR, (P, P + 2 * s))[r[idx] - h, cr[idx] - h - s].astype(np.float32)
-    lp -= lp.mean(axis=(1, 2), keepdims=True)
-    cost = np.empty((idx.size, 2 * s + 1), np.float32)
-    for k in range(2 * s + 1):
-        rp = strip[:, :, k:k + P]
-        cost[:, k] = np.abs(lp - (rp - rp.mean(axis=(1, 2), keepdims=True))).sum(axis=(1, 2))
+    if P * P <= MAX_SAD_TERMS and numba_enabled():  # the same costs compiled (bit for bit, tested; issue 25)
+        cost = sad_costs(IL, IR, r[idx], c[idx], cr[idx], h, s)
+    else:
+        lp = sliding_window_view(IL, (P, P))[r[idx] - h, c[idx] - h].astype(np.float32)
+        strip = sliding_window_view(IR, (P, P + 2 * s))[r[idx] - h, cr[idx] - h - s].astype(np.float32)
+        lp -= lp.mean(axis=(1, 2), keepdims=True)
+        cost = np.empty((idx.size, 2 * s + 1), np.float32)
+        for k in range(2 * s + 1):
+            rp = strip[:, :, k:k + P]
+            cost[:, k] = np.abs(lp - (rp - rp.mean(axis=(1, 2), keepdims=True))).sum(axis=(1, 2))
     k = np.argmin(cost, axis=1)
     inner = (k > 0) & (k < 2 * s)
     kk = np.clip(k, 1, 2 * s - 1)

@@ -139,3 +139,46 @@ def test_numpy_paths_without_numba(monkeypatch):
     dist, ids = exact_knn(D, Dt, 2, np.array([5, 6, 7]))
     assert dist.tolist() == [[0.0, 0.0]] * 2
     assert ids.tolist() == [[5, 7]] * 2
+
+
+@pytest.mark.skipif(not numba_enabled(), reason="numba disabled (SLAMLAB_NO_NUMBA)")
+@pytest.mark.parametrize(("half_px", "search_px"), [(5, 4), (1, 1), (2, 3), (3, 6), (4, 2), (6, 4)])
+def test_subpixel_kernel_matches_numpy(half_px, search_px, monkeypatch):
+    """The sub-pixel disparity refinement (our addition to 000 §3.3) with its patch costs compiled = the numpy
+    version, bit for bit: refined right keypoints and masks, on random images and on smooth ones (many equal
+    costs); a 13 x 13 patch (more terms than the kernel's summation order covers) takes numpy either way."""
+    from slamlab.stereo._sad_kernel import sad_costs
+    from slamlab.stereo.local_stages import _subpixel_disparity
+
+    rng = np.random.default_rng(10 * half_px + search_px)
+    H, W = 120, 160
+    noise = rng.integers(0, 256, (2, H, W)).astype(np.uint8)
+    yy, xx = np.mgrid[0:H, 0:W]
+    smooth = np.stack([(xx * 3 + yy) % 256, (xx * 3 + yy + 7) % 256]).astype(np.uint8)
+    m = 3000
+    uvl = np.column_stack([rng.uniform(-2, W + 1, m), rng.uniform(-2, H + 1, m)])
+    uvr = uvl - np.column_stack([rng.uniform(0, 30, m), np.zeros(m)])
+    uvl[:50] = np.round(uvl[:50]) + 0.5  # halfway columns: np.rint's ties
+    for IL, IR in (noise, smooth):
+        compiled = _subpixel_disparity(IL, IR, uvl, uvr, half_px, search_px)
+        with monkeypatch.context() as mp:
+            mp.setenv("SLAMLAB_NO_NUMBA", "1")
+            ref = _subpixel_disparity(IL, IR, uvl, uvr, half_px, search_px)
+        assert compiled[2].sum() > (m // 4 if IL is noise[0] else 0)  # the ramp: equal costs, mostly at an end
+        for a, b in zip(ref, compiled, strict=True):
+            np.testing.assert_array_equal(a, b)
+    # the costs themselves, against the numpy expression
+    from numpy.lib.stride_tricks import sliding_window_view
+
+    if (2 * half_px + 1) ** 2 <= 128:
+        IL, IR = noise
+        h, s, P = half_px, search_px, 2 * half_px + 1
+        r = rng.integers(h, H - h, 500)
+        c = rng.integers(h, W - h, 500)
+        cr = rng.integers(h + s, W - h - s, 500)
+        lp = sliding_window_view(IL, (P, P))[r - h, c - h].astype(np.float32)
+        lp -= lp.mean(axis=(1, 2), keepdims=True)
+        strip = sliding_window_view(IR, (P, P + 2 * s))[r - h, cr - h - s].astype(np.float32)
+        ref = np.stack([np.abs(lp - (strip[:, :, k:k + P] - strip[:, :, k:k + P].mean(axis=(1, 2), keepdims=True)))
+                        .sum(axis=(1, 2)) for k in range(2 * s + 1)], axis=1)
+        np.testing.assert_array_equal(sad_costs(IL, IR, r, c, cr, h, s), ref)
