@@ -55,7 +55,8 @@ def test_features_from_keypoints_reads_every_keypoint_field(method):
     if method == "sift":
         octave = [(o & 255) - 256 if (o & 255) >= 128 else o & 255 for o in octave]
     assert f.octave.tolist() == octave
-    assert f.octave.dtype == np.int64 and f.uv.dtype == np.float64
+    assert f.octave.dtype == np.int64
+    assert f.uv.dtype == np.float64
 
 
 def test_colour_and_float_images_are_accepted():
