@@ -17,9 +17,10 @@ from ..features.detect import detect
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.camera import StereoRig
 from ..geometry.triangulation import triangulate_stereo
+from ._pairs import _pairs_two_nearest
 from ._sad_kernel import MAX_SAD_TERMS, sad_costs
 from .params import StereoParams
-from .window_kernel import epipolar_hamming_2nn, ranges_hamming_2nn
+from .window_kernel import epipolar_hamming_2nn
 
 __all__ = [
     "LocalCloud",
@@ -148,38 +149,6 @@ def _stereo_match(left, right, F, ratio, epi_tol_px, max_distance=None) -> Stere
     return StereoMatches(li[sel], ri[sel], d1[sel])
 
 
-def _pairs_two_nearest(A, B, qi, ti):
-    """Nearest and second-nearest target of each query among the candidate pairs ``(qi, ti)`` (grouped by
-    ascending query index), by descriptor distance: ``(query, nearest, d1, d2, second)`` as :func:`_two_nearest`.
-    Binary descriptors take the compiled kernel when numba is enabled (same result, tested), otherwise numpy."""
-    if A.dtype == np.uint8 and A.shape[1] % 8 == 0 and numba_enabled():
-        cnt = np.bincount(qi, minlength=len(A))
-        hi = np.cumsum(cnt)
-        r1, d1, d2, r2 = ranges_hamming_2nn(A.view(np.uint64), B.view(np.uint64), ti, hi - cnt, hi)
-        q = np.flatnonzero(r1 >= 0)
-        return q, r1[q], d1[q], d2[q], r2[q]
-    return _two_nearest(qi, ti, _pair_distances(A, B, qi, ti))
-
-
-def _two_nearest(qi, ti, d):
-    """Nearest and second-nearest target of each query from candidate pairs ``(qi, ti)`` with distances
-    ``d``, the pairs grouped by ascending query index: ``(query, nearest, d1, d2, second)``, one row per
-    query with candidates (``d2 = inf`` and ``second = -1`` for a single candidate; with a tie, d2 = d1)."""
-    start = np.flatnonzero(np.r_[True, qi[1:] != qi[:-1]])
-    size = np.diff(np.r_[start, qi.size])
-    d1 = np.minimum.reduceat(d, start)
-    at_min = np.flatnonzero(d == np.repeat(d1, size))
-    first_min = at_min[np.r_[True, qi[at_min][1:] != qi[at_min][:-1]]]
-    d_rest = d.copy()
-    d_rest[first_min] = np.inf
-    d2 = np.minimum.reduceat(d_rest, start)
-    at2 = np.flatnonzero((d_rest == np.repeat(d2, size)) & np.isfinite(d_rest))
-    second = np.full(start.size, -1, dtype=np.int64)
-    g2 = np.searchsorted(start, at2, side="right") - 1
-    second[g2[::-1]] = ti[at2[::-1]]  # the first second-nearest of each group wins
-    return qi[first_min], ti[first_min], d1, d2, second
-
-
 def epipolar_pairs(uv_left, uv_right, F, tol_px):
     """All (left, right) keypoint pairs with the right point within ``tol_px`` of the left one's
     epipolar line ``l = F x_l``, grouped by left index (ascending) (000 §3.3: the epipolar check of stereo matching).
@@ -237,7 +206,7 @@ def _epipolar_ranges(uv_left, uv_right, F, tol_px):
 
 
 def _epipolar_two_nearest(A, B, uv_left, uv_right, F, tol_px):
-    """:func:`epipolar_pairs` and then :func:`_pairs_two_nearest` on them: ``(query, nearest, d1, d2, second)``.
+    """:func:`epipolar_pairs` and then ``_pairs_two_nearest`` on them: ``(query, nearest, d1, d2, second)``.
     Binary descriptors on a nearly rectified rig take one compiled kernel for both when numba is enabled (the
     same pairs in the same order, the same distance test; same result, tested), otherwise numpy."""
     if A.dtype == np.uint8 and A.shape[1] % 8 == 0 and len(uv_right) and numba_enabled():
@@ -252,25 +221,6 @@ def _epipolar_two_nearest(A, B, uv_left, uv_right, F, tol_px):
     if li.size == 0:
         return li, ri, np.empty(0), np.empty(0), ri
     return _pairs_two_nearest(A, B, li, ri)
-
-
-def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
-    """Descriptor distance of each pair ``(A[ia], B[ib])``: Hamming for uint8, Euclidean otherwise."""
-    out = np.empty(ia.size)
-    for s0 in range(0, ia.size, block):
-        x, y = A[ia[s0:s0 + block]], B[ib[s0:s0 + block]]
-        if A.dtype == np.uint8:
-            if A.shape[1] % 8 == 0:  # 8 bytes at a time
-                x, y = x.view(np.uint64), y.view(np.uint64)
-            bits = np.bitwise_count(x ^ y)
-            acc = bits[:, 0].astype(np.uint16)
-            for j in range(1, bits.shape[1]):  # column adds: ~2x faster than .sum(axis=1) on 4 columns
-                acc += bits[:, j]
-            out[s0:s0 + block] = acc
-        else:
-            dxy = x.astype(np.float32) - y
-            out[s0:s0 + block] = np.sqrt(np.einsum("ij,ij->i", dxy, dxy))
-    return out
 
 
 # --- sub-pixel disparity along the rows of a rectified pair (our addition) -------------------------

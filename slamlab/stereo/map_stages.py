@@ -17,7 +17,7 @@ from ..geometry.ransac import ransac
 from ..geometry.registration import RigidTransform, _umeyama
 from ..geometry.so3 import hat
 from ..kdtree.stores import LandmarkStore
-from .local_stages import _pair_distances, _two_nearest
+from ._pairs import _pair_distances, _two_nearest
 from .params import StereoParams
 from .window_kernel import window_hamming_2nn
 

@@ -20,7 +20,7 @@ from ..geometry.camera import StereoRig, project_points
 from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore, base_rule
-from .frame import STAGES, FrameRecord, _detect_pair, _StageClock, default_store
+from .frame import STAGES, FrameRecord, _append_rows, _detect_pair, _StageClock, default_store
 from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
 from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
 from .params import StereoParams
@@ -82,7 +82,7 @@ class StereoSLAM:
         self.n_seen = np.empty(0, dtype=np.int64)
         self.alive = np.empty(0, dtype=bool)
         self.desc: np.ndarray | None = None  # descriptor of each landmark (the window search's copy)
-        self._buffers: dict[str, np.ndarray] = {}  # the arrays above are views of these (see _append)
+        self._buffers: dict[str, np.ndarray] = {}  # the arrays above are views of these (frame._append_rows)
         self._last_ids = np.empty(0, dtype=np.int64)  # landmarks matched or added by the last located frame
         self.T = np.eye(4)  # current pose of the body in the map
         self.poses: list[np.ndarray] = []
@@ -386,31 +386,11 @@ class StereoSLAM:
     def _add_landmarks(self, pts_body, cov_body, desc, T):
         R, t = T[:3, :3], T[:3, 3]
         ids = np.arange(len(self.X), len(self.X) + len(pts_body))
-        self._append("X", pts_body @ R.T + t)
-        self._append("P", R @ cov_body @ R.T)
-        self._append("first_seen", np.full(len(ids), self.frame))
-        self._append("n_seen", np.ones(len(ids), dtype=np.int64))
-        self._append("alive", np.ones(len(ids), dtype=bool))
-        self._append("desc", desc)
+        for name, rows in (("X", pts_body @ R.T + t), ("P", R @ cov_body @ R.T), ("first_seen", np.full(len(ids), self.frame)),
+                           ("n_seen", np.ones(len(ids), dtype=np.int64)), ("alive", np.ones(len(ids), dtype=bool)),
+                           ("desc", desc)):
+            setattr(self, name, _append_rows(self._buffers, name, getattr(self, name), rows))
         self.store.add(desc, ids)
-
-    def _append(self, name, rows):
-        """``self.<name>`` with ``rows`` appended: a view of the first rows of a buffer that doubles when full
-        (the arrays grow every frame; concatenating copied all of them each time)."""
-        old = getattr(self, name)
-        n = 0 if old is None else len(old)
-        buf = self._buffers.get(name)
-        if old is not None and (buf is None or old.base is not buf):  # set from outside: start from it
-            buf = None
-        need = n + len(rows)
-        dtype = rows.dtype if old is None else np.result_type(old, rows)
-        if buf is None or len(buf) < need or buf.dtype != dtype or buf.shape[1:] != rows.shape[1:]:
-            new = np.empty((max(need, 2 * len(buf) if buf is not None else 0, 256), *rows.shape[1:]), dtype)
-            if n:
-                new[:n] = old
-            buf = self._buffers[name] = new
-        buf[n:need] = rows
-        setattr(self, name, buf[:need])
 
     def _finish(self, rec, clock, pts_body, inl_mask):
         self.store.end_iteration()

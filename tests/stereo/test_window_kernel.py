@@ -7,13 +7,8 @@ import pytest
 
 from slamlab._compiled import numba_enabled
 from slamlab.kdtree.knn import exact_knn
-from slamlab.stereo.local_stages import (
-    _epipolar_two_nearest,
-    _pair_distances,
-    _pairs_two_nearest,
-    _two_nearest,
-    epipolar_pairs,
-)
+from slamlab.stereo._pairs import _pair_distances, _pairs_two_nearest, _two_nearest
+from slamlab.stereo.local_stages import _epipolar_two_nearest, epipolar_pairs
 from slamlab.stereo.map_stages import _radius_pairs, _window_two_nearest
 
 
