@@ -177,3 +177,30 @@ def test_subpixel_kernel_matches_numpy(half_px, search_px, monkeypatch):
         ref = np.stack([np.abs(lp - (strip[:, :, k:k + P] - strip[:, :, k:k + P].mean(axis=(1, 2), keepdims=True)))
                         .sum(axis=(1, 2)) for k in range(2 * s + 1)], axis=1)
         np.testing.assert_array_equal(sad_costs(IL, IR, r, c, cr, h, s), ref)
+
+
+@pytest.mark.parametrize("trial", range(6))
+def test_radius_cells_ranges_and_pairs(trial):
+    """The window search's grid (our addition to 000 §3.4): each query's 3 column ranges are where the cells'
+    keys sit in the sorted keys (as np.searchsorted finds them), and the pairs within the radius are exactly those
+    of a brute-force distance test, grouped by ascending query."""
+    from slamlab.stereo.map_stages import _radius_cells
+
+    rng = np.random.default_rng(300 + trial)
+    k, n = int(rng.integers(1, 300)), int(rng.integers(1, 500))
+    uv, uv_t = rng.uniform(-20, 700, (k, 2)), rng.uniform(-20, 700, (n, 2))
+    if trial % 2:  # whole pixels: pairs exactly at the radius
+        uv, uv_t = np.round(uv), np.round(uv_t)
+    radius = (15.0, 7.5, 40.0)[trial % 3]
+    order, lo, hi = _radius_cells(uv, uv_t, radius)
+    lo_xy = np.minimum(uv.min(axis=0), uv_t.min(axis=0))
+    cq, ct = (np.floor((p - lo_xy) / radius).astype(np.int64) for p in (uv, uv_t))
+    ny = int(max(cq[:, 1].max(), ct[:, 1].max())) + 3
+    keys = ((ct[:, 0] + 1) * ny + ct[:, 1] + 1)[order]
+    base = (cq[:, 0:1] + 1 + np.arange(-1, 2)) * ny + cq[:, 1:2] + 1
+    np.testing.assert_array_equal(lo, np.searchsorted(keys, base - 1, side="left"))
+    np.testing.assert_array_equal(hi, np.searchsorted(keys, base + 1, side="right"))
+    qi, ti = _radius_pairs(uv, uv_t, radius)
+    d2 = ((uv[:, None, :] - uv_t[None, :, :]) ** 2).sum(axis=2)
+    assert np.all(np.diff(qi) >= 0)
+    assert sorted(zip(qi.tolist(), ti.tolist(), strict=True)) == sorted(zip(*np.nonzero(d2 <= radius**2), strict=True))
