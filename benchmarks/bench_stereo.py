@@ -18,8 +18,9 @@ query vs ``cv2.BFMatcher.knnMatch``.
 
 Every run uses the pipeline's defaults (oldest-landmark policy; store: multi kd-tree for SURF/SIFT,
 exact Hamming brute force for ORB; the two images detected in two threads). ORB's Hamming two-nearest
-searches (stereo matching, the last frame's landmarks, the window search) run compiled (numba); with
-``SLAMLAB_NO_NUMBA=1`` they run the numpy versions (same results), for a row beside the compiled one.
+searches (stereo matching, the last frame's landmarks, the window search) and the sub-pixel disparity's patch
+costs run compiled (numba); with ``SLAMLAB_NO_NUMBA=1`` they run the numpy versions (same results), for a row
+beside the compiled one.
 """
 
 from __future__ import annotations

@@ -104,8 +104,8 @@ def detect(image, method: str = "surf", *, descriptors: bool = True, max_points:
         f = moravec_detect(image, **params)
     else:
         f = mser_cv(image, **params)
-    if max_points is not None:
-        f = f.strongest(v.check_int(max_points, "max_points", minimum=1))
+    if max_points is not None and len(f) > v.check_int(max_points, "max_points", minimum=1):
+        f = f.strongest(max_points)  # (fewer points: strongest() would keep them all, in order)
     if descriptors and method == "fast":
         f = describe_surf(image, f, scale_px=2.0, upright=True)
     return f

@@ -4,8 +4,14 @@ The numpy versions build every candidate pair's distance (OpenCV's ``batchDistan
 :func:`slamlab.kdtree.knn.exact_knn`; ``_pair_distances`` + ``_two_nearest`` in the stereo matching);
 this kernel walks the same candidates in the same order and keeps only the two nearest, so the
 results are the same, ties included (the first in order wins; tested against both).
-Users: :func:`slamlab.kdtree.knn.exact_knn` (binary, k = 2: every stored row a candidate) and the
-stereo matching's epipolar pairs (000 §3.3, a range of candidates per query).
+Users: :func:`slamlab.kdtree.knn.exact_knn` (binary, k = 2: every stored row a candidate, by
+``all_hamming_2nn``) and the stereo matching's epipolar pairs (000 §3.3, a range of candidates per
+query, by ``ranges_hamming_2nn``).
+
+``all_hamming_2nn`` takes the targets' words transposed, ``(W, N)``: the distances of one query to all
+targets then run over contiguous rows, which the compiler turns into vector instructions (about 3.5x
+faster than the row-major walk: 1.0 against 3.5 ms CPU for 1300 x 1300 queries x targets on our machine, issue 25;
+the counts are integers, the same either way).
 """
 
 from __future__ import annotations
@@ -14,7 +20,7 @@ import numpy as np
 
 from .._compiled import kernel
 
-__all__ = ["ranges_hamming_2nn"]
+__all__ = ["all_hamming_2nn", "ranges_hamming_2nn"]
 
 
 def _ranges_hamming_2nn(Dq, Dt, order, lo, hi):  # pragma: no cover - compiled
@@ -73,4 +79,64 @@ Returns
 tuple
     ``r1, d1, d2, r2`` per query (``r1 = -1``, ``d1 = inf``: no candidate; ``r2 = -1``, ``d2 = inf``: one);
     among equal distances the first in ``order`` wins.
+"""
+
+
+def _all_hamming_2nn(Dq, DtT):  # pragma: no cover - compiled
+    """For each query ``i``: every target ``t = 0 .. N-1`` in order (words ``DtT[:, t]``), the nearest and second
+    nearest by Hamming distance, each the first in that order among equals (as ``_ranges_hamming_2nn`` with
+    every target a candidate)."""
+    k, W, N = Dq.shape[0], DtT.shape[0], DtT.shape[1]
+    r1 = np.full(k, -1, np.int64)
+    r2 = np.full(k, -1, np.int64)
+    d1 = np.full(k, np.inf)
+    d2 = np.full(k, np.inf)
+    if W == 0 or N == 0:
+        return r1, d1, d2, r2
+    bits = np.empty(N, np.uint64)  # the distances of one query to all targets
+    big = np.uint64(1 << 62)
+    for i in range(k):
+        # word by word over contiguous rows (the compiler vectorises this loop); bits set in a 64-bit word by
+        # the "SWAR" count (Hacker's Delight §5-1)
+        bits[:] = 0
+        for w in range(W):
+            q, row = Dq[i, w], DtT[w]
+            for t in range(N):
+                x = q ^ row[t]
+                x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+                x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+                x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+                x = (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+                bits[t] += x
+        a1, a2, b1, b2 = big, big, -1, -1
+        for t in range(N):
+            d = bits[t]
+            if d < a2:  # a1 <= a2: the same outcome as "d < a1, else d < a2"
+                if d < a1:  # a new nearest: the old one becomes the second
+                    a2, b2 = a1, b1
+                    a1, b1 = d, t
+                else:
+                    a2, b2 = d, t
+        if b1 >= 0:
+            d1[i], r1[i] = float(a1), b1
+        if b2 >= 0:
+            d2[i], r2[i] = float(a2), b2
+    return r1, d1, d2, r2
+
+
+all_hamming_2nn = kernel(_all_hamming_2nn)
+all_hamming_2nn.__doc__ = """Two nearest targets of every query by Hamming distance, all targets searched (compiled).
+
+Parameters
+----------
+Dq : numpy.ndarray of uint64, shape (K, W)
+    Query descriptors as 64-bit words.
+DtT : numpy.ndarray of uint64, shape (W, N)
+    Target descriptors as 64-bit words, transposed (word ``w`` of target ``t`` at ``DtT[w, t]``).
+
+Returns
+-------
+tuple
+    ``r1, d1, d2, r2`` per query (row indices of the targets; ``r2 = -1``, ``d2 = inf`` when ``N = 1``);
+    among equal distances the lower row wins.
 """

@@ -180,11 +180,10 @@ def exact_knn(Q, X, k: int = 2, ids=None, *, augmented=None):
     if Q.dtype == np.uint8 and kk == 2 and Q.shape[1] % 8 == 0 and numba_enabled():
         # the same search compiled: each query keeps its two nearest while it walks X in order, ties to the
         # first, as batchDistance (issue 25; no (M, N) distance matrix)
-        from ._hamming_kernel import ranges_hamming_2nn
+        from ._hamming_kernel import all_hamming_2nn
 
-        r1, d1, d2, r2 = ranges_hamming_2nn(np.ascontiguousarray(Q).view(np.uint64),
-                                            np.ascontiguousarray(X).view(np.uint64), np.arange(N),
-                                            np.zeros(M, np.int64), np.full(M, N, np.int64))
+        r1, d1, d2, r2 = all_hamming_2nn(np.ascontiguousarray(Q).view(np.uint64),
+                                         np.ascontiguousarray(np.ascontiguousarray(X).view(np.uint64).T))
         d, idx = np.column_stack([d1, d2]), np.column_stack([r1, r2])
     elif Q.dtype == np.uint8:
         import cv2  # OpenCV's popcount: several times faster than numpy's for Hamming

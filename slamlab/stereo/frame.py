@@ -7,6 +7,8 @@ from __future__ import annotations
 import time
 from concurrent.futures import ThreadPoolExecutor
 
+import numpy as np
+
 from ..features.detect import detect
 from ..kdtree.stores import ExactStore, LandmarkStore, make_store
 from .params import StereoParams
@@ -50,6 +52,25 @@ def default_store(params: StereoParams | None = None) -> LandmarkStore:
     if p.binary:
         return ExactStore(p.base_seen_times, p.max_non_base_time)
     return make_store("multi", base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
+
+
+def _append_rows(buffers, name, old, rows):
+    """``old`` (None: empty) with ``rows`` appended, as a view of the first rows of ``buffers[name]``, a buffer that
+    doubles when full (the landmark arrays grow every frame; concatenating copied all of them each time). An ``old``
+    that is not a view of that buffer (set from outside) starts a new one."""
+    n = 0 if old is None else len(old)
+    buf = buffers.get(name)
+    if old is not None and (buf is None or old.base is not buf):
+        buf = None
+    need = n + len(rows)
+    dtype = rows.dtype if old is None else np.result_type(old, rows)
+    if buf is None or len(buf) < need or buf.dtype != dtype or buf.shape[1:] != rows.shape[1:]:
+        new = np.empty((max(need, 2 * len(buf) if buf is not None else 0, 256), *rows.shape[1:]), dtype)
+        if n:
+            new[:n] = old
+        buf = buffers[name] = new
+    buf[n:need] = rows
+    return buf[:need]
 
 
 #: the per-frame stages whose times are recorded

@@ -17,8 +17,10 @@ from ..features.detect import detect
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.camera import StereoRig
 from ..geometry.triangulation import triangulate_stereo
+from ._pairs import _pairs_two_nearest
+from ._sad_kernel import MAX_SAD_TERMS, sad_costs
 from .params import StereoParams
-from .window_kernel import ranges_hamming_2nn
+from .window_kernel import epipolar_hamming_2nn
 
 __all__ = [
     "LocalCloud",
@@ -136,48 +138,15 @@ def _stereo_match(left, right, F, ratio, epi_tol_px, max_distance=None) -> Stere
     empty = StereoMatches(np.empty(0, np.intp), np.empty(0, np.intp), np.empty(0))
     if len(left.uv) == 0 or len(right.uv) == 0:
         return empty
-    li, ri = epipolar_pairs(left.uv, right.uv, F, epi_tol_px)
+    li, ri, d1, d2, _ = _epipolar_two_nearest(left.descriptors, right.descriptors, left.uv, right.uv, F, epi_tol_px)
     if li.size == 0:
         return empty
-    li, ri, d1, d2, _ = _pairs_two_nearest(left.descriptors, right.descriptors, li, ri)
     keep = ratio_rule(d1, d2, ratio)
     if max_distance is not None:
         keep &= d1 <= max_distance
     li, ri, d1 = li[keep], ri[keep], d1[keep]
     sel = best_per_target(ri, d1)  # each right keypoint goes to its best left keypoint only
     return StereoMatches(li[sel], ri[sel], d1[sel])
-
-
-def _pairs_two_nearest(A, B, qi, ti):
-    """Nearest and second-nearest target of each query among the candidate pairs ``(qi, ti)`` (grouped by
-    ascending query index), by descriptor distance: ``(query, nearest, d1, d2, second)`` as :func:`_two_nearest`.
-    Binary descriptors take the compiled kernel when numba is enabled (same result, tested), otherwise numpy."""
-    if A.dtype == np.uint8 and A.shape[1] % 8 == 0 and numba_enabled():
-        cnt = np.bincount(qi, minlength=len(A))
-        hi = np.cumsum(cnt)
-        r1, d1, d2, r2 = ranges_hamming_2nn(A.view(np.uint64), B.view(np.uint64), ti, hi - cnt, hi)
-        q = np.flatnonzero(r1 >= 0)
-        return q, r1[q], d1[q], d2[q], r2[q]
-    return _two_nearest(qi, ti, _pair_distances(A, B, qi, ti))
-
-
-def _two_nearest(qi, ti, d):
-    """Nearest and second-nearest target of each query from candidate pairs ``(qi, ti)`` with distances
-    ``d``, the pairs grouped by ascending query index: ``(query, nearest, d1, d2, second)``, one row per
-    query with candidates (``d2 = inf`` and ``second = -1`` for a single candidate; with a tie, d2 = d1)."""
-    start = np.flatnonzero(np.r_[True, qi[1:] != qi[:-1]])
-    size = np.diff(np.r_[start, qi.size])
-    d1 = np.minimum.reduceat(d, start)
-    at_min = np.flatnonzero(d == np.repeat(d1, size))
-    first_min = at_min[np.r_[True, qi[at_min][1:] != qi[at_min][:-1]]]
-    d_rest = d.copy()
-    d_rest[first_min] = np.inf
-    d2 = np.minimum.reduceat(d_rest, start)
-    at2 = np.flatnonzero((d_rest == np.repeat(d2, size)) & np.isfinite(d_rest))
-    second = np.full(start.size, -1, dtype=np.int64)
-    g2 = np.searchsorted(start, at2, side="right") - 1
-    second[g2[::-1]] = ti[at2[::-1]]  # the first second-nearest of each group wins
-    return qi[first_min], ti[first_min], d1, d2, second
 
 
 def epipolar_pairs(uv_left, uv_right, F, tol_px):
@@ -202,19 +171,9 @@ def epipolar_pairs(uv_left, uv_right, F, tol_px):
     left, right : ndarray of int
         Indices of the pairs, grouped by left index (ascending).
     """
-    xl = np.column_stack([uv_left, np.ones(len(uv_left))])
-    lines = xl @ F.T
-    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
-    a, b, c = lines.T
+    a, b, c, order, lo, hi = _epipolar_ranges(uv_left, uv_right, F, tol_px)
     n = len(uv_left)
-    if np.all(np.abs(b) > 0.5):
-        order = np.argsort(uv_right[:, 1], kind="stable")
-        ys = uv_right[order, 1]
-        x_lo, x_hi = uv_right[:, 0].min(), uv_right[:, 0].max()
-        y_lo, y_hi = -(a * x_lo + c) / b, -(a * x_hi + c) / b
-        pad = tol_px / np.abs(b) + 1e-9  # |a x + b y + c| <= tol  <=>  |y - y_line(x)| <= tol / |b|
-        lo = np.searchsorted(ys, np.minimum(y_lo, y_hi) - pad, side="left")
-        hi = np.searchsorted(ys, np.maximum(y_lo, y_hi) + pad, side="right")
+    if order is not None:
         cnt = hi - lo
         li = np.repeat(np.arange(n), cnt)
         ri = order[np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt - lo, cnt)]
@@ -225,23 +184,43 @@ def epipolar_pairs(uv_left, uv_right, F, tol_px):
     return li[keep], ri[keep]
 
 
-def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
-    """Descriptor distance of each pair ``(A[ia], B[ib])``: Hamming for uint8, Euclidean otherwise."""
-    out = np.empty(ia.size)
-    for s0 in range(0, ia.size, block):
-        x, y = A[ia[s0:s0 + block]], B[ib[s0:s0 + block]]
-        if A.dtype == np.uint8:
-            if A.shape[1] % 8 == 0:  # 8 bytes at a time
-                x, y = x.view(np.uint64), y.view(np.uint64)
-            bits = np.bitwise_count(x ^ y)
-            acc = bits[:, 0].astype(np.uint16)
-            for j in range(1, bits.shape[1]):  # column adds: ~2x faster than .sum(axis=1) on 4 columns
-                acc += bits[:, j]
-            out[s0:s0 + block] = acc
-        else:
-            dxy = x.astype(np.float32) - y
-            out[s0:s0 + block] = np.sqrt(np.einsum("ij,ij->i", dxy, dxy))
-    return out
+def _epipolar_ranges(uv_left, uv_right, F, tol_px):
+    """The left keypoints' epipolar lines ``l = F x_l`` scaled to a unit normal, ``(a, b, c)``, and when every
+    line is nearly horizontal their candidates for :func:`epipolar_pairs` before the distance test: left
+    keypoint ``i``'s are ``order[lo[i]:hi[i]]`` (right keypoints sorted by row). ``(a, b, c, order, lo, hi)``,
+    the last three None when some line is steep (then every pair is a candidate)."""
+    xl = np.column_stack([uv_left, np.ones(len(uv_left))])
+    lines = xl @ F.T
+    lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None]
+    a, b, c = lines.T
+    if not np.all(np.abs(b) > 0.5):
+        return a, b, c, None, None, None
+    order = np.argsort(uv_right[:, 1], kind="stable")
+    ys = uv_right[order, 1]
+    x_lo, x_hi = uv_right[:, 0].min(), uv_right[:, 0].max()
+    y_lo, y_hi = -(a * x_lo + c) / b, -(a * x_hi + c) / b
+    pad = tol_px / np.abs(b) + 1e-9  # |a x + b y + c| <= tol  <=>  |y - y_line(x)| <= tol / |b|
+    lo = np.searchsorted(ys, np.minimum(y_lo, y_hi) - pad, side="left")
+    hi = np.searchsorted(ys, np.maximum(y_lo, y_hi) + pad, side="right")
+    return a, b, c, order, lo, hi
+
+
+def _epipolar_two_nearest(A, B, uv_left, uv_right, F, tol_px):
+    """:func:`epipolar_pairs` and then ``_pairs_two_nearest`` on them: ``(query, nearest, d1, d2, second)``.
+    Binary descriptors on a nearly rectified rig take one compiled kernel for both when numba is enabled (the
+    same pairs in the same order, the same distance test; same result, tested), otherwise numpy."""
+    if A.dtype == np.uint8 and A.shape[1] % 8 == 0 and len(uv_right) and numba_enabled():
+        a, b, c, order, lo, hi = _epipolar_ranges(uv_left, uv_right, F, tol_px)
+        if order is not None:
+            r1, d1, d2, r2 = epipolar_hamming_2nn(A.view(np.uint64), B.view(np.uint64), a, b, c,
+                                                  np.ascontiguousarray(uv_right, dtype=np.float64), order, lo, hi,
+                                                  float(tol_px))
+            q = np.flatnonzero(r1 >= 0)
+            return q, r1[q], d1[q], d2[q], r2[q]
+    li, ri = epipolar_pairs(uv_left, uv_right, F, tol_px)
+    if li.size == 0:
+        return li, ri, np.empty(0), np.empty(0), ri
+    return _pairs_two_nearest(A, B, li, ri)
 
 
 # --- sub-pixel disparity along the rows of a rectified pair (our addition) -------------------------
@@ -333,13 +312,16 @@ def _subpixel_disparity(IL, IR, uvl, uvr, h, s):
     if idx.size == 0:
         return uvl.copy(), out_r, ok
     P = 2 * h + 1
-    lp = sliding_window_view(IL, (P, P))[r[idx] - h, c[idx] - h].astype(np.float32)
-    strip = sliding_window_view(IR, (P, P + 2 * s))[r[idx] - h, cr[idx] - h - s].astype(np.float32)
-    lp -= lp.mean(axis=(1, 2), keepdims=True)
-    cost = np.empty((idx.size, 2 * s + 1), np.float32)
-    for k in range(2 * s + 1):
-        rp = strip[:, :, k:k + P]
-        cost[:, k] = np.abs(lp - (rp - rp.mean(axis=(1, 2), keepdims=True))).sum(axis=(1, 2))
+    if P * P <= MAX_SAD_TERMS and numba_enabled():  # the same costs compiled (bit for bit, tested; issue 25)
+        cost = sad_costs(IL, IR, r[idx], c[idx], cr[idx], h, s)
+    else:
+        lp = sliding_window_view(IL, (P, P))[r[idx] - h, c[idx] - h].astype(np.float32)
+        strip = sliding_window_view(IR, (P, P + 2 * s))[r[idx] - h, cr[idx] - h - s].astype(np.float32)
+        lp -= lp.mean(axis=(1, 2), keepdims=True)
+        cost = np.empty((idx.size, 2 * s + 1), np.float32)
+        for k in range(2 * s + 1):
+            rp = strip[:, :, k:k + P]
+            cost[:, k] = np.abs(lp - (rp - rp.mean(axis=(1, 2), keepdims=True))).sum(axis=(1, 2))
     k = np.argmin(cost, axis=1)
     inner = (k > 0) & (k < 2 * s)
     kk = np.clip(k, 1, 2 * s - 1)

@@ -17,7 +17,7 @@ from ..geometry.ransac import ransac
 from ..geometry.registration import RigidTransform, _umeyama
 from ..geometry.so3 import hat
 from ..kdtree.stores import LandmarkStore
-from .local_stages import _pair_distances, _two_nearest
+from ._pairs import _pair_distances, _two_nearest
 from .params import StereoParams
 from .window_kernel import window_hamming_2nn
 
@@ -165,7 +165,11 @@ def _radius_cells(uv_q, uv_t, radius):
     keys = key_t[order]
     # the 3 cells of a column are consecutive keys: one range per column offset
     base = (cq[:, 0:1] + 1 + np.arange(-1, 2)) * ny + cq[:, 1:2] + 1  # (k, 3) middle cell of each column
-    return order, np.searchsorted(keys, base - 1, side="left"), np.searchsorted(keys, base + 1, side="right")
+    # where each key starts in the sorted keys: searchsorted(keys, x, "left") = start[x], (x, "right") = start[x + 1]
+    n_keys = (int(max(cq[:, 0].max(), ct[:, 0].max())) + 3) * ny  # above every key and every base + 1
+    start = np.zeros(n_keys + 1, np.int64)
+    np.cumsum(np.bincount(keys, minlength=n_keys), out=start[1:])
+    return order, start[base - 1], start[base + 2]
 
 
 def _radius_pairs(uv_q, uv_t, radius):

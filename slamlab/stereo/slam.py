@@ -20,7 +20,7 @@ from ..geometry.camera import StereoRig, project_points
 from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore, base_rule
-from .frame import STAGES, FrameRecord, _detect_pair, _StageClock, default_store
+from .frame import STAGES, FrameRecord, _append_rows, _detect_pair, _StageClock, default_store
 from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
 from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
 from .params import StereoParams
@@ -82,6 +82,7 @@ class StereoSLAM:
         self.n_seen = np.empty(0, dtype=np.int64)
         self.alive = np.empty(0, dtype=bool)
         self.desc: np.ndarray | None = None  # descriptor of each landmark (the window search's copy)
+        self._buffers: dict[str, np.ndarray] = {}  # the arrays above are views of these (frame._append_rows)
         self._last_ids = np.empty(0, dtype=np.int64)  # landmarks matched or added by the last located frame
         self.T = np.eye(4)  # current pose of the body in the map
         self.poses: list[np.ndarray] = []
@@ -385,12 +386,10 @@ class StereoSLAM:
     def _add_landmarks(self, pts_body, cov_body, desc, T):
         R, t = T[:3, :3], T[:3, 3]
         ids = np.arange(len(self.X), len(self.X) + len(pts_body))
-        self.X = np.concatenate([self.X, pts_body @ R.T + t])
-        self.P = np.concatenate([self.P, R @ cov_body @ R.T])
-        self.first_seen = np.concatenate([self.first_seen, np.full(len(ids), self.frame)])
-        self.n_seen = np.concatenate([self.n_seen, np.ones(len(ids), dtype=np.int64)])
-        self.alive = np.concatenate([self.alive, np.ones(len(ids), dtype=bool)])
-        self.desc = desc.copy() if self.desc is None else np.concatenate([self.desc, desc])
+        for name, rows in (("X", pts_body @ R.T + t), ("P", R @ cov_body @ R.T), ("first_seen", np.full(len(ids), self.frame)),
+                           ("n_seen", np.ones(len(ids), dtype=np.int64)), ("alive", np.ones(len(ids), dtype=bool)),
+                           ("desc", desc)):
+            setattr(self, name, _append_rows(self._buffers, name, getattr(self, name), rows))
         self.store.add(desc, ids)
 
     def _finish(self, rec, clock, pts_body, inl_mask):

@@ -9,8 +9,12 @@ allocated; the results are the same, bit for bit (tested against the numpy versi
   pairs of ``_radius_pairs`` in :mod:`slamlab.stereo.map_stages`;
 - ``ranges_hamming_2nn`` (in :mod:`slamlab.kdtree`, re-exported here): candidates given as a range of an
   index list per query — the epipolar pairs of the stereo matching (000 §3.3,
-  ``slamlab.stereo.local_stages.epipolar_pairs``); :func:`slamlab.kdtree.knn.exact_knn` takes it for binary 2-NN (the
-  brute-force search of the last frame's landmarks), keeping OpenCV's ``batchDistance`` order and ties.
+  ``slamlab.stereo.local_stages.epipolar_pairs``);
+- :func:`epipolar_hamming_2nn`: the stereo matching in one pass when the epipolar lines are nearly rows
+  (the rendered and KITTI rigs): each left keypoint's rows of right keypoints, the distance test of
+  ``epipolar_pairs`` (the same arithmetic) and the two nearest, without the arrays of pairs. The brute-force search of the last frame's landmarks
+  (:func:`slamlab.kdtree.knn.exact_knn`, binary 2-NN) has its own kernel beside it, keeping OpenCV's
+  ``batchDistance`` order and ties.
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ import numpy as np
 from .._compiled import kernel
 from ..kdtree._hamming_kernel import ranges_hamming_2nn  # re-exported: the stereo matching's user
 
-__all__ = ["ranges_hamming_2nn", "window_hamming_2nn"]
+__all__ = ["epipolar_hamming_2nn", "ranges_hamming_2nn", "window_hamming_2nn"]
 
 
 def _window_hamming_2nn(Dq, Dt, uv_q, uv_t, order, lo, hi, radius):  # pragma: no cover - compiled
@@ -85,3 +89,59 @@ tuple
 """
 
 
+
+
+def _epipolar_hamming_2nn(Dq, Dt, a, b, c, uv_t, order, lo, hi, tol):  # pragma: no cover - compiled
+    """For each query ``i``: the targets ``t = order[j]``, ``j`` in ``lo[i]:hi[i]``, whose distance
+    ``|a[i] u_t + b[i] v_t + c[i]|`` (``epipolar_pairs``' expression, evaluated in the same order) is at most
+    ``tol``, their Hamming distances and the nearest / second nearest, each the first in that order among equals."""
+    k = Dq.shape[0]
+    r1 = np.full(k, -1, np.int64)
+    r2 = np.full(k, -1, np.int64)
+    d1 = np.full(k, np.inf)
+    d2 = np.full(k, np.inf)
+    for i in range(k):
+        for j in range(lo[i], hi[i]):
+            t = order[j]
+            if not np.abs(a[i] * uv_t[t, 0] + b[i] * uv_t[t, 1] + c[i]) <= tol:  # off the epipolar line
+                continue
+            bits = np.uint64(0)
+            for w in range(Dq.shape[1]):
+                # bits set in a 64-bit word: the "SWAR" count (Hacker's Delight §5-1)
+                x = Dq[i, w] ^ Dt[t, w]
+                x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+                x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+                x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+                bits += (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+            d = float(bits)
+            if d < d1[i]:  # a new nearest: the old one becomes the second
+                d2[i], r2[i] = d1[i], r1[i]
+                d1[i], r1[i] = d, t
+            elif d < d2[i]:
+                d2[i], r2[i] = d, t
+    return r1, d1, d2, r2
+
+
+epipolar_hamming_2nn = kernel(_epipolar_hamming_2nn)
+epipolar_hamming_2nn.__doc__ = """Two nearest right keypoints by Hamming distance near each left keypoint's epipolar line (compiled).
+
+Parameters
+----------
+Dq : numpy.ndarray of uint64, shape (K, W)
+    Left descriptors as 64-bit words.
+Dt : numpy.ndarray of uint64, shape (N, W)
+    Right descriptors as 64-bit words.
+a, b, c : numpy.ndarray, shape (K,)
+    Each left keypoint's epipolar line ``a u + b v + c = 0`` with ``a² + b² = 1``.
+uv_t : numpy.ndarray, shape (N, 2)
+    Right keypoint pixels.
+order, lo, hi : numpy.ndarray of int
+    Right keypoints sorted by row; left keypoint ``i``'s candidate rows are ``order[lo[i]:hi[i]]``.
+tol : float
+    Largest distance from the line [px].
+
+Returns
+-------
+tuple
+    ``r1, d1, d2, r2`` per left keypoint (``r1 = -1``: no candidate; ``r2 = -1``, ``d2 = inf``: one).
+"""

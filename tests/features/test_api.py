@@ -35,6 +35,30 @@ def test_every_detector_returns_features(method):
     assert len(g) <= 5
 
 
+@pytest.mark.parametrize("method", ["orb", "sift"])
+def test_features_from_keypoints_reads_every_keypoint_field(method):
+    """The conversion of cv2.KeyPoint lists (000 §1.4.1) against the fields read one keypoint at a time: position,
+    size / 2, angle in radians in [0, 2π) (-1: 0), response, octave (SIFT's packed byte unpacked)."""
+    import cv2
+
+    det = cv2.ORB_create(500, fastThreshold=5) if method == "orb" else cv2.SIFT_create()
+    kp, d = det.detectAndCompute(_image(), None)
+    kp = [*kp, cv2.KeyPoint(3.25, 4.5, 7.0, -1.0, 0.5, 2)]  # an angle of -1: none
+    f = F.features_from_keypoints(kp, np.vstack([d, d[:1]]), method.upper())
+    assert len(kp) > 20
+    np.testing.assert_array_equal(f.uv, [k.pt for k in kp])
+    np.testing.assert_array_equal(f.scale_px, [k.size / 2 for k in kp])
+    np.testing.assert_array_equal(f.response, [k.response for k in kp])
+    ang = np.array([k.angle for k in kp])
+    np.testing.assert_allclose(f.orientation_rad, np.where(ang < 0, 0.0, np.deg2rad(ang) % (2 * np.pi)), rtol=0, atol=0)
+    octave = [k.octave for k in kp]
+    if method == "sift":
+        octave = [(o & 255) - 256 if (o & 255) >= 128 else o & 255 for o in octave]
+    assert f.octave.tolist() == octave
+    assert f.octave.dtype == np.int64
+    assert f.uv.dtype == np.float64
+
+
 def test_colour_and_float_images_are_accepted():
     img = _image()
     rgb = np.repeat(img[:, :, None], 3, axis=2)
