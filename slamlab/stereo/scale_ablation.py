@@ -168,8 +168,9 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
     resolved = {}
     for label, over in variants.items():
         over = dict(over)
+        oracle_items = frozenset(over.pop("_oracle", ()))
         noise = v.check_positive(over.pop("pixel_std_obs", sigma), "pixel_std_obs", allow_zero=True)
-        resolved[label] = (StereoParams.resolve(base, **over), noise)
+        resolved[label] = (StereoParams.resolve(base, **over), noise, oracle_items)
     seeds = np.random.SeedSequence(int(v.as_rng(rng).integers(2**32))).spawn(n_seeds)
     S, n = len(variants), len(P)
     path_ratio, ate_m, n_deg = np.empty((S, n_seeds)), np.empty((S, n_seeds)), np.zeros((S, n_seeds), int)
@@ -183,11 +184,18 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         truth = np.array([(T0inv @ scene.ground_truth_se3(p))[:3, 3] for p in P])
         true_steps = np.linalg.norm(np.diff(truth, axis=0), axis=1)
         path_len = float(true_steps.sum())
-        for i, (p, noise) in enumerate(resolved.values()):
+        for i, (p, noise, oracle_items) in enumerate(resolved.values()):
             g = np.random.default_rng(s_noise)  # the same keypoints for every setting
             slam = StereoSLAM(scene.rig, scene.T_body_left, params=p, rng=np.random.default_rng(s_slam))
+            slam._oracle = oracle_items
+            oracle = "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or bool(oracle_items)
             for pose in P:
-                slam.process_features(*scene.observe(pose, pixel_std=noise, rng=g))
+                fl, fr = scene.observe(pose, pixel_std=noise, rng=g)
+                if oracle:  # the true left-camera position of every left keypoint (the ablation's oracle)
+                    T_wl = scene.ground_truth_se3(pose) @ scene.T_body_left
+                    X = scene.points_at(pose)[scene.last_observed[0]]
+                    slam.truth_left_cam_m = (X - T_wl[:3, 3]) @ T_wl[:3, :3]
+                slam.process_features(fl, fr)
             est = slam.trajectory[:, :3, 3]
             est_steps = np.linalg.norm(np.diff(est, axis=0), axis=1)
             steps[i, j] = est_steps / true_steps

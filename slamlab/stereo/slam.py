@@ -22,7 +22,15 @@ from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore, base_rule
 from .frame import STAGES, FrameRecord, _detect_pair, _StageClock, default_store
 from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
-from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
+from .map_stages import (
+    _estimate_pose,
+    _match_to_map,
+    _matches_from_knn,
+    _refine_pose_stereo,
+    _stereo_project,
+    _window_match,
+    pose_std,
+)
 from .params import StereoParams
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
@@ -91,6 +99,12 @@ class StereoSLAM:
         self.frame = 0
         self.last_cloud_map = np.empty((0, 3))
         self.last_inlier_map = np.empty((0, 3))
+        #: an ablation oracle (issue 25; a simulator sets it, never a user): (n_left, 3) true left-camera
+        #: position of each left keypoint of the next frame, read by the settings whose depth source is
+        #: 'true' (``weight_depth``, ``update_cov_depth``, ``init_cov_depth``) and cleared after the frame
+        self.truth_left_cam_m: np.ndarray | None = None
+        self._true_cam = None
+        self._oracle = frozenset()  # exploratory oracles (ablation only): 'cut', 'init_position', 'pose_points'
 
     # -- the loop ------------------------------------------------------------------------------------
     def _check_pair(self, left, right):
@@ -156,10 +170,30 @@ class StereoSLAM:
         if self._refine and left is not None:
             refine = (to_gray_uint8(left, "left", channel_order=p.channel_order),
                       to_gray_uint8(right, "right", channel_order=p.channel_order), p.subpixel_half_px, p.subpixel_search_px)
-        cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m, p.pixel_std, refine)
+        oracle = self._oracle
+        if "cut" in oracle and self.truth_left_cam_m is not None:  # the depth cut on the true depth (ablation)
+            cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, 1e12, p.pixel_std, refine)
+            zt = self.truth_left_cam_m[cloud.left, 2]
+            keep = (zt >= p.min_depth_m) & (zt <= p.max_depth_m)
+            cloud = type(cloud)(cloud.points[keep], cloud.cov[keep], cloud.left[keep], cloud.gap_m[keep])
+        else:
+            cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m * p.reobserve_depth_factor,
+                                       p.pixel_std, refine)
+        # beyond max_depth_m a point may match a landmark but does not become one (reobserve_depth_factor > 1)
+        self._may_be_new = cloud.points[:, 2] <= p.max_depth_m
         Rb, tb = self.T_body_left[:3, :3], self.T_body_left[:3, 3]
         pts_body = cloud.points @ Rb.T + tb
         cov_body = Rb @ cloud.cov @ Rb.T
+        self._true_cam, truth = None, self.truth_left_cam_m
+        self.truth_left_cam_m = None
+        if "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or self._oracle:
+            if truth is None or len(truth) != len(fl.uv):
+                raise ValueError("a depth source 'true' (an ablation oracle) needs `truth_left_cam_m`: the true "
+                                 "left-camera position of every left keypoint, set before each frame")
+            self._true_cam = np.asarray(truth, dtype=float)[cloud.left]
+        cov_init = cov_body
+        if p.init_cov_depth == "true":
+            cov_init = Rb @ stereo_point_cov(self._true_cam, self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rb.T
         desc = fl.descriptors[cloud.left]
         clock.lap("triangulate")
         rec = FrameRecord(
@@ -171,10 +205,11 @@ class StereoSLAM:
         no_inliers = np.zeros(len(pts_body), bool)
         if len(self.X) == 0:
             # first frame (or an empty map): it defines the map frame
-            if len(pts_body) >= p.min_inliers:
-                self._add_landmarks(pts_body, cov_body, desc, self.T)
-                self._last_ids = np.arange(len(pts_body))
-                rec["n_new"] = len(pts_body)
+            first = np.flatnonzero(self._may_be_new)
+            if len(first) >= p.min_inliers:
+                self._add_landmarks(pts_body[first], cov_init[first], desc[first], self.T)
+                self._last_ids = np.arange(len(first))
+                rec["n_new"] = len(first)
                 rec["status"] = "init"
             else:
                 rec["status"] = "too_few_points"
@@ -201,12 +236,13 @@ class StereoSLAM:
                 self.T = self.T @ (np.linalg.inv(self.poses[-2]) @ self.poses[-1])
             self._finish(rec, clock, pts_body, no_inliers)
             return rec
-        inl_mask = self._update_map(rec, est, mm, pts_body, cov_body, desc)
+        inl_mask = self._update_map(rec, est, mm, pts_body, cov_body, desc, cov_init)
         self._finish(rec, clock, pts_body, inl_mask)
         return rec
 
-    def _update_map(self, rec, est, mm, pts_body, cov_body, desc):
-        """Take the pose ``est``; refine the re-seen landmarks, add the unmatched points (000 §3.6).
+    def _update_map(self, rec, est, mm, pts_body, cov_body, desc, cov_init=None):
+        """Take the pose ``est``; refine the re-seen landmarks, add the unmatched points (000 §3.6);
+        ``cov_init``: the new landmarks' first covariances (default ``cov_body``).
 
         Returns the mask of the local points that were inliers of the pose.
         """
@@ -219,7 +255,11 @@ class StereoSLAM:
         loc = mm.local[est.inliers]
         Z = pts_body[loc] @ R.T + t
         pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
-        if p.update_cov_depth == "map":
+        if p.update_cov_depth == "true":  # the ablation oracle: the covariance at the point's true position
+            Rwc = (est.T @ self.T_body_left)[:3, :3]
+            Rz = Rwc @ stereo_point_cov(self._true_cam[loc], self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rwc.T
+            Rz += pose_var[:, None, None] * np.eye(3)
+        elif p.update_cov_depth == "map":
             # the observation's covariance at the landmark's position seen from the new pose, not at the
             # measured one: a measurement's weight then does not depend on its own error (issue 25)
             T_wc = est.T @ self.T_body_left
@@ -235,7 +275,7 @@ class StereoSLAM:
         self.store.observe(ids)
         rec["n_inliers"] = len(ids)
         # unmatched local points become new (non-base) landmarks
-        new = mm.unmatched
+        new = mm.unmatched[self._may_be_new[mm.unmatched]]
         if p.duplicate_gap_m is not None and new.size:
             # a point whose nearest landmark by descriptor sits where it is, is that landmark again
             nn = mm.nearest[new]
@@ -246,7 +286,10 @@ class StereoSLAM:
             rec["n_duplicates"] = int(dup.sum())
             new = new[~dup]
         first_new = len(self.X)
-        self._add_landmarks(pts_body[new], cov_body[new], desc[new], est.T)
+        pts_new = pts_body[new]
+        if "init_position" in self._oracle:
+            pts_new = self._true_cam[new] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
+        self._add_landmarks(pts_new, (cov_body if cov_init is None else cov_init)[new], desc[new], est.T)
         rec["n_new"] = len(new)
         self._last_ids = np.concatenate([ids, np.arange(first_new, len(self.X))])
         inl_mask = np.zeros(len(pts_body), bool)
@@ -306,15 +349,22 @@ class StereoSLAM:
             rec["status"] = "too_few_matches"
         else:
             d_use = depth[mm.local]
-            if p.weight_depth == "map":
+            if p.weight_depth == "true":  # the ablation oracle: the point's true depth in this frame
+                d_use = self._true_cam[mm.local, 2]
+            elif p.weight_depth == "map":
                 # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
                 T_wc = self.T @ self.T_body_left
                 d_use = np.maximum(((self.X[mm.ids] - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], p.min_depth_m)
-            est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], d_use,
+            src = pts_body[mm.local]
+            if "pose_points" in self._oracle:
+                src = self._true_cam[mm.local] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
+            est = _estimate_pose(src, self.X[mm.ids], self.first_seen[mm.ids], d_use,
                                  cov_body[mm.local], p, self.rng)
             rec["n_used"] = est.n_used
             if not est.converged:
                 rec["status"], est = "ransac_failed", None
+            elif p.pose_refine == "reprojection":
+                est = est._replace(T=self._refine_pose(est.T, self.X[mm.ids[est.inliers]], pts_body[mm.local[est.inliers]]))
             elif p.max_rot_std_rad is not None:
                 R, inl = est.T[:3, :3], mm.local[est.inliers]
                 rec["rot_std_rad"] = float(np.max(pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)[:3]))
@@ -324,6 +374,17 @@ class StereoSLAM:
         std = "" if np.isnan(rec["rot_std_rad"]) else f" (rot std {np.rad2deg(rec['rot_std_rad']):.2f} deg)"
         rec["trail"] += f"{search} {len(mm.local)} {rec['status'] if est is None else 'ok'}{std}; "
         return mm, est
+
+    def _refine_pose(self, T_body, X_map, pts_body):
+        """``pose_refine='reprojection'``: the pose moved to minimise the stereo reprojection error of the
+        inliers (landmarks ``X_map``, this frame's body-frame points ``pts_body``; our option, issue 25)."""
+        p = self.params
+        Tbl = self.T_body_left
+        pts_left = (pts_body - Tbl[:3, 3]) @ Tbl[:3, :3]
+        T_cw = np.linalg.inv(T_body @ Tbl)
+        T_cw = _refine_pose_stereo(T_cw, X_map, _stereo_project(self.rig, pts_left)[0], self.rig, p.refine_iters,
+                                   p.refine_huber_px, p.min_depth_m)
+        return np.linalg.inv(T_cw) @ np.linalg.inv(Tbl)
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
