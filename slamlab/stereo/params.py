@@ -132,6 +132,8 @@ class StereoParams(Params):
         ours: most Gauss-Newton steps of pose_refine
     refine_huber_px : float
         ours: Huber threshold of pose_refine on a point's pixel residual norm
+    refine_min_seen : int
+        ours: pose_refine uses the inliers whose landmark was seen at least this often (a landmark seen once was selected by the depth cut on its own noisy depth; 1: all)
     degenerate_pose : str
         ours: pose of a frame that gives none: 'last' (keep the last pose) or 'constant_velocity' (the last frame's motion once more)
     state_var : float
@@ -144,6 +146,8 @@ class StereoParams(Params):
         ours: chi^2_3 at 99.9 % (None: always update)
     update_cov_depth : str
         ours: depth behind an observation's covariance in the landmark filter: 'measured' or 'map' (the landmark seen from the new pose; issue 25); 'true': the oracle as for ``weight_depth``
+    filter_space : str
+        ours: the landmark filter's update in 'xyz' (000 §3.6) or in the stereo 'pixels' (u_l, v_l, u_r) of the current camera, one pixel noise for all (rectified rigs; issue 25)
     init_cov_depth : str
         ours: depth behind a new landmark's first covariance in the filter: 'measured' or 'true' (the oracle as for ``weight_depth``; issue 25)
 
@@ -218,6 +222,8 @@ class StereoParams(Params):
                                      "issue 25)")
     refine_iters: int = param(5, "ours: most Gauss-Newton steps of pose_refine")
     refine_huber_px: float = param(2.0, "ours: Huber threshold of pose_refine on a point's pixel residual norm")
+    refine_min_seen: int = param(1, "ours: pose_refine uses the inliers whose landmark was seen at least this often "
+                                    "(a landmark seen once was selected by the depth cut on its own noisy depth; 1: all)")
     degenerate_pose: str = param("last", "ours: pose of a frame that gives none: 'last' (keep the last pose) or "
                                          "'constant_velocity' (the last frame's motion once more)")
     # -- landmark filter (000 §3.6) --------------------------------------------------------------------
@@ -227,6 +233,9 @@ class StereoParams(Params):
     update_gate: float | None = param(16.27, "ours: chi^2_3 at 99.9 % (None: always update)")
     update_cov_depth: str = param("measured", "ours: depth behind an observation's covariance in the landma"
                                               "rk filter: 'measured' or 'map' (the landmark seen from the new pose; issue 25)")
+    filter_space: str = param("xyz", "ours: the landmark filter's update in 'xyz' (000 §3.6) or in the stereo 'pixels' "
+                                     "(u_l, v_l, u_r) of the current camera, one pixel noise for all (rectified rigs; "
+                                     "issue 25)")
     init_cov_depth: str = param("measured", "ours: depth behind a new landmark's first covariance: 'measured' ('true': "
                                             "an ablation oracle; issue 25)")
 
@@ -270,9 +279,11 @@ class StereoParams(Params):
         v.check_choice(self.weight_depth, "weight_depth", DEPTH_SOURCES)
         v.check_choice(self.update_cov_depth, "update_cov_depth", DEPTH_SOURCES)
         v.check_choice(self.init_cov_depth, "init_cov_depth", ("measured", "true"))
+        v.check_choice(self.filter_space, "filter_space", ("xyz", "pixels"))
         v.check_choice(self.pose_refine, "pose_refine", ("none", "reprojection"))
         v.check_int(self.refine_iters, "refine_iters", minimum=1)
         v.check_positive(self.refine_huber_px, "refine_huber_px")
+        v.check_int(self.refine_min_seen, "refine_min_seen", minimum=1)
         v.check_int(self.n_oldest, "n_oldest", minimum=3)
         if v.check_positive(self.oldest_fraction, "oldest_fraction") > 1:
             raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {self.oldest_fraction}")

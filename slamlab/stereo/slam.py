@@ -83,6 +83,9 @@ class StereoSLAM:
         self._detect_kwargs = p.detect_kwargs()
         self._image_shape = (rig.left.height_px, rig.left.width_px)
         self._refine = p.refine_disparity and is_rectified(rig)
+        # the landmark filter in stereo pixels needs a rectified rig with one focal length (else: in x, y, z)
+        self._pixel_filter = (p.filter_space == "pixels" and is_rectified(rig)
+                              and bool(np.isclose(rig.left.fx, rig.right.fx)))
         # landmarks (ids are row indices): position, covariance, bookkeeping
         self.X = np.empty((0, 3))
         self.P = np.empty((0, 3, 3))
@@ -270,7 +273,12 @@ class StereoSLAM:
             Rz += pose_var[:, None, None] * np.eye(3)
         else:
             Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
-        rec["n_gated"] = int((~self.refine_landmarks(ids, Z, Rz)).sum())
+        if self._pixel_filter:
+            T_wc = est.T @ self.T_body_left
+            pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
+            rec["n_gated"] = int((~self._refine_landmarks_in_pixels(ids, pts_left, T_wc, pose_var)).sum())
+        else:
+            rec["n_gated"] = int((~self.refine_landmarks(ids, Z, Rz)).sum())
         self.n_seen[ids] += 1
         self.store.observe(ids)
         rec["n_inliers"] = len(ids)
@@ -364,7 +372,11 @@ class StereoSLAM:
             if not est.converged:
                 rec["status"], est = "ransac_failed", None
             elif p.pose_refine == "reprojection":
-                est = est._replace(T=self._refine_pose(est.T, self.X[mm.ids[est.inliers]], pts_body[mm.local[est.inliers]]))
+                ids, loc = mm.ids[est.inliers], mm.local[est.inliers]
+                seen = self.n_seen[ids] >= p.refine_min_seen
+                if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
+                    ids, loc = ids[seen], loc[seen]
+                est = est._replace(T=self._refine_pose(est.T, self.X[ids], pts_body[loc]))
             elif p.max_rot_std_rad is not None:
                 R, inl = est.T[:3, :3], mm.local[est.inliers]
                 rec["rot_std_rad"] = float(np.max(pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)[:3]))
@@ -441,6 +453,40 @@ class StereoSLAM:
             ok = np.einsum("ni,ni->n", innov, np.linalg.solve(P_pred + Rz, innov[:, :, None])[:, :, 0]) <= gate
         up = ids[ok]
         self.X[up], self.P[up] = landmark_update(self.X[up], P_pred[ok], Z[ok], Rz[ok])
+        return ok
+
+    def _refine_landmarks_in_pixels(self, ids, pts_left, T_wc, pose_var) -> np.ndarray:
+        """``filter_space='pixels'`` (our option; issue 25): the static-landmark Kalman update of 000 §3.6 in the
+        stereo pixels ``(u_l, v_l, u_r)`` of the current left camera (pose ``T_wc``), where every observation
+        has the same noise ``pixel_std`` (plus the pose's, ``pose_var`` m² per point): the landmark's mean is
+        projected there exactly, its covariance through the projection's Jacobian, the fused pixels are
+        triangulated back. Weights then do not depend on a noisy depth and the disparities are averaged
+        (unbiased for Gaussian pixel noise, where depths are not). Rectified rigs only. Returns the mask of the
+        landmarks updated (the innovation gate ``update_gate`` as in :meth:`refine_landmarks`)."""
+        p, cam = self.params, self.rig.left
+        R, t = T_wc[:3, :3], T_wc[:3, 3]
+        P_pred = landmark_predict(self.P[ids], p.state_var)
+        Xc = (self.X[ids] - t) @ R
+        ok = Xc[:, 2] > p.min_depth_m
+        h, J = _stereo_project(self.rig, np.where(ok[:, None], Xc, [0.0, 0.0, 1.0]))
+        h, J = h[:, :3], J[:, :3]
+        z = _stereo_project(self.rig, pts_left)[0][:, :3]
+        C_lm = J @ (R.T @ P_pred @ R) @ np.swapaxes(J, 1, 2)
+        C_z = p.pixel_std**2 * np.eye(3) + pose_var[:, None, None] * (J @ np.swapaxes(J, 1, 2))
+        if p.update_gate is not None and len(ids):
+            innov = z - h
+            ok &= np.einsum("ni,ni->n", innov, np.linalg.solve(C_lm + C_z, innov[:, :, None])[:, :, 0]) <= p.update_gate
+        m, C = landmark_update(h[ok], C_lm[ok], z[ok], C_z[ok])
+        disp = (m[:, 0] - cam.cx) - (m[:, 2] - self.rig.right.cx)
+        good = disp > 0
+        ok[np.flatnonzero(ok)[~good]] = False
+        m, C = m[good], C[good]
+        zc = cam.fx * self.rig.baseline_m / disp[good]
+        Xn = np.column_stack([(m[:, 0] - cam.cx) * zc / cam.fx, (m[:, 1] - cam.cy) * zc / cam.fy, zc])
+        Ji = np.linalg.inv(_stereo_project(self.rig, Xn)[1][:, :3])
+        up = ids[ok]
+        self.X[up] = Xn @ R.T + t
+        self.P[up] = R @ (Ji @ C @ np.swapaxes(Ji, 1, 2)) @ R.T
         return ok
 
     def _add_landmarks(self, pts_body, cov_body, desc, T):
