@@ -21,12 +21,13 @@ from .kitti_experiments import KITTI_PARAMS
 from .params import StereoParams
 from .slam import StereoSLAM
 
-__all__ = ["CONDITION_SETTINGS", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
+__all__ = ["CONDITION_SETTINGS", "PROPOSED_FIX", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
            "run_scale_ablation"]
 
 #: the settings of the ablation: label -> overrides of KITTI_PARAMS (``pixel_std_obs``: the scene's keypoint noise);
 #: 'measured' / 'map': the depth behind a match's weight in the pose (``weight_depth``) and an observation's
-#: covariance in the landmark filter (``update_cov_depth``)
+#: covariance in the landmark filter (``update_cov_depth``); 'true' and ``_oracle``: the simulator's truth
+#: (see :func:`run_scale_ablation`)
 SCALE_ABLATION = {
     "KITTI_PARAMS (both at the landmark's depth)": {},
     "no keypoint noise": {"pixel_std_obs": 0.0},
@@ -38,12 +39,33 @@ SCALE_ABLATION = {
                                                    "update_cov_depth": "measured"},
     "RANSAC threshold 0.5 m at every depth, equal weights": {"depth_ref_m": 1000.0, "threshold_m": 0.5},
     "pose from all inliers": {"policy": "all"},
+    # oracles (stop 37): the simulator's truth where a noisy estimate was used; which one removes the bias?
+    "pose weight at the true depth (oracle)": {"weight_depth": "true"},
+    "pose weight, filter and first covariances at the true depth (oracle)": {
+        "weight_depth": "true", "update_cov_depth": "true", "init_cov_depth": "true"},
+    "depth cut on the true depth (oracle)": {"_oracle": ("cut",)},
+    "new landmarks at their true position (oracle)": {"_oracle": ("init_position",)},
+    "pose from the exact local points (oracle)": {"_oracle": ("pose_points",)},
+    # the options that do not know the scene (stop 37; all off in KITTI_PARAMS)
+    "points up to 1.5 x the cut match landmarks": {"reobserve_depth_factor": 1.5},
+    "landmark filter in pixels": {"filter_space": "pixels"},
+    "pose refined on the reprojection error": {"pose_refine": "reprojection"},
+    "refined pose + 1.5 x the cut (PROPOSED_FIX)": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5},
+    "PROPOSED_FIX + landmark filter in pixels": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5,
+                                                 "filter_space": "pixels"},
+    "PROPOSED_FIX, new landmarks at their true position (oracle)": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "_oracle": ("init_position",)},
 }
+
+#: the options stop 37 proposes against the displacement underestimate (issue 25): the pose refined on the
+#: stereo reprojection error, and points up to 1.5 x ``max_depth_m`` matched to landmarks (not made new ones)
+PROPOSED_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5}
 
 #: the two settings of :func:`run_condition_ablation`: the defaults before issue 25 and today's KITTI_PARAMS
 CONDITION_SETTINGS = {
     "old defaults (measured depth)": {"weight_depth": "measured", "update_cov_depth": "measured"},
     "KITTI_PARAMS": {},
+    "KITTI_PARAMS + PROPOSED_FIX": PROPOSED_FIX,
 }
 
 
@@ -140,7 +162,12 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         Body poses ``(x_m, y_m, yaw_rad)``, N ≥ 3 (:func:`slamlab.sim.highway.highway_path`).
     variants : dict, optional
         Label -> overrides of ``params`` (default :data:`SCALE_ABLATION`); the key ``pixel_std_obs``
-        sets the keypoint noise instead.
+        sets the keypoint noise instead. Oracles (ablation only): a depth source ``'true'``
+        (``weight_depth``, ``update_cov_depth``, ``init_cov_depth``) takes the true depth of each point
+        from the scene (``last_observed``); the key ``_oracle``, a tuple of ``'cut'`` (the depth cut on
+        the true depth), ``'init_position'`` (new landmarks at their true position seen from the
+        estimated pose) and ``'pose_points'`` (the pose fit from the exact local points), replaces
+        one noisy quantity by the truth.
     params : StereoParams, optional
         Base settings (default :data:`~slamlab.stereo.KITTI_PARAMS`).
     n_seeds : int, default 3
