@@ -53,6 +53,7 @@ SCALE_ABLATION = {
     "refined pose + 1.5 x the cut (PROPOSED_FIX)": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5},
     "PROPOSED_FIX + landmark filter in pixels": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5,
                                                  "filter_space": "pixels"},
+    "refined pose, depth cut on the true depth (oracle)": {"pose_refine": "reprojection", "_oracle": ("cut",)},
     "PROPOSED_FIX, new landmarks at their true position (oracle)": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "_oracle": ("init_position",)},
 }

@@ -184,6 +184,8 @@ class StereoSLAM:
                                        p.pixel_std, refine)
         # beyond max_depth_m a point may match a landmark but does not become one (reobserve_depth_factor > 1)
         self._may_be_new = cloud.points[:, 2] <= p.max_depth_m
+        if "cut" in oracle and self.truth_left_cam_m is not None:
+            self._may_be_new[:] = True  # the oracle's cut on the true depth replaces it
         Rb, tb = self.T_body_left[:3, :3], self.T_body_left[:3, 3]
         pts_body = cloud.points @ Rb.T + tb
         cov_body = Rb @ cloud.cov @ Rb.T
