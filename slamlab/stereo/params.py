@@ -134,6 +134,8 @@ class StereoParams(Params):
         ours: Huber threshold of pose_refine on a point's pixel residual norm
     refine_min_seen : int
         ours: pose_refine uses the inliers whose landmark was seen at least this often (a landmark seen once was selected by the depth cut on its own noisy depth; 1: all)
+    drop_first_sighting : bool
+        ours: a landmark's second sighting replaces its first triangulation (which the depth cut selected on its own noisy depth) instead of being fused with it (issue 25)
     degenerate_pose : str
         ours: pose of a frame that gives none: 'last' (keep the last pose) or 'constant_velocity' (the last frame's motion once more)
     state_var : float
@@ -224,6 +226,9 @@ class StereoParams(Params):
     refine_huber_px: float = param(2.0, "ours: Huber threshold of pose_refine on a point's pixel residual norm")
     refine_min_seen: int = param(1, "ours: pose_refine uses the inliers whose landmark was seen at least this often "
                                     "(a landmark seen once was selected by the depth cut on its own noisy depth; 1: all)")
+    drop_first_sighting: bool = param(False, "ours: a landmark's second sighting replaces its first triangulation "
+                                             "(which the depth cut selected on its own noisy depth) instead of being "
+                                             "fused with it (issue 25)")
     degenerate_pose: str = param("last", "ours: pose of a frame that gives none: 'last' (keep the last pose) or "
                                          "'constant_velocity' (the last frame's motion once more)")
     # -- landmark filter (000 §3.6) --------------------------------------------------------------------
@@ -284,6 +289,8 @@ class StereoParams(Params):
         v.check_int(self.refine_iters, "refine_iters", minimum=1)
         v.check_positive(self.refine_huber_px, "refine_huber_px")
         v.check_int(self.refine_min_seen, "refine_min_seen", minimum=1)
+        if not isinstance(self.drop_first_sighting, bool):
+            raise TypeError(f"`drop_first_sighting` must be a bool; got {type(self.drop_first_sighting).__name__}")
         v.check_int(self.n_oldest, "n_oldest", minimum=3)
         if v.check_positive(self.oldest_fraction, "oldest_fraction") > 1:
             raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {self.oldest_fraction}")

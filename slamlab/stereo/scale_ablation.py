@@ -50,17 +50,25 @@ SCALE_ABLATION = {
     "points up to 1.5 x the cut match landmarks": {"reobserve_depth_factor": 1.5},
     "landmark filter in pixels": {"filter_space": "pixels"},
     "pose refined on the reprojection error": {"pose_refine": "reprojection"},
-    "refined pose + 1.5 x the cut (PROPOSED_FIX)": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5},
-    "PROPOSED_FIX + landmark filter in pixels": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5,
-                                                 "filter_space": "pixels"},
+    "refined pose + 1.5 x the cut": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5},
+    "refined pose + 1.5 x the cut + landmark filter in pixels": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "filter_space": "pixels"},
     "refined pose, depth cut on the true depth (oracle)": {"pose_refine": "reprojection", "_oracle": ("cut",)},
-    "PROPOSED_FIX, new landmarks at their true position (oracle)": {
+    "refined pose + 1.5 x the cut, new landmarks at their true position (oracle)": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "_oracle": ("init_position",)},
+    "refined pose + 1.5 x the cut + second sighting replaces the first": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True},
+    "... + refinement on landmarks seen twice (PROPOSED_FIX)": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
+        "refine_min_seen": 2},
 }
 
 #: the options stop 37 proposes against the displacement underestimate (issue 25): the pose refined on the
-#: stereo reprojection error, and points up to 1.5 x ``max_depth_m`` matched to landmarks (not made new ones)
-PROPOSED_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5}
+#: stereo reprojection error of the landmarks seen at least twice; points up to 1.5 x ``max_depth_m`` matched to
+#: landmarks (not made new ones); a landmark's second sighting replaces its first triangulation, which the depth
+#: cut selected on its own noisy depth
+PROPOSED_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
+                "refine_min_seen": 2}
 
 #: the two settings of :func:`run_condition_ablation`: the defaults before issue 25 and today's KITTI_PARAMS
 CONDITION_SETTINGS = {

@@ -275,12 +275,20 @@ class StereoSLAM:
             Rz += pose_var[:, None, None] * np.eye(3)
         else:
             Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
+        if p.drop_first_sighting:
+            # a landmark's first triangulation passed the depth cut on its own noisy depth (selected too near):
+            # its second sighting replaces it instead of being fused with it (our option; issue 25)
+            second = self.n_seen[ids] == 1
+            self.X[ids[second]], self.P[ids[second]] = Z[second], Rz[second]
+        else:
+            second = np.zeros(len(ids), bool)
+        f = ~second  # the landmarks the filter fuses
         if self._pixel_filter:
             T_wc = est.T @ self.T_body_left
-            pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
-            rec["n_gated"] = int((~self._refine_landmarks_in_pixels(ids, pts_left, T_wc, pose_var)).sum())
+            pts_left = (pts_body[loc[f]] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
+            rec["n_gated"] = int((~self._refine_landmarks_in_pixels(ids[f], pts_left, T_wc, pose_var[f])).sum())
         else:
-            rec["n_gated"] = int((~self.refine_landmarks(ids, Z, Rz)).sum())
+            rec["n_gated"] = int((~self.refine_landmarks(ids[f], Z[f], Rz[f])).sum())
         self.n_seen[ids] += 1
         self.store.observe(ids)
         rec["n_inliers"] = len(ids)

@@ -125,3 +125,26 @@ def test_the_oracle_depth_needs_the_truth():
         slam.process_features(*sc.observe(highway_path(2)[0], rng=1))
     assert sc.last_observed is not None
     assert len(sc.last_observed[0]) > 100
+
+
+def test_second_sighting_replaces_the_first_triangulation():
+    """drop_first_sighting: a landmark seen twice holds one observation's covariance, not two fused ones.
+
+    Construction: the Kalman fusion of two observations has a smaller covariance than either; with the option
+    the second sighting replaces the first, so the landmarks seen twice keep a larger covariance (trace).
+    """
+    from slamlab.sim.highway import HighwayScene, highway_path
+
+    tr = {}
+    for drop in (False, True):
+        sc = HighwayScene(rng=0)
+        slam = StereoSLAM(sc.rig, sc.T_body_left, params=StereoParams(max_depth_m=40.0, drop_first_sighting=drop), rng=0)
+        g = np.random.default_rng(1)
+        for pose in highway_path(2):
+            slam.process_features(*sc.observe(pose, pixel_std=0.5, rng=g))
+        twice = np.flatnonzero(slam.n_seen == 2)
+        assert twice.size > 50
+        tr[drop] = np.trace(slam.P[twice], axis1=1, axis2=2)
+    assert np.median(tr[True]) > 1.5 * np.median(tr[False])
+    with pytest.raises(TypeError, match="drop_first_sighting"):
+        StereoParams(drop_first_sighting=1)
