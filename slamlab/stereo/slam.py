@@ -379,14 +379,14 @@ class StereoSLAM:
             est = _estimate_pose(src, self.X[mm.ids], self.first_seen[mm.ids], d_use,
                                  cov_body[mm.local], p, self.rng)
             rec["n_used"] = est.n_used
-            if not est.converged:
-                rec["status"], est = "ransac_failed", None
-            elif p.pose_refine == "reprojection":
+            if est.converged and p.pose_refine == "reprojection":
                 ids, loc = mm.ids[est.inliers], mm.local[est.inliers]
                 seen = self.n_seen[ids] >= p.refine_min_seen
                 if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
                     ids, loc = ids[seen], loc[seen]
                 est = est._replace(T=self._refine_pose(est.T, self.X[ids], pts_body[loc]))
+            if not est.converged:
+                rec["status"], est = "ransac_failed", None
             elif p.max_rot_std_rad is not None:
                 R, inl = est.T[:3, :3], mm.local[est.inliers]
                 rec["rot_std_rad"] = float(np.max(pose_std(self.X[mm.ids[est.inliers]], R @ cov_body[inl] @ R.T)[:3]))
