@@ -136,6 +136,9 @@ class HighwayScene:
         Motion of each landmark along the world ``x`` axis per metre we travel (0: static).
     descriptors : numpy.ndarray of float32, shape (K, 64)
         Unit-norm descriptor of each landmark.
+    last_observed : tuple of numpy.ndarray or None
+        The landmark index of every left and right keypoint of the last :meth:`observe` (the truth an
+        ablation oracle needs; None before the first call).
 
     Examples
     --------
@@ -204,6 +207,7 @@ class HighwayScene:
             self.velocity = np.concatenate([self.velocity, vel])
             desc = np.concatenate([desc, g.standard_normal((len(cars), 64)).astype(np.float32)])
         self.descriptors = desc / np.linalg.norm(desc, axis=1, keepdims=True)
+        self.last_observed: tuple | None = None
 
     def points_at(self, pose) -> np.ndarray:
         """Landmarks in the world frame when we are at ``pose`` (vehicles moved along the road; issue 25).
@@ -286,7 +290,7 @@ class HighwayScene:
         if self.pyramid_levels > 1:  # noise grows with the keypoint's pyramid level
             level = self._levels((points - T_wl[:3, 3]) @ T_wl[:3, 2], g)
             sigma = sigma * self.pyramid_scale ** level[:, None]
-        out, uv_left = [], None
+        out, uv_left, ids = [], None, []
         for cam, t_cam in ((self.rig.left, np.zeros(3)), (self.rig.right, self.rig.t_rl)):
             Xc = (points - T_wl[:3, 3]) @ T_wl[:3, :3] + t_cam
             z = Xc[:, 2]
@@ -303,11 +307,13 @@ class HighwayScene:
             keep = front & (uv[:, 0] >= 0) & (uv[:, 0] < cam.width_px) & (uv[:, 1] >= 0) & (uv[:, 1] < cam.height_px)
             keep &= g.random(len(Xc)) < p_det
             idx = g.permutation(np.flatnonzero(keep))
+            ids.append(idx)
             d = self.descriptors[idx] + d_noise * g.standard_normal((idx.size, 64)).astype(np.float32)
             d /= np.linalg.norm(d, axis=1, keepdims=True)
             n = idx.size
             out.append(Features(uv[idx], 2.0 * self.pyramid_scale ** level[idx], np.zeros(n), np.ones(n), level[idx],
                                 d.astype(np.float32), "highway-sim"))
+        self.last_observed = (ids[0], ids[1])
         return out[0], out[1]
 
 

@@ -13,9 +13,10 @@ import numpy as np
 from .. import _validate as v
 from .._compiled import numba_enabled
 from ..features.matching import best_per_target, ratio_rule
+from ..geometry.camera import StereoRig
 from ..geometry.ransac import ransac
 from ..geometry.registration import RigidTransform, _umeyama
-from ..geometry.so3 import hat
+from ..geometry.so3 import hat, se3_exp
 from ..kdtree.stores import LandmarkStore
 from ._pairs import _pair_distances, _two_nearest
 from .params import StereoParams
@@ -27,6 +28,7 @@ __all__ = [
     "estimate_pose",
     "match_to_map",
     "pose_std",
+    "refine_pose_stereo",
     "select_oldest",
 ]
 
@@ -487,3 +489,123 @@ def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> Po
     T = np.eye(4)
     T[:3, :3], T[:3, 3] = Tm.R, Tm.t
     return PoseEstimate(T, inl, bool(inl.sum() >= min_inliers), int(used.size), r.n_iters)
+
+
+# --- pose refinement on the stereo reprojection error (our option; issue 25) -------------------------
+
+
+def _project_jac(X, fx, fy, cx, cy):
+    """Pixels ``(K, 2)`` of camera-frame points ``X`` and their Jacobians ``(K, 2, 3)`` w.r.t. ``X``."""
+    iz = 1.0 / X[:, 2]
+    u = fx * X[:, 0] * iz + cx
+    v = fy * X[:, 1] * iz + cy
+    J = np.zeros((len(X), 2, 3))
+    J[:, 0, 0] = fx * iz
+    J[:, 0, 2] = -fx * X[:, 0] * iz * iz
+    J[:, 1, 1] = fy * iz
+    J[:, 1, 2] = -fy * X[:, 1] * iz * iz
+    return np.column_stack([u, v]), J
+
+
+def _stereo_project(rig, Xc):
+    """``(K, 4)`` pixels ``(u_l, v_l, u_r, v_r)`` of left-camera points and their ``(K, 4, 3)`` Jacobians."""
+    L, Rr = rig.left, rig.right
+    uv_l, J_l = _project_jac(Xc, L.fx, L.fy, L.cx, L.cy)
+    uv_r, J_r = _project_jac(Xc @ rig.R_rl.T + rig.t_rl, Rr.fx, Rr.fy, Rr.cx, Rr.cy)
+    return np.hstack([uv_l, uv_r]), np.concatenate([J_l, J_r @ rig.R_rl], axis=1)
+
+
+def _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m):
+    """Gauss-Newton on ``T_cw`` (map to left camera): the stereo pixels ``z_px`` (K, 4) of landmarks ``X_map``;
+    left-multiplied twist updates ``T ← exp(δ) T``; Huber weights on each point's pixel residual norm."""
+    T = T_cw.copy()
+    for _ in range(iters):
+        Xc = X_map @ T[:3, :3].T + T[:3, 3]
+        ok = Xc[:, 2] > min_depth_m
+        if ok.sum() < 3:
+            break
+        h, J3 = _stereo_project(rig, Xc[ok])
+        r = z_px[ok] - h
+        # d(Xc)/d(δ) for δ = (v, ω): [I, -[Xc]x]
+        D = np.zeros((ok.sum(), 3, 6))
+        D[:, :, :3] = np.eye(3)
+        D[:, :, 3:] = hat(-Xc[ok])
+        J = J3 @ D  # (K, 4, 6)
+        norm = np.linalg.norm(r, axis=1)
+        w = np.where(norm <= huber_px, 1.0, huber_px / np.maximum(norm, 1e-300))
+        H = np.einsum("k,kai,kaj->ij", w, J, J)
+        g = np.einsum("k,kai,ka->i", w, J, r)
+        try:
+            delta = np.linalg.solve(H, g)
+        except np.linalg.LinAlgError:
+            break
+        T = se3_exp(delta) @ T
+        if np.linalg.norm(delta) < 1e-10:
+            break
+    return T
+
+
+def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_body_left=None, *, iters: int = 5,
+                       huber_px: float = 2.0, min_depth_m: float = 0.1) -> np.ndarray:
+    """Refine a body pose by minimising the stereo reprojection error of matched landmarks (our option; issue 25).
+
+    Motion-only bundle adjustment as in ORB-SLAM's pose optimisation (Mur-Artal & Tardós 2017, §V-B): the
+    landmarks stay fixed, the pose moves; each match's measurement is the pair of pixels ``(u_l, v_l, u_r,
+    v_r)`` of its stereo point (``points_left`` projected into both cameras: the keypoints it was triangulated
+    from), with one pixel noise for all (a Huber loss of ``huber_px`` on each point's residual norm). Unlike the
+    weighted 3-D fit of :func:`estimate_pose`, no weight depends on a noisy depth, and the error is modelled
+    where it arises (along the ray the pixels say little, across it much). Gauss-Newton on SE(3) with updates
+    ``T_cw ← exp(δ) T_cw`` (:func:`slamlab.geometry.se3_exp`), ``iters`` steps at most.
+
+    Parameters
+    ----------
+    T_body : array_like, shape (4, 4)
+        Starting body-to-map pose (the 3-D fit's).
+    landmarks_map : array_like, shape (M, 3)
+        Matched landmarks in the map frame [m], M ≥ 3.
+    points_left : array_like, shape (M, 3)
+        Their stereo points of this frame in the left-camera frame [m] (``z`` > 0).
+    rig : StereoRig
+        The calibrated pair.
+    T_body_left : array_like, shape (4, 4), optional
+        Left camera in the body frame (default identity).
+    iters : int, default 5
+        Most Gauss-Newton steps.
+    huber_px : float, default 2.0
+        Residual norm [px] beyond which a point's weight falls as ``huber_px / norm``.
+    min_depth_m : float, default 0.1
+        Landmarks nearer than this to the left camera (or behind it) are left out.
+
+    Returns
+    -------
+    numpy.ndarray, shape (4, 4)
+        The refined body-to-map pose.
+
+    Examples
+    --------
+    >>> from slamlab.geometry import se3_from_planar
+    >>> rig = StereoRig.parallel(baseline_m=0.5)
+    >>> P = np.random.default_rng(0).uniform([-5, -2, 5], [5, 2, 30], (40, 3))  # left camera = body
+    >>> T = se3_from_planar(0.3, -0.1, 0.05)
+    >>> T_est = refine_pose_stereo(se3_from_planar(0.2, 0.0, 0.0), P @ T[:3, :3].T + T[:3, 3], P, rig)
+    >>> bool(np.allclose(T_est, T, atol=1e-9))
+    True
+    """
+    Tb = v.as_matrix(T_body, "T_body", (4, 4))
+    X = v.as_finite_array(landmarks_map, "landmarks_map", ndim=2)
+    Pl = v.as_finite_array(points_left, "points_left", ndim=2)
+    if X.shape[1:] != (3,) or Pl.shape != X.shape:
+        raise ValueError(f"`landmarks_map` and `points_left` must both have shape (M, 3); got {X.shape} and {Pl.shape}")
+    if len(X) < 3:
+        raise ValueError(f"`landmarks_map` must hold at least 3 matches; got {len(X)}")
+    if np.any(Pl[:, 2] <= 0):
+        raise ValueError("`points_left` must lie in front of the left camera (z > 0)")
+    if not isinstance(rig, StereoRig):
+        raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
+    Tbl = np.eye(4) if T_body_left is None else v.as_matrix(T_body_left, "T_body_left", (4, 4))
+    iters = v.check_int(iters, "iters", minimum=1)
+    huber_px = v.check_positive(huber_px, "huber_px")
+    min_depth_m = v.check_positive(min_depth_m, "min_depth_m")
+    z_px = _stereo_project(rig, Pl)[0]
+    T_cw = np.linalg.inv(Tb @ Tbl)
+    return np.linalg.inv(_refine_pose_stereo(T_cw, X, z_px, rig, iters, huber_px, min_depth_m)) @ np.linalg.inv(Tbl)

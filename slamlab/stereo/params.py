@@ -23,7 +23,7 @@ __all__ = ["STEREO_DETECTORS", "RenderParams", "StereoParams"]
 STEREO_DETECTORS = ("surf", "sift", "orb")
 POLICIES = ("oldest", "all")
 MAP_SEARCHES = ("global", "window")
-DEPTH_SOURCES = ("measured", "map")
+DEPTH_SOURCES = ("measured", "map", "true")  # "true": an ablation oracle (run_scale_ablation only)
 
 
 def _fraction(value, name):
@@ -88,6 +88,8 @@ class StereoParams(Params):
         ours: fewer window matches than this share of the points: search globally (a first pose from repeated texture is confirmed by few windows)
     view_margin_deg : float or None
         ours: match only landmarks in view (None: the whole map, as 000)
+    reobserve_depth_factor : float
+        ours: a point up to this times max_depth_m deep may match a landmark (pose, filter) but becomes a new one only within max_depth_m (1: one cut; issue 25)
     view_depth_factor : float
         ours: the view gate keeps landmarks up to this times max_depth_m away
     base_seen_times : int
@@ -105,7 +107,7 @@ class StereoParams(Params):
     min_inliers : int
         ours: RANSAC inliers needed for a valid pose
     weight_depth : str
-        ours: depth behind a match's RANSAC threshold and weight: 'measured' (this frame's point) or 'map' (the landmark seen from the last pose; issue 25)
+        ours: depth behind a match's RANSAC threshold and weight: 'measured' (this frame's point) or 'map' (the landmark seen from the last pose; issue 25); 'true': the simulator's true depth, an ablation oracle (needs ``StereoSLAM.truth_hook``)
     n_oldest : int
         ours: 000 §3.5 says 'sufficiently large'
     oldest_fraction : float
@@ -124,6 +126,16 @@ class StereoParams(Params):
         ours: bound on the oldest set's correction (None: none)
     max_rot_std_rad : float or None
         ours: reject a pose whose rotation std exceeds this (None: off)
+    pose_refine : str
+        ours: after RANSAC, 'none' or 'reprojection': Gauss-Newton on the inliers' stereo reprojection error with one pixel noise (motion-only bundle adjustment; issue 25)
+    refine_iters : int
+        ours: most Gauss-Newton steps of pose_refine
+    refine_huber_px : float
+        ours: Huber threshold of pose_refine on a point's pixel residual norm
+    refine_min_seen : int
+        ours: pose_refine uses the inliers whose landmark was seen at least this often (a landmark seen once was selected by the depth cut on its own noisy depth; 1: all)
+    drop_first_sighting : bool
+        ours: a landmark's second sighting replaces its first triangulation (which the depth cut selected on its own noisy depth) instead of being fused with it (issue 25)
     degenerate_pose : str
         ours: pose of a frame that gives none: 'last' (keep the last pose) or 'constant_velocity' (the last frame's motion once more)
     state_var : float
@@ -135,7 +147,11 @@ class StereoParams(Params):
     update_gate : float or None
         ours: chi^2_3 at 99.9 % (None: always update)
     update_cov_depth : str
-        ours: depth behind an observation's covariance in the landmark filter: 'measured' or 'map' (the landmark seen from the new pose; issue 25)
+        ours: depth behind an observation's covariance in the landmark filter: 'measured' or 'map' (the landmark seen from the new pose; issue 25); 'true': the oracle as for ``weight_depth``
+    filter_space : str
+        ours: the landmark filter's update in 'xyz' (000 §3.6) or in the stereo 'pixels' (u_l, v_l, u_r) of the current camera, one pixel noise for all (rectified rigs; issue 25)
+    init_cov_depth : str
+        ours: depth behind a new landmark's first covariance in the filter: 'measured' or 'true' (the oracle as for ``weight_depth``; issue 25)
 
     Examples
     --------
@@ -180,6 +196,9 @@ class StereoParams(Params):
     window_min_share: float = param(0.1, "ours: fewer window matches than this share of the points: search globally "
                                          "(a first pose from repeated texture is confirmed by few windows)")
     view_margin_deg: float | None = param(None, "ours: match only landmarks in view (None: the whole map, as 000)")
+    reobserve_depth_factor: float = param(1.0, "ours: a point up to this times max_depth_m deep may match a landmark "
+                                                 "(pose, filter) but becomes a new one only within max_depth_m (1: one "
+                                                 "cut; issue 25)")
     view_depth_factor: float = param(1.5, "ours: the view gate keeps landmarks up to this times max_depth_m away")
     base_seen_times: int = param(3, "000 §3.4: BaseSeenTimes = 3")
     max_non_base_time: int = param(7, "000 §3.4: MaxNonBaseTime = 7")
@@ -200,6 +219,16 @@ class StereoParams(Params):
     max_correction_rad: float | None = param(None, "ours: bound on the oldest set's correction (None: none)")
     max_correction_m: float | None = param(None, "ours: bound on the oldest set's correction (None: none)")
     max_rot_std_rad: float | None = param(0.01, "ours: reject a pose whose rotation std exceeds this (None: off)")
+    pose_refine: str = param("none", "ours: after RANSAC, 'none' or 'reprojection': Gauss-Newton on the inliers' "
+                                     "stereo reprojection error with one pixel noise (motion-only bundle adjustment; "
+                                     "issue 25)")
+    refine_iters: int = param(5, "ours: most Gauss-Newton steps of pose_refine")
+    refine_huber_px: float = param(2.0, "ours: Huber threshold of pose_refine on a point's pixel residual norm")
+    refine_min_seen: int = param(1, "ours: pose_refine uses the inliers whose landmark was seen at least this often "
+                                    "(a landmark seen once was selected by the depth cut on its own noisy depth; 1: all)")
+    drop_first_sighting: bool = param(False, "ours: a landmark's second sighting replaces its first triangulation "
+                                             "(which the depth cut selected on its own noisy depth) instead of being "
+                                             "fused with it (issue 25)")
     degenerate_pose: str = param("last", "ours: pose of a frame that gives none: 'last' (keep the last pose) or "
                                          "'constant_velocity' (the last frame's motion once more)")
     # -- landmark filter (000 §3.6) --------------------------------------------------------------------
@@ -209,6 +238,11 @@ class StereoParams(Params):
     update_gate: float | None = param(16.27, "ours: chi^2_3 at 99.9 % (None: always update)")
     update_cov_depth: str = param("measured", "ours: depth behind an observation's covariance in the landma"
                                               "rk filter: 'measured' or 'map' (the landmark seen from the new pose; issue 25)")
+    filter_space: str = param("xyz", "ours: the landmark filter's update in 'xyz' (000 §3.6) or in the stereo 'pixels' "
+                                     "(u_l, v_l, u_r) of the current camera, one pixel noise for all (rectified rigs; "
+                                     "issue 25)")
+    init_cov_depth: str = param("measured", "ours: depth behind a new landmark's first covariance: 'measured' ('true': "
+                                            "an ablation oracle; issue 25)")
 
     def check(self) -> None:
         v.check_choice(self.detector, "detector", STEREO_DETECTORS)
@@ -224,6 +258,8 @@ class StereoParams(Params):
         if v.check_positive(self.max_depth_m, "max_depth_m") <= self.min_depth_m:
             raise ValueError(f"`max_depth_m` must exceed `min_depth_m` = {self.min_depth_m}; got {self.max_depth_m}")
         v.check_positive(self.pixel_std, "pixel_std")
+        if v.check_positive(self.reobserve_depth_factor, "reobserve_depth_factor") < 1:
+            raise ValueError(f"`reobserve_depth_factor` must be at least 1; got {self.reobserve_depth_factor}")
         if self.subpixel_stereo is not None and not isinstance(self.subpixel_stereo, bool):
             raise TypeError(f"`subpixel_stereo` must be a bool or None; got {type(self.subpixel_stereo).__name__}")
         v.check_int(self.subpixel_half_px, "subpixel_half_px", minimum=1)
@@ -247,6 +283,14 @@ class StereoParams(Params):
         v.check_int(self.min_inliers, "min_inliers", minimum=3)
         v.check_choice(self.weight_depth, "weight_depth", DEPTH_SOURCES)
         v.check_choice(self.update_cov_depth, "update_cov_depth", DEPTH_SOURCES)
+        v.check_choice(self.init_cov_depth, "init_cov_depth", ("measured", "true"))
+        v.check_choice(self.filter_space, "filter_space", ("xyz", "pixels"))
+        v.check_choice(self.pose_refine, "pose_refine", ("none", "reprojection"))
+        v.check_int(self.refine_iters, "refine_iters", minimum=1)
+        v.check_positive(self.refine_huber_px, "refine_huber_px")
+        v.check_int(self.refine_min_seen, "refine_min_seen", minimum=1)
+        if not isinstance(self.drop_first_sighting, bool):
+            raise TypeError(f"`drop_first_sighting` must be a bool; got {type(self.drop_first_sighting).__name__}")
         v.check_int(self.n_oldest, "n_oldest", minimum=3)
         if v.check_positive(self.oldest_fraction, "oldest_fraction") > 1:
             raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {self.oldest_fraction}")

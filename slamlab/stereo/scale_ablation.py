@@ -21,12 +21,13 @@ from .kitti_experiments import KITTI_PARAMS
 from .params import StereoParams
 from .slam import StereoSLAM
 
-__all__ = ["CONDITION_SETTINGS", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
+__all__ = ["CONDITION_SETTINGS", "PROPOSED_FIX", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
            "run_scale_ablation"]
 
 #: the settings of the ablation: label -> overrides of KITTI_PARAMS (``pixel_std_obs``: the scene's keypoint noise);
 #: 'measured' / 'map': the depth behind a match's weight in the pose (``weight_depth``) and an observation's
-#: covariance in the landmark filter (``update_cov_depth``)
+#: covariance in the landmark filter (``update_cov_depth``); 'true' and ``_oracle``: the simulator's truth
+#: (see :func:`run_scale_ablation`)
 SCALE_ABLATION = {
     "KITTI_PARAMS (both at the landmark's depth)": {},
     "no keypoint noise": {"pixel_std_obs": 0.0},
@@ -38,12 +39,42 @@ SCALE_ABLATION = {
                                                    "update_cov_depth": "measured"},
     "RANSAC threshold 0.5 m at every depth, equal weights": {"depth_ref_m": 1000.0, "threshold_m": 0.5},
     "pose from all inliers": {"policy": "all"},
+    # oracles (stop 37): the simulator's truth where a noisy estimate was used; which one removes the bias?
+    "pose weight at the true depth (oracle)": {"weight_depth": "true"},
+    "pose weight, filter and first covariances at the true depth (oracle)": {
+        "weight_depth": "true", "update_cov_depth": "true", "init_cov_depth": "true"},
+    "depth cut on the true depth (oracle)": {"_oracle": ("cut",)},
+    "new landmarks at their true position (oracle)": {"_oracle": ("init_position",)},
+    "pose from the exact local points (oracle)": {"_oracle": ("pose_points",)},
+    # the options that do not know the scene (stop 37; all off in KITTI_PARAMS)
+    "points up to 1.5 x the cut match landmarks": {"reobserve_depth_factor": 1.5},
+    "landmark filter in pixels": {"filter_space": "pixels"},
+    "pose refined on the reprojection error": {"pose_refine": "reprojection"},
+    "refined pose + 1.5 x the cut": {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5},
+    "refined pose + 1.5 x the cut + landmark filter in pixels": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "filter_space": "pixels"},
+    "refined pose, depth cut on the true depth (oracle)": {"pose_refine": "reprojection", "_oracle": ("cut",)},
+    "refined pose + 1.5 x the cut, new landmarks at their true position (oracle)": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "_oracle": ("init_position",)},
+    "refined pose + 1.5 x the cut + second sighting replaces the first": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True},
+    "... + refinement on landmarks seen twice (PROPOSED_FIX)": {
+        "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
+        "refine_min_seen": 2},
 }
+
+#: the options stop 37 proposes against the displacement underestimate (issue 25): the pose refined on the
+#: stereo reprojection error of the landmarks seen at least twice; points up to 1.5 x ``max_depth_m`` matched to
+#: landmarks (not made new ones); a landmark's second sighting replaces its first triangulation, which the depth
+#: cut selected on its own noisy depth
+PROPOSED_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
+                "refine_min_seen": 2}
 
 #: the two settings of :func:`run_condition_ablation`: the defaults before issue 25 and today's KITTI_PARAMS
 CONDITION_SETTINGS = {
     "old defaults (measured depth)": {"weight_depth": "measured", "update_cov_depth": "measured"},
     "KITTI_PARAMS": {},
+    "KITTI_PARAMS + PROPOSED_FIX": PROPOSED_FIX,
 }
 
 
@@ -140,7 +171,12 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         Body poses ``(x_m, y_m, yaw_rad)``, N ≥ 3 (:func:`slamlab.sim.highway.highway_path`).
     variants : dict, optional
         Label -> overrides of ``params`` (default :data:`SCALE_ABLATION`); the key ``pixel_std_obs``
-        sets the keypoint noise instead.
+        sets the keypoint noise instead. Oracles (ablation only): a depth source ``'true'``
+        (``weight_depth``, ``update_cov_depth``, ``init_cov_depth``) takes the true depth of each point
+        from the scene (``last_observed``); the key ``_oracle``, a tuple of ``'cut'`` (the depth cut on
+        the true depth), ``'init_position'`` (new landmarks at their true position seen from the
+        estimated pose) and ``'pose_points'`` (the pose fit from the exact local points), replaces
+        one noisy quantity by the truth.
     params : StereoParams, optional
         Base settings (default :data:`~slamlab.stereo.KITTI_PARAMS`).
     n_seeds : int, default 3
@@ -168,8 +204,9 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
     resolved = {}
     for label, over in variants.items():
         over = dict(over)
+        oracle_items = frozenset(over.pop("_oracle", ()))
         noise = v.check_positive(over.pop("pixel_std_obs", sigma), "pixel_std_obs", allow_zero=True)
-        resolved[label] = (StereoParams.resolve(base, **over), noise)
+        resolved[label] = (StereoParams.resolve(base, **over), noise, oracle_items)
     seeds = np.random.SeedSequence(int(v.as_rng(rng).integers(2**32))).spawn(n_seeds)
     S, n = len(variants), len(P)
     path_ratio, ate_m, n_deg = np.empty((S, n_seeds)), np.empty((S, n_seeds)), np.zeros((S, n_seeds), int)
@@ -183,11 +220,18 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         truth = np.array([(T0inv @ scene.ground_truth_se3(p))[:3, 3] for p in P])
         true_steps = np.linalg.norm(np.diff(truth, axis=0), axis=1)
         path_len = float(true_steps.sum())
-        for i, (p, noise) in enumerate(resolved.values()):
+        for i, (p, noise, oracle_items) in enumerate(resolved.values()):
             g = np.random.default_rng(s_noise)  # the same keypoints for every setting
             slam = StereoSLAM(scene.rig, scene.T_body_left, params=p, rng=np.random.default_rng(s_slam))
+            slam._oracle = oracle_items
+            oracle = "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or bool(oracle_items)
             for pose in P:
-                slam.process_features(*scene.observe(pose, pixel_std=noise, rng=g))
+                fl, fr = scene.observe(pose, pixel_std=noise, rng=g)
+                if oracle:  # the true left-camera position of every left keypoint (the ablation's oracle)
+                    T_wl = scene.ground_truth_se3(pose) @ scene.T_body_left
+                    X = scene.points_at(pose)[scene.last_observed[0]]
+                    slam.truth_left_cam_m = (X - T_wl[:3, 3]) @ T_wl[:3, :3]
+                slam.process_features(fl, fr)
             est = slam.trajectory[:, :3, 3]
             est_steps = np.linalg.norm(np.diff(est, axis=0), axis=1)
             steps[i, j] = est_steps / true_steps

@@ -22,7 +22,15 @@ from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore, base_rule
 from .frame import STAGES, FrameRecord, _append_rows, _detect_pair, _StageClock, default_store
 from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
-from .map_stages import _estimate_pose, _match_to_map, _matches_from_knn, _window_match, pose_std
+from .map_stages import (
+    _estimate_pose,
+    _match_to_map,
+    _matches_from_knn,
+    _refine_pose_stereo,
+    _stereo_project,
+    _window_match,
+    pose_std,
+)
 from .params import StereoParams
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
@@ -75,6 +83,9 @@ class StereoSLAM:
         self._detect_kwargs = p.detect_kwargs()
         self._image_shape = (rig.left.height_px, rig.left.width_px)
         self._refine = p.refine_disparity and is_rectified(rig)
+        # the landmark filter in stereo pixels needs a rectified rig with one focal length (else: in x, y, z)
+        self._pixel_filter = (p.filter_space == "pixels" and is_rectified(rig)
+                              and bool(np.isclose(rig.left.fx, rig.right.fx)))
         # landmarks (ids are row indices): position, covariance, bookkeeping
         self.X = np.empty((0, 3))
         self.P = np.empty((0, 3, 3))
@@ -92,6 +103,12 @@ class StereoSLAM:
         self.frame = 0
         self.last_cloud_map = np.empty((0, 3))
         self.last_inlier_map = np.empty((0, 3))
+        #: an ablation oracle (issue 25; a simulator sets it, never a user): (n_left, 3) true left-camera
+        #: position of each left keypoint of the next frame, read by the settings whose depth source is
+        #: 'true' (``weight_depth``, ``update_cov_depth``, ``init_cov_depth``) and cleared after the frame
+        self.truth_left_cam_m: np.ndarray | None = None
+        self._true_cam = None
+        self._oracle = frozenset()  # exploratory oracles (ablation only): 'cut', 'init_position', 'pose_points'
 
     # -- the loop ------------------------------------------------------------------------------------
     def _check_pair(self, left, right):
@@ -157,10 +174,32 @@ class StereoSLAM:
         if self._refine and left is not None:
             refine = (to_gray_uint8(left, "left", channel_order=p.channel_order),
                       to_gray_uint8(right, "right", channel_order=p.channel_order), p.subpixel_half_px, p.subpixel_search_px)
-        cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m, p.pixel_std, refine)
+        oracle = self._oracle
+        if "cut" in oracle and self.truth_left_cam_m is not None:  # the depth cut on the true depth (ablation)
+            cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, 1e12, p.pixel_std, refine)
+            zt = self.truth_left_cam_m[cloud.left, 2]
+            keep = (zt >= p.min_depth_m) & (zt <= p.max_depth_m)
+            cloud = type(cloud)(cloud.points[keep], cloud.cov[keep], cloud.left[keep], cloud.gap_m[keep])
+        else:
+            cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m * p.reobserve_depth_factor,
+                                       p.pixel_std, refine)
+        # beyond max_depth_m a point may match a landmark but does not become one (reobserve_depth_factor > 1)
+        self._may_be_new = cloud.points[:, 2] <= p.max_depth_m
+        if "cut" in oracle and self.truth_left_cam_m is not None:
+            self._may_be_new[:] = True  # the oracle's cut on the true depth replaces it
         Rb, tb = self.T_body_left[:3, :3], self.T_body_left[:3, 3]
         pts_body = cloud.points @ Rb.T + tb
         cov_body = Rb @ cloud.cov @ Rb.T
+        self._true_cam, truth = None, self.truth_left_cam_m
+        self.truth_left_cam_m = None
+        if "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or self._oracle:
+            if truth is None or len(truth) != len(fl.uv):
+                raise ValueError("a depth source 'true' (an ablation oracle) needs `truth_left_cam_m`: the true "
+                                 "left-camera position of every left keypoint, set before each frame")
+            self._true_cam = np.asarray(truth, dtype=float)[cloud.left]
+        cov_init = cov_body
+        if p.init_cov_depth == "true":
+            cov_init = Rb @ stereo_point_cov(self._true_cam, self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rb.T
         desc = fl.descriptors[cloud.left]
         clock.lap("triangulate")
         rec = FrameRecord(
@@ -172,10 +211,11 @@ class StereoSLAM:
         no_inliers = np.zeros(len(pts_body), bool)
         if len(self.X) == 0:
             # first frame (or an empty map): it defines the map frame
-            if len(pts_body) >= p.min_inliers:
-                self._add_landmarks(pts_body, cov_body, desc, self.T)
-                self._last_ids = np.arange(len(pts_body))
-                rec["n_new"] = len(pts_body)
+            first = np.flatnonzero(self._may_be_new)
+            if len(first) >= p.min_inliers:
+                self._add_landmarks(pts_body[first], cov_init[first], desc[first], self.T)
+                self._last_ids = np.arange(len(first))
+                rec["n_new"] = len(first)
                 rec["status"] = "init"
             else:
                 rec["status"] = "too_few_points"
@@ -202,12 +242,13 @@ class StereoSLAM:
                 self.T = self.T @ (np.linalg.inv(self.poses[-2]) @ self.poses[-1])
             self._finish(rec, clock, pts_body, no_inliers)
             return rec
-        inl_mask = self._update_map(rec, est, mm, pts_body, cov_body, desc)
+        inl_mask = self._update_map(rec, est, mm, pts_body, cov_body, desc, cov_init)
         self._finish(rec, clock, pts_body, inl_mask)
         return rec
 
-    def _update_map(self, rec, est, mm, pts_body, cov_body, desc):
-        """Take the pose ``est``; refine the re-seen landmarks, add the unmatched points (000 §3.6).
+    def _update_map(self, rec, est, mm, pts_body, cov_body, desc, cov_init=None):
+        """Take the pose ``est``; refine the re-seen landmarks, add the unmatched points (000 §3.6);
+        ``cov_init``: the new landmarks' first covariances (default ``cov_body``).
 
         Returns the mask of the local points that were inliers of the pose.
         """
@@ -220,7 +261,11 @@ class StereoSLAM:
         loc = mm.local[est.inliers]
         Z = pts_body[loc] @ R.T + t
         pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
-        if p.update_cov_depth == "map":
+        if p.update_cov_depth == "true":  # the ablation oracle: the covariance at the point's true position
+            Rwc = (est.T @ self.T_body_left)[:3, :3]
+            Rz = Rwc @ stereo_point_cov(self._true_cam[loc], self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rwc.T
+            Rz += pose_var[:, None, None] * np.eye(3)
+        elif p.update_cov_depth == "map":
             # the observation's covariance at the landmark's position seen from the new pose, not at the
             # measured one: a measurement's weight then does not depend on its own error (issue 25)
             T_wc = est.T @ self.T_body_left
@@ -231,12 +276,25 @@ class StereoSLAM:
             Rz += pose_var[:, None, None] * np.eye(3)
         else:
             Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
-        rec["n_gated"] = int((~self.refine_landmarks(ids, Z, Rz)).sum())
+        if p.drop_first_sighting:
+            # a landmark's first triangulation passed the depth cut on its own noisy depth (selected too near):
+            # its second sighting replaces it instead of being fused with it (our option; issue 25)
+            second = self.n_seen[ids] == 1
+            self.X[ids[second]], self.P[ids[second]] = Z[second], Rz[second]
+        else:
+            second = np.zeros(len(ids), bool)
+        f = ~second  # the landmarks the filter fuses
+        if self._pixel_filter:
+            T_wc = est.T @ self.T_body_left
+            pts_left = (pts_body[loc[f]] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
+            rec["n_gated"] = int((~self._refine_landmarks_in_pixels(ids[f], pts_left, T_wc, pose_var[f])).sum())
+        else:
+            rec["n_gated"] = int((~self.refine_landmarks(ids[f], Z[f], Rz[f])).sum())
         self.n_seen[ids] += 1
         self.store.observe(ids)
         rec["n_inliers"] = len(ids)
         # unmatched local points become new (non-base) landmarks
-        new = mm.unmatched
+        new = mm.unmatched[self._may_be_new[mm.unmatched]]
         if p.duplicate_gap_m is not None and new.size:
             # a point whose nearest landmark by descriptor sits where it is, is that landmark again
             nn = mm.nearest[new]
@@ -247,7 +305,10 @@ class StereoSLAM:
             rec["n_duplicates"] = int(dup.sum())
             new = new[~dup]
         first_new = len(self.X)
-        self._add_landmarks(pts_body[new], cov_body[new], desc[new], est.T)
+        pts_new = pts_body[new]
+        if "init_position" in self._oracle:
+            pts_new = self._true_cam[new] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
+        self._add_landmarks(pts_new, (cov_body if cov_init is None else cov_init)[new], desc[new], est.T)
         rec["n_new"] = len(new)
         self._last_ids = np.concatenate([ids, np.arange(first_new, len(self.X))])
         inl_mask = np.zeros(len(pts_body), bool)
@@ -307,13 +368,24 @@ class StereoSLAM:
             rec["status"] = "too_few_matches"
         else:
             d_use = depth[mm.local]
-            if p.weight_depth == "map":
+            if p.weight_depth == "true":  # the ablation oracle: the point's true depth in this frame
+                d_use = self._true_cam[mm.local, 2]
+            elif p.weight_depth == "map":
                 # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
                 T_wc = self.T @ self.T_body_left
                 d_use = np.maximum(((self.X[mm.ids] - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], p.min_depth_m)
-            est = _estimate_pose(pts_body[mm.local], self.X[mm.ids], self.first_seen[mm.ids], d_use,
+            src = pts_body[mm.local]
+            if "pose_points" in self._oracle:
+                src = self._true_cam[mm.local] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
+            est = _estimate_pose(src, self.X[mm.ids], self.first_seen[mm.ids], d_use,
                                  cov_body[mm.local], p, self.rng)
             rec["n_used"] = est.n_used
+            if est.converged and p.pose_refine == "reprojection":
+                ids, loc = mm.ids[est.inliers], mm.local[est.inliers]
+                seen = self.n_seen[ids] >= p.refine_min_seen
+                if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
+                    ids, loc = ids[seen], loc[seen]
+                est = est._replace(T=self._refine_pose(est.T, self.X[ids], pts_body[loc]))
             if not est.converged:
                 rec["status"], est = "ransac_failed", None
             elif p.max_rot_std_rad is not None:
@@ -325,6 +397,17 @@ class StereoSLAM:
         std = "" if np.isnan(rec["rot_std_rad"]) else f" (rot std {np.rad2deg(rec['rot_std_rad']):.2f} deg)"
         rec["trail"] += f"{search} {len(mm.local)} {rec['status'] if est is None else 'ok'}{std}; "
         return mm, est
+
+    def _refine_pose(self, T_body, X_map, pts_body):
+        """``pose_refine='reprojection'``: the pose moved to minimise the stereo reprojection error of the
+        inliers (landmarks ``X_map``, this frame's body-frame points ``pts_body``; our option, issue 25)."""
+        p = self.params
+        Tbl = self.T_body_left
+        pts_left = (pts_body - Tbl[:3, 3]) @ Tbl[:3, :3]
+        T_cw = np.linalg.inv(T_body @ Tbl)
+        T_cw = _refine_pose_stereo(T_cw, X_map, _stereo_project(self.rig, pts_left)[0], self.rig, p.refine_iters,
+                                   p.refine_huber_px, p.min_depth_m)
+        return np.linalg.inv(T_cw) @ np.linalg.inv(Tbl)
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
@@ -381,6 +464,40 @@ class StereoSLAM:
             ok = np.einsum("ni,ni->n", innov, np.linalg.solve(P_pred + Rz, innov[:, :, None])[:, :, 0]) <= gate
         up = ids[ok]
         self.X[up], self.P[up] = landmark_update(self.X[up], P_pred[ok], Z[ok], Rz[ok])
+        return ok
+
+    def _refine_landmarks_in_pixels(self, ids, pts_left, T_wc, pose_var) -> np.ndarray:
+        """``filter_space='pixels'`` (our option; issue 25): the static-landmark Kalman update of 000 §3.6 in the
+        stereo pixels ``(u_l, v_l, u_r)`` of the current left camera (pose ``T_wc``), where every observation
+        has the same noise ``pixel_std`` (plus the pose's, ``pose_var`` m² per point): the landmark's mean is
+        projected there exactly, its covariance through the projection's Jacobian, the fused pixels are
+        triangulated back. Weights then do not depend on a noisy depth and the disparities are averaged
+        (unbiased for Gaussian pixel noise, where depths are not). Rectified rigs only. Returns the mask of the
+        landmarks updated (the innovation gate ``update_gate`` as in :meth:`refine_landmarks`)."""
+        p, cam = self.params, self.rig.left
+        R, t = T_wc[:3, :3], T_wc[:3, 3]
+        P_pred = landmark_predict(self.P[ids], p.state_var)
+        Xc = (self.X[ids] - t) @ R
+        ok = Xc[:, 2] > p.min_depth_m
+        h, J = _stereo_project(self.rig, np.where(ok[:, None], Xc, [0.0, 0.0, 1.0]))
+        h, J = h[:, :3], J[:, :3]
+        z = _stereo_project(self.rig, pts_left)[0][:, :3]
+        C_lm = J @ (R.T @ P_pred @ R) @ np.swapaxes(J, 1, 2)
+        C_z = p.pixel_std**2 * np.eye(3) + pose_var[:, None, None] * (J @ np.swapaxes(J, 1, 2))
+        if p.update_gate is not None and len(ids):
+            innov = z - h
+            ok &= np.einsum("ni,ni->n", innov, np.linalg.solve(C_lm + C_z, innov[:, :, None])[:, :, 0]) <= p.update_gate
+        m, C = landmark_update(h[ok], C_lm[ok], z[ok], C_z[ok])
+        disp = (m[:, 0] - cam.cx) - (m[:, 2] - self.rig.right.cx)
+        good = disp > 0
+        ok[np.flatnonzero(ok)[~good]] = False
+        m, C = m[good], C[good]
+        zc = cam.fx * self.rig.baseline_m / disp[good]
+        Xn = np.column_stack([(m[:, 0] - cam.cx) * zc / cam.fx, (m[:, 1] - cam.cy) * zc / cam.fy, zc])
+        Ji = np.linalg.inv(_stereo_project(self.rig, Xn)[1][:, :3])
+        up = ids[ok]
+        self.X[up] = Xn @ R.T + t
+        self.P[up] = R @ (Ji @ C @ np.swapaxes(Ji, 1, 2)) @ R.T
         return ok
 
     def _add_landmarks(self, pts_body, cov_body, desc, T):

@@ -30,6 +30,7 @@ from .map_stages import (
     estimate_pose,
     match_to_map,
     pose_std,
+    refine_pose_stereo,
     select_oldest,
 )
 
@@ -44,6 +45,7 @@ __all__ = [
     "is_rectified",
     "match_to_map",
     "pose_std",
+    "refine_pose_stereo",
     "select_oldest",
     "stereo_match",
     "stereo_point_cov",
