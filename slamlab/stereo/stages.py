@@ -7,8 +7,9 @@ Each public stage takes ``params=`` (:class:`~slamlab.stereo.params.StereoParams
 overrides and checks its arguments once; the loop calls the unchecked cores (``_stereo_match``,
 ...) with arguments it checked once.
 
-Stages 1-2 (features, stereo matching, local cloud) live in :mod:`slamlab.stereo.local_stages`, stages 3-4
-(map matching, pose) in :mod:`slamlab.stereo.map_stages`; this module gathers their public names.
+Stages 1-2 (features, stereo matching, local cloud) live in :mod:`slamlab.stereo.local_stages`, stage 3 (map
+matching) in :mod:`slamlab.stereo.map_stages`, stage 4 (pose) in :mod:`slamlab.stereo.pose_stages`; this module
+gathers their public names.
 """
 
 from __future__ import annotations
@@ -24,15 +25,8 @@ from .local_stages import (
     subpixel_disparity,
     triangulate_local,
 )
-from .map_stages import (
-    MapMatches,
-    PoseEstimate,
-    estimate_pose,
-    match_to_map,
-    pose_std,
-    refine_pose_stereo,
-    select_oldest,
-)
+from .map_stages import MapMatches, match_to_map
+from .pose_stages import PoseEstimate, estimate_pose, pose_std, refine_pose_stereo, select_oldest
 
 __all__ = [
     "LocalCloud",

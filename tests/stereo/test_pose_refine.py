@@ -7,7 +7,7 @@ from slamlab.geometry import StereoRig, se3_from_planar
 from slamlab.geometry.camera import PinholeCamera
 from slamlab.geometry.registration import umeyama
 from slamlab.stereo import StereoParams, StereoSLAM
-from slamlab.stereo.map_stages import _stereo_project, refine_pose_stereo
+from slamlab.stereo.pose_stages import _stereo_project, refine_pose_stereo
 
 
 def _kitti_like_rig():
