@@ -23,8 +23,8 @@ from ..kdtree.stores import LandmarkStore, base_rule
 from .frame import STAGES, FrameRecord, _append_rows, _detect_pair, _StageClock, default_store
 from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
 from .map_stages import _match_to_map, _matches_from_knn, _window_match
-from .pose_stages import _estimate_pose, _refine_pose_stereo, _stereo_project, pose_std
 from .params import StereoParams
+from .pose_stages import _estimate_pose, _refine_pose_stereo, _stereo_project, pose_std
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
 
