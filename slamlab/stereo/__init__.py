@@ -25,7 +25,7 @@ from .experiments import (
 from .heading import heading_frames
 from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
-from .scale_ablation import SCALE_ABLATION, ScaleAblation, run_scale_ablation
+from .scale_ablation import ABLATION_BASE, PROPOSED_FIX, SCALE_ABLATION, ScaleAblation, run_scale_ablation
 from .slam import STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
     LocalCloud,
@@ -53,8 +53,10 @@ _LAZY = {
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 
 __all__ = [
+    "ABLATION_BASE",
     "COMPARISON",
     "KITTI_PARAMS",
+    "PROPOSED_FIX",
     "SCALE_ABLATION",
     "SIZES",
     "STAGES",

@@ -4,7 +4,7 @@
 simulated scene (such as :class:`slamlab.sim.highway.HighwayScene`, passed in: this module does not
 import the simulator) once per setting and seed, and tabulates the path-length ratio, the per-frame
 step ratios (mean ± standard error) and the ATE. Each setting changes one thing against
-:data:`~slamlab.stereo.KITTI_PARAMS`: the pixel noise of the keypoints, which depth sets a match's
+:data:`ABLATION_BASE` (:data:`~slamlab.stereo.KITTI_PARAMS` without the stop-37 fix): the pixel noise of the keypoints, which depth sets a match's
 weight in the pose and an observation's covariance in the landmark filter, the depth cut, the RANSAC
 threshold's growth with depth, the oldest-landmark policy.
 """
@@ -21,15 +21,15 @@ from .kitti_experiments import KITTI_PARAMS
 from .params import StereoParams
 from .slam import StereoSLAM
 
-__all__ = ["CONDITION_SETTINGS", "PROPOSED_FIX", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
+__all__ = ["ABLATION_BASE", "CONDITION_SETTINGS", "PROPOSED_FIX", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
            "run_scale_ablation"]
 
-#: the settings of the ablation: label -> overrides of KITTI_PARAMS (``pixel_std_obs``: the scene's keypoint noise);
+#: the settings of the ablation: label -> overrides of ABLATION_BASE (``pixel_std_obs``: the scene's keypoint noise);
 #: 'measured' / 'map': the depth behind a match's weight in the pose (``weight_depth``) and an observation's
 #: covariance in the landmark filter (``update_cov_depth``); 'true' and ``_oracle``: the simulator's truth
 #: (see :func:`run_scale_ablation`)
 SCALE_ABLATION = {
-    "KITTI_PARAMS (both at the landmark's depth)": {},
+    "KITTI_PARAMS of stop 36 (both at the landmark's depth)": {},
     "no keypoint noise": {"pixel_std_obs": 0.0},
     "both at the measured depth (before issue 25)": {"weight_depth": "measured", "update_cov_depth": "measured"},
     "pose weight at the measured depth only": {"weight_depth": "measured"},
@@ -46,7 +46,7 @@ SCALE_ABLATION = {
     "depth cut on the true depth (oracle)": {"_oracle": ("cut",)},
     "new landmarks at their true position (oracle)": {"_oracle": ("init_position",)},
     "pose from the exact local points (oracle)": {"_oracle": ("pose_points",)},
-    # the options that do not know the scene (stop 37; all off in KITTI_PARAMS)
+    # the options that do not know the scene (stop 37; all off in ABLATION_BASE)
     "points up to 1.5 x the cut match landmarks": {"reobserve_depth_factor": 1.5},
     "landmark filter in pixels": {"filter_space": "pixels"},
     "pose refined on the reprojection error": {"pose_refine": "reprojection"},
@@ -58,7 +58,7 @@ SCALE_ABLATION = {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "_oracle": ("init_position",)},
     "refined pose + 1.5 x the cut + second sighting replaces the first": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True},
-    "... + refinement on landmarks seen twice (PROPOSED_FIX)": {
+    "... + refinement on landmarks seen twice (PROPOSED_FIX: today's KITTI_PARAMS)": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
         "refine_min_seen": 2},
 }
@@ -70,11 +70,17 @@ SCALE_ABLATION = {
 PROPOSED_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
                 "refine_min_seen": 2}
 
-#: the two settings of :func:`run_condition_ablation`: the defaults before issue 25 and today's KITTI_PARAMS
+#: the base of the ablations: :data:`~slamlab.stereo.KITTI_PARAMS` without ``PROPOSED_FIX`` (its options at
+#: :class:`StereoParams`' defaults), i.e. KITTI_PARAMS as it was until stop 37 made the fix part of it; every row
+#: of :data:`SCALE_ABLATION` and :data:`CONDITION_SETTINGS` overrides this
+ABLATION_BASE = KITTI_PARAMS.replace(**{k: getattr(StereoParams(), k) for k in PROPOSED_FIX})
+
+#: the settings of :func:`run_condition_ablation`: the defaults before issue 25, KITTI_PARAMS of stop 36 and
+#: today's (with PROPOSED_FIX)
 CONDITION_SETTINGS = {
     "old defaults (measured depth)": {"weight_depth": "measured", "update_cov_depth": "measured"},
-    "KITTI_PARAMS": {},
-    "KITTI_PARAMS + PROPOSED_FIX": PROPOSED_FIX,
+    "KITTI_PARAMS of stop 36": {},
+    "KITTI_PARAMS (+ PROPOSED_FIX)": PROPOSED_FIX,
 }
 
 
@@ -178,7 +184,7 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         estimated pose) and ``'pose_points'`` (the pose fit from the exact local points), replaces
         one noisy quantity by the truth.
     params : StereoParams, optional
-        Base settings (default :data:`~slamlab.stereo.KITTI_PARAMS`).
+        Base settings (default :data:`ABLATION_BASE`).
     n_seeds : int, default 3
         Scenes (layouts and noise) per setting.
     pixel_std : float, default 0.5
@@ -200,7 +206,7 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         raise TypeError("`variants` must be a non-empty dict of label -> dict of overrides")
     n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
     sigma = v.check_positive(pixel_std, "pixel_std", allow_zero=True)
-    base = KITTI_PARAMS if params is None else StereoParams.resolve(params)
+    base = ABLATION_BASE if params is None else StereoParams.resolve(params)
     resolved = {}
     for label, over in variants.items():
         over = dict(over)
@@ -299,7 +305,7 @@ def run_condition_ablation(conditions: dict, poses, variants: dict | None = None
     variants : dict, optional
         Settings (default :data:`CONDITION_SETTINGS`).
     params : StereoParams, optional
-        Base settings (default :data:`~slamlab.stereo.KITTI_PARAMS`).
+        Base settings (default :data:`ABLATION_BASE`).
     n_seeds : int, default 3
         Scenes per condition and setting.
     rng : int or numpy.random.Generator, default 0
