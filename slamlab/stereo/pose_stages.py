@@ -340,6 +340,14 @@ def _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m):
     return T
 
 
+def _refine_body_pose(T_body, X_map, pts_left, rig, T_body_left, iters, huber_px, min_depth_m):
+    """:func:`refine_pose_stereo` without the checks (``StereoSLAM``'s ``pose_refine='reprojection'``)."""
+    z_px = _stereo_project(rig, pts_left)[0]
+    T_cw = np.linalg.inv(T_body @ T_body_left)
+    T_cw = _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m)
+    return np.linalg.inv(T_cw) @ np.linalg.inv(T_body_left)
+
+
 def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_body_left=None, *, iters: int = 5,
                        huber_px: float = 2.0, min_depth_m: float = 0.1) -> np.ndarray:
     """Refine a body pose by minimising the stereo reprojection error of matched landmarks (our option; issue 25).
@@ -401,6 +409,4 @@ def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_bod
     iters = v.check_int(iters, "iters", minimum=1)
     huber_px = v.check_positive(huber_px, "huber_px")
     min_depth_m = v.check_positive(min_depth_m, "min_depth_m")
-    z_px = _stereo_project(rig, Pl)[0]
-    T_cw = np.linalg.inv(Tb @ Tbl)
-    return np.linalg.inv(_refine_pose_stereo(T_cw, X, z_px, rig, iters, huber_px, min_depth_m)) @ np.linalg.inv(Tbl)
+    return _refine_body_pose(Tb, X, Pl, rig, Tbl, iters, huber_px, min_depth_m)
