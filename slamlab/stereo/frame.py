@@ -9,9 +9,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from ..features.base import to_gray_uint8
 from ..features.detect import detect
 from ..kdtree.stores import ExactStore, LandmarkStore, make_store
-from .local_stages import _triangulate_local
+from .local_stages import _triangulate_local, stereo_point_cov
 from .params import StereoParams
 
 __all__ = ["STAGES", "FrameRecord", "default_store"]
@@ -93,6 +94,32 @@ def _local_cloud(rig, fl, fr, sm, p: StereoParams, refine, oracle, truth):
                                p.pixel_std, refine)
     # beyond max_depth_m a point may match a landmark but does not become one (reobserve_depth_factor > 1)
     return cloud, cloud.points[:, 2] <= p.max_depth_m
+
+
+def _frame_points(rig, T_body_left, fl, fr, sm, p: StereoParams, images, oracle, truth):
+    """The frame's stereo points (000 §3.3) in the body frame: ``(cloud, may_be_new, pts_body, cov_body, cov_init,
+    true_cam)``; ``cov_init`` the new landmarks' first covariances, ``true_cam`` the points' true left-camera
+    positions (from ``truth``, the ablation oracle; None when no setting asks for them). ``images``: the
+    ``(left, right)`` pair whose disparities are refined first (None: not refined)."""
+    refine = None
+    if images is not None:
+        refine = (to_gray_uint8(images[0], "left", channel_order=p.channel_order),
+                  to_gray_uint8(images[1], "right", channel_order=p.channel_order), p.subpixel_half_px,
+                  p.subpixel_search_px)
+    cloud, may_be_new = _local_cloud(rig, fl, fr, sm, p, refine, oracle, truth)
+    Rb, tb = T_body_left[:3, :3], T_body_left[:3, 3]
+    pts_body = cloud.points @ Rb.T + tb
+    cov_body = Rb @ cloud.cov @ Rb.T
+    true_cam = None
+    if "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or oracle:
+        if truth is None or len(truth) != len(fl.uv):
+            raise ValueError("a depth source 'true' (an ablation oracle) needs `truth_left_cam_m`: the true "
+                             "left-camera position of every left keypoint, set before each frame")
+        true_cam = np.asarray(truth, dtype=float)[cloud.left]
+    cov_init = cov_body
+    if p.init_cov_depth == "true":
+        cov_init = Rb @ stereo_point_cov(true_cam, rig.left.fx, rig.baseline_m, p.pixel_std) @ Rb.T
+    return cloud, may_be_new, pts_body, cov_body, cov_init, true_cam
 
 
 def _append_rows(buffers, name, old, rows):

@@ -15,12 +15,17 @@ from .pose_stages import _stereo_project
 __all__: list[str] = []
 
 
-def _observation_cov(depth_source, T_body, T_body_left, cov_body, pose_var, rig, pixel_std, min_depth_m,
-                     true_cam=None, X_map=None):
-    """``(K, 3, 3)`` map-frame covariances of the observations of landmarks ``X_map`` at body pose ``T_body``
-    (``params.update_cov_depth``): 'measured' the points' own (``cov_body``, body frame), 'map' the stereo
-    covariance at the landmark seen from the pose, 'true' at the point's true left-camera position ``true_cam``
-    (the ablation oracle); each plus the pose's ``pose_var`` m² per axis."""
+def _observations(pts_body, cov_body, T_body, T_body_left, rig, p, true_cam=None, X_map=None):
+    """The map-frame observations ``Z`` of landmarks ``X_map`` by this frame's points ``pts_body`` (covariances
+    ``cov_body``, body frame) at body pose ``T_body``: ``(Z, pose_var, Rz)``, ``pose_var`` the pose's variance per
+    point [m²] (``params.pose_std_m``, ``pose_std_rad``), ``Rz`` the ``(K, 3, 3)`` covariances
+    (``params.update_cov_depth``): 'measured' the points' own, 'map' the stereo covariance at the landmark seen
+    from the pose, 'true' at the point's true left-camera position ``true_cam`` (the ablation oracle); each plus
+    ``pose_var`` per axis."""
+    R, t = T_body[:3, :3], T_body[:3, 3]
+    Z = pts_body @ R.T + t
+    pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body, axis=1)) ** 2
+    depth_source, pixel_std, min_depth_m = p.update_cov_depth, p.pixel_std, p.min_depth_m
     if depth_source == "true":  # the ablation oracle: the covariance at the point's true position
         Rwc = (T_body @ T_body_left)[:3, :3]
         Rz = Rwc @ stereo_point_cov(true_cam, rig.left.fx, rig.baseline_m, pixel_std) @ Rwc.T
@@ -35,9 +40,18 @@ def _observation_cov(depth_source, T_body, T_body_left, cov_body, pose_var, rig,
         Rz = Rwc @ stereo_point_cov(Xc, rig.left.fx, rig.baseline_m, pixel_std) @ Rwc.T
         Rz += pose_var[:, None, None] * np.eye(3)
     else:
-        R = T_body[:3, :3]
         Rz = R @ cov_body @ R.T + pose_var[:, None, None] * np.eye(3)
-    return Rz
+    return Z, pose_var, Rz
+
+
+def _duplicates(pts_body, nearest, X, T_body, gap_m):
+    """Mask of the body-frame points ``pts_body`` whose nearest landmark by descriptor (``nearest``, -1: none)
+    lies within ``gap_m`` of them in the map at body pose ``T_body``: that landmark again (``duplicate_gap_m``)."""
+    R, t = T_body[:3, :3], T_body[:3, 3]
+    has = nearest >= 0
+    gap = np.full(len(nearest), np.inf)
+    gap[has] = np.linalg.norm(pts_body[has] @ R.T + t - X[nearest[has]], axis=1)
+    return gap <= gap_m
 
 
 def _gated_update(X, P, Z, Rz, state_var, gate):

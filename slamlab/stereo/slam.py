@@ -14,8 +14,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .. import _validate as v
-from ..features.base import to_gray_uint8
-from ..geometry.camera import StereoRig, project_points
+from ..geometry.camera import StereoRig
 from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
 from ..kdtree.stores import base_rule
@@ -25,16 +24,16 @@ from .frame import (
     _append_rows,
     _check_pair,
     _detect_pair,
-    _local_cloud,
+    _frame_points,
     _resolve_store,
     _StageClock,
     default_store,
 )
-from .landmark_filter import _gated_update, _in_view, _observation_cov, _pixel_update
-from .local_stages import _check_features, _stereo_match, is_rectified, stereo_point_cov
-from .map_stages import _match_to_map, _matches_from_knn, _window_match
+from .landmark_filter import _duplicates, _gated_update, _in_view, _observations, _pixel_update
+from .local_stages import _check_features, _stereo_match, is_rectified
+from .map_stages import _match_to_map, _matches_from_knn, _window_candidates, _window_match
 from .params import StereoParams
-from .pose_stages import _estimate_pose, _refine_body_pose, pose_std
+from .pose_stages import _estimate_pose, _refine_body_pose, _refine_matches, _weight_depth, pose_std
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
 
@@ -155,24 +154,10 @@ class StereoSLAM:
         clock.lap("detect")
         sm = _stereo_match(fl, fr, self.rig.F, p.ratio, p.epi_tol_px)
         clock.lap("stereo")
-        refine = None
-        if self._refine and left is not None:
-            refine = (to_gray_uint8(left, "left", channel_order=p.channel_order),
-                      to_gray_uint8(right, "right", channel_order=p.channel_order), p.subpixel_half_px, p.subpixel_search_px)
-        cloud, self._may_be_new = _local_cloud(self.rig, fl, fr, sm, p, refine, self._oracle, self.truth_left_cam_m)
-        Rb, tb = self.T_body_left[:3, :3], self.T_body_left[:3, 3]
-        pts_body = cloud.points @ Rb.T + tb
-        cov_body = Rb @ cloud.cov @ Rb.T
-        self._true_cam, truth = None, self.truth_left_cam_m
-        self.truth_left_cam_m = None
-        if "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or self._oracle:
-            if truth is None or len(truth) != len(fl.uv):
-                raise ValueError("a depth source 'true' (an ablation oracle) needs `truth_left_cam_m`: the true "
-                                 "left-camera position of every left keypoint, set before each frame")
-            self._true_cam = np.asarray(truth, dtype=float)[cloud.left]
-        cov_init = cov_body
-        if p.init_cov_depth == "true":
-            cov_init = Rb @ stereo_point_cov(self._true_cam, self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rb.T
+        images = (left, right) if self._refine and left is not None else None
+        truth, self.truth_left_cam_m, self._true_cam = self.truth_left_cam_m, None, None
+        cloud, self._may_be_new, pts_body, cov_body, cov_init, self._true_cam = _frame_points(
+            self.rig, self.T_body_left, fl, fr, sm, p, images, self._oracle, truth)
         desc = fl.descriptors[cloud.left]
         clock.lap("triangulate")
         rec = FrameRecord(
@@ -228,15 +213,12 @@ class StereoSLAM:
         p = self.params
         rec["status"] = "ok"
         self.T = est.T
-        R, t = est.T[:3, :3], est.T[:3, 3]
         # refine re-seen landmarks with the static Kalman filter (000 §3.6)
         ids = mm.ids[est.inliers]
         loc = mm.local[est.inliers]
-        Z = pts_body[loc] @ R.T + t
-        pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
         true_cam = self._true_cam[loc] if p.update_cov_depth == "true" else None
-        Rz = _observation_cov(p.update_cov_depth, est.T, self.T_body_left, cov_body[loc], pose_var, self.rig,
-                              p.pixel_std, p.min_depth_m, true_cam, self.X[ids])
+        Z, pose_var, Rz = _observations(pts_body[loc], cov_body[loc], est.T, self.T_body_left, self.rig, p, true_cam,
+                                        self.X[ids])
         if p.drop_first_sighting:
             # a landmark's first triangulation passed the depth cut on its own noisy depth (selected too near):
             # its second sighting replaces it instead of being fused with it (our option; issue 25)
@@ -257,12 +239,7 @@ class StereoSLAM:
         # unmatched local points become new (non-base) landmarks
         new = mm.unmatched[self._may_be_new[mm.unmatched]]
         if p.duplicate_gap_m is not None and new.size:
-            # a point whose nearest landmark by descriptor sits where it is, is that landmark again
-            nn = mm.nearest[new]
-            has = nn >= 0
-            gap = np.full(new.size, np.inf)
-            gap[has] = np.linalg.norm(pts_body[new[has]] @ R.T + t - self.X[nn[has]], axis=1)
-            dup = gap <= p.duplicate_gap_m
+            dup = _duplicates(pts_body[new], mm.nearest[new], self.X, est.T, p.duplicate_gap_m)
             rec["n_duplicates"] = int(dup.sum())
             new = new[~dup]
         first_new = len(self.X)
@@ -291,13 +268,8 @@ class StereoSLAM:
         mm, est = self._pose(rec, clock, mm, pts_body, cov_body, depth, "last")
         if est is None:
             return mm, None
-        T_wc = est.T @ self.T_body_left
-        cam = self.rig.left
-        cand = self.landmarks_in_view(np.rad2deg(p.window_px / cam.fx), T_body=est.T)
-        Xc = (self.X[cand] - T_wc[:3, 3]) @ T_wc[:3, :3]
-        uv_lm = project_points(cam.K, Xc)
-        inside = (uv_lm[:, 1] >= -p.window_px) & (uv_lm[:, 1] <= cam.height_px + p.window_px)
-        cand, uv_lm = cand[inside], uv_lm[inside]
+        cand = self.landmarks_in_view(np.rad2deg(p.window_px / self.rig.left.fx), T_body=est.T)
+        cand, uv_lm = _window_candidates(self.X[cand], cand, est.T @ self.T_body_left, self.rig.left, p.window_px)
         max_d = p.window_max_hamming if p.binary else np.inf
         mm, n_pairs = _window_match(desc, uv, self.desc[cand], uv_lm, cand, p.window_px, p.map_ratio, max_d, self.X,
                                     p.twin_gap_m)
@@ -328,13 +300,9 @@ class StereoSLAM:
         if len(mm.local) < max(3, p.min_inliers):
             rec["status"] = "too_few_matches"
         else:
-            d_use = depth[mm.local]
-            if p.weight_depth == "true":  # the ablation oracle: the point's true depth in this frame
-                d_use = self._true_cam[mm.local, 2]
-            elif p.weight_depth == "map":
-                # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
-                T_wc = self.T @ self.T_body_left
-                d_use = np.maximum(((self.X[mm.ids] - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], p.min_depth_m)
+            true_z = self._true_cam[mm.local, 2] if p.weight_depth == "true" else None
+            d_use = _weight_depth(p.weight_depth, depth[mm.local], true_z, self.X[mm.ids], self.T @ self.T_body_left,
+                                  p.min_depth_m)
             src = pts_body[mm.local]
             if "pose_points" in self._oracle:
                 src = self._true_cam[mm.local] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
@@ -342,10 +310,7 @@ class StereoSLAM:
                                  cov_body[mm.local], p, self.rng)
             rec["n_used"] = est.n_used
             if est.converged and p.pose_refine == "reprojection":
-                ids, loc = mm.ids[est.inliers], mm.local[est.inliers]
-                seen = self.n_seen[ids] >= p.refine_min_seen
-                if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
-                    ids, loc = ids[seen], loc[seen]
+                ids, loc = _refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
                 pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
                 est = est._replace(T=_refine_body_pose(est.T, self.X[ids], pts_left, self.rig, self.T_body_left,
                                                        p.refine_iters, p.refine_huber_px, p.min_depth_m))
