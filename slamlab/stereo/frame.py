@@ -1,5 +1,6 @@
 """The pieces of one frame of the stereo loop (000 §3.3-3.6): both images' features in two threads, the stage
-names and clock, the frame record, the default landmark store. Split from :mod:`slamlab.stereo.slam` (which
+names and clock, the frame record, the default landmark store, the input checks and the frame's stereo points
+in the body frame (with the ablation oracle's truth). Split from :mod:`slamlab.stereo.slam` (which
 re-exports the public names)."""
 
 from __future__ import annotations
