@@ -13,6 +13,7 @@ import numpy as np
 from .. import _validate as v
 from .._compiled import numba_enabled
 from ..features.matching import best_per_target, ratio_rule
+from ..geometry.camera import project_points
 from ..kdtree.stores import LandmarkStore
 from ._pairs import _pair_distances, _two_nearest
 from .params import StereoParams
@@ -217,3 +218,12 @@ def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance,
     claimed = np.zeros(k, dtype=bool)
     claimed[loc] = True
     return MapMatches(loc[sel], lid[sel], dd[sel], np.flatnonzero(~claimed), nearest), n_pairs
+
+
+def _window_candidates(X, ids, T_wc, cam, window_px):
+    """The landmarks ``X`` (ids ``ids``) projected into ``cam`` at ``T_wc`` whose row lies within ``window_px`` of
+    the image: ``(ids, uv)`` of those (the window search's candidates)."""
+    Xc = (X - T_wc[:3, 3]) @ T_wc[:3, :3]
+    uv_lm = project_points(cam.K, Xc)
+    inside = (uv_lm[:, 1] >= -window_px) & (uv_lm[:, 1] <= cam.height_px + window_px)
+    return ids[inside], uv_lm[inside]

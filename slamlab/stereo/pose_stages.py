@@ -289,6 +289,27 @@ def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> Po
 # --- pose refinement on the stereo reprojection error (our option; issue 25) -------------------------
 
 
+def _weight_depth(source, depth, true_depth, X_map, T_wc, min_depth_m):
+    """The depth behind each match's RANSAC threshold and weight (``weight_depth``): 'measured' the point's own
+    ``depth``, 'true' ``true_depth`` (the ablation oracle: its true depth in this frame), 'map' the depth of the
+    landmark ``X_map`` seen from the left camera at ``T_wc`` (the last pose), at least ``min_depth_m``."""
+    if source == "true":  # the ablation oracle: the point's true depth in this frame
+        return true_depth
+    if source == "map":
+        # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
+        return np.maximum(((X_map - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], min_depth_m)
+    return depth
+
+
+def _refine_matches(ids, loc, n_seen, p: StereoParams):
+    """The inliers ``(ids, loc)`` the reprojection refinement uses: those whose landmark was seen at least
+    ``p.refine_min_seen`` times, or all when fewer than ``p.min_inliers`` were."""
+    seen = n_seen[ids] >= p.refine_min_seen
+    if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
+        ids, loc = ids[seen], loc[seen]
+    return ids, loc
+
+
 def _project_jac(X, fx, fy, cx, cy):
     """Pixels ``(K, 2)`` of camera-frame points ``X`` and their Jacobians ``(K, 2, 3)`` w.r.t. ``X``."""
     iz = 1.0 / X[:, 2]
@@ -338,6 +359,14 @@ def _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m):
         if np.linalg.norm(delta) < 1e-10:
             break
     return T
+
+
+def _refine_body_pose(T_body, X_map, pts_left, rig, T_body_left, iters, huber_px, min_depth_m):
+    """:func:`refine_pose_stereo` without the checks (``StereoSLAM``'s ``pose_refine='reprojection'``)."""
+    z_px = _stereo_project(rig, pts_left)[0]
+    T_cw = np.linalg.inv(T_body @ T_body_left)
+    T_cw = _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m)
+    return np.linalg.inv(T_cw) @ np.linalg.inv(T_body_left)
 
 
 def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_body_left=None, *, iters: int = 5,
@@ -401,6 +430,4 @@ def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_bod
     iters = v.check_int(iters, "iters", minimum=1)
     huber_px = v.check_positive(huber_px, "huber_px")
     min_depth_m = v.check_positive(min_depth_m, "min_depth_m")
-    z_px = _stereo_project(rig, Pl)[0]
-    T_cw = np.linalg.inv(Tb @ Tbl)
-    return np.linalg.inv(_refine_pose_stereo(T_cw, X, z_px, rig, iters, huber_px, min_depth_m)) @ np.linalg.inv(Tbl)
+    return _refine_body_pose(Tb, X, Pl, rig, Tbl, iters, huber_px, min_depth_m)

@@ -14,17 +14,26 @@ from collections.abc import Callable
 import numpy as np
 
 from .. import _validate as v
-from ..features.base import to_gray_uint8
-from ..filters.landmark import landmark_predict, landmark_update
-from ..geometry.camera import StereoRig, project_points
+from ..geometry.camera import StereoRig
 from ..geometry.se3 import planar_from_se3
 from ..kdtree.knn import exact_knn
-from ..kdtree.stores import LandmarkStore, base_rule
-from .frame import STAGES, FrameRecord, _append_rows, _detect_pair, _StageClock, default_store
-from .local_stages import _check_features, _stereo_match, _triangulate_local, is_rectified, stereo_point_cov
-from .map_stages import _match_to_map, _matches_from_knn, _window_match
+from ..kdtree.stores import base_rule
+from .frame import (
+    STAGES,
+    FrameRecord,
+    _append_rows,
+    _check_pair,
+    _detect_pair,
+    _frame_points,
+    _resolve_store,
+    _StageClock,
+    default_store,
+)
+from .landmark_filter import _duplicates, _gated_update, _in_view, _observations, _pixel_update
+from .local_stages import _check_features, _stereo_match, is_rectified
+from .map_stages import _match_to_map, _matches_from_knn, _window_candidates, _window_match
 from .params import StereoParams
-from .pose_stages import _estimate_pose, _refine_pose_stereo, _stereo_project, pose_std
+from .pose_stages import _estimate_pose, _refine_body_pose, _refine_matches, _weight_depth, pose_std
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
 
@@ -64,14 +73,7 @@ class StereoSLAM:
         self.rig = rig
         self.T_body_left = np.eye(4) if T_body_left is None else v.as_matrix(T_body_left, "T_body_left", (4, 4))
         self.params = p = StereoParams.resolve(params, **overrides)
-        if store is None:
-            store = default_store(p)
-        elif isinstance(store, type) or (callable(store) and not isinstance(store, LandmarkStore)):
-            store = store()  # a class or a factory
-        if not isinstance(store, LandmarkStore):
-            raise TypeError(f"`store` must be a slamlab.kdtree.LandmarkStore or a factory of one; "
-                            f"got {type(store).__name__}")
-        self.store = store
+        self.store = _resolve_store(store, p)
         self.rng = v.as_rng(rng)
         self._detect_kwargs = p.detect_kwargs()
         self._image_shape = (rig.left.height_px, rig.left.width_px)
@@ -104,17 +106,6 @@ class StereoSLAM:
         self._oracle = frozenset()  # exploratory oracles (ablation only): 'cut', 'init_position', 'pose_points'
 
     # -- the loop ------------------------------------------------------------------------------------
-    def _check_pair(self, left, right):
-        """The images' shapes: equal to each other and to the rig's image size (grey or colour)."""
-        sl, sr = np.shape(left), np.shape(right)
-        if len(sl) not in (2, 3) or len(sr) not in (2, 3):
-            raise ValueError(f"`left` and `right` must be (H, W) or (H, W, 3) images; got shapes {sl} and {sr}")
-        if sl != sr:
-            raise ValueError(f"`left` and `right` must have the same shape; got {sl} and {sr}")
-        if sl[:2] != self._image_shape:
-            raise ValueError(f"images must be {self._image_shape[0]}x{self._image_shape[1]} (rows x columns) like "
-                             f"the rig's cameras; got {sl[0]}x{sl[1]}")
-
     def process(self, left, right) -> FrameRecord:
         """Run all stages on one stereo pair; returns the frame's counts (000 §3.3-3.6).
 
@@ -131,7 +122,7 @@ class StereoSLAM:
         FrameRecord
             Counts per stage, ``status``, the pose.
         """
-        self._check_pair(left, right)
+        _check_pair(left, right, self._image_shape)
         p = self.params
         clock = _StageClock()
         fl, fr = _detect_pair(left, right, p.detector, self._detect_kwargs, p.parallel_detect)
@@ -163,36 +154,10 @@ class StereoSLAM:
         clock.lap("detect")
         sm = _stereo_match(fl, fr, self.rig.F, p.ratio, p.epi_tol_px)
         clock.lap("stereo")
-        refine = None
-        if self._refine and left is not None:
-            refine = (to_gray_uint8(left, "left", channel_order=p.channel_order),
-                      to_gray_uint8(right, "right", channel_order=p.channel_order), p.subpixel_half_px, p.subpixel_search_px)
-        oracle = self._oracle
-        if "cut" in oracle and self.truth_left_cam_m is not None:  # the depth cut on the true depth (ablation)
-            cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, 1e12, p.pixel_std, refine)
-            zt = self.truth_left_cam_m[cloud.left, 2]
-            keep = (zt >= p.min_depth_m) & (zt <= p.max_depth_m)
-            cloud = type(cloud)(cloud.points[keep], cloud.cov[keep], cloud.left[keep], cloud.gap_m[keep])
-        else:
-            cloud = _triangulate_local(self.rig, fl, fr, sm, p.min_depth_m, p.max_depth_m * p.reobserve_depth_factor,
-                                       p.pixel_std, refine)
-        # beyond max_depth_m a point may match a landmark but does not become one (reobserve_depth_factor > 1)
-        self._may_be_new = cloud.points[:, 2] <= p.max_depth_m
-        if "cut" in oracle and self.truth_left_cam_m is not None:
-            self._may_be_new[:] = True  # the oracle's cut on the true depth replaces it
-        Rb, tb = self.T_body_left[:3, :3], self.T_body_left[:3, 3]
-        pts_body = cloud.points @ Rb.T + tb
-        cov_body = Rb @ cloud.cov @ Rb.T
-        self._true_cam, truth = None, self.truth_left_cam_m
-        self.truth_left_cam_m = None
-        if "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or self._oracle:
-            if truth is None or len(truth) != len(fl.uv):
-                raise ValueError("a depth source 'true' (an ablation oracle) needs `truth_left_cam_m`: the true "
-                                 "left-camera position of every left keypoint, set before each frame")
-            self._true_cam = np.asarray(truth, dtype=float)[cloud.left]
-        cov_init = cov_body
-        if p.init_cov_depth == "true":
-            cov_init = Rb @ stereo_point_cov(self._true_cam, self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rb.T
+        images = (left, right) if self._refine and left is not None else None
+        truth, self.truth_left_cam_m, self._true_cam = self.truth_left_cam_m, None, None
+        cloud, self._may_be_new, pts_body, cov_body, cov_init, self._true_cam = _frame_points(
+            self.rig, self.T_body_left, fl, fr, sm, p, images, self._oracle, truth)
         desc = fl.descriptors[cloud.left]
         clock.lap("triangulate")
         rec = FrameRecord(
@@ -248,27 +213,12 @@ class StereoSLAM:
         p = self.params
         rec["status"] = "ok"
         self.T = est.T
-        R, t = est.T[:3, :3], est.T[:3, 3]
         # refine re-seen landmarks with the static Kalman filter (000 §3.6)
         ids = mm.ids[est.inliers]
         loc = mm.local[est.inliers]
-        Z = pts_body[loc] @ R.T + t
-        pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body[loc], axis=1)) ** 2
-        if p.update_cov_depth == "true":  # the ablation oracle: the covariance at the point's true position
-            Rwc = (est.T @ self.T_body_left)[:3, :3]
-            Rz = Rwc @ stereo_point_cov(self._true_cam[loc], self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rwc.T
-            Rz += pose_var[:, None, None] * np.eye(3)
-        elif p.update_cov_depth == "map":
-            # the observation's covariance at the landmark's position seen from the new pose, not at the
-            # measured one: a measurement's weight then does not depend on its own error (issue 25)
-            T_wc = est.T @ self.T_body_left
-            Xc = (self.X[ids] - T_wc[:3, 3]) @ T_wc[:3, :3]
-            Xc[:, 2] = np.maximum(Xc[:, 2], p.min_depth_m)
-            Rwc = T_wc[:3, :3]
-            Rz = Rwc @ stereo_point_cov(Xc, self.rig.left.fx, self.rig.baseline_m, p.pixel_std) @ Rwc.T
-            Rz += pose_var[:, None, None] * np.eye(3)
-        else:
-            Rz = R @ cov_body[loc] @ R.T + pose_var[:, None, None] * np.eye(3)
+        true_cam = self._true_cam[loc] if p.update_cov_depth == "true" else None
+        Z, pose_var, Rz = _observations(pts_body[loc], cov_body[loc], est.T, self.T_body_left, self.rig, p, true_cam,
+                                        self.X[ids])
         if p.drop_first_sighting:
             # a landmark's first triangulation passed the depth cut on its own noisy depth (selected too near):
             # its second sighting replaces it instead of being fused with it (our option; issue 25)
@@ -289,12 +239,7 @@ class StereoSLAM:
         # unmatched local points become new (non-base) landmarks
         new = mm.unmatched[self._may_be_new[mm.unmatched]]
         if p.duplicate_gap_m is not None and new.size:
-            # a point whose nearest landmark by descriptor sits where it is, is that landmark again
-            nn = mm.nearest[new]
-            has = nn >= 0
-            gap = np.full(new.size, np.inf)
-            gap[has] = np.linalg.norm(pts_body[new[has]] @ R.T + t - self.X[nn[has]], axis=1)
-            dup = gap <= p.duplicate_gap_m
+            dup = _duplicates(pts_body[new], mm.nearest[new], self.X, est.T, p.duplicate_gap_m)
             rec["n_duplicates"] = int(dup.sum())
             new = new[~dup]
         first_new = len(self.X)
@@ -323,13 +268,8 @@ class StereoSLAM:
         mm, est = self._pose(rec, clock, mm, pts_body, cov_body, depth, "last")
         if est is None:
             return mm, None
-        T_wc = est.T @ self.T_body_left
-        cam = self.rig.left
-        cand = self.landmarks_in_view(np.rad2deg(p.window_px / cam.fx), T_body=est.T)
-        Xc = (self.X[cand] - T_wc[:3, 3]) @ T_wc[:3, :3]
-        uv_lm = project_points(cam.K, Xc)
-        inside = (uv_lm[:, 1] >= -p.window_px) & (uv_lm[:, 1] <= cam.height_px + p.window_px)
-        cand, uv_lm = cand[inside], uv_lm[inside]
+        cand = self.landmarks_in_view(np.rad2deg(p.window_px / self.rig.left.fx), T_body=est.T)
+        cand, uv_lm = _window_candidates(self.X[cand], cand, est.T @ self.T_body_left, self.rig.left, p.window_px)
         max_d = p.window_max_hamming if p.binary else np.inf
         mm, n_pairs = _window_match(desc, uv, self.desc[cand], uv_lm, cand, p.window_px, p.map_ratio, max_d, self.X,
                                     p.twin_gap_m)
@@ -360,13 +300,9 @@ class StereoSLAM:
         if len(mm.local) < max(3, p.min_inliers):
             rec["status"] = "too_few_matches"
         else:
-            d_use = depth[mm.local]
-            if p.weight_depth == "true":  # the ablation oracle: the point's true depth in this frame
-                d_use = self._true_cam[mm.local, 2]
-            elif p.weight_depth == "map":
-                # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
-                T_wc = self.T @ self.T_body_left
-                d_use = np.maximum(((self.X[mm.ids] - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], p.min_depth_m)
+            true_z = self._true_cam[mm.local, 2] if p.weight_depth == "true" else None
+            d_use = _weight_depth(p.weight_depth, depth[mm.local], true_z, self.X[mm.ids], self.T @ self.T_body_left,
+                                  p.min_depth_m)
             src = pts_body[mm.local]
             if "pose_points" in self._oracle:
                 src = self._true_cam[mm.local] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
@@ -374,11 +310,10 @@ class StereoSLAM:
                                  cov_body[mm.local], p, self.rng)
             rec["n_used"] = est.n_used
             if est.converged and p.pose_refine == "reprojection":
-                ids, loc = mm.ids[est.inliers], mm.local[est.inliers]
-                seen = self.n_seen[ids] >= p.refine_min_seen
-                if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
-                    ids, loc = ids[seen], loc[seen]
-                est = est._replace(T=self._refine_pose(est.T, self.X[ids], pts_body[loc]))
+                ids, loc = _refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
+                pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
+                est = est._replace(T=_refine_body_pose(est.T, self.X[ids], pts_left, self.rig, self.T_body_left,
+                                                       p.refine_iters, p.refine_huber_px, p.min_depth_m))
             if not est.converged:
                 rec["status"], est = "ransac_failed", None
             elif p.max_rot_std_rad is not None:
@@ -390,17 +325,6 @@ class StereoSLAM:
         std = "" if np.isnan(rec["rot_std_rad"]) else f" (rot std {np.rad2deg(rec['rot_std_rad']):.2f} deg)"
         rec["trail"] += f"{search} {len(mm.local)} {rec['status'] if est is None else 'ok'}{std}; "
         return mm, est
-
-    def _refine_pose(self, T_body, X_map, pts_body):
-        """``pose_refine='reprojection'``: the pose moved to minimise the stereo reprojection error of the
-        inliers (landmarks ``X_map``, this frame's body-frame points ``pts_body``; our option, issue 25)."""
-        p = self.params
-        Tbl = self.T_body_left
-        pts_left = (pts_body - Tbl[:3, 3]) @ Tbl[:3, :3]
-        T_cw = np.linalg.inv(T_body @ Tbl)
-        T_cw = _refine_pose_stereo(T_cw, X_map, _stereo_project(self.rig, pts_left)[0], self.rig, p.refine_iters,
-                                   p.refine_huber_px, p.min_depth_m)
-        return np.linalg.inv(T_cw) @ np.linalg.inv(Tbl)
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
@@ -420,15 +344,10 @@ class StereoSLAM:
             Landmark ids.
         """
         T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
-        T_wc = T @ self.T_body_left
         live = np.flatnonzero(self.alive)
-        Xc = (self.X[live] - T_wc[:3, 3]) @ T_wc[:3, :3]
-        cam = self.rig.left
-        half = np.arctan2(max(cam.cx, cam.width_px - cam.cx), cam.fx) + np.deg2rad(margin_deg)
-        z = Xc[:, 2]
-        keep = (z > 0) & (np.abs(np.arctan2(Xc[:, 0], z)) <= half)
-        keep &= np.einsum("ij,ij->i", Xc, Xc) <= (self.params.view_depth_factor * self.params.max_depth_m) ** 2
-        return live[keep]
+        p = self.params
+        return live[_in_view(self.X[live], T @ self.T_body_left, self.rig.left, margin_deg,
+                             p.view_depth_factor * p.max_depth_m)]
 
     def refine_landmarks(self, ids, Z, Rz) -> np.ndarray:
         """Kalman-update landmarks ``ids`` with map-frame observations ``Z`` (covariances ``Rz``) (000 §3.6).
@@ -449,48 +368,17 @@ class StereoSLAM:
         -------
         numpy.ndarray of bool, shape (M,)
         """
-        gate = self.params.update_gate
-        P_pred = landmark_predict(self.P[ids], self.params.state_var)
-        ok = np.ones(len(ids), dtype=bool)
-        if gate is not None and len(ids):
-            innov = Z - self.X[ids]
-            ok = np.einsum("ni,ni->n", innov, np.linalg.solve(P_pred + Rz, innov[:, :, None])[:, :, 0]) <= gate
-        up = ids[ok]
-        self.X[up], self.P[up] = landmark_update(self.X[up], P_pred[ok], Z[ok], Rz[ok])
+        ok, X_new, P_new = _gated_update(self.X[ids], self.P[ids], Z, Rz, self.params.state_var, self.params.update_gate)
+        self.X[ids[ok]], self.P[ids[ok]] = X_new, P_new
         return ok
 
     def _refine_landmarks_in_pixels(self, ids, pts_left, T_wc, pose_var) -> np.ndarray:
-        """``filter_space='pixels'`` (our option; issue 25): the static-landmark Kalman update of 000 §3.6 in the
-        stereo pixels ``(u_l, v_l, u_r)`` of the current left camera (pose ``T_wc``), where every observation
-        has the same noise ``pixel_std`` (plus the pose's, ``pose_var`` m² per point): the landmark's mean is
-        projected there exactly, its covariance through the projection's Jacobian, the fused pixels are
-        triangulated back. Weights then do not depend on a noisy depth and the disparities are averaged
-        (unbiased for Gaussian pixel noise, where depths are not). Rectified rigs only. Returns the mask of the
-        landmarks updated (the innovation gate ``update_gate`` as in :meth:`refine_landmarks`)."""
-        p, cam = self.params, self.rig.left
-        R, t = T_wc[:3, :3], T_wc[:3, 3]
-        P_pred = landmark_predict(self.P[ids], p.state_var)
-        Xc = (self.X[ids] - t) @ R
-        ok = Xc[:, 2] > p.min_depth_m
-        h, J = _stereo_project(self.rig, np.where(ok[:, None], Xc, [0.0, 0.0, 1.0]))
-        h, J = h[:, :3], J[:, :3]
-        z = _stereo_project(self.rig, pts_left)[0][:, :3]
-        C_lm = J @ (R.T @ P_pred @ R) @ np.swapaxes(J, 1, 2)
-        C_z = p.pixel_std**2 * np.eye(3) + pose_var[:, None, None] * (J @ np.swapaxes(J, 1, 2))
-        if p.update_gate is not None and len(ids):
-            innov = z - h
-            ok &= np.einsum("ni,ni->n", innov, np.linalg.solve(C_lm + C_z, innov[:, :, None])[:, :, 0]) <= p.update_gate
-        m, C = landmark_update(h[ok], C_lm[ok], z[ok], C_z[ok])
-        disp = (m[:, 0] - cam.cx) - (m[:, 2] - self.rig.right.cx)
-        good = disp > 0
-        ok[np.flatnonzero(ok)[~good]] = False
-        m, C = m[good], C[good]
-        zc = cam.fx * self.rig.baseline_m / disp[good]
-        Xn = np.column_stack([(m[:, 0] - cam.cx) * zc / cam.fx, (m[:, 1] - cam.cy) * zc / cam.fy, zc])
-        Ji = np.linalg.inv(_stereo_project(self.rig, Xn)[1][:, :3])
-        up = ids[ok]
-        self.X[up] = Xn @ R.T + t
-        self.P[up] = R @ (Ji @ C @ np.swapaxes(Ji, 1, 2)) @ R.T
+        """``filter_space='pixels'``: landmarks ``ids`` updated in the stereo pixels of the left camera at
+        ``T_wc`` (``landmark_filter._pixel_update``); returns the mask of the updated ones."""
+        p = self.params
+        ok, X_new, P_new = _pixel_update(self.X[ids], self.P[ids], pts_left, T_wc, pose_var, self.rig, p.state_var,
+                                         p.pixel_std, p.min_depth_m, p.update_gate)
+        self.X[ids[ok]], self.P[ids[ok]] = X_new, P_new
         return ok
 
     def _add_landmarks(self, pts_body, cov_body, desc, T):
