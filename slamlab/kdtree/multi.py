@@ -326,6 +326,8 @@ class NonBaseBuffer(LandmarkStore):
         X, ids = self.base._stored()
         if not self._pts.n:
             return X, ids
+        if not len(self.base):  # an empty base does not know the points' width yet: (0, 0)
+            return self._pts.points, self._pts.point_ids
         return np.concatenate([self._pts.points, X.astype(self._pts.points.dtype)]), np.concatenate([self._pts.point_ids, ids])
 
     @property

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from slamlab.kdtree.knn import exact_knn
 from slamlab.kdtree.stores import (
     BruteForceStore,
     FlannStore,
@@ -143,6 +144,20 @@ def test_base_rule_promotes_after_three_sightings_and_drops_after_seven_iteratio
     assert len(buf) == 1
     assert buf.n_dropped == 3
     assert buf.n_promoted == 1
+
+
+def test_query_among_with_points_in_the_buffer_only_equals_the_exact_search():
+    """Before any promotion the base is empty; the search among given ids must still see the buffer's points
+    (it raised a ValueError: the empty base's points had width 0). Reference: exact_knn on the chosen rows."""
+    rng = np.random.default_rng(8)
+    buf = NonBaseBuffer(MultiKDTree(100, 2.0, tree="ckdtree"), tree="ckdtree")
+    X, Q = rng.random((20, 64)).astype(np.float32), rng.random((5, 64)).astype(np.float32)
+    buf.add(X, np.arange(100, 120))
+    among = np.arange(100, 120, 2)
+    d, i = buf.query_among(Q, among, k=2)
+    d_ref, i_ref = exact_knn(Q, X[::2], 2, among)
+    np.testing.assert_array_equal(i, i_ref)
+    np.testing.assert_allclose(d, d_ref)
 
 
 def test_rebuild_store_applies_the_same_rule_as_buffer():
