@@ -20,7 +20,11 @@ from __future__ import annotations
 
 import os
 
-__all__ = ["kernel", "numba_enabled"]
+__all__ = ["jitable", "kernel", "numba_enabled"]
+
+#: helpers marked by :func:`jitable`, made callable from compiled code when the first kernel compiles
+_JITABLE: list = []
+_REGISTERED: set = set()
 
 
 def numba_enabled() -> bool:
@@ -61,7 +65,12 @@ def kernel(fn):
         nonlocal compiled
         if compiled is None:
             import numba
+            from numba.extending import register_jitable
 
+            for helper in _JITABLE:  # before the first kernel compiles: the helpers it may call
+                if id(helper) not in _REGISTERED:
+                    register_jitable(inline="always")(helper)
+                    _REGISTERED.add(id(helper))
             compiled = numba.njit(cache=True, nogil=True)(fn)
         return compiled(*args)
 
@@ -71,3 +80,24 @@ def kernel(fn):
     call.__wrapped__ = fn
     call.py_func = fn
     return call
+
+
+def jitable(fn):
+    """Mark ``fn`` as a helper that kernels may call (one place for a few lines that several kernels share).
+
+    ``fn`` stays a plain Python function, so importing its module does not import numba; when the first kernel
+    compiles, numba's ``register_jitable(inline="always")`` makes it callable from compiled code, inlined into
+    each caller (the same machine code as the lines written out in place).
+
+    Parameters
+    ----------
+    fn : callable
+        A function written in the numba-supported subset of Python and numpy.
+
+    Returns
+    -------
+    callable
+        ``fn`` itself.
+    """
+    _JITABLE.append(fn)
+    return fn

@@ -41,3 +41,16 @@ def test_defining_a_kernel_does_not_import_numba(tmp_path):
         "assert mod.f(1) == 2 and 'numba' in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, cwd=tmp_path)
+
+
+def test_popcount64_counts_bits_in_python_and_inside_a_kernel():
+    """The one SWAR bit count the Hamming kernels share (``jitable``): plain Python and compiled give numpy's
+    ``bitwise_count`` (the reference) on random and extreme words."""
+    from slamlab.kdtree._hamming_kernel import all_hamming_2nn, popcount64
+
+    rng = np.random.default_rng(0)
+    words = np.r_[np.array([0, 1, 2**63, 2**64 - 1], dtype=np.uint64), rng.integers(0, 2**63, 200, dtype=np.uint64)]
+    assert popcount64(words).tolist() == np.bitwise_count(words).tolist()
+    # compiled: one word per descriptor, against the zero descriptor, so the distances are the bit counts
+    d1 = all_hamming_2nn(words[:, None], np.zeros((1, 2), np.uint64))[1]
+    assert d1.tolist() == np.bitwise_count(words).astype(float).tolist()

@@ -18,9 +18,36 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._compiled import kernel
+from .._compiled import jitable, kernel
 
-__all__ = ["all_hamming_2nn", "ranges_hamming_2nn"]
+__all__ = ["all_hamming_2nn", "popcount64", "ranges_hamming_2nn"]
+
+
+@jitable
+def popcount64(x):
+    """Bits set in the 64-bit word ``x``: the "SWAR" count (Hacker's Delight §5-1), the one copy every Hamming
+    kernel calls (inlined into each when it compiles). In plain Python it takes an array of words too (numpy
+    scalars warn on the multiply's intended wrap-around; arrays wrap silently).
+
+    Parameters
+    ----------
+    x : numpy.uint64 or numpy.ndarray of uint64
+        The word(s).
+
+    Returns
+    -------
+    numpy.uint64 or numpy.ndarray of uint64
+        The number of set bits of each.
+
+    Examples
+    --------
+    >>> popcount64(np.array([0xF0F0, 2**64 - 1], dtype=np.uint64)).tolist()
+    [8, 64]
+    """
+    x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+    return (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
 
 
 def _ranges_hamming_2nn(Dq, Dt, order, lo, hi):  # pragma: no cover - compiled
@@ -42,12 +69,7 @@ def _ranges_hamming_2nn(Dq, Dt, order, lo, hi):  # pragma: no cover - compiled
             t = order[lo[i] + j]
             b = np.uint64(0)
             for w in range(Dq.shape[1]):
-                # bits set in a 64-bit word: the "SWAR" count (Hacker's Delight §5-1)
-                x = Dq[i, w] ^ Dt[t, w]
-                x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
-                x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
-                x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
-                b += (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+                b += popcount64(Dq[i, w] ^ Dt[t, w])
             bits[j] = b
         # ... then the two smallest, as in the window kernel
         for j in range(n):
@@ -96,18 +118,12 @@ def _all_hamming_2nn(Dq, DtT):  # pragma: no cover - compiled
     bits = np.empty(N, np.uint64)  # the distances of one query to all targets
     big = np.uint64(1 << 62)
     for i in range(k):
-        # word by word over contiguous rows (the compiler vectorises this loop); bits set in a 64-bit word by
-        # the "SWAR" count (Hacker's Delight §5-1)
+        # word by word over contiguous rows (the compiler vectorises this loop)
         bits[:] = 0
         for w in range(W):
             q, row = Dq[i, w], DtT[w]
             for t in range(N):
-                x = q ^ row[t]
-                x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
-                x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
-                x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
-                x = (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
-                bits[t] += x
+                bits[t] += popcount64(q ^ row[t])
         a1, a2, b1, b2 = big, big, -1, -1
         for t in range(N):
             d = bits[t]

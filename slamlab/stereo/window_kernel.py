@@ -22,7 +22,10 @@ from __future__ import annotations
 import numpy as np
 
 from .._compiled import kernel
-from ..kdtree._hamming_kernel import ranges_hamming_2nn  # re-exported: the stereo matching's user
+from ..kdtree._hamming_kernel import (  # ranges_hamming_2nn re-exported: the stereo matching's user
+    popcount64,
+    ranges_hamming_2nn,
+)
 
 __all__ = ["epipolar_hamming_2nn", "ranges_hamming_2nn", "window_hamming_2nn"]
 
@@ -48,12 +51,7 @@ def _window_hamming_2nn(Dq, Dt, uv_q, uv_t, order, lo, hi, radius):  # pragma: n
                 n_pairs += 1
                 bits = np.uint64(0)
                 for w in range(Dq.shape[1]):
-                    # bits set in a 64-bit word: the "SWAR" count (Hacker's Delight §5-1)
-                    x = Dq[i, w] ^ Dt[t, w]
-                    x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
-                    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
-                    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
-                    bits += (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+                    bits += popcount64(Dq[i, w] ^ Dt[t, w])
                 d = float(bits)
                 if d < d1[i]:  # a new nearest: the old one becomes the second
                     d2[i], r2[i] = d1[i], r1[i]
@@ -107,12 +105,7 @@ def _epipolar_hamming_2nn(Dq, Dt, a, b, c, uv_t, order, lo, hi, tol):  # pragma:
                 continue
             bits = np.uint64(0)
             for w in range(Dq.shape[1]):
-                # bits set in a 64-bit word: the "SWAR" count (Hacker's Delight §5-1)
-                x = Dq[i, w] ^ Dt[t, w]
-                x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
-                x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
-                x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
-                bits += (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+                bits += popcount64(Dq[i, w] ^ Dt[t, w])
             d = float(bits)
             if d < d1[i]:  # a new nearest: the old one becomes the second
                 d2[i], r2[i] = d1[i], r1[i]
