@@ -373,9 +373,9 @@ def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_bod
                        huber_px: float = 2.0, min_depth_m: float = 0.1) -> np.ndarray:
     """Refine a body pose by minimising the stereo reprojection error of matched landmarks (our option; issue 25).
 
-    Motion-only bundle adjustment as in ORB-SLAM's pose optimisation (Mur-Artal & Tardós 2017, §V-B): the
-    landmarks stay fixed, the pose moves; each match's measurement is the pair of pixels ``(u_l, v_l, u_r,
-    v_r)`` of its stereo point (``points_left`` projected into both cameras: the keypoints it was triangulated
+    Motion-only bundle adjustment as in ORB-SLAM2's tracking (Mur-Artal & Tardós 2017, its bundle adjustment with
+    monocular and stereo constraints, where a stereo keypoint is ``(u_l, v_l, u_r)``): the landmarks stay fixed, the
+    pose moves; each match's measurement here is the pair of pixels ``(u_l, v_l, u_r, v_r)`` of its stereo point (``points_left`` projected into both cameras: the keypoints it was triangulated
     from), with one pixel noise for all (a Huber loss of ``huber_px`` on each point's residual norm). Unlike the
     weighted 3-D fit of :func:`estimate_pose`, no weight depends on a noisy depth, and the error is modelled
     where it arises (along the ray the pixels say little, across it much). Gauss-Newton on SE(3) with updates
