@@ -127,6 +127,10 @@ def main():
     ap.add_argument("--refine-cost", action="store_true",
                     help="CPU time of run_log_localisation with refine=10 vs without, every 25th csail scan, modes "
                          "1 and 3 (issue 25)")
+    ap.add_argument("--compare", action="append", default=[], metavar="NAME=VALUE",
+                    help="with --logs: run the suite again with these settings added (a Python literal, e.g. "
+                         "--compare score_norm='explored') and print per log the successes of both and the scans "
+                         "gained / lost (issue 25)")
     ap.add_argument("--only", default=None, help="comma-separated short log names for --logs (default all five)")
     ap.add_argument("--jobs", type=int, default=1, help="sweep workers of the --intel/--logs runs (same result for any)")
     args = ap.parse_args()
@@ -202,7 +206,49 @@ def main():
             if not sep:
                 ap.error(f"--set takes NAME=VALUE; got {item!r}")
             settings[name.strip()] = ast.literal_eval(value.strip())
-        logs(args.every, args.only, args.jobs, settings, args.map_check, args.failures)
+        compare = {}
+        for item in args.compare:
+            name, sep, value = item.partition("=")
+            if not sep:
+                ap.error(f"--compare takes NAME=VALUE; got {item!r}")
+            compare[name.strip()] = ast.literal_eval(value.strip())
+        if compare:
+            compare_logs(args.every, args.only, args.jobs, settings, compare)
+        else:
+            logs(args.every, args.only, args.jobs, settings, args.map_check, args.failures)
+
+
+def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extra: dict) -> None:
+    """Issue 25: the log suite with ``settings`` and with ``settings`` + ``extra``; per log and mode the successes
+    of both and the scans gained / lost."""
+    from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
+
+    paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
+    runs = []
+    for label, kw in (("base", settings), ("with", {**settings, **extra})):
+        print(f"\nShared CARMEN logs, every {every}th scan, settings {kw or 'defaults'}, "
+              f"load average {os.getloadavg()[0]:.1f}")
+        t0 = time.perf_counter()
+        r = sl.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs,
+                                         progress=False, **kw)
+        print(f"took {time.perf_counter() - t0:.1f} s wall ({n_jobs} job(s)); load average now "
+              f"{os.getloadavg()[0]:.1f}")
+        print(r.table())
+        runs.append(r)
+    base, new = runs
+    print(f"\n{extra} against {settings or 'defaults'}: successes per log and mode, scans gained / lost")
+    print(f"| log | mode | base | with | gained | lost |\n|---|---|---:|---:|---|---|")
+    tot = np.zeros((2, len(base.results[0].joined)), dtype=int)
+    for name, rb, rn in zip(base.names, base.results, new.results, strict=True):
+        for m, k in enumerate(rb.joined):
+            sb, sn = rb.success[m], rn.success[m]
+            tot[:, m] += sb.sum(), sn.sum()
+            gained = ", ".join(str(int(i)) for i in rb.scan_indices[~sb & sn]) or "–"
+            lost = ", ".join(str(int(i)) for i in rb.scan_indices[sb & ~sn]) or "–"
+            print(f"| {name} | {k} | {sb.sum()}/{sb.size} | {sn.sum()}/{sn.size} | {gained} | {lost} |")
+    n = sum(r.success.shape[1] for r in base.results)
+    for m, k in enumerate(base.results[0].joined):
+        print(f"| all | {k} | {tot[0, m]}/{n} | {tot[1, m]}/{n} | | |")
 
 
 def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: bool = False,

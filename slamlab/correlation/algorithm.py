@@ -46,7 +46,7 @@ from .. import _validate as v
 from ..geometry import wrap_angle
 from ..geometry.se2 import check_poses, se2_relative, se2_transform
 from ..scans import Scan, check_grid, grid_to_values
-from .scoring import _map_spectra, _peak_search, _rival_search, _Stamps, score_maps
+from .scoring import _ExploredNorm, _map_spectra, _peak_search, _rival_search, _Stamps, score_maps
 from .settings import Localisation, LocaliseParams, _check_real, check_constants
 
 __all__ = [
@@ -290,8 +290,14 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
     amax = max(abs(p.a_c), float(np.max(np.abs(a_p), initial=0.0)), abs(p.a_n))
     tol = (1e-9 if dtype == np.float64 else 2e-5) * amax * amax * n_marks
     specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=p.workers)
+    norm = None
+    if p.score_norm == "explored":  # scores per mark on an explored cell (ours, issue 25)
+        norm = _ExploredNorm(Mv, free, obs, headings, o, p.a_n, p.min_explored_fraction,
+                             min(p.a_c, float(np.min(a_p, initial=p.a_p)), p.a_n) - 1.0, dtype=dtype,
+                             workers=p.workers)
+        tol = tol / max(1.0, p.min_explored_fraction * float(norm.marks.min()))
     found = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=p.workers, chunk=p.chunk, tol=tol,
-                         specs=specs, n_peaks=refine)
+                         specs=specs, n_peaks=refine, norm=norm)
     best_val, best_idx, best_map, best, arg = found[:5]
     n, row, col = (int(i) for i in best_idx)
 
@@ -303,10 +309,12 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
     if p.ambiguity:
         rival_val, ridx = _rival_search(specs, stamps, headings, S, best_idx, best, arg,
                                         radius_cells=p.rival_radius_cells, heading_rad=p.rival_heading_rad,
-                                        chunk=p.chunk)
+                                        chunk=p.chunk, norm=norm)
         rival_pose = None if ridx is None else pose_of(*ridx)
     pose = pose_of(n, row, col)
     if refine:
+        if norm is not None:
+            raise ValueError("`refine` does not support `score_norm='explored'` (it re-scores by the raw score)")
         pose = _refine_peaks(Mv, free, obs, p.a_c, a_p, headings, found[5], refine, refine_heading_rad)
         if not tracking:
             pose[2] = float(np.mod(pose[2], 2 * np.pi))

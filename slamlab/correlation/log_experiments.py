@@ -381,6 +381,9 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     if (truth_check or rf) and p.a_n != 0:
         raise ValueError(f"`truth_check` and `refine` score by the definition with a_n = 0 (004's value); got a_n = "
                          f"{p.a_n}")
+    if (truth_check or rf) and p.score_norm != "none":
+        raise ValueError(f"`truth_check` and `refine` score by the raw correlation; got score_norm = "
+                         f"{p.score_norm!r} (use 'none')")
     sd = v.as_finite_array(odom_std, "odom_std")
     if sd.shape != (2,) or np.any(sd < 0):
         raise ValueError(f"`odom_std` must be (σ_xy_m, σ_θ_rad) >= 0; got {odom_std!r}")

@@ -131,30 +131,64 @@ def _map_spectra(Mv, stamps, S, o, *, dtype, workers):
             for q in sorted(set(stamps.quarter.tolist()))}
 
 
-def _iter_scores(specs, stamps, sel, S, chunk):
+class _ExploredNorm:
+    """What :func:`_iter_scores` needs to divide each pose's score by its marks on explored cells (ours, issue 25).
+
+    ``count[n, row, col] = Σ_{i,j} [T_n[i, j] marked]·E[row + i - o, col + j - o]`` with ``E`` = 1 on the
+    explored cells of the map (value ≠ ``a_n``) and 0 elsewhere and outside: one more correlation, of the
+    indicator stamps (the same samples rasterised with value 1) with ``E``, by the same batched FFTs. A pose
+    scores ``D / count`` when ``count ≥ min_fraction · marks_n`` (``marks_n``: the stamp's marked cells), else
+    ``floor``.
+    """
+
+    def __init__(self, Mv, free, obs, headings, o, a_n, min_fraction, floor, *, dtype, workers):
+        S = 2 * o
+        self.stamps = _Stamps(free, obs, headings, 1.0, 1.0, 0.0, o, dtype)
+        self.marks = np.count_nonzero(self.stamps.Tb, axis=1)  # per base stamp (a quarter turn keeps the count)
+        self.specs = _map_spectra((Mv != a_n).astype(np.float64), self.stamps, S, o, dtype=dtype, workers=workers)
+        self.min_fraction, self.floor = float(min_fraction), float(floor)
+
+    def apply(self, D, FTc_ind, q, heads):
+        """``D`` normalised for the headings ``heads`` of quarter turn ``q``."""
+        cnt = self.specs[q].inverse(FTc_ind)
+        if q:
+            cnt = np.rot90(cnt, -q, axes=(1, 2))
+        cnt = np.rint(cnt)
+        need = self.min_fraction * self.marks[self.stamps.inv[heads]][:, None, None] - 1e-9
+        return np.where(cnt >= need, D / np.maximum(cnt, 1.0), self.floor)
+
+
+def _iter_scores(specs, stamps, sel, S, chunk, norm: _ExploredNorm | None = None):
     """Yield ``(heads, D)``: score maps ``D[k] = D_{heads[k]}`` for the headings ``sel``, in chunks of base stamps.
 
     Quarter turns: with ``R`` the quarter turn of the stamps, ``D_{T∘R⁻¹}(M) = rot90(D_T(rot90(M)), -1)``
     (derivation in the notebook), so the spectrum of each base stamp (heading mod 90°) is computed once
-    and correlated with the four rotated maps' spectra.
+    and correlated with the four rotated maps' spectra. With ``norm`` (:class:`_ExploredNorm`) the maps are
+    divided by the marks on explored cells.
     """
     quarters = sorted(specs)
     bases = np.unique(stamps.inv[sel])
     for b0 in range(0, bases.size, chunk):
         bs = bases[b0:b0 + chunk]
         FTc = specs[quarters[0]].forward(stamps.Tb[bs].reshape(bs.size, S, S))
+        if norm is not None:
+            FTi = norm.specs[quarters[0]].forward(norm.stamps.Tb[bs].reshape(bs.size, S, S))
         in_chunk = sel[np.isin(stamps.inv[sel], bs)]
         for q in quarters:
             heads = in_chunk[stamps.quarter[in_chunk] == q]
             if heads.size == 0:
                 continue
-            D = specs[q].inverse(FTc[np.searchsorted(bs, stamps.inv[heads])])
+            pick = np.searchsorted(bs, stamps.inv[heads])
+            D = specs[q].inverse(FTc[pick])
             if q:
                 D = np.rot90(D, -q, axes=(1, 2))
+            if norm is not None:
+                D = norm.apply(D, FTi[pick], q, heads)
             yield heads, D
 
 
-def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None, n_peaks: int = 0):
+def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None, n_peaks: int = 0,
+                 norm: _ExploredNorm | None = None):
     """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
 
     Returns ``(best_val, (n, row, col), best_map, best_per_heading, argmax_per_heading)``; ties within
@@ -169,7 +203,7 @@ def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, spec
     arg_per = np.zeros(headings.size, dtype=np.int64)
     best_val, best_idx, best_map = -np.inf, None, None
     peaks = []
-    for heads, D in _iter_scores(specs, stamps, np.arange(headings.size), S, chunk):
+    for heads, D in _iter_scores(specs, stamps, np.arange(headings.size), S, chunk, norm):
         if n_peaks:
             peaks.append(_local_peaks(D, heads, 4 * n_peaks))
         flat_D = D.reshape(D.shape[0], -1)
@@ -228,7 +262,8 @@ def _distinct_peaks(peaks: np.ndarray, headings: np.ndarray, k: int, radius_cell
     return np.array(kept).reshape(-1, 4)
 
 
-def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, radius_cells, heading_rad, chunk):
+def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, radius_cells, heading_rad, chunk,
+                  norm: _ExploredNorm | None = None):
     """Best pose more than ``radius_cells`` or ``heading_rad`` away from the peak ``best_idx`` (ours).
 
     Headings farther than ``heading_rad`` count with their whole map (their maxima are already known);
@@ -249,7 +284,7 @@ def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, ra
     if not outside.any():
         return val, idx
     cells = np.nonzero(outside)[0]
-    for heads, D in _iter_scores(specs, stamps, near, S, chunk):
+    for heads, D in _iter_scores(specs, stamps, near, S, chunk, norm):
         Dm = D.reshape(D.shape[0], -1)[:, cells]
         am = Dm.argmax(axis=1)
         per = Dm[np.arange(am.size), am]
