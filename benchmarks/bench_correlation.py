@@ -225,7 +225,7 @@ def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extr
 
     paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
     runs = []
-    for label, kw in (("base", settings), ("with", {**settings, **extra})):
+    for kw in (settings, {**settings, **extra}):
         print(f"\nShared CARMEN logs, every {every}th scan, settings {kw or 'defaults'}, "
               f"load average {os.getloadavg()[0]:.1f}")
         t0 = time.perf_counter()
@@ -237,14 +237,14 @@ def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extr
         runs.append(r)
     base, new = runs
     print(f"\n{extra} against {settings or 'defaults'}: successes per log and mode, scans gained / lost")
-    print(f"| log | mode | base | with | gained | lost |\n|---|---|---:|---:|---|---|")
+    print("| log | mode | base | with | gained | lost |\n|---|---|---:|---:|---|---|")
     tot = np.zeros((2, len(base.results[0].joined)), dtype=int)
     for name, rb, rn in zip(base.names, base.results, new.results, strict=True):
         for m, k in enumerate(rb.joined):
             sb, sn = rb.success[m], rn.success[m]
             tot[:, m] += sb.sum(), sn.sum()
-            gained = ", ".join(str(int(i)) for i in rb.scan_indices[~sb & sn]) or "–"
-            lost = ", ".join(str(int(i)) for i in rb.scan_indices[sb & ~sn]) or "–"
+            gained = ", ".join(str(int(i)) for i in rb.scan_indices[~sb & sn]) or "-"
+            lost = ", ".join(str(int(i)) for i in rb.scan_indices[sb & ~sn]) or "-"
             print(f"| {name} | {k} | {sb.sum()}/{sb.size} | {sn.sum()}/{sn.size} | {gained} | {lost} |")
     n = sum(r.success.shape[1] for r in base.results)
     for m, k in enumerate(base.results[0].joined):
