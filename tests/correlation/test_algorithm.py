@@ -248,3 +248,67 @@ def test_wall_balance_weights_corridor_walls_less():
     assert np.array_equal(T1, T2)
     with pytest.raises(TypeError, match="`wall_balance` must be a bool"):
         C.LocaliseParams(wall_balance=1)
+
+
+def _explored_reference(M_codes, T, o, min_fraction, floor):
+    """score_norm='explored' by hand: Σ T·M / Σ [T marked]·[M explored] per pose (scipy's correlate), floor
+    where the marks on explored cells are fewer than ``min_fraction`` of the stamp's marks."""
+    Mv = S.grid_to_values(M_codes)
+    E = (M_codes != -1).astype(float)
+    H, W = M_codes.shape
+    Sz = T.shape[1]
+    a0 = Sz - 1 - o
+    out = np.empty((T.shape[0], H, W))
+    for n in range(T.shape[0]):
+        D = correlate(Mv, T[n], mode="full", method="direct")[a0:a0 + H, a0:a0 + W]
+        ind = (T[n] != 0).astype(float)
+        cnt = np.rint(correlate(E, ind, mode="full", method="direct")[a0:a0 + H, a0:a0 + W])
+        out[n] = np.where(cnt >= min_fraction * ind.sum(), D / np.maximum(cnt, 1), floor)
+    return out
+
+
+@pytest.mark.parametrize("min_fraction", [0.3, 0.8])
+def test_score_norm_explored_matches_definition(min_fraction):
+    """Issue 25 (ours): the normalised score equals Σ T·M / (marks on explored cells), by hand, at every pose."""
+    M = S.test_room_200()[20:80, 10:70].copy()
+    M[:, 35:] = -1  # the right part unexplored (a leave-out's hole)
+    scan = S.Rangefinder(n_beams=90, max_range_cells=25.0).scan(S.test_room_200(), [50.0, 45.0, np.radians(20)])
+    hd = C.heading_candidates(np.radians(30.0))
+    T, o = C.rasterise_scan(scan, hd, dtype="float64")
+    ref = _explored_reference(M, T, o, min_fraction, -2.0)
+    loc = C.localise(M, scan, delta_alpha_rad=np.radians(30.0), dtype="float64", ambiguity=False,
+                     score_norm="explored", min_explored_fraction=min_fraction)
+    n, r, c = np.unravel_index(np.argmax(ref), ref.shape)
+    assert (loc.heading_index, loc.row, loc.col) == (n, r, c)
+    assert loc.score == pytest.approx(ref[n, r, c], abs=1e-9)
+    np.testing.assert_allclose(loc.score_map, ref[n], atol=1e-9)
+    np.testing.assert_allclose(loc.best_per_heading, ref.reshape(ref.shape[0], -1).max(axis=1), atol=1e-9)
+    # a few poses by the definition itself (loops over the stamp's cells)
+    Mv, E = S.grid_to_values(M), M != -1
+    for rr, cc in ((r, c), (10, 5), (30, 40), (55, 20)):
+        num = cnt = 0.0
+        for i, j in zip(*np.nonzero(T[n]), strict=True):
+            y, x = rr + i - o, cc + j - o
+            if 0 <= y < M.shape[0] and 0 <= x < M.shape[1]:
+                num += T[n, i, j] * Mv[y, x]
+                cnt += E[y, x]
+        want = num / max(cnt, 1) if cnt >= min_fraction * np.count_nonzero(T[n]) else -2.0
+        assert loc.score_map[rr, cc] == pytest.approx(want, abs=1e-9)
+    # float32 FFTs find the same peak
+    loc32 = C.localise(M, scan, delta_alpha_rad=np.radians(30.0), ambiguity=False, score_norm="explored",
+                       min_explored_fraction=min_fraction)
+    assert (loc32.heading_index, loc32.row, loc32.col) == (n, r, c)
+
+
+def test_score_norm_bad_parameters():
+    with pytest.raises(ValueError, match="`score_norm` must be one of"):
+        C.LocaliseParams(score_norm="mean")
+    with pytest.raises(ValueError, match="`min_explored_fraction` must be > 0"):
+        C.LocaliseParams(min_explored_fraction=0.0)
+    with pytest.raises(ValueError, match="`min_explored_fraction` must be <= 1"):
+        C.LocaliseParams(min_explored_fraction=1.5)
+    with pytest.raises(TypeError, match="`min_explored_fraction` must be a real number"):
+        C.LocaliseParams(min_explored_fraction="0.5")
+    with pytest.raises(ValueError, match="needs `a_n` to differ"):
+        C.LocaliseParams(score_norm="explored", a_c=0.0)
+    assert C.LocaliseParams().score_norm == "none"  # off by default

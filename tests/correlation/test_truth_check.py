@@ -56,6 +56,8 @@ def test_truth_check_on_csail_scans(shared_data):
         C.run_log_localisation(log, (100,), truth_check="yes")
     with pytest.raises(ValueError, match="`truth_check` and `refine` score by the definition with a_n = 0"):
         C.run_log_localisation(log, (100,), truth_check=True, a_n=0.5)
+    with pytest.raises(ValueError, match="score by the raw correlation; got score_norm = 'explored'"):
+        C.run_log_localisation(log, (100,), truth_check=True, score_norm="explored")
     with pytest.raises(ValueError, match="`refine`"):
         C.run_log_localisation(log, (100,), refine=-1)
     with pytest.raises(TypeError, match="`refine`"):
