@@ -47,7 +47,7 @@ from ..geometry import wrap_angle
 from ..geometry.se2 import check_poses, se2_relative, se2_transform
 from ..scans import Scan, check_grid, grid_to_values
 from .scoring import _ExploredNorm, _map_spectra, _peak_search, _rival_search, _Stamps, score_maps
-from .settings import Localisation, LocaliseParams, _check_real, check_constants
+from .settings import Localisation, LocaliseParams, _check_real, _check_score_norm, check_constants
 
 __all__ = [
     "Localisation",
@@ -195,7 +195,8 @@ def _reach(r, h, p) -> float:
 
 
 def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_heading_rad: float | None = None,
-             window_rad: float | None = None, **overrides) -> Localisation:
+             window_rad: float | None = None, score_norm: str = "none", min_explored_fraction: float = 0.5,
+             **overrides) -> Localisation:
     """Pose of the robot on map ``grid`` from one scan: maximum of the correlation stack (004 §7).
 
     Parameters
@@ -210,6 +211,16 @@ def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_he
     prior_heading_rad, window_rad : float, optional
         Tracking mode: search only ``prior ± window`` (default window ±π when only
         the prior is given); full circle when the prior is None.
+    score_norm : {"none", "explored"}
+        ``"explored"`` (ours, issue 25; default ``"none"``): a pose scores the correlation divided by the number of
+        the stamp's marked cells that fall on explored map cells (free or obstacle), the mean match per mark the
+        map can judge, so a pose is not penalised for the map's holes (a leave-out's). The count is one more
+        batched FFT correlation, of the stamps' marks with the explored cells. ``score``, ``score_map``,
+        ``best_per_heading`` and the rival are then in these units (the margin's counting argument no longer
+        holds).
+    min_explored_fraction : float
+        With ``score_norm="explored"``: a pose whose marks on explored cells are fewer than this fraction of the
+        stamp's marks scores ``min(a_c, a_p, a_n) - 1`` (below every normalised score), in (0, 1]; default 0.5.
     **overrides
         Fields of :class:`LocaliseParams` to change, e.g. ``delta_alpha_rad=np.radians(5)``.
 
@@ -229,21 +240,24 @@ def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_he
     (70, 30, 40)
     """
     p = LocaliseParams.resolve(params, **overrides)
+    sn, frac = _check_score_norm(score_norm, min_explored_fraction, p)
     g = check_grid(grid)
     a, r, h = _scan_beams(scan)
     if prior_heading_rad is None and window_rad is not None:
         raise ValueError("`window_rad` needs `prior_heading_rad` (tracking mode)")
     headings = heading_candidates(p.delta_alpha_rad, center_rad=prior_heading_rad, window_rad=window_rad)
     return _localise(grid_to_values(g, p.a_c, p.a_p, p.a_n), a, r, h, headings, p,
-                     tracking=prior_heading_rad is not None)
+                     tracking=prior_heading_rad is not None, score_norm=sn, min_explored_fraction=frac)
 
 
-def _localise(Mv, a, r, h, headings, p: LocaliseParams, *, tracking: bool) -> Localisation:
+def _localise(Mv, a, r, h, headings, p: LocaliseParams, *, tracking: bool, score_norm: str = "none",
+              min_explored_fraction: float = 0.5) -> Localisation:
     """The search itself, on checked arguments: ``Mv`` the map in 004's values (called per scan by the runs)."""
     free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
                               step_cells=p.step_cells, use_misses=p.use_misses)
     return _localise_samples(Mv, free, obs, int(np.ceil(_reach(r, h, p))) + 2, headings, p, tracking=tracking,
-                             obs_weights=_wall_weights([(a, r, h)], np.zeros((1, 3)), p) if p.wall_balance else None)
+                             obs_weights=_wall_weights([(a, r, h)], np.zeros((1, 3)), p) if p.wall_balance else None,
+                             score_norm=score_norm, min_explored_fraction=min_explored_fraction)
 
 
 def _wall_weights(beams, rel_poses, p: LocaliseParams, n_bins: int = 12) -> np.ndarray:
@@ -273,14 +287,16 @@ def _wall_weights(beams, rel_poses, p: LocaliseParams, n_bins: int = 12) -> np.n
 
 
 def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking: bool, n_scans: int = 1,
-                      obs_weights=None, refine: int = 0, refine_heading_rad: float = float(np.radians(3.0))):
+                      obs_weights=None, refine: int = 0, refine_heading_rad: float = float(np.radians(3.0)),
+                      score_norm: str = "none", min_explored_fraction: float = 0.5):
     """Rasterise the robot-frame samples ``free`` / ``obs`` (stamp half-size ``o``), search the peak and its rival.
 
     ``obs_weights`` (one per obstacle sample, optional) multiply ``a_p`` in the stamps (:func:`_wall_weights`).
     ``refine`` > 0 (ours, issue 25; off by default): the ``refine`` best distinct peaks of the grid search
     (more than 2 cells or 3° apart) are scored again off the grid, every 0.5 cell within 1 cell and every
     0.5° within ``refine_heading_rad`` (:func:`_refine_peaks`), and the pose is the best of those (``score``
-    and the rival stay the grid search's).
+    and the rival stay the grid search's). ``score_norm`` / ``min_explored_fraction``: as in :func:`localise`
+    (checked by the caller).
     """
     dtype = np.dtype(p.dtype)
     S = 2 * o
@@ -291,11 +307,11 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
     tol = (1e-9 if dtype == np.float64 else 2e-5) * amax * amax * n_marks
     specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=p.workers)
     norm = None
-    if p.score_norm == "explored":  # scores per mark on an explored cell (ours, issue 25)
-        norm = _ExploredNorm(Mv, free, obs, headings, o, p.a_n, p.min_explored_fraction,
+    if score_norm == "explored":  # scores per mark on an explored cell (ours, issue 25)
+        norm = _ExploredNorm(Mv, free, obs, headings, o, p.a_n, min_explored_fraction,
                              min(p.a_c, float(np.min(a_p, initial=p.a_p)), p.a_n) - 1.0, dtype=dtype,
                              workers=p.workers)
-        tol = tol / max(1.0, p.min_explored_fraction * float(norm.marks.min()))
+        tol = tol / max(1.0, min_explored_fraction * float(norm.marks.min()))
     found = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=p.workers, chunk=p.chunk, tol=tol,
                          specs=specs, n_peaks=refine, norm=norm)
     best_val, best_idx, best_map, best, arg = found[:5]
@@ -365,7 +381,7 @@ def _joined_samples(beams, rel_poses, p: LocaliseParams):
 
 def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = None,
                     prior_heading_rad: float | None = None, window_rad: float | None = None,
-                    **overrides) -> Localisation:
+                    score_norm: str = "none", min_explored_fraction: float = 0.5, **overrides) -> Localisation:
     """Pose of the first of several scans joined by odometry into one stamp (ours, on 004 §7).
 
     A single scan in a corridor or a symmetric room matches equally well turned by 180° or
@@ -384,7 +400,7 @@ def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = 
     odom_poses : array_like, shape (len(scans), 3)
         Odometry pose of each scan in any common frame (cells, rad); only the relative
         poses matter.
-    params, prior_heading_rad, window_rad, **overrides
+    params, prior_heading_rad, window_rad, score_norm, min_explored_fraction, **overrides
         As in :func:`localise`.
 
     Returns
@@ -403,6 +419,7 @@ def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = 
     (70, 30, 40, 2)
     """
     p = LocaliseParams.resolve(params, **overrides)
+    sn, frac = _check_score_norm(score_norm, min_explored_fraction, p)
     g = check_grid(grid)
     if isinstance(scans, Scan) or not isinstance(scans, (list, tuple)):
         raise TypeError(f"`scans` must be a list or tuple of Scan; got {type(scans).__name__}")
@@ -417,7 +434,8 @@ def localise_joined(grid, scans, odom_poses, *, params: LocaliseParams | None = 
     free, obs, o = _joined_samples(beams, rel, p)
     return _localise_samples(grid_to_values(g, p.a_c, p.a_p, p.a_n), free, obs, o, headings, p,
                              tracking=prior_heading_rad is not None, n_scans=len(scans),
-                             obs_weights=_wall_weights(beams, rel, p) if p.wall_balance else None)
+                             obs_weights=_wall_weights(beams, rel, p) if p.wall_balance else None,
+                             score_norm=sn, min_explored_fraction=frac)
 
 
 def heading_error(est_rad, true_rad):

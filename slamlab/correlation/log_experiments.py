@@ -31,6 +31,7 @@ from .experiments import (
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
 from .log_truth import _TRUTH_COLUMNS, _failure_table, _localise_log_scan, _truth_frame
+from .settings import _check_score_norm
 from .studies import _errors
 
 __all__ = [
@@ -294,6 +295,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                          odom_std=ODOM_STD, hit_ratio: float = 0.25, params: LocaliseParams | None = None, rng=2017,
                          n_jobs: int = 1, progress: bool | None = None, truth_check: bool = False,
                          refine: int = 0, refine_heading_rad: float = float(np.radians(3.0)),
+                         score_norm: str = "none", min_explored_fraction: float = 0.5,
                          **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
 
@@ -355,6 +357,11 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     refine_heading_rad : float, default 3°
         Half-width of the refinement's headings around each peak [rad] (3°: with 1°, intel scan 550 is lost,
         ``docs/benchmarks.md``; chosen on that one scan).
+    score_norm : {"none", "explored"}, default "none"
+        ``"explored"``: score per mark on an explored cell (:func:`~slamlab.correlation.localise`; ours, issue
+        25); not with ``truth_check`` or ``refine`` (they score by the raw correlation).
+    min_explored_fraction : float, default 0.5
+        Its guard (:func:`~slamlab.correlation.localise`).
 
     Returns
     -------
@@ -381,9 +388,10 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     if (truth_check or rf) and p.a_n != 0:
         raise ValueError(f"`truth_check` and `refine` score by the definition with a_n = 0 (004's value); got a_n = "
                          f"{p.a_n}")
-    if (truth_check or rf) and p.score_norm != "none":
-        raise ValueError(f"`truth_check` and `refine` score by the raw correlation; got score_norm = "
-                         f"{p.score_norm!r} (use 'none')")
+    sn, frac = _check_score_norm(score_norm, min_explored_fraction, p)
+    if (truth_check or rf) and sn != "none":
+        raise ValueError(f"`truth_check` and `refine` score by the raw correlation; got score_norm = {sn!r} (use "
+                         f"'none')")
     sd = v.as_finite_array(odom_std, "odom_std")
     if sd.shape != (2,) or np.any(sd < 0):
         raise ValueError(f"`odom_std` must be (σ_xy_m, σ_θ_rad) >= 0; got {odom_std!r}")
@@ -407,7 +415,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                        "rel": np.array(rel)})
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes, "hit_ratio": hr, "truth_check": bool(truth_check),
-             "refine": rf, "refine_heading_rad": rfh}
+             "refine": rf, "refine_heading_rad": rfh, "score_norm": sn, "min_explored_fraction": frac}
     table = sweep(_localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed,
                   on_error="raise", desc="localise log scans")
     true_m = log.poses[idx]

@@ -23,7 +23,8 @@ __all__: list[str] = []
 
 def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, headings, joined,
                        hit_ratio: float = 0.25, truth_check: bool = False, refine: int = 0,
-                       refine_heading_rad: float = float(np.radians(3.0))) -> dict:
+                       refine_heading_rad: float = float(np.radians(3.0)), score_norm: str = "none",
+                       min_explored_fraction: float = 0.5) -> dict:
     """One sweep task: the leave-out grid of scan ``index`` and its localisation in every mode (deterministic);
     with ``truth_check`` also :func:`_truth_check`'s columns per mode."""
     if hit_ratio == 0.25:  # occupancy_grid's default rule: leave_out_grid labels the counts
@@ -37,7 +38,8 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
         free, obs, o = _joined_samples(beams[:k], rel[:k], p)
         loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k,
                                 obs_weights=_wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None,
-                                refine=refine, refine_heading_rad=refine_heading_rad)
+                                refine=refine, refine_heading_rad=refine_heading_rad, score_norm=score_norm,
+                                min_explored_fraction=min_explored_fraction)
         row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity,
                     f"mar{k}": loc.margin})
         if truth_check:

@@ -44,6 +44,22 @@ def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
     return a_c, a_p, a_n
 
 
+#: Choices of ``score_norm`` (:func:`~slamlab.correlation.localise`; ours, issue 25).
+SCORE_NORMS = ("none", "explored")
+
+
+def _check_score_norm(score_norm, min_explored_fraction, p) -> tuple[str, float]:
+    """Validate ``score_norm`` / ``min_explored_fraction`` (ours, issue 25) against the settings ``p``."""
+    sn = v.check_choice(score_norm, "score_norm", SCORE_NORMS)
+    f = v.check_positive(min_explored_fraction, "min_explored_fraction")
+    if f > 1:
+        raise ValueError(f"`min_explored_fraction` must be <= 1; got {f}")
+    if sn == "explored" and p.a_n in (p.a_c, p.a_p):
+        raise ValueError(f"`score_norm='explored'` needs `a_n` to differ from `a_c` and `a_p` (it tells explored "
+                         f"cells by their value); got a_n = {p.a_n}")
+    return sn, f
+
+
 @dataclass(frozen=True)
 class Localisation:
     """Result of :func:`localise`: the pose at the correlation maximum (004 §7).
@@ -163,13 +179,6 @@ class LocaliseParams(Params):
     wall_balance : bool
         Weigh each obstacle mark of the scan(s) by the rarity of its wall direction (ours, issue 25): returns
         on a corridor's long walls count less, those on door frames and corners more.
-    score_norm : {"none", "explored"}
-        ``"explored"`` (ours, issue 25; off by default): a pose scores the correlation divided by the number of
-        the stamp's marked cells that fall on explored map cells (free or obstacle), i.e. the mean match per
-        mark the map can judge, so a pose is not penalised for the map's holes (the leave-out's).
-    min_explored_fraction : float
-        With ``score_norm="explored"``: a pose whose marks on explored cells are fewer than this fraction of
-        the stamp's marks scores ``min(a_c, a_p, a_n) - 1`` (below every normalised score), in (0, 1].
     """
 
     delta_alpha_rad: float = param(float(np.radians(1.0)), "004 §7: Δα = 1°")
@@ -187,8 +196,6 @@ class LocaliseParams(Params):
     rival_radius_cells: float = param(5.0, "ours: a rival is farther than this from the peak (1 m at 0.2 m)")
     rival_heading_rad: float = param(float(np.radians(30.0)), "ours: ... or its heading is more than 30° off")
     wall_balance: bool = param(False, "ours (issue 25): a_p × count(wall-direction bin)^(-1/2), mean 1, cap 4")
-    score_norm: str = param("none", "ours (issue 25): 'explored' = score / marks on explored cells")
-    min_explored_fraction: float = param(0.5, "ours (issue 25): guard of score_norm='explored'")
 
     def __post_init__(self) -> None:
         with contextlib.suppress(TypeError):  # accept numpy dtypes (np.float32) too; check() names a bad one
@@ -216,13 +223,6 @@ class LocaliseParams(Params):
         v.check_positive(self.rival_radius_cells, "rival_radius_cells", allow_zero=True)
         if not isinstance(self.wall_balance, (bool, np.bool_)):
             raise TypeError(f"`wall_balance` must be a bool; got {type(self.wall_balance).__name__}")
-        v.check_choice(self.score_norm, "score_norm", ("none", "explored"))
-        f = v.check_positive(self.min_explored_fraction, "min_explored_fraction")
-        if f > 1:
-            raise ValueError(f"`min_explored_fraction` must be <= 1; got {f}")
-        if self.score_norm == "explored" and self.a_n in (self.a_c, self.a_p):
-            raise ValueError(f"`score_norm='explored'` needs `a_n` to differ from `a_c` and `a_p` (it tells "
-                             f"explored cells by their value); got a_n = {self.a_n}")
         h = v.check_positive(self.rival_heading_rad, "rival_heading_rad", allow_zero=True)
         if h >= np.pi:
             raise ValueError(f"`rival_heading_rad` must be < π (else no heading is far enough); got {h}")

@@ -301,14 +301,22 @@ def test_score_norm_explored_matches_definition(min_fraction):
 
 
 def test_score_norm_bad_parameters():
-    with pytest.raises(ValueError, match="`score_norm` must be one of"):
-        C.LocaliseParams(score_norm="mean")
-    with pytest.raises(ValueError, match="`min_explored_fraction` must be > 0"):
-        C.LocaliseParams(min_explored_fraction=0.0)
-    with pytest.raises(ValueError, match="`min_explored_fraction` must be <= 1"):
-        C.LocaliseParams(min_explored_fraction=1.5)
-    with pytest.raises(TypeError, match="`min_explored_fraction` must be a real number"):
-        C.LocaliseParams(min_explored_fraction="0.5")
-    with pytest.raises(ValueError, match="needs `a_n` to differ"):
-        C.LocaliseParams(score_norm="explored", a_c=0.0)
-    assert C.LocaliseParams().score_norm == "none"  # off by default
+    M = S.test_room_200()
+    rf = S.Rangefinder(n_beams=36, max_range_cells=30)
+    s = rf.scan(M, [70, 30, 0.0])
+    kw = {"delta_alpha_rad": np.radians(90.0), "ambiguity": False}
+    for f in (C.localise, lambda M, s, **k: C.localise_joined(M, [s], np.zeros((1, 3)), **k)):
+        with pytest.raises(ValueError, match="`score_norm` must be one of"):
+            f(M, s, score_norm="mean", **kw)
+        with pytest.raises(ValueError, match="`min_explored_fraction` must be > 0"):
+            f(M, s, score_norm="explored", min_explored_fraction=0.0, **kw)
+        with pytest.raises(ValueError, match="`min_explored_fraction` must be <= 1"):
+            f(M, s, score_norm="explored", min_explored_fraction=1.5, **kw)
+        with pytest.raises(TypeError, match="`min_explored_fraction` must be a real number"):
+            f(M, s, score_norm="explored", min_explored_fraction="0.5", **kw)
+        with pytest.raises(ValueError, match="needs `a_n` to differ"):
+            f(M, s, score_norm="explored", a_c=0.0, **kw)
+    # off by default: "none" is the raw score, bit for bit
+    a, b = C.localise(M, s, **kw), C.localise(M, s, score_norm="none", **kw)
+    assert (a.row, a.col, a.heading_index, a.score) == (b.row, b.col, b.heading_index, b.score)
+    assert "score_norm" not in C.LocaliseParams.field_names()
