@@ -295,7 +295,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                          odom_std=ODOM_STD, hit_ratio: float = 0.25, params: LocaliseParams | None = None, rng=2017,
                          n_jobs: int = 1, progress: bool | None = None, truth_check: bool = False,
                          refine: int = 0, refine_heading_rad: float = float(np.radians(3.0)),
-                         score_norm: str = "none", min_explored_fraction: float = 0.5,
+                         score_norm: str = "none", min_explored_fraction: float = 0.8,
                          **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
 
@@ -360,7 +360,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     score_norm : {"none", "explored"}, default "none"
         ``"explored"``: score per mark on an explored cell (:func:`~slamlab.correlation.localise`; ours, issue
         25); not with ``truth_check`` or ``refine`` (they score by the raw correlation).
-    min_explored_fraction : float, default 0.5
+    min_explored_fraction : float, default 0.8
         Its guard (:func:`~slamlab.correlation.localise`).
 
     Returns

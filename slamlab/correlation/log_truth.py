@@ -24,7 +24,7 @@ __all__: list[str] = []
 def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, headings, joined,
                        hit_ratio: float = 0.25, truth_check: bool = False, refine: int = 0,
                        refine_heading_rad: float = float(np.radians(3.0)), score_norm: str = "none",
-                       min_explored_fraction: float = 0.5) -> dict:
+                       min_explored_fraction: float = 0.8) -> dict:
     """One sweep task: the leave-out grid of scan ``index`` and its localisation in every mode (deterministic);
     with ``truth_check`` also :func:`_truth_check`'s columns per mode."""
     if hit_ratio == 0.25:  # occupancy_grid's default rule: leave_out_grid labels the counts
