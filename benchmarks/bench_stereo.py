@@ -168,9 +168,7 @@ def main(argv=None):
         folder = sl.data.find_data("kitti-odometry-06-stereo-51/calib.txt").parent
         for det in args.detectors.split(","):
             t0 = time.perf_counter()
-            from slamlab.stereo.scale_ablation import PROPOSED_FIX
-
-            fix_off = {k: getattr(sl.stereo.StereoParams(), k) for k in PROPOSED_FIX}
+            fix_off = sl.stereo.PROPOSED_FIX_OFF
             variants = {"before (issue 25: global search, measured-depth weights)": {
                 "detector": det, "map_search": "global", "weight_depth": "measured", "update_cov_depth": "measured",
                 **fix_off},

@@ -20,7 +20,7 @@ import numpy as np
 
 from .._compiled import jitable, kernel
 
-__all__ = ["all_hamming_2nn", "popcount64", "ranges_hamming_2nn"]
+__all__ = ["all_hamming_2nn", "no_two_nearest", "popcount64", "ranges_hamming_2nn"]
 
 
 @jitable
@@ -50,14 +50,28 @@ def popcount64(x):
     return (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
 
 
+@jitable
+def no_two_nearest(k):
+    """``r1, d1, d2, r2`` for ``k`` queries before any candidate: indices −1, distances ∞ (the kernels' start).
+
+    Parameters
+    ----------
+    k : int
+        Number of queries.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``r1`` (int64), ``d1``, ``d2`` (float64), ``r2`` (int64), each of length ``k``.
+    """
+    return np.full(k, -1, np.int64), np.full(k, np.inf), np.full(k, np.inf), np.full(k, -1, np.int64)
+
+
 def _ranges_hamming_2nn(Dq, Dt, order, lo, hi):  # pragma: no cover - compiled
     """For each query ``i``: the targets ``order[lo[i]:hi[i]]`` in that order, their Hamming distances
     (descriptors as uint64 words) and the nearest / second nearest, each the first in that order among equals."""
     k = Dq.shape[0]
-    r1 = np.full(k, -1, np.int64)
-    r2 = np.full(k, -1, np.int64)
-    d1 = np.full(k, np.inf)
-    d2 = np.full(k, np.inf)
+    r1, d1, d2, r2 = no_two_nearest(k)
     n_max = 0
     for i in range(k):
         n_max = max(n_max, hi[i] - lo[i])
@@ -109,10 +123,7 @@ def _all_hamming_2nn(Dq, DtT):  # pragma: no cover - compiled
     nearest by Hamming distance, each the first in that order among equals (as ``_ranges_hamming_2nn`` with
     every target a candidate)."""
     k, W, N = Dq.shape[0], DtT.shape[0], DtT.shape[1]
-    r1 = np.full(k, -1, np.int64)
-    r2 = np.full(k, -1, np.int64)
-    d1 = np.full(k, np.inf)
-    d2 = np.full(k, np.inf)
+    r1, d1, d2, r2 = no_two_nearest(k)
     if W == 0 or N == 0:
         return r1, d1, d2, r2
     bits = np.empty(N, np.uint64)  # the distances of one query to all targets

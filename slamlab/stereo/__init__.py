@@ -25,7 +25,14 @@ from .experiments import (
 from .heading import heading_frames
 from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
-from .scale_ablation import ABLATION_BASE, PROPOSED_FIX, SCALE_ABLATION, ScaleAblation, run_scale_ablation
+from .scale_ablation import (
+    ABLATION_BASE,
+    PROPOSED_FIX,
+    PROPOSED_FIX_OFF,
+    SCALE_ABLATION,
+    ScaleAblation,
+    run_scale_ablation,
+)
 from .slam import STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
     LocalCloud,
@@ -57,6 +64,7 @@ __all__ = [
     "COMPARISON",
     "KITTI_PARAMS",
     "PROPOSED_FIX",
+    "PROPOSED_FIX_OFF",
     "SCALE_ABLATION",
     "SIZES",
     "STAGES",

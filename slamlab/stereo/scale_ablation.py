@@ -21,7 +21,7 @@ from .kitti_experiments import KITTI_PARAMS
 from .params import StereoParams
 from .slam import StereoSLAM
 
-__all__ = ["ABLATION_BASE", "CONDITION_SETTINGS", "PROPOSED_FIX", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
+__all__ = ["ABLATION_BASE", "CONDITION_SETTINGS", "PROPOSED_FIX", "PROPOSED_FIX_OFF", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
            "run_scale_ablation"]
 
 #: the settings of the ablation: label -> overrides of ABLATION_BASE (``pixel_std_obs``: the scene's keypoint noise);
@@ -73,7 +73,9 @@ PROPOSED_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "d
 #: the base of the ablations: :data:`~slamlab.stereo.KITTI_PARAMS` without ``PROPOSED_FIX`` (its options at
 #: :class:`StereoParams`' defaults), i.e. KITTI_PARAMS as it was until stop 37 made the fix part of it; every row
 #: of :data:`SCALE_ABLATION` and :data:`CONDITION_SETTINGS` overrides this
-ABLATION_BASE = KITTI_PARAMS.replace(**{k: getattr(StereoParams(), k) for k in PROPOSED_FIX})
+#: ``PROPOSED_FIX``'s options at :class:`StereoParams`' defaults: overrides that turn the fix off
+PROPOSED_FIX_OFF = {k: getattr(StereoParams(), k) for k in PROPOSED_FIX}
+ABLATION_BASE = KITTI_PARAMS.replace(**PROPOSED_FIX_OFF)
 
 #: the settings of :func:`run_condition_ablation`: the defaults before issue 25, KITTI_PARAMS of stop 36 and
 #: today's (with PROPOSED_FIX)

@@ -23,6 +23,7 @@ import numpy as np
 
 from .._compiled import kernel
 from ..kdtree._hamming_kernel import (  # ranges_hamming_2nn re-exported: the stereo matching's user
+    no_two_nearest,
     popcount64,
     ranges_hamming_2nn,
 )
@@ -35,10 +36,7 @@ def _window_hamming_2nn(Dq, Dt, uv_q, uv_t, order, lo, hi, radius):  # pragma: n
     the numpy version's order) within ``radius`` px, their Hamming distances (descriptors as uint64 words)
     and the nearest / second nearest, each the first in that order among equals."""
     k = Dq.shape[0]
-    r1 = np.full(k, -1, np.int64)
-    r2 = np.full(k, -1, np.int64)
-    d1 = np.full(k, np.inf)
-    d2 = np.full(k, np.inf)
+    r1, d1, d2, r2 = no_two_nearest(k)
     r2_lim = radius * radius
     n_pairs = 0
     for i in range(k):
@@ -94,10 +92,7 @@ def _epipolar_hamming_2nn(Dq, Dt, a, b, c, uv_t, order, lo, hi, tol):  # pragma:
     ``|a[i] u_t + b[i] v_t + c[i]|`` (``epipolar_pairs``' expression, evaluated in the same order) is at most
     ``tol``, their Hamming distances and the nearest / second nearest, each the first in that order among equals."""
     k = Dq.shape[0]
-    r1 = np.full(k, -1, np.int64)
-    r2 = np.full(k, -1, np.int64)
-    d1 = np.full(k, np.inf)
-    d2 = np.full(k, np.inf)
+    r1, d1, d2, r2 = no_two_nearest(k)
     for i in range(k):
         for j in range(lo[i], hi[i]):
             t = order[j]
