@@ -5,8 +5,8 @@ ranking keys ``|x|²/2 - q·x`` of every query against the block (queries × blo
 numpy path then selects from that matrix with a ``min`` pass and ``argmin`` passes (the teaching
 version, :func:`slamlab.kdtree.knn._exact_knn_float`). The kernel here does the selection in one pass
 over each row of the block while the row is in cache: it keeps, per query, the ``c`` smallest keys seen
-so far, sorted, and compares every key with the ``c``-th smallest (a vectorisable count over chunks of
-64 keys; the rare chunks with a smaller key are walked once more to insert them).
+so far, sorted, and compares every key with the ``c``-th smallest (a branch-free test over chunks of
+64 keys, compiled to SIMD compares; the rare chunks with a smaller key are walked once more to insert them).
 
 Ties keep the lowest database index first (a key equal to the ``c``-th best does not enter; an entering
 key goes behind the equal ones already kept), as the numpy path's ``argmin`` does.
@@ -28,7 +28,7 @@ from slamlab._threads import blas_one_thread, shared_pool
 
 __all__ = ["top_c_blocks", "update_top_c"]
 
-_CHUNK = 64  # keys per vectorised test (256 bytes of one row)
+_CHUNK = 64  # keys per vectorised test (256 bytes of one row; 32: slower, 128: about the same)
 
 
 @kernel
@@ -59,10 +59,13 @@ def update_top_c(G, s0, best_key, best_idx, r0, r1):
         worst = best_key[i, c - 1]  # the c-th smallest key so far: a key must beat it to enter
         for j0 in range(0, b, _CHUNK):
             j1 = min(j0 + _CHUNK, b)
-            n = 0
-            for j in range(j0, j1):  # how many keys of the chunk beat it (a SIMD compare-and-count)
-                n += row[j] < worst
-            if n == 0:
+            beats = False
+            # does any key of the chunk beat it? Branch-free, so it compiles to SIMD compares; the index is
+            # unsigned because a signed one may be negative, which numba wraps around (row[-1] is the last key),
+            # and that per-key check made LLVM gather the keys one by one instead of loading 16 at a time
+            for j in range(np.uint64(j0), np.uint64(j1)):
+                beats |= row[j] < worst
+            if not beats:
                 continue
             for j in range(j0, j1):  # insertion of the few that do, keeping the list sorted
                 g = row[j]
