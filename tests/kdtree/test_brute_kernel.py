@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from slamlab import _threads
+from slamlab._compiled import numba_enabled
 from slamlab._threads import blas_one_thread, blas_threads_settable
 from slamlab.kdtree import _brute_kernel as _brute
 from slamlab.kdtree import knn
@@ -81,6 +82,29 @@ def test_kernel_one_block_by_hand():
     assert idx[0].tolist() == [201, 104, 101]
 
 
+@pytest.mark.parametrize("b", [1, 63, 64, 65, 130, 262])
+def test_kernel_equals_a_sort_across_chunk_edges(b):
+    # by definition: the c smallest finite keys seen so far, ordered by (key, database index); keys drawn from a few
+    # values (many ties), some +inf and NaN (never kept), over several blocks whose width b crosses the 64-key chunks
+    rng = np.random.default_rng(b)
+    c, M = 3, 40
+    key = np.full((M, c), np.inf, np.float32)
+    idx = np.full((M, c), -1, np.int64)
+    seen = []
+    for s0 in range(0, 4 * b, b):
+        G = rng.integers(0, 6, (M, b)).astype(np.float32) - 0.5 * (s0 // b)  # later blocks smaller: more inserts
+        G[rng.random((M, b)) < 0.05] = np.inf
+        G[rng.random((M, b)) < 0.05] = np.nan
+        update_top_c(G, s0, key, idx, 0, M)
+        seen.append(G)
+    allk = np.hstack(seen)
+    for i in range(M):
+        j = np.flatnonzero(np.isfinite(allk[i]))
+        o = j[np.lexsort((j, allk[i, j]))][:c]
+        assert idx[i].tolist() == o.tolist() + [-1] * (c - o.size)
+        np.testing.assert_array_equal(key[i, :o.size], allk[i, o])
+
+
 def test_store_rejects_nan_as_before():
     s = BruteForceStore()
     s.add(np.zeros((3, 4), np.float32), [0, 1, 2])
@@ -138,6 +162,7 @@ def test_two_workers_ties_across_blocks_keep_the_lowest_index():
     np.testing.assert_array_equal(knn._exact_knn_float_compiled(Q, X, 2, block=128, workers=2)[1], i_ref)
 
 
+@pytest.mark.skipif(not numba_enabled(), reason="SLAMLAB_NO_NUMBA: the store takes the numpy path")
 def test_store_takes_two_workers_for_large_problems(monkeypatch):
     rng = np.random.default_rng(9)
     X = rng.standard_normal((3000, 8)).astype(np.float32)
