@@ -250,7 +250,8 @@ def main(argv=None):
               f"= {g['ours_ms'] / g['bound_ms']:.2f} x the GEMM bound = {g['ours_ms'] / g['blocks2_ms']:.2f} x its products "
               f"alone; all three give the numpy path's results: {g['same_as_numpy']}")
         print(f"the store's default right after a block product on BLAS's threads (which then spin ~0.1 s; the "
-              f"store's lines above are each timed after a {_SETTLE_S} s pause): best {g['hot_ms']:.1f} ms, median {g['hot_median_ms']:.1f} ms "
+              f"store's lines above are each timed after a {_SETTLE_S} s pause"
+              + ("; --cpu-time: one BLAS thread, none spins" if args.cpu_time else "") + f"): best {g['hot_ms']:.1f} ms, median {g['hot_median_ms']:.1f} ms "
               f"= {g['hot_ms'] / g['bound_ms']:.2f} x the GEMM bound")
         print(f"selection kernel: compile {g['compile_s']:.2f} s (fresh), first call in this process "
               f"{g['load_s']:.2f} s (compiled or loaded from __pycache__)")
