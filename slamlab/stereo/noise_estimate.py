@@ -1,14 +1,18 @@
 """The keypoint noise estimated online from the pose refinement's stereo reprojection residuals (ours; issue 25).
 
 The stereo pipeline's noise model (``StereoParams.pixel_std``) sets every stereo point's covariance, hence the
-landmark filter's weights and its innovation gate. When the images' keypoints are noisier than assumed, the gate
-keeps landmarks from being updated. With ``pixel_std_estimate`` (:class:`~slamlab.stereo.StereoParams`), the
-pipeline measures the noise from data it already has: after the pose refinement
-(``pose_refine='reprojection'``), the residuals of the inliers' horizontal pixels ``u_l``, ``u_r`` (each a
-keypoint coordinate, where the midpoint triangulation keeps it; ``v`` is the two images' mean) give one robust
-standard deviation per frame, 1.4826 x the median absolute deviation (Hampel 1974; the normal distribution's
-factor), smoothed over frames and never below ``pixel_std`` (the nominal noise is a floor: the data may raise
-the model, not lower it). No knowledge of the scene is used.
+landmark filter's weights and its innovation gate. When the keypoints are noisier than assumed, the gate keeps
+landmarks from being updated. With ``pixel_std_estimate`` (:class:`~slamlab.stereo.StereoParams`), the pipeline
+measures the noise from data it already has: after the pose refinement (``pose_refine='reprojection'``), each
+inlier's **disparity residual** ``(u_l - u_r)`` of the frame's keypoints minus that of its landmark seen from the
+refined pose. Its variance is ``2 σ² + q``: the two keypoints' noise ``σ`` and the landmark's own error ``q``
+(its filter covariance projected on the disparity). The frame's estimate is the ``σ`` for which the residuals
+normalised by that variance have the median of a χ²₁ variable, 0.4549 (a robust, median-based moment
+condition, as 1.4826 x MAD is for a plain normal sample); it is smoothed over frames and never below ``pixel_std``
+(the nominal noise is a floor: the data may raise the model, not lower it). The disparity is used, not the
+single coordinates: a landmark's error in ``u_l``, ``u_r`` also holds its depth error seen from a moved camera and
+the pose inflation of the filter (``pose_std_m``, ``pose_std_rad``), both of which the difference nearly cancels.
+No knowledge of the scene is used.
 """
 
 from __future__ import annotations
@@ -19,11 +23,13 @@ from .. import _validate as v
 from .params import StereoParams
 from .pose_stages import _refine_body_pose, _stereo_project
 
-__all__ = ["MAD_TO_STD", "robust_pixel_std", "stereo_residuals_px"]
+__all__ = ["CHI2_1_MEDIAN", "MAD_TO_STD", "disparity_noise_px", "robust_pixel_std", "stereo_residuals_px"]
 
 #: 1 / Φ⁻¹(3/4): the median absolute deviation of a normal sample times this is its standard deviation
 MAD_TO_STD = 1.4826
-#: fewest residual pairs (matches) a frame needs to contribute an estimate
+#: the median of a χ² variable with one degree of freedom, (Φ⁻¹(3/4))² = 1 / 1.4826²
+CHI2_1_MEDIAN = 0.45493642311957283
+#: fewest residuals (matches) a frame needs to contribute an estimate
 MIN_RESIDUALS = 20
 
 
@@ -98,11 +104,63 @@ def robust_pixel_std(residuals_px) -> float:
     return float(MAD_TO_STD * np.median(np.abs(r - np.median(r))))
 
 
+def disparity_noise_px(disparity_residuals_px, landmark_var_px2=None) -> float:
+    """Keypoint noise ``σ`` [px] behind disparity residuals whose variance is ``2 σ² + q`` (ours; issue 25).
+
+    ``σ`` solves ``median(r² / (2 σ² + q)) = 0.4549`` (the median of χ²₁): the residuals ``r`` of the disparity
+    ``u_l - u_r`` of two keypoints with independent noise ``σ`` each, against a prediction whose own variance
+    is ``q`` (a landmark's, from its covariance). With ``q = 0`` this is ``1.4826 x median|r| / √2``. The
+    left side falls as ``σ`` grows, so bisection finds it; 0 when ``q`` alone explains the residuals.
+
+    Parameters
+    ----------
+    disparity_residuals_px : array_like, shape (K,)
+        Disparity residuals [px]; NaNs are left out.
+    landmark_var_px2 : array_like, shape (K,), optional
+        The predictions' variances ``q`` [px²] (default 0).
+
+    Returns
+    -------
+    float
+        ``σ`` [px] (NaN when no finite residual is given).
+
+    Examples
+    --------
+    >>> g = np.random.default_rng(0)
+    >>> r = g.normal(0.0, 0.8, 20000) - g.normal(0.0, 0.8, 20000) + g.normal(0.0, 0.5, 20000)
+    >>> round(disparity_noise_px(r, np.full(20000, 0.25)), 1)
+    0.8
+    """
+    r = np.asarray(disparity_residuals_px, dtype=float).ravel()
+    q = np.zeros_like(r) if landmark_var_px2 is None else np.asarray(landmark_var_px2, dtype=float).ravel()
+    if q.shape != r.shape:
+        raise ValueError(f"`landmark_var_px2` must have the shape of `disparity_residuals_px`; got {q.shape} and {r.shape}")
+    if np.any(q < 0):
+        raise ValueError("`landmark_var_px2` must be non-negative")
+    ok = np.isfinite(r) & np.isfinite(q)
+    r2, q = r[ok] ** 2, q[ok]
+    if r2.size == 0:
+        return float("nan")
+
+    def excess(sigma):  # median normalised square minus its target: falls as sigma grows
+        return np.median(r2 / np.maximum(2.0 * sigma**2 + q, 1e-300)) - CHI2_1_MEDIAN
+
+    if excess(0.0) <= 0.0:
+        return 0.0
+    lo, hi = 0.0, max(float(np.sqrt(np.median(r2) / (2 * CHI2_1_MEDIAN))), 1e-12)
+    while excess(hi) > 0.0:
+        hi *= 2.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if excess(mid) > 0.0 else (lo, mid)
+    return float(0.5 * (lo + hi))
+
+
 class _NoiseTracker:
     """The running keypoint-noise estimate of one :class:`~slamlab.stereo.StereoSLAM` (``pixel_std_estimate``).
 
     ``params`` is the user's settings with ``pixel_std`` replaced by the estimate; ``refine`` runs the pose
-    refinement and feeds its residuals to the estimate. ``history`` holds each frame's raw estimate."""
+    refinement and feeds its disparity residuals to the estimate. ``history`` holds each frame's raw estimate."""
 
     def __init__(self, params: StereoParams):
         self.nominal = params
@@ -110,21 +168,38 @@ class _NoiseTracker:
         self.sigma_px = params.pixel_std
         self.history: list[float] = []
 
-    def refine(self, T_body, X_map, pts_left, rig, T_body_left):
-        p = self.nominal
-        T = _refine_body_pose(T_body, X_map, pts_left, rig, T_body_left, p.refine_iters, p.refine_huber_px,
-                              p.min_depth_m)
+    def refine(self, slam, T_body, ids, pts_left):
+        """The refined pose of ``slam``'s landmarks ``ids`` matched by the left-camera points ``pts_left``."""
+        p, rig, T_bl = self.nominal, slam.rig, slam.T_body_left
+        X = slam.X[ids]
+        T = _refine_body_pose(T_body, X, pts_left, rig, T_bl, p.refine_iters, p.refine_huber_px, p.min_depth_m)
         if p.pixel_std_estimate:
-            self.observe(_residuals(T, X_map, pts_left, rig, T_body_left)[:, [0, 2]])
+            self.observe(*_disparity_residuals(T, X, slam.P[ids], pts_left, rig, T_bl))
         return T
 
-    def observe(self, residuals_px):
-        """One frame's residuals of the inliers' ``u_l``, ``u_r`` [px]: update the smoothed estimate."""
-        r = np.asarray(residuals_px, dtype=float)
-        if np.isfinite(r).sum() < 2 * MIN_RESIDUALS:
+    def observe(self, disparity_residuals_px, landmark_var_px2=None):
+        """One frame's disparity residuals [px] (and their landmarks' variances [px²]): update the estimate."""
+        r = np.asarray(disparity_residuals_px, dtype=float)
+        if np.isfinite(r).sum() < MIN_RESIDUALS:
             return
-        s = robust_pixel_std(r)
+        s = disparity_noise_px(r, landmark_var_px2)
         self.history.append(s)
         a = self.nominal.pixel_std_smoothing
         self.sigma_px = (1.0 - a) * self.sigma_px + a * s
         self.params = self.nominal.replace(pixel_std=max(self.nominal.pixel_std, self.sigma_px))
+
+
+def _disparity_residuals(T_body, X_map, P_map, pts_left, rig, T_body_left):
+    """Disparity residuals ``(u_l - u_r)`` [px] of the points ``pts_left`` against landmarks ``X_map`` at
+    ``T_body``, and the variance [px²] of each landmark's predicted disparity (covariances ``P_map``)."""
+    T_cw = np.linalg.inv(T_body @ T_body_left)
+    R = T_cw[:3, :3]
+    Xc = X_map @ R.T + T_cw[:3, 3]
+    ok = Xc[:, 2] > 0
+    r, q = np.full(len(X_map), np.nan), np.full(len(X_map), np.nan)
+    h, J = _stereo_project(rig, Xc[ok])
+    z = _stereo_project(rig, pts_left[ok])[0]
+    r[ok] = (z[:, 0] - z[:, 2]) - (h[:, 0] - h[:, 2])
+    Jd = (J[:, 0] - J[:, 2]) @ R  # d(disparity) / d(X_map)
+    q[ok] = np.einsum("ki,kij,kj->k", Jd, P_map[ok], Jd)
+    return r, q

@@ -67,7 +67,7 @@ class StereoParams(Params):
     pixel_std : float
         ours: pixel error behind a stereo point's covariance
     pixel_std_estimate : bool
-        ours: raise pixel_std to the keypoint noise estimated online from the pose refinement's stereo reprojection residuals (1.4826 MAD per frame, smoothed; pixel_std its floor; needs pose_refine; issue 25)
+        ours: raise pixel_std to the keypoint noise estimated online from the pose refinement's disparity residuals (per frame, given the landmarks' covariances; smoothed; pixel_std its floor; needs pose_refine; issue 25)
     pixel_std_smoothing : float
         ours: weight of a frame's noise estimate in the running one
     subpixel_stereo : bool or None
@@ -182,8 +182,8 @@ class StereoParams(Params):
     max_depth_m: float = param(10.0, "ours: the 6x8 m arena (KITTI: 40, see run_kitti)")
     pixel_std: float = param(0.5, "ours: pixel error behind a stereo point's covariance")
     pixel_std_estimate: bool = param(False, "ours: raise pixel_std to the keypoint noise estimated online from the "
-                                            "pose refinement's stereo reprojection residuals (1.4826 MAD per frame, "
-                                            "smoothed; pixel_std its floor; needs pose_refine; issue 25)")
+                                            "pose refinement's disparity residuals (per frame, given the landmarks' "
+                                            "covariances; smoothed; pixel_std its floor; needs pose_refine; issue 25)")
     pixel_std_smoothing: float = param(0.2, "ours: weight of a frame's noise estimate in the running one")
     subpixel_stereo: bool | None = param(None, "ours: refine each match's disparity by a patch search along the row "
                                                "(rectified rigs); None: for ORB only, whose pyramid keypoints are off by "

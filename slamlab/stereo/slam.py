@@ -314,7 +314,7 @@ class StereoSLAM:
             if est.converged and p.pose_refine == "reprojection":
                 ids, loc = _refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
                 pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
-                est = est._replace(T=self._noise.refine(est.T, self.X[ids], pts_left, self.rig, self.T_body_left))
+                est = est._replace(T=self._noise.refine(self, est.T, ids, pts_left))
             if not est.converged:
                 rec["status"], est = "ransac_failed", None
             elif p.max_rot_std_rad is not None:
