@@ -24,7 +24,7 @@ from .experiments import (
 )
 from .heading import heading_frames
 from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
-from .noise_estimate import robust_pixel_std, stereo_residuals_px
+from .noise_estimate import disparity_noise_px, robust_pixel_std, stereo_residuals_px
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
 from .scale_ablation import (
     ABLATION_BASE,
@@ -86,6 +86,7 @@ __all__ = [
     "default_store",
     "detect_features",
     "disparity_errors",
+    "disparity_noise_px",
     "estimate_pose",
     "experiment_poses",
     "heading_frames",
