@@ -159,34 +159,40 @@ def disparity_noise_px(disparity_residuals_px, landmark_var_px2=None) -> float:
 class _NoiseTracker:
     """The running keypoint-noise estimate of one :class:`~slamlab.stereo.StereoSLAM` (``pixel_std_estimate``).
 
-    ``params`` is the user's settings with ``pixel_std`` replaced by the estimate; ``refine`` runs the pose
-    refinement and feeds its disparity residuals to the estimate. ``history`` holds each frame's raw estimate."""
+    ``current(params)`` is ``params`` with ``pixel_std`` raised to the estimate (``params`` itself when the
+    option is off); ``refine`` runs the pose refinement and feeds its disparity residuals to the estimate.
+    ``history`` holds each frame's raw estimate."""
 
     def __init__(self, params: StereoParams):
-        self.nominal = params
-        self.params = params
         self.sigma_px = params.pixel_std
         self.history: list[float] = []
+        self._cache: tuple = (None, None, None)
+
+    def current(self, params: StereoParams) -> StereoParams:
+        if not params.pixel_std_estimate:
+            return params
+        sigma = max(params.pixel_std, self.sigma_px)
+        if self._cache[0] is not params or self._cache[1] != sigma:
+            self._cache = (params, sigma, params.replace(pixel_std=sigma))
+        return self._cache[2]
 
     def refine(self, slam, T_body, ids, pts_left):
         """The refined pose of ``slam``'s landmarks ``ids`` matched by the left-camera points ``pts_left``."""
-        p, rig, T_bl = self.nominal, slam.rig, slam.T_body_left
+        p, rig, T_bl = slam.params, slam.rig, slam.T_body_left
         X = slam.X[ids]
         T = _refine_body_pose(T_body, X, pts_left, rig, T_bl, p.refine_iters, p.refine_huber_px, p.min_depth_m)
         if p.pixel_std_estimate:
-            self.observe(*_disparity_residuals(T, X, slam.P[ids], pts_left, rig, T_bl))
+            self.observe(*_disparity_residuals(T, X, slam.P[ids], pts_left, rig, T_bl), smoothing=p.pixel_std_smoothing)
         return T
 
-    def observe(self, disparity_residuals_px, landmark_var_px2=None):
+    def observe(self, disparity_residuals_px, landmark_var_px2=None, smoothing=0.2):
         """One frame's disparity residuals [px] (and their landmarks' variances [px²]): update the estimate."""
         r = np.asarray(disparity_residuals_px, dtype=float)
         if np.isfinite(r).sum() < MIN_RESIDUALS:
             return
         s = disparity_noise_px(r, landmark_var_px2)
         self.history.append(s)
-        a = self.nominal.pixel_std_smoothing
-        self.sigma_px = (1.0 - a) * self.sigma_px + a * s
-        self.params = self.nominal.replace(pixel_std=max(self.nominal.pixel_std, self.sigma_px))
+        self.sigma_px = (1.0 - smoothing) * self.sigma_px + smoothing * s
 
 
 def _disparity_residuals(T_body, X_map, P_map, pts_left, rig, T_body_left):

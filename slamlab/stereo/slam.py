@@ -150,7 +150,7 @@ class StereoSLAM:
 
     def _process(self, fl, fr, left, right, clock) -> FrameRecord:
         """The stages after detection; ``left``/``right`` images (None: no disparity refinement)."""
-        p = self._noise.params
+        p = self._noise.current(self.params)
         _check_features(fl, "left features")
         _check_features(fr, "right features")
         clock.lap("detect")
@@ -212,7 +212,7 @@ class StereoSLAM:
 
         Returns the mask of the local points that were inliers of the pose.
         """
-        p = self._noise.params
+        p = self._noise.current(self.params)
         rec["status"] = "ok"
         self.T = est.T
         # refine re-seen landmarks with the static Kalman filter (000 §3.6)
@@ -297,7 +297,7 @@ class StereoSLAM:
     def _pose(self, rec, clock, mm, pts_body, cov_body, depth, search):
         """The pose of map matches ``mm`` (000 §3.5) with our checks; ``(mm, estimate or None)``, ``rec.status``
         saying why when None. Each attempt goes to ``rec["trail"]``: "search matches outcome" (``search``: which)."""
-        p = self._noise.params
+        p = self._noise.current(self.params)
         rec["n_map_matches"], rec["rot_std_rad"], est = len(mm.local), np.nan, None
         if len(mm.local) < max(3, p.min_inliers):
             rec["status"] = "too_few_matches"
@@ -376,7 +376,7 @@ class StereoSLAM:
     def _refine_landmarks_in_pixels(self, ids, pts_left, T_wc, pose_var) -> np.ndarray:
         """``filter_space='pixels'``: landmarks ``ids`` updated in the stereo pixels of the left camera at
         ``T_wc`` (``landmark_filter._pixel_update``); returns the mask of the updated ones."""
-        p = self._noise.params
+        p = self._noise.current(self.params)
         ok, X_new, P_new = _pixel_update(self.X[ids], self.P[ids], pts_left, T_wc, pose_var, self.rig, p.state_var,
                                          p.pixel_std, p.min_depth_m, p.update_gate)
         self.X[ids[ok]], self.P[ids[ok]] = X_new, P_new

@@ -117,18 +117,21 @@ def test_tracker_smooths_and_floors_the_estimate():
     tr = _NoiseTracker(p)
     g = np.random.default_rng(3)
     for _ in range(40):  # 0.8^40 = 1e-4 of the start left
-        tr.observe(np.sqrt(2) * g.normal(0.0, 1.2, 4000))
+        tr.observe(np.sqrt(2) * g.normal(0.0, 1.2, 4000), smoothing=0.2)
     assert tr.sigma_px == pytest.approx(1.2, rel=0.03)
-    assert tr.params.pixel_std == tr.sigma_px
-    assert tr.params.update_gate == p.update_gate
-    assert tr.nominal is p
+    q = tr.current(p)
+    assert q.pixel_std == tr.sigma_px
+    assert q.update_gate == p.update_gate
+    assert tr.current(p) is q  # cached while nothing changes
+    off = p.replace(pixel_std_estimate=False)
+    assert tr.current(off) is off
     n = len(tr.history)
     tr.observe(g.normal(0.0, 1.2, MIN_RESIDUALS - 1))
     assert len(tr.history) == n
     for _ in range(60):
-        tr.observe(np.sqrt(2) * g.normal(0.0, 0.1, 4000))
+        tr.observe(np.sqrt(2) * g.normal(0.0, 0.1, 4000), smoothing=0.2)
     assert tr.sigma_px == pytest.approx(0.1, rel=0.05)
-    assert tr.params.pixel_std == p.pixel_std  # the floor
+    assert tr.current(p).pixel_std == p.pixel_std  # the floor
 
 
 def test_params_are_checked():
@@ -153,7 +156,7 @@ def test_off_by_default_and_near_the_injected_noise_on_the_highway():
         slam.process_features(*scene.observe(pose, pixel_std=1.0, rng=g))
     assert slam.params is p
     assert len(slam._noise.history) == 10
-    assert slam._noise.params.pixel_std == pytest.approx(1.0, rel=0.2)
+    assert slam._noise.current(slam.params).pixel_std == pytest.approx(1.0, rel=0.2)
 
 
 def test_kitti_params_meet_the_goal_at_one_pixel_noise():
