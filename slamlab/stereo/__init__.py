@@ -24,6 +24,7 @@ from .experiments import (
 )
 from .heading import heading_frames
 from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
+from .noise_estimate import disparity_noise_px, robust_pixel_std, stereo_residuals_px
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
 from .scale_ablation import (
     ABLATION_BASE,
@@ -85,6 +86,7 @@ __all__ = [
     "default_store",
     "detect_features",
     "disparity_errors",
+    "disparity_noise_px",
     "estimate_pose",
     "experiment_poses",
     "heading_frames",
@@ -95,6 +97,7 @@ __all__ = [
     "pose_std",
     "record_stereo_stream",
     "refine_pose_stereo",
+    "robust_pixel_std",
     "run_closed_loop",
     "run_comparison",
     "run_drift_study",
@@ -106,6 +109,7 @@ __all__ = [
     "select_oldest",
     "stereo_match",
     "stereo_point_cov",
+    "stereo_residuals_px",
     "subpixel_disparity",
     "triangulate_local",
 ]

@@ -66,6 +66,10 @@ class StereoParams(Params):
         ours: the 6x8 m arena (KITTI: 40, see run_kitti)
     pixel_std : float
         ours: pixel error behind a stereo point's covariance
+    pixel_std_estimate : bool
+        ours: raise pixel_std to the keypoint noise estimated online from the pose refinement's disparity residuals (per frame, given the landmarks' covariances; smoothed; pixel_std its floor; needs pose_refine; issue 25)
+    pixel_std_smoothing : float
+        ours: weight of a frame's noise estimate in the running one
     subpixel_stereo : bool or None
         ours: refine each match's disparity by a patch search along the row (rectified rigs); None: for ORB only, whose pyramid keypoints are off by up to 1.2^L / 2 px
     subpixel_half_px : int
@@ -177,6 +181,10 @@ class StereoParams(Params):
     min_depth_m: float = param(0.3, "ours")
     max_depth_m: float = param(10.0, "ours: the 6x8 m arena (KITTI: 40, see run_kitti)")
     pixel_std: float = param(0.5, "ours: pixel error behind a stereo point's covariance")
+    pixel_std_estimate: bool = param(False, "ours: raise pixel_std to the keypoint noise estimated online from the "
+                                            "pose refinement's disparity residuals (per frame, given the landmarks' "
+                                            "covariances; smoothed; pixel_std its floor; needs pose_refine; issue 25)")
+    pixel_std_smoothing: float = param(0.2, "ours: weight of a frame's noise estimate in the running one")
     subpixel_stereo: bool | None = param(None, "ours: refine each match's disparity by a patch search along the row "
                                                "(rectified rigs); None: for ORB only, whose pyramid keypoints are off by "
                                                "up to 1.2^L / 2 px")
@@ -258,6 +266,12 @@ class StereoParams(Params):
         if v.check_positive(self.max_depth_m, "max_depth_m") <= self.min_depth_m:
             raise ValueError(f"`max_depth_m` must exceed `min_depth_m` = {self.min_depth_m}; got {self.max_depth_m}")
         v.check_positive(self.pixel_std, "pixel_std")
+        if not isinstance(self.pixel_std_estimate, bool):
+            raise TypeError(f"`pixel_std_estimate` must be a bool; got {type(self.pixel_std_estimate).__name__}")
+        if not 0 < v.check_positive(self.pixel_std_smoothing, "pixel_std_smoothing") <= 1:
+            raise ValueError(f"`pixel_std_smoothing` must be in (0, 1]; got {self.pixel_std_smoothing}")
+        if self.pixel_std_estimate and self.pose_refine != "reprojection":
+            raise ValueError("`pixel_std_estimate` needs `pose_refine='reprojection'` (its residuals give the estimate)")
         if v.check_positive(self.reobserve_depth_factor, "reobserve_depth_factor") < 1:
             raise ValueError(f"`reobserve_depth_factor` must be at least 1; got {self.reobserve_depth_factor}")
         if self.subpixel_stereo is not None and not isinstance(self.subpixel_stereo, bool):

@@ -24,6 +24,8 @@ from .slam import StereoSLAM
 __all__ = ["ABLATION_BASE", "CONDITION_SETTINGS", "PROPOSED_FIX", "PROPOSED_FIX_OFF", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
            "run_scale_ablation"]
 
+_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True, "refine_min_seen": 2}
+
 #: the settings of the ablation: label -> overrides of ABLATION_BASE (``pixel_std_obs``: the scene's keypoint noise);
 #: 'measured' / 'map': the depth behind a match's weight in the pose (``weight_depth``) and an observation's
 #: covariance in the landmark filter (``update_cov_depth``); 'true' and ``_oracle``: the simulator's truth
@@ -58,31 +60,37 @@ SCALE_ABLATION = {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "_oracle": ("init_position",)},
     "refined pose + 1.5 x the cut + second sighting replaces the first": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True},
-    "... + refinement on landmarks seen twice (PROPOSED_FIX: today's KITTI_PARAMS)": {
+    "... + refinement on landmarks seen twice (PROPOSED_FIX: KITTI_PARAMS of stop 37)": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
         "refine_min_seen": 2},
+    # the noise model (stop 38): the filter's pixel_std (0.5 px) against the scene's keypoint noise
+    "PROPOSED_FIX + pixel_std 1 px (the 1 px scene's noise: an oracle there)": {**_FIX, "pixel_std": 1.0},
+    "PROPOSED_FIX + no innovation gate in the landmark filter": {**_FIX, "update_gate": None},
+    "PROPOSED_FIX + Huber threshold 4 px": {**_FIX, "refine_huber_px": 4.0},
+    "PROPOSED_FIX + pixel_std estimated online (today's KITTI_PARAMS)": {**_FIX, "pixel_std_estimate": True},
 }
 
 #: the options stop 37 proposes against the displacement underestimate (issue 25): the pose refined on the
 #: stereo reprojection error of the landmarks seen at least twice; points up to 1.5 x ``max_depth_m`` matched to
 #: landmarks (not made new ones); a landmark's second sighting replaces its first triangulation, which the depth
 #: cut selected on its own noisy depth
-PROPOSED_FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
-                "refine_min_seen": 2}
+PROPOSED_FIX = dict(_FIX)
 
 #: the base of the ablations: :data:`~slamlab.stereo.KITTI_PARAMS` without ``PROPOSED_FIX`` (its options at
 #: :class:`StereoParams`' defaults), i.e. KITTI_PARAMS as it was until stop 37 made the fix part of it; every row
 #: of :data:`SCALE_ABLATION` and :data:`CONDITION_SETTINGS` overrides this
 #: ``PROPOSED_FIX``'s options at :class:`StereoParams`' defaults: overrides that turn the fix off
-PROPOSED_FIX_OFF = {k: getattr(StereoParams(), k) for k in PROPOSED_FIX}
+#: (stop 38: and the online noise estimate, which needs the refinement)
+PROPOSED_FIX_OFF = {k: getattr(StereoParams(), k) for k in (*PROPOSED_FIX, "pixel_std_estimate")}
 ABLATION_BASE = KITTI_PARAMS.replace(**PROPOSED_FIX_OFF)
 
-#: the settings of :func:`run_condition_ablation`: the defaults before issue 25, KITTI_PARAMS of stop 36 and
-#: today's (with PROPOSED_FIX)
+#: the settings of :func:`run_condition_ablation`: the defaults before issue 25, KITTI_PARAMS of stop 36, of
+#: stop 37 (with PROPOSED_FIX) and today's (with the noise estimated online, stop 38)
 CONDITION_SETTINGS = {
     "old defaults (measured depth)": {"weight_depth": "measured", "update_cov_depth": "measured"},
     "KITTI_PARAMS of stop 36": {},
-    "KITTI_PARAMS (+ PROPOSED_FIX)": PROPOSED_FIX,
+    "KITTI_PARAMS of stop 37 (+ PROPOSED_FIX)": PROPOSED_FIX,
+    "KITTI_PARAMS (+ pixel_std estimated online)": {**PROPOSED_FIX, "pixel_std_estimate": True},
 }
 
 

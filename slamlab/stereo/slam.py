@@ -32,8 +32,9 @@ from .frame import (
 from .landmark_filter import _duplicates, _gated_update, _in_view, _observations, _pixel_update
 from .local_stages import _check_features, _stereo_match, is_rectified
 from .map_stages import _match_to_map, _matches_from_knn, _window_candidates, _window_match
+from .noise_estimate import _NoiseTracker
 from .params import StereoParams
-from .pose_stages import _estimate_pose, _refine_body_pose, _refine_matches, _weight_depth, pose_std
+from .pose_stages import _estimate_pose, _refine_matches, _weight_depth, pose_std
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
 
@@ -74,6 +75,7 @@ class StereoSLAM:
         self.T_body_left = np.eye(4) if T_body_left is None else v.as_matrix(T_body_left, "T_body_left", (4, 4))
         self.params = p = StereoParams.resolve(params, **overrides)
         self.store = _resolve_store(store, p)
+        self._noise = _NoiseTracker(p)  # pixel_std: the nominal, or raised to the online estimate (pixel_std_estimate)
         self.rng = v.as_rng(rng)
         self._detect_kwargs = p.detect_kwargs()
         self._image_shape = (rig.left.height_px, rig.left.width_px)
@@ -148,7 +150,7 @@ class StereoSLAM:
 
     def _process(self, fl, fr, left, right, clock) -> FrameRecord:
         """The stages after detection; ``left``/``right`` images (None: no disparity refinement)."""
-        p = self.params
+        p = self._noise.current(self.params)
         _check_features(fl, "left features")
         _check_features(fr, "right features")
         clock.lap("detect")
@@ -210,7 +212,7 @@ class StereoSLAM:
 
         Returns the mask of the local points that were inliers of the pose.
         """
-        p = self.params
+        p = self._noise.current(self.params)
         rec["status"] = "ok"
         self.T = est.T
         # refine re-seen landmarks with the static Kalman filter (000 §3.6)
@@ -295,7 +297,7 @@ class StereoSLAM:
     def _pose(self, rec, clock, mm, pts_body, cov_body, depth, search):
         """The pose of map matches ``mm`` (000 §3.5) with our checks; ``(mm, estimate or None)``, ``rec.status``
         saying why when None. Each attempt goes to ``rec["trail"]``: "search matches outcome" (``search``: which)."""
-        p = self.params
+        p = self._noise.current(self.params)
         rec["n_map_matches"], rec["rot_std_rad"], est = len(mm.local), np.nan, None
         if len(mm.local) < max(3, p.min_inliers):
             rec["status"] = "too_few_matches"
@@ -312,8 +314,7 @@ class StereoSLAM:
             if est.converged and p.pose_refine == "reprojection":
                 ids, loc = _refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
                 pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
-                est = est._replace(T=_refine_body_pose(est.T, self.X[ids], pts_left, self.rig, self.T_body_left,
-                                                       p.refine_iters, p.refine_huber_px, p.min_depth_m))
+                est = est._replace(T=self._noise.refine(self, est.T, ids, pts_left))
             if not est.converged:
                 rec["status"], est = "ransac_failed", None
             elif p.max_rot_std_rad is not None:
@@ -375,7 +376,7 @@ class StereoSLAM:
     def _refine_landmarks_in_pixels(self, ids, pts_left, T_wc, pose_var) -> np.ndarray:
         """``filter_space='pixels'``: landmarks ``ids`` updated in the stereo pixels of the left camera at
         ``T_wc`` (``landmark_filter._pixel_update``); returns the mask of the updated ones."""
-        p = self.params
+        p = self._noise.current(self.params)
         ok, X_new, P_new = _pixel_update(self.X[ids], self.P[ids], pts_left, T_wc, pose_var, self.rig, p.state_var,
                                          p.pixel_std, p.min_depth_m, p.update_gate)
         self.X[ids[ok]], self.P[ids[ok]] = X_new, P_new
