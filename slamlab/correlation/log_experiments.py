@@ -30,7 +30,7 @@ from .experiments import (
     Table1Result,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
-from .log_truth import _TRUTH_COLUMNS, _failure_table, _localise_log_scan, _truth_frame
+from .log_truth import _TRUTH_COLUMNS, _failure_table, _localise_log_scan, _terms_table, _truth_frame
 from .settings import _check_score_norm
 from .studies import _errors
 
@@ -181,6 +181,27 @@ class LogLocalisationResult:
         str
         """
         return _failure_table(self)
+
+    def terms_table(self, scans=None) -> str:
+        """The score taken apart at the estimate and near the truth (ours, issue 25; needs ``truth_check=True``).
+
+        Per case and mode: the four signed terms of the score (obstacle marks on map obstacles / on map free
+        cells, free marks on map free cells / on map obstacles; :func:`~slamlab.correlation.score_terms`) and the
+        marks on unexplored cells (which count nothing), at the estimate and at the best grid pose within the
+        success tolerance of the logged pose, and their difference; for the truth also where its obstacle marks
+        on unexplored cells come from: seen by a left-out scan 1 or 2 steps away in the log, or by no other scan.
+
+        Parameters
+        ----------
+        scans : sequence of int, optional
+            The scans to show; default every failure and, per mode, the success with the median fraction of end
+            points on walls at the truth.
+
+        Returns
+        -------
+        str
+        """
+        return _terms_table(self, scans)
 
     def __str__(self) -> str:
         ok = self.success
