@@ -56,7 +56,8 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
 
 #: Where the truth's marks on unexplored cells come from (:func:`_unexplored_origin`): obstacle / free marks
 #: on a cell a left-out scan 1 or 2 steps away saw, or no other scan.
-_ORIGIN_COLUMNS = tuple(f"unex_{kind}_{w}" for kind in ("obs", "free") for w in ("1", "2", "none"))
+#: ``conf_obs_…``: obstacle marks on map free cells that a left-out scan 1 or 2 steps away hit, or none did.
+_ORIGIN_COLUMNS = tuple(f"{what}_{w}" for what in ("unex_obs", "unex_free", "conf_obs") for w in ("1", "2", "none"))
 #: Columns of :func:`_truth_check` (per mode) and of :meth:`LogLocalisationResult.truth_check`: the scores, the
 #: wall fractions, the score's terms (:mod:`slamlab.correlation.score_terms`) at the estimate (``est_…``) and at
 #: the best grid pose near the truth (``truth_…``), and the origin of the truth's unexplored obstacle marks.
@@ -64,30 +65,34 @@ _TRUTH_COLUMNS = ("score_est", "score_truth", "score_est_fine", "score_truth_fin
                   *(f"{w}_{t}" for w in ("est", "truth") for t in (*TERM_NAMES, *COUNT_NAMES)), *_ORIGIN_COLUMNS)
 
 
-def _explored(scan_c, pose_c, shape) -> np.ndarray:
-    """Cells one scan (cells, at ``pose_c``) hit or passed through (:func:`~slamlab.scans.occupancy_grid`)."""
+def _explored(scan_c, pose_c, shape) -> tuple[np.ndarray, np.ndarray]:
+    """Cells one scan (cells, at ``pose_c``) hit or passed through, and the cells it hit
+    (:func:`~slamlab.scans.occupancy_grid`)."""
     og = occupancy_grid([scan_c], np.asarray(pose_c)[None], shape)
-    return (og.hits > 0) | (og.passes > 0)
+    return (og.hits > 0) | (og.passes > 0), og.hits > 0
 
 
-def _unexplored_origin(marks, shape, left_out_seen) -> dict:
-    """The marks of ``marks`` on unexplored cells (map value 0), obstacle and free ones apart: how many lie on a
-    cell that a scan left out of the grid (other than the joined ones) saw, by its nearest such scan's distance
-    in the log (1 or 2 scans; farther ones drew the grid), and how many no other scan saw (or lie outside the
-    map): ``unex_{obs,free}_{1,2,none}``."""
+def _unexplored_origin(marks, shape, left_out_seen, a_c: float) -> dict:
+    """Where ``marks`` lack map (ours, issue 25). Its marks on unexplored cells (map value 0), obstacle and free
+    ones apart (``unex_obs_…``, ``unex_free_…``): how many lie on a cell that a scan left out of the grid (other
+    than the joined ones) saw, by its nearest such scan's distance in the log (``…_1``, ``…_2``; farther ones drew
+    the grid), and how many no other scan saw or lie outside the map (``…_none``). Its obstacle marks on map free
+    cells (value ``a_c``; ``conf_obs_…``): the same for a left-out scan that *hit* the cell. ``left_out_seen``:
+    ``(offset in the log, (explored, hit) masks)`` per left-out scan."""
     H, W = shape
     out = {}
-    for kind, sel in (("obs", marks.is_obs), ("free", ~marks.is_obs)):
-        u = sel & (marks.map == 0)
-        r, c = marks.row[u], marks.col[u]
+    for what, sel, which in (("unex_obs", marks.is_obs & (marks.map == 0), 0),
+                             ("unex_free", ~marks.is_obs & (marks.map == 0), 0),
+                             ("conf_obs", marks.is_obs & (marks.map == a_c), 1)):
+        r, c = marks.row[sel], marks.col[sel]
         inside = (r >= 0) & (r < H) & (c >= 0) & (c < W)
         nearest = np.full(r.size, np.inf)
-        for off, seen in left_out_seen:
+        for off, masks in left_out_seen:
             hit = np.zeros(r.size, dtype=bool)
-            hit[inside] = seen[r[inside], c[inside]]
+            hit[inside] = masks[which][r[inside], c[inside]]
             nearest = np.where(hit, np.minimum(nearest, abs(off)), nearest)
-        out.update({f"unex_{kind}_1": int(np.sum(nearest == 1)), f"unex_{kind}_2": int(np.sum(nearest == 2)),
-                    f"unex_{kind}_none": int(np.sum(~np.isfinite(nearest) | (nearest > 2)))})
+        out.update({f"{what}_1": int(np.sum(nearest == 1)), f"{what}_2": int(np.sum(nearest == 2)),
+                    f"{what}_none": int(np.sum(~np.isfinite(nearest) | (nearest > 2)))})
     return out
 
 
@@ -167,7 +172,7 @@ def _truth_check(Mv, grid, free, obs, obs_weights, headings, est_pose, truth_pos
     return {"score_est": score_est, "score_truth": score_truth, "score_est_fine": est_fine,
             "score_truth_fine": truth_fine, "walls_truth": _walls_fraction(grid, scans_c, true_poses_c),
             "walls_est": _walls_fraction(grid, scans_c, est_poses), **terms,
-            **_unexplored_origin(marks["truth"], grid.shape, left_out_seen)}
+            **_unexplored_origin(marks["truth"], grid.shape, left_out_seen, p.a_c)}
 
 
 def _truth_frame(res):
@@ -240,8 +245,8 @@ def _terms_table(res, scans=None) -> str:
             vals[who].append(n_obs)
         score = {"est": r["score_est"], "truth": r["score_truth"]}
         head = [int(r["scan"]), res._mode(int(r["joined"])), case, f"{r['err_m']:.1f} m {r['err_deg']:.0f}°"]
-        origin = "; ".join(" / ".join(str(int(r[f"unex_{kind}_{w}"])) for w in ("1", "2", "none"))
-                           for kind in ("obs", "free"))
+        origin = "; ".join(" / ".join(str(int(r[f"{what}_{w}"])) for w in ("1", "2", "none"))
+                           for what in ("unex_obs", "unex_free", "conf_obs"))
         for who, label in (("est", "estimate"), ("truth", "truth (best near)")):
             rows.append([*head, label, f"{score[who]:.0f}", *(f"{x:+.0f}" for x in vals[who][:4]),
                          *(f"{x:.0f}" for x in vals[who][4:]), origin if who == "truth" else ""])
@@ -250,10 +255,11 @@ def _terms_table(res, scans=None) -> str:
                      ""])
     return format_table(["scan", "mode", "case", "error", "pose", "score", "obs. on obs.", "obs. on free",
                          "free on free", "free on obs.", "obs. marks unexpl.", "free marks unexpl.", "obs. marks",
-                         "unexpl. marks (obs.; free) seen by ±1 / ±2 / no other scan"], rows,
+                         "origin ±1 / ±2 / none: unexpl. obs.; unexpl. free; obs. on free"], rows,
                         title=(f"{res.name}: the score's terms (a_c = {res.params.a_c:g}, a_p = {res.params.a_p:g}; "
                                "score = the four signed terms) at the estimate and at the best grid pose within "
                                f"{FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the logged pose; unexpl. = on unexplored "
-                               f"cells of the leave-out grid (±{res.exclude} scans), which count 0; the last column: "
-                               "the truth's obstacle and free marks on unexplored cells that a left-out scan 1 or 2 "
-                               "steps away saw (the leave-out removed them) or no other scan saw"))
+                               f"cells of the leave-out grid (±{res.exclude} scans), which count 0; origin: the truth's "
+                               "obstacle and free marks on unexplored cells that a left-out scan 1 or 2 steps away "
+                               "saw (the leave-out removed them) or no other scan saw, and its obstacle marks on map "
+                               "free cells that such a scan hit"))

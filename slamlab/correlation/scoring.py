@@ -384,7 +384,7 @@ def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, 
 class _Marks:
     """The marked stamp cells of one pose (:func:`_pose_marks`): each cell once, the last write winning."""
 
-    __slots__ = ("row", "col", "stamp", "map", "is_obs")
+    __slots__ = ("col", "is_obs", "map", "row", "stamp")
 
     def __init__(self, row, col, stamp, map_, is_obs):
         self.row, self.col, self.stamp, self.map, self.is_obs = row, col, stamp, map_, is_obs
