@@ -18,6 +18,7 @@ from ..scans.occupancy import label_counts, occupancy_grid
 from .algorithm import LocaliseParams, _joined_samples, _localise_samples, _wall_weights, heading_error
 from .experiments import FAIL_CELLS, FAIL_DEG
 from .score_terms import COUNT_NAMES, TERM_NAMES, _terms_of
+from .settings import _stamp_a_c
 
 __all__: list[str] = []
 
@@ -151,21 +152,22 @@ def _truth_check(Mv, grid, free, obs, obs_weights, headings, est_pose, truth_pos
     from .scoring import _pose_marks, _pose_scores
 
     a_p = p.a_p if obs_weights is None else p.a_p * np.asarray(obs_weights, dtype=float)
+    a_c = _stamp_a_c(p)  # the stamp's free marks (the map keeps p.a_c)
     tol_c, tol_h = FAIL_CELLS, float(np.radians(FAIL_DEG))
     est = np.asarray(est_pose, dtype=float)
-    score_est = float(_pose_scores(Mv, free, obs, p.a_c, a_p, est[None])[0])
+    score_est = float(_pose_scores(Mv, free, obs, a_c, a_p, est[None])[0])
     near = _tolerance_poses(truth_pose, headings, tol_c, tol_h)
-    near_scores = _pose_scores(Mv, free, obs, p.a_c, a_p, near)
+    near_scores = _pose_scores(Mv, free, obs, a_c, a_p, near)
     best_near = near[int(np.argmax(near_scores))]
     score_truth = float(np.max(near_scores))
     failed = np.hypot(*(est[:2] - truth_pose[:2])) > tol_c + 1e-9 or heading_error(est[2], truth_pose[2]) > tol_h
     if failed:
-        est_fine = float(np.max(_pose_scores(Mv, free, obs, p.a_c, a_p, _fine_poses(est, tol_c, tol_h))))
-        truth_fine = float(np.max(_pose_scores(Mv, free, obs, p.a_c, a_p, _fine_poses(truth_pose, tol_c, tol_h))))
+        est_fine = float(np.max(_pose_scores(Mv, free, obs, a_c, a_p, _fine_poses(est, tol_c, tol_h))))
+        truth_fine = float(np.max(_pose_scores(Mv, free, obs, a_c, a_p, _fine_poses(truth_pose, tol_c, tol_h))))
     else:
         est_fine = truth_fine = float("nan")
     est_poses = np.array([se2_compose(est, q) for q in rel])
-    marks = dict(zip(("est", "truth"), (mk for _m, mk in _pose_marks(Mv, free, obs, p.a_c, a_p,
+    marks = dict(zip(("est", "truth"), (mk for _m, mk in _pose_marks(Mv, free, obs, a_c, a_p,
                                                                       np.vstack([est, best_near]))), strict=True))
     terms = {f"{who}_{k}": val for who, mk in marks.items() for k, val in _terms_of(mk, p.a_c, p.a_p).items()
              if k != "score"}

@@ -19,6 +19,7 @@ import numpy as np
 from ..geometry.se2 import check_poses
 from ..scans import check_grid, grid_to_values
 from .algorithm import LocaliseParams, _beam_samples, _scan_beams
+from .settings import _stamp_a_c
 
 __all__ = ["TERM_NAMES", "score_terms"]
 
@@ -108,6 +109,6 @@ def score_terms(grid, scan, poses, *, params: LocaliseParams | None = None, **ov
     lim = 4 * (g.shape[0] + g.shape[1])
     if np.any(np.abs(P[:, :2]) > lim):
         raise ValueError(f"`poses` must lie within {lim} cells of the map; got {np.abs(P[:, :2]).max():.0f}")
-    rows = _score_terms(grid_to_values(g, p.a_c, p.a_p, p.a_n), free, obs, p.a_c, p.a_p, P, p.a_c, p.a_p)
+    rows = _score_terms(grid_to_values(g, p.a_c, p.a_p, p.a_n), free, obs, _stamp_a_c(p), p.a_p, P, p.a_c, p.a_p)
     return pd.DataFrame(rows, columns=[*TERM_NAMES, *COUNT_NAMES, "score"])
 
