@@ -163,3 +163,22 @@ def test_score_terms_bad_input():
         C.score_terms(M, scan, [[np.nan, 20, 0.0]])
     with pytest.raises(ValueError, match="`grid`"):
         C.score_terms(np.full((5, 5), 7), scan, [[2, 2, 0.0]])
+
+
+def test_unexplored_origin_counts_the_nearest_left_out_scan():
+    from slamlab.correlation.log_truth import _unexplored_origin
+    from slamlab.correlation.scoring import _Marks
+
+    # five marks on a 3x4 map: obstacle marks on unexplored (0, 0), (0, 1), (0, 2) and outside; a free mark on
+    # unexplored (1, 0); an obstacle mark on a map free cell (2, 3) (value a_c = -1)
+    row, col = np.array([0, 0, 0, -1, 1, 2]), np.array([0, 1, 2, 0, 0, 3])
+    marks = _Marks(row, col, np.ones(6), np.array([0, 0, 0, 0, 0, -1.0]),
+                   np.array([True, True, True, True, False, True]))
+    seen_a, hit_a = np.zeros((3, 4), bool), np.zeros((3, 4), bool)
+    seen_b, hit_b = np.zeros((3, 4), bool), np.zeros((3, 4), bool)
+    seen_a[0, 0] = seen_a[1, 0] = True  # the scan 2 steps away saw (0, 0) and (1, 0)
+    seen_b[0, 0] = seen_b[0, 1] = True  # the scan 1 step back saw (0, 0) and (0, 1) and hit (2, 3)
+    seen_b[2, 3] = hit_b[2, 3] = True
+    out = _unexplored_origin(marks, (3, 4), [(2, (seen_a, hit_a)), (-1, (seen_b, hit_b))], -1.0)
+    assert out == {"unex_obs_1": 2, "unex_obs_2": 0, "unex_obs_none": 2, "unex_free_1": 0, "unex_free_2": 1,
+                   "unex_free_none": 0, "conf_obs_1": 1, "conf_obs_2": 0, "conf_obs_none": 0}
