@@ -5,11 +5,11 @@ With 004's constants the map holds free cells (``a_c``), obstacle cells (``a_p``
 ``Σ T·M`` is therefore the sum of four non-zero terms — obstacle marks on map obstacles (``a_p·a_p`` > 0) and
 on map free cells (``a_p·a_c`` < 0), free marks on map free cells (``a_c·a_c`` > 0) and on map obstacles
 (``a_c·a_p`` < 0) — while marks on unexplored cells count nothing. :func:`score_terms` returns the four terms
-and the marks of each kind; the log runs' truth check (:meth:`LogLocalisationResult.terms_table`) prints them
-at the estimate and near the logged pose of failures. A truth whose obstacle marks fall on unexplored cells
-lacks map (no score over this map can reward it); one whose free marks cross map obstacles or whose obstacle
-marks fall on map free cells is in conflict with the map; a wrong pose may win by many free marks agreeing in
-open space.
+and the marks of each kind; the log runs' truth check
+(:meth:`~slamlab.correlation.LogLocalisationResult.terms_table`) prints them at the estimate and near the logged
+pose of failures. A truth whose marks fall on unexplored cells lacks map (the score gives it nothing there); one
+whose free marks cross map obstacles or whose obstacle marks fall on map free cells is in conflict with the map;
+a wrong pose may win by many free marks agreeing in open space.
 """
 
 from __future__ import annotations
