@@ -30,7 +30,7 @@ from .experiments import (
 from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, ours_vs_source, run_log_localisation
 from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, run_log_suite
 from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
-from .score_terms import TERM_NAMES, score_terms
+from .terms import TERM_NAMES, score_terms
 
 _PLOT = (
     "constants_figure",

@@ -17,8 +17,8 @@ from ..scans.logmap import leave_out_grid
 from ..scans.occupancy import label_counts, occupancy_grid
 from .algorithm import LocaliseParams, _joined_samples, _localise_samples, _wall_weights, heading_error
 from .experiments import FAIL_CELLS, FAIL_DEG
-from .score_terms import COUNT_NAMES, TERM_NAMES, _terms_of
 from .settings import _stamp_a_c
+from .terms import COUNT_NAMES, TERM_NAMES, _terms_of
 
 __all__: list[str] = []
 
@@ -60,7 +60,7 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
 #: ``conf_obs_…``: obstacle marks on map free cells that a left-out scan 1 or 2 steps away hit, or none did.
 _ORIGIN_COLUMNS = tuple(f"{what}_{w}" for what in ("unex_obs", "unex_free", "conf_obs") for w in ("1", "2", "none"))
 #: Columns of :func:`_truth_check` (per mode) and of :meth:`LogLocalisationResult.truth_check`: the scores, the
-#: wall fractions, the score's terms (:mod:`slamlab.correlation.score_terms`) at the estimate (``est_…``) and at
+#: wall fractions, the score's terms (:mod:`slamlab.correlation.terms`) at the estimate (``est_…``) and at
 #: the best grid pose near the truth (``truth_…``), and the origin of the truth's unexplored obstacle marks.
 _TRUTH_COLUMNS = ("score_est", "score_truth", "score_est_fine", "score_truth_fine", "walls_truth", "walls_est",
                   *(f"{w}_{t}" for w in ("est", "truth") for t in (*TERM_NAMES, *COUNT_NAMES)), *_ORIGIN_COLUMNS)
