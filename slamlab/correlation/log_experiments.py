@@ -367,8 +367,9 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     truth_check : bool, default False
         Also score each scan near its logged pose with the search's own score (ours, issue 25): is a failure a
         score failure (the truth scores lower than the estimate) or a search failure?
-        :meth:`~slamlab.correlation.LogLocalisationResult.truth_check` tabulates it. Needs ``a_n = 0`` (004's
-        value).
+        :meth:`~slamlab.correlation.LogLocalisationResult.truth_check` tabulates it and
+        :meth:`~slamlab.correlation.LogLocalisationResult.terms_table` the score's four terms at the estimate and
+        near the truth (:func:`~slamlab.correlation.score_terms`). Needs ``a_n = 0`` (004's value).
     refine : int, default 0
         Off by default. ``refine`` > 0 (ours, issue 25): score the ``refine`` best distinct peaks of the grid
         search (more than 2 cells or 3° apart) again every 0.5 cell within 1 cell and every 0.5° within
