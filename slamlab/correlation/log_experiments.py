@@ -167,8 +167,12 @@ class LogLocalisationResult:
             One row per mode and scan: ``scan``, ``joined``, ``ok``, ``err_m``, ``err_deg``, the scores
             ``score_est``, ``score_truth`` (grid) and ``score_est_fine``, ``score_truth_fine`` (off the grid;
             NaN for a success), ``walls_truth`` / ``walls_est`` (fraction of the joined scans' end points on
-            obstacle cells of the scan's leave-out grid at the logged poses / at the estimate) and ``kind``
-            (``"ok"`` for a success).
+            obstacle cells of the scan's leave-out grid at the logged poses / at the estimate), ``kind``
+            (``"ok"`` for a success), the score's terms and mark counts at the estimate (``est_obs_on_obs``, …,
+            ``est_n_free_unexplored``) and at the best grid pose near the truth (``truth_…``; the names of
+            :func:`~slamlab.correlation.score_terms`), and where the latter's marks on unexplored cells and its
+            obstacle marks on map free cells come from (``unex_obs_…``, ``unex_free_…``, ``conf_obs_…`` with
+            ``1`` / ``2``: a left-out scan that many steps away saw / hit the cell, ``none``: no other scan).
         """
         return _truth_frame(self)
 
