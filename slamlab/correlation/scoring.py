@@ -382,12 +382,37 @@ def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, 
 
 
 class _Marks:
-    """The marked stamp cells of one pose (:func:`_pose_marks`): each cell once, the last write winning."""
+    """The marked stamp cells of one pose (:func:`_pose_marks`): each cell once, the last write winning.
 
-    __slots__ = ("col", "is_obs", "map", "row", "stamp")
+    ``row`` / ``col`` (map cell, possibly outside the map), ``stamp`` (the mark's value), ``map`` (the map's
+    value there, 0 outside) and ``is_obs`` (an obstacle sample wrote it), each computed on first use.
+    """
 
-    def __init__(self, row, col, stamp, map_, is_obs):
-        self.row, self.col, self.stamp, self.map, self.is_obs = row, col, stamp, map_, is_obs
+    __slots__ = ("_col", "_flat", "_idx", "_kind", "_last", "_row", "_vals")
+
+    def __init__(self, last, row, col, idx, vals, kind, flat):
+        self._last, self._row, self._col, self._idx = last, row, col, idx
+        self._vals, self._kind, self._flat = vals, kind, flat
+
+    @property
+    def row(self):
+        return self._row[self._last]
+
+    @property
+    def col(self):
+        return self._col[self._last]
+
+    @property
+    def stamp(self):
+        return self._vals[self._last]
+
+    @property
+    def map(self):
+        return self._flat[self._idx[self._last]]
+
+    @property
+    def is_obs(self):
+        return self._kind[self._last]
 
 
 def _pose_marks(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p, poses):
@@ -445,4 +470,4 @@ def _pose_marks(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a
         seen[idx] = order  # the last write of a cell wins, as in the stamp
         last = (seen[idx] == order) & inside
         seen[idx] = -1
-        yield m, _Marks(row[last], col[last], vals[last], flat[idx[last]], kind[last])
+        yield m, _Marks(last, row, col, idx, vals, kind, flat)

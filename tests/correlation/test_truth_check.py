@@ -172,8 +172,8 @@ def test_unexplored_origin_counts_the_nearest_left_out_scan():
     # five marks on a 3x4 map: obstacle marks on unexplored (0, 0), (0, 1), (0, 2) and outside; a free mark on
     # unexplored (1, 0); an obstacle mark on a map free cell (2, 3) (value a_c = -1)
     row, col = np.array([0, 0, 0, -1, 1, 2]), np.array([0, 1, 2, 0, 0, 3])
-    marks = _Marks(row, col, np.ones(6), np.array([0, 0, 0, 0, 0, -1.0]),
-                   np.array([True, True, True, True, False, True]))
+    marks = _Marks(np.ones(6, bool), row, col, np.arange(6), np.ones(6), np.array([True, True, True, True, False, True]),
+                   np.array([0, 0, 0, 0, 0, -1.0]))
     seen_a, hit_a = np.zeros((3, 4), bool), np.zeros((3, 4), bool)
     seen_b, hit_b = np.zeros((3, 4), bool), np.zeros((3, 4), bool)
     seen_a[0, 0] = seen_a[1, 0] = True  # the scan 2 steps away saw (0, 0) and (1, 0)
