@@ -216,6 +216,14 @@ def _failure_table(res) -> str:
                                "0.5 cell and 0.5°); walls = end points on obstacle cells of the leave-out grid"))
 
 
+def _describe(idx) -> str:
+    """The scans of a run in words, for the tables' titles."""
+    d = np.diff(idx)
+    if idx.size > 2 and np.all(d == d[0]):
+        return f"every {int(d[0])}th from {int(idx[0])} to {int(idx[-1])}"
+    return "scans " + ", ".join(str(int(i)) for i in idx)
+
+
 def _median_success(d):
     """The row of ``d`` (one mode's :meth:`truth_check` rows) that is the success with the median wall fraction
     at the truth (the lower middle one; first scan on ties); None without a success."""

@@ -21,6 +21,14 @@ def _check_real(value, name: str) -> float:
     return float(value)
 
 
+def _check_unit(x, name: str) -> float:
+    """A number in [0, 1], named ``name`` in the error."""
+    x = v.check_positive(x, name, allow_zero=True)
+    if x > 1:
+        raise ValueError(f"`{name}` must lie in [0, 1]; got {x}")
+    return x
+
+
 def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
     """Validate 004's constants: real numbers with ``a_c ≠ a_p`` (004 §7, conditions (1)-(3)).
 
