@@ -12,6 +12,7 @@ definition on a small case; every pair must give the identical peak.
     python benchmarks/bench_correlation.py --logs --every 100 --only intel,seattle   # smaller / fewer logs
     python benchmarks/bench_correlation.py --logs --map-check   # + is each log's beam layout read right? (issue 25)
     python benchmarks/bench_correlation.py --logs --failures    # + each failure: score failure or search failure?
+    python benchmarks/bench_correlation.py --logs --failures --terms   # + the score's terms at estimate and truth
     python benchmarks/bench_correlation.py --refine-cost        # + CPU time of refine=10 (issue 25)
 """
 
@@ -124,6 +125,9 @@ def main():
     ap.add_argument("--failures", action="store_true",
                     help="with --logs: score each scan near its logged pose too and print the failures by kind "
                          "(score failure or search failure, issue 25)")
+    ap.add_argument("--terms", action="store_true",
+                    help="with --logs --failures: print the score's four terms at the estimate and near the truth "
+                         "for every failure and each mode's median success (issue 25)")
     ap.add_argument("--refine-cost", action="store_true",
                     help="CPU time of run_log_localisation with refine=10 vs without, every 25th csail scan, modes "
                          "1 and 3 (issue 25)")
@@ -215,7 +219,9 @@ def main():
         if compare:
             compare_logs(args.every, args.only, args.jobs, settings, compare)
         else:
-            logs(args.every, args.only, args.jobs, settings, args.map_check, args.failures)
+            if args.terms and not args.failures:
+                ap.error("--terms needs --failures (the truth check computes the terms)")
+            logs(args.every, args.only, args.jobs, settings, args.map_check, args.failures, args.terms)
 
 
 def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extra: dict) -> None:
@@ -252,7 +258,7 @@ def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extr
 
 
 def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: bool = False,
-         failures: bool = False) -> None:
+         failures: bool = False, terms: bool = False) -> None:
     """Issue 25: every ``every``-th scan of each shared CARMEN log, modes 1/2/3, with the real-log defaults."""
     from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
 
@@ -274,6 +280,9 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
         print(r.failure_table())
         for res in r.results:
             print(res.failure_table())
+    if terms:
+        for res in r.results:
+            print(res.terms_table())
     for t in (0.75, 0.8, 0.85, 0.9):
         print(r.ambiguity_table(t))
     for t in (1.0, 1.2, 1.3):  # issue 25: the margin, threshold 1.2 tuned on csail, orebro and seattle

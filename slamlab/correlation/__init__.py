@@ -30,6 +30,7 @@ from .experiments import (
 from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, ours_vs_source, run_log_localisation
 from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, run_log_suite
 from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
+from .terms import TERM_NAMES, score_terms
 
 _PLOT = (
     "constants_figure",
@@ -53,6 +54,7 @@ __all__ = [
     "MAP_CHECK_LAYOUTS",
     "SHARED_CARMEN_LOGS",
     "SOURCE_TABLE1",
+    "TERM_NAMES",
     "ConstantsResult",
     "CorridorResult",
     "Localisation",
@@ -80,6 +82,7 @@ __all__ = [
     "run_monte_carlo",
     "run_table1",
     "score_maps",
+    "score_terms",
     "time_localise",
 ]
 __all__ += list(_PLOT + _WIDGETS)  # loaded on first use

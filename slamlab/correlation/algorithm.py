@@ -47,7 +47,14 @@ from ..geometry import wrap_angle
 from ..geometry.se2 import check_poses, se2_relative, se2_transform
 from ..scans import Scan, check_grid, grid_to_values
 from .scoring import _ExploredNorm, _map_spectra, _peak_search, _rival_search, _Stamps, score_maps
-from .settings import Localisation, LocaliseParams, _check_real, _check_score_norm, check_constants
+from .settings import (
+    Localisation,
+    LocaliseParams,
+    _check_real,
+    _check_score_norm,
+    _stamp_a_c,
+    check_constants,
+)
 
 __all__ = [
     "Localisation",
@@ -185,7 +192,7 @@ def rasterise_scan(scan: Scan, headings_rad, *, params: LocaliseParams | None = 
     o = l_max + 2
     free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
                               step_cells=p.step_cells, use_misses=p.use_misses)
-    stamps = _Stamps(free, obs, th, p.a_c, p.a_p, p.a_n, o, np.dtype(p.dtype))
+    stamps = _Stamps(free, obs, th, _stamp_a_c(p), p.a_p, p.a_n, o, np.dtype(p.dtype))
     return stamps.take(np.arange(th.size)), o
 
 
@@ -303,7 +310,8 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
     dtype = np.dtype(p.dtype)
     S = 2 * o
     a_p = p.a_p if obs_weights is None else p.a_p * np.asarray(obs_weights, dtype=float)
-    stamps = _Stamps(free, obs, headings, p.a_c, a_p, p.a_n, o, dtype)
+    a_c = _stamp_a_c(p)
+    stamps = _Stamps(free, obs, headings, a_c, a_p, p.a_n, o, dtype)
     n_marks = max(1, free.shape[0] + obs.shape[0])
     amax = max(abs(p.a_c), float(np.max(np.abs(a_p), initial=0.0)), abs(p.a_n))
     tol = (1e-9 if dtype == np.float64 else 2e-5) * amax * amax * n_marks
@@ -333,7 +341,7 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
     if refine:
         if norm is not None:
             raise ValueError("`refine` does not support `score_norm='explored'` (it re-scores by the raw score)")
-        pose = _refine_peaks(Mv, free, obs, p.a_c, a_p, headings, found[5], refine, refine_heading_rad)
+        pose = _refine_peaks(Mv, free, obs, a_c, a_p, headings, found[5], refine, refine_heading_rad)
         if not tracking:
             pose[2] = float(np.mod(pose[2], 2 * np.pi))
     return Localisation(pose=pose, row=row, col=col, heading_index=n, score=best_val,

@@ -30,8 +30,15 @@ from .experiments import (
     Table1Result,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
-from .log_truth import _TRUTH_COLUMNS, _failure_table, _localise_log_scan, _truth_frame
-from .settings import _check_score_norm
+from .log_truth import (
+    _TRUTH_COLUMNS,
+    _describe,
+    _failure_table,
+    _localise_log_scan,
+    _terms_table,
+    _truth_frame,
+)
+from .settings import _check_score_norm, _check_unit
 from .studies import _errors
 
 __all__ = [
@@ -167,8 +174,8 @@ class LogLocalisationResult:
             One row per mode and scan: ``scan``, ``joined``, ``ok``, ``err_m``, ``err_deg``, the scores
             ``score_est``, ``score_truth`` (grid) and ``score_est_fine``, ``score_truth_fine`` (off the grid;
             NaN for a success), ``walls_truth`` / ``walls_est`` (fraction of the joined scans' end points on
-            obstacle cells of the scan's leave-out grid at the logged poses / at the estimate) and ``kind``
-            (``"ok"`` for a success).
+            obstacle cells of the scan's leave-out grid at the logged poses / at the estimate), ``kind``
+            (``"ok"`` for a success), and the columns of :meth:`terms_table`.
         """
         return _truth_frame(self)
 
@@ -181,6 +188,24 @@ class LogLocalisationResult:
         str
         """
         return _failure_table(self)
+
+    def terms_table(self, scans=None) -> str:
+        """The score's four terms (:func:`~slamlab.correlation.score_terms`) and marks on unexplored cells at the
+        estimate and at the best grid pose near the truth, and their difference (ours, issue 25; ``truth_check=True``;
+        columns ``est_…`` / ``truth_…`` of :meth:`truth_check`); for the truth also where its marks on unexplored
+        cells and its obstacle marks on map free cells come from (``unex_…``, ``conf_obs_…``: ``1`` / ``2`` = a
+        left-out scan that many steps away saw / hit the cell, ``none`` = no other scan).
+
+        Parameters
+        ----------
+        scans : sequence of int, optional
+            The scans to show; default every failure and per mode the success with the median wall fraction.
+
+        Returns
+        -------
+        str
+        """
+        return _terms_table(self, scans)
 
     def __str__(self) -> str:
         ok = self.success
@@ -276,20 +301,6 @@ class LogLocalisationResult:
         return format_table(head, rows, title=title)
 
 
-def _describe(idx) -> str:
-    d = np.diff(idx)
-    if idx.size > 2 and np.all(d == d[0]):
-        return f"every {int(d[0])}th from {int(idx[0])} to {int(idx[-1])}"
-    return "scans " + ", ".join(str(int(i)) for i in idx)
-
-
-def _check_unit(x, name: str) -> float:
-    x = v.check_positive(x, name, allow_zero=True)
-    if x > 1:
-        raise ValueError(f"`{name}` must lie in [0, 1]; got {x}")
-    return x
-
-
 def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *,
                          cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int = 2, joined=(1,),
                          odom_std=ODOM_STD, hit_ratio: float = 0.25, params: LocaliseParams | None = None, rng=2017,
@@ -346,8 +357,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     truth_check : bool, default False
         Also score each scan near its logged pose with the search's own score (ours, issue 25): is a failure a
         score failure (the truth scores lower than the estimate) or a search failure?
-        :meth:`~slamlab.correlation.LogLocalisationResult.truth_check` tabulates it. Needs ``a_n = 0`` (004's
-        value).
+        :meth:`~slamlab.correlation.LogLocalisationResult.truth_check` tabulates it, ``terms_table()`` the
+        score's terms. Needs ``a_n = 0`` (004's value).
     refine : int, default 0
         Off by default. ``refine`` > 0 (ours, issue 25): score the ``refine`` best distinct peaks of the grid
         search (more than 2 cells or 3° apart) again every 0.5 cell within 1 cell and every 0.5° within

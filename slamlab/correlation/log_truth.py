@@ -17,6 +17,8 @@ from ..scans.logmap import leave_out_grid
 from ..scans.occupancy import label_counts, occupancy_grid
 from .algorithm import LocaliseParams, _joined_samples, _localise_samples, _wall_weights, heading_error
 from .experiments import FAIL_CELLS, FAIL_DEG
+from .settings import _stamp_a_c
+from .terms import COUNT_NAMES, TERM_NAMES, _terms_of
 
 __all__: list[str] = []
 
@@ -44,14 +46,55 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
                     f"mar{k}": loc.margin})
         if truth_check:
             w = _wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None
+            own = {index - j for j in range(k)}
+            seen = [(j - index, _explored(scans_c[j], Pc[j], grid.shape)) for j in leave if j not in own]
             chk = _truth_check(Mv, grid, free, obs, w, headings, loc.pose, Pc[index], p,
-                               [scans_c[index - j] for j in range(k)], Pc[[index - j for j in range(k)]], rel[:k])
+                               [scans_c[index - j] for j in range(k)], Pc[[index - j for j in range(k)]], rel[:k],
+                               left_out_seen=seen)
             row.update({f"{name}{k}": val for name, val in chk.items()})
     return row
 
 
-#: Columns of :func:`_truth_check` (per mode) and of :meth:`LogLocalisationResult.truth_check`.
-_TRUTH_COLUMNS = ("score_est", "score_truth", "score_est_fine", "score_truth_fine", "walls_truth", "walls_est")
+#: Where the truth's marks on unexplored cells come from (:func:`_unexplored_origin`): obstacle / free marks
+#: on a cell a left-out scan 1 or 2 steps away saw, or no other scan.
+#: ``conf_obs_…``: obstacle marks on map free cells that a left-out scan 1 or 2 steps away hit, or none did.
+_ORIGIN_COLUMNS = tuple(f"{what}_{w}" for what in ("unex_obs", "unex_free", "conf_obs") for w in ("1", "2", "none"))
+#: Columns of :func:`_truth_check` (per mode) and of :meth:`LogLocalisationResult.truth_check`: the scores, the
+#: wall fractions, the score's terms (:mod:`slamlab.correlation.terms`) at the estimate (``est_…``) and at
+#: the best grid pose near the truth (``truth_…``), and the origin of the truth's unexplored obstacle marks.
+_TRUTH_COLUMNS = ("score_est", "score_truth", "score_est_fine", "score_truth_fine", "walls_truth", "walls_est",
+                  *(f"{w}_{t}" for w in ("est", "truth") for t in (*TERM_NAMES, *COUNT_NAMES)), *_ORIGIN_COLUMNS)
+
+
+def _explored(scan_c, pose_c, shape) -> tuple[np.ndarray, np.ndarray]:
+    """Cells one scan (cells, at ``pose_c``) hit or passed through, and the cells it hit
+    (:func:`~slamlab.scans.occupancy_grid`)."""
+    og = occupancy_grid([scan_c], np.asarray(pose_c)[None], shape)
+    return (og.hits > 0) | (og.passes > 0), og.hits > 0
+
+
+def _unexplored_origin(marks, shape, left_out_seen, a_c: float) -> dict:
+    """Where ``marks`` lack map (ours, issue 25). Its marks on unexplored cells (map value 0), obstacle and free
+    ones apart (``unex_obs_…``, ``unex_free_…``): how many lie on a cell that a scan left out of the grid (other
+    than the joined ones) saw, by its nearest such scan's distance in the log (``…_1``, ``…_2``; farther ones drew
+    the grid), and how many no other scan saw or lie outside the map (``…_none``). Its obstacle marks on map free
+    cells (value ``a_c``; ``conf_obs_…``): the same for a left-out scan that *hit* the cell. ``left_out_seen``:
+    ``(offset in the log, (explored, hit) masks)`` per left-out scan."""
+    H, W = shape
+    out = {}
+    for what, sel, which in (("unex_obs", marks.is_obs & (marks.map == 0), 0),
+                             ("unex_free", ~marks.is_obs & (marks.map == 0), 0),
+                             ("conf_obs", marks.is_obs & (marks.map == a_c), 1)):
+        r, c = marks.row[sel], marks.col[sel]
+        inside = (r >= 0) & (r < H) & (c >= 0) & (c < W)
+        nearest = np.full(r.size, np.inf)
+        for off, masks in left_out_seen:
+            hit = np.zeros(r.size, dtype=bool)
+            hit[inside] = masks[which][r[inside], c[inside]]
+            nearest = np.where(hit, np.minimum(nearest, abs(off)), nearest)
+        out.update({f"{what}_1": int(np.sum(nearest == 1)), f"{what}_2": int(np.sum(nearest == 2)),
+                    f"{what}_none": int(np.sum(~np.isfinite(nearest) | (nearest > 2)))})
+    return out
 
 
 def _tolerance_poses(center, headings, radius_cells: float, heading_rad: float) -> np.ndarray:
@@ -93,7 +136,7 @@ def _walls_fraction(grid, scans_c, poses_c) -> float:
 
 
 def _truth_check(Mv, grid, free, obs, obs_weights, headings, est_pose, truth_pose, p: LocaliseParams, scans_c,
-                 true_poses_c, rel) -> dict:
+                 true_poses_c, rel, left_out_seen=()) -> dict:
     """Score failure or search failure? The search's score at its estimate and near the truth (ours, issue 25).
 
     ``score_est``: the score at the estimate; ``score_truth``: the best score of the grid poses that count as
@@ -102,26 +145,36 @@ def _truth_check(Mv, grid, free, obs, obs_weights, headings, est_pose, truth_pos
     0.5°) within the same tolerance of the estimate / the truth (NaN for a success). ``walls_truth``: fraction
     of the joined scans' end points at their logged poses on obstacle cells of ``grid``; ``walls_est``: the
     same at the estimate (the joined scans placed by ``rel``). Scores by :func:`_pose_scores` (float64, the
-    definition; ``a_n`` must be 0).
+    definition; ``a_n`` must be 0). ``est_<term>`` / ``truth_<term>``: :func:`_score_terms` at the estimate and
+    at the best grid pose near the truth; ``unex_…``: :func:`_unexplored_origin` of the latter's marks with
+    ``left_out_seen`` (``(offset in the log, explored mask)`` of each left-out scan that is not a joined one).
     """
-    from .scoring import _pose_scores
+    from .scoring import _pose_marks, _pose_scores
 
     a_p = p.a_p if obs_weights is None else p.a_p * np.asarray(obs_weights, dtype=float)
+    a_c = _stamp_a_c(p)  # the stamp's free marks (the map keeps p.a_c)
     tol_c, tol_h = FAIL_CELLS, float(np.radians(FAIL_DEG))
     est = np.asarray(est_pose, dtype=float)
-    score_est = float(_pose_scores(Mv, free, obs, p.a_c, a_p, est[None])[0])
-    score_truth = float(np.max(_pose_scores(Mv, free, obs, p.a_c, a_p,
-                                            _tolerance_poses(truth_pose, headings, tol_c, tol_h))))
+    score_est = float(_pose_scores(Mv, free, obs, a_c, a_p, est[None])[0])
+    near = _tolerance_poses(truth_pose, headings, tol_c, tol_h)
+    near_scores = _pose_scores(Mv, free, obs, a_c, a_p, near)
+    best_near = near[int(np.argmax(near_scores))]
+    score_truth = float(np.max(near_scores))
     failed = np.hypot(*(est[:2] - truth_pose[:2])) > tol_c + 1e-9 or heading_error(est[2], truth_pose[2]) > tol_h
     if failed:
-        est_fine = float(np.max(_pose_scores(Mv, free, obs, p.a_c, a_p, _fine_poses(est, tol_c, tol_h))))
-        truth_fine = float(np.max(_pose_scores(Mv, free, obs, p.a_c, a_p, _fine_poses(truth_pose, tol_c, tol_h))))
+        est_fine = float(np.max(_pose_scores(Mv, free, obs, a_c, a_p, _fine_poses(est, tol_c, tol_h))))
+        truth_fine = float(np.max(_pose_scores(Mv, free, obs, a_c, a_p, _fine_poses(truth_pose, tol_c, tol_h))))
     else:
         est_fine = truth_fine = float("nan")
     est_poses = np.array([se2_compose(est, q) for q in rel])
+    marks = dict(zip(("est", "truth"), (mk for _m, mk in _pose_marks(Mv, free, obs, a_c, a_p,
+                                                                      np.vstack([est, best_near]))), strict=True))
+    terms = {f"{who}_{k}": val for who, mk in marks.items() for k, val in _terms_of(mk, p.a_c, p.a_p).items()
+             if k != "score"}
     return {"score_est": score_est, "score_truth": score_truth, "score_est_fine": est_fine,
             "score_truth_fine": truth_fine, "walls_truth": _walls_fraction(grid, scans_c, true_poses_c),
-            "walls_est": _walls_fraction(grid, scans_c, est_poses)}
+            "walls_est": _walls_fraction(grid, scans_c, est_poses), **terms,
+            **_unexplored_origin(marks["truth"], grid.shape, left_out_seen, p.a_c)}
 
 
 def _truth_frame(res):
@@ -161,3 +214,62 @@ def _failure_table(res) -> str:
                         title=(f"{res.name}: failures, the search's score at its estimate and the best within "
                                f"{FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the logged pose (grid; fine = every "
                                "0.5 cell and 0.5°); walls = end points on obstacle cells of the leave-out grid"))
+
+
+def _describe(idx) -> str:
+    """The scans of a run in words, for the tables' titles."""
+    d = np.diff(idx)
+    if idx.size > 2 and np.all(d == d[0]):
+        return f"every {int(d[0])}th from {int(idx[0])} to {int(idx[-1])}"
+    return "scans " + ", ".join(str(int(i)) for i in idx)
+
+
+def _median_success(d):
+    """The row of ``d`` (one mode's :meth:`truth_check` rows) that is the success with the median wall fraction
+    at the truth (the lower middle one; first scan on ties); None without a success."""
+    ok = d[d["ok"]]
+    if ok.empty:
+        return None
+    order = ok.sort_values(["walls_truth", "scan"], kind="stable")
+    return order.iloc[(len(order) - 1) // 2]
+
+
+def _terms_table(res, scans=None) -> str:
+    """``LogLocalisationResult.terms_table``: the score's terms at the estimate and near the truth."""
+    d = res.truth_check()
+    cases = []
+    for k in res.joined:
+        dk = d[d["joined"] == k]
+        sel = dk[~dk["ok"]] if scans is None else dk[dk["scan"].isin(list(scans))]
+        cases += [(r, "failure" if not r.ok else "success") for _i, r in sel.iterrows()]
+        med = _median_success(dk)
+        if scans is None and med is not None:
+            cases.append((med, "median success"))
+    rows = []
+    for r, case in cases:
+        vals = {}
+        for who in ("est", "truth"):
+            vals[who] = [r[f"{who}_{t}"] for t in TERM_NAMES] + [r[f"{who}_n_obs_unexplored"],
+                                                                  r[f"{who}_n_free_unexplored"]]
+            n_obs = r[f"{who}_n_obs_on_obs"] + r[f"{who}_n_obs_on_free"] + r[f"{who}_n_obs_unexplored"]
+            vals[who].append(n_obs)
+        score = {"est": r["score_est"], "truth": r["score_truth"]}
+        head = [int(r["scan"]), res._mode(int(r["joined"])), case, f"{r['err_m']:.1f} m {r['err_deg']:.0f}°"]
+        origin = "; ".join(" / ".join(str(int(r[f"{what}_{w}"])) for w in ("1", "2", "none"))
+                           for what in ("unex_obs", "unex_free", "conf_obs"))
+        for who, label in (("est", "estimate"), ("truth", "truth (best near)")):
+            rows.append([*head, label, f"{score[who]:.0f}", *(f"{x:+.0f}" for x in vals[who][:4]),
+                         *(f"{x:.0f}" for x in vals[who][4:]), origin if who == "truth" else ""])
+        diff = [vals["truth"][i] - vals["est"][i] for i in range(7)]
+        rows.append([*head, "truth - est.", f"{score['truth'] - score['est']:+.0f}", *(f"{x:+.0f}" for x in diff),
+                     ""])
+    return format_table(["scan", "mode", "case", "error", "pose", "score", "obs. on obs.", "obs. on free",
+                         "free on free", "free on obs.", "obs. marks unexpl.", "free marks unexpl.", "obs. marks",
+                         "origin ±1 / ±2 / none: unexpl. obs.; unexpl. free; obs. on free"], rows,
+                        title=(f"{res.name}: the score's terms (a_c = {res.params.a_c:g}, a_p = {res.params.a_p:g}; "
+                               "score = the four signed terms) at the estimate and at the best grid pose within "
+                               f"{FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the logged pose; unexpl. = on unexplored "
+                               f"cells of the leave-out grid (±{res.exclude} scans), which count 0; origin: the truth's "
+                               "obstacle and free marks on unexplored cells that a left-out scan 1 or 2 steps away "
+                               "saw (the leave-out removed them) or no other scan saw, and its obstacle marks on map "
+                               "free cells that such a scan hit"))

@@ -372,13 +372,63 @@ def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, 
     heading modulo 90° in float32, then the quarter turn on integer offsets), so the value equals the search's
     ``D[n, row, col]`` up to its FFT rounding; off the grid the fractional part of the position is added before
     rounding. Free samples are written first, obstacle samples (``a_p``: a scalar or one value per sample) over
-    them, each cell counted once; the map is 0 outside (``a_n = 0``). Returns ``(m,)`` float64 scores.
+    them, each cell counted once; the map is 0 outside (``a_n = 0``). Returns ``(m,)`` float64 scores (NaN for a
+    pose that is not finite or far outside the map).
+    """
+    out = np.full(np.asarray(poses).reshape(-1, 3).shape[0], np.nan)
+    for m, marks in _pose_marks(Mv, free, obs, a_c, a_p, poses):
+        out[m] = float(np.dot(marks.stamp, marks.map))
+    return out
+
+
+class _Marks:
+    """The marked stamp cells of one pose (:func:`_pose_marks`): each cell once, the last write winning.
+
+    ``row`` / ``col`` (map cell, possibly outside the map), ``stamp`` (the mark's value), ``map`` (the map's
+    value there, 0 outside) and ``is_obs`` (an obstacle sample wrote it), each computed on first use.
+    """
+
+    __slots__ = ("_col", "_flat", "_idx", "_kind", "_last", "_row", "_vals")
+
+    def __init__(self, last, row, col, idx, vals, kind, flat):
+        self._last, self._row, self._col, self._idx = last, row, col, idx
+        self._vals, self._kind, self._flat = vals, kind, flat
+
+    @property
+    def row(self):
+        return self._row[self._last]
+
+    @property
+    def col(self):
+        return self._col[self._last]
+
+    @property
+    def stamp(self):
+        return self._vals[self._last]
+
+    @property
+    def map(self):
+        return self._flat[self._idx[self._last]]
+
+    @property
+    def is_obs(self):
+        return self._kind[self._last]
+
+
+def _pose_marks(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p, poses):
+    """Yield ``(m, marks)`` for each finite pose ``poses[m]``: the stamp's marked cells there (ours, issue 25).
+
+    ``marks`` (:class:`_Marks`): map ``row`` / ``col`` of each marked cell (possibly outside the map), its
+    ``stamp`` value (``a_c`` or the obstacle sample's ``a_p``), the ``map`` value there (0 outside) and
+    ``is_obs`` (an obstacle sample wrote it last). The rasterisation of :func:`_pose_scores` (which sums
+    ``stamp·map``); poses that are not finite or lie more than ``4(H + W)`` cells out are skipped.
     """
     H, W = Mv.shape
     pts = np.vstack([free.reshape(-1, 2), obs.reshape(-1, 2)])
     n_free = free.shape[0]
     vals = np.concatenate([np.full(n_free, float(a_c)), np.broadcast_to(np.asarray(a_p, dtype=float),
                                                                          (obs.shape[0],))])
+    kind = np.arange(pts.shape[0]) >= n_free
     P = np.asarray(poses, dtype=float).reshape(-1, 3)
     reach = float(np.sqrt(np.max(np.sum(pts ** 2, axis=1)))) if pts.size else 0.0
     pad = int(np.ceil(reach)) + 3
@@ -388,11 +438,9 @@ def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, 
     seen = np.full(Mp.size, -1, dtype=np.int64)
     order = np.arange(pts.shape[0])
     px, py = pts[:, 0].astype(np.float32), pts[:, 1].astype(np.float32)
-    out = np.empty(P.shape[0])
     last_h = None
     for m, (x, y, h) in enumerate(P):
         if not (np.isfinite(x) and np.isfinite(y)) or abs(x) > 4 * (H + W) or abs(y) > 4 * (H + W):
-            out[m] = np.nan
             continue
         if h != last_h:  # the samples turned by the heading's base (mod 90°), once per run of equal headings
             q = int(np.floor(np.mod(h, 2 * np.pi) / (np.pi / 2) + 1e-9)) % 4
@@ -421,6 +469,5 @@ def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, 
         idx = np.where(inside, (row + pad) * Wp + (col + pad), 0)
         seen[idx] = order  # the last write of a cell wins, as in the stamp
         last = (seen[idx] == order) & inside
-        out[m] = float(np.dot(vals[last], flat[idx[last]]))
         seen[idx] = -1
-    return out
+        yield m, _Marks(last, row, col, idx, vals, kind, flat)

@@ -21,6 +21,14 @@ def _check_real(value, name: str) -> float:
     return float(value)
 
 
+def _check_unit(x, name: str) -> float:
+    """A number in [0, 1], named ``name`` in the error."""
+    x = v.check_positive(x, name, allow_zero=True)
+    if x > 1:
+        raise ValueError(f"`{name}` must lie in [0, 1]; got {x}")
+    return x
+
+
 def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
     """Validate 004's constants: real numbers with ``a_c ≠ a_p`` (004 §7, conditions (1)-(3)).
 
@@ -58,6 +66,11 @@ def _check_score_norm(score_norm, min_explored_fraction, p) -> tuple[str, float]
         raise ValueError(f"`score_norm='explored'` needs `a_n` to differ from `a_c` and `a_p` (it tells explored "
                          f"cells by their value); got a_n = {p.a_n}")
     return sn, f
+
+
+def _stamp_a_c(p) -> float:
+    """The value of the stamp's free marks: ``a_c`` times :attr:`LocaliseParams.free_mark_weight` (ours)."""
+    return p.a_c * p.free_mark_weight
 
 
 @dataclass(frozen=True)
@@ -179,6 +192,10 @@ class LocaliseParams(Params):
     wall_balance : bool
         Weigh each obstacle mark of the scan(s) by the rarity of its wall direction (ours, issue 25): returns
         on a corridor's long walls count less, those on door frames and corners more.
+    free_mark_weight : float
+        The stamp's free marks are ``free_mark_weight·a_c`` (the map keeps ``a_c``; ours, issue 25): below 1
+        the agreement of free marks with free map cells, and their conflicts with map obstacles, count less
+        than the obstacle marks (1: 004's stamp).
     """
 
     delta_alpha_rad: float = param(float(np.radians(1.0)), "004 §7: Δα = 1°")
@@ -196,6 +213,7 @@ class LocaliseParams(Params):
     rival_radius_cells: float = param(5.0, "ours: a rival is farther than this from the peak (1 m at 0.2 m)")
     rival_heading_rad: float = param(float(np.radians(30.0)), "ours: ... or its heading is more than 30° off")
     wall_balance: bool = param(False, "ours (issue 25): a_p × count(wall-direction bin)^(-1/2), mean 1, cap 4")
+    free_mark_weight: float = param(1.0, "ours (issue 25): the stamp's free marks are a_c × this (1: 004's stamp)")
 
     def __post_init__(self) -> None:
         with contextlib.suppress(TypeError):  # accept numpy dtypes (np.float32) too; check() names a bad one
@@ -223,6 +241,7 @@ class LocaliseParams(Params):
         v.check_positive(self.rival_radius_cells, "rival_radius_cells", allow_zero=True)
         if not isinstance(self.wall_balance, (bool, np.bool_)):
             raise TypeError(f"`wall_balance` must be a bool; got {type(self.wall_balance).__name__}")
+        v.check_positive(self.free_mark_weight, "free_mark_weight")
         h = v.check_positive(self.rival_heading_rad, "rival_heading_rad", allow_zero=True)
         if h >= np.pi:
             raise ValueError(f"`rival_heading_rad` must be < π (else no heading is far enough); got {h}")

@@ -320,3 +320,27 @@ def test_score_norm_bad_parameters():
     a, b = C.localise(M, s, **kw), C.localise(M, s, score_norm="none", **kw)
     assert (a.row, a.col, a.heading_index, a.score) == (b.row, b.col, b.heading_index, b.score)
     assert "score_norm" not in C.LocaliseParams.field_names()
+
+
+def test_free_mark_weight_scales_the_stamps_free_marks_only():
+    """Issue 25 (ours): free_mark_weight = λ puts λ·a_c at the stamp's free marks, a_p at its obstacle marks; the
+    map keeps 004's values, so the search maximises the definition with that stamp."""
+    M = S.test_room_200()[20:100, 0:90]
+    scan = S.Rangefinder(n_beams=90, max_range_cells=25.0).scan(M, [40.0, 30.0, np.radians(33.0)])
+    hs = C.heading_candidates(np.radians(10.0))
+    T1, o = C.rasterise_scan(scan, hs, dtype="float64")
+    Tl, _ = C.rasterise_scan(scan, hs, dtype="float64", free_mark_weight=0.25)
+    assert np.array_equal(Tl, np.where(T1 == -1.0, -0.25, T1))
+    D = C.score_maps(S.grid_to_values(M), Tl, o, method="direct")
+    loc = C.localise(M, scan, delta_alpha_rad=np.radians(10.0), free_mark_weight=0.25, dtype="float64",
+                     ambiguity=False)
+    assert np.isclose(loc.score, D.max())
+    assert np.isclose(D[loc.heading_index, loc.row, loc.col], D.max())
+    # the score's terms: the free ones scale by λ, the obstacle ones do not, and they still sum to the score
+    poses = [[40, 30, np.radians(30.0)], [45, 28, np.radians(120.0)]]
+    d1, dl = C.score_terms(M, scan, poses), C.score_terms(M, scan, poses, free_mark_weight=0.25)
+    np.testing.assert_array_equal(dl[["free_on_free", "free_on_obs"]], 0.25 * d1[["free_on_free", "free_on_obs"]])
+    np.testing.assert_array_equal(dl[["obs_on_obs", "obs_on_free"]], d1[["obs_on_obs", "obs_on_free"]])
+    np.testing.assert_allclose(dl[list(C.TERM_NAMES)].sum(axis=1), dl["score"])
+    with pytest.raises(ValueError, match="`free_mark_weight`"):
+        C.LocaliseParams(free_mark_weight=0.0)

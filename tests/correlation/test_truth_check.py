@@ -52,6 +52,18 @@ def test_truth_check_on_csail_scans(shared_data):
     assert d["walls_truth"].between(0, 1).all()
     assert d["walls_est"].between(0, 1).all()
     assert "kind" in r.failure_table()
+    # the terms add up to the truth check's scores (construction), the origins split the unexplored marks
+    from slamlab.correlation.log_truth import _TRUTH_COLUMNS
+
+    for who in ("est", "truth"):
+        total = sum(d[f"{who}_{t}"] for t in C.TERM_NAMES)
+        np.testing.assert_array_equal(total.to_numpy(), d[f"score_{who}"].to_numpy())
+    for what, n in (("unex_obs", "truth_n_obs_unexplored"), ("unex_free", "truth_n_free_unexplored"),
+                    ("conf_obs", "truth_n_obs_on_free")):
+        np.testing.assert_array_equal(sum(d[f"{what}_{w}"] for w in ("1", "2", "none")).to_numpy(), d[n].to_numpy())
+    assert set(_TRUTH_COLUMNS) <= set(d.columns)
+    assert "free on free" in r.terms_table()
+    assert "truth - est." in r.terms_table()
     with pytest.raises(TypeError, match="`truth_check` must be a bool"):
         C.run_log_localisation(log, (100,), truth_check="yes")
     with pytest.raises(ValueError, match="`truth_check` and `refine` score by the definition with a_n = 0"):
@@ -101,3 +113,72 @@ def test_refine_scores_at_least_the_grid_peak_and_the_truth():
     assert np.hypot(*(fine.pose[:2] - truth[:2])) <= 1.0
     assert abs(np.degrees(fine.pose[2] - truth[2])) <= 1.0 + 1e-9
     assert fine.score == grid.score  # the score and the rival stay the grid search's
+
+
+def test_score_terms_sum_to_the_score_and_count_every_mark():
+    # construction: every marked cell is a free or an obstacle mark on a free, obstacle or unexplored map cell, and
+    # only the first two kinds of map cell count (a_n = 0), so the four signed terms add up to the score; at grid
+    # poses that score is the correlation's definition (score_maps(method="direct"))
+    M = S.test_room_200()[20:100, 0:90].copy()
+    M[30:50, 60:90] = -1  # an unexplored block (UNEXPLORED = -1) so that marks fall on unexplored cells too
+    Mv = S.grid_to_values(M)
+    scan = S.Rangefinder(n_beams=90, max_range_cells=25.0, range_std_cells=0.3).scan(
+        S.test_room_200()[20:100, 0:90], [40.0, 30.0, np.radians(33.0)], rng=3)
+    hs = C.heading_candidates(np.radians(7.5))
+    T, o = C.rasterise_scan(scan, hs, dtype="float64")
+    D = C.score_maps(Mv, T, o, method="direct")
+    rng = np.random.default_rng(1)
+    n, r, c = rng.integers(0, hs.size, 40), rng.integers(0, M.shape[0], 40), rng.integers(0, M.shape[1], 40)
+    grid_poses = np.column_stack([c, r, hs[n]]).astype(float)
+    off_grid = grid_poses + rng.uniform(-0.5, 0.5, grid_poses.shape) * [1, 1, 0.1]
+    d = C.score_terms(M, scan, np.vstack([grid_poses, off_grid]))
+    terms = d[list(C.TERM_NAMES)].sum(axis=1).to_numpy()
+    np.testing.assert_array_equal(terms, d["score"].to_numpy())
+    np.testing.assert_array_equal(d["score"].to_numpy()[:40], D[n, r, c])
+    free, obs = _beam_samples(scan.bearings_rad, scan.ranges, scan.valid, delta_l_cells=0.0, hit_offset_cells=0.5,
+                              step_cells=0.5, use_misses=False)
+    np.testing.assert_array_equal(d["score"].to_numpy()[40:], _pose_scores(Mv, free, obs, -1.0, 1.0, off_grid))
+    # with 004's ±1 values each term is ± its count
+    for t, sign in (("obs_on_obs", 1), ("obs_on_free", -1), ("free_on_free", 1), ("free_on_obs", -1)):
+        np.testing.assert_array_equal(d[t].to_numpy(), sign * d[f"n_{t}"].to_numpy())
+    assert (d["n_obs_unexplored"] > 0).any()
+    assert (d["n_free_unexplored"] > 0).any()
+    # a mark counts once: the stamp's marked cells at a grid pose are the nonzero cells of T_n
+    counts = d[[c for c in d.columns if c.startswith("n_")]].sum(axis=1).to_numpy()[:40]
+    np.testing.assert_array_equal(counts, np.count_nonzero(T[n], axis=(1, 2)))
+
+
+def test_score_terms_bad_input():
+    M = S.test_room_200()[:40, :40]
+    scan = S.Rangefinder(n_beams=30, max_range_cells=10.0).scan(M, [20.0, 20.0, 0.0])
+    with pytest.raises(ValueError, match="`a_n` must be 0"):
+        C.score_terms(M, scan, [[20, 20, 0.0]], a_n=0.5)
+    with pytest.raises(TypeError, match=r"`scan` must be a slamlab\.scans\.Scan"):
+        C.score_terms(M, [1.0, 2.0], [[20, 20, 0.0]])
+    with pytest.raises(ValueError, match="`poses` must have shape"):
+        C.score_terms(M, scan, [20, 20, 0.0])
+    with pytest.raises(ValueError, match="`poses` must lie within"):
+        C.score_terms(M, scan, [[1e6, 20, 0.0]])
+    with pytest.raises(ValueError, match="`poses`"):
+        C.score_terms(M, scan, [[np.nan, 20, 0.0]])
+    with pytest.raises(ValueError, match="`grid`"):
+        C.score_terms(np.full((5, 5), 7), scan, [[2, 2, 0.0]])
+
+
+def test_unexplored_origin_counts_the_nearest_left_out_scan():
+    from slamlab.correlation.log_truth import _unexplored_origin
+    from slamlab.correlation.scoring import _Marks
+
+    # five marks on a 3x4 map: obstacle marks on unexplored (0, 0), (0, 1), (0, 2) and outside; a free mark on
+    # unexplored (1, 0); an obstacle mark on a map free cell (2, 3) (value a_c = -1)
+    row, col = np.array([0, 0, 0, -1, 1, 2]), np.array([0, 1, 2, 0, 0, 3])
+    marks = _Marks(np.ones(6, bool), row, col, np.arange(6), np.ones(6), np.array([True, True, True, True, False, True]),
+                   np.array([0, 0, 0, 0, 0, -1.0]))
+    seen_a, hit_a = np.zeros((3, 4), bool), np.zeros((3, 4), bool)
+    seen_b, hit_b = np.zeros((3, 4), bool), np.zeros((3, 4), bool)
+    seen_a[0, 0] = seen_a[1, 0] = True  # the scan 2 steps away saw (0, 0) and (1, 0)
+    seen_b[0, 0] = seen_b[0, 1] = True  # the scan 1 step back saw (0, 0) and (0, 1) and hit (2, 3)
+    seen_b[2, 3] = hit_b[2, 3] = True
+    out = _unexplored_origin(marks, (3, 4), [(2, (seen_a, hit_a)), (-1, (seen_b, hit_b))], -1.0)
+    assert out == {"unex_obs_1": 2, "unex_obs_2": 0, "unex_obs_none": 2, "unex_free_1": 0, "unex_free_2": 1,
+                   "unex_free_none": 0, "conf_obs_1": 1, "conf_obs_2": 0, "conf_obs_none": 0}
