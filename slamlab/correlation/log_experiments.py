@@ -17,10 +17,9 @@ import numpy as np
 from .. import _validate as v
 from .._table import format_table
 from ..geometry import wrap_angle
-from ..geometry.se2 import se2_compose, se2_relative
 from ..scans import GridFrame
 from ..scans.logmap import log_counts
-from .algorithm import LocaliseParams, _scan_beams, heading_candidates, heading_error
+from .algorithm import LocaliseParams, heading_candidates, heading_error
 from .experiments import (
     FAIL_CELLS,
     FAIL_DEG,
@@ -32,9 +31,12 @@ from .experiments import (
 )
 from .log_truth import (
     _TRUTH_COLUMNS,
+    _check_leave,
     _describe,
     _failure_table,
+    _leave_text,
     _localise_log_scan,
+    _log_points,
     _terms_table,
     _truth_frame,
 )
@@ -107,8 +109,8 @@ class LogLocalisationResult:
         Grid cell size [m].
     max_range_m : float
         Range limit of the scans used [m].
-    exclude : int
-        Scans on either side of a test scan left out of its grid.
+    exclude : int or None
+        Scans on either side of a test scan left out of its grid (None with ``leave_out="used"``).
     grid : numpy.ndarray of int, shape (H, W)
         The whole log's grid.
     frame : GridFrame
@@ -123,6 +125,8 @@ class LogLocalisationResult:
         Settings of the localisations.
     time_s : float
         Wall time [s] (not compared).
+    leave_out : {"window", "used"}
+        Which scans each test scan's grid lacks (:func:`run_log_localisation`).
     """
 
     name: str  # the log's file name
@@ -134,8 +138,8 @@ class LogLocalisationResult:
     ambiguity: np.ndarray  # (modes, n) Localisation.ambiguity
     cell_m: float
     max_range_m: float
-    exclude: int
-    grid: np.ndarray = field(repr=False)  # the whole log's grid (each scan is localised on it minus ±exclude scans)
+    exclude: int | None
+    grid: np.ndarray = field(repr=False)  # the whole log's grid (each scan is localised on it minus leave-out scans)
     frame: GridFrame = field(repr=False)
     joined: tuple[int, ...] = (1,)
     odom_std: tuple[float, float] = (0.0, 0.0)  # (m, rad) per step between consecutive scans
@@ -144,6 +148,7 @@ class LogLocalisationResult:
     time_s: float = field(default=0.0, compare=False)
     margin: np.ndarray | None = field(default=None, repr=False)  # (modes, n) Localisation.margin
     truth: dict | None = field(default=None, repr=False, compare=False)  # truth_check=True: _TRUTH_COLUMNS
+    leave_out: str = "window"  # "window": ±exclude scans; "used": each mode's own scans
 
     @property
     def success(self) -> np.ndarray:
@@ -215,7 +220,7 @@ class LogLocalisationResult:
 
     def _title(self) -> str:
         return (f"{self.name} (CARMEN, logged laser poses): grid {self.grid.shape[0]}x{self.grid.shape[1]} cells of "
-                f"{self.cell_m:g} m from the other scans (±{self.exclude} scans left out), ranges < "
+                f"{self.cell_m:g} m from the other scans ({_leave_text(self)} left out), ranges < "
                 f"{self.max_range_m:g} m, Δα = {np.degrees(self.params.delta_alpha_rad):g}°, no prior")
 
     def table(self) -> str:
@@ -302,16 +307,16 @@ class LogLocalisationResult:
 
 
 def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *,
-                         cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int = 2, joined=(1,),
+                         cell_m: float = 0.2, max_range_m: float = 10.0, exclude: int | None = None, joined=(1,),
                          odom_std=ODOM_STD, hit_ratio: float = 0.25, params: LocaliseParams | None = None, rng=2017,
                          n_jobs: int = 1, progress: bool | None = None, truth_check: bool = False,
                          refine: int = 0, refine_heading_rad: float = float(np.radians(3.0)),
-                         score_norm: str = "none", min_explored_fraction: float = 0.8,
+                         score_norm: str = "none", min_explored_fraction: float = 0.8, leave_out: str = "window",
                          **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
 
     Each test scan is localised on the grid (``cell_m`` cells, 004's three values) of every
-    scan of the log except ``±exclude`` scans around it, so a scan is never matched against
+    scan of the log except ``±exclude`` scans around it (``leave_out``), so a scan is never matched against
     cells it or its nearest neighbours drew (ours), from no prior (full 360°), and
     compared with its logged pose (SLAM-corrected in the Radish logs). A success is a pose
     within 2 cells and 5° of the logged one.
@@ -334,8 +339,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         Grid cell size [m].
     max_range_m : float, default 10.0
         Returns farther than this are not used [m].
-    exclude : int, default 2
-        Scans on either side of each test scan left out of its grid (at least ``max(joined) - 1``).
+    exclude : int, optional
+        Scans either side of each test scan left out of its grid (``"window"``; default 2, ``>= max(joined) - 1``).
         The real-log default (ours, issue 25): the scan and the 2 scans joined before it never draw its
         grid; the issue-17 runs left out ±10 (≈ ±10 m of path on the shared logs, whose scans are
         ≈ 1 m apart), which removed the map of places the robot passed once (csail, orebro:
@@ -373,6 +378,10 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         25); not with ``truth_check`` or ``refine`` (they score by the raw correlation).
     min_explored_fraction : float, default 0.8
         Its guard (:func:`~slamlab.correlation.localise`).
+    leave_out : {"window", "used"}, default "window"
+        ``"window"``: the ``±exclude`` scans, one grid for every mode. ``"used"`` (ours, issue 25): each mode's
+        grid lacks exactly the scans it localises with (mode ``k``: scans ``i - k + 1 .. i``), so cells the
+        scans after ``i`` drew may be in it; ``exclude`` must not be given.
 
     Returns
     -------
@@ -384,13 +393,11 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     log = _carmen_log(path)
     cell = v.check_positive(cell_m, "cell_m")
     rmax = v.check_positive(max_range_m, "max_range_m")
-    ex = v.check_int(exclude, "exclude", minimum=0)
     modes = tuple(int(k) for k in np.atleast_1d(np.asarray(joined)))
     if not modes or any(k not in (1, 2, 3, 4, 5) for k in modes) or len(set(modes)) != len(modes):
         raise ValueError(f"`joined` must be distinct numbers of scans from {{1, ..., 5}}; got {joined!r}")
     kmax = max(modes)
-    if ex < kmax - 1:
-        raise ValueError(f"`exclude` must be >= {kmax - 1} so the joined scans are not in the map; got {ex}")
+    lo, ex = _check_leave(leave_out, exclude, kmax)
     hr = _check_unit(hit_ratio, "hit_ratio")
     if not isinstance(truth_check, (bool, np.bool_)):
         raise TypeError(f"`truth_check` must be a bool; got {type(truth_check).__name__}")
@@ -416,14 +423,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     t0 = time.perf_counter()
     frame, scans_c, Pc, full = log_counts(log, cell_m=cell, max_range_m=rmax)
     noise = rng.normal(size=(idx.size, kmax - 1, 3)) * np.array([sd[0] / cell, sd[0] / cell, sd[1]])
-    points = []
-    for n, i in enumerate(idx):
-        rel = [np.zeros(3)]
-        for j in range(1, kmax):  # chain the noisy steps back from scan i
-            rel.append(se2_compose(rel[-1], se2_relative(Pc[i - j + 1], Pc[i - j]) + noise[n, j - 1]))
-        points.append({"index": int(i), "leave": range(max(0, i - ex), min(log.n_scans, i + ex + 1)),
-                       "beams": [_scan_beams(scans_c[i - j], f"scan {i - j}") for j in range(kmax)],
-                       "rel": np.array(rel)})
+    points = _log_points(idx, modes, scans_c, Pc, noise, lo, ex)
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes, "hit_ratio": hr, "truth_check": bool(truth_check),
              "refine": rf, "refine_heading_rad": rfh, "score_norm": sn, "min_explored_fraction": frac}
@@ -438,9 +438,9 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     example = log.scan(int(idx[0])).points(est_m[0, 0])
     truth = ({c: np.stack([table[f"{c}{k}"].to_numpy(dtype=float) for k in modes]) for c in _TRUTH_COLUMNS}
              if truth_check else None)
-    return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, amb, cell, rmax, ex, full.grid, frame,
-                                 modes, (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0,
-                                 margin, truth)
+    return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, amb, cell, rmax,
+                                 ex if lo == "window" else None, full.grid, frame, modes,
+                                 (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0, margin, truth, lo)
 
 
 def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = None,

@@ -17,6 +17,7 @@ from .. import _validate as v
 from .._table import format_table
 from .experiments import FAIL_CELLS, FAIL_DEG
 from .log_experiments import LogLocalisationResult, run_log_localisation
+from .log_truth import _leave_text
 from .settings import LocaliseParams
 
 __all__ = ["SHARED_CARMEN_LOGS", "LogSuiteResult", "run_log_suite"]
@@ -86,7 +87,7 @@ class LogSuiteResult:
                                                                  f"{tot[m].mean():.1%}", "")])
         title = (f"Every {self.every}th scan of each log from no prior; success = within {FAIL_CELLS:g} cells "
                  f"({FAIL_CELLS * r0.cell_m:.1f} m) and {FAIL_DEG:g}° of the logged pose; cells {r0.cell_m:g} m, "
-                 f"ranges < {r0.max_range_m:g} m, ±{r0.exclude} scans left out of each grid")
+                 f"ranges < {r0.max_range_m:g} m, {_leave_text(r0)} left out of each grid")
         return format_table(head, rows, title=title)
 
     def ambiguity_table(self, threshold: float = 0.75) -> str:
@@ -206,7 +207,7 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: Loca
         Progress bars (default: unless ``$SLAMLAB_PROGRESS=0``).
     **settings
         Any other argument of :func:`~slamlab.correlation.run_log_localisation` (``cell_m``, ``max_range_m``,
-        ``exclude``, ``odom_std``, ``hit_ratio``, :class:`LocaliseParams` fields).
+        ``exclude``, ``leave_out``, ``odom_std``, ``hit_ratio``, :class:`LocaliseParams` fields).
 
     Returns
     -------

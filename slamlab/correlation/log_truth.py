@@ -10,12 +10,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _validate as v
 from .._table import format_table
-from ..geometry.se2 import se2_compose
+from ..geometry.se2 import se2_compose, se2_relative
 from ..scans import grid_to_values
 from ..scans.logmap import leave_out_grid
 from ..scans.occupancy import label_counts, occupancy_grid
-from .algorithm import LocaliseParams, _joined_samples, _localise_samples, _wall_weights, heading_error
+from .algorithm import (
+    LocaliseParams,
+    _joined_samples,
+    _localise_samples,
+    _scan_beams,
+    _wall_weights,
+    heading_error,
+)
 from .experiments import FAIL_CELLS, FAIL_DEG
 from .settings import _stamp_a_c
 from .terms import COUNT_NAMES, TERM_NAMES, _terms_of
@@ -23,20 +31,90 @@ from .terms import COUNT_NAMES, TERM_NAMES, _terms_of
 __all__: list[str] = []
 
 
+#: ``leave_out`` of :func:`~slamlab.correlation.run_log_localisation`: which scans a test scan's grid lacks.
+LEAVE_OUT = ("window", "used")
+
+
+def _leave_sets(index: int, joined, exclude: int, n_scans: int, leave_out: str = "window") -> dict:
+    """Per mode ``k`` the scans left out of scan ``index``'s grid: ``"window"``, the ``±exclude`` scans around it
+    (the same for every mode); ``"used"``, exactly the mode's own scans ``index - k + 1 .. index`` (ours, issue 25)."""
+    if leave_out == "used":
+        return {k: range(index - k + 1, index + 1) for k in joined}
+    window = range(max(0, index - exclude), min(n_scans, index + exclude + 1))
+    return dict.fromkeys(joined, window)
+
+
+def _check_leave(leave_out, exclude, kmax: int) -> tuple[str, int]:
+    """``leave_out`` and ``exclude`` of :func:`~slamlab.correlation.run_log_localisation` checked, with
+    ``max(joined) = kmax``: ``(leave_out, exclude)``, ``exclude`` 2 when not given."""
+    lo = v.check_choice(leave_out, "leave_out", LEAVE_OUT)
+    if lo == "used" and exclude is not None:
+        raise ValueError(f"`exclude` is for leave_out='window'; leave_out='used' leaves out each mode's own scans "
+                         f"(got exclude={exclude!r})")
+    ex = v.check_int(2 if exclude is None else exclude, "exclude", minimum=0)
+    if lo == "window" and ex < kmax - 1:
+        raise ValueError(f"`exclude` must be >= {kmax - 1} so the joined scans are not in the map; got {ex}")
+    return lo, ex
+
+
+def _log_points(idx, modes, scans_c, Pc, noise, leave_out: str = "window", exclude: int = 2) -> list[dict]:
+    """The sweep's points of :func:`_localise_log_scan`, one per test scan ``i`` of ``idx``: its leave-out sets
+    (:func:`_leave_sets`), the beams of scans ``i, i-1, …`` and their poses relative to scan ``i`` (the logged
+    steps plus ``noise[n]``, cells and rad, chained back from scan ``i``)."""
+    kmax = max(modes)
+    points = []
+    for n, i in enumerate(idx):
+        rel = [np.zeros(3)]
+        for j in range(1, kmax):  # chain the noisy steps back from scan i
+            rel.append(se2_compose(rel[-1], se2_relative(Pc[i - j + 1], Pc[i - j]) + noise[n, j - 1]))
+        points.append({"index": int(i), "leave": _leave_sets(int(i), modes, exclude, len(scans_c), leave_out),
+                       "beams": [_scan_beams(scans_c[i - j], f"scan {i - j}") for j in range(kmax)],
+                       "rel": np.array(rel)})
+    return points
+
+
+def _leave_text(res) -> str:
+    """What a result's grids lack, in words, for the tables' titles."""
+    if getattr(res, "leave_out", "window") == "used":
+        return "each mode's own scans"
+    return f"±{res.exclude} scans"
+
+
+def _leave_grid(full, scans_c, Pc, leave, hit_ratio: float = 0.25) -> np.ndarray:
+    """The log's grid without the scans ``leave`` (cell codes), labelled with ``hit_ratio``."""
+    if hit_ratio == 0.25:  # occupancy_grid's default rule: leave_out_grid labels the counts
+        return leave_out_grid(full, scans_c, Pc, leave)
+    # the same counts labelled with another hit ratio (ours, issue 25)
+    part = occupancy_grid([scans_c[j] for j in leave], Pc[list(leave)], full.grid.shape)
+    return label_counts(full.hits - part.hits, full.passes - part.passes, hit_ratio=hit_ratio)
+
+
+def _mode_grids(leaves: dict, full, scans_c, Pc, hit_ratio: float = 0.25) -> dict:
+    """Per mode its leave-out grid (:func:`_leave_grid` of ``leaves[k]``), built once per distinct set."""
+    built, out = {}, {}
+    for k, leave in leaves.items():
+        key = tuple(leave)
+        if key not in built:
+            built[key] = _leave_grid(full, scans_c, Pc, leave, hit_ratio)
+        out[k] = built[key]
+    return out
+
+
 def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, headings, joined,
                        hit_ratio: float = 0.25, truth_check: bool = False, refine: int = 0,
                        refine_heading_rad: float = float(np.radians(3.0)), score_norm: str = "none",
                        min_explored_fraction: float = 0.8) -> dict:
-    """One sweep task: the leave-out grid of scan ``index`` and its localisation in every mode (deterministic);
-    with ``truth_check`` also :func:`_truth_check`'s columns per mode."""
-    if hit_ratio == 0.25:  # occupancy_grid's default rule: leave_out_grid labels the counts
-        grid = leave_out_grid(full, scans_c, Pc, leave)
-    else:  # the same counts labelled with another hit ratio (ours, issue 25)
-        part = occupancy_grid([scans_c[j] for j in leave], Pc[list(leave)], full.grid.shape)
-        grid = label_counts(full.hits - part.hits, full.passes - part.passes, hit_ratio=hit_ratio)
-    Mv = grid_to_values(grid, p.a_c, p.a_p, p.a_n)
+    """One sweep task: the leave-out grids of scan ``index`` (``leave``: per mode the scans left out,
+    :func:`_leave_sets`) and its localisation in every mode (deterministic); with ``truth_check`` also
+    :func:`_truth_check`'s columns per mode."""
+    grids = _mode_grids(leave, full, scans_c, Pc, hit_ratio)
+    values = {}  # the score's map values per distinct grid
     row = {}
     for k in joined:
+        grid = grids[k]
+        if id(grid) not in values:
+            values[id(grid)] = grid_to_values(grid, p.a_c, p.a_p, p.a_n)
+        Mv = values[id(grid)]
         free, obs, o = _joined_samples(beams[:k], rel[:k], p)
         loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k,
                                 obs_weights=_wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None,
@@ -47,7 +125,7 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
         if truth_check:
             w = _wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None
             own = {index - j for j in range(k)}
-            seen = [(j - index, _explored(scans_c[j], Pc[j], grid.shape)) for j in leave if j not in own]
+            seen = [(j - index, _explored(scans_c[j], Pc[j], grid.shape)) for j in leave[k] if j not in own]
             chk = _truth_check(Mv, grid, free, obs, w, headings, loc.pose, Pc[index], p,
                                [scans_c[index - j] for j in range(k)], Pc[[index - j for j in range(k)]], rel[:k],
                                left_out_seen=seen)
@@ -269,7 +347,7 @@ def _terms_table(res, scans=None) -> str:
                         title=(f"{res.name}: the score's terms (a_c = {res.params.a_c:g}, a_p = {res.params.a_p:g}; "
                                "score = the four signed terms) at the estimate and at the best grid pose within "
                                f"{FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the logged pose; unexpl. = on unexplored "
-                               f"cells of the leave-out grid (±{res.exclude} scans), which count 0; origin: the truth's "
+                               f"cells of the leave-out grid ({_leave_text(res)} left out), which count 0; origin: the truth's "
                                "obstacle and free marks on unexplored cells that a left-out scan 1 or 2 steps away "
                                "saw (the leave-out removed them) or no other scan saw, and its obstacle marks on map "
                                "free cells that such a scan hit"))
