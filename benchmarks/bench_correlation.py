@@ -12,6 +12,7 @@ definition on a small case; every pair must give the identical peak.
     python benchmarks/bench_correlation.py --logs --every 100 --only intel,seattle   # smaller / fewer logs
     python benchmarks/bench_correlation.py --logs --map-check   # + is each log's beam layout read right? (issue 25)
     python benchmarks/bench_correlation.py --logs --failures    # + each failure: score failure or search failure?
+    python benchmarks/bench_correlation.py --logs --set 'joined=(1, 3)' --leave-out used   # each mode's own scans left out
     python benchmarks/bench_correlation.py --logs --failures --terms   # + the score's terms at estimate and truth
     python benchmarks/bench_correlation.py --refine-cost        # + CPU time of refine=10 (issue 25)
 """
@@ -117,6 +118,9 @@ def main():
     ap.add_argument("--exclude", type=int, default=None,
                     help="scans left out on either side of each --logs scan (default: run_log_localisation's, 2)")
     ap.add_argument("--max-range", type=float, default=None, help="range limit [m] of the --logs run (default 10)")
+    ap.add_argument("--leave-out", choices=("window", "used"), default=None,
+                    help="which scans each --logs grid lacks: 'window' (±exclude, the default) or 'used' (each "
+                         "mode's own scans only; issue 25)")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="any other setting of the --logs run (run_log_localisation's arguments, LocaliseParams "
                          "fields), a Python literal: --set 'odom_std=(0, 0)' --set a_p=4 --set hit_ratio=0.1")
@@ -204,7 +208,8 @@ def main():
     if args.refine_cost:
         refine_cost()
     if args.logs:
-        settings = {k: val for k, val in (("exclude", args.exclude), ("max_range_m", args.max_range)) if val is not None}
+        settings = {k: val for k, val in (("exclude", args.exclude), ("max_range_m", args.max_range),
+                                          ("leave_out", args.leave_out)) if val is not None}
         for item in args.set:
             name, sep, value = item.partition("=")
             if not sep:
