@@ -126,7 +126,7 @@ class LogLocalisationResult:
     time_s : float
         Wall time [s] (not compared).
     leave_out : {"window", "used"}
-        Which scans each test scan's grid lacks (:func:`run_log_localisation`).
+        Which scans each test scan's grid lacks (:func:`~slamlab.correlation.run_log_localisation`).
     """
 
     name: str  # the log's file name
