@@ -316,8 +316,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
 
     Each test scan is localised on the grid (``cell_m`` cells, 004's three values) of every
-    scan of the log except ``±exclude`` scans around it (``leave_out``), so a scan is never matched against
-    cells it or its nearest neighbours drew (ours), from no prior (full 360°), and
+    scan of the log except ``±exclude`` scans around it (by default; see ``leave_out``), so a scan is never
+    matched against cells it or its nearest neighbours drew (ours), from no prior (full 360°), and
     compared with its logged pose (SLAM-corrected in the Radish logs). A success is a pose
     within 2 cells and 5° of the logged one.
 
