@@ -81,10 +81,11 @@ _GOAL_LOGS = [
     pytest.param("fhw", 50, id="fhw-every-50th"),
     pytest.param("orebro", 25, id="orebro-every-25th", marks=pytest.mark.xfail(
         strict=True, reason="issue 25: orebro misses the goal (4/9 single, 7/9 with 3 scans; orebro 50 and 200 are "
-                            "score failures, docs/benchmarks.md): passes the day it is met")),
+                            "score failures: the map they see was drawn only by scans the ±2 leave-out removes, "
+                            "docs/benchmarks.md): passes the day it is met")),
     pytest.param("seattle", 25, id="seattle-every-25th", marks=pytest.mark.xfail(
         strict=True, reason="issue 25: seattle misses the 3-scan goal (7/9 with 3 scans; seattle 75 is a score "
-                            "failure, docs/benchmarks.md): passes the day it is met")),
+                            "failure in every term, with either leave-out, docs/benchmarks.md): passes the day it is met")),
 ]
 
 
