@@ -54,3 +54,21 @@ def test_popcount64_counts_bits_in_python_and_inside_a_kernel():
     # compiled: one word per descriptor, against the zero descriptor, so the distances are the bit counts
     d1 = all_hamming_2nn(words[:, None], np.zeros((1, 2), np.uint64))[1]
     assert d1.tolist() == np.bitwise_count(words).astype(float).tolist()
+
+
+def test_hamming_words_is_the_bit_count_of_the_xor_in_python_and_inside_the_kernels():
+    """The per-pair Hamming distance three kernels share (``jitable``): plain Python gives numpy's
+    ``bitwise_count`` of the rows' XOR (the reference); compiled, the range kernel's nearest distance over one
+    candidate is that count too."""
+    from slamlab.kdtree._hamming_kernel import hamming_words, ranges_hamming_2nn
+
+    rng = np.random.default_rng(1)
+    Dq = rng.integers(0, 2**63, (20, 4), dtype=np.uint64)
+    Dt = np.r_[rng.integers(0, 2**63, (19, 4), dtype=np.uint64), np.full((1, 4), 2**64 - 1, dtype=np.uint64)]
+    ref = np.bitwise_count(Dq[:, None, :] ^ Dt[None, :, :]).sum(axis=2)
+    with np.errstate(over="ignore"):  # numpy scalars warn on the bit count's intended wrap-around
+        py = [[int(hamming_words(Dq, i, Dt, t)) for t in range(20)] for i in range(20)]
+    assert py == ref.tolist()
+    t = np.arange(20)[::-1].copy()  # query i's one candidate: target 19 - i
+    d1 = ranges_hamming_2nn(Dq, Dt, t, np.arange(20), np.arange(1, 21))[1]
+    assert d1.tolist() == ref[np.arange(20), t].astype(float).tolist()

@@ -20,7 +20,7 @@ import numpy as np
 
 from .._compiled import jitable, kernel
 
-__all__ = ["all_hamming_2nn", "no_two_nearest", "popcount64", "ranges_hamming_2nn"]
+__all__ = ["all_hamming_2nn", "hamming_words", "no_two_nearest", "popcount64", "ranges_hamming_2nn"]
 
 
 @jitable
@@ -48,6 +48,35 @@ def popcount64(x):
     x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
     x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
     return (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+
+
+@jitable
+def hamming_words(Dq, i, Dt, t):
+    """Hamming distance between row ``i`` of ``Dq`` and row ``t`` of ``Dt`` (descriptors as uint64 words): the
+    per-pair count the window, epipolar and range kernels share (inlined into each when it compiles).
+
+    Parameters
+    ----------
+    Dq, Dt : numpy.ndarray of uint64, shape (K, W) and (N, W)
+        Descriptors as 64-bit words.
+    i, t : int
+        The rows compared.
+
+    Returns
+    -------
+    numpy.uint64
+        The number of differing bits.
+
+    Examples
+    --------
+    >>> Dq = np.array([[0xFF, 0]], dtype=np.uint64); Dt = np.array([[0x0F, 1]], dtype=np.uint64)
+    >>> int(hamming_words(Dq, 0, Dt, 0))
+    5
+    """
+    bits = np.uint64(0)
+    for w in range(Dq.shape[1]):
+        bits += popcount64(Dq[i, w] ^ Dt[t, w])
+    return bits
 
 
 @jitable
@@ -80,11 +109,7 @@ def _ranges_hamming_2nn(Dq, Dt, order, lo, hi):  # pragma: no cover - compiled
         n = hi[i] - lo[i]
         # first the distances, in a loop without branches (the compiler vectorises it) ...
         for j in range(n):
-            t = order[lo[i] + j]
-            b = np.uint64(0)
-            for w in range(Dq.shape[1]):
-                b += popcount64(Dq[i, w] ^ Dt[t, w])
-            bits[j] = b
+            bits[j] = hamming_words(Dq, i, Dt, order[lo[i] + j])
         # ... then the two smallest, as in the window kernel
         for j in range(n):
             d = float(bits[j])

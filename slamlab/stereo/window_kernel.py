@@ -23,8 +23,8 @@ import numpy as np
 
 from .._compiled import kernel
 from ..kdtree._hamming_kernel import (  # ranges_hamming_2nn re-exported: the stereo matching's user
+    hamming_words,
     no_two_nearest,
-    popcount64,
     ranges_hamming_2nn,
 )
 
@@ -47,10 +47,7 @@ def _window_hamming_2nn(Dq, Dt, uv_q, uv_t, order, lo, hi, radius):  # pragma: n
                 if dx * dx + dy * dy > r2_lim:  # outside the window
                     continue
                 n_pairs += 1
-                bits = np.uint64(0)
-                for w in range(Dq.shape[1]):
-                    bits += popcount64(Dq[i, w] ^ Dt[t, w])
-                d = float(bits)
+                d = float(hamming_words(Dq, i, Dt, t))
                 if d < d1[i]:  # a new nearest: the old one becomes the second
                     d2[i], r2[i] = d1[i], r1[i]
                     d1[i], r1[i] = d, t
@@ -98,10 +95,7 @@ def _epipolar_hamming_2nn(Dq, Dt, a, b, c, uv_t, order, lo, hi, tol):  # pragma:
             t = order[j]
             if not np.abs(a[i] * uv_t[t, 0] + b[i] * uv_t[t, 1] + c[i]) <= tol:  # off the epipolar line
                 continue
-            bits = np.uint64(0)
-            for w in range(Dq.shape[1]):
-                bits += popcount64(Dq[i, w] ^ Dt[t, w])
-            d = float(bits)
+            d = float(hamming_words(Dq, i, Dt, t))
             if d < d1[i]:  # a new nearest: the old one becomes the second
                 d2[i], r2[i] = d1[i], r1[i]
                 d1[i], r1[i] = d, t
