@@ -292,6 +292,9 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
         print(r.ambiguity_table(t))
     for t in (1.0, 1.2, 1.3):  # issue 25: the margin, threshold 1.2 tuned on csail, orebro and seattle
         print(r.margin_table(t))
+    if r.results[0].votes is not None:  # --set votes=True (issue 25): the neighbours' single-scan votes
+        for t in (2, 1, 3):
+            print(r.votes_table(t))
     if 1 in r.results[0].joined and 3 in r.results[0].joined:
         more_confident(r)
     for res in r.results:

@@ -27,9 +27,10 @@ from .experiments import (
     run_table1,
     time_localise,
 )
-from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, ours_vs_source, run_log_localisation
+from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, run_log_localisation
 from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, run_log_suite
 from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
+from .source_table import ours_vs_source
 from .terms import TERM_NAMES, score_terms
 
 _PLOT = (

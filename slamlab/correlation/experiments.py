@@ -1,5 +1,5 @@
 """Ch. 5 experiments (004 §7): Table 1, a Monte Carlo study, the constants a_c/a_p, the corridor tie (the real
-CARMEN log and the closing table: :mod:`~slamlab.correlation.log_experiments`).
+CARMEN log: :mod:`~slamlab.correlation.log_experiments`; the closing table: :mod:`~slamlab.correlation.source_table`).
 
 Every ``run_*`` takes ``params=`` (a :class:`~slamlab.correlation.LocaliseParams`, the
 same settings and defaults as :func:`~slamlab.correlation.localise`) plus overrides

@@ -1,5 +1,4 @@
-"""Ch. 5 experiments (004 §7) on real data: correlation localisation along a CARMEN log with corrected poses, and
-ours beside the source's figures (the closing table).
+"""Ch. 5 experiments (004 §7) on real data: correlation localisation along a CARMEN log with corrected poses.
 
 Part of the chapter's experiments (:mod:`slamlab.correlation.experiments` holds the simulated ones and the helpers used here;
 :mod:`slamlab.correlation.log_truth` the per-scan task and the truth check).
@@ -23,14 +22,10 @@ from .algorithm import LocaliseParams, heading_candidates, heading_error
 from .experiments import (
     FAIL_CELLS,
     FAIL_DEG,
-    SOURCE_TABLE1,
-    ConstantsResult,
-    MonteCarloResult,
-    Table1Result,
-    run_table1,  # noqa: F401 (ours_vs_source's example)
 )
 from .log_truth import (
     _TRUTH_COLUMNS,
+    VOTE_SCANS,
     _check_leave,
     _describe,
     _failure_table,
@@ -41,13 +36,11 @@ from .log_truth import (
     _truth_frame,
 )
 from .settings import _check_score_norm, _check_unit
-from .studies import _errors
 
 __all__ = [
     "DEFAULT_CARMEN_LOG",
     "ODOM_STD",
     "LogLocalisationResult",
-    "ours_vs_source",
     "run_log_localisation",
 ]
 
@@ -127,6 +120,9 @@ class LogLocalisationResult:
         Wall time [s] (not compared).
     leave_out : {"window", "used"}
         Which scans each test scan's grid lacks (:func:`~slamlab.correlation.run_log_localisation`).
+    votes : numpy.ndarray of int, shape (modes, n), optional
+        Per answer, how many of the single-scan localisations of scans i, i-1, i-2 agree with it
+        (``run_log_localisation(votes=True)``; None: not run); :meth:`flagged` marks those with fewer than 2.
     """
 
     name: str  # the log's file name
@@ -149,11 +145,32 @@ class LogLocalisationResult:
     margin: np.ndarray | None = field(default=None, repr=False)  # (modes, n) Localisation.margin
     truth: dict | None = field(default=None, repr=False, compare=False)  # truth_check=True: _TRUTH_COLUMNS
     leave_out: str = "window"  # "window": ±exclude scans; "used": each mode's own scans
+    votes: np.ndarray | None = field(default=None, repr=False)  # (modes, n) votes=True: agreeing single scans
 
     @property
     def success(self) -> np.ndarray:
         """``(modes, n)``: within 2 cells and 5° of the logged pose."""
         return (self.err_pos_m <= FAIL_CELLS * self.cell_m) & (np.degrees(self.err_heading_rad) <= FAIL_DEG)
+
+    def flagged(self, min_votes: int = 2) -> np.ndarray:
+        """``(modes, n)``: answers fewer than ``min_votes`` of the three single-scan voters agree with (ours, issue
+        25; needs ``votes=True``).
+
+        Parameters
+        ----------
+        min_votes : int, default 2
+            Votes an answer needs not to be flagged (2: a majority of scans i, i-1, i-2), in 0..3.
+
+        Returns
+        -------
+        numpy.ndarray of bool
+        """
+        t = v.check_int(min_votes, "min_votes", minimum=0)
+        if t > VOTE_SCANS:
+            raise ValueError(f"`min_votes` must lie in 0..{VOTE_SCANS}; got {t}")
+        if self.votes is None:
+            raise ValueError("this result has no votes: run run_log_localisation(..., votes=True)")
+        return self.votes < t
 
     def _mode(self, k: int) -> str:
         return "1 scan" if k == 1 else f"{k} scans + odometry"
@@ -312,7 +329,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                          n_jobs: int = 1, progress: bool | None = None, truth_check: bool = False,
                          refine: int = 0, refine_heading_rad: float = float(np.radians(3.0)),
                          score_norm: str = "none", min_explored_fraction: float = 0.8, leave_out: str = "window",
-                         **overrides) -> LogLocalisationResult:
+                         votes: bool = False, **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
 
     Each test scan is localised on the grid (``cell_m`` cells, 004's three values) of every
@@ -382,6 +399,13 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         ``"window"``: the ``±exclude`` scans, one grid for every mode. ``"used"`` (ours, issue 25): each mode's
         grid lacks exactly the scans it localises with (mode ``k``: scans ``i - k + 1 .. i``), so cells the
         scans after ``i`` drew may be in it; ``exclude`` must not be given.
+    votes : bool, default False
+        Also localise scans ``i - 1`` and ``i - 2`` alone (ours, issue 25), on a grid that lacks them and scan ``i``
+        (with the ``±2`` window: the test scan's own grid), carry each answer to scan ``i`` by the same noisy
+        odometry as the joined modes, and count per mode how many of these three single-scan answers (scans
+        ``i, i-1, i-2``) lie within a success's tolerance of the mode's answer (``result.votes``; an answer with
+        fewer than 2 is :meth:`~slamlab.correlation.LogLocalisationResult.flagged`). The modes' answers are
+        unchanged; about twice the single-scan work.
 
     Returns
     -------
@@ -399,8 +423,9 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     kmax = max(modes)
     lo, ex = _check_leave(leave_out, exclude, kmax)
     hr = _check_unit(hit_ratio, "hit_ratio")
-    if not isinstance(truth_check, (bool, np.bool_)):
-        raise TypeError(f"`truth_check` must be a bool; got {type(truth_check).__name__}")
+    for name, flag in (("truth_check", truth_check), ("votes", votes)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise TypeError(f"`{name}` must be a bool; got {type(flag).__name__}")
     rf = v.check_int(refine, "refine", minimum=0)
     rfh = v.check_positive(refine_heading_rad, "refine_heading_rad", allow_zero=True)
     if (truth_check or rf) and p.a_n != 0:
@@ -416,14 +441,18 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     idx = np.asarray(scan_indices)
     if idx.ndim != 1 or idx.size == 0 or not np.issubdtype(idx.dtype, np.integer):
         raise ValueError(f"`scan_indices` must be a non-empty list of ints; got {scan_indices!r}")
-    if idx.min() < kmax - 1 or idx.max() >= log.n_scans:
-        raise ValueError(f"`scan_indices` must lie in [{kmax - 1}, {log.n_scans - 1}] (the {kmax - 1} scans before "
-                         f"each are joined); got {idx.min()}..{idx.max()}")
+    back = max(kmax, VOTE_SCANS) if votes else kmax  # scans read back from each test scan
+    if idx.min() < back - 1 or idx.max() >= log.n_scans:
+        raise ValueError(f"`scan_indices` must lie in [{back - 1}, {log.n_scans - 1}] (the {back - 1} scans before "
+                         f"each are joined or vote); got {idx.min()}..{idx.max()}")
     rng = v.as_rng(rng)
     t0 = time.perf_counter()
     frame, scans_c, Pc, full = log_counts(log, cell_m=cell, max_range_m=rmax)
-    noise = rng.normal(size=(idx.size, kmax - 1, 3)) * np.array([sd[0] / cell, sd[0] / cell, sd[1]])
-    points = _log_points(idx, modes, scans_c, Pc, noise, lo, ex)
+    scale = np.array([sd[0] / cell, sd[0] / cell, sd[1]])
+    noise = rng.normal(size=(idx.size, kmax - 1, 3)) * scale
+    if back > kmax:  # the voters' steps, drawn after the modes' so their answers do not change
+        noise = np.concatenate([noise, rng.normal(size=(idx.size, back - kmax, 3)) * scale], axis=1)
+    points = _log_points(idx, modes, scans_c, Pc, noise, lo, ex, votes=bool(votes))
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes, "hit_ratio": hr, "truth_check": bool(truth_check),
              "refine": rf, "refine_heading_rad": rfh, "score_norm": sn, "min_explored_fraction": frac}
@@ -438,63 +467,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     example = log.scan(int(idx[0])).points(est_m[0, 0])
     truth = ({c: np.stack([table[f"{c}{k}"].to_numpy(dtype=float) for k in modes]) for c in _TRUTH_COLUMNS}
              if truth_check else None)
+    vote = np.stack([table[f"vote{k}"].to_numpy(dtype=int) for k in modes]) if votes else None
     return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, amb, cell, rmax,
                                  ex if lo == "window" else None, full.grid, frame, modes,
-                                 (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0, margin, truth, lo)
-
-
-def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = None,
-                   constants: ConstantsResult | None = None, log: LogLocalisationResult | None = None) -> str:
-    """The notebook's closing table: 004's figures (§7, Table 1) beside ours, from the runs' results.
-
-    Parameters
-    ----------
-    table1 : Table1Result
-        From :func:`run_table1`.
-    monte_carlo : MonteCarloResult, optional
-        From :func:`run_monte_carlo`; its row is left out when None.
-    constants : ConstantsResult, optional
-        From :func:`run_constants_study`.
-    log : LogLocalisationResult, optional
-        From :func:`run_log_localisation`.
-
-    Returns
-    -------
-    str
-        The table: 004's claim, our figures, agreement.
-
-    Examples
-    --------
-    >>> print(ours_vs_source(run_table1(2, rng=1)).splitlines()[0])
-    Ours vs the source (004 §7)
-    """
-    if not isinstance(table1, Table1Result):
-        raise TypeError(f"`table1` must be a Table1Result; got {type(table1).__name__}")
-    src = SOURCE_TABLE1
-    s_ea, s_ex, s_ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
-    t = table1
-    rows = [
-        ["Table 1: poses", f"{src.shape[0]}", f"{t.true_poses.shape[0]}"],
-        ["Table 1: max position error [cells]", f"{max(s_ex.max(), s_ey.max()):.0f}",
-         f"{max(t.err_x_cells.max(), t.err_y_cells.max()):.0f}"],
-        ["Table 1: max heading error [rad]", f"{s_ea.max():.4f}", f"{t.err_heading_rad.max():.4f}"],
-        ["Table 1: range noise σ [cells]", "not given", f"{t.range_std_cells:g}"],
-    ]
-    if monte_carlo is not None:
-        mc = monte_carlo
-        rows += [[f"Monte Carlo ({mc.n_poses} poses): position exact", "no study", f"{np.mean(mc.err_pos_cells == 0):.1%}"],
-                 [f"Monte Carlo ({mc.n_poses} poses): failures (> 2 cells or > 5°)", "no study",
-                  f"{mc.failure_rate:.1%}"]]
-    if constants is not None:
-        c = constants
-        for k, lb in enumerate(c.labels):
-            rows.append([f"{lb}: heading margin / half-max area [cells]",
-                         "sharpest at a_p = -a_c" if k == 0 else "more robust to clutter",
-                         f"{np.median(c.heading_margin[k]):.3f} / {np.median(c.half_max_area[k]):.0f}"])
-            rows.append([f"{lb}: failures in the crowded room", "not measured", f"{c.failure_rate[k]:.0%}"])
-    if log is not None:
-        for m, k in enumerate(log.joined):
-            rows.append([(f"real log {log.name}, {log._mode(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
-                          f"and {FAIL_DEG:g}°"), "none (simulation only)",
-                         f"{int(log.success[m].sum())}/{log.success.shape[1]}"])
-    return format_table(["quantity", "004", "ours"], rows, title="Ours vs the source (004 §7)")
+                                 (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0, margin, truth, lo,
+                                 vote)

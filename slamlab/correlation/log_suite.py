@@ -129,6 +129,26 @@ class LogSuiteResult:
         return self._flag_table([r.margin for r in self.results], lambda a: a <= t, f"<= {t:g}", "margin",
                                 f"Margin (best - rival) / sqrt(best - base) as a failure flag, threshold {t:g}")
 
+    def votes_table(self, min_votes: int = 2) -> str:
+        """Per log and mode, then pooled over the logs: failures flagged (fewer than ``min_votes`` of the single-scan
+        localisations of scans i, i-1, i-2 agree with the answer) and successes flagged (ours, issue 25; needs
+        ``votes=True``).
+
+        Parameters
+        ----------
+        min_votes : int, default 2
+            Votes an answer needs not to be flagged, in 0..3 (2: a majority).
+
+        Returns
+        -------
+        str
+        """
+        for r in self.results:
+            r.flagged(min_votes)  # checks min_votes, and that the votes were run
+        return self._flag_table([r.votes for r in self.results], lambda a: a < min_votes, f"< {min_votes} votes",
+                                "votes", f"Votes as a failure flag: scans i, i-1, i-2 localised alone and carried to "
+                                f"scan i by odometry; flagged when fewer than {min_votes} agree (2 cells, 5°)")
+
     def _flag_table(self, values, flag, rule: str, short: str, title: str) -> str:
         """Rows per log and mode, then pooled: failures and successes ``flag``-ged, and their median ``values``."""
         def row(name, mode, a, ok):

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import _validate as v
 from .._table import format_table
-from ..geometry.se2 import se2_compose, se2_relative
+from ..geometry.se2 import se2_compose, se2_inverse, se2_relative
 from ..scans import grid_to_values
 from ..scans.logmap import leave_out_grid
 from ..scans.occupancy import label_counts, occupancy_grid
@@ -57,20 +57,42 @@ def _check_leave(leave_out, exclude, kmax: int) -> tuple[str, int]:
     return lo, ex
 
 
-def _log_points(idx, modes, scans_c, Pc, noise, leave_out: str = "window", exclude: int = 2) -> list[dict]:
+def _log_points(idx, modes, scans_c, Pc, noise, leave_out: str = "window", exclude: int = 2,
+                votes: bool = False) -> list[dict]:
     """The sweep's points of :func:`_localise_log_scan`, one per test scan ``i`` of ``idx``: its leave-out sets
-    (:func:`_leave_sets`), the beams of scans ``i, i-1, …`` and their poses relative to scan ``i`` (the logged
-    steps plus ``noise[n]``, cells and rad, chained back from scan ``i``)."""
-    kmax = max(modes)
+    (:func:`_leave_sets`; with ``votes`` also ``"votes"``, :func:`_vote_leave`), the beams of scans ``i, i-1, …``
+    (``max(modes)`` scans, at least :data:`VOTE_SCANS` with ``votes``) and their poses relative to scan ``i`` (the
+    logged steps plus ``noise[n]``, cells and rad, chained back from scan ``i``)."""
+    back = noise.shape[1] + 1
     points = []
     for n, i in enumerate(idx):
         rel = [np.zeros(3)]
-        for j in range(1, kmax):  # chain the noisy steps back from scan i
+        for j in range(1, back):  # chain the noisy steps back from scan i
             rel.append(se2_compose(rel[-1], se2_relative(Pc[i - j + 1], Pc[i - j]) + noise[n, j - 1]))
-        points.append({"index": int(i), "leave": _leave_sets(int(i), modes, exclude, len(scans_c), leave_out),
-                       "beams": [_scan_beams(scans_c[i - j], f"scan {i - j}") for j in range(kmax)],
+        leave = _leave_sets(int(i), modes, exclude, len(scans_c), leave_out)
+        if votes:
+            leave["votes"] = _vote_leave(int(i), leave)
+        points.append({"index": int(i), "leave": leave,
+                       "beams": [_scan_beams(scans_c[i - j], f"scan {i - j}") for j in range(back)],
                        "rel": np.array(rel)})
     return points
+
+
+#: Single-scan localisations that vote on each answer (``run_log_localisation(votes=True)``): scans i, i-1, i-2.
+VOTE_SCANS = 3
+
+
+def _vote_leave(index: int, leave: dict) -> tuple[int, ...]:
+    """The scans the voters' grid lacks: the largest mode's leave-out set and the voters ``index - 2 .. index``, so
+    no voter is matched against cells it drew (with the ``±2`` window: the window itself, no new grid)."""
+    own = set(leave[max(leave)]) | set(range(index - VOTE_SCANS + 1, index + 1))
+    return tuple(sorted(own))
+
+
+def _agrees(a, b) -> bool:
+    """Two poses (cells, rad) within a success's tolerance of each other (2 cells and 5°)."""
+    return bool(np.hypot(a[0] - b[0], a[1] - b[1]) <= FAIL_CELLS
+                and np.degrees(abs(heading_error(a[2], b[2]))) <= FAIL_DEG)
 
 
 def _leave_text(res) -> str:
@@ -106,20 +128,35 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
                        min_explored_fraction: float = 0.8) -> dict:
     """One sweep task: the leave-out grids of scan ``index`` (``leave``: per mode the scans left out,
     :func:`_leave_sets`) and its localisation in every mode (deterministic); with ``truth_check`` also
-    :func:`_truth_check`'s columns per mode."""
+    :func:`_truth_check`'s columns per mode; with a ``"votes"`` leave-out set also each mode's votes
+    (:func:`_votes`)."""
     grids = _mode_grids(leave, full, scans_c, Pc, hit_ratio)
     values = {}  # the score's map values per distinct grid
-    row = {}
-    for k in joined:
-        grid = grids[k]
+
+    def map_values(grid):
         if id(grid) not in values:
             values[id(grid)] = grid_to_values(grid, p.a_c, p.a_p, p.a_n)
-        Mv = values[id(grid)]
+        return values[id(grid)]
+
+    def localise_alone(grid, j):
+        """Scan ``index - j`` alone localised on ``grid`` (the modes' settings)."""
+        b, q = [beams[j]], np.zeros((1, 3))
+        free, obs, o = _joined_samples(b, q, p)
+        return _localise_samples(map_values(grid), free, obs, o, headings, p, tracking=False, n_scans=1,
+                                 obs_weights=_wall_weights(b, q, p) if p.wall_balance else None,
+                                 refine=refine, refine_heading_rad=refine_heading_rad, score_norm=score_norm,
+                                 min_explored_fraction=min_explored_fraction)
+
+    row, poses = {}, {}
+    for k in joined:
+        grid = grids[k]
+        Mv = map_values(grid)
         free, obs, o = _joined_samples(beams[:k], rel[:k], p)
         loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k,
                                 obs_weights=_wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None,
                                 refine=refine, refine_heading_rad=refine_heading_rad, score_norm=score_norm,
                                 min_explored_fraction=min_explored_fraction)
+        poses[k] = loc.pose
         row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity,
                     f"mar{k}": loc.margin})
         if truth_check:
@@ -130,7 +167,20 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
                                [scans_c[index - j] for j in range(k)], Pc[[index - j for j in range(k)]], rel[:k],
                                left_out_seen=seen)
             row.update({f"{name}{k}": val for name, val in chk.items()})
+    if "votes" in leave:
+        vgrid = grids["votes"]
+        reuse = 1 in joined and vgrid is grids[1]  # scan i alone on the same grid: mode 1's answer
+        voters = [poses[1] if reuse and j == 0 else localise_alone(vgrid, j).pose for j in range(VOTE_SCANS)]
+        row.update(_votes(voters, rel, poses))
     return row
+
+
+def _votes(voters, rel, poses: dict) -> dict:
+    """Per mode ``k`` (``vote{k}``): how many of the voters — scan ``i - j`` localised alone, ``voters[j]``, carried
+    to scan ``i`` by the (noisy) odometry ``rel[j]`` — agree with the mode's answer ``poses[k]`` (:func:`_agrees`;
+    ours, issue 25)."""
+    carried = [se2_compose(v_, se2_inverse(rel[j])) for j, v_ in enumerate(voters)]
+    return {f"vote{k}": sum(_agrees(c, pose) for c in carried) for k, pose in poses.items()}
 
 
 #: Where the truth's marks on unexplored cells come from (:func:`_unexplored_origin`): obstacle / free marks
