@@ -138,24 +138,21 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
             values[id(grid)] = grid_to_values(grid, p.a_c, p.a_p, p.a_n)
         return values[id(grid)]
 
-    def localise_alone(grid, j):
-        """Scan ``index - j`` alone localised on ``grid`` (the modes' settings)."""
-        b, q = [beams[j]], np.zeros((1, 3))
+    def search(grid, b, q):
+        """Scans ``b`` (beams) at poses ``q`` relative to the first, joined and localised on ``grid``; and their
+        free and obstacle samples."""
         free, obs, o = _joined_samples(b, q, p)
-        return _localise_samples(map_values(grid), free, obs, o, headings, p, tracking=False, n_scans=1,
-                                 obs_weights=_wall_weights(b, q, p) if p.wall_balance else None,
-                                 refine=refine, refine_heading_rad=refine_heading_rad, score_norm=score_norm,
-                                 min_explored_fraction=min_explored_fraction)
+        loc = _localise_samples(map_values(grid), free, obs, o, headings, p, tracking=False, n_scans=len(b),
+                                obs_weights=_wall_weights(b, q, p) if p.wall_balance else None,
+                                refine=refine, refine_heading_rad=refine_heading_rad, score_norm=score_norm,
+                                min_explored_fraction=min_explored_fraction)
+        return loc, free, obs
 
     row, poses = {}, {}
     for k in joined:
         grid = grids[k]
+        loc, free, obs = search(grid, beams[:k], rel[:k])
         Mv = map_values(grid)
-        free, obs, o = _joined_samples(beams[:k], rel[:k], p)
-        loc = _localise_samples(Mv, free, obs, o, headings, p, tracking=False, n_scans=k,
-                                obs_weights=_wall_weights(beams[:k], rel[:k], p) if p.wall_balance else None,
-                                refine=refine, refine_heading_rad=refine_heading_rad, score_norm=score_norm,
-                                min_explored_fraction=min_explored_fraction)
         poses[k] = loc.pose
         row.update({f"x{k}": loc.pose[0], f"y{k}": loc.pose[1], f"h{k}": loc.pose[2], f"amb{k}": loc.ambiguity,
                     f"mar{k}": loc.margin})
@@ -170,7 +167,8 @@ def _localise_log_scan(*, index: int, leave, beams, rel, full, scans_c, Pc, p, h
     if "votes" in leave:
         vgrid = grids["votes"]
         reuse = 1 in joined and vgrid is grids[1]  # scan i alone on the same grid: mode 1's answer
-        voters = [poses[1] if reuse and j == 0 else localise_alone(vgrid, j).pose for j in range(VOTE_SCANS)]
+        voters = [poses[1] if reuse and j == 0 else search(vgrid, [beams[j]], np.zeros((1, 3)))[0].pose
+                  for j in range(VOTE_SCANS)]
         row.update(_votes(voters, rel, poses))
     return row
 
