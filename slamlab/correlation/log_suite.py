@@ -3,7 +3,8 @@ corrected Radish log with one set of real-log defaults, and the per-log tables.
 
 :func:`run_log_suite` runs :func:`~slamlab.correlation.run_log_localisation` on each log with the same settings;
 :class:`LogSuiteResult` prints the per-log success rates (:meth:`~LogSuiteResult.table`) and how well the
-ambiguity separates failures from successes (:meth:`~LogSuiteResult.ambiguity_table`).
+ambiguity, the margin and the neighbours' votes separate failures from successes
+(:meth:`~LogSuiteResult.ambiguity_table`, :meth:`~LogSuiteResult.margin_table`, :meth:`~LogSuiteResult.votes_table`).
 """
 
 from __future__ import annotations
@@ -227,7 +228,7 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: Loca
         Progress bars (default: unless ``$SLAMLAB_PROGRESS=0``).
     **settings
         Any other argument of :func:`~slamlab.correlation.run_log_localisation` (``cell_m``, ``max_range_m``,
-        ``exclude``, ``leave_out``, ``odom_std``, ``hit_ratio``, :class:`LocaliseParams` fields).
+        ``exclude``, ``leave_out``, ``odom_std``, ``hit_ratio``, ``votes``, :class:`LocaliseParams` fields).
 
     Returns
     -------
