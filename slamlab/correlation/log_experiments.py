@@ -341,7 +341,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     Modes (``joined``): 1 = the scan alone (004's method); 2 or 3 = the scan and the 1 or 2
     scans before it joined by odometry (:func:`~slamlab.correlation.localise_joined`, ours).
     The corrected logs carry no raw odometry, so each step between consecutive scans is the
-    logged relative pose plus Gaussian noise ``odom_std = (σ_xy [m], σ_θ [rad])`` drawn from ``rng``.
+    logged relative pose plus Gaussian noise ``odom_std = (σ_xy [m], σ_θ [rad])``, drawn from ``rng`` once per
+    step of the log, so a scan's joined odometry does not depend on which other scans are localised.
     Every result carries the ambiguity of :class:`~slamlab.correlation.Localisation`.
 
     Parameters
@@ -372,7 +373,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     params, **overrides
         :class:`LocaliseParams` of every localisation (``rival_radius_cells`` 5 = 1 m at 0.2 m cells).
     rng : int or numpy.random.Generator, default 2017
-        Seed or generator of the odometry noise.
+        Seed or generator of the odometry noise (one draw of ``n_scans × 3`` normals per call).
     n_jobs, progress
         The scans run on :func:`slamlab.sweep.sweep` (one task per scan; same result for any
         ``n_jobs``) with a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
@@ -449,9 +450,9 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     t0 = time.perf_counter()
     frame, scans_c, Pc, full = log_counts(log, cell_m=cell, max_range_m=rmax)
     scale = np.array([sd[0] / cell, sd[0] / cell, sd[1]])
-    noise = rng.normal(size=(idx.size, kmax - 1, 3)) * scale
-    if back > kmax:  # the voters' steps, drawn after the modes' so their answers do not change
-        noise = np.concatenate([noise, rng.normal(size=(idx.size, back - kmax, 3)) * scale], axis=1)
+    # one noise draw per step of the log (row m: scan m-1 -> m), so a scan's odometry is the same in any list
+    steps = rng.normal(size=(log.n_scans, 3)) * scale
+    noise = steps[idx[:, None] - np.arange(back - 1)[None, :]]  # (n, back - 1): steps i -> i-1, i-1 -> i-2, …
     points = _log_points(idx, modes, scans_c, Pc, noise, lo, ex, votes=bool(votes))
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes, "hit_ratio": hr, "truth_check": bool(truth_check),

@@ -97,3 +97,19 @@ def test_log_meets_the_issue_25_goals(shared_data, name, every):
     single, three = _goal_rates(shared_data, name, every)
     assert single >= 0.75
     assert three >= 0.90
+
+
+@pytest.mark.realdata
+def test_joined_odometry_noise_is_drawn_per_step_of_the_log(shared_data):
+    # the noise belongs to the log's steps, not to a scan's place in the list: scan 75 joined with the 2 scans
+    # before it gets the same odometry, so the same answer, alone or among other scans, with or without votes
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
+    fast = {"joined": (3,), "delta_alpha_rad": np.radians(5.0), "progress": False}
+    alone = C.run_log_localisation(log, (75,), **fast)
+    among = C.run_log_localisation(log, (50, 75, 76, 225), **fast)
+    np.testing.assert_array_equal(among.est_poses_m[:, 1], alone.est_poses_m[:, 0])
+    np.testing.assert_array_equal(among.ambiguity[:, 1], alone.ambiguity[:, 0])
+    # scans 75 and 76 share the step 74 -> 75: with odometry noise only on that step their joined answers move
+    # together; a different seed draws other steps and so (here) another answer for at least one scan
+    other = C.run_log_localisation(log, (50, 75, 76, 225), rng=5, **fast)
+    assert not np.array_equal(other.est_poses_m, among.est_poses_m)

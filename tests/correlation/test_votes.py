@@ -44,7 +44,7 @@ def test_votes_leave_the_answers_unchanged_and_count_the_answer_itself(shared_da
     for joined in ((1, 3), (2,)):
         r0 = C.run_log_localisation(log, idx, joined=joined, **fast)
         r = C.run_log_localisation(log, idx, joined=joined, votes=True, **fast)
-        # the voters' odometry is drawn after the modes': every answer is the one without votes
+        # the voters use the log's per-step odometry noise: every answer is the one without votes
         np.testing.assert_array_equal(r.est_poses_m, r0.est_poses_m)
         np.testing.assert_array_equal(r.ambiguity, r0.ambiguity)
         assert r0.votes is None
