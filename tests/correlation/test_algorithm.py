@@ -275,7 +275,8 @@ def test_score_norm_explored_matches_definition(min_fraction):
     scan = S.Rangefinder(n_beams=90, max_range_cells=25.0).scan(S.test_room_200(), [50.0, 45.0, np.radians(20)])
     hd = C.heading_candidates(np.radians(30.0))
     T, o = C.rasterise_scan(scan, hd, dtype="float64")
-    ref = _explored_reference(M, T, o, min_fraction, -2.0)
+    floor = -1.0 / min_fraction - 1.0  # the documented floor: -max|T|·max|M| / min_fraction - 1, here |T|, |M| <= 1
+    ref = _explored_reference(M, T, o, min_fraction, floor)
     loc = C.localise(M, scan, delta_alpha_rad=np.radians(30.0), dtype="float64", ambiguity=False,
                      score_norm="explored", min_explored_fraction=min_fraction)
     n, r, c = np.unravel_index(np.argmax(ref), ref.shape)
@@ -292,12 +293,32 @@ def test_score_norm_explored_matches_definition(min_fraction):
             if 0 <= y < M.shape[0] and 0 <= x < M.shape[1]:
                 num += T[n, i, j] * Mv[y, x]
                 cnt += E[y, x]
-        want = num / max(cnt, 1) if cnt >= min_fraction * np.count_nonzero(T[n]) else -2.0
+        want = num / max(cnt, 1) if cnt >= min_fraction * np.count_nonzero(T[n]) else floor
         assert loc.score_map[rr, cc] == pytest.approx(want, abs=1e-9)
     # float32 FFTs find the same peak
     loc32 = C.localise(M, scan, delta_alpha_rad=np.radians(30.0), ambiguity=False, score_norm="explored",
                        min_explored_fraction=min_fraction)
     assert (loc32.heading_index, loc32.row, loc32.col) == (n, r, c)
+
+
+def test_score_norm_floor_lies_below_every_score_with_heavy_free_marks():
+    """Issue 25 (ours): with free marks weighted 5 (``free_mark_weight``), a map of obstacles only and a scan in open
+    space, every pose with enough marks on explored cells scores about -5 per mark (free marks on obstacles); the
+    poses with too few must still score lower, so the estimate keeps >= min_explored_fraction of its marks on the
+    map (a floor of min(a_c, a_p, a_n) - 1 = -2 would let the off-map poses win)."""
+    world = np.zeros((80, 80), dtype=np.int8)
+    world[[0, -1], :] = 1
+    world[:, [0, -1]] = 1
+    scan = S.Rangefinder(n_beams=90, max_range_cells=60.0).scan(world, [40.0, 40.0, 0.0])
+    M = np.ones((160, 160), dtype=np.int8)  # every cell an obstacle
+    hd = C.heading_candidates(np.radians(30.0))
+    loc = C.localise(M, scan, delta_alpha_rad=np.radians(30.0), dtype="float64", ambiguity=False,
+                     score_norm="explored", min_explored_fraction=0.8, free_mark_weight=5.0)
+    T, o = C.rasterise_scan(scan, hd, a_c=-5.0, a_p=1.0, dtype="float64")
+    marks = np.argwhere(T[loc.heading_index] != 0) - o + [loc.row, loc.col]
+    inside = np.all((marks >= 0) & (marks < 160), axis=1)
+    assert inside.mean() >= 0.8
+    assert loc.score < -3.0  # a real normalised score (free marks on obstacles dominate), not a floor
 
 
 def test_score_norm_bad_parameters():
