@@ -228,7 +228,8 @@ def localise(grid, scan: Scan, *, params: LocaliseParams | None = None, prior_he
     min_explored_fraction : float
         With ``score_norm="explored"``: a pose whose marks on explored cells are fewer than this fraction of the
         stamp's marks scores ``-max|T|·max|M| / min_explored_fraction - 1`` (below every normalised score; ``T``:
-        the stamp's values, ``M``: the map's), in (0, 1]; default 0.8
+        the stamp's values, ``M``: the map's; with ``a_n`` ≠ 0 times the stamp's cells per mark), in (0, 1];
+        default 0.8
         (the best of 0.5, 0.7, 0.8, 0.9 and 0.95 on the five shared CARMEN logs, ``docs/benchmarks.md``; still
         worse than no normalisation there).
     **overrides
@@ -296,14 +297,15 @@ def _wall_weights(beams, rel_poses, p: LocaliseParams, n_bins: int = 12) -> np.n
     return np.repeat(w, n_obs)
 
 
-def _explored_floor(a_c: float, a_p, p: LocaliseParams, min_fraction: float) -> float:
+def _explored_floor(a_c: float, a_p, p: LocaliseParams, min_fraction: float, per_mark: float = 1.0) -> float:
     """The score of a pose with too few marks on explored cells under ``score_norm="explored"``: below every
-    normalised score. A pose's ``Σ T·M`` is at most ``B = max|T|·max|M|`` per mark in size, and it is divided by at
-    least ``min_fraction`` of its marks, so ``-B / min_fraction - 1`` (``a_c``: the stamp's free value, ``a_p``: its
-    obstacle values)."""
-    stamp_max = max(abs(a_c), float(np.max(np.abs(a_p), initial=0.0)))
+    normalised score. A pose's ``Σ T·M`` is at most ``B = max|T|·max|M|`` per mark in size (``per_mark`` times that
+    when the stamp's unmarked cells, ``a_n``, count too), and it is divided by at least ``min_fraction`` of its
+    marks, so ``-B·per_mark / min_fraction - 1`` (``a_c``: the stamp's free value, ``a_p``: its obstacle
+    values)."""
+    stamp_max = max(abs(a_c), float(np.max(np.abs(a_p), initial=0.0)), abs(p.a_n))
     map_max = max(abs(p.a_c), abs(p.a_p), abs(p.a_n))
-    return -stamp_max * map_max / min_fraction - 1.0
+    return -stamp_max * map_max * per_mark / min_fraction - 1.0
 
 
 def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking: bool, n_scans: int = 1,
@@ -329,8 +331,11 @@ def _localise_samples(Mv, free, obs, o, headings, p: LocaliseParams, *, tracking
     specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=p.workers)
     norm = None
     if score_norm == "explored":  # scores per mark on an explored cell (ours, issue 25)
-        norm = _ExploredNorm(Mv, free, obs, headings, o, p.a_n, min_explored_fraction,
-                             _explored_floor(a_c, a_p, p, min_explored_fraction), dtype=dtype, workers=p.workers)
+        norm = _ExploredNorm(Mv, free, obs, headings, o, p.a_n, min_explored_fraction, 0.0, dtype=dtype,
+                             workers=p.workers)
+        # with a_n != 0 every stamp cell, not only the marks, adds to the score
+        per_mark = 1.0 if p.a_n == 0 else S * S / max(1.0, float(norm.marks.min()))
+        norm.floor = _explored_floor(a_c, a_p, p, min_explored_fraction, per_mark)
         tol = tol / max(1.0, min_explored_fraction * float(norm.marks.min()))
     found = _peak_search(Mv, stamps, headings, S, o, dtype=dtype, workers=p.workers, chunk=p.chunk, tol=tol,
                          specs=specs, n_peaks=refine, norm=norm)
