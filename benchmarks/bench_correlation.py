@@ -295,8 +295,8 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
     if r.results[0].votes is not None:  # --set votes=True (issue 25): the neighbours' single-scan votes
         for t in (2, 1, 3):
             print(r.votes_table(t))
-    if 1 in r.results[0].joined and 3 in r.results[0].joined:
-        more_confident(r)
+    if 1 in r.results[0].joined and 3 in r.results[0].joined:  # issue 25: per scan the answer with the larger margin
+        print(r.confident_table((1, 3)))
     for res in r.results:
         print(res.table())
 
@@ -317,19 +317,6 @@ def refine_cost(repeat: int = 2) -> None:
     t0, t10 = min(times[0]), min(times[10])
     print(f"best: defaults {t0:.1f} s, refine=10 {t10:.1f} s, ratio {t10 / t0:.2f}; load average now "
           f"{os.getloadavg()[0]:.1f}")
-
-
-def more_confident(r) -> None:
-    """Issue 25 (ours, an experiment): per scan, the 1-scan or the 3-scan answer, whichever has the larger margin."""
-    print("\nPer scan the answer of the mode with the larger margin (1 scan or 3 joined), localised per log:")
-    tot = [0, 0, 0]
-    for name, res in zip(r.names, r.results, strict=True):
-        m1, m3 = res.joined.index(1), res.joined.index(3)
-        pick = np.where(res.margin[m1] > res.margin[m3], res.success[m1], res.success[m3])
-        n = pick.size
-        tot = [tot[0] + res.success[m3].sum(), tot[1] + pick.sum(), tot[2] + n]
-        print(f"{name:>8}: 3 scans {res.success[m3].sum()}/{n}, more confident of 1 and 3: {pick.sum()}/{n}")
-    print(f"{'all':>8}: 3 scans {tot[0]}/{tot[2]}, more confident of 1 and 3: {tot[1]}/{tot[2]}")
 
 
 def intel(n_jobs: int) -> None:

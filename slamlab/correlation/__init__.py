@@ -28,7 +28,7 @@ from .experiments import (
     time_localise,
 )
 from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, run_log_localisation
-from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, run_log_suite
+from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, more_confident, run_log_suite
 from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
 from .source_table import ours_vs_source
 from .terms import TERM_NAMES, score_terms
@@ -73,6 +73,7 @@ __all__ = [
     "localise_joined",
     "log_grid",
     "map_check",
+    "more_confident",
     "ours_vs_source",
     "random_clutter",
     "rasterise_scan",

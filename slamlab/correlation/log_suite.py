@@ -21,7 +21,7 @@ from .log_experiments import LogLocalisationResult, run_log_localisation
 from .log_truth import _leave_text
 from .settings import LocaliseParams
 
-__all__ = ["SHARED_CARMEN_LOGS", "LogSuiteResult", "run_log_suite"]
+__all__ = ["SHARED_CARMEN_LOGS", "LogSuiteResult", "more_confident", "run_log_suite"]
 
 #: The five corrected Radish logs of the shared data (found by :func:`slamlab.data.find_data`).
 SHARED_CARMEN_LOGS = tuple(f"carmen-radish-corrected/{n}-corrected.log.gz"
@@ -150,6 +150,37 @@ class LogSuiteResult:
                                 "votes", f"Votes as a failure flag: scans i, i-1, i-2 localised alone and carried to "
                                 f"scan i by odometry; flagged when fewer than {min_votes} agree (2 cells, 5°)")
 
+    def confident_table(self, modes=(1, 3)) -> str:
+        """Per log, then pooled: the scans localised by each of two modes, and by the more confident of their two
+        answers per scan (:func:`more_confident`; ours, issue 25, an experiment: not a mode of
+        :func:`~slamlab.correlation.run_log_localisation`).
+
+        Parameters
+        ----------
+        modes : pair of int, default (1, 3)
+            Two of the results' modes (numbers of joined scans).
+
+        Returns
+        -------
+        str
+        """
+        a, b = _mode_pair(modes, self.results[0].joined)
+        rows, tot = [], np.zeros(3, dtype=int)
+        for name, r in zip(self.names, self.results, strict=True):
+            keep = more_confident(r, (a, b))
+            ok = r.success[r.joined.index(a)], r.success[r.joined.index(b)]
+            both = np.where(keep == a, ok[0], ok[1])
+            counts = np.array([ok[0].sum(), ok[1].sum(), both.sum()])
+            tot += counts
+            rows.append([name, str(both.size), *(f"{c}/{both.size}" for c in counts), str(int(np.sum(keep == a)))])
+        n = sum(r.success.shape[1] for r in self.results)
+        rows.append(["all", str(n), *(f"{c}/{n}" for c in tot), ""])
+        r0 = self.results[0]
+        return format_table(["log", "scans", r0._mode(a), r0._mode(b), "more confident of the two",
+                             f"answers kept from {r0._mode(a)}"], rows,
+                            title=(f"Per scan the answer with the larger margin ({r0._mode(a)} or {r0._mode(b)}; a tie "
+                                   f"keeps {r0._mode(b)}); {_leave_text(r0)} left out of each grid"))
+
     def _flag_table(self, values, flag, rule: str, short: str, title: str) -> str:
         """Rows per log and mode, then pooled: failures and successes ``flag``-ged, and their median ``values``."""
         def row(name, mode, a, ok):
@@ -198,6 +229,42 @@ class LogSuiteResult:
         rates = "; ".join(f"{n} " + ", ".join(f"{ok.sum()}/{ok.size}" for ok in r.success)
                           for n, r in zip(self.names, self.results, strict=True))
         return f"{len(self.results)} logs, every {self.every}th scan, localised per mode: {rates}"
+
+
+def _mode_pair(modes, joined) -> tuple[int, int]:
+    """``modes`` checked: two distinct modes of ``joined``."""
+    pair = tuple(np.atleast_1d(np.asarray(modes)).tolist())
+    if len(pair) != 2 or pair[0] == pair[1] or any(k not in joined for k in pair):
+        raise ValueError(f"`modes` must be two distinct modes of the run {tuple(joined)}; got {modes!r}")
+    return int(pair[0]), int(pair[1])
+
+
+def more_confident(result: LogLocalisationResult, modes=(1, 3)) -> np.ndarray:
+    """Per scan, which of two modes' answers has the larger margin (ours, issue 25; an experiment).
+
+    :attr:`~slamlab.correlation.Localisation.margin` measures how far the peak leads its rival; keeping, per
+    scan, the answer that leads by more is one way to use two modes together (``docs/benchmarks.md``, "the more
+    confident of the 1-scan and 3-scan answers"). A tie keeps the second mode's answer.
+
+    Parameters
+    ----------
+    result : LogLocalisationResult
+        A run with both modes (:func:`~slamlab.correlation.run_log_localisation`).
+    modes : pair of int, default (1, 3)
+        The two modes (numbers of joined scans).
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (n,)
+        The mode whose answer is kept, per scan.
+    """
+    if not isinstance(result, LogLocalisationResult):
+        raise TypeError(f"`result` must be a LogLocalisationResult; got {type(result).__name__}")
+    a, b = _mode_pair(modes, result.joined)
+    if result.margin is None:
+        raise ValueError("`result` carries no margins (run it with run_log_localisation)")
+    ma, mb = result.margin[result.joined.index(a)], result.margin[result.joined.index(b)]
+    return np.where(ma > mb, a, b)
 
 
 def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: LocaliseParams | None = None, rng=2017,

@@ -113,3 +113,31 @@ def test_joined_odometry_noise_is_drawn_per_step_of_the_log(shared_data):
     # together; a different seed draws other steps and so (here) another answer for at least one scan
     other = C.run_log_localisation(log, (50, 75, 76, 225), rng=5, **fast)
     assert not np.array_equal(other.est_poses_m, among.est_poses_m)
+
+
+@pytest.mark.realdata
+def test_more_confident_keeps_the_answer_with_the_larger_margin(shared_data):
+    # a real two-mode run, then margins and errors set by hand so the choice and the counts are known
+    import dataclasses
+
+    log = read_carmen(shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
+    r = C.run_log_localisation(log, (75, 150, 225), joined=(1, 3), delta_alpha_rad=np.radians(10.0),
+                               progress=False)
+    margin = np.array([[2.0, 0.5, 1.0], [1.0, 3.0, 1.0]])       # scan 75: mode 1 leads; 150: mode 3; 225: a tie
+    err = np.array([[0.1, 0.1, 5.0], [5.0, 5.0, 0.1]])          # mode 1 right on 75, 150; mode 3 right on 225
+    r = dataclasses.replace(r, margin=margin, err_pos_m=err, err_heading_rad=np.zeros((2, 3)))
+    assert C.more_confident(r).tolist() == [1, 3, 3]            # a tie keeps the second mode
+    assert C.more_confident(r, (3, 1)).tolist() == [1, 3, 1]    # ... whichever is second
+    s = C.LogSuiteResult((r,), 75)
+    row = s.confident_table().splitlines()[3].split()
+    # kept: mode 1 on 75 (right), mode 3 on 150 (wrong), mode 3 on 225 (right): 2/3; mode 1 alone 2/3, mode 3 1/3
+    assert row == ["seattle", "3", "2/3", "1/3", "2/3", "1"]
+    assert s.confident_table().splitlines()[-1].split()[:5] == ["all", "3", "2/3", "1/3", "2/3"]
+    with pytest.raises(ValueError, match=r"`modes` must be two distinct modes of the run \(1, 3\); got \(1, 2\)"):
+        C.more_confident(r, (1, 2))
+    with pytest.raises(ValueError, match="`modes` must be two distinct modes"):
+        s.confident_table((3, 3))
+    with pytest.raises(TypeError, match="`result` must be a LogLocalisationResult; got dict"):
+        C.more_confident({})
+    with pytest.raises(ValueError, match="carries no margins"):
+        C.more_confident(dataclasses.replace(r, margin=None))
