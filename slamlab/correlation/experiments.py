@@ -40,6 +40,7 @@ from .studies import (
     _errors,
     _estimates,
     _localise_scans,
+    _within_tolerance,
     corridor_grid,
     time_localise,
 )
@@ -218,7 +219,7 @@ def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, 
     est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
     ea, ex, ey = _errors(poses, est)
     ep = np.hypot(ex, ey)
-    failed = (ep > FAIL_CELLS) | (np.degrees(ea) > FAIL_DEG)
+    failed = ~_within_tolerance(ep, ea)
     return MonteCarloResult(n, ea, ep, failed, float(range_std_cells), ec, time.perf_counter() - t0)
 
 
@@ -289,7 +290,7 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     pm = table["half_max_area"].to_numpy(dtype=float).reshape(k, n)
     hm = table["heading_margin"].to_numpy(dtype=float).reshape(k, n)
     ep = np.hypot(est[..., 0] - poses[:, 0], est[..., 1] - poses[:, 1])
-    failed = (ep > FAIL_CELLS) | (np.degrees(heading_error(est[..., 2], poses[:, 2])) > FAIL_DEG)
+    failed = ~_within_tolerance(ep, heading_error(est[..., 2], poses[:, 2]))
     h0 = np.radians(np.round(np.degrees(poses[0, 2])))
     maps = [localise(M, scans[0], params=q, prior_heading_rad=h0, window_rad=0.0).score_map for q in settings]
     labels = tuple(f"a_c={c[0]:g}, a_p={c[1]:g}, a_n={c[2]:g}" for c in consts)

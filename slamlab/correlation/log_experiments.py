@@ -36,6 +36,7 @@ from .log_truth import (
     _truth_frame,
 )
 from .settings import _check_score_norm, _check_unit
+from .studies import _within_tolerance
 
 __all__ = [
     "DEFAULT_CARMEN_LOG",
@@ -150,7 +151,7 @@ class LogLocalisationResult:
     @property
     def success(self) -> np.ndarray:
         """``(modes, n)``: within 2 cells and 5° of the logged pose."""
-        return (self.err_pos_m <= FAIL_CELLS * self.cell_m) & (np.degrees(self.err_heading_rad) <= FAIL_DEG)
+        return _within_tolerance(self.err_pos_m, self.err_heading_rad, self.cell_m)
 
     def flagged(self, min_votes: int = 2) -> np.ndarray:
         """``(modes, n)``: answers fewer than ``min_votes`` of the three single-scan voters agree with (ours, issue

@@ -26,6 +26,7 @@ from .algorithm import (
 )
 from .experiments import FAIL_CELLS, FAIL_DEG
 from .settings import _stamp_a_c
+from .studies import _within_tolerance
 from .terms import COUNT_NAMES, TERM_NAMES, _terms_of
 
 __all__: list[str] = []
@@ -91,8 +92,7 @@ def _vote_leave(index: int, leave: dict) -> tuple[int, ...]:
 
 def _agrees(a, b) -> bool:
     """Two poses (cells, rad) within a success's tolerance of each other (2 cells and 5°)."""
-    return bool(np.hypot(a[0] - b[0], a[1] - b[1]) <= FAIL_CELLS
-                and np.degrees(abs(heading_error(a[2], b[2]))) <= FAIL_DEG)
+    return bool(_within_tolerance(np.hypot(a[0] - b[0], a[1] - b[1]), heading_error(a[2], b[2])))
 
 
 def _leave_text(res) -> str:

@@ -22,6 +22,12 @@ FAIL_CELLS = 2.0  # a localisation farther than this from the truth (or > FAIL_D
 FAIL_DEG = 5.0
 
 
+def _within_tolerance(err_pos, err_heading_rad, cell_m: float = 1.0) -> np.ndarray:
+    """A success by the chapter's criterion: position error ``err_pos`` within ``FAIL_CELLS`` cells (in the units of
+    ``cell_m``: cells by default, metres with the cell size) and absolute heading error within ``FAIL_DEG``."""
+    return (np.asarray(err_pos) <= FAIL_CELLS * cell_m) & (np.degrees(np.abs(err_heading_rad)) <= FAIL_DEG)
+
+
 def _localise_one(*, beams, choice: int, Mvs, settings, headings, margins: bool = False, pose_index: int = 0) -> dict:
     """One sweep task: localise one scan's ``beams`` on map ``Mvs[choice]`` with ``settings[choice]`` (deterministic)."""
     loc = _localise(Mvs[choice], *beams, headings, settings[choice], tracking=False)
