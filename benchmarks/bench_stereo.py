@@ -165,7 +165,7 @@ def main(argv=None):
                     f"{st.std(ddof=1) / np.sqrt(st.size):.4f} | {st.std(ddof=1):.4f} |")
     if args.kitti51:
         say()
-        folder = sl.data.find_data("kitti-odometry-06-stereo-51/calib.txt").parent
+        folder = sl.data.find_data("kitti-odometry-06-stereo-51")
         for det in args.detectors.split(","):
             t0 = time.perf_counter()
             fix_off = sl.stereo.PROPOSED_FIX_OFF

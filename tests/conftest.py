@@ -1,13 +1,16 @@
-"""Shared test set-up: the ``realdata`` marker and the ``shared_data`` fixture.
+"""Shared test set-up: the ``realdata`` marker and the ``real_data`` fixture.
 
-A test marked ``@pytest.mark.realdata`` needs the shared data folder
-(``$SLAMLAB_DATA`` or ``../shared/data``). When the folder is missing the test is
-skipped with a message naming every place searched -- unless the environment
-sets ``SLAMLAB_REQUIRE_REALDATA=1`` (CI does), in which case it fails.
+A test marked ``@pytest.mark.realdata`` needs the registered real data sets. They are taken
+from the first data folder that holds every registered file (``$SLAMLAB_DATA``,
+``../shared/data``, or the cache that ``make data`` fills); when none does, they are fetched
+into the cache once per session. When that fails (no network, no mirror) the test is skipped
+with the reason -- unless the environment sets ``SLAMLAB_REQUIRE_REALDATA=1`` (CI does), in
+which case it fails.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -25,24 +28,42 @@ def _require_realdata() -> bool:
     return os.environ.get(REQUIRE_ENV, "").strip() not in ("", "0")
 
 
-def _locate_shared_data() -> Path:
-    """The shared data folder, or skip/fail the current test with the searched places."""
+def _find_real_data() -> Path:
+    """A data folder holding every registered file, fetching into the cache when none does."""
+    files = sl_data.registry().files
+    for _label, folder in sl_data.data_locations():
+        if folder is not None and all((folder / f.relpath).is_file() for f in files):
+            return folder
+    sl_data.fetch_sets(progress=False)
+    return sl_data.cache_dir()
+
+
+@functools.cache
+def _real_data_or_reason() -> Path | str:
+    """The folder, or why there is none (looked up once per session)."""
     try:
-        return sl_data.shared_data_dir()
-    except FileNotFoundError as err:
-        message = f"real data not available: {err}"
+        return _find_real_data()
+    except FileNotFoundError as err:  # DataUnavailableError is one
+        return f"real data not available: {err}"
+
+
+def _locate_real_data() -> Path:
+    """The real-data folder, or skip/fail the current test with the reason."""
+    found = _real_data_or_reason()
+    if isinstance(found, Path):
+        return found
     if _require_realdata():
-        pytest.fail(f"{message}\n({REQUIRE_ENV}=1 makes a missing folder an error)", pytrace=False)
-    pytest.skip(message)
+        pytest.fail(f"{found}\n({REQUIRE_ENV}=1 makes missing data an error)", pytrace=False)
+    pytest.skip(found)
 
 
 @pytest.fixture(scope="session")
-def shared_data() -> Path:
-    """Root of the shared real-data folder (skips or fails when it is missing)."""
-    return _locate_shared_data()
+def real_data() -> Path:
+    """A data folder holding every registered file in the shared layout (skips or fails when there is none)."""
+    return _locate_real_data()
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:
     """Give every ``realdata`` test the skip/fail behaviour, fixture or not."""
     if item.get_closest_marker("realdata") is not None:
-        _locate_shared_data()
+        _locate_real_data()

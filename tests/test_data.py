@@ -129,7 +129,7 @@ def test_find_data_rejects_bad_relpath(relpath, error, match):
 
 
 @pytest.mark.realdata
-def test_real_shared_data_is_found(shared_data):
+def test_real_shared_data_is_found(real_data):
     provenance = data.find_data("oxford-affine/PROVENANCE.md")
     assert provenance.is_file()
-    assert provenance == shared_data / "oxford-affine" / "PROVENANCE.md"
+    assert provenance == real_data / "oxford-affine" / "PROVENANCE.md"

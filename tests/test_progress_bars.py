@@ -41,7 +41,7 @@ def test_store_comparison_and_crossover_bars_over_stores(capsys, monkeypatch):
 
 
 @pytest.mark.realdata
-def test_feature_experiments_bars(capsys, monkeypatch, shared_data):
+def test_feature_experiments_bars(capsys, monkeypatch, real_data):
     quiet, shown, err = _both(capsys, monkeypatch, lambda p: sl.features.run_pair_evaluation(
         "graf", (2, 3), detectors=("ORB",), scale=0.25, n_points=100, progress=p))
     assert "pair evaluation" in err

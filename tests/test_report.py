@@ -64,7 +64,7 @@ def test_parse_params_reads_literals_and_words():
 
 @pytest.mark.slow
 @pytest.mark.realdata
-def test_report_runs_notebook_06_with_fewer_poses(tmp_path, shared_data):
+def test_report_runs_notebook_06_with_fewer_poses(tmp_path, real_data):
     params = report.parse_params(["TABLE1_POSES=3", "MC_SIZE=4", "CONSTANTS_POSES=2", "LOG_EVERY=300",
                                   "LOG_JOINED=(1, 3)"])
     out = report.run_report("06", params, tmp_path)

@@ -62,7 +62,7 @@ def oxford_folder(sequence) -> Path:
         The sequence's folder.
     """
     if isinstance(sequence, str) and sequence in OXFORD_SEQUENCES:
-        return Path(find_data(f"oxford-affine/{sequence}/H1to2p")).parent
+        return Path(find_data(f"oxford-affine/{sequence}"))
     if isinstance(sequence, str) and not any(c in sequence for c in "/\\") and not Path(sequence).exists():
         raise ValueError(f"`sequence` must be one of {OXFORD_SEQUENCES} or the path of an Oxford-layout folder; "
                          f"got {sequence!r}")

@@ -33,7 +33,7 @@ def chapter_cameras(kitti_folder=None) -> dict:
 
     w, h = SIZES["tiny"]
     cams = {"rendered (tiny)": (mono_sim("tiny").rig.left.K, w, h)}
-    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if kitti_folder is None else \
+    d = find_data("kitti-odometry-06-stereo") if kitti_folder is None else \
         v.as_path(kitti_folder, "kitti_folder", kind="dir")
     cams["KITTI 06 left"] = (read_kitti_calib(d / "calib.txt")["P0"][:, :3], 1226, 370)
     return cams

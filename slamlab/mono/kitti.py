@@ -42,7 +42,7 @@ def load_kitti(folder=None, n_frames: int | None = None):
     from ..evaluation import read_kitti
     from ..io.kitti import read_kitti_calib, read_kitti_image
 
-    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else v.as_path(folder, "folder", kind="dir")
+    d = find_data("kitti-odometry-06-stereo") if folder is None else v.as_path(folder, "folder", kind="dir")
     K = read_kitti_calib(d / "calib.txt")["P0"][:, :3]
     gt = read_kitti(d / "poses.txt").poses
     n = len(gt) if n_frames is None else min(len(gt), v.check_int(n_frames, "n_frames", minimum=2))
@@ -154,7 +154,7 @@ def epipolar_demo(folder=None, *, frames=(0, 1, 2), n_seeds: int = 60, depth_mea
     from .depth_filter import compute_tau, init_seeds, tau_inverse, update_seeds
     from .epipolar import extract_patches, search_epipolar
 
-    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else v.as_path(folder, "folder", kind="dir")
+    d = find_data("kitti-odometry-06-stereo") if folder is None else v.as_path(folder, "folder", kind="dir")
     K = read_kitti_calib(d / "calib.txt")["P0"][:, :3]
     gt = read_kitti(d / "poses.txt").poses
     imgs = {i: read_kitti_image(d / "image_0" / f"{i:06d}.png") for i in frames}

@@ -8,7 +8,7 @@ API summary
   :func:`world_to_cell` / :func:`cell_to_world`, :func:`make_grid`, :func:`check_grid`,
   :func:`grid_to_values`.
 - :func:`free_cells`.
-- :func:`test_room_200` (the mapped room, read from ``data/test_room_200.txt``),
+- :func:`test_room_200` (the mapped room, read from ``slamlab/data/bundled/test_room_200.txt``),
   :func:`build_test_room_200` (how that file was made), :func:`add_clutter` and
   :func:`measurement_room_200` (the room with unmapped chair legs, people's legs
   and bins, 004 Fig. 3b), :data:`TEST_ROOM_CLUTTER`.
@@ -156,7 +156,7 @@ def build_test_room_200() -> np.ndarray:
     L-shaped room with 2-cell walls, the corner outside the L left unexplored,
     two partition walls with doorways and furniture of several shapes (desks,
     a round column, shelves, a sofa), placed without symmetry so that the
-    correlation has a single best match. ``data/test_room_200.txt`` holds its
+    correlation has a single best match. ``slamlab/data/bundled/test_room_200.txt`` holds its
     output (:func:`test_room_200` reads it; a test checks they agree).
 
     Returns
@@ -251,7 +251,7 @@ def _room_path() -> Path:
 
 
 def test_room_200() -> np.ndarray:
-    """The 200×200 test room M that the robot keeps in memory (004 Fig. 3a), from ``data/test_room_200.txt``.
+    """The 200×200 test room M that the robot keeps in memory (004 Fig. 3a), from ``slamlab/data/bundled/test_room_200.txt``.
 
     Returns
     -------

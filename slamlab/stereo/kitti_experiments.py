@@ -174,7 +174,7 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
     from ..evaluation import Trajectory, ate, read_kitti, rpe
     from ..io.kitti import kitti_rig, read_kitti_image
 
-    d = find_data("kitti-odometry-06-stereo/calib.txt").parent if folder is None else v.as_path(folder, "folder", kind="dir")
+    d = find_data("kitti-odometry-06-stereo") if folder is None else v.as_path(folder, "folder", kind="dir")
     p = StereoParams.resolve(KITTI_PARAMS if params is None else params, **overrides)
     gt34 = read_kitti(d / "poses.txt").poses[:, :3, :]
     n = len(gt34) if n_frames is None else min(len(gt34), v.check_int(n_frames, "n_frames", minimum=2))

@@ -86,8 +86,8 @@ def test_bad_input(tmp_path):
 
 
 @pytest.mark.realdata
-def test_log_localisation_from_no_prior(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+def test_log_localisation_from_no_prior(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
     idx = (50, 150, 350, 450, 550, 750, 850, 250, 650)
     r = C.run_log_localisation(log, idx)
     # bound: at least 6 of 9 scans within 2 cells (0.4 m) and 5° of the corrected pose, from no prior;
@@ -103,10 +103,10 @@ def test_log_localisation_from_no_prior(shared_data):
 
 @pytest.mark.realdata
 @pytest.mark.slow
-def test_log_localisation_every_25th_scan_single_and_joined(shared_data):
+def test_log_localisation_every_25th_scan_single_and_joined(real_data):
     """The issue-17 run: every 25th Intel scan (25..900, 36 scans, ±10 scans left out of each grid), one scan vs
     three joined by odometry."""
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    log = read_carmen(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
     r = C.run_log_localisation(log, range(25, log.n_scans, 25), joined=(1, 3), exclude=10)
     ok = r.success
     assert ok.shape == (2, 36)
@@ -124,8 +124,8 @@ def test_log_localisation_every_25th_scan_single_and_joined(shared_data):
 
 
 @pytest.mark.realdata
-def test_log_localisation_joined_mode_bad_input(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+def test_log_localisation_joined_mode_bad_input(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
     with pytest.raises(ValueError, match=r"`joined` must be distinct numbers of scans from \{1, \.\.\., 5\}"):
         C.run_log_localisation(log, (150,), joined=(1, 6))
     with pytest.raises(ValueError, match=r"`scan_indices` must lie in \[2, 909\]"):
@@ -142,9 +142,9 @@ def test_log_localisation_joined_mode_bad_input(shared_data):
 
 
 @pytest.mark.realdata
-def test_log_localisation_takes_any_path_and_labels_from_it(shared_data, tmp_path):
+def test_log_localisation_takes_any_path_and_labels_from_it(real_data, tmp_path):
     copy = tmp_path / "my_lab_run.log.gz"
-    shutil.copy(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz", copy)
+    shutil.copy(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz", copy)
     r = C.run_log_localisation(str(copy), (150,), delta_alpha_rad=np.radians(2.0))
     assert r.name == "my_lab_run.log.gz"
     assert str(r).startswith("my_lab_run.log.gz:")
@@ -203,8 +203,8 @@ def test_localisation_table_has_one_row_per_choice_and_pose():
 
 
 @pytest.mark.realdata
-def test_log_localisation_progress_bar_only_when_asked(shared_data, capsys):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+def test_log_localisation_progress_bar_only_when_asked(real_data, capsys):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
     quiet = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0))  # SLAMLAB_PROGRESS=0 in tests
     assert capsys.readouterr().err == ""
     shown = C.run_log_localisation(log, (150,), delta_alpha_rad=np.radians(5.0), progress=True)

@@ -21,10 +21,10 @@ def test_leave_sets_by_definition():
 
 @pytest.mark.realdata
 @pytest.mark.parametrize("hit_ratio", [0.25, 0.1])
-def test_used_mode_grids_are_the_other_scans_grids(shared_data, hit_ratio):
+def test_used_mode_grids_are_the_other_scans_grids(real_data, hit_ratio):
     # construction: the grid of mode k under "used" = the counts of every scan but i-k+1 .. i, labelled; built
     # here from the kept scans directly (counts add over scans), not as the whole log minus the left-out ones
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
+    log = read_carmen(real_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
     _frame, scans_c, Pc, full = log_counts(log, cell_m=0.2, max_range_m=10.0)
     i = 150
     grids = _mode_grids(_leave_sets(i, (1, 3), 2, log.n_scans, "used"), full, scans_c, Pc, hit_ratio)
@@ -39,8 +39,8 @@ def test_used_mode_grids_are_the_other_scans_grids(shared_data, hit_ratio):
 
 
 @pytest.mark.realdata
-def test_used_localises_each_mode_on_its_own_grid(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
+def test_used_localises_each_mode_on_its_own_grid(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
     idx, fast = (100, 150), {"delta_alpha_rad": np.radians(5.0), "progress": False}
     r = C.run_log_localisation(log, idx, joined=(1, 3), leave_out="used", truth_check=True, **fast)
     assert r.leave_out == "used"
@@ -67,8 +67,8 @@ def test_used_localises_each_mode_on_its_own_grid(shared_data):
 
 
 @pytest.mark.realdata
-def test_leave_out_bad_values(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
+def test_leave_out_bad_values(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
     with pytest.raises(ValueError, match="`leave_out` must be one of 'window', 'used'; got 'all'"):
         C.run_log_localisation(log, (100,), leave_out="all")
     with pytest.raises(ValueError, match="`leave_out` must be one of"):

@@ -24,8 +24,8 @@ def test_log_suite_bad_input(tmp_path):
 
 
 @pytest.mark.realdata
-def test_log_suite_tables_and_bad_threshold(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+def test_log_suite_tables_and_bad_threshold(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
     with pytest.raises(ValueError, match=r"`every` \(950\) leaves no scan of intel-corrected.log.gz"):
         C.run_log_suite([log], every=950)
     r = C.run_log_suite([log], every=500, joined=(1,), delta_alpha_rad=np.radians(5.0))
@@ -48,12 +48,12 @@ def test_log_suite_tables_and_bad_threshold(shared_data):
 
 
 @pytest.mark.realdata
-def test_intel_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
+def test_intel_meets_the_issue_25_goals_at_every_25th_scan(real_data):
     """Issue 25's goal on the Intel log at the goal's size (every 25th scan, 36 scans) with the real-log defaults.
 
     csail and fhw meet the goal too (docs/benchmarks.md) but cost 60-85 s each; orebro and seattle do not yet.
     """
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
+    log = read_carmen(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
     r = C.run_log_suite([log], 25, joined=(1, 3))
     ok = r.results[0].success
     assert ok.shape == (2, 36)
@@ -62,13 +62,13 @@ def test_intel_meets_the_issue_25_goals_at_every_25th_scan(shared_data):
     assert ok[1].mean() >= 0.90
 
 
-def _goal_rates(shared_data, name: str, every: int):
+def _goal_rates(real_data, name: str, every: int):
     """Single-scan and 3-scan success rates of every ``every``-th scan of a shared log with the real-log defaults.
 
     ``ambiguity=False``: the rival search only scores the estimate's rivals, it never moves the estimate (the
     peak search runs before it), so the success counts are the defaults' at about 3/4 of the time.
     """
-    log = read_carmen(shared_data / "carmen-radish-corrected" / f"{name}-corrected.log.gz")
+    log = read_carmen(real_data / "carmen-radish-corrected" / f"{name}-corrected.log.gz")
     ok = C.run_log_suite([log], every, joined=(1, 3), ambiguity=False).results[0].success
     return ok.mean(axis=1)
 
@@ -91,19 +91,19 @@ _GOAL_LOGS = [
 
 @pytest.mark.realdata
 @pytest.mark.parametrize(("name", "every"), _GOAL_LOGS)
-def test_log_meets_the_issue_25_goals(shared_data, name, every):
+def test_log_meets_the_issue_25_goals(real_data, name, every):
     """Issue 25's goal on each shared log but intel (above). Bounds from the goal: >= 75 % single, >= 90 % with 3
     joined scans."""
-    single, three = _goal_rates(shared_data, name, every)
+    single, three = _goal_rates(real_data, name, every)
     assert single >= 0.75
     assert three >= 0.90
 
 
 @pytest.mark.realdata
-def test_joined_odometry_noise_is_drawn_per_step_of_the_log(shared_data):
+def test_joined_odometry_noise_is_drawn_per_step_of_the_log(real_data):
     # the noise belongs to the log's steps, not to a scan's place in the list: scan 75 joined with the 2 scans
     # before it gets the same odometry, so the same answer, alone or among other scans, with or without votes
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
+    log = read_carmen(real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
     fast = {"joined": (3,), "delta_alpha_rad": np.radians(5.0), "progress": False}
     alone = C.run_log_localisation(log, (75,), **fast)
     among = C.run_log_localisation(log, (50, 75, 76, 225), **fast)
@@ -115,11 +115,11 @@ def test_joined_odometry_noise_is_drawn_per_step_of_the_log(shared_data):
 
 
 @pytest.mark.realdata
-def test_more_confident_keeps_the_answer_with_the_larger_margin(shared_data):
+def test_more_confident_keeps_the_answer_with_the_larger_margin(real_data):
     # a real two-mode run, then margins and errors set by hand so the choice and the counts are known
     import dataclasses
 
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
+    log = read_carmen(real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
     r = C.run_log_localisation(log, (75, 150, 225), joined=(1, 3), delta_alpha_rad=np.radians(10.0),
                                progress=False)
     margin = np.array([[2.0, 0.5, 1.0], [1.0, 3.0, 1.0]])       # scan 75: mode 1 leads; 150: mode 3; 225: a tie

@@ -48,9 +48,9 @@ def test_endpoint_agreement_on_a_tiny_log(tiny_log):
 
 
 @pytest.mark.realdata
-def test_orebro_layout_is_carmens(shared_data):
+def test_orebro_layout_is_carmens(real_data):
     """The reversed beam order puts far fewer end points on the other scans' walls than CARMEN's layout."""
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
+    log = read_carmen(real_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
     carmen = C.endpoint_agreement(log, every=20)
     rev = C.endpoint_agreement(log, reverse=True, every=20)
     assert carmen[0] > 2 * rev[0]

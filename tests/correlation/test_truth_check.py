@@ -36,8 +36,8 @@ def test_pose_scores_equal_the_definition_at_grid_poses():
 
 
 @pytest.mark.realdata
-def test_truth_check_on_csail_scans(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "csail-corrected.log.gz")
+def test_truth_check_on_csail_scans(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "csail-corrected.log.gz")
     r = C.run_log_localisation(log, (100, 150), joined=(1,), truth_check=True, ambiguity=False)
     d = r.truth_check()
     assert list(d["scan"]) == [100, 150]

@@ -38,8 +38,8 @@ def test_votes_count_agreeing_voters_by_geometry():
 
 
 @pytest.mark.realdata
-def test_votes_leave_the_answers_unchanged_and_count_the_answer_itself(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
+def test_votes_leave_the_answers_unchanged_and_count_the_answer_itself(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
     idx, fast = (75, 150, 225), {"delta_alpha_rad": np.radians(5.0), "progress": False}
     for joined in ((1, 3), (2,)):
         r0 = C.run_log_localisation(log, idx, joined=joined, **fast)
@@ -65,8 +65,8 @@ def test_votes_leave_the_answers_unchanged_and_count_the_answer_itself(shared_da
 
 
 @pytest.mark.realdata
-def test_votes_bad_input(shared_data):
-    log = read_carmen(shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
+def test_votes_bad_input(real_data):
+    log = read_carmen(real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
     with pytest.raises(TypeError, match="`votes` must be a bool; got str"):
         C.run_log_localisation(log, (75,), votes="yes")
     with pytest.raises(ValueError, match=r"`scan_indices` must lie in \[2, .*join.* or vote"):

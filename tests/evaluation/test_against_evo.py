@@ -51,10 +51,10 @@ def _assert_same(ours, theirs):
 
 
 @pytest.mark.parametrize(("ref_path", "est_path", "align"), TUM_CASES)
-def test_ate_equals_evo_tum(shared_data, ref_path, est_path, align):
-    ours = ate(read_tum(shared_data / ref_path), read_tum(shared_data / est_path), align=align)
-    ref = file_interface.read_tum_trajectory_file(str(shared_data / ref_path))
-    est = file_interface.read_tum_trajectory_file(str(shared_data / est_path))
+def test_ate_equals_evo_tum(real_data, ref_path, est_path, align):
+    ours = ate(read_tum(real_data / ref_path), read_tum(real_data / est_path), align=align)
+    ref = file_interface.read_tum_trajectory_file(str(real_data / ref_path))
+    est = file_interface.read_tum_trajectory_file(str(real_data / est_path))
     ref, est = sync.associate_trajectories(ref, est, max_diff=0.01)
     _assert_same(ours, _evo_ape(ref, est, align))
     assert ours.n == ref.num_poses
@@ -63,27 +63,27 @@ def test_ate_equals_evo_tum(shared_data, ref_path, est_path, align):
 @pytest.mark.parametrize(("ref_path", "est_path", "align"), TUM_CASES)
 @pytest.mark.parametrize(("delta", "unit", "relation"), [(1, "frames", "translation"), (10, "frames", "rotation_deg"),
                                                          (0.5, "m", "translation")])
-def test_rpe_equals_evo_tum(shared_data, ref_path, est_path, align, delta, unit, relation):
+def test_rpe_equals_evo_tum(real_data, ref_path, est_path, align, delta, unit, relation):
     a = "sim3" if align == "sim3" else "none"
-    ours = rpe(read_tum(shared_data / ref_path), read_tum(shared_data / est_path), delta=delta, delta_unit=unit,
+    ours = rpe(read_tum(real_data / ref_path), read_tum(real_data / est_path), delta=delta, delta_unit=unit,
                relation=relation, align=a)
-    ref = file_interface.read_tum_trajectory_file(str(shared_data / ref_path))
-    est = file_interface.read_tum_trajectory_file(str(shared_data / est_path))
+    ref = file_interface.read_tum_trajectory_file(str(real_data / ref_path))
+    est = file_interface.read_tum_trajectory_file(str(real_data / est_path))
     ref, est = sync.associate_trajectories(ref, est, max_diff=0.01)
     _assert_same(ours, _evo_rpe(ref, est, delta, unit, relation, a))
 
 
 @pytest.mark.parametrize(("ref_path", "est_path"), KITTI_CASES)
-def test_ate_and_rpe_equal_evo_kitti(shared_data, ref_path, est_path):
+def test_ate_and_rpe_equal_evo_kitti(real_data, ref_path, est_path):
     from evo.core.trajectory import PosePath3D
 
-    r, e = read_kitti(shared_data / ref_path), read_kitti(shared_data / est_path)
+    r, e = read_kitti(real_data / ref_path), read_kitti(real_data / est_path)
     if e.frame_ids is not None:  # indexed result file (evo cannot read it): give evo the same poses
         ref = PosePath3D(poses_se3=list(r.poses[e.frame_ids]))
         est = PosePath3D(poses_se3=list(e.poses))
     else:
-        ref = file_interface.read_kitti_poses_file(str(shared_data / ref_path))
-        est = file_interface.read_kitti_poses_file(str(shared_data / est_path))
+        ref = file_interface.read_kitti_poses_file(str(real_data / ref_path))
+        est = file_interface.read_kitti_poses_file(str(real_data / est_path))
     _assert_same(rpe(r, e, delta=10, delta_unit="m"), _evo_rpe(ref, est, 10, "m", "translation"))
     _assert_same(rpe(r, e, delta=10, delta_unit="m", pairs_from="reference"),
                  _evo_rpe(ref, est, 10, "m", "translation", pairs_from_reference=True))
@@ -91,21 +91,21 @@ def test_ate_and_rpe_equal_evo_kitti(shared_data, ref_path, est_path):
     _assert_same(ate(r, e, align="se3"), _evo_ape(ref, est, "se3"))
 
 
-def test_indexed_kitti_result_is_paired_by_frame(shared_data):
-    gt = read_kitti(shared_data / "kitti-odom-eval/gt_poses/09.txt")
-    est = read_kitti(shared_data / "kitti-odom-eval/result/example_0/09.txt")
+def test_indexed_kitti_result_is_paired_by_frame(real_data):
+    gt = read_kitti(real_data / "kitti-odom-eval/gt_poses/09.txt")
+    est = read_kitti(real_data / "kitti-odom-eval/result/example_0/09.txt")
     assert len(gt) == 1591
     assert len(est) == 1589
     assert est.frame_ids[0] == 2  # PROVENANCE: frames 0 and 1 absent
     assert ate(gt, est).n == 1589
 
 
-def test_ate_is_zero_for_a_rigidly_moved_copy(shared_data):
+def test_ate_is_zero_for_a_rigidly_moved_copy(real_data):
     from scipy.spatial.transform import Rotation
 
     from slamlab.evaluation import Trajectory
 
-    r = read_tum(shared_data / TUM_CASES[0][0])
+    r = read_tum(real_data / TUM_CASES[0][0])
     R = Rotation.from_rotvec([0.2, -0.1, 0.4]).as_matrix()
     moved = Trajectory(r.positions_m @ R.T + [1.0, 2.0, 3.0], R @ r.rotations, r.timestamps_s)
     assert ate(r, moved, align="se3").rmse < 1e-9

@@ -115,7 +115,7 @@ def test_plots_run():
 
 
 @pytest.mark.realdata
-def test_widgets_never_raise(shared_data, capsys):
+def test_widgets_never_raise(real_data, capsys):
     # interactive() swallows exceptions of its callback, so call the callback itself
     w = F.explore_detectors()
     for det in ("SURF (ours)", "FAST-9 (ours)", "MSER (OpenCV)"):

@@ -9,9 +9,9 @@ import slamlab.features as F
 
 
 @pytest.fixture
-def my_pair(shared_data, tmp_path):
+def my_pair(real_data, tmp_path):
     """A two-image Oxford-layout folder under another name (a copy of graf 1, 2 and H1to2p)."""
-    src = shared_data / "oxford-affine" / "graf"
+    src = real_data / "oxford-affine" / "graf"
     dst = tmp_path / "my-wall-pair"
     dst.mkdir()
     for name in ("img1.png", "img2.png", "H1to2p"):

@@ -39,8 +39,8 @@ def test_fast_equals_opencv_synthetic(seed, t, nonmax):
 @pytest.mark.realdata
 @pytest.mark.parametrize(("seq", "t"), [("graf", 20), ("boat", 10), ("bark", 25)])
 @pytest.mark.parametrize("nonmax", [True, False])
-def test_fast_equals_opencv_real(shared_data, seq, t, nonmax):
-    img = cv2.imread(str(shared_data / "oxford-affine" / seq / "img1.png"), cv2.IMREAD_GRAYSCALE)[:320, :400]
+def test_fast_equals_opencv_real(real_data, seq, t, nonmax):
+    img = cv2.imread(str(real_data / "oxford-affine" / seq / "img1.png"), cv2.IMREAD_GRAYSCALE)[:320, :400]
     ref = _cv_fast(img, t, nonmax)
     assert len(ref) > 50
     assert _ours(img, t, nonmax) == ref

@@ -18,7 +18,7 @@ def evaluation():
                                  n_points=500)
 
 
-def test_homography_maps_corresponding_points(shared_data):
+def test_homography_maps_corresponding_points(real_data):
     img1, img2, H = F.load_oxford_pair("boat", 3, scale=0.5)
     f1 = F.detect(img1, "sift", max_points=300)
     f2 = F.detect(img2, "sift", max_points=300)
@@ -105,7 +105,7 @@ def test_experiment_bad_input():
         F.load_oxford_image("graf", 1, size=(768,))
 
 
-def test_load_oxford_image_to_000s_size(shared_data):
+def test_load_oxford_image_to_000s_size(real_data):
     import cv2
 
     img = F.load_oxford_image("graf", 1)

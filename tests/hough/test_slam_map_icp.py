@@ -199,8 +199,8 @@ def test_whole_system_starts_from_correlation():
 
 
 @pytest.mark.realdata
-def test_real_mbicp_log_map_is_sharper_than_odometry(shared_data):
-    res = E.run_real_log(shared_data / E.SHARED_LOGS["mbicp"], n_scans=300)
+def test_real_mbicp_log_map_is_sharper_than_odometry(real_data):
+    res = E.run_real_log(real_data / E.SHARED_LOGS["mbicp"], n_scans=300)
     # stated bounds (ours): the Hough map draws walls with fewer cells than odometry's, and most steps
     # find a usable pair of lines
     assert res.sharpness("slam") < 0.75 * res.sharpness("odometry")
@@ -222,10 +222,10 @@ def test_real_urg_log_runs_with_raw_odometry():
 
 @pytest.mark.realdata
 @pytest.mark.parametrize("key", ["urg04lx", "mbicp"])
-def test_real_logs_meet_the_issue_25_goals_with_one_set_of_defaults(shared_data, key):
+def test_real_logs_meet_the_issue_25_goals_with_one_set_of_defaults(real_data, key):
     # bounds from issue 25's goal: on both shared logs, with run_real_log's defaults, the map is >= 10 %
     # sharper than odometry's and <= 5 % of the steps fall back on odometry alone
-    res = E.run_real_log(shared_data / E.SHARED_LOGS[key], progress=False)
+    res = E.run_real_log(real_data / E.SHARED_LOGS[key], progress=False)
     assert res.sharper_than_odometry() >= 0.10
     assert res.slam.lost[1:].mean() <= 0.05
     counts = res.slam.cause_counts()
@@ -242,9 +242,9 @@ def test_real_logs_meet_the_issue_25_goals_with_one_set_of_defaults(shared_data,
 @pytest.mark.realdata
 @pytest.mark.parametrize(("key", "new_name", "label"), [("urg04lx", "hallway_run.dat", "URG-04LX"),
                                                         ("mbicp", "office.clf", "CARMEN")])
-def test_real_log_takes_any_path_and_labels_from_it(shared_data, tmp_path, key, new_name, label):
+def test_real_log_takes_any_path_and_labels_from_it(real_data, tmp_path, key, new_name, label):
     copy = tmp_path / new_name
-    shutil.copy(shared_data / E.SHARED_LOGS[key], copy)
+    shutil.copy(real_data / E.SHARED_LOGS[key], copy)
     res = E.run_real_log(str(copy), n_scans=20)
     assert E.log_format(copy) == {"URG-04LX": "urg04lx", "CARMEN": "carmen"}[label]
     assert res.name == f"{label} log {new_name} (raw odometry)"

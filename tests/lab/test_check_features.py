@@ -117,7 +117,7 @@ def _hint_of(task_id, value):
 
 
 @pytest.mark.realdata
-def test_lab02_wall_range_is_a_brute_force_count_equal_to_the_library(shared_data):
+def test_lab02_wall_range_is_a_brute_force_count_equal_to_the_library(real_data):
     import slamlab as sl
     from slamlab.lab.features_checks import wall_repeatability_brute_force
 
@@ -138,7 +138,7 @@ def test_lab02_wall_range_is_a_brute_force_count_equal_to_the_library(shared_dat
 
 @pytest.mark.realdata
 @pytest.mark.slow
-def test_lab02_exploration_answers(shared_data):
+def test_lab02_exploration_answers(real_data):
     import slamlab as sl
 
     img = sl.features.load_oxford_image("graf", 1, size=(768, 576))
@@ -238,7 +238,7 @@ def test_lab03_mistakes():
 
 
 @pytest.mark.realdata
-def test_lab03_budget_range_from_exact_neighbours_over_three_query_sets(shared_data):
+def test_lab03_budget_range_from_exact_neighbours_over_three_query_sets(real_data):
     import slamlab as sl
     from slamlab.lab.tasks_features import EXPLORE_BUDGETS, bbf_recall_exact_truth
 
@@ -256,7 +256,7 @@ def test_lab03_budget_range_from_exact_neighbours_over_three_query_sets(shared_d
 
 
 @pytest.mark.realdata
-def test_lab03_ratio_range_from_a_brute_force_matcher(shared_data):
+def test_lab03_ratio_range_from_a_brute_force_matcher(real_data):
     import slamlab as sl
     from slamlab.lab.tasks_features import EXPLORE_RATIOS, ratio_precision_independent
 

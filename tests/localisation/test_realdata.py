@@ -18,8 +18,8 @@ pytestmark = pytest.mark.realdata
 
 
 @pytest.fixture(scope="module")
-def results(shared_data):
-    return {name: L.run_log_mcl(shared_data / "carmen-radish-corrected" / f"{name}-corrected.log.gz", n_scans=60,
+def results(real_data):
+    return {name: L.run_log_mcl(real_data / "carmen-radish-corrected" / f"{name}-corrected.log.gz", n_scans=60,
                                 rng=0)
             for name in L.CARMEN_LOGS}
 
@@ -50,11 +50,11 @@ def test_log_by_path_and_bad_path(tmp_path):
 
 
 
-def test_protocol_runs_on_a_log_by_path(shared_data):
+def test_protocol_runs_on_a_log_by_path(real_data):
     """The protocol on any CARMEN log by path: one row per stretch and count, the same stretches for every count,
     and a stretch's run does not depend on what else shares the call (its streams are keyed by log, stretch and
     count)."""
-    path = shared_data / "carmen-radish-corrected" / "seattle-corrected.log.gz"
+    path = real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz"
     res = L.run_log_protocol(path, (300, 600), n_runs=2, n_scans=4, rng=0, progress=False)
     df = res.table_df
     assert len(df) == 4

@@ -9,8 +9,8 @@ from slamlab.mono.kitti import run_kitti_mono
 
 
 @pytest.mark.realdata
-def test_kitti_left_camera(shared_data):
-    r = run_kitti_mono(shared_data / "kitti-odometry-06-stereo")  # the first 20 frames
+def test_kitti_left_camera(real_data):
+    r = run_kitti_mono(real_data / "kitti-odometry-06-stereo")  # the first 20 frames
     first = int(np.argmax(r.claimed))
     assert r.tracked.any()
     assert first <= 2  # initialised by frame 2 (the car moves > 15 px per frame)
@@ -20,8 +20,8 @@ def test_kitti_left_camera(shared_data):
 
 
 @pytest.mark.realdata
-def test_kitti_51_frames_meet_the_goal_of_issue_28(shared_data):
-    r = run_kitti_mono(shared_data / "kitti-odometry-06-stereo-51")
+def test_kitti_51_frames_meet_the_goal_of_issue_28(real_data):
+    r = run_kitti_mono(real_data / "kitti-odometry-06-stereo-51")
     assert len(r.tracked) == 51
     # correctly tracked: claimed by the tracker and within 5 % of the path after the run's Sim(3)
     assert r.fraction_tracked >= 0.80

@@ -10,8 +10,8 @@ from slamlab.stereo import StereoSLAM
 
 
 @pytest.mark.realdata
-def test_kitti_06_first_20_frames(shared_data):
-    d = shared_data / "kitti-odometry-06-stereo"
+def test_kitti_06_first_20_frames(real_data):
+    d = real_data / "kitti-odometry-06-stereo"
     P = np.loadtxt(d / "calib.txt").reshape(2, 3, 4)  # P0, P1 of the rectified pair (PROVENANCE.md)
     fx, cx, cy = P[0][0, 0], P[0][0, 2], P[0][1, 2]
     baseline_m = -P[1][0, 3] / fx
@@ -40,10 +40,10 @@ def test_kitti_06_first_20_frames(shared_data):
 
 
 @pytest.mark.realdata
-def test_run_kitti_matches_the_manual_loop(shared_data):
+def test_run_kitti_matches_the_manual_loop(real_data):
     from slamlab.stereo import run_kitti
 
-    res = run_kitti(shared_data / "kitti-odometry-06-stereo")
+    res = run_kitti(real_data / "kitti-odometry-06-stereo")
     assert res.n_degenerate == 0
     assert res.path_length_m == pytest.approx(22.7, abs=0.1)
     assert res.ate_se3_m < 0.2
@@ -53,7 +53,7 @@ def test_run_kitti_matches_the_manual_loop(shared_data):
 
 
 @pytest.mark.realdata
-def test_orb_on_kitti_keeps_the_scale(shared_data):
+def test_orb_on_kitti_keeps_the_scale(real_data):
     """ORB with KITTI_PARAMS (refined disparities, one pyramid level): issue 17's 1 % scale goal.
 
     Measured (seed 0): path length 1.0066 x and start-to-end 1.0040 x the truth, ATE 0.26 m, final 0.28 m;
@@ -63,7 +63,7 @@ def test_orb_on_kitti_keeps_the_scale(shared_data):
     """
     from slamlab.stereo import run_kitti
 
-    res = run_kitti(shared_data / "kitti-odometry-06-stereo", detector="orb", progress=False)
+    res = run_kitti(real_data / "kitti-odometry-06-stereo", detector="orb", progress=False)
     assert res.n_degenerate == 0
     assert abs(res.length_ratio - 1) < 0.015
     assert abs(res.end_distance_ratio - 1) < 0.015

@@ -14,8 +14,8 @@ from slamlab.stereo import run_kitti
 @pytest.mark.realdata
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize("detector", ["surf", "orb"])
-def test_kitti_06_51_frames_keeps_the_scale(shared_data, detector, seed):
-    res = run_kitti(shared_data / "kitti-odometry-06-stereo-51", detector=detector, rng=seed, progress=False)
+def test_kitti_06_51_frames_keeps_the_scale(real_data, detector, seed):
+    res = run_kitti(real_data / "kitti-odometry-06-stereo-51", detector=detector, rng=seed, progress=False)
     assert len(res.truth) == 51
     assert res.path_length_m == pytest.approx(59.9, abs=0.1)
     assert res.n_degenerate == 0

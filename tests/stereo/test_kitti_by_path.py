@@ -14,8 +14,8 @@ N = 3
 
 
 @pytest.fixture(scope="module")
-def my_kitti(shared_data, tmp_path_factory):
-    src = shared_data / "kitti-odometry-06-stereo"
+def my_kitti(real_data, tmp_path_factory):
+    src = real_data / "kitti-odometry-06-stereo"
     dst = tmp_path_factory.mktemp("kitti") / "my-drive-07"
     for cam in ("image_0", "image_1"):
         (dst / cam).mkdir(parents=True)
@@ -33,18 +33,18 @@ def my_kitti(shared_data, tmp_path_factory):
     return dst
 
 
-def test_official_and_stripped_calib_give_the_same_matrices(shared_data, my_kitti):
+def test_official_and_stripped_calib_give_the_same_matrices(real_data, my_kitti):
     official = read_kitti_calib(str(my_kitti / "calib.txt"))
-    stripped = read_kitti_calib(shared_data / "kitti-odometry-06-stereo" / "calib.txt")
+    stripped = read_kitti_calib(real_data / "kitti-odometry-06-stereo" / "calib.txt")
     assert sorted(official) == ["P0", "P1", "P2", "P3", "Tr"]
     assert sorted(stripped) == ["P0", "P1"]
     for k in ("P0", "P1"):
         np.testing.assert_allclose(official[k], stripped[k], rtol=1e-12)
 
 
-def test_run_kitti_from_a_str_path_names_the_run_after_the_folder(shared_data, my_kitti):
+def test_run_kitti_from_a_str_path_names_the_run_after_the_folder(real_data, my_kitti):
     res = run_kitti(str(my_kitti), rng=0)
-    ref = run_kitti(shared_data / "kitti-odometry-06-stereo", n_frames=N, rng=0)
+    ref = run_kitti(real_data / "kitti-odometry-06-stereo", n_frames=N, rng=0)
     assert res.name == "my-drive-07"
     assert "my-drive-07, frames 0-2" in res.table()
     assert str(res).startswith("my-drive-07, 3 frames")

@@ -347,11 +347,11 @@ def test_disparity_errors_table_shows_the_refinement_per_level():
 
 
 @pytest.mark.realdata
-def test_kitti_comparison_prints_one_row_per_setting(shared_data):
+def test_kitti_comparison_prints_one_row_per_setting(real_data):
     from slamlab.stereo import kitti_comparison
 
     table = kitti_comparison({"a": {"detector": "orb"}, "b": {"detector": "orb", "subpixel_stereo": False}},
-                             shared_data / "kitti-odometry-06-stereo", n_frames=3)
+                             real_data / "kitti-odometry-06-stereo", n_frames=3)
     assert "kitti-odometry-06-stereo, 3 frames" in table
     assert [line.split()[0] for line in table.splitlines()[3:]] == ["a", "b"]
     with pytest.raises(TypeError, match="variants"):
