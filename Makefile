@@ -11,7 +11,7 @@ PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
 	-p no:cacheprovider -n 2 --dist loadfile --durations=30
 
-.PHONY: venv lab test reproducible notebooks report student autograde docs lint bench lock clean distclean
+.PHONY: venv data lab test reproducible notebooks report student autograde docs lint bench lock clean distclean
 
 ## venv: create .venv if missing and install slamlab[test] from constraints.txt (again only when those change)
 venv: $(STAMP)
@@ -21,6 +21,13 @@ $(STAMP): pyproject.toml constraints.txt
 	$(BIN)/python -m pip install --upgrade pip
 	$(BIN)/python -m pip install -c constraints.txt -e '.[test]'
 	touch $(STAMP)
+
+## data: fetch every registered real data set that no data folder holds into the cache, verified (optional:
+## notebooks fetch what they need on first use). SETS="carmen-radish-corrected oxford-affine" fetches only those;
+## python -m slamlab.data list | verify | mirror DIR for the rest (README, "Data")
+SETS ?=
+data: venv
+	$(BIN)/python -m slamlab.data fetch $(SETS)
 
 ## lab: start JupyterLab on notebooks/ (as root too, as the Jupyter Docker stacks do: containers and lab VMs)
 LAB_ARGS ?=

@@ -10,11 +10,11 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import derive
 from .._progress import check_progress, progress_enabled
+from . import derive
 from .fetch import download
 from .locate import cache_dir, find_data, found_at
-from .registry import DataFile, format_size, registry, upstream_relpath
+from .registry import DataFile, count_files, format_size, registry, upstream_relpath
 
 __all__ = ["VerifyRow", "fetch_sets", "list_sets", "make_mirror", "verify"]
 
@@ -56,7 +56,7 @@ def list_sets() -> str:
     lines = []
     for s in reg.sets:
         lines += [
-            f"{s.name}  ({len(s.files)} files, {format_size(s.size)})",
+            f"{s.name}  ({count_files(len(s.files))}, {format_size(s.size)})",
             f"  {s.title}",
             f"  licence: {s.licence}",
             f"  found:   {_where(s.files)}",
@@ -84,7 +84,7 @@ def fetch_sets(names=(), progress=None) -> str:
     lines = []
     for name in _check_set_names(names):
         folder = find_data(name, progress=progress)
-        lines.append(f"{name}: {len(registry().set(name).files)} files in {folder}")
+        lines.append(f"{name}: {count_files(len(registry().set(name).files))} in {folder}")
     return "\n".join(lines)
 
 

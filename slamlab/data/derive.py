@@ -111,7 +111,7 @@ def file_matches(entry: DataFile, data: bytes) -> bool:
     if entry.pixels_sha256 is not None:
         try:
             return pixels_sha256(_png_pixels(data)) == entry.pixels_sha256
-        except Exception:  # not a readable image: not the registered file
+        except (OSError, ValueError, SyntaxError):  # not a readable image (PIL raises these): not the file
             return False
     return False
 

@@ -22,7 +22,15 @@ from pathlib import Path
 
 from .._progress import check_progress, progress_enabled
 from . import derive
-from .registry import DATA_URL_ENV_VAR, DataFile, format_size, registry, source_url, upstream_relpath
+from .registry import (
+    DATA_URL_ENV_VAR,
+    DataFile,
+    count_files,
+    format_size,
+    registry,
+    source_url,
+    upstream_relpath,
+)
 
 __all__ = ["DataFetchError", "DataIntegrityError", "DataUnavailableError", "download", "fetch_files"]
 
@@ -60,7 +68,7 @@ def _announce(set_name: str) -> None:
     _ANNOUNCED.add(set_name)
     s = registry().set(set_name)
     print(
-        f"Data set '{s.name}' ({len(s.files)} files, {format_size(s.size)}): {s.title}\n"
+        f"Data set '{s.name}' ({count_files(len(s.files))}, {format_size(s.size)}): {s.title}\n"
         f"  source:  {s.source}\n  licence: {s.licence}\n  cite:    {s.citation}",
         file=sys.stderr,
     )
@@ -136,7 +144,7 @@ def download(entry: DataFile, folder: Path, fname: str, progress: bool = False) 
         with _quiet_pooch():
             path = pooch.retrieve(url, known_hash=f"sha256:{entry.fetched_sha256}", fname=fname, path=cache,
                                   downloader=downloader)
-    except ValueError as err:
+    except ValueError:
         if downloader.received_sha256 is None or downloader.received_sha256 == entry.fetched_sha256:
             raise
         _remove_empty_dirs(target.parent, cache)

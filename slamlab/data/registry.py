@@ -26,6 +26,7 @@ __all__ = [
     "DataFile",
     "DataSet",
     "Registry",
+    "count_files",
     "data_table_markdown",
     "format_size",
     "load_registry",
@@ -190,6 +191,15 @@ def source_url(url: str) -> str:
     if not mirror:
         return url
     return mirror.rstrip("/") + "/" + upstream_relpath(url)
+
+
+def count_files(n: int) -> str:
+    """``'1 file'``, ``'5 files'``.
+
+    >>> count_files(1), count_files(347)
+    ('1 file', '347 files')
+    """
+    return f"{n} file" if n == 1 else f"{n} files"
 
 
 def format_size(n_bytes: int) -> str:
