@@ -10,8 +10,9 @@ Sphinx needs every page inside one source folder, so this script first lays out 
 chapter notebook with its **stored** outputs (myst-nb renders them; nothing is executed), the student
 version of every lab (``tools/labs.py student``, as ``make student``), the instructor guide with each
 lab's time plan and points, one API page per subpackage (autodoc + numpydoc), ``docs/*.md`` and
-``environment.md``, and the data sets' ``PROVENANCE.md`` read from ``$SLAMLAB_DATA`` or ``../shared/data``
-(never copied into the repository). Then it runs ``sphinx-build -W --keep-going`` (warnings are errors).
+``environment.md``, and the data pages generated from slamlab's data registry (``slamlab/data/registry.json``:
+each set's source, licence, citation and files with their upstream URLs and sha256; the data themselves are
+never read). Then it runs ``sphinx-build -W --keep-going`` (warnings are errors).
 
 Cross-references both ways come from the notebooks' code: every ``sl.<pkg>.<name>`` (also through an alias
 such as ``L = sl.localisation``, and ``from slamlab… import``) in a chapter's code cells is resolved to the
@@ -381,27 +382,82 @@ def api_page(page: str, modules: list[str], xref: dict[str, list[str]], chapter_
     return "\n".join(out)
 
 
+def _md_text(text: str) -> str:
+    """Plain ``text`` as Markdown in a table cell or list item: no table split at ``|``, no HTML read into
+    ``<x>`` (a source such as ``images/<sequence>/``), no emphasis or maths."""
+    for ch in "\\|<*_$":
+        text = text.replace(ch, "\\" + ch)
+    return text.replace("\n", " ")
+
+
+def _code_cell(text: str) -> str:
+    """``text`` as inline code in a table cell (a code span keeps backslashes; only ``|`` is escaped)."""
+    return "`" + text.replace("|", "\\|") + "`"
+
+
+def _derivation(f) -> str:
+    """How a registered file is made from its upstream file ('' for a byte-for-byte copy)."""
+    from slamlab.data.registry import format_size
+
+    if f.derive is None:
+        return ""
+    kind = f.derive.get("kind")
+    if kind == "lines":
+        how = f"first {f.derive['count']} lines of the upstream file"
+    elif kind == "png_from_pnm":
+        how = "the upstream PPM/PGM stored as lossless PNG; same pixels"
+    else:
+        how = f"derived from the upstream file ({kind})"
+    if f.upstream_sha256:
+        size = f", {format_size(f.upstream_size)}" if f.upstream_size is not None else ""
+        how += f" (upstream sha256 `{f.upstream_sha256}`{size})"
+    return how
+
+
+def _url_label(url: str) -> str:
+    """A link's text: the file's path in its repository for a raw GitHub URL, else the URL."""
+    parts = url.split("/", 3)[3].split("/") if url.startswith("https://raw.githubusercontent.com/") else []
+    return "/".join(parts[3:]) if len(parts) > 3 else url
+
+
+def data_set_page(s) -> str:
+    """The site page of one registered data set (:class:`slamlab.data.DataSet`) as MyST Markdown."""
+    from slamlab.data.registry import format_size
+
+    out = [f"# {s.name}", "", _md_text(s.title), "",
+           f"- **Source:** {_md_text(s.source)}",
+           f"- **Licence:** {_md_text(s.licence)}",
+           f"- **Cite:** {_md_text(s.citation)}",
+           f"- **Size:** {len(s.files)} file{'' if len(s.files) == 1 else 's'}, {format_size(s.size)}"]
+    if s.note:
+        out.append(f"- **Note:** {_md_text(s.note)}")
+    out += ["", "## How to get it", "",
+            ("The notebooks fetch what they need on first use; to fetch the whole set beforehand (into the cache, "
+             "unless `$SLAMLAB_DATA` or `../shared/data` already holds it):"), "",
+            "```", f"python -m slamlab.data fetch {s.name}", "```", "",
+            f"`python -m slamlab.data verify {s.name}` re-hashes the files found against the table below.", "",
+            "## Files", "",
+            "| file | size | upstream (pinned commit) | sha256 | made from the upstream file |",
+            "|---|---|---|---|---|"]
+    for f in s.files:
+        out.append(f"| {_code_cell(f.path)} | {format_size(f.size)} | [{_code_cell(_url_label(f.url))}]({f.url}) "
+                   f"| `{f.sha256}` | {_derivation(f) or 'as is'} |")
+    return "\n".join(out) + "\n"
+
+
 def data_pages(dst: Path) -> list[str]:
-    """One page per data set from its PROVENANCE.md (read where slamlab reads the data); their names."""
-    from slamlab import data as sl_data
+    """The data pages, from slamlab's registry only: an index with the table of sets, one page per set; their names."""
+    from slamlab.data.registry import data_table_markdown, registry
 
     dst.mkdir(parents=True, exist_ok=True)
-    try:
-        root = Path(sl_data.shared_data_dir())
-    except FileNotFoundError as err:
-        (dst / "index.md").write_text("# Data sets: provenance and licences\n\nThe shared data folder was not "
-                                      f"found when this site was built:\n\n```\n{err}\n```\n", encoding="utf-8")
-        return []
-    names = []
-    for prov in sorted(root.glob("*/PROVENANCE.md")):
-        text = prov.read_text(encoding="utf-8")
-        if not re.match(r"\s*# ", text):
-            text = f"# {prov.parent.name}\n\n" + text
-        (dst / f"{prov.parent.name}.md").write_text(text, encoding="utf-8")
-        names.append(prov.parent.name)
-    intro = (SITE_SRC / "data.md").read_text(encoding="utf-8")
-    (dst / "index.md").write_text(intro + "\n```{toctree}\n:maxdepth: 1\n\n" + "\n".join(names) + "\n```\n",
-                                  encoding="utf-8")
+    reg = registry()
+    names = list(reg.set_names)
+    for s in reg.sets:
+        (dst / f"{s.name}.md").write_text(data_set_page(s), encoding="utf-8")
+    intro = (SITE_SRC / "data.md").read_text(encoding="utf-8").rstrip("\n")
+    table = re.sub(r"(?<!\\)<", r"\\<", data_table_markdown(reg))  # images/<sequence>/ is not HTML
+    (dst / "index.md").write_text(intro + "\n\n" + table + "\n```{toctree}\n:maxdepth: 1\n\n" + "\n".join(names)
+                                  + "\n```\n", encoding="utf-8")
     return names
 
 

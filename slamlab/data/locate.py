@@ -25,6 +25,7 @@ import os
 import warnings
 from pathlib import Path
 
+from .._progress import check_progress
 from .._validate import check_choice
 from . import derive
 from .fetch import DataUnavailableError, fetch_files
@@ -271,6 +272,7 @@ def find_data(relpath: str | os.PathLike, *, fetch: bool = True, progress=None) 
     'no/such/file.txt' not found in any data folder, and no registered data set holds it; searched:
     """
     rel = _check_relpath(relpath)
+    check_progress(progress)
     bundled = _BUNDLED_DIR / rel
     if bundled.exists():
         return bundled
@@ -292,10 +294,10 @@ def find_data(relpath: str | os.PathLike, *, fetch: bool = True, progress=None) 
             continue
         if folder == cache:
             stale = [e for e in entries if not _matches(e, folder / e.relpath)]
-            if stale:  # a cached file changed since it was verified: fetch it again
+            if stale:  # a cached file changed since it was verified: drop it, look further, else fetch it again
                 for e in stale:
                     (folder / e.relpath).unlink()
-                break
+                continue
         else:
             _warn_if_changed(entries, folder, label)
         return folder / rel

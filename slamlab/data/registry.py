@@ -228,7 +228,7 @@ def data_table_markdown(reg: Registry | None = None) -> str:
     ]
     for s in reg.sets:
         cells = [f"`{s.name}`", s.title, str(len(s.files)), format_size(s.size), s.source, s.licence, s.citation]
-        rows.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+        rows.append("| " + " | ".join(c.replace("|", "\\|").replace("<", "\\<") for c in cells) + " |")
     total = sum(s.size for s in reg.sets)
     n_files = sum(len(s.files) for s in reg.sets)
     rows.append(f"| **all** | | {n_files} | {format_size(total)} | | | |")
