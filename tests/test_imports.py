@@ -133,7 +133,8 @@ def test_experiment_helpers_import_neither_sim_nor_experiments():
 
 SUBPACKAGES = ["slamlab", "slamlab.geometry", "slamlab.scans", "slamlab.io", "slamlab.sim", "slamlab.filters",
                "slamlab.features", "slamlab.kdtree", "slamlab.stereo", "slamlab.correlation", "slamlab.hough",
-               "slamlab.planes", "slamlab.evaluation", "slamlab.lab", "slamlab.sweep", "slamlab.mono", "slamlab.localisation"]
+               "slamlab.planes", "slamlab.evaluation", "slamlab.lab", "slamlab.sweep", "slamlab.mono", "slamlab.localisation",
+               "slamlab.data"]
 
 
 def test_every_subpackage_is_listed():

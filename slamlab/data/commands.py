@@ -12,7 +12,7 @@ from pathlib import Path
 
 from .._progress import check_progress, progress_enabled
 from . import derive
-from .fetch import download
+from .fetch import download, write_atomically
 from .locate import cache_dir, find_data, found_at
 from .registry import DataFile, count_files, format_size, registry, upstream_relpath
 
@@ -90,7 +90,19 @@ def fetch_sets(names=(), progress=None) -> str:
 
 @dataclass(frozen=True)
 class VerifyRow:
-    """One registered file at one place where it was found, and whether its hash matches."""
+    """One registered file at one place where it was found, and whether its hash matches.
+
+    Attributes
+    ----------
+    relpath : str
+        ``<set>/<path>``.
+    where : str
+        The data folder's label (``"-"`` when found nowhere).
+    path : pathlib.Path or None
+        The file found, or ``None``.
+    status : str
+        ``"match"``, ``"pixels match"`` (an image with the registered pixels), ``"DIFFERS"`` or ``"missing"``.
+    """
 
     relpath: str
     where: str
@@ -131,6 +143,13 @@ def verify(names=()) -> list[VerifyRow]:
 
 def verify_report(rows: list[VerifyRow], every_file: bool = False) -> tuple[str, bool]:
     """The text of :func:`verify`'s rows: per set and place, counts; every file that is not a match.
+
+    Parameters
+    ----------
+    rows : list of VerifyRow
+        What :func:`verify` returned.
+    every_file : bool
+        Also list the files that match.
 
     Returns
     -------
@@ -212,13 +231,7 @@ def make_mirror(dest: str | os.PathLike, progress=None) -> str:
             n_fetched += 1
             n_bytes += download(entries[0], dest, upstream_relpath(url), bar).stat().st_size
             continue
-        target.parent.mkdir(parents=True, exist_ok=True)
-        tmp = target.with_name(f".{target.name}.part-{os.getpid()}")
-        try:
-            tmp.write_bytes(data)
-            os.replace(tmp, target)
-        finally:
-            tmp.unlink(missing_ok=True)
+        write_atomically(target, data)
         n_bytes += len(data)
     return (
         f"mirror: {len(by_url)} upstream files ({n_fetched} downloaded), {format_size(n_bytes)}, in {dest.resolve()}\n"

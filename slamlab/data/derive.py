@@ -29,15 +29,38 @@ _PNM = re.compile(rb"P([56])\s+(?:#[^\n]*\n\s*)*(\d+)\s+(?:#[^\n]*\n\s*)*(\d+)\s
 
 
 def sha256_bytes(data: bytes) -> str:
-    """Hex sha256 of ``data``."""
+    """Hex sha256 of ``data``.
+
+    Parameters
+    ----------
+    data : bytes
+        Any bytes.
+
+    Returns
+    -------
+    str
+        64 hex digits.
+    """
     return hashlib.sha256(data).hexdigest()
 
 
 def pixels_sha256(pixels: np.ndarray) -> str:
     """The hash of an image's pixels, shape and dtype included (independent of the file's encoding).
 
-    >>> pixels_sha256(np.zeros((2, 3), np.uint8))[:12]
-    '1d0ed5a2b0a1'
+    Parameters
+    ----------
+    pixels : ndarray
+        A decoded image, e.g. ``(H, W)`` or ``(H, W, 3)`` ``uint8``.
+
+    Returns
+    -------
+    str
+        64 hex digits.
+
+    Examples
+    --------
+    >>> pixels_sha256(np.zeros((2, 3), np.uint8)) == pixels_sha256(np.zeros((3, 2), np.uint8))
+    False
     """
     a = np.ascontiguousarray(pixels)
     return sha256_bytes(f"{a.shape}|{a.dtype.str}|".encode() + a.tobytes())
@@ -105,7 +128,19 @@ def make_derived(entry: DataFile, upstream: bytes) -> bytes:
 
 
 def file_matches(entry: DataFile, data: bytes) -> bool:
-    """Whether ``data`` is the registered file: its sha256, or for an image its pixels' hash."""
+    """Whether ``data`` is the registered file: its sha256, or for an image its pixels' hash.
+
+    Parameters
+    ----------
+    entry : DataFile
+        The registered file.
+    data : bytes
+        A file's contents.
+
+    Returns
+    -------
+    bool
+    """
     if sha256_bytes(data) == entry.sha256:
         return True
     if entry.pixels_sha256 is not None:
@@ -122,6 +157,17 @@ def upstream_candidates(entry: DataFile, data: bytes) -> list[bytes]:
     A copy gives itself; a line excerpt gives itself and itself without its final newline (the
     upstream when the excerpt kept every line); a PNG gives the PNM header plus its pixels. The
     caller keeps the one whose sha256 is ``entry.fetched_sha256``.
+
+    Parameters
+    ----------
+    entry : DataFile
+        The registered file.
+    data : bytes
+        Its contents as found.
+
+    Returns
+    -------
+    list of bytes
     """
     rule = entry.derive
     if rule is None:

@@ -32,7 +32,7 @@ from .registry import (
     upstream_relpath,
 )
 
-__all__ = ["DataFetchError", "DataIntegrityError", "DataUnavailableError", "download", "fetch_files"]
+__all__ = ["DataFetchError", "DataIntegrityError", "DataUnavailableError", "download", "fetch_files", "write_atomically"]
 
 #: Seconds pooch waits for the server (connect and each read).
 TIMEOUT_S = 60
@@ -179,7 +179,16 @@ def _short_reason(err: Exception) -> str:
     return f"{type(err).__name__}: {err}"
 
 
-def _write_atomically(path: Path, data: bytes) -> None:
+def write_atomically(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file beside it: a reader never sees half a file.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file to write (its folder is made if needed).
+    data : bytes
+        The contents.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.part-{os.getpid()}")
     try:
@@ -205,7 +214,7 @@ def _fetch_one(entry: DataFile, cache: Path, progress: bool) -> Path:
                 f"'{entry.relpath}' (set {entry.set_name}) made from {entry.url} does not match the registry: "
                 f"expected sha256 {entry.sha256}, made {derive.sha256_bytes(data)}. Nothing was kept."
             )
-        _write_atomically(target, data)
+        write_atomically(target, data)
     finally:
         upstream.unlink(missing_ok=True)
         _remove_empty_dirs(upstream.parent, cache)

@@ -211,7 +211,17 @@ def _matches(entry: DataFile, path: Path) -> bool:
 
 
 def found_at(entry: DataFile) -> list[tuple[str, Path]]:
-    """``(label, path)`` of every data folder that holds ``entry`` (shared candidates, then the cache)."""
+    """``(label, path)`` of every data folder that holds ``entry`` (shared candidates, then the cache).
+
+    Parameters
+    ----------
+    entry : DataFile
+        A registered file.
+
+    Returns
+    -------
+    list of (str, pathlib.Path)
+    """
     out = []
     for label, folder in data_locations():
         if folder is not None and (folder / entry.relpath).is_file():

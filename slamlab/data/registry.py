@@ -17,7 +17,7 @@ from __future__ import annotations
 import functools
 import json
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from urllib.parse import urlsplit
 
@@ -46,9 +46,26 @@ REGISTRY_PATH = Path(__file__).resolve().parent / "registry.json"
 class DataFile:
     """One registered file: ``relpath`` (``<set>/<path>``), upstream ``url``, ``sha256`` and ``size``.
 
-    ``derive`` is ``None`` for a byte-for-byte copy of the upstream file; otherwise the rule that
-    makes the file from the upstream file whose hash is ``upstream_sha256`` (and, for an image,
-    ``pixels_sha256``, the hash of its decoded pixels: the PNG's bytes depend on the encoder).
+    Attributes
+    ----------
+    set_name : str
+        The set (a folder of the data layout) the file belongs to.
+    path : str
+        The file's path inside its set.
+    url : str
+        The upstream URL at the pinned commit.
+    sha256 : str
+        Hex sha256 of the file as slamlab uses it.
+    size : int
+        Its size in bytes.
+    upstream_sha256, upstream_size : str, int or None
+        For a derived file, the upstream file's hash and size; ``None`` for a copy.
+    derive : dict or None
+        ``None`` for a byte-for-byte copy of the upstream file; otherwise the rule that makes the
+        file from the upstream one (:mod:`slamlab.data.derive`).
+    pixels_sha256 : str or None
+        For an image made from the upstream one, the hash of its decoded pixels (the PNG's bytes
+        depend on the encoder).
     """
 
     set_name: str
@@ -79,7 +96,23 @@ class DataFile:
 
 @dataclass(frozen=True)
 class DataSet:
-    """One registered set: its name, what it is, its source, licence, citation and files."""
+    """One registered set: its name, what it is, its source, licence, citation and files.
+
+    Attributes
+    ----------
+    name : str
+        The set's folder name, e.g. ``"carmen-radish-corrected"``.
+    title : str
+        What the set is, in one line.
+    source : str
+        The upstream repository and pinned commit.
+    licence, citation : str
+        As the source states them.
+    files : tuple of DataFile
+        The set's registered files.
+    note : str
+        How any file differs from its upstream copy ("" when none does).
+    """
 
     name: str
     title: str
@@ -95,20 +128,39 @@ class DataSet:
         return sum(f.size for f in self.files)
 
 
-@dataclass(frozen=True)
 class Registry:
-    """Every registered set, with look-ups by set name and by relative path."""
+    """Every registered set, with look-ups by set name and by relative path.
 
-    sets: tuple[DataSet, ...]
-    _by_relpath: dict = field(default_factory=dict, repr=False, compare=False)
+    Parameters
+    ----------
+    sets : sequence of DataSet
+        The sets, in registry order.
+    """
 
-    def __post_init__(self):
-        for s in self.sets:
-            for f in s.files:
-                self._by_relpath[f.relpath] = f
+    def __init__(self, sets):
+        self.sets: tuple[DataSet, ...] = tuple(sets)
+        self._by_relpath = {f.relpath: f for s in self.sets for f in s.files}
+
+    def __repr__(self) -> str:
+        return f"Registry({len(self.sets)} sets, {len(self._by_relpath)} files)"
 
     def set(self, name: str) -> DataSet:
-        """The set called ``name``; ``KeyError`` naming the registered sets otherwise."""
+        """The set called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A set's name.
+
+        Returns
+        -------
+        DataSet
+
+        Raises
+        ------
+        KeyError
+            Naming the registered sets, when there is no such set.
+        """
         for s in self.sets:
             if s.name == name:
                 return s
@@ -127,7 +179,15 @@ class Registry:
     def files_under(self, relpath: str) -> tuple[DataFile, ...]:
         """The registered file at ``relpath``, or every registered file inside the folder ``relpath``.
 
-        Empty when ``relpath`` is neither (e.g. a file the registry does not list).
+        Parameters
+        ----------
+        relpath : str
+            A path relative to a data folder (``"oxford-affine/graf"``, ``"kitti-odometry-06-stereo/calib.txt"``).
+
+        Returns
+        -------
+        tuple of DataFile
+            Empty when ``relpath`` is neither (e.g. a file the registry does not list).
         """
         rel = PurePosixPath(relpath).as_posix()
         if rel in self._by_relpath:
@@ -178,6 +238,17 @@ def registry() -> Registry:
 def upstream_relpath(url: str) -> str:
     """``<host>/<path>`` of an upstream URL: its place in a mirror folder.
 
+    Parameters
+    ----------
+    url : str
+        An http(s) URL.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
     >>> upstream_relpath("https://raw.githubusercontent.com/o/r/abc/data/x.log.gz")
     'raw.githubusercontent.com/o/r/abc/data/x.log.gz'
     """
@@ -186,7 +257,17 @@ def upstream_relpath(url: str) -> str:
 
 
 def source_url(url: str) -> str:
-    """Where to fetch ``url`` from: the URL itself, or ``<$SLAMLAB_DATA_URL>/<host>/<path>`` when that is set."""
+    """Where to fetch ``url`` from: the URL itself, or ``<$SLAMLAB_DATA_URL>/<host>/<path>`` when that is set.
+
+    Parameters
+    ----------
+    url : str
+        A registered upstream URL.
+
+    Returns
+    -------
+    str
+    """
     mirror = os.environ.get(DATA_URL_ENV_VAR, "").strip()
     if not mirror:
         return url
@@ -196,6 +277,17 @@ def source_url(url: str) -> str:
 def count_files(n: int) -> str:
     """``'1 file'``, ``'5 files'``.
 
+    Parameters
+    ----------
+    n : int
+        A file count.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
     >>> count_files(1), count_files(347)
     ('1 file', '347 files')
     """
@@ -205,6 +297,17 @@ def count_files(n: int) -> str:
 def format_size(n_bytes: int) -> str:
     """A byte count for people: ``'448 kB'``, ``'27.8 MB'`` (decimal units, as pip prints them).
 
+    Parameters
+    ----------
+    n_bytes : int
+        A size in bytes.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
     >>> format_size(448366), format_size(27_812_345), format_size(177)
     ('448 kB', '27.8 MB', '177 B')
     """
@@ -220,6 +323,16 @@ def data_table_markdown(reg: Registry | None = None) -> str:
 
     The README's data section and the course site's data page print this table, so both
     follow the registry.
+
+    Parameters
+    ----------
+    reg : Registry or None
+        The registry (the package's own by default).
+
+    Returns
+    -------
+    str
+        The table, with a final row of totals.
     """
     reg = registry() if reg is None else reg
     rows = [
