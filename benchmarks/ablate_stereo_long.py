@@ -1,7 +1,7 @@
 """Ablations of the stereo pipeline on the ~80 m run of ``bench_stereo.py --long`` (000 §4.2).
 
 The 401 stereo pairs are rendered once into ``--cache`` (2 × 177 MB of .npy) with the same
-seeds as :func:`slamlab.stereo.run_stereo_slam_variants` (``rng=0``), so a variant here gives
+seeds as :func:`slamlab.studies.stereo.run_stereo_slam_variants` (``rng=0``), so a variant here gives
 the same trajectory as that variant in ``bench_stereo.py --long``; each variant is one
 ``label=JSON`` argument of :class:`slamlab.stereo.StereoParams` overrides. Run several
 processes side by side to use both cores.
@@ -14,7 +14,7 @@ processes side by side to use both cores.
 The key ``"numba": false`` in a variant's JSON runs it without the compiled kernels (the numpy path), e.g.
 ``'numpy={"detector": "orb", "numba": false}' 'compiled={"detector": "orb"}'``.
 ``--heading-frames DEG`` prints, per variant, the frames whose heading error exceeds DEG with what the
-pipeline did on them (:func:`slamlab.stereo.heading_frames`).
+pipeline did on them (:func:`slamlab.studies.stereo.heading_frames`).
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ def main(argv=None):
               f"{int(c['gate_fallback'].sum())} whole-map fallbacks, {int(c['window_fallback'].sum())} window "
               f"fallbacks, {c['n_compared'][1:].mean() / 1e6:.2f} M descriptor distances per frame (mean)", flush=True)
         if args.heading_frames is not None:
-            print(sl.stereo.heading_frames(slam, truth, args.heading_frames), flush=True)
+            print(sl.studies.stereo.heading_frames(slam, truth, args.heading_frames), flush=True)
 
 
 if __name__ == "__main__":

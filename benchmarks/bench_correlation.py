@@ -196,10 +196,10 @@ def main():
 
     if args.monte_carlo:
         t0 = time.perf_counter()
-        mc = sl.correlation.run_monte_carlo("full", rng=2011)
+        mc = sl.studies.correlation.run_monte_carlo("full", rng=2011)
         print(f"\nMonte Carlo (200 poses, float32), took {time.perf_counter() - t0:.1f} s")
         print(mc.table())
-        mc2 = sl.correlation.run_monte_carlo("full", extra_clutter=60, rng=2011)
+        mc2 = sl.studies.correlation.run_monte_carlo("full", extra_clutter=60, rng=2011)
         print(mc2.table())
 
 
@@ -232,7 +232,7 @@ def main():
 def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extra: dict) -> None:
     """Issue 25: the log suite with ``settings`` and with ``settings`` + ``extra``; per log and mode the successes
     of both and the scans gained / lost."""
-    from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
+    from slamlab.studies.correlation.log_suite import SHARED_CARMEN_LOGS
 
     paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
     runs = []
@@ -240,7 +240,7 @@ def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extr
         print(f"\nShared CARMEN logs, every {every}th scan, settings {kw or 'defaults'}, "
               f"load average {os.getloadavg()[0]:.1f}")
         t0 = time.perf_counter()
-        r = sl.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs,
+        r = sl.studies.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs,
                                          progress=False, **kw)
         print(f"took {time.perf_counter() - t0:.1f} s wall ({n_jobs} job(s)); load average now "
               f"{os.getloadavg()[0]:.1f}")
@@ -265,19 +265,19 @@ def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extr
 def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: bool = False,
          failures: bool = False, terms: bool = False) -> None:
     """Issue 25: every ``every``-th scan of each shared CARMEN log, modes 1/2/3, with the real-log defaults."""
-    from slamlab.correlation.log_suite import SHARED_CARMEN_LOGS
+    from slamlab.studies.correlation.log_suite import SHARED_CARMEN_LOGS
 
     paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
     if map_check:
         t0 = time.perf_counter()
         print(f"\nBeam layout check (every 5th scan, ±2 scans left out, 0.2 m cells, ranges < 10 m), load average "
               f"{os.getloadavg()[0]:.1f}")
-        print(sl.correlation.map_check([sl.data.find_data(p) for p in paths]))
+        print(sl.studies.correlation.map_check([sl.data.find_data(p) for p in paths]))
         print(f"took {time.perf_counter() - t0:.1f} s wall")
     print(f"\nShared CARMEN logs, every {every}th scan, settings {settings or 'defaults'}, "
           f"load average {os.getloadavg()[0]:.1f}")
     t0 = time.perf_counter()
-    r = sl.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs, progress=False,
+    r = sl.studies.correlation.run_log_suite([sl.data.find_data(p) for p in paths], every, n_jobs=n_jobs, progress=False,
                                      **settings, **({"truth_check": True} if failures else {}))
     print(f"took {time.perf_counter() - t0:.1f} s wall ({n_jobs} job(s)); load average now {os.getloadavg()[0]:.1f}")
     print(r.table())
@@ -311,7 +311,7 @@ def refine_cost(repeat: int = 2) -> None:
     for _ in range(repeat):
         for k, ts in times.items():
             t0 = time.process_time()
-            r = sl.correlation.run_log_localisation(log, idx, joined=(1, 3), refine=k, progress=False)
+            r = sl.studies.correlation.run_log_localisation(log, idx, joined=(1, 3), refine=k, progress=False)
             ts.append(time.process_time() - t0)
             print(f"  refine={k}: {ts[-1]:.1f} s CPU, localised {r.success.sum(axis=1).tolist()} (1 / 3 scans)")
     t0, t10 = min(times[0]), min(times[10])
@@ -321,23 +321,23 @@ def refine_cost(repeat: int = 2) -> None:
 
 def intel(n_jobs: int) -> None:
     """Issue 17: every 25th scan of the corrected Intel log, from no prior, one scan and 2/3 joined by odometry."""
-    log = sl.io.read_carmen(sl.data.find_data(sl.correlation.DEFAULT_CARMEN_LOG))
+    log = sl.io.read_carmen(sl.data.find_data(sl.studies.correlation.DEFAULT_CARMEN_LOG))
     idx = range(25, log.n_scans, 25)
     print(f"\nIntel log, every 25th scan ({len(idx)} scans), load average {os.getloadavg()[0]:.1f}")
     t0 = time.perf_counter()
-    r = sl.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), exclude=10, n_jobs=n_jobs)  # issue 17's
+    r = sl.studies.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), exclude=10, n_jobs=n_jobs)  # issue 17's
     t = time.perf_counter() - t0
     print(f"took {t:.1f} s wall ({t / len(idx):.2f} s per scan for the three modes, {n_jobs} job(s)); "
           f"load average now {os.getloadavg()[0]:.1f}")
     print(r.summary_table())
     print(r.ambiguity_table())
     print(r.table())
-    r0 = sl.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), exclude=10, odom_std=(0.0, 0.0),
+    r0 = sl.studies.correlation.run_log_localisation(log, idx, joined=(1, 2, 3), exclude=10, odom_std=(0.0, 0.0),
                                              n_jobs=n_jobs)
     print("\nthe same without odometry noise (the logged relative poses):")
     print(r0.summary_table())
     # cost of the ambiguity: the peak search alone vs the peak plus its rival, on one scan
-    G, _frame, scans_c, _Pc = sl.correlation.log_grid(log, leave_out=range(140, 161))
+    G, _frame, scans_c, _Pc = sl.scans.log_grid(log, leave_out=range(140, 161))
     t_plain, _ = best_of(lambda: sl.correlation.localise(G, scans_c[150], ambiguity=False))
     t_amb, loc = best_of(lambda: sl.correlation.localise(G, scans_c[150]))
     print(f"\none Intel scan, CPU time: localise without the rival {t_plain:.3f} s, with it {t_amb:.3f} s "

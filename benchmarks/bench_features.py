@@ -18,8 +18,8 @@ import cv2
 import numpy as np
 
 import slamlab.features as F
-from slamlab.features.matching_experiments import _matching_workload
 from slamlab.kdtree import KDTree
+from slamlab.studies.features.matching_workload import _matching_workload
 
 
 def best_of(fn, repeats):

@@ -31,6 +31,7 @@ import cv2
 import numpy as np
 
 import slamlab.hough as h
+import slamlab.studies.hough as sh
 from slamlab import sim
 
 
@@ -97,8 +98,8 @@ def measure(phi, r, d_rho, d_theta, r_max, repeat):
     }
 
 
-#: The ablation of ``--real-logs``: label → overrides of :data:`slamlab.hough.REAL_LOG_PARAMS` (per log key
-#: when a dict of dicts). The first row is the settings before issue 25 (per-format max_gap, no heading step,
+#: The ablation of ``--real-logs``: label → overrides of :data:`slamlab.studies.hough.REAL_LOG_PARAMS` (per log
+#: key when a dict of dicts). The first row is the settings before issue 25 (per-format max_gap, no heading step,
 #: no second line search at ``H_min_retry``).
 ABLATION = (
     ("before issue 25: per-format max_gap, no heading step",
@@ -121,14 +122,14 @@ def real_log_ablation():
     """Print the ``--real-logs`` table: each setting of :data:`ABLATION` on both shared logs."""
     from slamlab.data import find_data
 
-    paths = {key: find_data(rel) for key, rel in h.SHARED_LOGS.items()}
+    paths = {key: find_data(rel) for key, rel in sh.SHARED_LOGS.items()}
     print(f"{'setting':56s} {'log':8s} {'alone':>7s} {'parallel':>9s} {'heading':>8s} {'cells S/O':>11s} "
           f"{'sharper':>8s} {'s':>5s}  causes of the steps on odometry alone")
     for label, over in ABLATION:
         for key, path in paths.items():
             kw = over.get(key, {}) if over and isinstance(next(iter(over.values())), dict) else over
             t0 = time.perf_counter()
-            r = h.run_real_log(path, progress=False, **kw)
+            r = sh.run_real_log(path, progress=False, **kw)
             c, n = r.slam.cause_counts(), r.odometry.shape[0] - 1
             print(f"{label:56s} {key:8s} {r.slam.lost[1:].sum() / n:7.1%} {c['partial'] / n:9.1%} "
                   f"{c['heading'] / n:8.1%} {r.sharpness('slam'):5.2f}/{r.sharpness('odometry'):5.2f} "

@@ -22,8 +22,8 @@ import time
 import numpy as np
 
 from slamlab.mono import depth_filter as df
-from slamlab.mono.experiments import mono_sim, render_sequence, sequence_poses
 from slamlab.mono.slam import STAGES, MonoSLAM
+from slamlab.studies.mono.experiments import mono_sim, render_sequence, sequence_poses
 
 
 def update_loop(mu, sigma2, a, b, x, tau2, rho_range):

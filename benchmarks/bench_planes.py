@@ -33,21 +33,20 @@ import time
 
 import numpy as np
 
-from slamlab.planes import (
+from slamlab.planes import STAGES, PlaneSLAM, PlaneSLAMParams, extract_planes
+from slamlab.sim import simulate_flight
+from slamlab.studies.planes import (
     GOAL_S,
     SOURCE_TIMES_S,
-    STAGES,
-    PlaneSLAM,
-    PlaneSLAMParams,
-    extract_planes,
     flight_frames,
     run_flight,
+    run_frame_source_ablation,
+    run_incidence_ablation,
     run_intensity_spread,
     run_intensity_study,
+    run_pairs_ablation,
     timing_table,
 )
-from slamlab.planes.ablations import run_frame_source_ablation, run_incidence_ablation, run_pairs_ablation
-from slamlab.sim import simulate_flight
 
 
 def load() -> str:

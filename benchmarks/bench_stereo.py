@@ -121,7 +121,7 @@ def main(argv=None):
     say(f"| exact store 2-NN, {len(Q)} queries x {len(store)} landmarks (vs BFMatcher.knnMatch) | {1000 * t_store:.1f} | {1000 * t_bf:.1f} | {t_store / t_bf:.2f} |")
     if args.drift:
         say()
-        study = sl.stereo.run_drift_study((0.0, 0.2e-3, 0.5e-3, 1e-3, 2e-3), "closed loop", rng=0)
+        study = sl.studies.stereo.run_drift_study((0.0, 0.2e-3, 0.5e-3, 1e-3, 2e-3), "closed loop", rng=0)
         say("```")
         say(study.table())
         say("```")
@@ -137,7 +137,7 @@ def main(argv=None):
                 variants["oldest, global search (before the window search)"] = {"detector": det, "map_search": "global"}
                 variants["oldest, before (global search, no sub-pixel disparity, no duplicate check)"] = {
                     "detector": det, "map_search": "global", "subpixel_stereo": False, "duplicate_gap_m": None}
-            runs = sl.stereo.run_stereo_slam_variants(path, variants, name="long path", arena=room, rng=0)
+            runs = sl.studies.stereo.run_stereo_slam_variants(path, variants, name="long path", arena=room, rng=0)
             for label, res in runs.items():
                 say(f"long path ({length_m:.0f} m, {len(path)} frames), {det}, policy {label}: max position error "
                     f"{res.pos_err_m.max():.2f} m, final {res.pos_err_m[-1]:.2f} m, mean {res.pos_err_m.mean():.3f} m, "
@@ -158,7 +158,7 @@ def main(argv=None):
                                                                           "orb_levels": 8}),
                         ("refined disparities, 8 ORB levels", {"orb_levels": 8}), ("after (KITTI_PARAMS)", {})]
             for label, over in variants if det == "orb" else [("before", {"subpixel_stereo": False}), ("after", {})]:
-                k = sl.stereo.run_kitti(rng=0, detector=det, progress=False, **over)
+                k = sl.studies.stereo.run_kitti(rng=0, detector=det, progress=False, **over)
                 st = k.step_ratios
                 say(f"| {det}, {label} | {k.ate_m:.3f} | {k.ate_se3_m:.3f} | {k.final_error_m:.3f} | "
                     f"{k.length_ratio:.4f} | {k.end_distance_ratio:.4f} | {st.mean():.4f} ± "
@@ -168,21 +168,21 @@ def main(argv=None):
         folder = sl.data.find_data("kitti-odometry-06-stereo-51")
         for det in args.detectors.split(","):
             t0 = time.perf_counter()
-            fix_off = sl.stereo.PROPOSED_FIX_OFF
+            fix_off = sl.studies.stereo.PROPOSED_FIX_OFF
             variants = {"before (issue 25: global search, measured-depth weights)": {
                 "detector": det, "map_search": "global", "weight_depth": "measured", "update_cov_depth": "measured",
                 **fix_off},
                 "stop 36 (KITTI_PARAMS without the stop-37 fix)": {"detector": det, **fix_off},
                 "after (KITTI_PARAMS)": {"detector": det}}
             say("```")
-            say(sl.stereo.kitti_comparison(variants, folder))
+            say(sl.studies.stereo.kitti_comparison(variants, folder))
             say("```")
             say(f"  ({det}: {time.perf_counter() - t0:.0f} s for both runs; load average "
                 f"{' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     if args.highway:
         say()
         t0 = time.perf_counter()
-        abl = sl.stereo.run_scale_ablation(lambda rng: sl.sim.HighwayScene(rng=rng), sl.sim.highway_path(args.highway_frames),
+        abl = sl.studies.stereo.run_scale_ablation(lambda rng: sl.sim.HighwayScene(rng=rng), sl.sim.highway_path(args.highway_frames),
                                            n_seeds=args.seeds, pixel_std=args.highway_noise, rng=0)
         say("```")
         say(abl.table(end=True))
@@ -190,7 +190,7 @@ def main(argv=None):
         say(f"  ({time.perf_counter() - t0:.0f} s; load average {' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     if args.conditions:
         from slamlab.sim.highway import HIGHWAY_CONDITIONS
-        from slamlab.stereo.scale_ablation import run_condition_ablation
+        from slamlab.studies.stereo.scale_ablation import run_condition_ablation
 
         say()
         t0 = time.perf_counter()

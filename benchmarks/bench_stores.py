@@ -33,10 +33,10 @@ import numpy as np
 
 import slamlab
 from slamlab.kdtree import knn
-from slamlab.kdtree.experiments import TABLES_000, run_crossover, run_store_comparison
 from slamlab.kdtree.stores import BruteForceStore
-from slamlab.kdtree.workloads import surf_like_descriptors
-from slamlab.stereo import record_stereo_stream
+from slamlab.studies.kdtree.experiments import TABLES_000, run_crossover, run_store_comparison
+from slamlab.studies.kdtree.workloads import surf_like_descriptors
+from slamlab.studies.stereo import record_stereo_stream
 
 _LABEL = {"rebuild": "kd-tree (rebuilt)", "multi": "buffer + multi kd-tree", "flann": "FLANN (rebuilt)",
           "brute": "brute force (BLAS)"}

@@ -46,7 +46,7 @@ def overhead(n_tasks: int = 400) -> None:
 def correlation_monte_carlo(size: str = "full") -> None:
     import numpy as np
 
-    from slamlab.correlation import run_monte_carlo
+    from slamlab.studies.correlation import run_monte_carlo
 
     t1, a = wall(lambda: run_monte_carlo(size, n_jobs=1, progress=False), repeat=1)
     t2, b = wall(lambda: run_monte_carlo(size, n_jobs=2, progress=False), repeat=1)

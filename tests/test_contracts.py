@@ -25,52 +25,52 @@ _NO_PIPELINE = ("no pipeline Params dataclass: a textbook experiment whose every
 #: function (module.name) -> {missing parameter: why it makes no sense there}
 ALLOWED: dict[str, dict[str, str]] = {
     # correlation: the constructed corridor is built without noise; its settings are LocaliseParams (params=)
-    "slamlab.correlation.experiments.run_corridor_tie": {"rng": _NO_RANDOMNESS + " (a noise-free corridor)"},
+    "slamlab.studies.correlation.experiments.run_corridor_tie": {"rng": _NO_RANDOMNESS + " (a noise-free corridor)"},
     # features: detectors and matchers on the Oxford images; their settings are the detectors' own arguments
-    "slamlab.features.experiments.run_pair_evaluation": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.detector_experiments.run_detector_summary": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.detector_experiments.run_surf_threshold": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.matching_experiments.run_knn_comparison": {
+    "slamlab.studies.features.experiments.run_pair_evaluation": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.studies.features.detector_experiments.run_detector_summary": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.studies.features.detector_experiments.run_surf_threshold": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.studies.features.matching_experiments.run_knn_comparison": {
         "params": _NO_PIPELINE, "rng": _NO_RANDOMNESS + " (FLANN's trees: cv2.setRNGSeed(0) in kdtree.knn)"},
-    "slamlab.features.matching_experiments.run_recall_vs_leaves": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.matching_experiments.run_ratio_tradeoff": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
-    "slamlab.features.detector_experiments.run_blob_scale": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.studies.features.matching_experiments.run_recall_vs_leaves": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.studies.features.matching_experiments.run_ratio_tradeoff": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
+    "slamlab.studies.features.detector_experiments.run_blob_scale": {"params": _NO_PIPELINE, "rng": _NO_RANDOMNESS},
     # filters: each experiment is one model (F, Q, H, R from its keywords) run through the filters
-    "slamlab.filters.experiments.run_cv_target": {"params": _NO_PIPELINE},
-    "slamlab.filters.studies.run_joseph_vs_short": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.run_unicycle_comparison": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.run_stabilising_noise": {"params": _NO_PIPELINE},
-    "slamlab.filters.experiments.run_sigma_alpha_study": {"params": _NO_PIPELINE},
-    "slamlab.filters.studies.run_landmark_filter": {"params": _NO_PIPELINE},
+    "slamlab.studies.filters.experiments.run_cv_target": {"params": _NO_PIPELINE},
+    "slamlab.studies.filters.studies.run_joseph_vs_short": {"params": _NO_PIPELINE},
+    "slamlab.studies.filters.experiments.run_unicycle_comparison": {"params": _NO_PIPELINE},
+    "slamlab.studies.filters.experiments.run_stabilising_noise": {"params": _NO_PIPELINE},
+    "slamlab.studies.filters.experiments.run_sigma_alpha_study": {"params": _NO_PIPELINE},
+    "slamlab.studies.filters.studies.run_landmark_filter": {"params": _NO_PIPELINE},
     # hough
-    "slamlab.hough.example.run_example_line": {
+    "slamlab.studies.hough.example.run_example_line": {
         "params": "004's worked example: one line, both transforms at 004's resolutions (no Hough SLAM run)",
         "rng": _NO_RANDOMNESS},
-    "slamlab.hough.logs.run_real_log": {"rng": _REPLAY},
+    "slamlab.studies.hough.logs.run_real_log": {"rng": _REPLAY},
     # kdtree: the stores are compared at the workload's own sizes; no pipeline settings
     "slamlab.kdtree.cost_model.run_cost_model": {
         "params": "evaluates 000's cost formula at four numbers (n, s, m, C): nothing else to set",
         "rng": _NO_RANDOMNESS},
-    "slamlab.kdtree.experiments.run_store_comparison": {"params": _NO_PIPELINE},
-    "slamlab.kdtree.crossover.run_crossover": {"params": _NO_PIPELINE},
-    "slamlab.kdtree.tree_studies.run_dimension_study": {"params": _NO_PIPELINE},
+    "slamlab.studies.kdtree.experiments.run_store_comparison": {"params": _NO_PIPELINE},
+    "slamlab.studies.kdtree.crossover.run_crossover": {"params": _NO_PIPELINE},
+    "slamlab.studies.kdtree.tree_studies.run_dimension_study": {"params": _NO_PIPELINE},
     # mono: MonoSLAM draws no random numbers (OpenCV's RANSAC is reseeded to 0 before each call,
     # mono/twoview.py); the streams are the renderer's, taken by the run_* that render
-    "slamlab.mono.runs.run_mono": {"rng": _NO_RANDOMNESS + " (MonoSLAM on given images)"},
-    "slamlab.mono.kitti.run_kitti_mono": {"rng": _REPLAY},
-    "slamlab.mono.kitti.run_kitti_ablation": {"rng": _REPLAY},
-    "slamlab.mono.convergence.run_depth_filter_convergence": {
+    "slamlab.studies.mono.runs.run_mono": {"rng": _NO_RANDOMNESS + " (MonoSLAM on given images)"},
+    "slamlab.studies.mono.kitti.run_kitti_mono": {"rng": _REPLAY},
+    "slamlab.studies.mono.kitti.run_kitti_ablation": {"rng": _REPLAY},
+    "slamlab.studies.mono.convergence.run_depth_filter_convergence": {
         "params": "the depth filter's maths on synthetic seeds (τ, outlier rates are the study's axes): "
                   "no MonoSLAM run, so no MonoParams"},
-    "slamlab.mono.convergence.run_convergence_tests": {
+    "slamlab.studies.mono.convergence.run_convergence_tests": {
         "params": "the two convergence tests on synthetic seeds (τ from the geometry, L_max the axis): "
                   "no MonoSLAM run, so no MonoParams"},
     # planes: Fig. 2 is 002's bare LM system (noise-free planes, no prior, 40 iterations), not the filter
-    "slamlab.planes.figures.run_pairs_figure": {
+    "slamlab.studies.planes.figures.run_pairs_figure": {
         "params": "002 Fig. 2: the bare LM solve of 1, 2, 3 plane pairs, no filter (none of PlaneSLAMParams "
                   "applies: no prior, no weights, its own iteration count)"},
     # stereo: draws a finished result
-    "slamlab.stereo.plot.run_figure": {
+    "slamlab.studies.stereo.plot.run_figure": {
         "params": "draws a finished StereoRunResult: no settings", "rng": _NO_RANDOMNESS},
 }
 
@@ -108,8 +108,8 @@ def run_functions():
 def test_the_walk_finds_the_experiments(run_functions):
     # a guard against a walk that silently finds nothing (e.g. an import path change)
     assert len(run_functions) > 40
-    assert "slamlab.localisation.studies.run_global_localisation" in run_functions
-    assert "slamlab.mono.experiments.run_parameter_sweep" in run_functions
+    assert "slamlab.studies.localisation.studies.run_global_localisation" in run_functions
+    assert "slamlab.studies.mono.experiments.run_parameter_sweep" in run_functions
 
 
 def test_every_run_takes_params_and_rng(run_functions):

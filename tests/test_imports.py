@@ -1,4 +1,4 @@
-"""CONVENTIONS, imports: `import slamlab` stays light; the import graph has no cycle; algorithms never import sim.
+"""CONVENTIONS, imports: `import slamlab` stays light; no cycle; only sim, the studies and the labs reach sim.
 
 The graph is read from the source (every ``import`` statement, at module level and inside
 functions, since an import hidden in a function still closes a cycle when it runs).
@@ -16,8 +16,6 @@ import pytest
 
 PKG = Path(__file__).resolve().parent.parent / "slamlab"
 HEAVY = ("cv2", "ipywidgets", "matplotlib.pyplot")
-#: modules that may use the simulator: they run experiments, draw or build widgets (CONVENTIONS: Layout)
-SIM_USERS = ("experiments", "widgets", "plot", "__init__")
 
 
 def _module_names() -> dict[str, Path]:
@@ -111,17 +109,57 @@ def test_import_graph_has_no_cycle_across_subpackages():
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles)
 
 
-def test_algorithm_modules_never_import_sim():
-    bad = [f"{m} -> {t}" for m, targets in _graph().items() for t in targets
-           if _subpackage(t) == "sim" and _subpackage(m) != "sim" and m.split(".")[-1] not in SIM_USERS
-           and m != "slamlab"]
-    assert not bad, "algorithm modules import slamlab.sim: " + ", ".join(sorted(bad))
+#: the layers that may use the simulator: the simulator itself, the chapters' studies and the labs' feedback
+SIM_LAYERS = ("sim", "studies", "lab")
+
+
+def _with_parents(module: str) -> set[str]:
+    """``module`` and the packages Python imports before it (``slamlab.a.b`` -> ``slamlab.a``; not ``slamlab``)."""
+    parts = module.split(".")
+    return {".".join(parts[:i]) for i in range(2, len(parts) + 1)}
+
+
+def _reach(graph: dict[str, set[str]]) -> dict[str, set[str]]:
+    """Every slamlab module each module loads when imported: its imports, their packages' ``__init__``, and so on."""
+    edges = {m: set().union(*(_with_parents(t) for t in ts), _with_parents(m)) - {m} for m, ts in graph.items()}
+    edges = {m: {t for t in ts if t in graph} for m, ts in edges.items()}
+    reach: dict[str, set[str]] = {}
+    for start in graph:
+        seen, todo = set(), [start]
+        while todo:
+            for t in edges[todo.pop()]:
+                if t not in seen:
+                    seen.add(t)
+                    todo.append(t)
+        reach[start] = seen - {start}
+    return reach
+
+
+def test_reach_follows_imports_and_packages():
+    graph = {"slamlab.a": set(), "slamlab.a.x": {"slamlab.b.y"}, "slamlab.b": {"slamlab.c.z"}, "slamlab.b.y": set(),
+             "slamlab.c": set(), "slamlab.c.z": set()}
+    # a.x imports b.y, whose package b imports c.z: a.x reaches c.z through b's __init__
+    assert _reach(graph)["slamlab.a.x"] == {"slamlab.a", "slamlab.b", "slamlab.b.y", "slamlab.c", "slamlab.c.z"}
+
+
+def test_no_module_outside_sim_studies_and_lab_reaches_sim():
+    reach = _reach(_graph())
+    bad = sorted(f"{m} -> {', '.join(sorted(t for t in ts if _subpackage(t) == 'sim'))}" for m, ts in reach.items()
+                 if _subpackage(m) not in SIM_LAYERS and m != "slamlab" and any(_subpackage(t) == "sim" for t in ts))
+    assert not bad, f"{len(bad)} modules reach slamlab.sim:\n" + "\n".join(bad)
+
+
+def test_only_the_labs_import_the_studies():
+    bad = sorted(f"{m} -> {t}" for m, ts in _graph().items() for t in ts
+                 if _subpackage(t) == "studies" and _subpackage(m) not in ("studies", "lab"))
+    assert not bad, "algorithm modules import slamlab.studies: " + ", ".join(bad)
 
 
 #: the sim-free helpers of an experiments.py (issue 23): results, tables, loops; the dependency is one way
-EXPERIMENT_HELPERS = ("slamlab.filters.results", "slamlab.filters.studies", "slamlab.filters.source_table",
-                      "slamlab.correlation.studies", "slamlab.correlation.study_results",
-                      "slamlab.stereo.run_results", "slamlab.stereo.disparity_check")
+EXPERIMENT_HELPERS = ("slamlab.studies.filters.results", "slamlab.studies.filters.studies",
+                      "slamlab.studies.filters.source_table", "slamlab.studies.correlation.studies",
+                      "slamlab.studies.correlation.study_results", "slamlab.studies.stereo.run_results",
+                      "slamlab.studies.stereo.disparity_check")
 
 
 def test_experiment_helpers_import_neither_sim_nor_experiments():
@@ -134,7 +172,8 @@ def test_experiment_helpers_import_neither_sim_nor_experiments():
 SUBPACKAGES = ["slamlab", "slamlab.geometry", "slamlab.scans", "slamlab.io", "slamlab.sim", "slamlab.filters",
                "slamlab.features", "slamlab.kdtree", "slamlab.stereo", "slamlab.correlation", "slamlab.hough",
                "slamlab.planes", "slamlab.evaluation", "slamlab.lab", "slamlab.sweep", "slamlab.mono", "slamlab.localisation",
-               "slamlab.data"]
+               "slamlab.data", "slamlab.studies", *(f"slamlab.studies.{p.parent.name}"
+                                                   for p in sorted((PKG / "studies").glob("*/__init__.py")))]
 
 
 def test_every_subpackage_is_listed():

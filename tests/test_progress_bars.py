@@ -21,7 +21,7 @@ def _both(capsys, monkeypatch, run):
 
 
 def test_hough_slam_bar_over_scans(capsys, monkeypatch):
-    quiet, shown, err = _both(capsys, monkeypatch, lambda p: sl.hough.run_sim_slam(
+    quiet, shown, err = _both(capsys, monkeypatch, lambda p: sl.studies.hough.run_sim_slam(
         8, with_icp=False, progress=p, rng=3))
     assert "Hough SLAM" in err
     assert "/8 " in err
@@ -29,12 +29,12 @@ def test_hough_slam_bar_over_scans(capsys, monkeypatch):
 
 
 def test_store_comparison_and_crossover_bars_over_stores(capsys, monkeypatch):
-    quiet, shown, err = _both(capsys, monkeypatch, lambda p: sl.kdtree.experiments.run_store_comparison(
+    quiet, shown, err = _both(capsys, monkeypatch, lambda p: sl.studies.kdtree.experiments.run_store_comparison(
         "table1", stores=("rebuild", "brute"), n_iterations=3, rng=1, progress=p))
     assert "stores" in err
     assert "/2 " in err
     assert quiet.recall == shown.recall
-    _, _, err = _both(capsys, monkeypatch, lambda p: sl.kdtree.experiments.run_crossover(
+    _, _, err = _both(capsys, monkeypatch, lambda p: sl.studies.kdtree.experiments.run_crossover(
         (200, 400), stores=("rebuild", "multi", "brute"), n_queries=20, n_new=50, repeats=1, rng=1, progress=p))
     assert "crossover: stores" in err
     assert "/3 " in err
@@ -42,12 +42,12 @@ def test_store_comparison_and_crossover_bars_over_stores(capsys, monkeypatch):
 
 @pytest.mark.realdata
 def test_feature_experiments_bars(capsys, monkeypatch, real_data):
-    quiet, shown, err = _both(capsys, monkeypatch, lambda p: sl.features.run_pair_evaluation(
+    quiet, shown, err = _both(capsys, monkeypatch, lambda p: sl.studies.features.run_pair_evaluation(
         "graf", (2, 3), detectors=("ORB",), scale=0.25, n_points=100, progress=p))
     assert "pair evaluation" in err
     assert "/2 " in err
     np.testing.assert_array_equal(quiet.rep, shown.rep)
-    _, _, err = _both(capsys, monkeypatch, lambda p: sl.features.run_recall_vs_leaves(
+    _, _, err = _both(capsys, monkeypatch, lambda p: sl.studies.features.run_recall_vs_leaves(
         (1, 5), n_stored=300, n_queries=20, progress=p))
     assert "recall vs leaves" in err
     assert "/2 " in err

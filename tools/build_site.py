@@ -79,11 +79,19 @@ def api_pages() -> dict[str, list[str]]:
     import slamlab
 
     pages: dict[str, list[str]] = {"slamlab": ["slamlab"]}
+    modules = public_modules()
     for info in pkgutil.iter_modules(slamlab.__path__):
         if info.name.startswith("_"):
             continue
-        if info.ispkg:
-            pages[info.name] = [m for m in public_modules()
+        if info.name == "studies":  # the studies layer: its own page, then one page per chapter's studies
+            import slamlab.studies
+
+            pages["studies"] = ["slamlab.studies"]
+            for sub in pkgutil.iter_modules(slamlab.studies.__path__):
+                name = f"studies.{sub.name}"
+                pages[name] = [m for m in modules if m == f"slamlab.{name}" or m.startswith(f"slamlab.{name}.")]
+        elif info.ispkg:
+            pages[info.name] = [m for m in modules
                                 if m == f"slamlab.{info.name}" or m.startswith(f"slamlab.{info.name}.")]
         else:
             pages["slamlab"].append(f"slamlab.{info.name}")

@@ -12,79 +12,28 @@ from .algorithm import (
     rasterise_scan,
     score_maps,
 )
-from .experiments import (
-    SOURCE_TABLE1,
-    ConstantsResult,
-    CorridorResult,
-    MonteCarloResult,
-    Table1Result,
-    corridor_grid,
-    log_grid,
-    random_clutter,
-    run_constants_study,
-    run_corridor_tie,
-    run_monte_carlo,
-    run_table1,
-    time_localise,
-)
-from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, run_log_localisation
-from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, more_confident, run_log_suite
-from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
-from .source_table import ours_vs_source
-from .terms import TERM_NAMES, score_terms
 
 _PLOT = (
-    "constants_figure",
     "localisation_figure",
-    "plot_error_distribution",
     "plot_grid",
     "plot_grids",
     "plot_heading_profile",
     "plot_localisation",
-    "plot_log_localisation",
     "plot_score_map",
     "plot_stamp",
     "plot_stamps",
-    "plot_table1",
 )
-_WIDGETS = ("explore_localisation", "explore_log_scan")
-__getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
+__getattr__, __dir__ = lazy_exports(__name__, dict.fromkeys(_PLOT, ".plot"))
 
 __all__ = [
-    "DEFAULT_CARMEN_LOG",
-    "MAP_CHECK_LAYOUTS",
-    "SHARED_CARMEN_LOGS",
-    "SOURCE_TABLE1",
-    "TERM_NAMES",
-    "ConstantsResult",
-    "CorridorResult",
     "Localisation",
     "LocaliseParams",
-    "LogLocalisationResult",
-    "LogSuiteResult",
-    "MonteCarloResult",
-    "Table1Result",
     "check_constants",
-    "corridor_grid",
-    "endpoint_agreement",
     "heading_candidates",
     "heading_error",
     "localise",
     "localise_joined",
-    "log_grid",
-    "map_check",
-    "more_confident",
-    "ours_vs_source",
-    "random_clutter",
     "rasterise_scan",
-    "run_constants_study",
-    "run_corridor_tie",
-    "run_log_localisation",
-    "run_log_suite",
-    "run_monte_carlo",
-    "run_table1",
     "score_maps",
-    "score_terms",
-    "time_localise",
 ]
-__all__ += list(_PLOT + _WIDGETS)  # loaded on first use
+__all__ += list(_PLOT)  # loaded on first use

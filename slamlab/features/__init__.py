@@ -23,13 +23,6 @@ from .evaluation import (
     project,
     repeatability,
 )
-from .experiments import (
-    EVAL_DETECTORS,
-    run_blob_scale,
-    run_detector_summary,
-    run_pair_evaluation,
-    run_surf_threshold,
-)
 from .fast import fast_corner_mask, fast_detect, fast_score
 from .matching import (
     KNN_METHODS,
@@ -42,12 +35,6 @@ from .matching import (
     match_descriptors,
     mutual_mask,
     ratio_rule,
-)
-from .matching_experiments import (
-    descriptor_pool,
-    run_knn_comparison,
-    run_ratio_tradeoff,
-    run_recall_vs_leaves,
 )
 from .moravec import moravec_detect, moravec_response
 from .opencv import fast_cv, features_from_keypoints, mser_cv, orb_cv, sift_cv
@@ -66,7 +53,6 @@ from .surf import (
 __all__ = [
     "CHANNEL_ORDERS",
     "DETECTORS",
-    "EVAL_DETECTORS",
     "KNN_METHODS",
     "OXFORD_SEQUENCES",
     "SURF",
@@ -79,7 +65,6 @@ __all__ = [
     "common_region",
     "correct_matches",
     "describe_surf",
-    "descriptor_pool",
     "detect",
     "fast_corner_mask",
     "fast_cv",
@@ -105,13 +90,6 @@ __all__ = [
     "project",
     "ratio_rule",
     "repeatability",
-    "run_blob_scale",
-    "run_detector_summary",
-    "run_knn_comparison",
-    "run_pair_evaluation",
-    "run_ratio_tradeoff",
-    "run_recall_vs_leaves",
-    "run_surf_threshold",
     "sift_cv",
     "surf_describe",
     "surf_detect",
@@ -121,13 +99,8 @@ __all__ = [
     "to_gray_uint8",
 ]
 
-#: plotting (pyplot) and widget (ipywidgets) names load on first use
-_LAZY = {
-    **dict.fromkeys(("DETECTOR_GALLERY", "plot_box_filters", "plot_detector_gallery", "plot_fast_circle",
-                     "plot_keypoint_pair", "plot_keypoints", "plot_matches", "plot_pair_evaluation",
-                     "plot_ratio_tradeoff", "plot_recall_vs_leaves", "plot_surf_threshold"), ".plot"),
-    "explore_detectors": ".widgets",
-    "explore_matching": ".widgets",
-}
+#: plotting (pyplot) names load on first use
+_LAZY = dict.fromkeys(("DETECTOR_GALLERY", "plot_box_filters", "plot_detector_gallery", "plot_fast_circle",
+                       "plot_keypoint_pair", "plot_keypoints", "plot_matches"), ".plot")
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ += list(_LAZY)

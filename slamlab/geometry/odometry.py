@@ -1,7 +1,7 @@
 """Odometry along a path of true poses: measured increments with noise and drift (004 §8; our model).
 
 One place for the odometry noise model: the simulator (:mod:`slamlab.sim.rangefinder` re-exports it)
-and the experiments on corrected real logs (``slamlab.localisation.logs``) both draw odometry with it.
+and the experiments on corrected real logs (``slamlab.studies.localisation.logs``) both draw odometry with it.
 """
 
 from __future__ import annotations

@@ -1,29 +1,10 @@
 """Hough-transform SLAM from a scanning rangefinder (004): polar and classic Hough transforms,
-peaks above H_min, line association and history, pose from two lines, an ICP baseline and the
-experiments of notebook 07. Scans are :class:`slamlab.scans.Scan` objects; maps come from
-:func:`slamlab.scans.occupancy_grid`.
+peaks above H_min, line association and history, pose from two lines and an ICP baseline.
+Scans are :class:`slamlab.scans.Scan` objects; maps come from :func:`slamlab.scans.occupancy_grid`.
 """
 
 from .._lazy import lazy_exports
 from .association import LineHistory, associate, association_probability
-from .experiments import (
-    LOG_PARAMS,
-    ODOMETRY_NOISE,
-    SHARED_LOGS,
-    ExampleLineResult,
-    NoiseStudyResult,
-    RealLogResult,
-    SimSlamResult,
-    check_pose_from_two_lines,
-    log_format,
-    ours_vs_source,
-    pose_errors,
-    run_example_line,
-    run_noise_study,
-    run_real_log,
-    run_sim_slam,
-    time_polar_vs_opencv,
-)
 from .icp import IcpResult, icp, icp_odometry, rigid_fit_2d
 from .lines import (
     Lines,
@@ -35,7 +16,6 @@ from .lines import (
     refine_lines,
     transform_lines,
 )
-from .logs import REAL_LOG_PARAMS, real_log_cause_table
 from .mapping import map_agreement
 from .pose import PoseChange, pose_from_lines, pose_from_two_lines, select_line_pair
 from .slam import STEP_CAUSES, HoughSlamParams, HoughSlamResult, detect_lines, hough_slam
@@ -50,41 +30,22 @@ from .transform import (
     theta_axis,
 )
 
-_PLOT = (
-    "accumulator_figure",
-    "example_figure",
-    "plot_accumulator",
-    "plot_built_map",
-    "plot_pose_errors",
-    "plot_scan_lines",
-    "real_log_figure",
-    "sim_figure",
-)
-_WIDGETS = ("explore_accumulator", "explore_hough_slam", "explore_real_log")
-__getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
+_PLOT = ("accumulator_figure", "plot_accumulator", "plot_built_map", "plot_scan_lines")
+__getattr__, __dir__ = lazy_exports(__name__, dict.fromkeys(_PLOT, ".plot"))
 
 __all__ = [
-    "LOG_PARAMS",
-    "ODOMETRY_NOISE",
-    "REAL_LOG_PARAMS",
-    "SHARED_LOGS",
     "STEP_CAUSES",
-    "ExampleLineResult",
     "HoughAccumulator",
     "HoughSlamParams",
     "HoughSlamResult",
     "IcpResult",
     "LineHistory",
     "Lines",
-    "NoiseStudyResult",
     "PoseChange",
-    "RealLogResult",
-    "SimSlamResult",
     "align_lines",
     "associate",
     "association_probability",
     "canonical_lines",
-    "check_pose_from_two_lines",
     "detect_lines",
     "find_peaks",
     "hough_classic",
@@ -96,24 +57,15 @@ __all__ = [
     "line_difference",
     "line_scan",
     "lines_about_centre",
-    "log_format",
     "map_agreement",
     "merge_duplicates",
-    "ours_vs_source",
-    "pose_errors",
     "pose_from_lines",
     "pose_from_two_lines",
     "rasterise_scan",
-    "real_log_cause_table",
     "refine_lines",
     "rigid_fit_2d",
-    "run_example_line",
-    "run_noise_study",
-    "run_real_log",
-    "run_sim_slam",
     "select_line_pair",
     "theta_axis",
-    "time_polar_vs_opencv",
     "transform_lines",
 ]
-__all__ += list(_PLOT + _WIDGETS)  # loaded on first use
+__all__ += list(_PLOT)  # loaded on first use

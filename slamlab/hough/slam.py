@@ -113,7 +113,7 @@ class HoughSlamParams(Params):
         With only parallel lines, move along them from odometry.
     heading : bool
         When lines are associated but give no pose, take the heading change from them and the
-        translation from odometry (ours; off in simulation, on in :func:`~slamlab.hough.run_real_log`).
+        translation from odometry (ours; off in simulation, on for the real logs of notebook 07).
     """
 
     delta_rho: float = param(1.0, "004 §Hough SLAM: Δrho = 1 cell")

@@ -12,12 +12,11 @@ The generic layer under the features and stereo chapters (it imports neither):
   (:mod:`.knn`): the one exact 2-NN and the one "pad to k".
 - :class:`LandmarkStore`, the interface every store implements, the stores of 000 §3.4
   and §4 and the base rule (:func:`base_rule`, :class:`SightingBook`) in :mod:`.stores`;
-  their workloads, the multi kd-tree cost model (:mod:`.cost_model`), experiments, plots
-  (loaded on first use) and widgets.
+  the multi kd-tree cost model (:mod:`.cost_model`); the 2-D tree plot (loaded on first use).
 """
 
 from .._lazy import lazy_exports
-from . import cost_model, experiments, stores, workloads
+from . import cost_model, stores
 from .knn import exact_knn, hamming_distances, merge_knn, pad_knn
 from .stores import (
     BruteForceStore,
@@ -34,17 +33,8 @@ from .stores import (
 from .trace import bbf_trace
 from .tree import KDTree, SearchStats, build_kdtree
 
-_LAZY = {
-    "plot_kdtree_2d": ".plot",
-    "plot_cost_surface": ".store_plot",
-    "plot_cost_contour": ".store_plot",
-    "plot_multi_tree_sizes": ".store_plot",
-    "plot_crossover": ".store_plot",
-    "plot_iteration_times": ".store_plot",
-    "explore_cost_model": ".widgets",
-    "explore_stores": ".widgets",
-}
-__getattr__, __dir__ = lazy_exports(__name__, _LAZY, submodules=("plot", "store_plot", "widgets"))
+_LAZY = {"plot_kdtree_2d": ".plot"}
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY, submodules=("plot",))
 
 __all__ = [
     "BruteForceStore",
@@ -62,12 +52,10 @@ __all__ = [
     "build_kdtree",
     "cost_model",
     "exact_knn",
-    "experiments",
     "hamming_distances",
     "make_store",
     "merge_knn",
     "pad_knn",
     "stores",
-    "workloads",
 ]
 __all__ += list(_LAZY)

@@ -68,7 +68,7 @@ def hough_scene_scan(pose_index: int, *, range_std_cells: float = 0.1, rng=2010)
 
 
 def hough_run_scans(n_poses: int = 121, *, range_std_cells: float = 0.1, rng=2010) -> list:
-    """Lab 07: the scans of :func:`slamlab.hough.run_sim_slam` (the room without clutter), drawn as it draws them.
+    """Lab 07: the scans of :func:`slamlab.studies.hough.run_sim_slam` (the room without clutter), drawn as it draws them.
 
     The run spawns two streams from ``SeedSequence(rng)``: the first casts the scans along 004's
     path (the second is the odometry's); these are the same scans, so an independent line count
@@ -94,7 +94,7 @@ def hough_run_scans(n_poses: int = 121, *, range_std_cells: float = 0.1, rng=201
 
 
 def monte_carlo_scene(n_poses: int = 12, *, range_std_cells: float = 2.0, extra_clutter: int = 120, rng=2010):
-    """Lab 06: the map, poses and scans of :func:`slamlab.correlation.run_monte_carlo`, drawn as it draws them.
+    """Lab 06: the map, poses and scans of :func:`slamlab.studies.correlation.run_monte_carlo`, drawn as it draws them.
 
     From one stream, in the run's order: ``extra_clutter`` discs of radius 1.5 cells on free cells
     (3 cells from obstacles) added to the measurement room, ``n_poses`` free whole-cell poses with

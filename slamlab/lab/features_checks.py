@@ -29,7 +29,8 @@ def wall_repeatability_brute_force() -> tuple[tuple[str, ...], np.ndarray]:
     rep : numpy.ndarray, shape (5, 4)
         Repeatability per pair (rows 1→2 ... 1→6) and detector.
     """
-    from ..features import EVAL_DETECTORS, detect, load_oxford_pair
+    from ..features import detect, load_oxford_pair
+    from ..studies.features import EVAL_DETECTORS
 
     names = tuple(EVAL_DETECTORS)
     rep = np.zeros((5, len(names)))
@@ -67,7 +68,8 @@ def bbf_recall_exact_truth(budgets: tuple[int, ...]) -> dict[str, np.ndarray]:
     """
     from scipy.spatial import cKDTree
 
-    from ..features import descriptor_pool, detect, load_oxford_pair
+    from ..features import detect, load_oxford_pair
+    from ..studies.features import descriptor_pool
 
     img1, img2, _ = load_oxford_pair("graf", 2, scale=0.5)
     f1 = detect(img1, "surf", threshold=5e-5).strongest(10000)

@@ -165,7 +165,7 @@ def failure_runs() -> tuple:
     tuple of MonteCarloResult
         One run per seed of :data:`FAILURE_SEEDS`.
     """
-    from ..correlation import run_monte_carlo
+    from ..studies.correlation import run_monte_carlo
 
     return tuple(run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120, delta_alpha_rad=np.radians(2.0),
                                  rng=seed, progress=False) for seed in FAILURE_SEEDS)

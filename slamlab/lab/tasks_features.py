@@ -171,7 +171,7 @@ def fast_threshold_opencv(*, nonmax: bool = True) -> float:
 
 
 def _best_repeatability_wall() -> float:
-    from ..features import run_pair_evaluation
+    from ..studies.features import run_pair_evaluation
 
     ev = run_pair_evaluation(("wall",), (2, 3, 4, 5, 6), scale=0.5, n_points=500)
     return float(np.nanmax(np.nanmean(ev.rep, axis=(0, 1))))
@@ -361,7 +361,7 @@ register(Task("03.bbf", "Task 4, Best-Bin-First: descent and backtracking", _bbf
 
 
 def _smallest_budget_90() -> float:
-    from ..features import run_recall_vs_leaves
+    from ..studies.features import run_recall_vs_leaves
 
     c = run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200)
     ok = c.budgets[c.recall_bbf >= 0.9]
@@ -369,7 +369,7 @@ def _smallest_budget_90() -> float:
 
 
 def _largest_precise_ratio() -> float:
-    from ..features import run_ratio_tradeoff
+    from ..studies.features import run_ratio_tradeoff
 
     tr = run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
     ok = tr.ratios[tr.precision >= 0.9]

@@ -106,7 +106,7 @@ EXPLORE_Q_RUNS, EXPLORE_Q_STEPS, EXPLORE_Q_SEED = 30, 60, 2010
 
 
 def _smallest_q_scale() -> float:
-    from ..filters import run_stabilising_noise
+    from ..studies.filters import run_stabilising_noise
 
     res = run_stabilising_noise(scales=EXPLORE_Q_SCALES, n_runs=EXPLORE_Q_RUNS, n_steps=EXPLORE_Q_STEPS,
                                 rng=EXPLORE_Q_SEED, progress=False)
@@ -177,7 +177,7 @@ def q_scale_study_filterpy(seed: int = EXPLORE_Q_SEED, n_runs: int = EXPLORE_Q_R
                            n_steps: int = EXPLORE_Q_STEPS) -> tuple[np.ndarray, tuple[float, float]]:
     """Exploration 1 of lab 01 redone with filterpy's EKF: mean NEES per Q scale and the 95 % interval.
 
-    Independent of :func:`slamlab.filters.run_stabilising_noise`: the chapter's unicycle and
+    Independent of :func:`slamlab.studies.filters.run_stabilising_noise`: the chapter's unicycle and
     range-bearing sensor are simulated here, filtered by ``filterpy.kalman.ExtendedKalmanFilter``
     (Jacobians written here, Joseph-form update) with the process noise scaled by each of
     :data:`EXPLORE_Q_SCALES`, and the interval is SciPy's chi-square quantiles of the run-averaged
@@ -232,7 +232,7 @@ def _q_single_run_interval() -> float:
 
 
 def _rmse_quarter_metre() -> float:
-    from ..filters import run_cv_target
+    from ..studies.filters import run_cv_target
 
     return run_cv_target(n_runs=50, n_steps=50, accel_std=0.2, pos_std_m=0.25, rng=2010,
                          progress=False).rmse_pos_m
@@ -242,7 +242,7 @@ def cv_position_rmse_analytic(pos_std_m: float, *, n_steps: int | None = 50, acc
                               dt_s: float = 1.0) -> float:
     """The KF's expected 2-D position RMSE on the chapter's constant-velocity target, from the Riccati recursion.
 
-    Independent of the Monte Carlo (:func:`slamlab.filters.run_cv_target`): with a matched linear
+    Independent of the Monte Carlo (:func:`slamlab.studies.filters.run_cv_target`): with a matched linear
     model the posterior covariance ``P_k`` is the error covariance, so the expected mean squared
     2-D position error over steps ``1..n_steps`` is the mean of ``P_k[x,x] + P_k[y,y]`` (per axis
     ``[p, v]``, ``Q = σ_a² [[dt³/3, dt²/2], [dt²/2, dt]]``, ``P_0 = diag(σ_z², 1)``, 000 §1.2.1's

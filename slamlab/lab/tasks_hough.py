@@ -175,7 +175,7 @@ def lost_runs() -> tuple:
     tuple of numpy.ndarray
         Each run's ``lost`` flags, shape (121,).
     """
-    from ..hough import run_sim_slam
+    from ..studies.hough import run_sim_slam
 
     return tuple(run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=LOST_H_MIN, rng=seed,
                               progress=False).slam.lost for seed in LOST_SEEDS)

@@ -1,30 +1,11 @@
-"""Probabilistic localisation: Markov grid localisation and Monte Carlo localisation (003 §1.2.4, §2.2; Ch. 8)."""
+"""Probabilistic localisation: Markov grid localisation and Monte Carlo localisation (003 §1.2.4, §2.2; Ch. 8).
+
+The chapter's studies (simulated runs, the global, kidnapped and Markov studies, the CARMEN logs, their
+tables, plots and widgets) are in :mod:`slamlab.studies.localisation`.
+"""
 
 from .._lazy import lazy_exports
-from .experiments import (
-    AMCL_DEFAULTS,
-    FilterRun,
-    MarkovVsMclResult,
-    SimRun,
-    amcl_defaults_table,
-    demo_run,
-    ours_vs_source,
-    run_filter,
-    run_markov_vs_mcl,
-    simulate_run,
-)
-from .log_protocol import LogProtocolResult, run_log_protocol
-from .logs import (
-    CARMEN_LOGS,
-    LogMCLResult,
-    carmen_path,
-    global_log_settings,
-    log_settings,
-    logs_table,
-    run_log_mcl,
-)
 from .markov import MarkovGrid, MarkovParams, markov_correct, markov_log_likelihood, markov_predict
-from .markov_study import MARKOV_PRIORS, MarkovStudyResult, run_markov_kidnap, run_markov_prior
 from .mcl import AVERAGES, MCL, MCLParams, MCLState, StepRecord, mcl_step
 from .models import (
     SCORES,
@@ -50,72 +31,29 @@ from .particles import (
     pose_estimate,
     uniform_free_particles,
 )
-from .side_by_side import SideBySideResult, run_correlation_side_by_side
-from .studies import (
-    ABLATION,
-    ABLATION_MORE,
-    CHAPTER_BEFORE,
-    KIDNAP_VARIANTS,
-    SCORE_VARIANTS,
-    AblationResult,
-    GlobalResult,
-    KidnapResult,
-    ScoreComparison,
-    run_global_ablation,
-    run_global_localisation,
-    run_kidnapped,
-    run_score_comparison,
-)
 
-_PLOT = ("mcl_figure", "recorded_step_figure", "plot_averages", "plot_belief", "plot_clouds", "plot_errors", "plot_global", "plot_log_run", "plot_map",
-         "plot_particles", "plot_weights")
-_WIDGETS = ("explore_log", "explore_markov", "explore_mcl", "explore_recorded_run")
-__getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
+_PLOT = ("plot_averages", "plot_belief", "plot_map", "plot_particles", "plot_weights")
+__getattr__, __dir__ = lazy_exports(__name__, dict.fromkeys(_PLOT, ".plot"))
 
 __all__ = [
-    "ABLATION",
-    "ABLATION_MORE",
-    "AMCL_DEFAULTS",
     "AVERAGES",
-    "CARMEN_LOGS",
-    "CHAPTER_BEFORE",
-    "KIDNAP_VARIANTS",
-    "MARKOV_PRIORS",
     "MCL",
     "SCORES",
-    "SCORE_VARIANTS",
-    "AblationResult",
     "Beams",
-    "FilterRun",
-    "GlobalResult",
-    "KidnapResult",
     "LikelihoodFieldModel",
-    "LogMCLResult",
-    "LogProtocolResult",
     "MCLParams",
     "MCLState",
     "MarkovGrid",
     "MarkovParams",
-    "MarkovStudyResult",
-    "MarkovVsMclResult",
     "ModelParams",
-    "ScoreComparison",
-    "SideBySideResult",
-    "SimRun",
     "StepRecord",
     "amcl_converged",
-    "amcl_defaults_table",
     "beam_model_prob",
-    "carmen_path",
     "check_particles",
-    "demo_run",
     "free_cell_centres",
-    "global_log_settings",
     "is_localised",
     "kld_bound",
     "kld_sample_count",
-    "log_settings",
-    "logs_table",
     "low_variance_resample",
     "markov_correct",
     "markov_log_likelihood",
@@ -125,22 +63,9 @@ __all__ = [
     "n_eff",
     "normalise_log_weights",
     "odometry_deltas",
-    "ours_vs_source",
     "pose_estimate",
-    "run_correlation_side_by_side",
-    "run_filter",
-    "run_global_ablation",
-    "run_global_localisation",
-    "run_kidnapped",
-    "run_log_mcl",
-    "run_log_protocol",
-    "run_markov_kidnap",
-    "run_markov_prior",
-    "run_markov_vs_mcl",
-    "run_score_comparison",
     "sample_motion_odometry",
     "scan_beams",
-    "simulate_run",
     "uniform_free_particles",
 ]
-__all__ += list(_PLOT + _WIDGETS)  # loaded on first use
+__all__ += list(_PLOT)  # loaded on first use

@@ -1,7 +1,8 @@
 """Monocular mapping (003 §2.1, §4, §5): SDVL/SVO-style depth filter, initialisation, tracking.
 
-Uses :mod:`slamlab.features` (FAST), :mod:`slamlab.geometry` and :mod:`slamlab.evaluation`;
-nothing below imports this package. cv2 loads inside the functions that need it.
+Uses :mod:`slamlab.features` (FAST) and :mod:`slamlab.geometry`; nothing below imports this package.
+cv2 loads inside the functions that need it. The chapter's runs, studies, tables and widgets are in
+:mod:`slamlab.studies.mono`.
 """
 
 from .._lazy import lazy_exports
@@ -63,17 +64,5 @@ __all__ = [
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, {
-    "plot_convergence": ".plot", "plot_epipolar_pair": ".plot", "plot_map_top": ".plot",
-    "plot_seed_histograms": ".plot", "explore_mono": ".widgets",
-    "run_depth_filter_convergence": ".experiments", "run_failure_cases": ".experiments",
-    "failure_table": ".experiments", "run_kitti_mono": ".kitti", "run_mono_vs_stereo": ".studies",
-    "run_parameter_sweep": ".experiments", "run_mono_sequence": ".experiments", "run_mono": ".experiments",
-    "ours_vs_source": ".studies", "epipolar_demo": ".kitti", "sequence_poses": ".experiments",
-    "compare_init_methods": ".studies",
-    "explore_failure_cases": ".widgets", "explore_motion_prior": ".widgets", "explore_depth_filter": ".widgets",
-    "plot_pinhole": ".plot", "score_run": ".evaluate", "pinhole_table": ".studies",
-    "inverse_depth_point_table": ".studies", "tau_table": ".studies", "run_convergence_tests": ".studies",
-    "run_ablation": ".studies", "ablation_table": ".studies", "source_findings_table": ".studies",
-    "chapter_cameras": ".studies", "run_kitti_ablation": ".kitti",
-    "load_kitti": ".kitti",
+    "plot_epipolar_pair": ".plot", "plot_seed_histograms": ".plot", "score_run": ".evaluate",
 })

@@ -392,7 +392,7 @@ def _code_sources(path: Path) -> list[str]:
 _PROGRESS_CELL = """import os
 os.environ.pop("SLAMLAB_PROGRESS", None)   # a student's kernel: no setting, bars on
 import slamlab as sl
-noise = sl.hough.run_noise_study((0.0, 0.1), 3, n_poses=20)
+noise = sl.studies.hough.run_noise_study((0.0, 0.1), 3, n_poses=20)
 print("rows", len(noise.runs), "coretype", os.environ.get("OPENBLAS_CORETYPE"), "prelude", os.environ.get("SLAMLAB_PRELUDE_RAN"))"""
 
 

@@ -7,6 +7,7 @@ from scipy.signal import correlate
 from slamlab import correlation as C
 from slamlab import sim as S
 from slamlab.scans import Scan
+from slamlab.studies import correlation as CS
 
 
 def test_score_maps_three_methods_agree_with_scipy_correlate():
@@ -359,9 +360,9 @@ def test_free_mark_weight_scales_the_stamps_free_marks_only():
     assert np.isclose(D[loc.heading_index, loc.row, loc.col], D.max())
     # the score's terms: the free ones scale by λ, the obstacle ones do not, and they still sum to the score
     poses = [[40, 30, np.radians(30.0)], [45, 28, np.radians(120.0)]]
-    d1, dl = C.score_terms(M, scan, poses), C.score_terms(M, scan, poses, free_mark_weight=0.25)
+    d1, dl = CS.score_terms(M, scan, poses), CS.score_terms(M, scan, poses, free_mark_weight=0.25)
     np.testing.assert_array_equal(dl[["free_on_free", "free_on_obs"]], 0.25 * d1[["free_on_free", "free_on_obs"]])
     np.testing.assert_array_equal(dl[["obs_on_obs", "obs_on_free"]], d1[["obs_on_obs", "obs_on_free"]])
-    np.testing.assert_allclose(dl[list(C.TERM_NAMES)].sum(axis=1), dl["score"])
+    np.testing.assert_allclose(dl[list(CS.TERM_NAMES)].sum(axis=1), dl["score"])
     with pytest.raises(ValueError, match="`free_mark_weight`"):
         C.LocaliseParams(free_mark_weight=0.0)

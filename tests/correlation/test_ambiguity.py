@@ -6,6 +6,7 @@ import pytest
 from slamlab import correlation as C
 from slamlab import sim as S
 from slamlab.geometry import wrap_angle
+from slamlab.studies import correlation as CS
 
 EXACT = {"dtype": "float64", "delta_alpha_rad": np.radians(10.0)}
 
@@ -33,7 +34,7 @@ def _rival_by_definition(grid, scan, loc, params):
 
 
 def test_corridor_reads_as_ambiguous():
-    g = C.corridor_grid()
+    g = CS.corridor_grid()
     scan = S.Rangefinder(n_beams=360, max_range_cells=25.0, quantum_cells=0.0).scan(g, [100.0, 25.0, np.pi])
     p = C.LocaliseParams(**EXACT)
     loc = C.localise(g, scan, params=p)
@@ -89,7 +90,7 @@ def test_rival_window_parameters_and_switch():
 
 
 def test_two_scans_joined_by_odometry_break_the_half_turn_tie():
-    g = C.corridor_grid()
+    g = CS.corridor_grid()
     rf = S.Rangefinder(n_beams=360, max_range_cells=25.0, quantum_cells=0.0)
     # moving towards -x: the scan at (100, 25) sees a plain corridor, the one 30 cells before sees the dead end
     poses = np.array([[100.0, 25.0, np.pi], [130.0, 25.0, np.pi]])
@@ -128,7 +129,7 @@ def test_joined_bad_input():
 
 
 def test_corridor_tie_run_reports_both_modes():
-    r = C.run_corridor_tie()
+    r = CS.run_corridor_tie()
     assert np.degrees(C.heading_error(r.single.pose[2], r.true_pose[2])) == pytest.approx(180.0)
     assert r.single.ambiguity == pytest.approx(1.0, abs=1e-12)
     assert (r.joined.col, r.joined.row) == (100, 25)
@@ -138,7 +139,7 @@ def test_corridor_tie_run_reports_both_modes():
     assert "1.000" in t
     assert str(r).startswith("corridor: one scan 180° off")
     with pytest.raises(ValueError, match="`step_cells` must be"):
-        C.run_corridor_tie(step_cells=-1.0)
+        CS.run_corridor_tie(step_cells=-1.0)
 
 
 def test_margin_edge_cases():

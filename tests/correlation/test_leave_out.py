@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from slamlab import correlation as C
-from slamlab.correlation.log_truth import _leave_sets, _mode_grids
 from slamlab.io import read_carmen
 from slamlab.scans.logmap import log_counts
 from slamlab.scans.occupancy import label_counts, occupancy_grid
+from slamlab.studies import correlation as CS
+from slamlab.studies.correlation.log_truth import _leave_sets, _mode_grids
 
 
 def test_leave_sets_by_definition():
@@ -42,15 +42,15 @@ def test_used_mode_grids_are_the_other_scans_grids(real_data, hit_ratio):
 def test_used_localises_each_mode_on_its_own_grid(real_data):
     log = read_carmen(real_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
     idx, fast = (100, 150), {"delta_alpha_rad": np.radians(5.0), "progress": False}
-    r = C.run_log_localisation(log, idx, joined=(1, 3), leave_out="used", truth_check=True, **fast)
+    r = CS.run_log_localisation(log, idx, joined=(1, 3), leave_out="used", truth_check=True, **fast)
     assert r.leave_out == "used"
     assert r.exclude is None
     # mode 1 leaves out scan i only: the window of 0 scans around it gives the same grid and so the same search
-    r1 = C.run_log_localisation(log, idx, joined=(1,), exclude=0, **fast)
+    r1 = CS.run_log_localisation(log, idx, joined=(1,), exclude=0, **fast)
     np.testing.assert_array_equal(r.est_poses_m[0], r1.est_poses_m[0])
     np.testing.assert_array_equal(r.ambiguity[0], r1.ambiguity[0])
     # mode 3's grid does not depend on the other modes run beside it
-    r3 = C.run_log_localisation(log, idx, joined=(3,), leave_out="used", **fast)
+    r3 = CS.run_log_localisation(log, idx, joined=(3,), leave_out="used", **fast)
     np.testing.assert_array_equal(r.est_poses_m[1], r3.est_poses_m[0])
     # the truth check runs per mode; only the mode's own scans are left out, so no mark is traced to a left-out
     # scan 1 or 2 steps away
@@ -62,7 +62,7 @@ def test_used_localises_each_mode_on_its_own_grid(real_data):
         assert (d[f"{what}_2"] == 0).all()
     assert "each mode's own scans left out" in r.table()
     assert "each mode's own scans left out" in r.terms_table()
-    s = C.run_log_suite([log], 100, joined=(1,), leave_out="used", **fast)
+    s = CS.run_log_suite([log], 100, joined=(1,), leave_out="used", **fast)
     assert "each mode's own scans left out of each grid" in s.table()
 
 
@@ -70,10 +70,10 @@ def test_used_localises_each_mode_on_its_own_grid(real_data):
 def test_leave_out_bad_values(real_data):
     log = read_carmen(real_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
     with pytest.raises(ValueError, match="`leave_out` must be one of 'window', 'used'; got 'all'"):
-        C.run_log_localisation(log, (100,), leave_out="all")
+        CS.run_log_localisation(log, (100,), leave_out="all")
     with pytest.raises(ValueError, match="`leave_out` must be one of"):
-        C.run_log_localisation(log, (100,), leave_out=None)
+        CS.run_log_localisation(log, (100,), leave_out=None)
     with pytest.raises(ValueError, match=r"`exclude` is for leave_out='window'.*got exclude=2"):
-        C.run_log_localisation(log, (100,), leave_out="used", exclude=2)
+        CS.run_log_localisation(log, (100,), leave_out="used", exclude=2)
     with pytest.raises(ValueError, match="`exclude` must be >= 2"):
-        C.run_log_localisation(log, (100,), joined=(3,), leave_out="window", exclude=1)
+        CS.run_log_localisation(log, (100,), joined=(3,), leave_out="window", exclude=1)

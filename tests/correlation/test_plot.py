@@ -6,6 +6,7 @@ import pytest
 
 from slamlab import correlation as C
 from slamlab import sim as S
+from slamlab.studies import correlation as CS
 
 
 def test_plots_draw():
@@ -26,11 +27,11 @@ def test_plots_draw():
     assert [ax.images[0].get_array().shape for ax in fig.axes] == [(200, 200), (100, 200)]
     with pytest.raises(ValueError, match="titles"):
         C.plot_grids([M], ["a", "b"])
-    t1 = C.run_table1(2, rng=1)
-    ax = C.plot_table1(t1, M)
+    t1 = CS.run_table1(2, rng=1)
+    ax = CS.plot_table1(t1, M)
     assert len(ax.lines) >= 4
-    mc = C.run_monte_carlo(2, rng=1)
-    axes = C.plot_error_distribution(mc)
+    mc = CS.run_monte_carlo(2, rng=1)
+    axes = CS.plot_error_distribution(mc)
     assert len(axes) == 2
     plt.close("all")
 
@@ -38,6 +39,6 @@ def test_plots_draw():
 def test_time_localise_reports_each_dtype():
     M = S.test_room_200()
     scan = S.Rangefinder(n_beams=90, max_range_cells=60).scan(M, [70, 30, 0.3])
-    t = C.time_localise(M, scan)
+    t = CS.time_localise(M, scan)
     assert set(t) == {"float64", "float32"}
     assert all(v > 0 for v in t.values())

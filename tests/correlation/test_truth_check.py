@@ -8,6 +8,7 @@ from slamlab import sim as S
 from slamlab.correlation.algorithm import _beam_samples
 from slamlab.correlation.scoring import _pose_scores
 from slamlab.io import read_carmen
+from slamlab.studies import correlation as CS
 
 
 def test_pose_scores_equal_the_definition_at_grid_poses():
@@ -38,7 +39,7 @@ def test_pose_scores_equal_the_definition_at_grid_poses():
 @pytest.mark.realdata
 def test_truth_check_on_csail_scans(real_data):
     log = read_carmen(real_data / "carmen-radish-corrected" / "csail-corrected.log.gz")
-    r = C.run_log_localisation(log, (100, 150), joined=(1,), truth_check=True, ambiguity=False)
+    r = CS.run_log_localisation(log, (100, 150), joined=(1,), truth_check=True, ambiguity=False)
     d = r.truth_check()
     assert list(d["scan"]) == [100, 150]
     assert set(d["kind"]) <= {"ok", "score", "search", "grid"}
@@ -53,10 +54,10 @@ def test_truth_check_on_csail_scans(real_data):
     assert d["walls_est"].between(0, 1).all()
     assert "kind" in r.failure_table()
     # the terms add up to the truth check's scores (construction), the origins split the unexplored marks
-    from slamlab.correlation.log_truth import _TRUTH_COLUMNS
+    from slamlab.studies.correlation.log_truth import _TRUTH_COLUMNS
 
     for who in ("est", "truth"):
-        total = sum(d[f"{who}_{t}"] for t in C.TERM_NAMES)
+        total = sum(d[f"{who}_{t}"] for t in CS.TERM_NAMES)
         np.testing.assert_array_equal(total.to_numpy(), d[f"score_{who}"].to_numpy())
     for what, n in (("unex_obs", "truth_n_obs_unexplored"), ("unex_free", "truth_n_free_unexplored"),
                     ("conf_obs", "truth_n_obs_on_free")):
@@ -65,19 +66,19 @@ def test_truth_check_on_csail_scans(real_data):
     assert "free on free" in r.terms_table()
     assert "truth - est." in r.terms_table()
     with pytest.raises(TypeError, match="`truth_check` must be a bool"):
-        C.run_log_localisation(log, (100,), truth_check="yes")
+        CS.run_log_localisation(log, (100,), truth_check="yes")
     with pytest.raises(ValueError, match="`truth_check` and `refine` score by the definition with a_n = 0"):
-        C.run_log_localisation(log, (100,), truth_check=True, a_n=0.5)
+        CS.run_log_localisation(log, (100,), truth_check=True, a_n=0.5)
     with pytest.raises(ValueError, match="score by the raw correlation; got score_norm = 'explored'"):
-        C.run_log_localisation(log, (100,), truth_check=True, score_norm="explored")
+        CS.run_log_localisation(log, (100,), truth_check=True, score_norm="explored")
     with pytest.raises(ValueError, match="`refine`"):
-        C.run_log_localisation(log, (100,), refine=-1)
+        CS.run_log_localisation(log, (100,), refine=-1)
     with pytest.raises(TypeError, match="`refine`"):
-        C.run_log_localisation(log, (100,), refine=2.5)
+        CS.run_log_localisation(log, (100,), refine=2.5)
     with pytest.raises(ValueError, match="`refine_heading_rad`"):
-        C.run_log_localisation(log, (100,), refine=3, refine_heading_rad=-0.1)
+        CS.run_log_localisation(log, (100,), refine=3, refine_heading_rad=-0.1)
     with pytest.raises(ValueError, match="this result has no truth check"):
-        C.run_log_localisation(log, (100,), ambiguity=False, delta_alpha_rad=np.radians(10.0)).truth_check()
+        CS.run_log_localisation(log, (100,), ambiguity=False, delta_alpha_rad=np.radians(10.0)).truth_check()
 
 
 def test_distinct_peaks_keeps_the_best_apart():
@@ -131,8 +132,8 @@ def test_score_terms_sum_to_the_score_and_count_every_mark():
     n, r, c = rng.integers(0, hs.size, 40), rng.integers(0, M.shape[0], 40), rng.integers(0, M.shape[1], 40)
     grid_poses = np.column_stack([c, r, hs[n]]).astype(float)
     off_grid = grid_poses + rng.uniform(-0.5, 0.5, grid_poses.shape) * [1, 1, 0.1]
-    d = C.score_terms(M, scan, np.vstack([grid_poses, off_grid]))
-    terms = d[list(C.TERM_NAMES)].sum(axis=1).to_numpy()
+    d = CS.score_terms(M, scan, np.vstack([grid_poses, off_grid]))
+    terms = d[list(CS.TERM_NAMES)].sum(axis=1).to_numpy()
     np.testing.assert_array_equal(terms, d["score"].to_numpy())
     np.testing.assert_array_equal(d["score"].to_numpy()[:40], D[n, r, c])
     free, obs = _beam_samples(scan.bearings_rad, scan.ranges, scan.valid, delta_l_cells=0.0, hit_offset_cells=0.5,
@@ -152,22 +153,22 @@ def test_score_terms_bad_input():
     M = S.test_room_200()[:40, :40]
     scan = S.Rangefinder(n_beams=30, max_range_cells=10.0).scan(M, [20.0, 20.0, 0.0])
     with pytest.raises(ValueError, match="`a_n` must be 0"):
-        C.score_terms(M, scan, [[20, 20, 0.0]], a_n=0.5)
+        CS.score_terms(M, scan, [[20, 20, 0.0]], a_n=0.5)
     with pytest.raises(TypeError, match=r"`scan` must be a slamlab\.scans\.Scan"):
-        C.score_terms(M, [1.0, 2.0], [[20, 20, 0.0]])
+        CS.score_terms(M, [1.0, 2.0], [[20, 20, 0.0]])
     with pytest.raises(ValueError, match="`poses` must have shape"):
-        C.score_terms(M, scan, [20, 20, 0.0])
+        CS.score_terms(M, scan, [20, 20, 0.0])
     with pytest.raises(ValueError, match="`poses` must lie within"):
-        C.score_terms(M, scan, [[1e6, 20, 0.0]])
+        CS.score_terms(M, scan, [[1e6, 20, 0.0]])
     with pytest.raises(ValueError, match="`poses`"):
-        C.score_terms(M, scan, [[np.nan, 20, 0.0]])
+        CS.score_terms(M, scan, [[np.nan, 20, 0.0]])
     with pytest.raises(ValueError, match="`grid`"):
-        C.score_terms(np.full((5, 5), 7), scan, [[2, 2, 0.0]])
+        CS.score_terms(np.full((5, 5), 7), scan, [[2, 2, 0.0]])
 
 
 def test_unexplored_origin_counts_the_nearest_left_out_scan():
-    from slamlab.correlation.log_truth import _unexplored_origin
     from slamlab.correlation.scoring import _Marks
+    from slamlab.studies.correlation.log_truth import _unexplored_origin
 
     # five marks on a 3x4 map: obstacle marks on unexplored (0, 0), (0, 1), (0, 2) and outside; a free mark on
     # unexplored (1, 0); an obstacle mark on a map free cell (2, 3) (value a_c = -1)

@@ -4,10 +4,10 @@ each answer?"""
 import numpy as np
 import pytest
 
-from slamlab import correlation as C
-from slamlab.correlation.log_truth import _leave_sets, _vote_leave, _votes
 from slamlab.geometry.se2 import se2_compose
 from slamlab.io import read_carmen
+from slamlab.studies import correlation as CS
+from slamlab.studies.correlation.log_truth import _leave_sets, _vote_leave, _votes
 
 
 def test_vote_leave_by_definition():
@@ -42,8 +42,8 @@ def test_votes_leave_the_answers_unchanged_and_count_the_answer_itself(real_data
     log = read_carmen(real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
     idx, fast = (75, 150, 225), {"delta_alpha_rad": np.radians(5.0), "progress": False}
     for joined in ((1, 3), (2,)):
-        r0 = C.run_log_localisation(log, idx, joined=joined, **fast)
-        r = C.run_log_localisation(log, idx, joined=joined, votes=True, **fast)
+        r0 = CS.run_log_localisation(log, idx, joined=joined, **fast)
+        r = CS.run_log_localisation(log, idx, joined=joined, votes=True, **fast)
         # the voters use the log's per-step odometry noise: every answer is the one without votes
         np.testing.assert_array_equal(r.est_poses_m, r0.est_poses_m)
         np.testing.assert_array_equal(r.ambiguity, r0.ambiguity)
@@ -54,11 +54,11 @@ def test_votes_leave_the_answers_unchanged_and_count_the_answer_itself(real_data
         np.testing.assert_array_equal(r.flagged(), r.votes < 2)
         assert not r.flagged(0).any()
     # mode 1 on the ±2 window: voter i is scan i alone on the same grid, i.e. the answer itself, so >= 1 vote
-    r_1 = C.run_log_localisation(log, idx, joined=(1,), votes=True, **fast)
+    r_1 = CS.run_log_localisation(log, idx, joined=(1,), votes=True, **fast)
     assert r_1.votes.min() >= 1
-    np.testing.assert_array_equal(r_1.votes, C.run_log_localisation(log, idx, joined=(1, 3), votes=True,
+    np.testing.assert_array_equal(r_1.votes, CS.run_log_localisation(log, idx, joined=(1, 3), votes=True,
                                                                     **fast).votes[:1])
-    s = C.run_log_suite([log], 75, joined=(1,), votes=True, **fast)
+    s = CS.run_log_suite([log], 75, joined=(1,), votes=True, **fast)
     assert "failures flagged (< 2 votes)" in s.votes_table()
     assert "flagged when fewer than 3 agree" in s.votes_table(3)
     assert s.votes_table().splitlines()[-1].split()[:3] == ["all", "1", "scan"]
@@ -68,15 +68,15 @@ def test_votes_leave_the_answers_unchanged_and_count_the_answer_itself(real_data
 def test_votes_bad_input(real_data):
     log = read_carmen(real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
     with pytest.raises(TypeError, match="`votes` must be a bool; got str"):
-        C.run_log_localisation(log, (75,), votes="yes")
+        CS.run_log_localisation(log, (75,), votes="yes")
     with pytest.raises(ValueError, match=r"`scan_indices` must lie in \[2, .*join.* or vote"):
-        C.run_log_localisation(log, (1,), votes=True)
-    r = C.run_log_localisation(log, (75,), delta_alpha_rad=np.radians(10.0), progress=False)
+        CS.run_log_localisation(log, (1,), votes=True)
+    r = CS.run_log_localisation(log, (75,), delta_alpha_rad=np.radians(10.0), progress=False)
     with pytest.raises(ValueError, match=r"no votes: run run_log_localisation\(\.\.\., votes=True\)"):
         r.flagged()
     with pytest.raises(ValueError, match="no votes"):
-        C.run_log_suite([log], 75, joined=(1,), delta_alpha_rad=np.radians(10.0), progress=False).votes_table()
-    rv = C.run_log_localisation(log, (75,), delta_alpha_rad=np.radians(10.0), votes=True, progress=False)
+        CS.run_log_suite([log], 75, joined=(1,), delta_alpha_rad=np.radians(10.0), progress=False).votes_table()
+    rv = CS.run_log_localisation(log, (75,), delta_alpha_rad=np.radians(10.0), votes=True, progress=False)
     with pytest.raises(ValueError, match=r"`min_votes` must lie in 0\.\.3; got 4"):
         rv.flagged(4)
     with pytest.raises(ValueError, match="`min_votes`"):

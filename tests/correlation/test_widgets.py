@@ -3,11 +3,11 @@
 import matplotlib.pyplot as plt
 import pytest
 
-from slamlab import correlation as C
+from slamlab.studies import correlation as CS
 
 
 def test_explore_localisation_messages(capsys):
-    w = C.explore_localisation()
+    w = CS.explore_localisation()
     capsys.readouterr()
     for kw, expect in (({"a_c": 1.0, "a_p": 1.0}, "must differ"), ({"x": 101, "y": 50}, "not in free space"),
                        ({"n_beams": 30, "delta_alpha_deg": 10.0, "extra_clutter": 20}, "pose x=")):
@@ -20,7 +20,7 @@ def test_explore_localisation_messages(capsys):
 
 @pytest.mark.realdata
 def test_explore_log_scan(capsys):
-    w = C.explore_log_scan(scan=50)
+    w = CS.explore_log_scan(scan=50)
     capsys.readouterr()
     w.f(**{**w.kwargs, "a_c": 1.0, "a_p": 1.0})
     assert "Cannot run with these settings" in capsys.readouterr().out

@@ -10,6 +10,7 @@ import pytest
 from scipy import ndimage
 
 import slamlab.features as F
+import slamlab.studies.features as SF
 from slamlab.kdtree import KDTree, bbf_trace, plot_kdtree_2d
 
 
@@ -117,14 +118,14 @@ def test_plots_run():
 @pytest.mark.realdata
 def test_widgets_never_raise(real_data, capsys):
     # interactive() swallows exceptions of its callback, so call the callback itself
-    w = F.explore_detectors()
+    w = SF.explore_detectors()
     for det in ("SURF (ours)", "FAST-9 (ours)", "MSER (OpenCV)"):
         for frac in (0.0, 1.0):
             w.f(**{**w.kwargs, "detector": det, "threshold_fraction": frac, "draw": False})
             out = capsys.readouterr().out
             assert out.strip(), "the widget printed nothing"
             assert "Traceback" not in out
-    m = F.explore_matching()
+    m = SF.explore_matching()
     for leaves, ratio in ((200, 0.3), (0, 1.0), (10, 0.6)):
         m.f(**{**m.kwargs, "max_leaves": leaves, "ratio": ratio, "draw": False})
         out = capsys.readouterr().out

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import slamlab.features as F
+import slamlab.studies.features as SF
 
 
 @pytest.fixture
@@ -21,8 +22,8 @@ def my_pair(real_data, tmp_path):
 
 @pytest.mark.realdata
 def test_pair_evaluation_runs_from_a_str_path_and_names_the_folder(my_pair):
-    by_path = F.run_pair_evaluation(str(my_pair), (2,), detectors=("ORB",), scale=0.5, n_points=200)
-    by_name = F.run_pair_evaluation(("graf",), (2,), detectors=("ORB",), scale=0.5, n_points=200)
+    by_path = SF.run_pair_evaluation(str(my_pair), (2,), detectors=("ORB",), scale=0.5, n_points=200)
+    by_name = SF.run_pair_evaluation(("graf",), (2,), detectors=("ORB",), scale=0.5, n_points=200)
     assert by_path.sequences == ("my-wall-pair",)
     np.testing.assert_array_equal(by_path.rep, by_name.rep)
     np.testing.assert_array_equal(by_path.precision, by_name.precision)

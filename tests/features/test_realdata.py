@@ -8,13 +8,14 @@ import numpy as np
 import pytest
 
 import slamlab.features as F
+import slamlab.studies.features as SF
 
 pytestmark = pytest.mark.realdata
 
 
 @pytest.fixture(scope="module")
 def evaluation():
-    return F.run_pair_evaluation(("graf", "boat"), (2, 3), detectors=("SIFT", "SURF", "ORB", "FAST"), scale=0.5,
+    return SF.run_pair_evaluation(("graf", "boat"), (2, 3), detectors=("SIFT", "SURF", "ORB", "FAST"), scale=0.5,
                                  n_points=500)
 
 
@@ -57,14 +58,14 @@ def test_matching_precision_and_recall(evaluation):
 
 
 def test_surf_threshold_scale():
-    r = F.run_surf_threshold()
+    r = SF.run_surf_threshold()
     assert r.source_count == 0  # 000's 0.05 read on our scale leaves nothing on a 768x576 image
     assert np.all(np.diff(r.counts) <= 0)
     assert 1e-5 <= r.threshold_for(2000) <= 4e-4
 
 
 def test_knn_comparison_small():
-    r = F.run_knn_comparison((1000,), n_queries=100, max_exact_ours=1000)
+    r = SF.run_knn_comparison((1000,), n_queries=100, max_exact_ours=1000)
     rec = dict(zip(r.methods, r.recall[0], strict=True))
     assert rec["kd-tree exact (ours)"] == 1.0
     assert rec["cKDTree exact (scipy)"] == 1.0
@@ -74,14 +75,14 @@ def test_knn_comparison_small():
 
 
 def test_recall_vs_leaves_monotone():
-    r = F.run_recall_vs_leaves((1, 10, 100, 1000), n_stored=2000, n_queries=100)
+    r = SF.run_recall_vs_leaves((1, 10, 100, 1000), n_stored=2000, n_queries=100)
     assert np.all(np.diff(r.recall_bbf) >= 0)
     assert r.recall_bbf[-1] > 0.95
     assert r.exact_evals > 0.3 * r.n_stored  # 64-d: the exact search looks at a large part of the store
 
 
 def test_ratio_tradeoff_monotone():
-    r = F.run_ratio_tradeoff((0.5, 0.7, 0.9), n_points=500)
+    r = SF.run_ratio_tradeoff((0.5, 0.7, 0.9), n_points=500)
     assert np.all(np.diff(r.n_matches) >= 0)
     assert np.all(np.diff(r.recall) >= 0)
     assert r.precision[0] >= r.precision[-1]
@@ -90,13 +91,13 @@ def test_ratio_tradeoff_monotone():
 
 def test_experiment_bad_input():
     with pytest.raises(ValueError, match=r"`sequence` must be one of .* or the path of an Oxford-layout folder"):
-        F.run_pair_evaluation(("leuven",), (2,))
+        SF.run_pair_evaluation(("leuven",), (2,))
     with pytest.raises(FileNotFoundError, match="no image img7"):
-        F.run_pair_evaluation(("graf",), (7,))
+        SF.run_pair_evaluation(("graf",), (7,))
     with pytest.raises(ValueError, match="`steps` must be >= 2"):
-        F.run_pair_evaluation(("graf",), (1,))
+        SF.run_pair_evaluation(("graf",), (1,))
     with pytest.raises(ValueError, match="`detectors` must be one of"):
-        F.run_pair_evaluation(("graf",), (2,), detectors=("AKAZE",))
+        SF.run_pair_evaluation(("graf",), (2,), detectors=("AKAZE",))
     with pytest.raises(FileNotFoundError, match="no image img7"):
         F.load_oxford_image("graf", 7)
     with pytest.raises(ValueError, match="not both"):

@@ -4,9 +4,9 @@ import matplotlib
 import numpy as np
 import pytest
 
-from slamlab.filters import experiments as E
-from slamlab.filters import plot as P
-from slamlab.filters import widgets as W
+from slamlab.studies.filters import experiments as E
+from slamlab.studies.filters import plot as P
+from slamlab.studies.filters import widgets as W
 
 matplotlib.use("Agg")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from slamlab.hough import run_noise_study
+from slamlab.studies.hough import run_noise_study
 
 
 def test_noise_study_same_for_one_and_two_workers_and_one_row_per_run():

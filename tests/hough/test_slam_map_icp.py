@@ -9,8 +9,9 @@ import pytest
 import slamlab.hough as h
 from slamlab import sim
 from slamlab.geometry import se2_relative
-from slamlab.hough import experiments as E
 from slamlab.scans import Scan, occupancy_grid
+from slamlab.studies.hough import experiments as E
+from slamlab.studies.hough import real_log_cause_table
 
 
 def _increments(P):
@@ -232,11 +233,11 @@ def test_real_logs_meet_the_issue_25_goals_with_one_set_of_defaults(real_data, k
     assert sum(counts.values()) == res.odometry.shape[0] - 1
     fallback = sum(c for name, c in counts.items() if name not in ("lines", "partial", "heading"))
     assert fallback == res.slam.lost[1:].sum()
-    table = h.real_log_cause_table([res])
+    table = real_log_cause_table([res])
     assert "odometry alone: all causes" in table
     assert "sharper than odometry" in table
     with pytest.raises(TypeError, match="`results` must be a non-empty sequence of RealLogResult"):
-        h.real_log_cause_table([res.slam])
+        real_log_cause_table([res.slam])
 
 
 @pytest.mark.realdata

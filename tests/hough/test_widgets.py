@@ -8,7 +8,7 @@ import re
 import matplotlib
 import pytest
 
-from slamlab.hough import widgets as W
+from slamlab.studies.hough import widgets as W
 
 matplotlib.use("Agg")
 

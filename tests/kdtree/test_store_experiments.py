@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from slamlab.kdtree.cost_model import calibrate_C, minimise_iter_time
-from slamlab.kdtree.experiments import (
+from slamlab.studies.kdtree.experiments import (
     TABLES_000,
     CrossoverResult,
     fit_C,
@@ -116,7 +116,7 @@ def test_recall_and_bad_input():
 
 
 def test_dimension_study_exact_search_visits_almost_all_leaves_in_64d():
-    from slamlab.kdtree.experiments import run_dimension_study
+    from slamlab.studies.kdtree.experiments import run_dimension_study
 
     r = run_dimension_study((2, 64), n=2000, n_queries=40)
     by = {row[0]: row for row in r.rows}
@@ -129,7 +129,7 @@ def test_dimension_study_exact_search_visits_almost_all_leaves_in_64d():
 
 def test_ours_vs_source_prints_the_runs_figures(table1):
     from slamlab.kdtree.cost_model import run_cost_model
-    from slamlab.kdtree.experiments import ours_vs_source, run_dimension_study
+    from slamlab.studies.kdtree.experiments import ours_vs_source, run_dimension_study
 
     cost = run_cost_model()
     dim = run_dimension_study((8, 64), n=500, n_queries=20)

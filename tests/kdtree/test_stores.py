@@ -15,7 +15,7 @@ from slamlab.kdtree.stores import (
     merge_knn,
     multi_tree_sizes,
 )
-from slamlab.kdtree.workloads import surf_like_descriptors
+from slamlab.studies.kdtree.workloads import surf_like_descriptors
 
 
 def _exact(X, Q, k=2):

@@ -3,9 +3,9 @@ since ``ipywidgets.interactive`` swallows exceptions)."""
 
 import matplotlib
 
-from slamlab.kdtree import widgets as W
 from slamlab.kdtree.cost_model import iter_time, run_cost_model
-from slamlab.kdtree.experiments import run_store_comparison
+from slamlab.studies.kdtree import widgets as W
+from slamlab.studies.kdtree.experiments import run_store_comparison
 
 matplotlib.use("Agg")
 

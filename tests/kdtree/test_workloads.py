@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from slamlab.kdtree.stores import make_store
-from slamlab.kdtree.workloads import SCENARIOS, make_workload, scenario, surf_like_descriptors
+from slamlab.studies.kdtree.workloads import SCENARIOS, make_workload, scenario, surf_like_descriptors
 
 
 @pytest.mark.parametrize(("name", "lo", "hi"), [("table1", 11000, 15000), ("table2", 60000, 70000)])

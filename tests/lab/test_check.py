@@ -113,8 +113,8 @@ def test_q_scale_range_is_filterpys_ekf_and_equals_the_library_run():
 
     from scipy.stats import chi2
 
-    from slamlab.filters import default_landmarks, run_stabilising_noise, run_unicycle_comparison
     from slamlab.lab import tasks_filters as tf
+    from slamlab.studies.filters import default_landmarks, run_stabilising_noise, run_unicycle_comparison
 
     d = {k: p.default for k, p in inspect.signature(run_unicycle_comparison).parameters.items()}
     assert (d["dt_s"], d["speed_mps"], d["turn_rate_degps"], d["v_std_mps"], d["omega_std_degps"], d["range_std_m"],

@@ -205,7 +205,7 @@ def test_failures_exploration_range():
     assert lab.task("06.explore.failures").accepted_range() == (lo, hi)
 
     def library(seed):
-        return sl.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120,
+        return sl.studies.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120,
                                               delta_alpha_rad=np.radians(2.0), rng=seed, progress=False).failed
 
     assert library(FAILURE_SEEDS[0]).astype(int).tolist() == list(runs[0])

@@ -43,8 +43,8 @@ def ready_made_calls(labs) -> list[tuple[str, str, str]]:
     """``(lab, grade_id, call)`` for every ``sl.`` call spelt out in the markdown of an exploration's cells.
 
     An exploration's cells are its question (grade id ``labNN_eK_text``) and any other markdown cell whose
-    grade id has the ``_eK_`` part; naming a library function (``sl.filters.run_cv_target``) is allowed,
-    writing the call (``sl.filters.run_cv_target(...)``) is not.
+    grade id has the ``_eK_`` part; naming a library function (``sl.studies.filters.run_cv_target``) is allowed,
+    writing the call (``sl.studies.filters.run_cv_target(...)``) is not.
     """
     found = []
     for lab in labs:
@@ -59,7 +59,7 @@ def ready_made_calls(labs) -> list[tuple[str, str, str]]:
 
 def test_the_scan_finds_a_ready_made_call(tmp_path):
     nb = {"cells": [{"cell_type": "markdown", "metadata": {"nbgrader": {"grade_id": "lab99_e1_text"}},
-                     "source": ["Use `sl.filters.run_cv_target` ", "or run `sl.sweep.sweep(f, grid)`."]}]}
+                     "source": ["Use `sl.studies.filters.run_cv_target` ", "or run `sl.sweep.sweep(f, grid)`."]}]}
     p = tmp_path / "99_x_lab.ipynb"
     p.write_text(json.dumps(nb))
     assert ready_made_calls([p]) == [("99_x_lab.ipynb", "lab99_e1_text", "sl.sweep.sweep(")]

@@ -122,7 +122,7 @@ def test_lab02_wall_range_is_a_brute_force_count_equal_to_the_library(real_data)
     from slamlab.lab.features_checks import wall_repeatability_brute_force
 
     names, rep = wall_repeatability_brute_force()
-    ev = sl.features.run_pair_evaluation(("wall",), (2, 3, 4, 5, 6), scale=0.5, n_points=500, progress=False)
+    ev = sl.studies.features.run_pair_evaluation(("wall",), (2, 3, 4, 5, 6), scale=0.5, n_points=500, progress=False)
     assert names == ev.detectors
     np.testing.assert_allclose(rep, ev.rep[0], rtol=0, atol=1e-12)  # kd-tree count == all pairwise distances
     means = rep.mean(axis=0)
@@ -243,7 +243,7 @@ def test_lab03_budget_range_from_exact_neighbours_over_three_query_sets(real_dat
     from slamlab.lab.tasks_features import EXPLORE_BUDGETS, bbf_recall_exact_truth
 
     curves = bbf_recall_exact_truth(EXPLORE_BUDGETS)
-    lib = sl.features.run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200, progress=False)
+    lib = sl.studies.features.run_recall_vs_leaves(EXPLORE_BUDGETS, n_stored=10000, n_queries=200, progress=False)
     np.testing.assert_array_equal(curves["ranks 0-199"], lib.recall_bbf)  # SciPy's truth == the library's
     firsts = {next(b for b, r in zip(EXPLORE_BUDGETS, c, strict=True) if r >= 0.9) for c in curves.values()}
     lo, hi = lab.task("03.explore.bbf_budget").accepted_range()
@@ -267,7 +267,7 @@ def test_lab03_ratio_range_from_a_brute_force_matcher(real_data):
     ok = np.hypot(*(p[:, :2] / p[:, 2:] - f2.uv[idx[:, 0]]).T) < 2.5
     prec = np.array([ok[dist[:, 0] < r * dist[:, 1]].mean() for r in EXPLORE_RATIOS])
     np.testing.assert_allclose(prec, ratio_precision_independent(EXPLORE_RATIOS))
-    lib = sl.features.run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
+    lib = sl.studies.features.run_ratio_tradeoff(EXPLORE_RATIOS, detector="SURF", sequence="boat", j=2)
     np.testing.assert_allclose(prec, lib.precision)
     holds = [r for r, q in zip(EXPLORE_RATIOS, prec, strict=True) if q >= 0.9]
     lo, hi = lab.task("03.explore.precise_ratio").accepted_range()

@@ -162,7 +162,7 @@ def test_exploration_answers():
     import slamlab as sl
     from slamlab.lab.tasks_hough import independent_lost_counts
 
-    res = sl.hough.run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=2010)
+    res = sl.studies.hough.run_sim_slam(121, range_std_cells=0.1, with_icp=False, H_min=40, rng=2010)
     assert int(res.slam.lost.sum()) == independent_lost_counts()[0][1]
     assert lab.answer("07.explore.lost_steps", int(res.slam.lost.sum()), quiet=True).passed
     assert lab.answer("07.explore.lost_steps", 0, quiet=True).status == "failed"

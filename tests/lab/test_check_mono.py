@@ -98,7 +98,7 @@ def test_doubling_range_holds_for_the_library_and_a_scalar_filter_on_coarse_and_
     for seed, step in ((2019, 0.05), (5, 0.05), (8, 0.1), (2019, 0.02)):  # the library's study, another code
         rates = np.round(np.arange(0.0, 0.7 + step / 2, step), 10)
         k = np.array([41 if n is None else n for n in
-                      sl.mono.run_depth_filter_convergence(tuple(rates), n_obs=40, rng=seed).first_half()])
+                      sl.studies.mono.run_depth_filter_convergence(tuple(rates), n_obs=40, rng=seed).first_half()])
         assert lo <= rates[np.flatnonzero(k >= 2 * k[0])[0]] <= hi, (seed, step)
     rates = (0.0, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6)
     k = np.array([_half_converged_scalar(r, 3) for r in rates])

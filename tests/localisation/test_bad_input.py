@@ -5,6 +5,7 @@ import pytest
 
 from slamlab import localisation as L
 from slamlab.scans import Scan
+from slamlab.studies import localisation as LS
 
 
 def _room():
@@ -96,11 +97,11 @@ def test_new_params_checks():
     with pytest.raises(ValueError, match="`uniform_floor` must be in"):
         L.MarkovParams(uniform_floor=1.0)
     with pytest.raises(TypeError, match="`variants` must hold"):
-        L.run_global_ablation([("a", 3)], n_runs=1)
+        LS.run_global_ablation([("a", 3)], n_runs=1)
     with pytest.raises(ValueError, match="`size` must be one of"):
-        L.run_global_ablation(size="huge")
+        LS.run_global_ablation(size="huge")
     with pytest.raises(TypeError, match="has no field"):
-        L.run_global_localisation((10,), n_runs=1, sigma=3)
+        LS.run_global_localisation((10,), n_runs=1, sigma=3)
     mg = L.MarkovGrid(_room(), 30.0, resolution=2, n_headings=8)
     with pytest.raises(ValueError, match="`pose` must be three finite"):
         mg.gaussian_prior([np.nan, 1, 0], 2.0, 0.3)
@@ -114,6 +115,6 @@ def test_log_with_too_few_scans_names_the_length(tmp_path):
                     poses=np.zeros((n, 3)), odom_poses=np.zeros((n, 3)), timestamps_s=np.arange(n, dtype=float),
                     odom=np.zeros((0, 4)), max_range_m=10.0)
     with pytest.raises(ValueError, match=r"`n_scans` must be <= the 5 scans of log 'tiny.log'; got 40"):
-        L.run_log_mcl(log, n_scans=40)
+        LS.run_log_mcl(log, n_scans=40)
     with pytest.raises(ValueError, match=r"`start` \+ `n_scans` must be <= the 5 scans of log 'tiny.log'; got 4 \+ 3"):
-        L.run_log_mcl(log, start=4, n_scans=3)
+        LS.run_log_mcl(log, start=4, n_scans=3)

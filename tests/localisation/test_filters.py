@@ -11,6 +11,7 @@ from scipy import stats
 from slamlab import localisation as L
 from slamlab import sim as S
 from slamlab.geometry import angle_mean, se2_integrate, se2_relative
+from slamlab.studies import localisation as LS
 
 
 @pytest.mark.parametrize("k", [2, 10, 50, 300])
@@ -87,7 +88,7 @@ def test_mcl_tracking_stays_within_a_cell(room_run, narrow):
     within 1.5 cells and 3°; the narrow cloud is also 'localised' (σ < 2 cells and 5°) at every step after the 5th
     (the defaults' cloud is wider by design: σ_hit 4, 4 × the motion noise, jitter, injected particles)."""
     M, P, scans, odo = room_run
-    kw = {**L.CHAPTER_BEFORE, "alpha_slow": 0.0, "alpha_fast": 0.0} if narrow else {}
+    kw = {**LS.CHAPTER_BEFORE, "alpha_slow": 0.0, "alpha_fast": 0.0} if narrow else {}
     f = L.MCL(M, 60.0, n_particles=500, rng=0, init_pose=P[0], init_std=(1.0, 1.0, 0.05), **kw)
     recs = _run(f, P, scans, odo)
     err = np.array([math.hypot(*(r.mean[:2] - p[:2])) for r, p in zip(recs, P, strict=True)])
@@ -193,7 +194,7 @@ def test_markov_predict_conserves_mass_and_moves_the_mode():
 
 
 def test_markov_vs_mcl_methods_share_the_runs():
-    from slamlab.localisation.experiments import run_markov_vs_mcl
+    from slamlab.studies.localisation.experiments import run_markov_vs_mcl
 
     res = run_markov_vs_mcl(markov=((8, 12),), particle_counts=(50, 60), n_runs=3, n_steps=3, rng=4)
     df = res.table_df
@@ -207,7 +208,7 @@ def test_markov_vs_mcl_methods_share_the_runs():
 def test_studies_take_params_and_any_rng_with_seed_deprecated():
     """The run_* contract: ``params=`` (+ overrides) and ``rng=`` as an int, a SeedSequence or a Generator;
     the old ``seed=`` still works, with a DeprecationWarning, and gives the same runs."""
-    from slamlab.localisation.experiments import run_markov_vs_mcl
+    from slamlab.studies.localisation.experiments import run_markov_vs_mcl
 
     kw = {"markov": (), "particle_counts": (40,), "n_runs": 2, "n_steps": 3}
     cols = ["start_x", "start_y", "final_err_cells"]
@@ -256,10 +257,10 @@ def test_debiased_averages_of_a_constant_are_the_constant(alpha):
 def test_injection_fires_with_the_defaults_after_a_kidnap_and_not_with_003_averages():
     """Issue 27: with 003's averages from 0 and (α_slow, α_fast) = (0.001, 0.1) nothing is injected; with the
     defaults (the same α, bias-corrected averages) a kidnap triggers injection."""
-    run = L.simulate_run(30, start=0, kidnap_step=12, rng=11)
+    run = LS.simulate_run(30, start=0, kidnap_step=12, rng=11)
     inj = {}
     for avg in ("003", "debiased"):
-        r = L.run_filter(run, init="tracking", n_particles=500, rng=2, averages=avg)
+        r = LS.run_filter(run, init="tracking", n_particles=500, rng=2, averages=avg)
         inj[avg] = [x.n_injected for x in r.records]
     assert sum(inj["003"]) == 0
     assert sum(inj["debiased"][12:]) > 500
@@ -289,10 +290,10 @@ def test_beam_skipping_keeps_the_beams_most_particles_agree_with():
 def test_markov_prior_and_uniform_floor_studies():
     """003's two claims as runs: with a weak sensor (3 beams) a prior at the truth localises where the uniform
     belief does not; after a kidnap a grid with a uniform floor is back within the bounds."""
-    mp = L.run_markov_prior(L.MARKOV_PRIORS[:2], n_runs=2, n_steps=8, rng=2026, progress=False, max_beams=3)
-    assert mp.success(L.MARKOV_PRIORS[1][0]) > mp.success(L.MARKOV_PRIORS[0][0])
-    mk = L.run_markov_kidnap((1e-3,), n_runs=1, n_steps=12, kidnap_step=6, rng=1, progress=False)
+    mp = LS.run_markov_prior(LS.MARKOV_PRIORS[:2], n_runs=2, n_steps=8, rng=2026, progress=False, max_beams=3)
+    assert mp.success(LS.MARKOV_PRIORS[1][0]) > mp.success(LS.MARKOV_PRIORS[0][0])
+    mk = LS.run_markov_kidnap((1e-3,), n_runs=1, n_steps=12, kidnap_step=6, rng=1, progress=False)
     assert mk.success(mk.labels[0], 5) == 1.0  # tracking before the kidnap
     assert mk.success(mk.labels[0]) == 1.0  # and back after it
     with pytest.raises(ValueError, match="`priors` must hold"):
-        L.run_markov_prior([("x", "flat", 0.0)])
+        LS.run_markov_prior([("x", "flat", 0.0)])

@@ -8,18 +8,18 @@
 
 import pytest
 
-from slamlab import localisation as L
+from slamlab.studies import localisation as LS
 
 
 @pytest.mark.slow
 def test_global_localisation_success_at_least_095():
-    g = L.run_global_localisation((5000,), n_runs=20, n_steps=30, rng=27, progress=False)
+    g = LS.run_global_localisation((5000,), n_runs=20, n_steps=30, rng=27, progress=False)
     assert g.success(5000, 30) >= 0.95, g.table()
 
 
 @pytest.mark.slow
 def test_kidnap_recovery_at_least_09_with_the_defaults():
-    k = L.run_kidnapped((("defaults", {}),), n_runs=20, n_particles=1000, n_steps=50, kidnap_step=20, rng=27,
+    k = LS.run_kidnapped((("defaults", {}),), n_runs=20, n_particles=1000, n_steps=50, kidnap_step=20, rng=27,
                         progress=False)
     assert k.recovered("defaults") >= 0.9, k.table()
     assert k.table_df["injected_after"].mean() > 0

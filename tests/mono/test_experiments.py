@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from slamlab.mono import MonoSLAM
-from slamlab.mono.experiments import (
+from slamlab.studies.mono.experiments import (
     mono_sim,
     render_sequence,
     run_depth_filter_convergence,
@@ -96,7 +96,7 @@ def test_both_convergence_criteria_run(strafe_frames):
 
 
 def test_run_mono_rejects_frames_of_different_sizes(strafe_frames):
-    from slamlab.mono.experiments import run_mono
+    from slamlab.studies.mono.experiments import run_mono
 
     imgs, Ts, K = strafe_frames
     frames = [*imgs[:3], imgs[3][:-2]]
@@ -113,7 +113,7 @@ def test_run_mono_rejects_frames_of_different_sizes(strafe_frames):
 
 
 def test_run_mono_rejects_truth_of_another_length(strafe_frames):
-    from slamlab.mono.experiments import run_mono
+    from slamlab.studies.mono.experiments import run_mono
 
     imgs, Ts, K = strafe_frames
     with pytest.raises(ValueError, match=r"`truth_T_wc` must hold one pose per frame: 6 frames in `images`, 5 poses"):
@@ -187,7 +187,7 @@ def test_poses_stay_rotations_under_the_constant_velocity_prior(strafe_frames):
 def test_mono_vs_stereo_repeats_from_its_seed():
     # the stereo pipeline's RANSAC draws from a child of the simulator's stream, not fresh entropy: the same seed
     # gives the same numbers (it once printed 0.01 or 0.02 by chance), and another seed other ones
-    from slamlab.mono import run_mono_vs_stereo
+    from slamlab.studies.mono import run_mono_vs_stereo
 
     a, b, c = (run_mono_vs_stereo("strafe", n_frames=8, size="tiny", rng=s) for s in (3, 3, 4))
     assert (a.stereo_rpe_m, a.stereo_ate_sim3_m, a.stereo_ate_se3_m) == (b.stereo_rpe_m, b.stereo_ate_sim3_m,

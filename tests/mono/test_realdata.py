@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from slamlab.mono.kitti import run_kitti_mono
+from slamlab.studies.mono.kitti import run_kitti_mono
 
 
 @pytest.mark.realdata

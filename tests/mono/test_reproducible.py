@@ -23,7 +23,7 @@ pytestmark = pytest.mark.slow
 
 _SCRIPT = r"""
 import hashlib, numpy as np
-from slamlab.mono import experiments as ex
+from slamlab.studies.mono import experiments as ex
 rng = np.random.default_rng(np.random.SeedSequence(2019).spawn(6)[3])
 imgs, Ts, K, _ = ex._case_frames("normal", "tiny", 16, rng)
 r = ex.run_mono(imgs, Ts, K, name="t", progress=False, max_keyframes=3, kf_min_frames=10)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from slamlab.mono.experiments import run_mono_sequence
+from slamlab.studies.mono.experiments import run_mono_sequence
 
 
 def test_strafe_sequence_tracks_with_centimetre_ate():

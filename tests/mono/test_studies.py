@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from slamlab.mono import studies
+from slamlab.studies.mono import studies
 
 
 def test_eq_6_4_points_reproject_to_their_pixel_at_every_inverse_depth():

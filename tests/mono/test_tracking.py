@@ -95,7 +95,7 @@ def test_refine_pose_exact_and_with_outliers():
 
 
 def test_sparse_align_recovers_motion_on_a_rendered_pair():
-    from slamlab.mono.experiments import mono_sim, render_sequence
+    from slamlab.studies.mono.experiments import mono_sim, render_sequence
 
     sim = mono_sim("small", noise_std=0.0)
     (A, B), (Ta, Tb) = render_sequence(sim, [[3.0, 2.5, -np.pi / 2], [3.02, 2.5, -np.pi / 2 + 0.004]], progress=False)

@@ -10,7 +10,7 @@ import pytest
 
 matplotlib.use("Agg")
 
-W = pytest.importorskip("slamlab.mono.widgets")
+W = pytest.importorskip("slamlab.studies.mono.widgets")
 
 
 def _call(w, capsys, **kw):

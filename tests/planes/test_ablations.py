@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from slamlab import sim
-from slamlab.planes import (
+from slamlab.studies.planes import (
     flight_head,
     in_frame_rotation_error_deg,
     map_normal_error_deg,

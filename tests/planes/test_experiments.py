@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from slamlab.planes import (
+from slamlab.studies.planes import (
     SOURCE_TIMES_S,
     ours_vs_source,
     run_flight,
@@ -48,7 +48,7 @@ def test_fig4_more_cycles_converge():
 
 
 def test_intensity_spread_and_bad_input():
-    from slamlab.planes import run_intensity_spread
+    from slamlab.studies.planes import run_intensity_spread
 
     s = run_intensity_spread((0.01, 0.36), n_particles=100, rng=1)
     assert len(s.results) == 2
@@ -78,7 +78,7 @@ def test_flight_tracks_and_reports(flight):
 
 
 def test_timing_goal_is_half_of_002():
-    from slamlab.planes import GOAL_S, timing_goal
+    from slamlab.studies.planes import GOAL_S, timing_goal
 
     stages = [SOURCE_TIMES_S[s] for s in ("extraction", "description", "motion", "equations", "weights", "pose")]
     assert sum(stages) == pytest.approx(SOURCE_TIMES_S["total"], abs=5e-4)   # 002's table adds up
@@ -108,7 +108,7 @@ def test_a_20_s_flight_beats_the_odometry():
 
 
 def test_intensity_study_runs_through_sweep():
-    from slamlab.planes import run_intensity_study
+    from slamlab.studies.planes import run_intensity_study
 
     s = run_intensity_study(2, (0.4,), n_particles=60, rng=1, progress=False)
     assert len(s.runs) == 2

@@ -79,12 +79,6 @@ def test_readings_at_or_beyond_max_range_become_no_return(room_log):
         np.testing.assert_allclose(s_c.ranges[~short], 15.0)
 
 
-def test_correlation_re_exports_the_scans_log_grid():
-    import slamlab.correlation as C
-
-    assert C.log_grid is SC.log_grid
-
-
 def test_bad_input_names_the_argument(room_log):
     _, log = room_log
     with pytest.raises(TypeError, match="`log` must be a laser log"):

@@ -6,7 +6,8 @@ import pytest
 
 from slamlab.geometry import StereoRig
 from slamlab.sim.arena import StereoArena, StereoSim
-from slamlab.stereo import StereoSLAM, heading_frames
+from slamlab.stereo import StereoSLAM
+from slamlab.studies.stereo import heading_frames
 
 
 @pytest.fixture(scope="module")

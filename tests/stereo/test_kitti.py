@@ -41,7 +41,7 @@ def test_kitti_06_first_20_frames(real_data):
 
 @pytest.mark.realdata
 def test_run_kitti_matches_the_manual_loop(real_data):
-    from slamlab.stereo import run_kitti
+    from slamlab.studies.stereo import run_kitti
 
     res = run_kitti(real_data / "kitti-odometry-06-stereo")
     assert res.n_degenerate == 0
@@ -61,7 +61,7 @@ def test_orb_on_kitti_keeps_the_scale(real_data):
     KITTI_PARAMS (window search, weights at the landmark's depth): 1.0042 / 1.0029, ATE 0.175 m. Bounds:
     1.5 % on the scale (the 19 steps' standard error is ~0.6 %), ATE and final error about 1.5x measured.
     """
-    from slamlab.stereo import run_kitti
+    from slamlab.studies.stereo import run_kitti
 
     res = run_kitti(real_data / "kitti-odometry-06-stereo", detector="orb", progress=False)
     assert res.n_degenerate == 0

@@ -8,7 +8,7 @@ met with one seed only is not met (stop 36's SURF missed it with seed 1).
 import numpy as np
 import pytest
 
-from slamlab.stereo import run_kitti
+from slamlab.studies.stereo import run_kitti
 
 
 @pytest.mark.realdata

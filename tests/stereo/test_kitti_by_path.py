@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from slamlab.io import read_kitti_calib
-from slamlab.stereo import run_kitti
+from slamlab.studies.stereo import run_kitti
 
 pytestmark = pytest.mark.realdata
 

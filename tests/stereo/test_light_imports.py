@@ -1,5 +1,5 @@
-"""The plot, widget and cv2-backed names of features, kdtree and stereo load on first use (tests/test_imports.py
-checks that importing the packages loads no cv2, ipywidgets or pyplot)."""
+"""The plot, widget and cv2-backed names of features, kdtree and stereo (and their studies) load on first use
+(tests/test_imports.py checks that importing the packages loads no cv2, ipywidgets or pyplot)."""
 
 import subprocess
 import sys
@@ -14,8 +14,8 @@ def _run(code: str) -> str:
 
 def test_lazy_names_still_resolve():
     code = """
-    import sys, slamlab.features as F, slamlab.kdtree as K, slamlab.stereo as S
-    print(callable(F.plot_matches), callable(K.plot_cost_contour), callable(S.run_figure),
+    import sys, slamlab.features as F, slamlab.studies.kdtree as K, slamlab.stereo as S, slamlab.studies.stereo as SS
+    print(callable(F.plot_matches), callable(K.plot_cost_contour), callable(S.plot_frame_stages), callable(SS.run_figure),
           K.store_plot.__name__, "plot_matches" in dir(F))
     """
-    assert _run(code) == "True True True slamlab.kdtree.store_plot True"
+    assert _run(code) == "True True True True slamlab.studies.kdtree.store_plot True"

@@ -7,7 +7,6 @@ from slamlab.geometry import StereoRig, se3_from_planar
 from slamlab.geometry.camera import PinholeCamera
 from slamlab.sim.highway import HighwayScene, highway_path
 from slamlab.stereo import (
-    KITTI_PARAMS,
     StereoParams,
     StereoSLAM,
     refine_pose_stereo,
@@ -22,7 +21,8 @@ from slamlab.stereo.noise_estimate import (
     disparity_noise_px,
 )
 from slamlab.stereo.pose_stages import _stereo_project
-from slamlab.stereo.scale_ablation import ABLATION_BASE, PROPOSED_FIX, run_scale_ablation
+from slamlab.studies.stereo import KITTI_PARAMS
+from slamlab.studies.stereo.scale_ablation import ABLATION_BASE, PROPOSED_FIX, run_scale_ablation
 
 
 def _kitti_like_rig():

@@ -7,14 +7,9 @@ from slamlab.geometry import StereoRig
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
 from slamlab.stereo import detect_features, stereo_match, triangulate_local
-from slamlab.stereo.experiments import run_stereo_slam
-from slamlab.stereo.plot import (
-    plot_frame_stages,
-    plot_kitti,
-    plot_run_errors,
-    plot_run_map,
-    plot_triangulation,
-)
+from slamlab.stereo.plot import plot_frame_stages, plot_triangulation
+from slamlab.studies.stereo.experiments import run_stereo_slam
+from slamlab.studies.stereo.plot import plot_kitti, plot_run_errors, plot_run_map
 
 
 def test_plots():
@@ -42,9 +37,10 @@ def test_plots():
 
 
 def test_widget_runs_the_same_run_as_the_tests(capsys):
-    from slamlab.stereo import RenderParams, run_turn_in_place
+    from slamlab.stereo import RenderParams
     from slamlab.stereo.params import STEREO_DETECTORS
-    from slamlab.stereo.widgets import explore_stereo_slam
+    from slamlab.studies.stereo import run_turn_in_place
+    from slamlab.studies.stereo.widgets import explore_stereo_slam
 
     w = explore_stereo_slam(policy="oldest", n_frames=3)
     names = [getattr(c, "description", "") for c in w.children]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from slamlab.stereo import run_turn_in_place
+from slamlab.studies.stereo import run_turn_in_place
 
 
 def test_bar_only_when_asked_and_callback_per_frame(capsys, monkeypatch):

@@ -2,8 +2,8 @@
 
 def test_recorded_stereo_stream_replays_through_the_stores():
     """A real descriptor stream recorded from the stereo pipeline (issue 4's 'real stream')."""
-    from slamlab.kdtree.experiments import run_store_comparison
-    from slamlab.stereo import record_stereo_stream
+    from slamlab.studies.kdtree.experiments import run_store_comparison
+    from slamlab.studies.stereo import record_stereo_stream
 
     w = record_stereo_stream(6, detector="sift", rng=0)
     assert len(w) >= 5

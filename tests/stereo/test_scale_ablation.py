@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from slamlab.sim.highway import HIGHWAY_CONDITIONS, HighwayScene, highway_path
-from slamlab.stereo import KITTI_PARAMS, StereoSLAM, run_scale_ablation
-from slamlab.stereo.scale_ablation import PROPOSED_FIX, run_condition_ablation
+from slamlab.stereo import StereoSLAM
+from slamlab.studies.stereo import KITTI_PARAMS, run_scale_ablation
+from slamlab.studies.stereo.scale_ablation import PROPOSED_FIX, run_condition_ablation
 
 
 def _scene(rng):
@@ -104,7 +105,7 @@ def test_proposed_fix_keeps_path_and_displacement_within_one_percent():
 def test_kitti_params_meet_the_highway_goal_in_path_and_displacement():
     """Today's KITTI_PARAMS themselves (PROPOSED_FIX adopted, stop 37), not an override of the ablation's base: the
     path and the displacement within 1 % on the simulated highway (bound from issue 25's goal; one seed, 21 frames)."""
-    from slamlab.stereo import KITTI_PARAMS
+    from slamlab.studies.stereo import KITTI_PARAMS
 
     a = run_scale_ablation(_scene, highway_path(21), {"KITTI_PARAMS": {}}, params=KITTI_PARAMS, n_seeds=1, rng=0)
     assert abs(a.path_ratio[0, 0] - 1) <= 0.01

@@ -9,7 +9,7 @@ from slamlab.kdtree.stores import MultiKDTree, NonBaseBuffer
 from slamlab.sim.arena import StereoArena, StereoSim
 from slamlab.sim.stereo_paths import turn_in_place
 from slamlab.stereo import STAGES, StereoParams, StereoSLAM
-from slamlab.stereo.experiments import StereoRunResult, run_stereo_slam, run_stereo_slam_variants
+from slamlab.studies.stereo.experiments import StereoRunResult, run_stereo_slam, run_stereo_slam_variants
 
 
 @pytest.fixture(scope="module")
@@ -148,7 +148,7 @@ def test_bad_input():
 
 
 def test_calibration_drift_costs_stereo_matches():
-    from slamlab.stereo import run_drift_study
+    from slamlab.studies.stereo import run_drift_study
 
     study = run_drift_study((0.0, 1e-3, 3e-3), n_frames=6, detector="orb", rng=0)
     none, mild, strong = study.runs
@@ -169,7 +169,8 @@ def test_calibration_drift_costs_stereo_matches():
 
 
 def test_drift_study_on_sweep_equals_the_sequential_loop_for_one_and_two_workers():
-    from slamlab.stereo import RenderParams, run_drift_study, run_turn_in_place
+    from slamlab.stereo import RenderParams
+    from slamlab.studies.stereo import run_drift_study, run_turn_in_place
 
     levels = (0.0, 2e-3)
     # the study as it was: one run per level, in order, every level with the same seed
@@ -214,7 +215,7 @@ def test_update_gate_keeps_inconsistent_observations_from_throwing_landmarks():
 
 
 def test_variants_on_shared_frames_equal_separate_runs(short_turn):
-    from slamlab.stereo import comparison_table, run_comparison, run_stereo_slam_variants
+    from slamlab.studies.stereo import comparison_table, run_comparison, run_stereo_slam_variants
 
     poses, res = short_turn
     both = run_stereo_slam_variants(poses, {"a": {}, "b": {"policy": "all"}}, name="turn in place", arena=StereoArena(seed=0), rng=0)
@@ -258,7 +259,7 @@ def test_ill_conditioned_poses_are_not_trusted():
 def test_params_are_one_frozen_object_shared_by_the_loop_and_the_runs():
     import dataclasses
 
-    from slamlab.stereo import run_turn_in_place
+    from slamlab.studies.stereo import run_turn_in_place
 
     p = StereoParams()
     with pytest.raises(dataclasses.FrozenInstanceError):
@@ -293,7 +294,7 @@ def test_colour_frames_follow_the_channel_order():
 
 
 def test_ours_vs_source_prints_the_runs_figures(short_turn):
-    from slamlab.stereo import ours_vs_source
+    from slamlab.studies.stereo import ours_vs_source
 
     _, res = short_turn
     table = ours_vs_source(res, {"SURF, oldest": res, "again": res})
@@ -334,7 +335,7 @@ def test_duplicate_check_keeps_re_sighted_points_out_of_the_map():
 
 
 def test_disparity_errors_table_shows_the_refinement_per_level():
-    from slamlab.stereo import disparity_errors
+    from slamlab.studies.stereo import disparity_errors
 
     table = disparity_errors()
     rows = [line.split() for line in table.splitlines()[3:]]
@@ -348,7 +349,7 @@ def test_disparity_errors_table_shows_the_refinement_per_level():
 
 @pytest.mark.realdata
 def test_kitti_comparison_prints_one_row_per_setting(real_data):
-    from slamlab.stereo import kitti_comparison
+    from slamlab.studies.stereo import kitti_comparison
 
     table = kitti_comparison({"a": {"detector": "orb"}, "b": {"detector": "orb", "subpixel_stereo": False}},
                              real_data / "kitti-odometry-06-stereo", n_frames=3)

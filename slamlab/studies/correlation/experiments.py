@@ -1,0 +1,335 @@
+"""Ch. 5 experiments (004 §7): Table 1, a Monte Carlo study, the constants a_c/a_p, the corridor tie (the real
+CARMEN log: :mod:`~slamlab.studies.correlation.log_experiments`; the closing table: :mod:`~slamlab.studies.correlation.source_table`).
+
+Every ``run_*`` takes ``params=`` (a :class:`~slamlab.correlation.LocaliseParams`, the
+same settings and defaults as :func:`~slamlab.correlation.localise`) plus overrides
+of its fields.
+
+Each ``run_*`` returns a frozen dataclass: ``str(result)`` is a one-line summary,
+``result.table()`` a fixed-precision text table (what the notebook prints and
+nbval compares); arrays for plotting live in fields, timings in ``time_s``
+(never in the table).
+
+This module builds the simulated worlds (the test room, its clutter, the rangefinder) and runs the
+experiments on them; the result dataclasses live in :mod:`~slamlab.studies.correlation.study_results`, the sim-free helpers (the sweep of
+localisations, errors, margins, Table 1's source values, the corridor, the timing) in :mod:`~slamlab.studies.correlation.studies` (all
+re-exported here).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ... import _validate as v
+from ...correlation.algorithm import (
+    LocaliseParams,
+    heading_error,
+    localise,
+    localise_joined,
+)
+from ...scans.logmap import log_grid  # log_grid re-exported (one place: scans)
+from ...sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
+from ...sim.paths import random_free_poses
+from ...sim.rangefinder import Rangefinder
+from .studies import (
+    FAIL_CELLS,
+    FAIL_DEG,
+    SOURCE_TABLE1,
+    _errors,
+    _estimates,
+    _localise_scans,
+    _within_tolerance,
+    corridor_grid,
+    time_localise,
+)
+from .study_results import ConstantsResult, CorridorResult, MonteCarloResult, Table1Result
+
+__all__ = [
+    "FAIL_CELLS",
+    "FAIL_DEG",
+    "SOURCE_TABLE1",
+    "ConstantsResult",
+    "CorridorResult",
+    "MonteCarloResult",
+    "Table1Result",
+    "corridor_grid",
+    "log_grid",
+    "random_clutter",
+    "run_constants_study",
+    "run_corridor_tie",
+    "run_monte_carlo",
+    "run_table1",
+    "time_localise",
+]
+
+
+def _sensor(n_beams, max_range_cells, range_std_cells, quantum_cells=0.1) -> Rangefinder:
+    return Rangefinder(n_beams=n_beams, fov_rad=2 * np.pi, max_range_cells=max_range_cells,
+                       range_std_cells=range_std_cells, quantum_cells=quantum_cells)
+
+
+def _worlds(clutter: bool, extra_clutter: int, rng):
+    M = test_room_200()
+    W = measurement_room_200() if clutter else M.copy()
+    if extra_clutter:
+        W = add_clutter(W, random_clutter(W, extra_clutter, rng=rng))
+    return M, W
+
+
+def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int = 3, rng=None) -> list[tuple]:
+    """``n`` extra unmapped discs ("people's legs", bins) on free cells of ``grid`` (our addition).
+
+    Parameters
+    ----------
+    grid : array_like of int, shape (H, W)
+        Cell codes; discs are centred on free cells.
+    n : int
+        Number of discs.
+    radius_cells : float, default 1.5
+        Disc radius [cells].
+    margin_cells : int, default 3
+        Centres keep this many cells from obstacles (see :func:`slamlab.sim.grid.free_cells`).
+    rng : int or numpy.random.Generator, optional
+        Seed or generator of the centres.
+
+    Returns
+    -------
+    list of tuple
+        ``("disc", col, row, radius_cells)`` shapes for :func:`slamlab.sim.grid.add_clutter`.
+
+    Examples
+    --------
+    >>> len(random_clutter(test_room_200(), 5, rng=0))
+    5
+    """
+    n = v.check_int(n, "n", minimum=0)
+    r = v.check_positive(radius_cells, "radius_cells")
+    rng = v.as_rng(rng)
+    cells = free_cells(grid, margin_cells)
+    pick = cells[rng.integers(0, cells.shape[0], n)]
+    return [("disc", int(c), int(rw), r) for rw, c in pick]
+
+
+def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int = 360,
+               max_range_cells: float = 100.0, clutter: bool = True, params: LocaliseParams | None = None,
+               rng=2010, n_jobs: int = 1, progress: bool | None = None, **overrides) -> Table1Result:
+    """Localise the robot from no prior at ``n_poses`` random free poses of the test room (004 Table 1).
+
+    The robot stands on whole cells with a uniform random heading; the scan is
+    cast in the measurement room (unmapped clutter) with Gaussian range noise and
+    0.1-cell quantisation, and localised on the mapped room M by the full 360°
+    search. 004 does not give σ, the beam count or the range limit: ours are
+    parameters. ``params`` / ``**overrides``: the :class:`LocaliseParams` of every localisation.
+    ``n_jobs`` / ``progress``: the localisations run on :func:`slamlab.sweep.sweep` (same result for any ``n_jobs``).
+
+    Parameters
+    ----------
+    n_poses : int, default 10
+        Random free poses.
+    range_std_cells : float, default 0.3
+        Range noise std [cells].
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    clutter : bool, default True
+        Cast in the measurement room (unmapped clutter of 004 Fig. 3b); False casts in the map itself.
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator of poses and scan noise.
+    n_jobs : int, default 1
+        Worker processes for the localisations (same result for any value).
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    Table1Result
+    """
+    p = LocaliseParams.resolve(params, **overrides)
+    n = v.check_int(n_poses, "n_poses", minimum=1)
+    rf = _sensor(n_beams, max_range_cells, range_std_cells)
+    rng = v.as_rng(rng)
+    M, W = _worlds(clutter, 0, rng)
+    poses = random_free_poses(W, n, margin_cells=2, rng=rng)
+    scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
+    t0 = time.perf_counter()
+    est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
+    ea, ex, ey = _errors(poses, est)
+    return Table1Result(poses, est, ea, ex, ey, float(range_std_cells), int(n_beams), p, time.perf_counter() - t0)
+
+_SIZES = {"small": 12, "full": 200}
+
+
+def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, n_beams: int = 360,
+                    max_range_cells: float = 100.0, extra_clutter: int = 0, params: LocaliseParams | None = None,
+                    rng=2011, n_jobs: int = 1, progress: bool | None = None, **overrides) -> MonteCarloResult:
+    """Full 360° localisation at many random poses: error distribution and failure rate (our addition).
+
+    ``size``: ``"small"`` (12 poses, the notebook), ``"full"`` (200) or an int.
+    ``params`` / ``**overrides``: the :class:`LocaliseParams` of every localisation.
+
+    The random part (clutter, poses, then one scan per pose, in that order from ``rng``)
+    runs here; the localisations, which draw nothing, run on :func:`slamlab.sweep.sweep`
+    with ``n_jobs`` workers (one task per pose; the result is the same for any ``n_jobs``)
+    and a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
+
+    Parameters
+    ----------
+    size : {"small", "full"} or int
+        Number of poses: "small" 12, "full" 200, or the int itself.
+    range_std_cells : float, default 0.3
+        Range noise std [cells].
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    extra_clutter : int, default 0
+        Random unmapped discs added (:func:`random_clutter`).
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    rng : int or numpy.random.Generator, default 2011
+        Seed or generator of clutter, poses and scan noise.
+    n_jobs : int, default 1
+        Worker processes for the localisations (same result for any value).
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    MonteCarloResult
+    """
+    p = LocaliseParams.resolve(params, **overrides)
+    n = _SIZES[v.check_choice(size, "size", _SIZES)] if isinstance(size, str) else v.check_int(size, "size",
+                                                                                                 minimum=1)
+    ec = v.check_int(extra_clutter, "extra_clutter", minimum=0)
+    rf = _sensor(n_beams, max_range_cells, range_std_cells)
+    rng = v.as_rng(rng)
+    M, W = _worlds(True, ec, rng)
+    poses = random_free_poses(W, n, margin_cells=2, rng=rng)
+    scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
+    t0 = time.perf_counter()
+    est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
+    ea, ex, ey = _errors(poses, est)
+    ep = np.hypot(ex, ey)
+    failed = ~_within_tolerance(ep, ea)
+    return MonteCarloResult(n, ea, ep, failed, float(range_std_cells), ec, time.perf_counter() - t0)
+
+
+def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std_cells: float = 0.3,
+                        n_beams: int = 360, max_range_cells: float = 100.0,
+                        choices=((-1.0, 1.0, 0.0), (0.0, 1.0, 0.0)), params: LocaliseParams | None = None,
+                        rng=2012, n_jobs: int = 1, progress: bool | None = None, **overrides) -> ConstantsResult:
+    """Compare 004's constant choices on the same cluttered scans (004 §7).
+
+    004: the peak is sharpest at ``a_p = -a_c``; with unmapped objects,
+    ``a_c = a_n = 0, a_p > 0`` can be more robust. Each choice localises the same
+    scans (cast in the room with 004's clutter plus ``extra_clutter`` random
+    discs). Our sharpness measures: the half-maximum area of the score map at the
+    best heading (cells scoring at least halfway from the median to the peak), the
+    heading margin (peak minus the best score ≥ 3° away, over peak minus the median
+    over headings), and the failure rate. ``params`` / ``**overrides``: the other
+    :class:`LocaliseParams` fields (each choice replaces ``a_c, a_p, a_n``).
+
+    The scans are drawn here; the ``len(choices) × n_poses`` localisations run on
+    :func:`slamlab.sweep.sweep` with ``n_jobs`` workers (same result for any ``n_jobs``)
+    and a progress bar unless ``progress=False`` or ``$SLAMLAB_PROGRESS=0``.
+
+    Parameters
+    ----------
+    n_poses : int, default 12
+        Random free poses, the same scans for every choice.
+    extra_clutter : int, default 60
+        Random unmapped discs added to 004's clutter.
+    range_std_cells : float, default 0.3
+        Range noise std [cells].
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    choices : sequence of tuple of float
+        ``(a_c, a_p, a_n)`` triples to compare.
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    rng : int or numpy.random.Generator, default 2012
+        Seed or generator of clutter, poses and scan noise.
+    n_jobs : int, default 1
+        Worker processes for the localisations (same result for any value).
+    progress : bool or None
+        Progress bar: None shows one in a notebook only.
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    ConstantsResult
+    """
+    base = LocaliseParams.resolve(params, **overrides)
+    n = v.check_int(n_poses, "n_poses", minimum=1)
+    ec = v.check_int(extra_clutter, "extra_clutter", minimum=0)
+    settings = tuple(base.replace(a_c=float(c[0]), a_p=float(c[1]), a_n=float(c[2])) for c in choices)
+    consts = tuple((q.a_c, q.a_p, q.a_n) for q in settings)
+    if not consts:
+        raise ValueError("`choices` must hold at least one (a_c, a_p, a_n) triple")
+    rf = _sensor(n_beams, max_range_cells, range_std_cells)
+    rng = v.as_rng(rng)
+    M, W = _worlds(True, ec, rng)
+    poses = random_free_poses(W, n, margin_cells=2, rng=rng)
+    scans = [rf.scan(W, p, rng) for p in poses]
+    k = len(consts)
+    t0 = time.perf_counter()
+    table = _localise_scans(M, scans, settings, margins=True, n_jobs=n_jobs, progress=progress)
+    est = _estimates(table).reshape(k, n, 3)
+    pm = table["half_max_area"].to_numpy(dtype=float).reshape(k, n)
+    hm = table["heading_margin"].to_numpy(dtype=float).reshape(k, n)
+    ep = np.hypot(est[..., 0] - poses[:, 0], est[..., 1] - poses[:, 1])
+    failed = ~_within_tolerance(ep, heading_error(est[..., 2], poses[:, 2]))
+    h0 = np.radians(np.round(np.degrees(poses[0, 2])))
+    maps = [localise(M, scans[0], params=q, prior_heading_rad=h0, window_rad=0.0).score_map for q in settings]
+    labels = tuple(f"a_c={c[0]:g}, a_p={c[1]:g}, a_n={c[2]:g}" for c in consts)
+    return ConstantsResult(labels, consts, pm, hm, failed.mean(axis=1), ep, ec, tuple(maps), poses[0].copy(),
+                           time.perf_counter() - t0)
+
+
+def run_corridor_tie(*, max_range_cells: float = 25.0, step_cells: float = 30.0,
+                     params: LocaliseParams | None = None, **overrides) -> CorridorResult:
+    """The half-turn tie of one scan in a corridor, broken by joining the scan before it (ours).
+
+    The robot drives towards −x along :func:`corridor_grid`; the last scan, at (100, 25), sees a plain
+    corridor (every shift and the half turn score alike: ambiguity 1, and the tie rule picks heading 0°,
+    180° off); the scan ``step_cells`` before it sees the dead end, which pins the pose once both are
+    joined by (exact) odometry. ``params`` / ``**overrides``: :class:`LocaliseParams` (default float64,
+    Δα = 10°, for exact scores).
+
+    Parameters
+    ----------
+    max_range_cells : float, default 25.0
+        Range limit of the noise-free scans [cells].
+    step_cells : float, default 30.0
+        Distance between the two scans [cells].
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    CorridorResult
+    """
+    p = LocaliseParams.resolve(params, **{"dtype": "float64", "delta_alpha_rad": float(np.radians(10.0)),
+                                          **overrides})
+    rmax = v.check_positive(max_range_cells, "max_range_cells")
+    step = v.check_positive(step_cells, "step_cells")
+    g = corridor_grid()
+    poses = np.array([[100.0, 25.0, np.pi], [100.0 + step, 25.0, np.pi]])
+    rf = Rangefinder(n_beams=360, max_range_cells=rmax, quantum_cells=0.0)
+    scans = [rf.scan(g, q) for q in poses]
+    return CorridorResult(poses[0].copy(), poses, localise(g, scans[0], params=p),
+                          localise_joined(g, scans, poses, params=p))

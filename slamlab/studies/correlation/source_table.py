@@ -1,0 +1,84 @@
+"""Ch. 5's closing table (004 §7): the source's figures beside ours, from the notebook's runs.
+
+Split from :mod:`slamlab.studies.correlation.log_experiments` (issue 25) unchanged.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..._table import format_table
+from .experiments import (
+    FAIL_CELLS,
+    FAIL_DEG,
+    SOURCE_TABLE1,
+    ConstantsResult,
+    MonteCarloResult,
+    Table1Result,
+    run_table1,  # noqa: F401 (ours_vs_source's example)
+)
+from .studies import _errors
+
+if TYPE_CHECKING:
+    from .log_experiments import LogLocalisationResult
+
+__all__ = ["ours_vs_source"]
+
+
+def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = None,
+                   constants: ConstantsResult | None = None, log: LogLocalisationResult | None = None) -> str:
+    """The notebook's closing table: 004's figures (§7, Table 1) beside ours, from the runs' results.
+
+    Parameters
+    ----------
+    table1 : Table1Result
+        From :func:`run_table1`.
+    monte_carlo : MonteCarloResult, optional
+        From :func:`run_monte_carlo`; its row is left out when None.
+    constants : ConstantsResult, optional
+        From :func:`run_constants_study`.
+    log : LogLocalisationResult, optional
+        From :func:`run_log_localisation`.
+
+    Returns
+    -------
+    str
+        The table: 004's claim, our figures, agreement.
+
+    Examples
+    --------
+    >>> print(ours_vs_source(run_table1(2, rng=1)).splitlines()[0])
+    Ours vs the source (004 §7)
+    """
+    if not isinstance(table1, Table1Result):
+        raise TypeError(f"`table1` must be a Table1Result; got {type(table1).__name__}")
+    src = SOURCE_TABLE1
+    s_ea, s_ex, s_ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
+    t = table1
+    rows = [
+        ["Table 1: poses", f"{src.shape[0]}", f"{t.true_poses.shape[0]}"],
+        ["Table 1: max position error [cells]", f"{max(s_ex.max(), s_ey.max()):.0f}",
+         f"{max(t.err_x_cells.max(), t.err_y_cells.max()):.0f}"],
+        ["Table 1: max heading error [rad]", f"{s_ea.max():.4f}", f"{t.err_heading_rad.max():.4f}"],
+        ["Table 1: range noise σ [cells]", "not given", f"{t.range_std_cells:g}"],
+    ]
+    if monte_carlo is not None:
+        mc = monte_carlo
+        rows += [[f"Monte Carlo ({mc.n_poses} poses): position exact", "no study", f"{np.mean(mc.err_pos_cells == 0):.1%}"],
+                 [f"Monte Carlo ({mc.n_poses} poses): failures (> 2 cells or > 5°)", "no study",
+                  f"{mc.failure_rate:.1%}"]]
+    if constants is not None:
+        c = constants
+        for k, lb in enumerate(c.labels):
+            rows.append([f"{lb}: heading margin / half-max area [cells]",
+                         "sharpest at a_p = -a_c" if k == 0 else "more robust to clutter",
+                         f"{np.median(c.heading_margin[k]):.3f} / {np.median(c.half_max_area[k]):.0f}"])
+            rows.append([f"{lb}: failures in the crowded room", "not measured", f"{c.failure_rate[k]:.0%}"])
+    if log is not None:
+        for m, k in enumerate(log.joined):
+            rows.append([(f"real log {log.name}, {log._mode(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
+                          f"and {FAIL_DEG:g}°"), "none (simulation only)",
+                         f"{int(log.success[m].sum())}/{log.success.shape[1]}"])
+    return format_table(["quantity", "004", "ours"], rows, title="Ours vs the source (004 §7)")

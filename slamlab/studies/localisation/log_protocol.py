@@ -1,0 +1,290 @@
+"""The success-rate protocol of global localisation on real logs (issue 27; ours: Beluga's and IR-MCL's reports give
+the error after convergence only): seeded global runs from no prior on stretches spread over each log, with the
+success rate, the step of convergence and the error after it, against the particle count.
+
+Success is the chapter's one criterion (:data:`~slamlab.localisation.particles.FAIL_POS_CELLS` map cells and
+:data:`~slamlab.localisation.particles.FAIL_DEG` degrees at the last scan, as the simulated study); the share within
+the tracking bound (:data:`~slamlab.studies.localisation.logs.REAL_POS_M`, :data:`~slamlab.studies.localisation.logs.REAL_DEG`) is
+printed beside it, and so is the ceiling: tracking from the corrected start pose on the same stretch and odometry.
+"""
+
+from __future__ import annotations
+
+import time
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ... import _validate as v
+from ..._table import format_table
+from ...geometry import wrap_angle
+from ...geometry.odometry import simulate_odometry
+from ...localisation.mcl import MCL, MCLParams
+from ...localisation.particles import FAIL_DEG, FAIL_POS_CELLS
+from .logs import CARMEN_LOGS, REAL_DEG, REAL_POS_M, _log_map, _resolve, global_log_settings, log_settings
+
+__all__ = ["LogProtocolResult", "run_log_protocol"]
+
+
+def _stream(seed: int, log: str, start: int, *tail: int) -> np.random.Generator:
+    """A stream keyed by (seed, the log's file name, the stretch's first scan, …): a stretch's run is the same
+    whichever logs, stretches and counts share the call."""
+    return np.random.default_rng([seed, zlib.crc32(Path(log).name.encode()), start, *tail])
+
+
+def _final_errors(est_m, true_m):
+    e = np.hypot(*(est_m[:, :2] - true_m[:, :2]).T)
+    h = np.degrees(np.abs(wrap_angle(est_m[:, 2] - true_m[:, 2])))
+    return e, h
+
+
+def _run_stretch(G, frame, scans_c, idx, odo, rng, n_particles: int, kw: dict) -> np.ndarray:
+    f = MCL(G, kw.pop("z_max"), rng=rng, n_particles=n_particles, **kw)
+    out = np.empty((idx.size, 3))
+    for k, i in enumerate(idx):
+        prev, now = (odo[k - 1], odo[k]) if k else (None, None)
+        out[k] = f.step(prev, now, scans_c[i]).mean
+    return frame.to_metres(out)
+
+
+def _protocol_task(log: str, run: int, n_particles: int, n_runs: int, n_scans: int, cell_m: float,
+                   max_range_m: float, odo_trans_frac: float, odo_rot_std_deg: float, seed: int, overrides: dict,
+                   track_particles: int):
+    lg, G, frame, scans_c, Pc = _log_map(log, cell_m, max_range_m)
+    if lg.n_scans < n_scans:
+        raise ValueError(f"`n_scans` must be <= the {lg.n_scans} scans of log {lg.name!r}; got {n_scans}")
+    s0 = round(run * (lg.n_scans - n_scans) / max(1, n_runs - 1)) if n_runs > 1 else 0
+    idx = np.arange(s0, s0 + n_scans)
+    # the same stretch and odometry noise for every particle count
+    odo = simulate_odometry(Pc[idx], trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
+                            rng=_stream(seed, log, s0, 0)).poses
+    true = lg.poses[idx]
+    base = {**log_settings(cell_m), "z_max": max_range_m / cell_m}
+    t0 = time.perf_counter()
+    est = _run_stretch(G, frame, scans_c, idx, odo, _stream(seed, log, s0, 1, n_particles), n_particles,
+                       {**base, **global_log_settings(cell_m), **overrides})
+    dt = time.perf_counter() - t0
+    e, h = _final_errors(est, true)
+    ok = (e < FAIL_POS_CELLS * cell_m) & (h < FAIL_DEG)
+    bad = np.flatnonzero(~ok)
+    conv = 0 if bad.size == 0 else int(bad[-1]) + 1
+    conv = conv if conv < n_scans else -1
+    row = {"name": lg.name, "start": s0, "success": bool(ok[-1]),
+           "within_tracking_bound": bool(e[-1] < REAL_POS_M and h[-1] < REAL_DEG), "converged_step": conv,
+           "err_after_m": float(np.median(e[conv:])) if conv >= 0 else float("nan"),
+           "final_err_m": float(e[-1]), "final_err_deg": float(h[-1]), "time_per_step_s": dt / n_scans,
+           "track_success": float("nan"), "track_within_tracking_bound": float("nan")}
+    if track_particles:
+        tr = _run_stretch(G, frame, scans_c, idx, odo, _stream(seed, log, s0, 2), track_particles,
+                          {**base, "init_pose": Pc[idx[0]], "init_std": (0.1 / cell_m, 0.1 / cell_m,
+                                                                         float(np.radians(2)))})
+        te, th = _final_errors(tr, true)
+        row["track_success"] = float(te[-1] < FAIL_POS_CELLS * cell_m and th[-1] < FAIL_DEG)
+        row["track_within_tracking_bound"] = float(te[-1] < REAL_POS_M and th[-1] < REAL_DEG)
+    return row
+
+
+def _sweep_task(rng, **kw):
+    """:func:`_protocol_task` on :func:`slamlab.sweep.sweep` (its stream unused: each stretch keys its own)."""
+    return _protocol_task(**kw)
+
+
+@dataclass(frozen=True)
+class LogProtocolResult:
+    """Global localisation from no prior on stretches of real logs: success, steps to converge and error after
+    convergence against the particle count (per log).
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (log, stretch, particle count): ``name``, ``start``, ``success`` (the chapter's criterion at
+        the last scan), ``within_tracking_bound`` (within 0.2 m and 2° there), ``converged_step`` (success from
+        that step on; −1: never), ``err_after_m``, ``final_err_m``, ``final_err_deg``, ``time_per_step_s``,
+        ``track_success`` (tracking from the corrected start pose: 1.0 / 0.0; NaN when not run),
+        ``track_within_tracking_bound`` (the same run within 0.2 m and 2°).
+    n_runs, n_scans : int
+        Stretches per log, scans per stretch.
+    overrides : dict
+        The MCLParams fields given on top of the log settings.
+    cell_m : float
+        The map's cell size [m].
+    track_particles : int
+        Particles of the tracking run (0: not run).
+    """
+
+    table_df: object = field(repr=False)
+    n_runs: int = 0
+    n_scans: int = 0
+    overrides: dict = field(default_factory=dict)
+    cell_m: float = 0.1
+    track_particles: int = 0
+
+    def summary(self):
+        """One row per (log, particle count) (pandas)."""
+        g = self.table_df.groupby(["name", "n_particles"], sort=False)
+        out = g.agg(success=("success", "mean"), within_tracking_bound=("within_tracking_bound", "mean"),
+                    track_success=("track_success", "mean"),
+                    track_within=("track_within_tracking_bound", "mean"), runs=("success", "size"),
+                    time_per_step_s=("time_per_step_s", "median"))
+        conv = self.table_df[self.table_df["converged_step"] >= 0].groupby(["name", "n_particles"], sort=False)
+        out["median_converged_step"] = conv["converged_step"].median()
+        out["median_err_after_m"] = conv["err_after_m"].median()
+        return out
+
+    def _of(self, column: str, n_particles: int | None) -> float:
+        df = self.table_df
+        n = int(df["n_particles"].max()) if n_particles is None else int(n_particles)
+        return float(df[df["n_particles"] == n][column].mean())
+
+    def success(self, n_particles: int | None = None) -> float:
+        """Success rate over every log and run for one particle count (default: the largest).
+
+        Parameters
+        ----------
+        n_particles : int, optional
+            The particle count (default: the largest).
+
+        Returns
+        -------
+        float
+        """
+        return self._of("success", n_particles)
+
+    def within_tracking_bound(self, n_particles: int | None = None) -> float:
+        """Share of the runs within 0.2 m and 2° at the last scan, over every log, for one particle count.
+
+        Parameters
+        ----------
+        n_particles : int, optional
+            The particle count (default: the largest).
+
+        Returns
+        -------
+        float
+        """
+        return self._of("within_tracking_bound", n_particles)
+
+    def track_success(self, column: str = "track_success") -> float:
+        """Success rate of tracking from the corrected start pose over every log and stretch (NaN if not run).
+
+        Parameters
+        ----------
+        column : str
+            ``"track_success"`` (the chapter's criterion) or ``"track_within_tracking_bound"`` (0.2 m and 2°).
+
+        Returns
+        -------
+        float
+        """
+        df = self.table_df
+        return float(df[df["n_particles"] == df["n_particles"].max()][column].mean())
+
+    def table(self) -> str:
+        s = self.summary()
+        rows = [[name, int(n), f"{r.success:.2f}", f"{r.within_tracking_bound:.2f}", _fmt2(r.track_success),
+                 _fmt2(r.track_within), "-" if np.isnan(r.median_converged_step) else f"{r.median_converged_step:.0f}",
+                 _fmt3(r.median_err_after_m)] for (name, n), r in s.iterrows()]
+        top = self.table_df["n_particles"].max()
+        for n in sorted(self.table_df["n_particles"].unique()):  # the ceiling is run once, with the largest count
+            track = [_fmt2(self.track_success()), _fmt2(self.track_success("track_within_tracking_bound"))] \
+                if n == top else ["-", "-"]
+            rows.append(["all logs", int(n), f"{self.success(n):.2f}", f"{self.within_tracking_bound(n):.2f}",
+                         *track, "", ""])
+        p = {**log_settings(self.cell_m), **global_log_settings(self.cell_m), **self.overrides}
+        track = (f"; tracking: {self.track_particles} particles from the corrected start pose, same odometry"
+                 if self.track_particles else "")
+        return format_table(
+            ["log", "particles", "success", f"within {REAL_POS_M:g} m/{REAL_DEG:g}°", "tracking success",
+             f"tracking within {REAL_POS_M:g} m/{REAL_DEG:g}°", "median step converged", "median err after [m]"], rows,
+            title=f"Global localisation on real logs: {self.n_runs} stretches of {self.n_scans} scans per log, spread "
+                  f"over the log, one seeded run each; success: within {FAIL_POS_CELLS:g} cells "
+                  f"({FAIL_POS_CELLS * self.cell_m:g} m) and {FAIL_DEG:g}° of the corrected pose at the last scan (the "
+                  f"simulated study's criterion); converged: success from that step to the end{track}\n"
+                  f"settings: {self.cell_m:g} m cells, odometry noise 10 % + 1°/step, σ_hit "
+                  f"{p['sigma_hit'] * self.cell_m:g} m, (z_hit, z_rand) = ({p['z_hit']:g}, {p['z_rand']:g}), α2 "
+                  f"{p['alpha'][1] / self.cell_m**2:g} rad²/m², (α_slow, α_fast) = ({p['alpha_slow']:g}, "
+                  f"{p['alpha_fast']:g}), averages {p['averages']}")
+
+    def __str__(self) -> str:
+        return f"Real-log protocol: success {self.success():.2f} ({self.n_runs} runs per log)"
+
+
+def _fmt2(x) -> str:
+    return "-" if x is None or np.isnan(x) else f"{x:.2f}"
+
+
+def _fmt3(x) -> str:
+    return "-" if x is None or np.isnan(x) else f"{x:.3f}"
+
+
+def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs: int = 10, n_scans: int = 30,
+                     odo_trans_frac: float = 0.1, odo_rot_std_deg: float = 1.0, track_particles: int = 3000,
+                     params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None, seed=None,
+                     **overrides) -> LogProtocolResult:
+    """Global localisation from no prior on ``n_runs`` stretches of ``n_scans`` scans of every log, spread evenly
+    over the log, for every particle count (the same stretches and odometry noise for every count), beside
+    tracking from the corrected start pose (the ceiling); on :func:`slamlab.sweep.sweep`. Settings as the global
+    run of :func:`~slamlab.studies.localisation.logs.run_log_mcl`.
+
+    Every stretch's odometry noise and filter stream are keyed by (seed, the log's file name, the stretch's first
+    scan, the particle count): a stretch gives the same run whichever logs, stretches and counts share the call.
+
+    Parameters
+    ----------
+    logs : str, os.PathLike or a sequence of them
+        Names of :data:`~slamlab.studies.localisation.logs.CARMEN_LOGS` or paths of any CARMEN log.
+    particle_counts : sequence of int
+        Particle counts (each replaces ``params.n_particles``).
+    n_runs, n_scans : int
+        Stretches per log, scans per stretch.
+    odo_trans_frac, odo_rot_std_deg : float
+        The odometry noise we add: share of each step's length, degrees per step.
+    track_particles : int
+        Particles of the tracking run from the corrected start pose (σ 0.1 m, 2°) with the tracking settings
+        (:func:`~slamlab.studies.localisation.logs.log_settings`); 0: no tracking run.
+    params : MCLParams, optional
+        Settings on top of :func:`~slamlab.studies.localisation.logs.log_settings` and
+        :func:`~slamlab.studies.localisation.logs.global_log_settings` (only the fields that differ from the
+        :class:`MCLParams` defaults count); the global runs only.
+    rng : int, SeedSequence or Generator
+        The seed of every stream (a SeedSequence or Generator gives it as its first generated word).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields (global runs).
+
+    Returns
+    -------
+    LogProtocolResult
+    """
+    import numbers
+
+    from ...sweep import renamed_seed, root_seed_sequence, sweep
+
+    rng = renamed_seed(rng, seed, "run_log_protocol")
+    root = root_seed_sequence(rng, "rng")
+    key = int(rng) if isinstance(rng, numbers.Integral) else int(root.generate_state(1, np.uint64)[0])
+    overrides = MCLParams.as_overrides(params, **overrides)
+    overrides.pop("n_particles", None)  # each count of `particle_counts` replaces it
+    if isinstance(logs, (str, bytes)) or not hasattr(logs, "__iter__"):
+        logs = [logs]
+    paths = [_resolve(p) for p in logs]
+    counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
+    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
+    n_scans = v.check_int(n_scans, "n_scans", minimum=2)
+    track_particles = v.check_int(track_particles, "track_particles", minimum=0)
+    # the tracking run (the ceiling) once per stretch: with the largest count's row
+    pts = [{"log": p, "run": r, "n_particles": c, "track_particles": track_particles if c == max(counts) else 0}
+           for p in paths for c in counts for r in range(n_runs)]
+    df = sweep(_sweep_task, pts, seeds=1, seed=root, n_jobs=n_jobs, progress=progress,
+               on_error="raise", desc="MCL log protocol",
+               fixed={"n_runs": n_runs, "n_scans": n_scans, "cell_m": 0.1, "max_range_m": 10.0,
+                      "odo_trans_frac": odo_trans_frac, "odo_rot_std_deg": odo_rot_std_deg, "seed": key,
+                      "overrides": dict(overrides)})
+    return LogProtocolResult(df, n_runs, n_scans, dict(overrides), 0.1, track_particles)

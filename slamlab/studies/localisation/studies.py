@@ -1,0 +1,476 @@
+"""Monte Carlo studies of MCL in the simulated test room (003 §2.2): global localisation against the step and the
+particle count, the ablation that finds what global localisation depends on, the kidnapped robot, and the
+observation score compared on both.
+
+Every study runs on :func:`slamlab.sweep.sweep` with one seeded stream per run. Variants of a study are run as one
+sweep each from the same seed, so run ``i`` of every variant is the same simulated run (path, scans, odometry)
+and the comparison is paired. Success at step ``k``: the estimate within 3 cells and 5° of the truth at that step
+(ours). AMCL's convergence test (ROS 1 amcl ``pf_update_converged``: every particle within ``converged_dist`` of
+the particles' mean in x and y) is reported beside it: "converged" says nothing about *where*, so a run can be
+converged and wrong.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ... import _validate as v
+from ..._table import format_table
+from ...localisation.mcl import MCLParams
+from .experiments import FAIL_DEG, FAIL_POS_CELLS, run_filter, simulate_run
+from .kidnap import KIDNAP_VARIANTS, KidnapResult, _fmt, _params_line, run_kidnapped
+
+__all__ = [
+    "ABLATION",
+    "ABLATION_MORE",
+    "CHAPTER_BEFORE",
+    "SCORE_VARIANTS",
+    "AblationResult",
+    "GlobalResult",
+    "KidnapResult",
+    "ScoreComparison",
+    "run_global_ablation",
+    "run_global_localisation",
+    "run_kidnapped",
+    "run_score_comparison",
+]
+
+#: The chapter's global-localisation set-up before issue 27 (what gave 0.10 / 0.30 / 0.52): PR's product weights
+#: (gamma = 1), the geometric-mean score in eq 2.8, 003's averages from 0 (so no injection with α_slow = 0.001),
+#: σ_hit 2 cells, the old motion noise, no jitter; the old study judged at step 20.
+CHAPTER_BEFORE = {"score": "geometric_mean", "averages": "003", "sigma_hit": 2.0, "max_dist": 8.0,
+                  "alpha": (0.05, 0.002, 0.05, 0.005), "gamma": 1.0, "jitter": (0.0, 0.0)}
+
+#: The ablation: (label, overrides of the defaults). The first block starts from :data:`CHAPTER_BEFORE` and
+#: changes one factor; the second starts from the defaults and takes one factor back.
+ABLATION = (
+    ("before (issue 12 set-up)", CHAPTER_BEFORE),
+    ("before + σ_hit 4, motion ×4, jitter, p^0.5", {**CHAPTER_BEFORE, "sigma_hit": 4.0, "max_dist": 12.0,
+                                                   "alpha": (0.2, 0.008, 0.2, 0.02), "jitter": (0.6, 0.04),
+                                                   "gamma": 0.5}),
+    ("before + injection (debiased averages)", {**CHAPTER_BEFORE, "averages": "debiased"}),
+    ("defaults", {}),
+    ("defaults, σ_hit 2 cells", {"sigma_hit": 2.0, "max_dist": 8.0}),
+    ("defaults, old motion noise", {"alpha": (0.05, 0.002, 0.05, 0.005)}),
+    ("defaults, no jitter", {"jitter": (0.0, 0.0)}),
+    ("defaults, weights p^1", {"gamma": 1.0}),
+    ("defaults, no injection", {"alpha_slow": 0.0, "alpha_fast": 0.0}),
+)
+
+#: More variants for the "full" ablation (benchmarks): resampling, beams, amcl's update thresholds, eq 2.8's score.
+ABLATION_MORE = (
+    ("defaults, eq 2.8 on p(z | x)", {"score": "likelihood"}),
+    ("defaults, resample every step", {"resample_threshold": 1.0}),
+    ("defaults, 60 beams", {"max_beams": 60}),
+    ("defaults, amcl update thresholds", {"update_min_d": 2.0, "update_min_a": float(np.pi / 6)}),
+)
+
+#: The observation scores compared (label, overrides): eq 2.8 averages ω; the weights are p(z | x) in every case.
+SCORE_VARIANTS = (
+    ("ω = p(z | x) (PR Table 8.3; amcl likelihood_field_prob)", {"score": "likelihood"}),
+    ("ω = per-beam geometric mean (ours; defaults)", {"score": "geometric_mean"}),
+    ("ω = 1 + Σ p³ (ROS 1 amcl likelihood_field, Beluga)", {"score": "amcl_cubes"}),
+)
+
+
+def _bits(flags) -> str:
+    return "".join("1" if f else "0" for f in flags)
+
+
+def _on_turn(run) -> bool:
+    """Whether the run starts in one of the path's turns on the spot (the first two poses at one place)."""
+    return bool(np.hypot(*(run.true_poses[1, :2] - run.true_poses[0, :2])) < 1e-9)
+
+
+def _global_task(rng, n_particles: int, n_steps: int, overrides: dict, variant: str = "", world: str = "map"):
+    run = simulate_run(n_steps, world=world, rng=rng)
+    r = run_filter(run, n_particles=n_particles, rng=rng, **overrides)
+    return {"ok": _bits(r.ok), "conv": _bits(x.converged for x in r.records), "on_turn": _on_turn(run),
+            "resampled": float(np.mean([x.resampled for x in r.records])), "time_per_step_s": r.time_s / run.n_steps}
+
+
+def _per_step(df, col: str) -> np.ndarray:
+    """(runs, steps) 0/1 array of a bit-string column."""
+    return np.array([[c == "1" for c in s] for s in df[col]], dtype=bool)
+
+
+def _stays_from(ok: np.ndarray) -> np.ndarray:
+    """Per run, the first step from which the estimate stays within the bounds to the end (-1: never)."""
+    out = np.full(ok.shape[0], -1)
+    for i, row in enumerate(ok):
+        bad = np.flatnonzero(~row)
+        k = 0 if bad.size == 0 else int(bad[-1]) + 1
+        out[i] = k if k < row.size else -1
+    return out
+
+
+def _group_stats(g, steps) -> dict:
+    ok, conv = _per_step(g, "ok"), _per_step(g, "conv")
+    n = ok.shape[1]
+    stays = _stays_from(ok)
+    turn = g["on_turn"].to_numpy(bool)
+    return {"runs": len(g), **{f"success@{k}": float(ok[:, k - 1].mean()) for k in steps if k <= n},
+            "amcl_converged": float(conv[:, -1].mean()), "converged_wrong": float((conv[:, -1] & ~ok[:, -1]).mean()),
+            "median_step": float(np.median(stays[stays >= 0])) if (stays >= 0).any() else float("nan"),
+            "success_turn_start": float(ok[turn, -1].mean()) if turn.any() else float("nan"),
+            "n_turn_start": int(turn.sum()),
+            "success_leg_start": float(ok[~turn, -1].mean()) if (~turn).any() else float("nan"),
+            "resampled": float(g["resampled"].mean()),
+            "time_per_step_s": float(g["time_per_step_s"].median())}
+
+
+# --- global localisation: success against the step and the particle count -----------------------------------
+
+
+@dataclass(frozen=True)
+class GlobalResult:
+    """Global localisation from no prior: per particle count and step, the share of runs within the bounds,
+    and AMCL's convergence test at the last step.
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (particle count, run).
+    n_runs, n_steps : int
+        Runs per count, steps per run.
+    overrides : dict
+        MCLParams fields given to every run.
+    """
+
+    table_df: object = field(repr=False)
+    n_runs: int = 0
+    n_steps: int = 0
+    overrides: dict = field(default_factory=dict)
+
+    def success(self, n_particles: int | None = None, step: int | None = None) -> float:
+        """Share of runs within 3 cells and 5° at ``step`` (default: the last) for one count (default: the
+        largest).
+
+        Parameters
+        ----------
+        n_particles : int, optional
+            The particle count (default: the largest).
+        step : int, optional
+            The step, from 1 (default: the last).
+
+        Returns
+        -------
+        float
+        """
+        df = self.table_df
+        n = int(df["n_particles"].max()) if n_particles is None else int(n_particles)
+        ok = _per_step(df[df["n_particles"] == n], "ok")
+        return float(ok[:, (self.n_steps if step is None else step) - 1].mean())
+
+    def summary(self):
+        """One row per particle count (pandas): success at steps 5, 10, 20, 30 and the last, AMCL's test…"""
+        import pandas as pd
+
+        steps = sorted({5, 10, 20, 30, self.n_steps})
+        rows = {int(n): _group_stats(g, steps) for n, g in self.table_df.groupby("n_particles")}
+        out = pd.DataFrame.from_dict(rows, orient="index")
+        out["success"] = out[f"success@{self.n_steps}"]
+        return out
+
+    def table(self) -> str:
+        s = self.summary()
+        steps = [k for k in (5, 10, 20, 30) if k <= self.n_steps]
+        if self.n_steps not in steps:
+            steps.append(self.n_steps)
+        rows = [[int(n), *(_fmt(r[f"success@{k}"]) for k in steps), _fmt(r.amcl_converged),
+                 _fmt(r.converged_wrong), _fmt(r.median_step, 0)] for n, r in s.iterrows()]
+        return format_table(["particles", *(f"success @{k}" for k in steps), "amcl converged @end",
+                             "converged but wrong", "median step localised"], rows,
+                            title=f"Global localisation from no prior, {self.n_runs} runs per count (the same runs), "
+                                  f"{self.n_steps} steps; success @k: within {FAIL_POS_CELLS:g} cells and "
+                                  f"{FAIL_DEG:g}° at step k; amcl: every particle within "
+                                  f"{MCLParams(**self.overrides).converged_dist:g} cells of the mean\n"
+                                  f"settings: {_params_line(self.overrides)}")
+
+    def step_table(self, every: int = 5) -> str:
+        """Success against the step, one column per particle count.
+
+        Parameters
+        ----------
+        every : int
+            Show every ``every``-th step.
+
+        Returns
+        -------
+        str
+        """
+        df = self.table_df
+        counts = sorted(int(n) for n in df["n_particles"].unique())
+        oks = {n: _per_step(df[df["n_particles"] == n], "ok").mean(axis=0) for n in counts}
+        convs = {n: _per_step(df[df["n_particles"] == n], "conv").mean(axis=0) for n in counts}
+        ks = sorted({1, *range(every, self.n_steps + 1, every), self.n_steps})
+        rows = [[k, *(f"{oks[n][k - 1]:.2f} / {convs[n][k - 1]:.2f}" for n in counts)] for k in ks]
+        return format_table(["step", *(f"{n} particles" for n in counts)], rows,
+                            title="Success / amcl-converged share against the step")
+
+    def timing_table(self) -> str:
+        s = self.summary()
+        rows = [[int(n), f"{1e3 * r.time_per_step_s:.2f}"] for n, r in s.iterrows()]
+        return format_table(["particles", "median ms per step"], rows, title="Time per MCL step (wall clock)")
+
+    def __str__(self) -> str:
+        s = self.summary()
+        return "Global localisation: success " + ", ".join(f"{r.success:.2f} at {int(n)}" for n, r in s.iterrows())
+
+
+def _paired_sweep(points, *, n_runs, rng, n_jobs, progress, fixed):
+    """One sweep per point from a fresh copy of the same seed: run i of every point is the same simulated run."""
+    import pandas as pd
+
+    from ...sweep import fresh_seed_sequence, sweep
+
+    frames = [sweep(_global_task, [pt], seeds=n_runs, seed=fresh_seed_sequence(rng), n_jobs=n_jobs,
+                    progress=progress, fixed=fixed, on_error="raise", desc="global localisation")
+              for pt in points]
+    return pd.concat(frames, ignore_index=True)
+
+
+def run_global_localisation(particle_counts=(500, 1000, 2500), *, n_runs: int = 50, n_steps: int = 30,
+                            params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None,
+                            seed=None, **overrides) -> GlobalResult:
+    """Global localisation in the test room from no prior: ``n_runs`` seeded runs per particle count (the same
+    runs for every count), each from a random place on 004's path.
+
+    Parameters
+    ----------
+    particle_counts : sequence of int
+        Particle counts (each replaces ``params.n_particles``).
+    n_runs, n_steps : int
+        Runs per count, and steps per run.
+    params : MCLParams, optional
+        Settings of MCL (default: the defaults); ``overrides`` and each variant's overrides apply on top.
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every variant).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields.
+
+    Returns
+    -------
+    GlobalResult
+    """
+    from ...sweep import renamed_seed
+
+    rng = renamed_seed(rng, seed, "run_global_localisation")
+    counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
+    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
+    n_steps = v.check_int(n_steps, "n_steps", minimum=2)
+    overrides = MCLParams.as_overrides(params, **overrides)  # a bad override fails here, naming the fields
+    overrides.pop("n_particles", None)  # each count of `particle_counts` replaces it
+    df = _paired_sweep([{"n_particles": c} for c in counts], n_runs=n_runs, rng=rng, n_jobs=n_jobs,
+                       progress=progress, fixed={"n_steps": n_steps, "overrides": dict(overrides)})
+    return GlobalResult(df, n_runs, n_steps, dict(overrides))
+
+
+# --- the ablation -------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class AblationResult:
+    """Global localisation with one factor changed at a time (the same runs for every variant).
+
+    Parameters
+    ----------
+    table_df : pandas.DataFrame
+        One row per (variant, run).
+    labels : tuple of str
+        The variants, in table order.
+    n_runs, n_steps, n_particles : int
+        Runs per variant, steps per run, particles.
+    world : str
+        What the scans see ("map" or "cluttered").
+    base : dict
+        MCLParams fields under every variant's.
+    """
+
+    table_df: object = field(repr=False)
+    labels: tuple = ()
+    n_runs: int = 0
+    n_steps: int = 0
+    n_particles: int = 0
+    world: str = "map"
+    base: dict = field(default_factory=dict)  # MCLParams overrides under every variant's (params=, **overrides)
+
+    @property
+    def mid_step(self) -> int:
+        """The earlier step of the table: 20 (issue 12's run length), or half the run when it is shorter."""
+        return 20 if self.n_steps > 20 else max(1, self.n_steps // 2)
+
+    def summary(self):
+        """One row per variant (pandas), in the order of the study."""
+        import pandas as pd
+
+        steps = sorted({self.mid_step, self.n_steps})
+        rows = [{"variant": lab, **_group_stats(self.table_df[self.table_df["variant"] == lab], steps)}
+                for lab in self.labels]
+        return pd.DataFrame(rows).set_index("variant")
+
+    def table(self) -> str:
+        s = self.summary()
+        rows = [[lab, _fmt(r[f"success@{self.mid_step}"]), _fmt(r[f"success@{self.n_steps}"]), _fmt(r.amcl_converged),
+                 _fmt(r.converged_wrong), f"{_fmt(r.success_turn_start)} ({int(r.n_turn_start)})",
+                 _fmt(r.success_leg_start), _fmt(r.resampled)] for lab, r in s.iterrows()]
+        return format_table(["variant", f"success @{self.mid_step}", f"success @{self.n_steps}", "amcl converged",
+                             "converged but wrong", "success, turn start (runs)", "success, leg start",
+                             "steps resampled"], rows,
+                            title=f"Global localisation{' among unmapped clutter' if self.world != 'map' else ''}: "
+                                  f"{self.n_particles} particles, the same "
+                                  f"{self.n_runs} runs for every variant, {self.n_steps} steps; columns after "
+                                  f"the second at step {self.n_steps}\ndefaults: {_params_line(self.base)}")
+
+    def __str__(self) -> str:
+        return f"Ablation of global localisation, {len(self.labels)} variants × {self.n_runs} runs"
+
+
+_SIZES = {"small": {"n_runs": 8, "n_particles": 2500}, "full": {"n_runs": 50, "n_particles": 2500}}
+
+
+def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int | None = None,
+                        n_particles: int | None = None, n_steps: int = 30, world: str = "map",
+                        params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None, seed=None,
+                        **overrides) -> AblationResult:
+    """Global localisation with one factor changed at a time (``variants``: (label, MCLParams overrides)).
+
+    Parameters
+    ----------
+    variants : sequence of (str, dict)
+        (label, :class:`MCLParams` overrides) pairs, applied on top of ``params`` and ``overrides``.
+    size : {"small", "full"}
+        "small" (8 runs of 2500 particles per variant, the notebook) or "full" (50 runs).
+    n_runs, n_particles : int, optional
+        Replace the size's runs per variant and particle count.
+    n_steps : int
+        Steps per run.
+    world : {"map", "cluttered"}
+        See :func:`~slamlab.studies.localisation.experiments.simulate_run` ("cluttered": scans with unmapped objects).
+    params : MCLParams, optional
+        The settings every variant changes (default: the defaults).
+    rng : int, SeedSequence or Generator
+        Where every run's stream is spawned from (run ``i`` the same for every variant).
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields under every variant.
+
+    Returns
+    -------
+    AblationResult
+    """
+    from ...sweep import renamed_seed
+
+    rng = renamed_seed(rng, seed, "run_global_ablation")
+    base = MCLParams.as_overrides(params, **overrides)
+    base.pop("n_particles", None)  # the particle count is `n_particles` (or the size's)
+    v.check_choice(size, "size", tuple(_SIZES))
+    n_runs = v.check_int(_SIZES[size]["n_runs"] if n_runs is None else n_runs, "n_runs", minimum=1)
+    n_part = v.check_int(_SIZES[size]["n_particles"] if n_particles is None else n_particles, "n_particles",
+                         minimum=1)
+    labels = []
+    for item in variants:
+        if not (isinstance(item, tuple) and len(item) == 2 and isinstance(item[0], str) and isinstance(item[1], dict)):
+            raise TypeError(f"`variants` must hold (label, overrides dict) pairs; got {item!r}")
+        MCLParams.resolve(None, **{**base, **item[1]})
+        labels.append(item[0])
+    if len(set(labels)) != len(labels):
+        raise ValueError("`variants` labels must be distinct")
+    df = _paired_sweep([{"variant": lab, "overrides": {**base, **ov}} for lab, ov in variants], n_runs=n_runs,
+                       rng=rng, n_jobs=n_jobs, progress=progress,
+                       fixed={"n_steps": n_steps, "n_particles": n_part, "world": v.check_choice(world, "world",
+                                                                                                ("map", "cluttered"))})
+    return AblationResult(df, tuple(labels), n_runs, n_steps, n_part, world, base)
+
+
+@dataclass(frozen=True)
+class ScoreComparison:
+    """Each observation score: global success (the ablation's runs) and kidnap recovery.
+
+    Parameters
+    ----------
+    global_ : AblationResult
+        Global success per score.
+    kidnap : KidnapResult
+        Kidnap recovery per score.
+    """
+
+    global_: AblationResult
+    kidnap: KidnapResult
+
+    def table(self) -> str:
+        g = self.global_.summary()
+        k = {r[0]: r for r in self.kidnap.rows()}
+        rows = [[lab, _fmt(g.loc[lab, f"success@{self.global_.n_steps}"]), _fmt(g.loc[lab, "amcl_converged"]),
+                 k[lab][2], k[lab][3], k[lab][4], k[lab][1]] for lab in self.global_.labels]
+        return format_table(["score ω that eq 2.8 averages", f"global success @{self.global_.n_steps}",
+                             "amcl converged", "kidnap recovered", "steps to recover", "% injected/step tracking",
+                             "tracked before"], rows,
+                            title=f"The observation score: global localisation ({self.global_.n_particles} particles, "
+                                  f"{self.global_.n_runs} runs) and kidnap ({self.kidnap.n_particles} particles, "
+                                  f"{self.kidnap.n_runs} runs); other settings the defaults")
+
+    def __str__(self) -> str:
+        return f"Observation scores compared: {len(self.global_.labels)} scores"
+
+
+def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000,
+                         global_particles: int = 2500, params: MCLParams | None = None, rng=0, n_jobs: int = 1,
+                         progress=None, seed=None, **overrides) -> ScoreComparison:
+    """Each score variant on the global study (``global_particles``) and the kidnap study (``n_particles``),
+    ``n_runs`` runs each.
+
+    Parameters
+    ----------
+    variants : sequence of (str, dict)
+        (label, :class:`MCLParams` overrides) pairs.
+    n_runs, n_particles, global_particles : int
+        Runs per variant; particles of the kidnap and of the global study.
+    params : MCLParams, optional
+        The settings every variant changes (default: the defaults).
+    rng : int, SeedSequence or Generator
+        An int seed ``s`` runs the global study from ``s`` and the kidnap study from ``s + 1``; otherwise the
+        two studies draw from two children spawned from ``rng``.
+    n_jobs : int
+        Parallel workers of :func:`slamlab.sweep.sweep`.
+    progress : bool, callable or None
+        See :mod:`slamlab._progress`.
+    seed : int, optional
+        Deprecated name of ``rng``.
+    **overrides
+        :class:`MCLParams` fields under every variant.
+
+    Returns
+    -------
+    ScoreComparison
+    """
+    import numbers
+
+    from ...sweep import renamed_seed, root_seed_sequence
+
+    rng = renamed_seed(rng, seed, "run_score_comparison")
+    if isinstance(rng, numbers.Integral) and not isinstance(rng, bool):
+        rng_g, rng_k = rng, rng + 1
+    else:
+        rng_g, rng_k = root_seed_sequence(rng, "rng").spawn(2)
+    g = run_global_ablation(variants, n_runs=n_runs, n_particles=global_particles, params=params, rng=rng_g,
+                            n_jobs=n_jobs, progress=progress, **overrides)
+    k = run_kidnapped(variants, n_runs=n_runs, n_particles=n_particles, params=params, rng=rng_k, n_jobs=n_jobs,
+                      progress=progress, **overrides)
+    return ScoreComparison(g, k)
+
+
+__all__ += ["KIDNAP_VARIANTS"]

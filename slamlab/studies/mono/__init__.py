@@ -1,0 +1,70 @@
+"""Ch. 9 monocular mapping's studies (003 §2.1, §4, §5): runs, failure cases, ablations, tables and widgets."""
+
+from ..._lazy import lazy_exports
+from .convergence import (
+    ConvergenceStudy,
+    ConvergenceTests,
+    run_convergence_tests,
+    run_depth_filter_convergence,
+)
+from .experiments import (
+    failure_table,
+    run_failure_cases,
+    run_mono_sequence,
+    run_parameter_sweep,
+    sequence_poses,
+)
+from .formulas import chapter_cameras, inverse_depth_point_table, pinhole_table, tau_table
+from .kitti import epipolar_demo, load_kitti, run_kitti_ablation, run_kitti_mono
+from .runs import MonoRunResult, run_mono
+from .studies import (
+    MonoVsStereo,
+    ablation_table,
+    compare_init_methods,
+    ours_vs_source,
+    run_ablation,
+    run_mono_vs_stereo,
+    source_findings_table,
+)
+
+__all__ = [
+    "ConvergenceStudy",
+    "ConvergenceTests",
+    "MonoRunResult",
+    "MonoVsStereo",
+    "ablation_table",
+    "chapter_cameras",
+    "compare_init_methods",
+    "epipolar_demo",
+    "explore_depth_filter",
+    "explore_failure_cases",
+    "explore_mono",
+    "explore_motion_prior",
+    "failure_table",
+    "inverse_depth_point_table",
+    "load_kitti",
+    "ours_vs_source",
+    "pinhole_table",
+    "plot_convergence",
+    "plot_map_top",
+    "plot_pinhole",
+    "run_ablation",
+    "run_convergence_tests",
+    "run_depth_filter_convergence",
+    "run_failure_cases",
+    "run_kitti_ablation",
+    "run_kitti_mono",
+    "run_mono",
+    "run_mono_sequence",
+    "run_mono_vs_stereo",
+    "run_parameter_sweep",
+    "sequence_poses",
+    "source_findings_table",
+    "tau_table",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, {
+    "plot_convergence": ".plot", "plot_map_top": ".plot", "plot_pinhole": ".plot",
+    "explore_depth_filter": ".widgets", "explore_failure_cases": ".widgets", "explore_mono": ".widgets",
+    "explore_motion_prior": ".widgets",
+})

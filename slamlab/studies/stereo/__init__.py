@@ -1,0 +1,65 @@
+"""Ch. 05 stereo SLAM (000 §3.2-3.7): the arena runs, KITTI, the drift and scale studies, their tables, plots and widget."""
+
+from ..._lazy import lazy_exports
+from .experiments import (
+    COMPARISON,
+    SIZES,
+    DriftStudy,
+    StereoRunResult,
+    comparison_table,
+    disparity_errors,
+    experiment_poses,
+    record_stereo_stream,
+    run_closed_loop,
+    run_comparison,
+    run_drift_study,
+    run_stereo_slam,
+    run_stereo_slam_variants,
+    run_turn_in_place,
+)
+from .heading import heading_frames
+from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
+from .scale_ablation import (
+    ABLATION_BASE,
+    PROPOSED_FIX,
+    PROPOSED_FIX_OFF,
+    SCALE_ABLATION,
+    ScaleAblation,
+    run_scale_ablation,
+)
+
+_LAZY = {
+    **dict.fromkeys(("plot_kitti", "plot_run_errors", "plot_run_map", "run_figure"), ".plot"),
+    "explore_stereo_slam": ".widgets",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY)
+
+__all__ = [
+    "ABLATION_BASE",
+    "COMPARISON",
+    "KITTI_PARAMS",
+    "PROPOSED_FIX",
+    "PROPOSED_FIX_OFF",
+    "SCALE_ABLATION",
+    "SIZES",
+    "DriftStudy",
+    "KittiRunResult",
+    "ScaleAblation",
+    "StereoRunResult",
+    "comparison_table",
+    "disparity_errors",
+    "experiment_poses",
+    "heading_frames",
+    "kitti_comparison",
+    "ours_vs_source",
+    "record_stereo_stream",
+    "run_closed_loop",
+    "run_comparison",
+    "run_drift_study",
+    "run_kitti",
+    "run_scale_ablation",
+    "run_stereo_slam",
+    "run_stereo_slam_variants",
+    "run_turn_in_place",
+]
+__all__ += list(_LAZY)
