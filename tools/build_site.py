@@ -373,8 +373,9 @@ def api_page(page: str, modules: list[str], xref: dict[str, list[str]], chapter_
     if users:
         out += ["Chapters that call this package: "
                 + ", ".join(f":doc:`{chapter_titles[c]} </chapters/{c}>`" for c in sorted(users)) + ".", ""]
-    out += [".. list-table::", "   :header-rows: 1", "   :widths: 40 25 35", "",
-            "   * - function or class", "     - source section", "     - called in chapters"]
+    if rows:  # a package of subpackages only (slamlab.studies) has no table of its own
+        out += [".. list-table::", "   :header-rows: 1", "   :widths: 40 25 35", "",
+                "   * - function or class", "     - source section", "     - called in chapters"]
     for name, section, chapters in rows:
         out += [f"   * - :py:obj:`~{name}`", f"     - {_rst_escape(section) if section else '—'}",
                 "     - " + (", ".join(f":doc:`{c[:2]} </chapters/{c}>`" for c in chapters) if chapters else "—")]

@@ -6,17 +6,15 @@ the course site import it. A reader of an algorithm finds the method, its settin
 plots in the algorithm's own package; the chapter's runs of it live here, e.g.
 ``sl.studies.localisation.run_global_localisation``.
 
-| subpackage | chapters |
-|---|---|
-| ``filters`` | 01 Kalman filters |
-| ``features`` | 02 detectors, 03 matching |
-| ``kdtree`` | 03 matching, 04 landmark stores |
-| ``stereo`` | 05 stereo SLAM |
-| ``correlation`` | 06 correlation localisation |
-| ``hough`` | 07 Hough SLAM |
-| ``localisation`` | 08 probabilistic localisation |
-| ``mono`` | 09 monocular mapping |
-| ``planes`` | 10 plane-based 3-D SLAM |
+- ``filters``: 01 Kalman filters;
+- ``features``: 02 detectors, 03 matching;
+- ``kdtree``: 03 matching, 04 landmark stores;
+- ``stereo``: 05 stereo SLAM;
+- ``correlation``: 06 correlation localisation;
+- ``hough``: 07 Hough SLAM;
+- ``localisation``: 08 probabilistic localisation;
+- ``mono``: 09 monocular mapping;
+- ``planes``: 10 plane-based 3-D SLAM.
 """
 
 from __future__ import annotations
