@@ -35,7 +35,7 @@ from slamlab.stereo import STAGES, RenderParams, StereoParams, StereoSLAM
 
 def load(n_frames, cache: Path):
     path = sl.sim.long_path(0.25, np.deg2rad(15.0))
-    room = sl.sim.StereoArena(10.0, 12.0, seed=0)
+    room = sl.sim.StereoArena(10.0, 12.0, texture_seed=0)
     render = RenderParams()
     r_sim, r_slam = np.random.SeedSequence(0).spawn(2)  # as run_stereo_slam_variants(rng=0)
     sim = sl.sim.StereoSim(room, None, camera_height_m=render.camera_height_m, noise_std=render.noise_std,

@@ -87,7 +87,7 @@ def _flann_recalls(Q, X, i_ref, seeds=range(10), checks=200):
     """NN recall of FLANN's one randomised tree (``checks`` points examined) built after ``cv2.setRNGSeed(s)``."""
     from slamlab.kdtree.knn import flann_index
 
-    return np.array([np.mean(F.knn2(Q, X, method="flann", checks=checks, tree=flann_index(X, trees=1, seed=s))[1][:, 0]
+    return np.array([np.mean(F.knn2(Q, X, method="flann", checks=checks, tree=flann_index(X, trees=1, opencv_seed=s))[1][:, 0]
                              == i_ref[:, 0]) for s in seeds])
 
 
@@ -111,7 +111,7 @@ def bench_matching(sizes, n_queries=500, repeats=3):
         t_build, tree = _timed(lambda X=train: KDTree(X), 1)
         t_build_opt, tree_opt = _timed(lambda X=train: KDTree(X, split=BEST_SPLIT, gap=BEST_GAP), 1)
         ck = cKDTree(train.astype(np.float64))
-        fl = flann_index(train, trees=1, seed=0)
+        fl = flann_index(train, trees=1, opencv_seed=0)
         results = {k: _timed(fn, 1 if "exact" in k else repeats)
                    for k, fn in _methods(Q, train, tree, tree_opt, ck, fl, n).items()}
         t_brute, (_, i_ref) = results["brute (BLAS)"]

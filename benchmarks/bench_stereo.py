@@ -85,7 +85,7 @@ def main(argv=None):
     say(f"load average at start: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     say(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
         f"numpy {np.__version__}, OpenCV {cv2.__version__}")  # fmt: skip
-    arena = sl.sim.StereoArena(seed=0)
+    arena = sl.sim.StereoArena(texture_seed=0)
     sim = sl.sim.StereoSim(arena, rng=0)
     poses = sl.sim.turn_in_place(np.deg2rad(5.0))[: args.frames]
     t_render, frames = best_wall(lambda: [sim.render_pair(p) for p in poses], repeat=1)
@@ -127,7 +127,7 @@ def main(argv=None):
         say("```")
     if args.long:
         say()
-        room = sl.sim.StereoArena(10.0, 12.0, seed=0)
+        room = sl.sim.StereoArena(10.0, 12.0, texture_seed=0)
         path = sl.sim.long_path(0.25, np.deg2rad(15.0))
         length_m = float(np.sum(np.hypot(*np.diff(path[:, :2], axis=0).T)))
         for det in args.detectors.split(","):

@@ -83,7 +83,7 @@ def compare_all(other):
     from slamlab import sim  # the stereo arena's renders (flat fences and floor: ties in the orientation)
 
     for noise in (0.0, 2.0):
-        rig = sim.StereoSim(sim.StereoArena(seed=0), noise_std=noise, rng=0)
+        rig = sim.StereoSim(sim.StereoArena(texture_seed=0), noise_std=noise, rng=0)
         for pose in ([2.0, 2.0, 0.3], [4.0, 3.0, 1.2], [3.0, 5.0, -2.0], [1.0, 1.0, 0.0], [4.5, 4.5, 2.5]):
             for side, im in zip("LR", rig.render_pair(pose), strict=True):
                 images.append((f"arena {pose} {side}", to_gray_float(im), settings[2:3] + settings[0:1] + settings[4:]))

@@ -35,9 +35,9 @@ def wall(fn, repeat=3):
 
 def overhead(n_tasks: int = 400) -> None:
     grid = {"scale": [float(s) for s in range(n_tasks)]}
-    t1, a = wall(lambda: sweep(noisy, grid, seed=1, progress=False))
-    sweep(noisy, {"scale": [1.0, 2.0]}, seed=1, n_jobs=2, progress=False)  # start the loky workers once
-    t2, b = wall(lambda: sweep(noisy, grid, seed=1, n_jobs=2, progress=False))
+    t1, a = wall(lambda: sweep(noisy, grid, rng=1, progress=False))
+    sweep(noisy, {"scale": [1.0, 2.0]}, rng=1, n_jobs=2, progress=False)  # start the loky workers once
+    t2, b = wall(lambda: sweep(noisy, grid, rng=1, n_jobs=2, progress=False))
     assert a.equals(b), "tables differ between 1 and 2 workers"
     print(f"trivial task x {n_tasks}: 1 worker {t1 * 1e6 / n_tasks:.0f} us/task, "
           f"2 workers {t2 * 1e6 / n_tasks:.0f} us/task (tables identical)")

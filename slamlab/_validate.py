@@ -169,7 +169,8 @@ def as_rng(rng: Any, name: str = "rng") -> np.random.Generator:
         if rng < 0:
             raise ValueError(f"`{name}` seed must be non-negative; got {rng}")
         return np.random.default_rng(int(rng))
-    raise TypeError(f"`{name}` must be a numpy Generator, an int seed or None; got {type(rng).__name__}")
+    raise TypeError(f"`{name}` must be a numpy Generator, an int seed, a SeedSequence or None; "
+                    f"got {type(rng).__name__}")
 
 
 def check_int(value: Any, name: str, *, minimum: int | None = None, maximum: int | None = None) -> int:

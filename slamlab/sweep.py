@@ -4,9 +4,10 @@
 DataFrame with one row per run: the parameters, the replicate number, the results
 and an ``error`` column (a run that raises is a row with its error, never a lost
 run). Each run draws its random numbers from its own ``numpy.random.Generator``
-built from ``SeedSequence(seed).spawn(n_runs)[i]``, where ``i`` is the run's place
-in the task list (grid points in order, replicates inside each). A run's numbers
-therefore depend on nothing but ``seed`` and ``i``, and the table is the same for
+built from ``SeedSequence(rng).spawn(n_runs)[i]`` (``rng``: an int seed, a
+``SeedSequence``, a Generator or None, see :func:`root_seed_sequence`), where ``i`` is
+the run's place in the task list (grid points in order, replicates inside each). A
+run's numbers therefore depend on nothing but ``rng`` and ``i``, and the table is the same for
 ``n_jobs=1``, ``n_jobs=2`` and a Dask cluster.
 
 Engines: ``backend="sequential"`` (the default for one job) runs in this process;
@@ -32,7 +33,7 @@ import numpy as np
 from . import _validate as v
 from ._progress import progress_bar
 
-__all__ = ["fresh_seed_sequence", "grid_points", "raise_failed", "renamed_seed", "result_row", "root_seed_sequence",
+__all__ = ["fresh_seed_sequence", "grid_points", "raise_failed", "result_row", "root_seed_sequence",
            "sweep"]
 
 BACKENDS = ("sequential", "loky", "dask")
@@ -83,16 +84,17 @@ def grid_points(grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | Non
     raise TypeError(f"`grid` must be a mapping name -> values, a sequence of points or None; got {type(grid).__name__}")
 
 
-def root_seed_sequence(seed, name: str = "seed") -> np.random.SeedSequence:
-    """The ``SeedSequence`` the runs' streams are spawned from: ``SeedSequence(seed)`` for an int or None,
-    the sequence itself, or a Generator's own (so ``Generator.spawn`` and :func:`sweep` give the same streams).
+def root_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
+    """The ``SeedSequence`` the runs' streams are spawned from: the sequence itself, or the one behind
+    :func:`slamlab._validate.as_rng` of ``rng`` (``SeedSequence(rng)`` for an int, fresh entropy for None,
+    a Generator's own, so ``Generator.spawn`` and :func:`sweep` give the same streams).
 
     Parameters
     ----------
-    seed : int, SeedSequence, Generator or None
+    rng : int, SeedSequence, Generator or None
         Non-negative int, an existing sequence, a Generator (its own sequence is used) or ``None`` (fresh entropy).
     name : str
-        Argument name used in the error messages (default ``"seed"``).
+        Argument name used in the error messages (default ``"rng"``).
 
     Returns
     -------
@@ -104,16 +106,9 @@ def root_seed_sequence(seed, name: str = "seed") -> np.random.SeedSequence:
     >>> root_seed_sequence(7).entropy
     7
     """
-    if isinstance(seed, np.random.SeedSequence):
-        return seed
-    if isinstance(seed, np.random.Generator):
-        return seed.bit_generator.seed_seq
-    if seed is None or (isinstance(seed, numbers.Integral) and not isinstance(seed, bool)):
-        if seed is not None and seed < 0:
-            raise ValueError(f"`{name}` must be non-negative; got {seed}")
-        return np.random.SeedSequence(seed)
-    raise TypeError(f"`{name}` must be a numpy Generator, an int seed, a SeedSequence or None; "
-                    f"got {type(seed).__name__}")
+    if isinstance(rng, np.random.SeedSequence):
+        return rng
+    return v.as_rng(rng, name).bit_generator.seed_seq
 
 
 def fresh_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
@@ -143,32 +138,6 @@ def fresh_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
     """
     ss = root_seed_sequence(rng, name)
     return np.random.SeedSequence(ss.entropy, spawn_key=ss.spawn_key, pool_size=ss.pool_size)
-
-
-def renamed_seed(rng, seed, where: str):
-    """``rng``, or the deprecated ``seed=`` a caller still passes (with a ``DeprecationWarning``).
-
-    Parameters
-    ----------
-    rng : int, SeedSequence, Generator or None
-        The value of the ``rng`` argument.
-    seed : int or None
-        The value of the old ``seed`` argument (None: not given).
-    where : str
-        The function's name, for the warning.
-
-    Returns
-    -------
-    int, SeedSequence, Generator or None
-        ``seed`` if it was given, else ``rng``.
-    """
-    if seed is None:
-        return rng
-    import warnings
-
-    warnings.warn(f"{where}(seed=...) is deprecated; pass rng=... (an int seed gives the same streams)",
-                  DeprecationWarning, stacklevel=3)
-    return seed
 
 
 def _is_scalar(x: Any) -> bool:
@@ -238,7 +207,7 @@ def _dask_config(client, n_jobs: int):
 
 
 def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | None = None, *,
-          seeds: int = 1, seed: int = 0, n_jobs: int = 1, backend: str | None = None, client=None,
+          seeds: int = 1, rng=0, n_jobs: int = 1, backend: str | None = None, client=None,
           rng_arg: str | None = "rng", progress=None, fixed: Mapping[str, Any] | None = None,
           desc: str | None = None, on_error: str = "row"):
     """Run ``fn(**fixed, **point, rng=Generator)`` for every grid point × ``seeds`` replicates.
@@ -251,8 +220,9 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
         See :func:`grid_points`.
     seeds : int
         Replicates per grid point (each with its own random stream).
-    seed : int, SeedSequence or Generator
-        Where every run's stream is spawned from (see :func:`root_seed_sequence`).
+    rng : int, SeedSequence, Generator or None
+        Where every run's stream is spawned from (see :func:`root_seed_sequence`); default ``0``. An int
+        gives the same table on every call.
     n_jobs : int
         Parallel workers (``-1``: one per core).
     backend : {"sequential", "loky", "dask"}, optional
@@ -288,7 +258,7 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
     --------
     >>> def noisy(scale, rng):
     ...     return {"draw": round(float(scale * rng.standard_normal()), 6)}
-    >>> table = sweep(noisy, {"scale": [1.0, 10.0]}, seeds=2, seed=7)
+    >>> table = sweep(noisy, {"scale": [1.0, 10.0]}, seeds=2, rng=7)
     >>> table.columns.tolist(), len(table)
     (['scale', 'replicate', 'draw', 'error'], 4)
     """
@@ -298,7 +268,7 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
     v.check_choice(on_error, "on_error", ON_ERROR)
     points = grid_points(grid)
     n_rep = v.check_int(seeds, "seeds", minimum=1)
-    root = root_seed_sequence(seed)
+    root = root_seed_sequence(rng)
     n_jobs = v.check_int(n_jobs, "n_jobs", minimum=-1)
     if n_jobs == 0:
         raise ValueError("`n_jobs` must be a positive number of workers or -1 (one per core); got 0")

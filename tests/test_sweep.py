@@ -12,7 +12,6 @@ import pytest
 from slamlab.sweep import (
     fresh_seed_sequence,
     grid_points,
-    renamed_seed,
     result_row,
     root_seed_sequence,
     sweep,
@@ -25,7 +24,7 @@ GRID = {"scale": [1.0, 2.0, 3.0], "label": ["a", "b"]}
 
 
 def test_each_run_draws_from_its_spawned_seed_sequence():
-    table = sweep(noisy, GRID, seeds=2, seed=11, progress=False)
+    table = sweep(noisy, GRID, seeds=2, rng=11, progress=False)
     assert len(table) == 12
     assert table.columns.tolist() == ["scale", "label", "replicate", "draw", "n", "error"]
     children = np.random.SeedSequence(11).spawn(12)
@@ -37,22 +36,22 @@ def test_each_run_draws_from_its_spawned_seed_sequence():
 
 
 def test_table_identical_for_one_and_two_loky_workers():
-    one = sweep(noisy, GRID, seeds=3, seed=5, n_jobs=1, progress=False)
-    two = sweep(noisy, GRID, seeds=3, seed=5, n_jobs=2, progress=False)
+    one = sweep(noisy, GRID, seeds=3, rng=5, n_jobs=1, progress=False)
+    two = sweep(noisy, GRID, seeds=3, rng=5, n_jobs=2, progress=False)
     assert one.equals(two)
 
 
 def test_table_identical_on_a_dask_local_cluster():
     distributed = pytest.importorskip("distributed")
-    one = sweep(noisy, GRID, seeds=2, seed=5, progress=False)
+    one = sweep(noisy, GRID, seeds=2, rng=5, progress=False)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
             distributed.Client(cl) as client:
-        dask_table = sweep(noisy, GRID, seeds=2, seed=5, n_jobs=2, backend="dask", client=client, progress=False)
+        dask_table = sweep(noisy, GRID, seeds=2, rng=5, n_jobs=2, backend="dask", client=client, progress=False)
     assert one.equals(dask_table)
 
 
 def test_a_failed_run_is_a_row_with_its_error():
-    table = sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, seed=1, progress=False)
+    table = sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, rng=1, progress=False)
     assert len(table) == 3
     assert table.loc[1, "error"] == "ValueError: scale 2.0 is not allowed"
     assert np.isnan(table.loc[1, "draw"])
@@ -63,16 +62,16 @@ def test_a_failed_run_is_a_row_with_its_error():
 def test_on_error_raise_names_the_count_and_the_first_error():
     with pytest.raises(RuntimeError, match=r"^2 of 4 run\(s\) of a study failed; first: ValueError: scale 2.0 is "
                                            r"not allowed$"):
-        sweep(noisy, {"scale": [1.0, 2.0, 3.0, 2.0]}, fixed={"fail_at": 2.0}, seed=1, progress=False,
+        sweep(noisy, {"scale": [1.0, 2.0, 3.0, 2.0]}, fixed={"fail_at": 2.0}, rng=1, progress=False,
               on_error="raise", desc="a study")
     # the default names the function; "row" (the default) keeps the failure as a row
     with pytest.raises(RuntimeError, match=r"^1 of 3 run\(s\) of noisy failed"):
-        sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, seed=1, progress=False, on_error="raise")
-    rows = sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, seed=1, progress=False, on_error="row")
+        sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, rng=1, progress=False, on_error="raise")
+    rows = sweep(noisy, {"scale": [1.0, 2.0, 3.0]}, fixed={"fail_at": 2.0}, rng=1, progress=False, on_error="row")
     assert rows["error"].notna().sum() == 1
     # with no failure "raise" returns the same table as "row"
-    ok = sweep(noisy, GRID, seed=4, progress=False, on_error="raise")
-    assert ok.equals(sweep(noisy, GRID, seed=4, progress=False))
+    ok = sweep(noisy, GRID, rng=4, progress=False, on_error="raise")
+    assert ok.equals(sweep(noisy, GRID, rng=4, progress=False))
     with pytest.raises(ValueError, match="`on_error` must be one of 'row', 'raise'; got 'ignore'"):
         sweep(noisy, GRID, on_error="ignore")
 
@@ -93,22 +92,16 @@ def test_fresh_seed_sequence_restarts_the_children():
         fresh_seed_sequence(1.5)
 
 
-def test_renamed_seed_warns_and_wins():
-    assert renamed_seed(4, None, "run_x") == 4
-    with pytest.warns(DeprecationWarning, match=r"run_x\(seed=...\) is deprecated; pass rng=..."):
-        assert renamed_seed(4, 7, "run_x") == 7
-
-
 def test_progress_bar_only_when_asked(capsys, monkeypatch):
     monkeypatch.setenv("SLAMLAB_PROGRESS", "0")
-    sweep(noisy, GRID, seed=1)
+    sweep(noisy, GRID, rng=1)
     assert capsys.readouterr().err == ""
-    sweep(noisy, GRID, seed=1, progress=True)
+    sweep(noisy, GRID, rng=1, progress=True)
     assert "noisy" in capsys.readouterr().err  # tqdm's text bar names the function
-    sweep(noisy, GRID, seed=1, progress=True, desc="a study")
+    sweep(noisy, GRID, rng=1, progress=True, desc="a study")
     assert "a study" in capsys.readouterr().err  # or says what the caller names it
     done = []
-    sweep(noisy, GRID, seed=1, progress=done.append)  # a callable: called with each finished run's index
+    sweep(noisy, GRID, rng=1, progress=done.append)  # a callable: called with each finished run's index
     assert done == list(range(6))
     assert capsys.readouterr().err == ""
 

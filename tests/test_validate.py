@@ -235,8 +235,8 @@ def test_as_rng_negative_seed():
 
 @pytest.mark.parametrize(("value", "typename"), [(True, "bool"), (1.5, "float"), ("7", "str")])
 def test_as_rng_wrong_type(value, typename):
-    with pytest.raises(TypeError, match=rf"^`seed` must be a numpy Generator, an int seed or None; got {typename}$"):
-        v.as_rng(value, "seed")
+    with pytest.raises(TypeError, match=rf"^`rng` must be a numpy Generator, an int seed, a SeedSequence or None; got {typename}$"):
+        v.as_rng(value, "rng")
 
 
 # --- check_int ---------------------------------------------------------------------------------

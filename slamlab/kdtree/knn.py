@@ -25,11 +25,11 @@ from .._compiled import numba_enabled
 __all__ = ["augment_rows", "exact_knn", "flann_index", "hamming_distances", "merge_knn", "pad_knn"]
 
 
-def flann_index(data, *, trees: int = 1, seed: int | None = 0):
+def flann_index(data, *, trees: int = 1, opencv_seed: int | None = 0):
     """OpenCV's FLANN randomised kd-trees (``cv2.flann_Index``, ``trees`` of them) over ``data (N, D)``.
 
     FLANN draws its split dimensions from OpenCV's global RNG, so an unseeded build depends on
-    whatever drew from that RNG before (in a notebook: any earlier cell). ``seed`` (not None)
+    whatever drew from that RNG before (in a notebook: any earlier cell). ``opencv_seed`` (not None)
     reseeds it with ``cv2.setRNGSeed`` first, so the same data give the same trees in any kernel
     (a side effect on OpenCV's global RNG).
 
@@ -39,8 +39,9 @@ def flann_index(data, *, trees: int = 1, seed: int | None = 0):
         Points (converted to contiguous float32).
     trees : int
         Number of randomised kd-trees.
-    seed : int or None
-        Seed for ``cv2.setRNGSeed`` before the build; None leaves OpenCV's RNG as it is.
+    opencv_seed : int or None
+        Seed for ``cv2.setRNGSeed`` before the build; None leaves OpenCV's RNG as it is. This seeds
+        OpenCV's global RNG, not a numpy stream, hence not ``rng=``.
 
     Returns
     -------
@@ -48,8 +49,8 @@ def flann_index(data, *, trees: int = 1, seed: int | None = 0):
     """
     import cv2
 
-    if seed is not None:
-        cv2.setRNGSeed(int(seed))
+    if opencv_seed is not None:
+        cv2.setRNGSeed(int(opencv_seed))
     return cv2.flann_Index(np.ascontiguousarray(data, dtype=np.float32), {"algorithm": 1, "trees": int(trees)})
 
 

@@ -243,7 +243,7 @@ class FlannStore(LandmarkStore):
     OpenCV's Python ``cv2.flann_Index`` exposes no ``add``/``addPoints``, so this
     adapter rebuilds the index on every add (the C++ ``addPoints`` is not
     reachable from Python). FLANN draws its random split dimensions from OpenCV's
-    global RNG; ``seed`` (not None) reseeds it with ``cv2.setRNGSeed`` before each
+    global RNG; ``opencv_seed`` (not None) reseeds it with ``cv2.setRNGSeed`` before each
     build so that runs repeat (a side effect on OpenCV's global RNG).
 
     Parameters
@@ -252,15 +252,16 @@ class FlannStore(LandmarkStore):
         Randomised kd-trees in the index.
     checks : int
         Leaves checked per query.
-    seed : int or None
-        Seed of OpenCV's RNG before each build (None: not reseeded).
+    opencv_seed : int or None
+        Seed of OpenCV's global RNG (``cv2.setRNGSeed``, not a numpy stream) before each build
+        (None: not reseeded).
     """
 
     name = "FLANN (OpenCV)"
 
-    def __init__(self, *, trees: int = 4, checks: int = 200, seed: int | None = 0):
+    def __init__(self, *, trees: int = 4, checks: int = 200, opencv_seed: int | None = 0):
         super().__init__()
-        self.seed = None if seed is None else v.check_int(seed, "seed", minimum=0)
+        self.opencv_seed = None if opencv_seed is None else v.check_int(opencv_seed, "opencv_seed", minimum=0)
         self.trees = v.check_int(trees, "trees", minimum=1)
         self.checks = v.check_int(checks, "checks", minimum=1)
         self._pts = _PointSet()
@@ -277,7 +278,7 @@ class FlannStore(LandmarkStore):
 
     def _build(self):
         self._data = np.ascontiguousarray(self._pts.points)
-        self._index = flann_index(self._data, trees=self.trees, seed=self.seed)
+        self._index = flann_index(self._data, trees=self.trees, opencv_seed=self.opencv_seed)
         self._id_map = self._pts.point_ids.copy()
         self.counters.points_rebuilt += self._pts.n
         self.counters.trees_built += self.trees

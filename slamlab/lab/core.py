@@ -25,6 +25,8 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import as_rng
+
 __all__ = ["Case", "CheckResult", "ExplorationTask", "Task", "WrongAnswer", "answer", "check", "register", "task"]
 
 _PKG_DIR = str(Path(__file__).resolve().parent.parent)
@@ -349,7 +351,7 @@ def _finish(result: CheckResult, quiet: bool) -> CheckResult:
     return result
 
 
-def check(task_id: str, fn: Callable, *, seed: int = 0, quiet: bool = False) -> CheckResult:
+def check(task_id: str, fn: Callable, *, rng=0, quiet: bool = False) -> CheckResult:
     """Run the student's ``fn`` on the task's cases; print and return pass, the first failure, or "not done yet".
 
     Parameters
@@ -358,8 +360,8 @@ def check(task_id: str, fn: Callable, *, seed: int = 0, quiet: bool = False) -> 
         An implementation task's id.
     fn : callable
         The student's function.
-    seed : int
-        Seed of the random cases.
+    rng : numpy.random.Generator, int or None
+        The random cases' stream (an int seed: the same cases every time).
     quiet : bool
         Do not print the message.
 
@@ -375,7 +377,7 @@ def check(task_id: str, fn: Callable, *, seed: int = 0, quiet: bool = False) -> 
         return _finish(CheckResult(task_id, "failed", f"{t.title}: expected a function; got {type(fn).__name__}"),
                        quiet)
     compare = t.compare or allclose()
-    cases = t.cases(np.random.default_rng(seed))
+    cases = t.cases(as_rng(rng))
     for n, case in enumerate(cases, start=1):
         expected = t.reference(**case.kwargs)
         try:

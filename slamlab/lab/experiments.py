@@ -143,4 +143,4 @@ def stereo_rig(*, arena_seed: int = 0, rng=2010):
     StereoRig
         The simulator's camera pair.
     """
-    return StereoSim(StereoArena(seed=arena_seed), rng=rng).rig
+    return StereoSim(StereoArena(texture_seed=arena_seed), rng=rng).rig

@@ -173,7 +173,7 @@ def _filterpy_unicycle_nees(seq, scale, n_steps):
 
 
 @functools.lru_cache(maxsize=4)
-def q_scale_study_filterpy(seed: int = EXPLORE_Q_SEED, n_runs: int = EXPLORE_Q_RUNS,
+def q_scale_study_filterpy(rng=EXPLORE_Q_SEED, n_runs: int = EXPLORE_Q_RUNS,
                            n_steps: int = EXPLORE_Q_STEPS) -> tuple[np.ndarray, tuple[float, float]]:
     """Exploration 1 of lab 01 redone with filterpy's EKF: mean NEES per Q scale and the 95 % interval.
 
@@ -182,12 +182,12 @@ def q_scale_study_filterpy(seed: int = EXPLORE_Q_SEED, n_runs: int = EXPLORE_Q_R
     (Jacobians written here, Joseph-form update) with the process noise scaled by each of
     :data:`EXPLORE_Q_SCALES`, and the interval is SciPy's chi-square quantiles of the run-averaged
     NEES (000 §1.2.2; Bar-Shalom's NEES test). Run ``r`` draws from child ``r`` of
-    ``SeedSequence(seed)`` in the library's order, so the same seed gives the same random runs.
+    ``SeedSequence(rng)`` in the library's order, so the same seed gives the same random runs.
 
     Parameters
     ----------
-    seed : int
-        Root seed of the runs.
+    rng : int, SeedSequence, numpy.random.Generator or None
+        Where the runs' streams are spawned from (:func:`slamlab.sweep.fresh_seed_sequence`).
     n_runs : int
         Monte Carlo runs per scale.
     n_steps : int
@@ -202,7 +202,9 @@ def q_scale_study_filterpy(seed: int = EXPLORE_Q_SEED, n_runs: int = EXPLORE_Q_R
     """
     from scipy.stats import chi2
 
-    kids = np.random.SeedSequence(seed).spawn(n_runs)
+    from ..sweep import fresh_seed_sequence
+
+    kids = fresh_seed_sequence(rng).spawn(n_runs)
     mean = np.array([np.mean([_filterpy_unicycle_nees(k, s, n_steps) for k in kids]) for s in EXPLORE_Q_SCALES])
     lo, hi = chi2.ppf([0.025, 0.975], 3 * n_runs) / n_runs
     return mean, (float(lo), float(hi))

@@ -163,13 +163,13 @@ def half_converged_observations(rates, *, n_seeds: int = 500, n_obs: int = 40, t
     return out
 
 
-def doubling_rate(seed, *, step: float = EXPLORE_RATE_STEP) -> float:
+def doubling_rate(rng, *, step: float = EXPLORE_RATE_STEP) -> float:
     """The smallest outlier rate (on a grid of ``step``) needing at least twice the outlier-free observations.
 
     Parameters
     ----------
-    seed : int
-        Seed of the independent run (:func:`half_converged_observations`).
+    rng : numpy.random.Generator, int or None
+        The independent run's stream (:func:`half_converged_observations`).
     step : float
         Grid step of the outlier rate.
 
@@ -180,7 +180,7 @@ def doubling_rate(seed, *, step: float = EXPLORE_RATE_STEP) -> float:
     """
     step = v.check_positive(step, "step")
     rates = np.round(np.arange(0.0, 0.9 + step / 2, step), 10)
-    k = half_converged_observations(rates, rng=seed)
+    k = half_converged_observations(rates, rng=rng)
     return float(rates[np.flatnonzero(k >= 2 * k[0])[0]])
 
 

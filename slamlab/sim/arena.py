@@ -132,11 +132,13 @@ class StereoArena:
     texel_m, floor_texel_m : texture resolution of the fence and of the floor.
     floor_contrast : contrast of the floor texture relative to the fence (our choice: 0.6).
     sky : brightness of the featureless background above the fence, in ``[0, 1]``.
-    seed : everything in the scene is deterministic from this seed.
+    texture_seed : int
+        The seed of the procedural textures: everything in the scene is deterministic from it (an int, not a
+        Generator: the textures are cached by it). The renderer's noise streams come from ``StereoSim(rng=)``.
 
     Examples
     --------
-    >>> arena = StereoArena(2.0, 3.0, texel_m=0.01, seed=1)
+    >>> arena = StereoArena(2.0, 3.0, texel_m=0.01, texture_seed=1)
     >>> arena.wall_texture.shape, arena.perimeter_m
     ((50, 1000), 10.0)
     """
@@ -151,7 +153,7 @@ class StereoArena:
         floor_texel_m: float = 0.01,
         floor_contrast: float = 0.6,
         sky: float = 0.12,
-        seed: int = 0,
+        texture_seed: int = 0,
     ):
         self.width_m = v.check_positive(width_m, "width_m")
         self.length_m = v.check_positive(length_m, "length_m")
@@ -160,7 +162,7 @@ class StereoArena:
         self.floor_texel_m = v.check_positive(floor_texel_m, "floor_texel_m")
         self.floor_contrast = v.check_positive(floor_contrast, "floor_contrast")
         self.sky = float(np.clip(v.check_positive(sky, "sky", allow_zero=True), 0.0, 1.0))
-        self.seed = v.check_int(seed, "seed", minimum=0)
+        self.seed = v.check_int(texture_seed, "texture_seed", minimum=0)
         self.wall_texture, self.floor_texture, self._wall_mips, self._floor_mips = _arena_textures(
             self.width_m, self.length_m, self.fence_height_m, self.texel_m, self.floor_texel_m, self.floor_contrast,
             self.seed)
@@ -292,7 +294,7 @@ class StereoArena:
 
         Examples
         --------
-        >>> arena = StereoArena(2.0, 3.0, texel_m=0.01, seed=1)
+        >>> arena = StereoArena(2.0, 3.0, texel_m=0.01, texture_seed=1)
         >>> cam = PinholeCamera.from_hfov(64, 48)
         >>> T = se3(R_BODY_CAM, [1.0, 1.0, 0.3])
         >>> img = arena.render(cam, T); img.shape, img.dtype

@@ -279,7 +279,7 @@ def test_flann_seed_repeats():
     Q, _ = surf_like_descriptors(200, rng=17)
     out = []
     for _ in range(2):
-        s = FlannStore(seed=3)
+        s = FlannStore(opencv_seed=3)
         s.add(X, np.arange(3000))
         out.append(s.query(Q)[1])
     np.testing.assert_array_equal(out[0], out[1])

@@ -131,7 +131,7 @@ def test_umeyama_mistakes():
 def test_depth_error_exploration():
     import slamlab as sl
 
-    rig = sl.sim.StereoSim(sl.sim.StereoArena(seed=0), rng=2010).rig
+    rig = sl.sim.StereoSim(sl.sim.StereoArena(texture_seed=0), rng=2010).rig
     f, B = rig.left.fx, rig.baseline_m
     d = f * B / 8.0
     err = f * B / (d - 0.5) - 8.0  # Z = f B / d with half a pixel less disparity
@@ -146,7 +146,7 @@ def test_drift_exploration():
     wrong ones fall where they should."""
     import slamlab as sl
 
-    rig = sl.sim.StereoSim(sl.sim.StereoArena(seed=0), rng=2010).rig
+    rig = sl.sim.StereoSim(sl.sim.StereoArena(texture_seed=0), rng=2010).rig
     f, cx, B, Z, turn = rig.left.fx, rig.left.cx, rig.baseline_m, 8.0, 2e-3
     errors = []
     for a in (turn, -turn):  # the right camera turned about its vertical axis, x_r = R_y(a) x_l + (-B, 0, 0)

@@ -205,9 +205,8 @@ def test_markov_vs_mcl_methods_share_the_runs():
     assert len({tuple(r) for r in first}) > 1  # and the runs differ from each other
 
 
-def test_studies_take_params_and_any_rng_with_seed_deprecated():
-    """The run_* contract: ``params=`` (+ overrides) and ``rng=`` as an int, a SeedSequence or a Generator;
-    the old ``seed=`` still works, with a DeprecationWarning, and gives the same runs."""
+def test_studies_take_params_and_any_rng():
+    """The run_* contract: ``params=`` (+ overrides) and ``rng=`` as an int, a SeedSequence or a Generator."""
     from slamlab.studies.localisation.experiments import run_markov_vs_mcl
 
     kw = {"markov": (), "particle_counts": (40,), "n_runs": 2, "n_steps": 3}
@@ -215,9 +214,6 @@ def test_studies_take_params_and_any_rng_with_seed_deprecated():
     ref = run_markov_vs_mcl(**kw, rng=4).table_df[cols]
     assert ref.equals(run_markov_vs_mcl(**kw, rng=np.random.SeedSequence(4)).table_df[cols])
     assert ref.equals(run_markov_vs_mcl(**kw, rng=np.random.default_rng(4)).table_df[cols])
-    with pytest.warns(DeprecationWarning, match=r"run_markov_vs_mcl\(seed=...\) is deprecated"):
-        old = run_markov_vs_mcl(**kw, seed=4)
-    assert ref.equals(old.table_df[cols])
     # params= and the same settings as overrides are one run; the particle counts replace params.n_particles
     p = L.MCLParams(sigma_hit=3.0, n_particles=999)
     a = run_markov_vs_mcl(**kw, params=p, rng=4).table_df[cols]

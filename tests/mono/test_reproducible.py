@@ -105,5 +105,5 @@ def test_flann_index_does_not_depend_on_what_drew_from_opencv_rng_before():
     unseeded = []
     for state in (1, 99):
         cv2.setRNGSeed(state)
-        unseeded.append(flann_index(data, trees=1, seed=None).knnSearch(q, 2, params={"checks": 16})[0])
+        unseeded.append(flann_index(data, trees=1, opencv_seed=None).knnSearch(q, 2, params={"checks": 16})[0])
     assert not np.array_equal(unseeded[0], unseeded[1])

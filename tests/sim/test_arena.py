@@ -12,7 +12,7 @@ from slamlab.sim.textures import crater_heightfield, fractal_noise, lunar_textur
 
 @pytest.fixture(scope="module")
 def arena():
-    return StereoArena(seed=3)
+    return StereoArena(texture_seed=3)
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +82,7 @@ def test_left_and_right_images_agree_at_corresponding_points(arena):
 
 
 def test_rendering_is_deterministic_from_the_seed():
-    a1, a2, a3 = StereoArena(3.0, 4.0, seed=5), StereoArena(3.0, 4.0, seed=5), StereoArena(3.0, 4.0, seed=6)
+    a1, a2, a3 = StereoArena(3.0, 4.0, texture_seed=5), StereoArena(3.0, 4.0, texture_seed=5), StereoArena(3.0, 4.0, texture_seed=6)
     # the textures are kept between arenas of the same parameters: a fresh generation gives the same bits
     from slamlab.sim.arena import _arena_textures
 
@@ -103,7 +103,7 @@ def test_rendering_is_deterministic_from_the_seed():
 
 
 def test_noise_and_drift():
-    arena = StereoArena(3.0, 4.0, seed=5)
+    arena = StereoArena(3.0, 4.0, texture_seed=5)
     clean = StereoSim(arena, rng=0).render_pair([1.5, 2.0, 0.5])
     noisy = StereoSim(arena, noise_std=4.0, rng=0).render_pair([1.5, 2.0, 0.5])
     diff = noisy[0].astype(float) - clean[0]

@@ -15,7 +15,7 @@ def turning():
     # three frames turning 3 deg per frame on a small rig; the third frame's pose is rejected (a
     # rotation-std limit of 1 urad) so it is degenerate
     rig = StereoRig.parallel(0.2, 384, 288)
-    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    sim = StereoSim(StereoArena(texture_seed=1), rig, rng=0)
     truth = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.03], [0.0, 0.0, 0.06]])
     pairs = [sim.render_pair([3.0, 4.0, yaw]) for yaw in truth[:, 2]]
     runs = {}

@@ -17,7 +17,7 @@ def test_plots():
     assert len(ax.lines) == 3
     plt.close(ax.figure)
     rig = StereoRig.parallel(0.2, 384, 288)
-    arena = StereoArena(seed=0)
+    arena = StereoArena(texture_seed=0)
     sim = StereoSim(arena, rig, rng=0)
     left, right = sim.render_pair([3.0, 4.0, 1.0])
     fl, fr = detect_features(left, n_features=500), detect_features(right, n_features=500)

@@ -16,7 +16,7 @@ from slamlab.studies.stereo.experiments import StereoRunResult, run_stereo_slam,
 def short_turn():
     # 8 frames of a turn in place, 5 deg per frame, in the 6x8 m arena
     poses = turn_in_place(np.deg2rad(5.0))[:8]
-    return poses, run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=0), rng=0)
+    return poses, run_stereo_slam(poses, name="turn in place", arena=StereoArena(texture_seed=0), rng=0)
 
 
 def test_short_turn_tracks_the_ground_truth(short_turn):
@@ -37,12 +37,12 @@ def test_short_turn_tracks_the_ground_truth(short_turn):
 
 def test_run_is_deterministic(short_turn):
     poses, res = short_turn
-    again = run_stereo_slam(poses[:4], name="turn in place", arena=StereoArena(seed=0), rng=0)
+    again = run_stereo_slam(poses[:4], name="turn in place", arena=StereoArena(texture_seed=0), rng=0)
     np.testing.assert_array_equal(again.estimate, res.estimate[:4])
 
 
 def test_same_frame_twice_gives_identity_and_base_landmarks():
-    sim = StereoSim(StereoArena(seed=1), rng=0)
+    sim = StereoSim(StereoArena(texture_seed=1), rng=0)
     slam = StereoSLAM(sim.rig, sim.T_body_left, params=StereoParams(), rng=0)
     pair = sim.render_pair([3.0, 4.0, 0.3])
     assert slam.process(*pair).status == "init"
@@ -67,7 +67,7 @@ def test_default_store_follows_the_descriptor_type():
 
 def test_parallel_detection_gives_the_serial_result():
     rig = StereoRig.parallel(0.2, 384, 288)
-    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    sim = StereoSim(StereoArena(texture_seed=1), rig, rng=0)
     pairs = [sim.render_pair([3.0, 4.0, yaw]) for yaw in (0.0, 0.05, 0.1)]
     runs = []
     for parallel in (True, False):
@@ -80,7 +80,7 @@ def test_parallel_detection_gives_the_serial_result():
 
 def test_degenerate_frames_keep_the_pose_and_are_counted():
     rig = StereoRig.parallel(0.2, 192, 144)
-    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    sim = StereoSim(StereoArena(texture_seed=1), rig, rng=0)
     slam = StereoSLAM(rig, sim.T_body_left, n_features=500, rng=0)
     slam.process(*sim.render_pair([3.0, 4.0, 0.0]))
     blank = np.zeros((144, 192), np.uint8)
@@ -99,7 +99,7 @@ def test_degenerate_frames_keep_the_pose_and_are_counted():
 
 def test_policy_and_store_are_pluggable():
     rig = StereoRig.parallel(0.2, 384, 288)
-    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    sim = StereoSim(StereoArena(texture_seed=1), rig, rng=0)
     created = []
 
     def factory():
@@ -218,9 +218,9 @@ def test_variants_on_shared_frames_equal_separate_runs(short_turn):
     from slamlab.studies.stereo import comparison_table, run_comparison, run_stereo_slam_variants
 
     poses, res = short_turn
-    both = run_stereo_slam_variants(poses, {"a": {}, "b": {"policy": "all"}}, name="turn in place", arena=StereoArena(seed=0), rng=0)
+    both = run_stereo_slam_variants(poses, {"a": {}, "b": {"policy": "all"}}, name="turn in place", arena=StereoArena(texture_seed=0), rng=0)
     np.testing.assert_array_equal(both["a"].estimate, res.estimate)
-    alone = run_stereo_slam(poses, name="turn in place", arena=StereoArena(seed=0), rng=0, policy="all")
+    alone = run_stereo_slam(poses, name="turn in place", arena=StereoArena(texture_seed=0), rng=0, policy="all")
     np.testing.assert_array_equal(both["b"].estimate, alone.estimate)
     cmp = run_comparison("turn in place", n_frames=3)
     assert [(r.detector, r.policy, r.n_frames) for r in cmp.values()] == [("surf", "oldest", 3), ("orb", "oldest", 3), ("orb", "all", 3)]
@@ -239,7 +239,7 @@ def test_ill_conditioned_poses_are_not_trusted():
     # the rotation std of a normal frame is ~0.3-1.4 mrad: a limit of 1 urad rejects every pose, and a
     # rejected frame behaves like a RANSAC failure (pose kept, nothing added, counted as degenerate)
     rig = StereoRig.parallel(0.2, 384, 288)
-    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    sim = StereoSim(StereoArena(texture_seed=1), rig, rng=0)
     pairs = [sim.render_pair([3.0, 4.0, yaw]) for yaw in (0.0, 0.05)]
     strict = StereoSLAM(rig, sim.T_body_left, max_rot_std_rad=1e-6, rng=0)
     loose = StereoSLAM(rig, sim.T_body_left, max_rot_std_rad=None, rng=0)
@@ -279,7 +279,7 @@ def test_params_are_one_frozen_object_shared_by_the_loop_and_the_runs():
 def test_colour_frames_follow_the_channel_order():
     cv2 = pytest.importorskip("cv2")
     rig = StereoRig.parallel(0.2, 192, 144)
-    sim = StereoSim(StereoArena(seed=1), rig, rng=0)
+    sim = StereoSim(StereoArena(texture_seed=1), rig, rng=0)
     left, right = sim.render_pair([3.0, 4.0, 0.0])
     rng = np.random.default_rng(0)
     # colour frames whose OpenCV grey version is the rendered frame +- a little
@@ -324,7 +324,7 @@ def test_duplicate_check_keeps_re_sighted_points_out_of_the_map():
     # duplicate check sees that its nearest landmark by descriptor already sits where the point is
     poses = turn_in_place(np.deg2rad(5.0))[:5]
     runs = run_stereo_slam_variants(poses, {"off": {"detector": "orb"}, "on": {"detector": "orb", "duplicate_gap_m": 0.1}},
-                                    arena=StereoArena(seed=0), rng=0, progress=False)
+                                    arena=StereoArena(texture_seed=0), rng=0, progress=False)
     off, on = runs["off"].counts, runs["on"].counts
     assert off["n_duplicates"].sum() == 0
     assert on["n_duplicates"][1:].min() > 0
@@ -361,7 +361,7 @@ def test_kitti_comparison_prints_one_row_per_setting(real_data):
 
 @pytest.fixture(scope="module")
 def orb_frames():
-    sim = StereoSim(StereoArena(seed=0), rng=0)
+    sim = StereoSim(StereoArena(texture_seed=0), rng=0)
     poses = turn_in_place(np.deg2rad(5.0))[:6]
     return sim, poses, [sim.render_pair(p) for p in poses]
 
@@ -433,7 +433,7 @@ def test_a_search_that_gives_no_pose_falls_back_to_the_whole_map(orb_frames):
 
 def test_stage_times_in_wall_and_cpu_time(short_turn):
     poses, _ = short_turn
-    sim = StereoSim(StereoArena(seed=0), rng=0)
+    sim = StereoSim(StereoArena(texture_seed=0), rng=0)
     slam = StereoSLAM(sim.rig, sim.T_body_left, detector="orb", rng=0)
     slam.run(sim.render_pair(p) for p in poses[:3])
     wall, cpu = slam.stage_times(), slam.stage_times(cpu=True)

@@ -35,7 +35,7 @@ def _features(uv, descriptors):
 
 @pytest.fixture(scope="module")
 def frame():
-    arena = StereoArena(seed=2)
+    arena = StereoArena(texture_seed=2)
     sim = StereoSim(arena, rng=0)
     left, right = sim.render_pair(POSE)
     T = se3_from_planar(*POSE) @ sim.T_body_left

@@ -26,7 +26,7 @@ def _monte_carlo(run, n_runs: int, rng, n_jobs: int, progress, **fixed):
     """``n_runs`` seeded runs of ``run`` on :func:`slamlab.sweep.sweep` (run r draws from child r of ``rng``)."""
     from ...sweep import root_seed_sequence, sweep
 
-    table = sweep(run, None, seeds=n_runs, seed=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress, fixed=fixed,
+    table = sweep(run, None, seeds=n_runs, rng=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress, fixed=fixed,
                   on_error="raise", desc=f"Monte Carlo ({run.__name__.strip('_').replace('_', ' ')})")
     return table
 

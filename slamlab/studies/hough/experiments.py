@@ -338,7 +338,7 @@ def run_noise_study(range_std_cells=(0.0, 0.1, 0.3, 0.5), n_runs: int = 4, *, n_
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_poses = v.check_int(n_poses, "n_poses", minimum=5)
     bad = v.check_positive(bad_pos_cells, "bad_pos_cells")
-    table = sweep(_noise_run, {"range_std_cells": sigmas}, seeds=n_runs, seed=root_seed_sequence(rng, "rng"),
+    table = sweep(_noise_run, {"range_std_cells": sigmas}, seeds=n_runs, rng=root_seed_sequence(rng, "rng"),
                   n_jobs=n_jobs, progress=progress,
                   fixed={"n_poses": n_poses, "clutter": bool(clutter), "params": params, "overrides": dict(overrides)},
                   on_error="raise", desc="Hough SLAM noise study")

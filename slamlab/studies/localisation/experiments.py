@@ -319,7 +319,7 @@ class MarkovVsMclResult:
 
 def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *, n_runs: int = 5,
                       n_steps: int = 30, params: MCLParams | None = None, rng=2, n_jobs: int = 1,
-                      progress=None, seed=None, **overrides) -> MarkovVsMclResult:
+                      progress=None, **overrides) -> MarkovVsMclResult:
     """Markov grids (belief cell size in map cells, headings) and MCL (particle counts) on the same seeded
     runs (every method's run ``i`` uses the same stream, so the same path, scans and odometry).
 
@@ -339,8 +339,6 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields for the MCL runs.
 
@@ -350,16 +348,15 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
     """
     import pandas as pd
 
-    from ...sweep import fresh_seed_sequence, renamed_seed, sweep
+    from ...sweep import fresh_seed_sequence, sweep
 
-    rng = renamed_seed(rng, seed, "run_markov_vs_mcl")
     ov = MCLParams.as_overrides(params, **overrides)
     pts = [{"method": "markov", "size": int(s), "n_headings": int(h)} for s, h in markov]
     pts += [{"method": "mcl", "size": int(n), "n_headings": 0} for n in particle_counts]
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     # one stream per run index, shared by all methods: one sweep per method from a fresh copy of the same
     # SeedSequence (spawn() is stateful: the same object would give each sweep the next children)
-    frames = [sweep(_compare_task, [p], seeds=n_runs, seed=fresh_seed_sequence(rng), n_jobs=n_jobs,
+    frames = [sweep(_compare_task, [p], seeds=n_runs, rng=fresh_seed_sequence(rng), n_jobs=n_jobs,
                     progress=progress, fixed={"n_steps": n_steps, "overrides": ov}, on_error="raise",
                     desc="Markov grid vs MCL") for p in pts]
     df = pd.concat(frames, ignore_index=True)
@@ -367,7 +364,7 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
 
 
 def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: int = 60,
-             params: MCLParams | None = None, rng=7, seed=None, **overrides):
+             params: MCLParams | None = None, rng=7, **overrides):
     """One recorded global run (with an optional kidnap) for the plots and the time slider.
 
     Parameters
@@ -382,8 +379,6 @@ def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: 
         Settings of MCL (default: the defaults).
     rng : int, SeedSequence or Generator
         The one stream of the simulated run and then of the filter.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields.
 
@@ -392,9 +387,8 @@ def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: 
     (SimRun, FilterRun)
         The simulated run and the recorded filter run.
     """
-    from ...sweep import renamed_seed
 
-    rng = v.as_rng(renamed_seed(rng, seed, "demo_run"))
+    rng = v.as_rng(rng)
     run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
     return run, run_filter(run, n_particles=n_particles, rng=rng, keep_particles=True,
                            **MCLParams.as_overrides(params, **overrides))

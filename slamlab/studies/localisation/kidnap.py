@@ -123,7 +123,7 @@ class KidnapResult:
 
 def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000, n_steps: int = 40,
                   kidnap_step: int = 20, world: str = "map", params: MCLParams | None = None, rng=1,
-                  n_jobs: int = 1, progress=None, seed=None, **overrides) -> KidnapResult:
+                  n_jobs: int = 1, progress=None, **overrides) -> KidnapResult:
     """Track from the known start, kidnap at ``kidnap_step``; recovery per variant (the same runs for every
     variant; on sweep).
 
@@ -143,8 +143,6 @@ def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: in
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields under every variant.
 
@@ -154,9 +152,8 @@ def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: in
     """
     import pandas as pd
 
-    from ...sweep import fresh_seed_sequence, renamed_seed, sweep
+    from ...sweep import fresh_seed_sequence, sweep
 
-    rng = renamed_seed(rng, seed, "run_kidnapped")
     base = MCLParams.as_overrides(params, **overrides)
     base.pop("n_particles", None)  # the particle count is `n_particles`
 
@@ -171,7 +168,7 @@ def run_kidnapped(variants=KIDNAP_VARIANTS, *, n_runs: int = 20, n_particles: in
         MCLParams.resolve(None, **{**base, **item[1]})
         labels.append(item[0])
         df = sweep(_kidnap_task, [{"variant": item[0], "overrides": {**base, **item[1]}}], seeds=n_runs,
-                   seed=fresh_seed_sequence(rng), n_jobs=n_jobs, progress=progress, on_error="raise",
+                   rng=fresh_seed_sequence(rng), n_jobs=n_jobs, progress=progress, on_error="raise",
                    desc="kidnapped robot",
                    fixed={"n_particles": n_particles, "n_steps": n_steps, "kidnap_step": kidnap_step,
                           "world": v.check_choice(world, "world", ("map", "cluttered"))})

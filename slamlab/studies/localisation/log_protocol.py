@@ -221,7 +221,7 @@ def _fmt3(x) -> str:
 
 def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs: int = 10, n_scans: int = 30,
                      odo_trans_frac: float = 0.1, odo_rot_std_deg: float = 1.0, track_particles: int = 3000,
-                     params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None, seed=None,
+                     params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None,
                      **overrides) -> LogProtocolResult:
     """Global localisation from no prior on ``n_runs`` stretches of ``n_scans`` scans of every log, spread evenly
     over the log, for every particle count (the same stretches and odometry noise for every count), beside
@@ -254,8 +254,6 @@ def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs:
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields (global runs).
 
@@ -265,9 +263,8 @@ def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs:
     """
     import numbers
 
-    from ...sweep import renamed_seed, root_seed_sequence, sweep
+    from ...sweep import root_seed_sequence, sweep
 
-    rng = renamed_seed(rng, seed, "run_log_protocol")
     root = root_seed_sequence(rng, "rng")
     key = int(rng) if isinstance(rng, numbers.Integral) else int(root.generate_state(1, np.uint64)[0])
     overrides = MCLParams.as_overrides(params, **overrides)
@@ -282,7 +279,7 @@ def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs:
     # the tracking run (the ceiling) once per stretch: with the largest count's row
     pts = [{"log": p, "run": r, "n_particles": c, "track_particles": track_particles if c == max(counts) else 0}
            for p in paths for c in counts for r in range(n_runs)]
-    df = sweep(_sweep_task, pts, seeds=1, seed=root, n_jobs=n_jobs, progress=progress,
+    df = sweep(_sweep_task, pts, seeds=1, rng=root, n_jobs=n_jobs, progress=progress,
                on_error="raise", desc="MCL log protocol",
                fixed={"n_runs": n_runs, "n_scans": n_scans, "cell_m": 0.1, "max_range_m": 10.0,
                       "odo_trans_frac": odo_trans_frac, "odo_rot_std_deg": odo_rot_std_deg, "seed": key,

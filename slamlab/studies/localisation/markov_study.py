@@ -137,7 +137,7 @@ def _run(points, fixed, *, n_runs, rng, n_jobs, progress):
 
     from ...sweep import fresh_seed_sequence, sweep
 
-    frames = [sweep(_markov_task, [pt], seeds=n_runs, seed=fresh_seed_sequence(rng), n_jobs=n_jobs,
+    frames = [sweep(_markov_task, [pt], seeds=n_runs, rng=fresh_seed_sequence(rng), n_jobs=n_jobs,
                     progress=progress, fixed=fixed, on_error="raise", desc="Markov grid study") for pt in points]
     return pd.concat(frames, ignore_index=True)
 
@@ -155,7 +155,7 @@ def _study_overrides(params, overrides: dict) -> dict:
 
 
 def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10, resolution: int = 4,
-                     n_headings: int = 36, params=None, rng=5, n_jobs: int = 1, progress=None, seed=None,
+                     n_headings: int = 36, params=None, rng=5, n_jobs: int = 1, progress=None,
                      **overrides) -> MarkovStudyResult:
     """The Markov grid from a uniform prior and from Gaussian priors; the same runs for every prior.
 
@@ -176,8 +176,6 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`~slamlab.localisation.markov.MarkovParams` fields (e.g. fewer beams, ``max_beams=4``).
 
@@ -185,9 +183,7 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
     -------
     MarkovStudyResult
     """
-    from ...sweep import renamed_seed
 
-    rng = renamed_seed(rng, seed, "run_markov_prior")
     overrides = _study_overrides(params, overrides)
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=2)
@@ -206,7 +202,7 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
 
 def run_markov_kidnap(floors=(0.0, 1e-6, 1e-3), *, n_runs: int = 5, n_steps: int = 24, kidnap_step: int = 8,
                       resolution: int = 4, n_headings: int = 36, params=None, rng=6, n_jobs: int = 1,
-                      progress=None, seed=None, **overrides) -> MarkovStudyResult:
+                      progress=None, **overrides) -> MarkovStudyResult:
     """The kidnapped robot on the Markov grid: tracking from a prior at the true start, carried elsewhere at
     ``kidnap_step``; per uniform floor ε (0: PR Table 8.1 as it is).
 
@@ -227,8 +223,6 @@ def run_markov_kidnap(floors=(0.0, 1e-6, 1e-3), *, n_runs: int = 5, n_steps: int
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`~slamlab.localisation.markov.MarkovParams` fields.
 
@@ -236,9 +230,7 @@ def run_markov_kidnap(floors=(0.0, 1e-6, 1e-3), *, n_runs: int = 5, n_steps: int
     -------
     MarkovStudyResult
     """
-    from ...sweep import renamed_seed
 
-    rng = renamed_seed(rng, seed, "run_markov_kidnap")
     overrides = _study_overrides(params, overrides)
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     pts = [{"variant": f"uniform floor ε = {v.check_positive(f, 'floors[]', allow_zero=True):g}", "kind": "gaussian",

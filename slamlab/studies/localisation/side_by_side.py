@@ -79,7 +79,7 @@ class SideBySideResult:
 
 def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_particles: int = 2000,
                                  delta_alpha_deg: float = 5.0, params: MCLParams | None = None, rng=3,
-                                 n_jobs: int = 1, progress=None, seed=None, **overrides) -> SideBySideResult:
+                                 n_jobs: int = 1, progress=None, **overrides) -> SideBySideResult:
     """Global MCL over each run and Ch. 5's correlation localisation of the run's last scan (on sweep).
 
     Parameters
@@ -98,8 +98,6 @@ def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_parti
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields.
 
@@ -107,11 +105,10 @@ def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_parti
     -------
     SideBySideResult
     """
-    from ...sweep import renamed_seed, root_seed_sequence, sweep
+    from ...sweep import root_seed_sequence, sweep
 
-    rng = renamed_seed(rng, seed, "run_correlation_side_by_side")
     ov = MCLParams.as_overrides(params, **overrides)
-    df = sweep(_side_task, None, seeds=v.check_int(n_runs, "n_runs", minimum=1), seed=root_seed_sequence(rng, "rng"),
+    df = sweep(_side_task, None, seeds=v.check_int(n_runs, "n_runs", minimum=1), rng=root_seed_sequence(rng, "rng"),
                n_jobs=n_jobs, progress=progress, on_error="raise", desc="MCL vs correlation",
                fixed={"n_steps": n_steps, "n_particles": n_particles, "delta_alpha_deg": delta_alpha_deg,
                       "overrides": ov})

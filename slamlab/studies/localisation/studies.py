@@ -226,7 +226,7 @@ def _paired_sweep(points, *, n_runs, rng, n_jobs, progress, fixed):
 
     from ...sweep import fresh_seed_sequence, sweep
 
-    frames = [sweep(_global_task, [pt], seeds=n_runs, seed=fresh_seed_sequence(rng), n_jobs=n_jobs,
+    frames = [sweep(_global_task, [pt], seeds=n_runs, rng=fresh_seed_sequence(rng), n_jobs=n_jobs,
                     progress=progress, fixed=fixed, on_error="raise", desc="global localisation")
               for pt in points]
     return pd.concat(frames, ignore_index=True)
@@ -234,7 +234,7 @@ def _paired_sweep(points, *, n_runs, rng, n_jobs, progress, fixed):
 
 def run_global_localisation(particle_counts=(500, 1000, 2500), *, n_runs: int = 50, n_steps: int = 30,
                             params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None,
-                            seed=None, **overrides) -> GlobalResult:
+                            **overrides) -> GlobalResult:
     """Global localisation in the test room from no prior: ``n_runs`` seeded runs per particle count (the same
     runs for every count), each from a random place on 004's path.
 
@@ -252,8 +252,6 @@ def run_global_localisation(particle_counts=(500, 1000, 2500), *, n_runs: int = 
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields.
 
@@ -261,9 +259,7 @@ def run_global_localisation(particle_counts=(500, 1000, 2500), *, n_runs: int = 
     -------
     GlobalResult
     """
-    from ...sweep import renamed_seed
 
-    rng = renamed_seed(rng, seed, "run_global_localisation")
     counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
     n_runs = v.check_int(n_runs, "n_runs", minimum=1)
     n_steps = v.check_int(n_steps, "n_steps", minimum=2)
@@ -339,7 +335,7 @@ _SIZES = {"small": {"n_runs": 8, "n_particles": 2500}, "full": {"n_runs": 50, "n
 
 def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int | None = None,
                         n_particles: int | None = None, n_steps: int = 30, world: str = "map",
-                        params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None, seed=None,
+                        params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None,
                         **overrides) -> AblationResult:
     """Global localisation with one factor changed at a time (``variants``: (label, MCLParams overrides)).
 
@@ -363,8 +359,6 @@ def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int |
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields under every variant.
 
@@ -372,9 +366,7 @@ def run_global_ablation(variants=ABLATION, *, size: str = "small", n_runs: int |
     -------
     AblationResult
     """
-    from ...sweep import renamed_seed
 
-    rng = renamed_seed(rng, seed, "run_global_ablation")
     base = MCLParams.as_overrides(params, **overrides)
     base.pop("n_particles", None)  # the particle count is `n_particles` (or the size's)
     v.check_choice(size, "size", tuple(_SIZES))
@@ -429,7 +421,7 @@ class ScoreComparison:
 
 def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, n_particles: int = 1000,
                          global_particles: int = 2500, params: MCLParams | None = None, rng=0, n_jobs: int = 1,
-                         progress=None, seed=None, **overrides) -> ScoreComparison:
+                         progress=None, **overrides) -> ScoreComparison:
     """Each score variant on the global study (``global_particles``) and the kidnap study (``n_particles``),
     ``n_runs`` runs each.
 
@@ -448,8 +440,6 @@ def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, n_particl
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MCLParams` fields under every variant.
 
@@ -459,9 +449,8 @@ def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, n_particl
     """
     import numbers
 
-    from ...sweep import renamed_seed, root_seed_sequence
+    from ...sweep import root_seed_sequence
 
-    rng = renamed_seed(rng, seed, "run_score_comparison")
     if isinstance(rng, numbers.Integral) and not isinstance(rng, bool):
         rng_g, rng_k = rng, rng + 1
     else:

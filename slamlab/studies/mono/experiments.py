@@ -120,7 +120,7 @@ def mono_sim(size: str = "small", *, arena: StereoArena | None = None, noise_std
         The simulator (its ``rig.left`` is the monocular camera).
     """
     w, h = SIZES[v.check_choice(size, "size", tuple(SIZES))]
-    return StereoSim(StereoArena(seed=0, floor_contrast=1.0) if arena is None else arena,
+    return StereoSim(StereoArena(texture_seed=0, floor_contrast=1.0) if arena is None else arena,
                      StereoRig.parallel(0.2, w, h), noise_std=noise_std, camera_height_m=camera_height_m, rng=rng)
 
 
@@ -235,7 +235,7 @@ def _case_frames(case: str, size: str, n_frames: int, rng):
     elif case == "pure_rotation":
         poses = sequence_poses("turn", n_frames)
     elif case == "distant_points":
-        arena = StereoArena(60.0, 60.0, floor_contrast=1.0, floor_texel_m=0.05, seed=0)
+        arena = StereoArena(60.0, 60.0, floor_contrast=1.0, floor_texel_m=0.05, texture_seed=0)
         poses = sequence_poses("strafe", n_frames)
         poses[:, 0] += 28.5
         poses[:, 1] = 30.0
@@ -333,7 +333,7 @@ def _sweep_run(init_disparity_px, max_keyframes, kf_max_lost_ratio, max_matches,
 
 
 def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_frames: int = 30,
-                        params: MonoParams | None = None, rng=0, progress=None, seed=None, **overrides):
+                        params: MonoParams | None = None, rng=0, progress=None, **overrides):
     """003 §5.1.1's four tuning parameters on the rendered strafe, via :func:`slamlab.sweep.sweep`.
 
     Parameters
@@ -353,8 +353,6 @@ def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_fra
         Where every run's stream is spawned from.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`MonoParams` fields under the grid's.
 
@@ -363,13 +361,12 @@ def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_fra
     pandas.DataFrame
         The sweep's table (``tracking_ms`` is a timing: print it only where timings are allowed).
     """
-    from ...sweep import renamed_seed, root_seed_sequence, sweep
+    from ...sweep import root_seed_sequence, sweep
 
-    rng = renamed_seed(rng, seed, "run_parameter_sweep")
     p = MonoParams.resolve(params, **overrides) if (params is not None or overrides) else None
     base = {"init_disparity_px": 15.0, "max_keyframes": 10, "kf_max_lost_ratio": 0.3, "max_matches": 120}
     if grid is None:
         grid = [base, {**base, "init_disparity_px": 5.0}, {**base, "init_disparity_px": 30.0},
                 {**base, "max_keyframes": 3}, {**base, "kf_max_lost_ratio": 0.1}, {**base, "max_matches": 30}]
-    return sweep(_sweep_run, grid, seed=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress,
+    return sweep(_sweep_run, grid, rng=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress,
                  fixed={"size": size, "n_frames": n_frames, "params": p})

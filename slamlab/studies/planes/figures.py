@@ -419,7 +419,7 @@ class IntensityStudy:
 
 
 def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_particles: int = 400, rounds: int = 1,
-                        params: PlaneSLAMParams | None = None, rng=0, n_jobs: int = 1, progress=None, seed=None,
+                        params: PlaneSLAMParams | None = None, rng=0, n_jobs: int = 1, progress=None,
                         **overrides) -> IntensityStudy:
     """Fig. 4 (:func:`run_intensity_figure`) repeated over ``n_seeds`` seeds for each offset, by
     :func:`slamlab.sweep.sweep` (ours: how reliably the intensities resolve the line).
@@ -440,8 +440,6 @@ def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_parti
         Parallel workers of :func:`slamlab.sweep.sweep`.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
-    seed : int, optional
-        Deprecated name of ``rng``.
     **overrides
         :class:`PlaneSLAMParams` fields.
 
@@ -449,14 +447,13 @@ def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_parti
     -------
     IntensityStudy
     """
-    from ...sweep import renamed_seed, root_seed_sequence, sweep
+    from ...sweep import root_seed_sequence, sweep
 
-    rng = renamed_seed(rng, seed, "run_intensity_study")
     PlaneSLAMParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
     n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
     rounds = v.check_int(rounds, "rounds", minimum=1)
     table = sweep(_fig4_trial, {"offset_m": [float(o) for o in offsets_m]}, seeds=n_seeds,
-                  seed=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, on_error="raise", desc="Fig. 4 study",
+                  rng=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, on_error="raise", desc="Fig. 4 study",
                   fixed={"n_particles": n_particles, "rounds": rounds, "params": params, "overrides": dict(overrides)},
                   progress=progress)
     return IntensityStudy(table, rounds)

@@ -168,7 +168,7 @@ def run_stereo_slam_variants(
     from ...sweep import fresh_seed_sequence
 
     r_sim, r_slam = fresh_seed_sequence(rng).spawn(2)  # an int seed: SeedSequence(seed)'s children as before
-    arena = StereoArena(seed=render.arena_seed) if arena is None else arena
+    arena = StereoArena(texture_seed=render.arena_seed) if arena is None else arena
     sim = StereoSim(arena, rig, camera_height_m=render.camera_height_m, noise_std=render.noise_std,
                     drift_std_rad=render.drift_std_rad, rng=np.random.default_rng(r_sim))
     slams = {k: StereoSLAM(sim.rig, sim.T_body_left, params=p, store=store, rng=np.random.default_rng(r_slam))
@@ -338,8 +338,8 @@ _RUNNERS = {"turn in place": "run_turn_in_place", "closed loop": "run_closed_loo
 
 
 def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, params: StereoParams,
-                render: RenderParams, seed) -> dict:
-    """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``seed``).
+                render: RenderParams, rng) -> dict:
+    """One task of :func:`run_drift_study`: the experiment at one drift level (deterministic from ``rng``).
 
     Parameters
     ----------
@@ -355,7 +355,7 @@ def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, p
         Pipeline settings.
     render : RenderParams
         Renderer settings (its ``drift_std_rad`` is replaced).
-    seed : int or SeedSequence
+    rng : int or SeedSequence
         The run's seed, the same for every level.
 
     Returns
@@ -365,7 +365,7 @@ def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, p
     """
     runner = globals()[_RUNNERS[experiment]]
     return {"run": runner(size, n_frames=n_frames, params=params, render=render.replace(drift_std_rad=drift_std_rad),
-                          progress=False, rng=seed)}
+                          progress=False, rng=rng)}
 
 
 def run_drift_study(
@@ -417,13 +417,13 @@ def run_drift_study(
     levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
     if min(levels) < 0:
         raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
-    seed = fresh_seed_sequence(rng)  # every level's run from the same (fresh) SeedSequence
+    root = fresh_seed_sequence(rng)  # every level's run from the same (fresh) SeedSequence
     p = StereoParams.resolve(params, **overrides)
     render = RenderParams.resolve(render)
     table = sweep(drift_level, {"drift_std_rad": levels}, rng_arg=None, n_jobs=n_jobs, progress=progress,
                   on_error="raise", desc=f"calibration drift study ({experiment})",
                   fixed={"experiment": experiment, "size": size, "n_frames": n_frames, "params": p, "render": render,
-                         "seed": seed})
+                         "rng": root})
     return DriftStudy(experiment, levels, tuple(table["run"]))
 
 
@@ -490,7 +490,7 @@ def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, 
     str
     """
     p = StereoParams.resolve(params, **({"detector": "orb"} | overrides))
-    arena = StereoArena(seed=0) if arena is None else arena
+    arena = StereoArena(texture_seed=0) if arena is None else arena
     sim = StereoSim(arena, rng=rng)
     pose = v.as_vector(pose, "pose", 3)
     left, right = sim.render_pair(pose)
