@@ -86,7 +86,7 @@ def grid_points(grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any]] | Non
 
 def root_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
     """The ``SeedSequence`` the runs' streams are spawned from: the sequence itself, or the one behind
-    :func:`slamlab._validate.as_rng` of ``rng`` (``SeedSequence(rng)`` for an int, fresh entropy for None,
+    the one normaliser ``as_rng`` (``slamlab._validate``) applied to ``rng`` (``SeedSequence(rng)`` for an int, fresh entropy for None,
     a Generator's own, so ``Generator.spawn`` and :func:`sweep` give the same streams).
 
     Parameters
