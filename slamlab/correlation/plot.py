@@ -131,7 +131,20 @@ def plot_grids(grids, titles):
     return fig
 
 
-def _pose_arrow(ax, pose, length, **kw):
+def pose_arrow(ax, pose, length, **kw):
+    """Draw a pose ``(x, y, θ)`` as an arrow of ``length`` along its heading (004 §7's figures).
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+        Where to draw.
+    pose : array_like, shape (3,)
+        ``(x, y, θ)`` in the axes' units and radians.
+    length : float
+        The arrow's length, in the axes' units.
+    **kw
+        Arrow properties (``color``, ...).
+    """
     ax.annotate("", xy=(pose[0] + length * np.cos(pose[2]), pose[1] + length * np.sin(pose[2])),
                 xytext=(pose[0], pose[1]), arrowprops=dict(arrowstyle="->", lw=1.8, **kw))
 
@@ -163,9 +176,9 @@ def plot_localisation(grid, scan, loc, truth=None, *, ax=None, title="Scan drawn
     ax.plot(pts[:, 0], pts[:, 1], **{**STYLE["measurement"], "markersize": 2.5}, label="scan at estimate")
     if truth is not None:
         ax.plot(truth[0], truth[1], "o", color="black", mfc="none", ms=9, label="true pose")
-        _pose_arrow(ax, truth, 12, color="black")
+        pose_arrow(ax, truth, 12, color="black")
     ax.plot(loc.pose[0], loc.pose[1], "x", color=STYLE["estimate"]["color"], ms=9, mew=2, label="estimate")
-    _pose_arrow(ax, loc.pose, 12, color=STYLE["estimate"]["color"])
+    pose_arrow(ax, loc.pose, 12, color=STYLE["estimate"]["color"])
     ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
     return ax
 

@@ -85,7 +85,7 @@ def plot_keypoint_pair(img1, f1, img2, f2, titles=("image 1", "image 2")):
     return fig
 
 
-_COLORS = {"SIFT": "tab:blue", "SURF": "tab:red", "ORB": "tab:green", "FAST": "tab:purple"}
+DETECTOR_COLORS = {"SIFT": "tab:blue", "SURF": "tab:red", "ORB": "tab:green", "FAST": "tab:purple"}
 
 
 def plot_keypoints(image, features, *, ax=None, max_points: int = 400, color="tab:red", title=None,

@@ -12,7 +12,7 @@ from ..plotting import new_axes
 
 __all__ = ["plot_nees"]
 
-_FILTER_COLORS = {"LKF": "tab:red", "EKF": "tab:orange", "UKF-aug": "tab:blue", "UKF-add": "tab:purple",
+FILTER_COLORS = {"LKF": "tab:red", "EKF": "tab:orange", "UKF-aug": "tab:blue", "UKF-add": "tab:purple",
                   "KF": "tab:blue"}
 
 
@@ -43,7 +43,7 @@ def plot_nees(anees, bounds, *, labels=None, ax=None, dim: int | None = None, ti
     labels = labels or [None] * len(anees)
     steps = np.arange(1, anees.shape[1] + 1)
     for a, lab in zip(anees, labels, strict=True):
-        ax.plot(steps, a, color=_FILTER_COLORS.get(lab), label=lab, linewidth=1.2)
+        ax.plot(steps, a, color=FILTER_COLORS.get(lab), label=lab, linewidth=1.2)
     lo, hi = bounds
     ax.axhspan(lo, hi, color="0.85", alpha=0.6, label="95% interval", zorder=0)
     if dim is not None:

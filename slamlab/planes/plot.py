@@ -17,7 +17,22 @@ __all__ = [
 ]
 
 
-def _ax3d(ax=None, figsize=(6, 5), title=None):
+def axes_3d(ax=None, figsize=(6, 5), title=None):
+    """A 3-D axes with metre labels: ``ax`` itself, or a new figure's (002's figures).
+
+    Parameters
+    ----------
+    ax : matplotlib 3-D Axes or None
+        Axes to use; None makes a figure of ``figsize``.
+    figsize : (float, float)
+        Size of a new figure, in inches.
+    title : str or None
+        The axes' title.
+
+    Returns
+    -------
+    matplotlib 3-D Axes
+    """
     if ax is None:
         fig = plt.figure(figsize=figsize)
         ax = fig.add_subplot(projection="3d")
@@ -29,7 +44,22 @@ def _ax3d(ax=None, figsize=(6, 5), title=None):
     return ax
 
 
-def _thin(n, max_points, rng=0):
+def thin_points(n, max_points, rng=0):
+    """Sorted indices of at most ``max_points`` of ``n`` points, drawn without replacement (for drawing only).
+
+    Parameters
+    ----------
+    n : int
+        How many points there are.
+    max_points : int
+        How many to keep at most.
+    rng : Generator, int or None
+        The draw's stream.
+
+    Returns
+    -------
+    ndarray of int
+    """
     if n <= max_points:
         return np.arange(n)
     return np.sort(np.random.default_rng(rng).choice(n, max_points, replace=False))
@@ -53,8 +83,8 @@ def plot_frame_points(frame, *, ax=None, max_points: int = 6000, title: str | No
     -------
     mpl_toolkits.mplot3d.Axes3D
     """
-    ax = _ax3d(ax, title=title or f"one frame: {len(frame)} points, coloured by intensity")
-    k = _thin(len(frame), max_points)
+    ax = axes_3d(ax, title=title or f"one frame: {len(frame)} points, coloured by intensity")
+    k = thin_points(len(frame), max_points)
     sc = ax.scatter(*frame.points[k].T, c=frame.intensities[k], s=1, cmap="gray")
     ax.figure.colorbar(sc, ax=ax, shrink=0.6, label="intensity")
     return ax
@@ -80,11 +110,11 @@ def plot_frame_planes(frame, found, *, ax=None, max_points: int = 6000, title: s
     -------
     mpl_toolkits.mplot3d.Axes3D
     """
-    ax = _ax3d(ax, title=title or f"{len(found)} planes found by RANSAC")
+    ax = axes_3d(ax, title=title or f"{len(found)} planes found by RANSAC")
     lab = np.full(len(frame), -1)
     for i, (_, _, idx) in enumerate(found):
         lab[idx] = i
-    k = _thin(len(frame), max_points)
+    k = thin_points(len(frame), max_points)
     off = k[lab[k] < 0]
     ax.scatter(*frame.points[off].T, s=1, c="0.7")
     for i in range(len(found)):
@@ -120,7 +150,7 @@ def plot_plane_description(plane, points=None, *, axs=None, max_points: int = 40
     if points is not None:
         X = np.asarray(points, dtype=float)
         local = (X - T[:3, 3]) @ T[:3, :3]                   # ᴾp = (ᵇ_ΠT)⁻¹ ᵇp
-        k = _thin(len(local), max_points)
+        k = thin_points(len(local), max_points)
         a1.scatter(local[k, 0], local[k, 1], s=1, c="tab:blue")
         a1.set_title(f"{len(X)} points in the plane's frame, on OXY\n(dropped z: |z| <= "
                      f"{np.abs(local[:, 2]).max():.3f} m)", fontsize=9)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ...correlation.plot import _pose_arrow, plot_grid
+from ...correlation.plot import plot_grid, pose_arrow
 from ...plotting import STYLE, new_axes
 
 __all__ = ["constants_figure", "plot_error_distribution", "plot_log_localisation", "plot_table1"]
@@ -30,9 +30,9 @@ def plot_table1(result, grid, *, ax=None):
     ax = plot_grid(grid, ax=ax, title="Table 1: true (o) and estimated (x) poses", figsize=(7, 7))
     for i, (t, e) in enumerate(zip(result.true_poses, result.est_poses, strict=True)):
         ax.plot(t[0], t[1], "o", color="black", mfc="none", ms=9)
-        _pose_arrow(ax, t, 10, color="black")
+        pose_arrow(ax, t, 10, color="black")
         ax.plot(e[0], e[1], "x", color=STYLE["estimate"]["color"], ms=8, mew=2)
-        _pose_arrow(ax, e, 10, color=STYLE["estimate"]["color"])
+        pose_arrow(ax, e, 10, color=STYLE["estimate"]["color"])
         ax.annotate(str(i + 1), (t[0] + 3, t[1] + 3), fontsize=9, color="tab:red")
     return ax
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ...features.plot import _COLORS
+from ...features.plot import DETECTOR_COLORS
 from ...plotting import new_axes
 
 __all__ = [
@@ -38,7 +38,7 @@ def plot_pair_evaluation(result, *, axes=None):
         for row, (arr, name) in enumerate(((result.rep, "repeatability"), (result.precision, "precision"))):
             ax = axes[row, i]
             for k, det in enumerate(result.detectors):
-                ax.plot(result.steps, arr[i, :, k], "o-", color=_COLORS.get(det), label=det)
+                ax.plot(result.steps, arr[i, :, k], "o-", color=DETECTOR_COLORS.get(det), label=det)
             ax.set_title(f"{seq}: {name}")
             ax.set_xlabel("img1 → img j")
             ax.set_ylim(0, 1)

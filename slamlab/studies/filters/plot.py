@@ -6,7 +6,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ...filters.plot import _FILTER_COLORS, plot_nees
+from ...filters.plot import FILTER_COLORS, plot_nees
 from ...geometry import covariance_ellipse
 from ...plotting import STYLE, new_axes
 
@@ -66,7 +66,7 @@ def plot_unicycle_paths(result, *, ax=None, ellipse_every: int = 10, n_std: floa
         E, P = result.example_est[i], result.example_P[i]
         if not np.all(np.isfinite(E)):
             continue
-        color = _FILTER_COLORS.get(name)
+        color = FILTER_COLORS.get(name)
         ax.plot(E[:, 0], E[:, 1], color=color, linewidth=1.2, label=name)
         for k in range(0, len(E), ellipse_every):
             pts = covariance_ellipse(P[k, :2, :2], E[k, :2], n_std=n_std)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ...planes.plot import _ax3d, _thin
+from ...planes.plot import axes_3d, thin_points
 from ...plotting import new_axes
 from ...sim.planes_room import PlaneScanner, scanner_beam_directions
 
@@ -29,7 +29,7 @@ def plot_pairs_figure(result):
     fig = plt.figure(figsize=(13, 4.2))
     for k in range(3):
         ax = fig.add_subplot(1, 3, k + 1, projection="3d")
-        _ax3d(ax, title=f"{k + 1} pair{'s' if k else ''}: a {('plane', 'line', 'point')[k]}")
+        axes_3d(ax, title=f"{k + 1} pair{'s' if k else ''}: a {('plane', 'line', 'point')[k]}")
         ax.scatter(*result.before[k].T, s=2, c="0.7", label="predicted")
         ax.scatter(*result.after[k].T, s=4, c="tab:blue", label="solved")
         ax.scatter(*result.true_t, s=40, c="tab:red", marker="*", label="truth")
@@ -109,10 +109,10 @@ def plot_plane_map(result, *, ax=None, max_cells: int = 20000):
     -------
     mpl_toolkits.mplot3d.Axes3D
     """
-    ax = _ax3d(ax, figsize=(8, 6), title=f"plane map: {len(result.map)} planes")
+    ax = axes_3d(ax, figsize=(8, 6), title=f"plane map: {len(result.map)} planes")
     c = np.concatenate([pl.cell_centres() for pl in result.map.planes])
     I = np.concatenate([pl.mean_intensity for pl in result.map.planes])
-    k = _thin(len(c), max_cells)
+    k = thin_points(len(c), max_cells)
     ax.scatter(*c[k].T, c=I[k], s=1, cmap="gray")
     ax.plot(*result.poses_true[:, :3, 3].T, color="tab:red", label="truth")
     ax.plot(*result.poses_est[:, :3, 3].T, color="tab:blue", label="SLAM")
@@ -186,7 +186,7 @@ def plot_room(room, *, ax=None, path=None, hide=("room z+",)):
     """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    ax = _ax3d(ax, figsize=(8, 6), title=f"the room: {len(room)} planes, {room.panel_m} m reflectance panels")
+    ax = axes_3d(ax, figsize=(8, 6), title=f"the room: {len(room)} planes, {room.panel_m} m reflectance panels")
     polys, shades = [], []
     for i in range(len(room)):
         if room.names[i] in hide:
