@@ -199,6 +199,9 @@ def _open(page, url: str, base: str) -> list[str]:
         math = page.evaluate(_MATH)
         if math["raw"] or (math["loaded"] and (math["errors"] or math["pending"])):
             problems.append(f"equations: {math}")
+        # MathJax asks for its fonts after typesetting: let them arrive (or fail, and be counted) before the next
+        # page's navigation cuts them off (seen once: MathJax_Main-Bold.woff ERR_ABORTED on chapter 02)
+        page.wait_for_load_state("networkidle", timeout=30_000)
     finally:
         page.remove_listener("console", on_console)
         page.remove_listener("requestfailed", on_failed)
