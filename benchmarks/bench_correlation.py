@@ -30,8 +30,8 @@ import scipy
 from scipy.signal import fftconvolve
 
 import slamlab as sl
-from slamlab.correlation.algorithm import _beam_samples
-from slamlab.correlation.scoring import _MapSpectrum, _peak_search, _Stamps
+from slamlab.correlation._fft import MapSpectrum, Stamps, peak_search
+from slamlab.correlation.samples import scan_samples
 
 
 def best_of(fn, repeat=3):
@@ -73,7 +73,7 @@ def peak_batched(Mv, T, o, dtype, chunk=8, workers=None):
 
 def peak_ours(Mv, T, o, dtype, chunk=8, workers=None, quarter_trick=True, stamps=None, headings=None):
     if not quarter_trick:
-        spec = _MapSpectrum(Mv, T.shape[1], o, dtype, workers)
+        spec = MapSpectrum(Mv, T.shape[1], o, dtype, workers)
         best = (-np.inf, None)
         for s in range(0, T.shape[0], chunk):
             val, (k, r, c) = first_peak(spec.scores(T[s:s + chunk]))
@@ -81,8 +81,8 @@ def peak_ours(Mv, T, o, dtype, chunk=8, workers=None, quarter_trick=True, stamps
                 best = (val, (s + k, r, c))
         return best
     tol = 1e-9 * 4e4 if np.dtype(dtype) == np.float64 else 0.5
-    val, idx, _m, _b, _a = _peak_search(Mv, stamps, headings, T.shape[1], o, dtype=dtype, workers=workers, chunk=chunk,
-                                    tol=tol)
+    val, idx, _m, _b, _a = peak_search(Mv, stamps, headings, T.shape[1], o, dtype=dtype, workers=workers, chunk=chunk,
+                                       tol=tol)
     return val, idx
 
 
@@ -150,21 +150,21 @@ def main():
     truth = np.array([60.0, 40.0, np.radians(30.0)])
     scan = rf.scan(W, truth, rng=1)
     headings = sl.correlation.heading_candidates(np.radians(1.0))
-    t_rast, (T, o) = best_of(lambda: sl.correlation.rasterise_scan(scan, headings, dtype="float64"))
+    t_rast, (T, o) = best_of(lambda: sl.correlation.scan_stamps(scan, headings, dtype="float64"))
     Mv = sl.sim.grid_to_values(M)
     print(f"\nCase 1: 360 headings, map 200x200, T_n {T.shape[1]}x{T.shape[1]}; rasterising all T_n took {t_rast:.3f} s")
     t_ref, p_ref = best_of(lambda: peak_fftconvolve(Mv, T, o), repeat=2)
     t_ref32, p_ref32 = best_of(lambda: peak_fftconvolve(Mv.astype(np.float32), T.astype(np.float32), o), repeat=2)
     rows = [("per-heading scipy.signal.fftconvolve (reference)", t_ref, p_ref),
             ("per-heading fftconvolve on float32 arrays", t_ref32, p_ref32)]
-    free, obs = _beam_samples(scan.bearings_rad, scan.ranges, scan.valid, delta_l_cells=0.0, hit_offset_cells=0.5,
-                              step_cells=0.5, use_misses=False)
+    samples = scan_samples(scan)
+    free, obs = samples.free, samples.obs
     for label, dt, workers, trick in (("ours, batched float64, no quarter-turn reuse", np.float64, None, False),
                                       ("ours, batched float64", np.float64, None, True),
                                       ("ours, batched float32", np.float32, None, True),
                                       ("ours, batched float64, 2 threads", np.float64, 2, True),
                                       ("ours, batched float32, 2 threads", np.float32, 2, True)):
-        st = _Stamps(free, obs, headings, -1.0, 1.0, 0.0, o, dt)
+        st = Stamps(free, obs, headings, -1.0, 1.0, 0.0, o, dt)
         timer = best_wall if workers else best_of
         t, p = timer(lambda dt=dt, workers=workers, trick=trick, st=st: peak_ours(
             Mv, T, o, dt, workers=workers, quarter_trick=trick, stamps=st, headings=headings))
@@ -183,7 +183,7 @@ def main():
     Ms = M[20:80, 0:60]
     s_small = sl.sim.Rangefinder(n_beams=90, max_range_cells=15.0).scan(Ms, [20.0, 25.0, np.radians(30.0)])
     hs = sl.correlation.heading_candidates(np.radians(10.0))
-    Ts, os_ = sl.correlation.rasterise_scan(s_small, hs, dtype="float64")
+    Ts, os_ = sl.correlation.scan_stamps(s_small, hs, dtype="float64")
     Mvs = sl.sim.grid_to_values(Ms)
     t_dir, p_dir = best_of(lambda: peak_direct(Mvs, Ts, os_), repeat=1)
     t_fc, p_fc = best_of(lambda: peak_fftconvolve(Mvs, Ts, os_))

@@ -19,7 +19,7 @@ import numpy as np
 
 import slamlab.features as F
 from slamlab.kdtree import KDTree
-from slamlab.studies.features.matching_workload import _matching_workload
+from slamlab.studies.features.matching_workload import matching_workload
 
 
 def best_of(fn, repeats):
@@ -106,7 +106,7 @@ def bench_matching(sizes, n_queries=500, repeats=3):
     print(f"{'stored':>7s} {'method':60s} {'time [ms]':>10s} {'/ brute':>8s} {'NN recall':>10s}")
     rows, goal = [], []
     for n in sizes:
-        _, q, train, _ = _matching_workload(n, n_queries, "graf", 2, 0.5 if n <= 13000 else 1.0, 5e-5)
+        _, q, train, _ = matching_workload(n, n_queries, "graf", 2, 0.5 if n <= 13000 else 1.0, 5e-5)
         Q = q.descriptors
         t_build, tree = _timed(lambda X=train: KDTree(X), 1)
         t_build_opt, tree_opt = _timed(lambda X=train: KDTree(X, split=BEST_SPLIT, gap=BEST_GAP), 1)
@@ -134,7 +134,7 @@ def bench_matching(sizes, n_queries=500, repeats=3):
 
 def bench_bbf_ablation(n=65000, n_queries=500, max_leaves=200):
     """Issue 25: recall@1 of our BBF at ``max_leaves`` 1-point leaves by split rule, gaps and bound, FLANN beside."""
-    _, q, train, _ = _matching_workload(n, n_queries, "graf", 2, 0.5 if n <= 13000 else 1.0, 5e-5)
+    _, q, train, _ = matching_workload(n, n_queries, "graf", 2, 0.5 if n <= 13000 else 1.0, 5e-5)
     Q = np.ascontiguousarray(q.descriptors, np.float32)
     X = np.ascontiguousarray(train, np.float32)
     _, i_ref = F.knn2(Q, X, method="brute")

@@ -99,10 +99,10 @@ def measure(phi, r, d_rho, d_theta, r_max, repeat):
 
 
 #: The ablation of ``--real-logs``: label → overrides of :data:`slamlab.studies.hough.REAL_LOG_PARAMS` (per log
-#: key when a dict of dicts). The first row is the settings before issue 25 (per-format max_gap, no heading step,
-#: no second line search at ``H_min_retry``).
+#: key when a dict of dicts). The first row is the settings without our two additions (per-format max_gap, no
+#: heading step, no second line search at ``H_min_retry``).
 ABLATION = (
-    ("before issue 25: per-format max_gap, no heading step",
+    ("per-format max_gap, no heading step",
      {"urg04lx": {"heading": False, "H_min_retry": None},
       "mbicp": {"heading": False, "H_min_retry": None, "max_gap": 0.3}}),
     ("one set (max_gap 0.2 m), no heading step, no retry", {"heading": False, "H_min_retry": None}),

@@ -183,7 +183,7 @@ def main(argv=None):
         say()
         t0 = time.perf_counter()
         abl = sl.studies.stereo.run_scale_ablation(lambda rng: sl.sim.HighwayScene(rng=rng), sl.sim.highway_path(args.highway_frames),
-                                           n_seeds=args.seeds, pixel_std=args.highway_noise, rng=0)
+                                           n_seeds=args.seeds, pixel_std_obs=args.highway_noise, rng=0)
         say("```")
         say(abl.table(end=True))
         say("```")

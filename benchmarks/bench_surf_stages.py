@@ -31,6 +31,7 @@ import numpy as np
 
 import slamlab.features as F
 from slamlab.features import surf as S
+from slamlab.features._padded_ii import PaddedIntegralImage
 from slamlab.features.base import to_gray_float
 
 
@@ -54,10 +55,10 @@ def _stages(img, workers):
 
     g = to_gray_float(img)
     mark("grey")
-    P = S._PaddedII(image=g, workers=workers)
+    P = PaddedIntegralImage(image=g, workers=workers)
     II = P.II
     mark("padded integral image")
-    ext = S._extrema(II, threshold=4e-4, n_octaves=4, init_step=2, workers=workers, padded=P)
+    ext = S.hessian_maxima(II, threshold=4e-4, n_octaves=4, init_step=2, workers=workers, _padded=P)
     mark("response maps + NMS + interp.")
     uv = np.column_stack([ext["u"], ext["v"]])
     sigma = 1.2 * ext["L"] / 9.0

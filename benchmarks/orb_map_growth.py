@@ -45,7 +45,7 @@ def main(argv=None):
         raise SystemExit("classify the global search (map_search='global'): the window search has no store 2-NN")
     slam = StereoSLAM(sim.rig, sim.T_body_left, params=p, rng=np.random.default_rng(r_slam))
     seen = {}
-    core = slam_module._match_to_map
+    core = slam_module.match_to_map
 
     def spy(D, store, *a, **k):  # keep the store's 2-NN of every point
         query = store.query
@@ -61,7 +61,7 @@ def main(argv=None):
             del store.query
         return seen["mm"]
 
-    slam_module._match_to_map = spy
+    slam_module.match_to_map = spy
     r = args.radius
     totals = np.zeros(len(CAUSES), dtype=np.int64)
     n_ratio_fail = 0

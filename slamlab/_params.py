@@ -23,11 +23,12 @@ never passes silently.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from typing import Any, TypeVar
 
 from ._table import format_table
 
-__all__ = ["Params", "param"]
+__all__ = ["Params", "param", "refuse_set_fields"]
 
 P = TypeVar("P", bound="Params")
 
@@ -116,6 +117,52 @@ class Params:
         src = self.sources()
         rows = [[k, _fmt(getattr(self, k)), src[k]] for k in self.field_names()]
         return format_table(["parameter", "value", "source"], rows, title=type(self).__name__)
+
+
+def refuse_set_fields(params: Params, names: Sequence[str], how: str) -> None:
+    """Refuse settings that change a field a study varies itself (ours: one route per setting).
+
+    A study whose grid runs over fields of its settings object (particle counts, the two arms of an ablation)
+    sets them itself; the settings the caller gave (``params`` with the overrides applied) must leave them at
+    their class defaults, else a ``ValueError`` names the fields and says how the study sets them, so a value is
+    never silently replaced.
+
+    Parameters
+    ----------
+    params : Params
+        The caller's settings (a frozen ``Params`` dataclass, e.g. :class:`~slamlab.localisation.MCLParams`).
+    names : sequence of str
+        The fields the study varies itself.
+    how : str
+        How the study sets them (e.g. "one run per count of `particle_counts`").
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ValueError
+        Naming every field in ``names`` that the settings change, with ``how`` and the defaults.
+
+    Examples
+    --------
+    >>> from slamlab.localisation import MCLParams
+    >>> refuse_set_fields(MCLParams(sigma_hit=3.0), ["n_particles"], "one run per count")
+    >>> refuse_set_fields(MCLParams(n_particles=50), ["n_particles"], "one run per count")
+    Traceback (most recent call last):
+    ...
+    ValueError: `n_particles` is set by this study itself (one run per count); `params` or an override sets it to 50 (leave the default 2000)
+    """
+    default = type(params)()
+    clash = [(n, getattr(params, n), getattr(default, n)) for n in names if getattr(params, n) != getattr(default, n)]
+    if clash:
+        fields = ", ".join(f"`{n}`" for n, _, _ in clash)
+        values = ", ".join(repr(v) for _, v, _ in clash)
+        defaults = ", ".join(repr(d) for _, _, d in clash)
+        verb = "is" if len(clash) == 1 else "are"
+        raise ValueError(f"{fields} {verb} set by this study itself ({how}); `params` or an override sets "
+                         f"{'it' if len(clash) == 1 else 'them'} to {values} (leave the default {defaults})")
 
 
 def _fmt(value: Any) -> str:

@@ -30,11 +30,11 @@ from typing import Any
 
 import numpy as np
 
-from . import _validate as v
 from ._progress import progress_bar
+from ._validate import as_rng, check_callable, check_choice, check_int
 
-__all__ = ["fresh_seed_sequence", "grid_points", "raise_failed", "result_row", "root_seed_sequence",
-           "sweep"]
+__all__ = ["fresh_seed_sequence", "grid_points", "raise_failed", "result_row",
+           "root_seed_sequence", "sweep"]
 
 BACKENDS = ("sequential", "loky", "dask")
 ON_ERROR = ("row", "raise")
@@ -108,7 +108,7 @@ def root_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
     """
     if isinstance(rng, np.random.SeedSequence):
         return rng
-    return v.as_rng(rng, name).bit_generator.seed_seq
+    return as_rng(rng, name).bit_generator.seed_seq
 
 
 def fresh_seed_sequence(rng, name: str = "rng") -> np.random.SeedSequence:
@@ -264,17 +264,17 @@ def sweep(fn: Callable, grid: Mapping[str, Sequence] | Sequence[Mapping[str, Any
     """
     import pandas as pd
 
-    v.check_callable(fn, "fn")
-    v.check_choice(on_error, "on_error", ON_ERROR)
+    check_callable(fn, "fn")
+    check_choice(on_error, "on_error", ON_ERROR)
     points = grid_points(grid)
-    n_rep = v.check_int(seeds, "seeds", minimum=1)
+    n_rep = check_int(seeds, "seeds", minimum=1)
     root = root_seed_sequence(rng)
-    n_jobs = v.check_int(n_jobs, "n_jobs", minimum=-1)
+    n_jobs = check_int(n_jobs, "n_jobs", minimum=-1)
     if n_jobs == 0:
         raise ValueError("`n_jobs` must be a positive number of workers or -1 (one per core); got 0")
     if backend is None:
         backend = "sequential" if n_jobs == 1 else "loky"
-    v.check_choice(backend, "backend", BACKENDS)
+    check_choice(backend, "backend", BACKENDS)
     if rng_arg is not None and not isinstance(rng_arg, str):
         raise TypeError(f"`rng_arg` must be a keyword name (str) or None; got {type(rng_arg).__name__}")
     fixed = dict(fixed or {})

@@ -54,8 +54,6 @@ ALLOWED: dict[str, dict[str, str]] = {
     "slamlab.kdtree.cost_model.run_cost_model": {
         "params": "evaluates 000's cost formula at four numbers (n, s, m, C): nothing else to set",
         "rng": _NO_RANDOMNESS},
-    "slamlab.studies.kdtree.experiments.run_store_comparison": {"params": _NO_PIPELINE},
-    "slamlab.studies.kdtree.crossover.run_crossover": {"params": _NO_PIPELINE},
     "slamlab.studies.kdtree.tree_studies.run_dimension_study": {"params": _NO_PIPELINE},
     # mono: MonoSLAM draws no random numbers (OpenCV's RANSAC is reseeded to 0 before each call,
     # mono/twoview.py); the streams are the renderer's, taken by the run_* that render

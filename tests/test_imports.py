@@ -60,8 +60,9 @@ def _subpackage(module: str) -> str:
     return parts[1] if len(parts) > 1 else ""
 
 
-def _cycles_across_subpackages(graph: dict[str, set[str]]) -> list[list[str]]:
-    """Strongly connected components (Tarjan) that span more than one subpackage."""
+def _cycles_across_subpackages(graph: dict[str, set[str]], key=None) -> list[list[str]]:
+    """Strongly connected components (Tarjan) that span more than one subpackage (more than one ``key``)."""
+    key = key or _subpackage
     index, low, stack, on_stack, out = {}, {}, [], set(), []
     counter = [0]
 
@@ -84,7 +85,7 @@ def _cycles_across_subpackages(graph: dict[str, set[str]]) -> list[list[str]]:
                 comp.append(w)
                 if w == v:
                     break
-            if len({_subpackage(c) for c in comp}) > 1:
+            if len({key(c) for c in comp}) > 1:
                 out.append(sorted(comp))
 
     sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
@@ -102,11 +103,82 @@ def test_graph_reader_sees_imports_inside_functions():
     assert "slamlab._progress" in graph["slamlab.stereo.slam"]
     # and a cycle made of two modules of different subpackages is reported
     assert _cycles_across_subpackages({"slamlab.a.x": {"slamlab.b.y"}, "slamlab.b.y": {"slamlab.a.x"}})
+    # a circle inside one package is seen when the key is the module, and only then
+    inside = {"slamlab.a.x": {"slamlab.a.y"}, "slamlab.a.y": {"slamlab.a.x"}}
+    assert not _cycles_across_subpackages(inside)
+    assert _cycles_across_subpackages(inside, key=lambda module: module)
 
 
 def test_import_graph_has_no_cycle_across_subpackages():
     cycles = _cycles_across_subpackages(_graph())
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles)
+
+
+def test_import_graph_has_no_cycle_at_all():
+    """Inside a package too (issue 42, item 3): a circle closed by an import inside a function is still a circle."""
+    cycles = _cycles_across_subpackages(_graph(), key=lambda module: module)
+    assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles)
+
+
+#: CONVENTIONS' layers, lowest first. A module may import its own layer's modules of its own package and any lower
+#: layer; the packages of one layer are peers and do not import each other. kdtree sits below features: its
+#: ``knn`` is the shared nearest-neighbour layer that features.matching uses (CONVENTIONS lists the packages
+#: in reading order, features first). ``sim`` is a peer of the algorithm packages: it makes scans, grids and
+#: images from the layers below, and no algorithm imports it (CONVENTIONS: algorithm modules never import sim).
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("_validate", "_table", "_lazy", "_compiled", "_threads"),
+    ("_params", "_progress", "plotting", "chapters"),
+    ("data", "sweep", "widgets"),
+    ("geometry",),
+    ("scans",),
+    ("io", "filters", "kdtree"),
+    ("features",),
+    ("sim", "stereo", "correlation", "hough", "localisation", "planes", "mono", "evaluation"),
+    ("studies",),
+    ("lab",),
+)
+
+
+def _layer(module: str) -> tuple[int, str]:
+    """The layer index and the layer's package (or root module) name of a ``slamlab.…`` module."""
+    top = _subpackage(module)
+    for i, names in enumerate(LAYERS):
+        if top in names:
+            return i, top
+    raise KeyError(f"{module}: its package {top!r} is in no layer of LAYERS")
+
+
+def _upward_imports(graph: dict[str, set[str]]) -> list[str]:
+    bad = []
+    for m, targets in graph.items():
+        if m == "slamlab":  # the package's lazy front door names every subpackage
+            continue
+        (i, top) = _layer(m)
+        for t in targets:
+            if t == "slamlab":
+                continue
+            (j, other) = _layer(t)
+            if j > i or (j == i and other != top):
+                bad.append(f"{m} -> {t}")
+    return sorted(bad)
+
+
+def test_layer_check_sees_an_upward_and_a_sideways_import():
+    graph = {"slamlab.geometry.se2": {"slamlab.scans.grid"}, "slamlab.hough.slam": {"slamlab.localisation.mcl"},
+             "slamlab.scans.grid": {"slamlab.geometry.se2"}, "slamlab.localisation.mcl": set()}
+    assert _upward_imports(graph) == ["slamlab.geometry.se2 -> slamlab.scans.grid",
+                                      "slamlab.hough.slam -> slamlab.localisation.mcl"]
+
+
+def test_every_module_is_in_a_layer():
+    for m in _graph():
+        if m != "slamlab":
+            _layer(m)
+
+
+def test_imports_run_down_the_layers():
+    bad = _upward_imports(_graph())
+    assert not bad, f"{len(bad)} imports go up or sideways across CONVENTIONS' layers:\n" + "\n".join(bad)
 
 
 #: the layers that may use the simulator: the simulator itself, the chapters' studies and the labs' feedback
@@ -206,3 +278,32 @@ def test_the_heavy_import_check_sees_a_heavy_module():
 @pytest.mark.parametrize("module", SUBPACKAGES)
 def test_import_loads_no_widgets_pyplot_or_cv2(module, heavy_loaded_by):
     assert heavy_loaded_by[module] == [], f"`import {module}` imported {heavy_loaded_by[module]}"
+
+
+#: at most this many from-imports of another module's underscore-private name (issue 42, item 3: a private
+#: name is used in its own module; shared machinery lives in a package-private module named as such, ``_pairs``,
+#: whose own names carry no underscore)
+PRIVATE_IMPORT_BUDGET = 0
+
+
+def _private_name_imports(source: str) -> list[str]:
+    """The names starting with one underscore that ``source`` imports from slamlab (absolute or relative)."""
+    names = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").split(".")[0] == "slamlab"):
+            names += [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+    return names
+
+
+def test_private_import_reader_sees_relative_absolute_and_nested_imports():
+    src = ("from ._pairs import two_nearest\nfrom .frame import _check_pair, clock\n"
+           "from slamlab.geometry.registration import _umeyama\nfrom numpy import _globals\n"
+           "def f():\n    from ..scans import _private\n")
+    assert _private_name_imports(src) == ["_check_pair", "_umeyama", "_private"]
+
+
+def test_private_names_stay_in_their_modules():
+    found = [f"{f.relative_to(PKG.parent)}: {name}" for f in sorted(PKG.rglob("*.py"))
+             for name in _private_name_imports(f.read_text(encoding="utf-8"))]
+    assert len(found) <= PRIVATE_IMPORT_BUDGET, (f"{len(found)} imports of another module's private names "
+                                                 f"(budget {PRIVATE_IMPORT_BUDGET}):\n" + "\n".join(found))

@@ -9,7 +9,7 @@ from .algorithm import (
     heading_error,
     localise,
     localise_joined,
-    rasterise_scan,
+    scan_stamps,
     score_maps,
 )
 
@@ -33,7 +33,7 @@ __all__ = [
     "heading_error",
     "localise",
     "localise_joined",
-    "rasterise_scan",
+    "scan_stamps",
     "score_maps",
 ]
 __all__ += list(_PLOT)  # loaded on first use

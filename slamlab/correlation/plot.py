@@ -58,7 +58,7 @@ def plot_stamp(T_n, origin: int, *, a_c: float = -1.0, a_p: float = 1.0, ax=None
     Parameters
     ----------
     T_n : array_like, shape (S, S)
-        One image of :func:`~slamlab.correlation.rasterise_scan`.
+        One image of :func:`~slamlab.correlation.scan_stamps`.
     origin : int
         The robot's cell ``T_n[origin, origin]``.
     a_c, a_p : float

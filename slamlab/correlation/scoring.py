@@ -1,297 +1,28 @@
-"""The correlation of a scan with the map for every heading at once: FFT scoring, peak and rival search (004 §5).
+"""The correlation of the map with a scan's stamps (004 §7): the score maps of every heading, and the score at
+any pose by the definition.
 
-The scan's stamps ``T_n`` (one per heading, rasterised by :func:`~slamlab.correlation.algorithm.rasterise_scan`)
-are correlated with the map by batched real FFTs (the map's spectrum once per quarter turn), pruned to the valid
-shifts; :func:`score_maps` is the public entry (methods ``"batched"``, ``"fftconvolve"``, ``"direct"``). Part of
-:mod:`slamlab.correlation.algorithm`, which re-exports :func:`score_maps`.
+- :func:`score_maps` ``(M_values, T, origin, method) -> (n, H, W)``: every stamp T_n against the map, by batched
+  FFTs (``"batched"``), ``scipy.signal.fftconvolve`` per heading or the definition (``"direct"``); the index
+  mapping is derived in :mod:`slamlab.correlation.algorithm`, which re-exports it.
+- :func:`pose_scores` ``(M_values, samples, poses) -> (m,)``: ``Σ T·M`` of a scan's
+  :class:`~slamlab.correlation.samples.ScanSamples` at any poses, on the search's grid or off it (ours, issue 25);
+  :func:`pose_marks` the marked cells behind each score (:class:`PoseMarks`).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
-import scipy.fft as sfft
 from scipy.signal import fftconvolve
 
-from .. import _validate as v
-from ..geometry import wrap_angle
+from .._validate import as_finite_array, check_choice, check_int
+from ._fft import MapSpectrum
+from .samples import ScanSamples
 
-__all__ = ["score_maps"]
+__all__ = ["PoseMarks", "pose_marks", "pose_scores", "score_maps"]
 
 _METHODS = ("batched", "fftconvolve", "direct")
-
-
-class _Stamps:
-    """T_n for a list of headings, rasterising each heading modulo 90° once (quarter turns are exact on the grid).
-
-    A point ``(x, y) → (-y, x)`` under a quarter turn: ``T'[o + x, o - y] = T[o + y, o + x]``, i.e.
-    ``T'[i, j] = T[(2o - j) mod S, i]`` (the wrapped row/column is the outer ring, always a_n).
-    """
-
-    def __init__(self, free, obs, headings, a_c, a_p, a_n, o, dtype):
-        S = 2 * o
-        self.S, self.dtype = S, dtype
-        self.quarter = np.floor(np.mod(headings, 2 * np.pi) / (np.pi / 2) + 1e-9).astype(int) % 4
-        base = np.mod(headings, np.pi / 2)
-        base[base > np.pi / 2 - 1e-9] = 0.0
-        ub, self.inv = np.unique(np.round(base, 12), return_inverse=True)
-        self.Tb = np.full((ub.size, S, S), a_n, dtype=dtype)
-        _stamp(self.Tb, ub, free, obs, a_c, a_p, o)
-        self.Tb = self.Tb.reshape(ub.size, S * S)
-        i, j = np.divmod(np.arange(S * S), S)
-        p1 = ((2 * o - j) % S) * S + i
-        self.perm = [None, p1, p1[p1], p1[p1][p1]]
-
-    def take(self, sel: np.ndarray) -> np.ndarray:
-        """The stack ``T[sel]`` of shape ``(len(sel), S, S)``."""
-        out = np.empty((sel.size, self.S * self.S), dtype=self.dtype)
-        q = self.quarter[sel]
-        for k in range(4):
-            m = np.nonzero(q == k)[0]
-            if m.size:
-                block = self.Tb[self.inv[sel[m]]]
-                out[m] = block if k == 0 else np.take(block, self.perm[k], axis=1)
-        return out.reshape(sel.size, self.S, self.S)
-
-
-def _stamp(T: np.ndarray, headings: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p: float,
-           o: int) -> None:
-    """Write a_c at the free samples and then a_p at the obstacle samples of each heading (in place)."""
-    n, S, _ = T.shape
-    flat = T.reshape(-1)
-    big = n * S * S >= 2**24  # float32 holds integers exactly below 2**24
-    ft = np.float64 if big else np.float32
-    c = np.cos(headings).astype(ft)[:, None]
-    s = np.sin(headings).astype(ft)[:, None]
-    base = (np.arange(n, dtype=ft) * (S * S) + o * S + o + 0.5 * (S + 1))[:, None]
-    chunk = max(1, int(4e6 // max(free.shape[0], 1)))
-    for pts, val in ((free, a_c), (obs, a_p)):  # obstacle marks overwrite free ones
-        if pts.shape[0] == 0:
-            continue
-        px, py = pts[:, 0].astype(ft), pts[:, 1].astype(ft)
-        for k0 in range(0, n, chunk):
-            cc, ss = c[k0:k0 + chunk], s[k0:k0 + chunk]
-            x = cc * px
-            x -= ss * py
-            y = ss * px
-            y += cc * py
-            # floor(v + 0.5) for row and column, folded: idx = (floor(y+.5)+o)·S + floor(x+.5)+o + n·S²
-            np.floor(x + 0.5, out=x)
-            np.floor(y + 0.5, out=y)
-            y *= S
-            y += x
-            y += base[k0:k0 + chunk] - 0.5 * (S + 1)
-            # val: a scalar, or one value per point (obstacle weights, ours): the same for every heading
-            flat[y.astype(np.int64).ravel()] = val if np.ndim(val) == 0 else np.broadcast_to(val, y.shape).ravel()
-
-
-def _fast_len(n: int) -> int:
-    return sfft.next_fast_len(n, real=True)
-
-
-class _MapSpectrum:
-    """rfft2 of the map zero-padded for the robot-inside-map shifts of an S×S stamp (computed once)."""
-
-    def __init__(self, Mv: np.ndarray, S: int, o: int, dtype, workers: int | None, L: tuple[int, int] | None = None):
-        H, W = Mv.shape
-        # circular correlation c[k] = Σ_i T[i]·Mp[(i + k) mod L] equals the linear one for the shifts
-        # k = row - o, row ∈ [0, H), when L ≥ H + o and L ≥ H + S - 1 - o (derivation in the module docstring)
-        need = (max(H + o, H + S - 1 - o), max(W + o, W + S - 1 - o))
-        self.L = (_fast_len(need[0]), _fast_len(need[1])) if L is None else L
-        if self.L[0] < need[0] or self.L[1] < need[1]:
-            raise ValueError(f"FFT size {self.L} too small for map {Mv.shape} and stamp {S}")
-        self.shape = (H, W)
-        self.S, self.o, self.dtype, self.workers = S, o, dtype, workers
-        self.FM = sfft.rfft2(Mv.astype(dtype, copy=False), s=self.L, workers=workers)
-        self.rows = (np.arange(H) - o) % self.L[0]
-        self.cols = (np.arange(W) - o) % self.L[1]
-
-    def forward(self, T: np.ndarray) -> np.ndarray:
-        """conj(rfft2(T)) at this spectrum's size (pruned: rfft on the S rows only, then fft along rows)."""
-        FT = sfft.rfft(T.astype(self.dtype, copy=False), n=self.L[1], axis=-1, workers=self.workers)
-        FT = sfft.fft(FT, n=self.L[0], axis=-2, workers=self.workers, overwrite_x=True)
-        return np.conjugate(FT, out=FT)
-
-    def inverse(self, FTc: np.ndarray) -> np.ndarray:
-        """Scores ``(n, H, W)`` from ``forward(T)``: product with the map spectrum, pruned irfft2."""
-        P = FTc * self.FM
-        c = sfft.ifft(P, axis=-2, workers=self.workers, overwrite_x=True)[:, self.rows]
-        c = sfft.irfft(c, n=self.L[1], axis=-1, workers=self.workers, overwrite_x=True)
-        return c[:, :, self.cols]
-
-    def scores(self, T: np.ndarray) -> np.ndarray:
-        return self.inverse(self.forward(T))
-
-
-def _map_spectra(Mv, stamps, S, o, *, dtype, workers):
-    """Spectra of the map turned by every quarter turn the stamps use (one FFT size for all)."""
-    H, W = Mv.shape
-    side = max(H, W)
-    L = _fast_len(max(side + o, side + S - 1 - o))
-    return {q: _MapSpectrum(np.ascontiguousarray(np.rot90(Mv, q)), S, o, dtype, workers, L=(L, L))
-            for q in sorted(set(stamps.quarter.tolist()))}
-
-
-class _ExploredNorm:
-    """What :func:`_iter_scores` needs to divide each pose's score by its marks on explored cells (ours, issue 25).
-
-    ``count[n, row, col] = Σ_{i,j} [T_n[i, j] marked]·E[row + i - o, col + j - o]`` with ``E`` = 1 on the
-    explored cells of the map (value ≠ ``a_n``) and 0 elsewhere and outside: one more correlation, of the
-    indicator stamps (the same samples rasterised with value 1) with ``E``, by the same batched FFTs. A pose
-    scores ``D / count`` when ``count ≥ min_fraction · marks_n`` (``marks_n``: the stamp's marked cells), else
-    ``floor``.
-    """
-
-    def __init__(self, Mv, free, obs, headings, o, a_n, min_fraction, floor, *, dtype, workers):
-        S = 2 * o
-        self.stamps = _Stamps(free, obs, headings, 1.0, 1.0, 0.0, o, dtype)
-        self.marks = np.count_nonzero(self.stamps.Tb, axis=1)  # per base stamp (a quarter turn keeps the count)
-        self.specs = _map_spectra((Mv != a_n).astype(np.float64), self.stamps, S, o, dtype=dtype, workers=workers)
-        self.min_fraction, self.floor = float(min_fraction), float(floor)
-
-    def apply(self, D, FTc_ind, q, heads):
-        """``D`` normalised for the headings ``heads`` of quarter turn ``q``."""
-        cnt = self.specs[q].inverse(FTc_ind)
-        if q:
-            cnt = np.rot90(cnt, -q, axes=(1, 2))
-        cnt = np.rint(cnt)
-        need = self.min_fraction * self.marks[self.stamps.inv[heads]][:, None, None] - 1e-9
-        return np.where(cnt >= need, D / np.maximum(cnt, 1.0), self.floor)
-
-
-def _iter_scores(specs, stamps, sel, S, chunk, norm: _ExploredNorm | None = None):
-    """Yield ``(heads, D)``: score maps ``D[k] = D_{heads[k]}`` for the headings ``sel``, in chunks of base stamps.
-
-    Quarter turns: with ``R`` the quarter turn of the stamps, ``D_{T∘R⁻¹}(M) = rot90(D_T(rot90(M)), -1)``
-    (derivation in the notebook), so the spectrum of each base stamp (heading mod 90°) is computed once
-    and correlated with the four rotated maps' spectra. With ``norm`` (:class:`_ExploredNorm`) the maps are
-    divided by the marks on explored cells.
-    """
-    quarters = sorted(specs)
-    bases = np.unique(stamps.inv[sel])
-    for b0 in range(0, bases.size, chunk):
-        bs = bases[b0:b0 + chunk]
-        FTc = specs[quarters[0]].forward(stamps.Tb[bs].reshape(bs.size, S, S))
-        if norm is not None:
-            FTi = norm.specs[quarters[0]].forward(norm.stamps.Tb[bs].reshape(bs.size, S, S))
-        in_chunk = sel[np.isin(stamps.inv[sel], bs)]
-        for q in quarters:
-            heads = in_chunk[stamps.quarter[in_chunk] == q]
-            if heads.size == 0:
-                continue
-            pick = np.searchsorted(bs, stamps.inv[heads])
-            D = specs[q].inverse(FTc[pick])
-            if q:
-                D = np.rot90(D, -q, axes=(1, 2))
-            if norm is not None:
-                D = norm.apply(D, FTi[pick], q, heads)
-            yield heads, D
-
-
-def _peak_search(Mv, stamps, headings, S, o, *, dtype, workers, chunk, tol, specs=None, n_peaks: int = 0,
-                 norm: _ExploredNorm | None = None):
-    """Maximum of the 3-D stack D[n, row, col] over all headings (streamed; bounded memory).
-
-    Returns ``(best_val, (n, row, col), best_map, best_per_heading, argmax_per_heading)``; ties within
-    ``tol`` go to the smallest heading index, then the first row and column. ``argmax_per_heading``
-    holds the flat cell index of each heading's maximum. With ``n_peaks`` > 0 a sixth item: the
-    ``(value, n, row, col)`` of up to ``4·n_peaks`` largest local maxima (5×5 cells) per chunk of
-    headings (:func:`_local_peaks`), for :func:`_distinct_peaks` (ours, issue 25).
-    """
-    if specs is None:
-        specs = _map_spectra(Mv, stamps, S, o, dtype=dtype, workers=workers)
-    best_per = np.full(headings.size, -np.inf)
-    arg_per = np.zeros(headings.size, dtype=np.int64)
-    best_val, best_idx, best_map = -np.inf, None, None
-    peaks = []
-    for heads, D in _iter_scores(specs, stamps, np.arange(headings.size), S, chunk, norm):
-        if n_peaks:
-            peaks.append(_local_peaks(D, heads, 4 * n_peaks))
-        flat_D = D.reshape(D.shape[0], -1)
-        am = flat_D.argmax(axis=1)
-        per = flat_D[np.arange(am.size), am]
-        best_per[heads], arg_per[heads] = per, am
-        m = float(per.max())
-        if m > best_val + tol or (m >= best_val - tol and best_idx is not None and heads.min() < best_idx[0]):
-            cand = np.nonzero(per >= max(m, best_val) - tol)[0]
-            k = cand[np.argmin(heads[cand])]
-            if best_idx is None or m > best_val + tol or heads[k] < best_idx[0]:
-                flat = int(np.argmax(D[k].ravel() >= max(m, best_val) - tol))
-                best_val = max(m, best_val)
-                best_idx = (int(heads[k]), *np.unravel_index(flat, D.shape[1:]))
-                best_map = np.ascontiguousarray(D[k])
-    if n_peaks:
-        return best_val, best_idx, best_map, best_per, arg_per, np.vstack(peaks)
-    return best_val, best_idx, best_map, best_per, arg_per
-
-
-def _local_peaks(D: np.ndarray, heads: np.ndarray, k: int) -> np.ndarray:
-    """``(value, n, row, col)`` rows of the ``k`` largest local maxima (over 5×5 cells) among the ``64·k``
-    largest cells of the maps ``D`` (a cell is a local maximum when no cell within 2 rows and columns of its
-    map is larger)."""
-    _n, H, W = D.shape
-    flat = D.reshape(-1)
-    m = min(64 * k, flat.size)
-    top = np.argpartition(flat, flat.size - m)[flat.size - m:]
-    n, rc = np.divmod(top, H * W)
-    r, c = np.divmod(rc, W)
-    val = flat[top]
-    is_peak = np.ones(top.size, dtype=bool)
-    for dr in range(-2, 3):
-        for dc in range(-2, 3):
-            rr, cc = r + dr, c + dc
-            inside = (rr >= 0) & (rr < H) & (cc >= 0) & (cc < W)
-            nb = D[n[inside], rr[inside], cc[inside]]
-            is_peak[np.nonzero(inside)[0][nb > val[inside]]] = False
-    n, r, c, val = n[is_peak], r[is_peak], c[is_peak], val[is_peak].astype(np.float64)
-    if val.size > k:
-        sel = np.argpartition(-val, k - 1)[:k]
-        n, r, c, val = n[sel], r[sel], c[sel], val[sel]
-    return np.column_stack([val, heads[n], r, c])
-
-
-def _distinct_peaks(peaks: np.ndarray, headings: np.ndarray, k: int, radius_cells: float, heading_rad: float):
-    """The ``k`` best of ``peaks`` (rows ``(value, n, row, col)``) that lie more than ``radius_cells`` or
-    ``heading_rad`` from every better one kept (greedy non-maximum suppression)."""
-    kept = []
-    for val, n, r, c in peaks[np.argsort(-peaks[:, 0], kind="stable")]:
-        if all(np.hypot(r - r2, c - c2) > radius_cells or abs(wrap_angle(headings[int(n)] - headings[int(n2)]))
-               > heading_rad for _v, n2, r2, c2 in kept):
-            kept.append((val, n, r, c))
-            if len(kept) == k:
-                break
-    return np.array(kept).reshape(-1, 4)
-
-
-def _rival_search(specs, stamps, headings, S, best_idx, best_per, arg_per, *, radius_cells, heading_rad, chunk,
-                  norm: _ExploredNorm | None = None):
-    """Best pose more than ``radius_cells`` or ``heading_rad`` away from the peak ``best_idx`` (ours).
-
-    Headings farther than ``heading_rad`` count with their whole map (their maxima are already known);
-    the others are scored again with the disc of radius ``radius_cells`` around the peak cell masked.
-    Returns ``(score, (n, row, col))``, ``(-inf, None)`` when no such pose exists.
-    """
-    n0, r0, c0 = best_idx
-    H, W = specs[next(iter(specs))].shape
-    dh = np.abs(wrap_angle(headings - headings[n0]))
-    far = np.nonzero(dh > heading_rad + 1e-12)[0]
-    val, idx = -np.inf, None
-    if far.size:
-        k = far[np.argmax(best_per[far])]
-        val, idx = float(best_per[k]), (int(k), *np.unravel_index(int(arg_per[k]), (H, W)))
-    near = np.nonzero(dh <= heading_rad + 1e-12)[0]
-    rows, cols = np.ogrid[:H, :W]
-    outside = ((rows - r0) ** 2 + (cols - c0) ** 2 > radius_cells ** 2).ravel()
-    if not outside.any():
-        return val, idx
-    cells = np.nonzero(outside)[0]
-    for heads, D in _iter_scores(specs, stamps, near, S, chunk, norm):
-        Dm = D.reshape(D.shape[0], -1)[:, cells]
-        am = Dm.argmax(axis=1)
-        per = Dm[np.arange(am.size), am]
-        k = int(np.argmax(per))
-        if per[k] > val:
-            val, idx = float(per[k]), (int(heads[k]), *np.unravel_index(int(cells[am[k]]), (H, W)))
-    return val, idx
 
 
 def _direct_scores(Mv: np.ndarray, T: np.ndarray, o: int) -> np.ndarray:
@@ -320,7 +51,7 @@ def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.fl
     M_values : array_like, shape (H, W)
         The map with 004's constants (see :func:`slamlab.scans.grid_to_values`).
     T : array_like, shape (n, S, S)
-        From :func:`rasterise_scan`.
+        From :func:`~slamlab.correlation.scan_stamps`.
     origin : int
         ``o``, the robot's cell in T.
     method : {"batched", "fftconvolve", "direct"}
@@ -342,16 +73,16 @@ def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.fl
     >>> score_maps(M, T, 2).round(9).tolist()
     [[[1.0, 0.0], [3.0, 0.0]]]
     """
-    Mv = v.as_finite_array(M_values, "M_values", ndim=2)
+    Mv = as_finite_array(M_values, "M_values", ndim=2)
     if Mv.size == 0:
         raise ValueError(f"`M_values` must not be empty; got shape {Mv.shape}")
-    T = v.as_finite_array(T, "T")
+    T = as_finite_array(T, "T")
     if T.ndim != 3 or T.shape[1] != T.shape[2] or T.shape[1] < 1:
         raise ValueError(f"`T` must have shape (n, S, S); got shape {T.shape}")
-    o = v.check_int(origin, "origin", minimum=0, maximum=T.shape[1] - 1)
-    method = v.check_choice(method, "method", _METHODS)
+    o = check_int(origin, "origin", minimum=0, maximum=T.shape[1] - 1)
+    method = check_choice(method, "method", _METHODS)
     if method == "batched":
-        return _MapSpectrum(Mv, T.shape[1], o, dtype, workers).scores(T)
+        return MapSpectrum(Mv, T.shape[1], o, dtype, workers).scores(T)
     if method == "direct":
         return _direct_scores(Mv, T, o)
     H, W = Mv.shape
@@ -364,72 +95,59 @@ def score_maps(M_values, T, origin: int, *, method: str = "batched", dtype=np.fl
     return out
 
 
-def _pose_scores(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p, poses) -> np.ndarray:
-    """The correlation Σ T·M of the robot-frame samples at any poses, by the definition (ours, issue 25).
+@dataclass(frozen=True, eq=False)  # arrays: compare fields explicitly, not with ==
+class PoseMarks:
+    """The marked stamp cells of one pose: each cell once, the sample written last winning (ours, issue 25).
 
-    ``poses`` ``(m, 3)``: ``(x = col, y = row, heading)`` in cells and radians, not necessarily on the search's
-    grid. At a grid pose (integer cell) the samples are rasterised exactly as :class:`_Stamps` does (the
-    heading modulo 90° in float32, then the quarter turn on integer offsets), so the value equals the search's
-    ``D[n, row, col]`` up to its FFT rounding; off the grid the fractional part of the position is added before
-    rounding. Free samples are written first, obstacle samples (``a_p``: a scalar or one value per sample) over
-    them, each cell counted once; the map is 0 outside (``a_n = 0``). Returns ``(m,)`` float64 scores (NaN for a
-    pose that is not finite or far outside the map).
-    """
-    out = np.full(np.asarray(poses).reshape(-1, 3).shape[0], np.nan)
-    for m, marks in _pose_marks(Mv, free, obs, a_c, a_p, poses):
-        out[m] = float(np.dot(marks.stamp, marks.map))
-    return out
-
-
-class _Marks:
-    """The marked stamp cells of one pose (:func:`_pose_marks`): each cell once, the last write winning.
-
-    ``row`` / ``col`` (map cell, possibly outside the map), ``stamp`` (the mark's value), ``map`` (the map's
-    value there, 0 outside) and ``is_obs`` (an obstacle sample wrote it), each computed on first use.
+    Attributes
+    ----------
+    row, col : numpy.ndarray of int, shape (k,)
+        The map cell of each mark (possibly outside the map).
+    stamp : numpy.ndarray, shape (k,)
+        The stamp's value there (the samples' ``free_value`` or ``obs_value``).
+    map : numpy.ndarray, shape (k,)
+        The map's value there (0 outside the map).
+    is_obs : numpy.ndarray of bool, shape (k,)
+        An obstacle sample wrote the mark (else a free one).
     """
 
-    __slots__ = ("_col", "_flat", "_idx", "_kind", "_last", "_row", "_vals")
-
-    def __init__(self, last, row, col, idx, vals, kind, flat):
-        self._last, self._row, self._col, self._idx = last, row, col, idx
-        self._vals, self._kind, self._flat = vals, kind, flat
-
-    @property
-    def row(self):
-        return self._row[self._last]
-
-    @property
-    def col(self):
-        return self._col[self._last]
-
-    @property
-    def stamp(self):
-        return self._vals[self._last]
-
-    @property
-    def map(self):
-        return self._flat[self._idx[self._last]]
-
-    @property
-    def is_obs(self):
-        return self._kind[self._last]
+    row: np.ndarray
+    col: np.ndarray
+    stamp: np.ndarray
+    map: np.ndarray
+    is_obs: np.ndarray
 
 
-def _pose_marks(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a_p, poses):
-    """Yield ``(m, marks)`` for each finite pose ``poses[m]``: the stamp's marked cells there (ours, issue 25).
+def _check_pose_args(M_values, samples, poses) -> tuple[np.ndarray, np.ndarray]:
+    """The map and the ``(m, 3)`` poses of :func:`pose_scores` / :func:`pose_marks`, checked."""
+    Mv = as_finite_array(M_values, "M_values", ndim=2)
+    if not isinstance(samples, ScanSamples):
+        raise TypeError(f"`samples` must be a ScanSamples (scan_samples, joined_samples); got {type(samples).__name__}")
+    try:
+        P = np.asarray(poses, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"`poses` must be numbers of shape (m, 3); got {type(poses).__name__}") from None
+    if P.ndim not in (1, 2) or P.shape[-1] != 3:
+        raise ValueError(f"`poses` must have shape (m, 3) or (3,) = (x, y, heading_rad); got shape {P.shape}")
+    return Mv, P.reshape(-1, 3)
 
-    ``marks`` (:class:`_Marks`): map ``row`` / ``col`` of each marked cell (possibly outside the map), its
-    ``stamp`` value (``a_c`` or the obstacle sample's ``a_p``), the ``map`` value there (0 outside) and
-    ``is_obs`` (an obstacle sample wrote it last). The rasterisation of :func:`_pose_scores` (which sums
-    ``stamp·map``); poses that are not finite or lie more than ``4(H + W)`` cells out are skipped.
+
+def _marks_at(Mv: np.ndarray, samples: ScanSamples, P: np.ndarray):
+    """Yield ``(m, last, row, col, idx, vals, kind, flat)`` for each finite pose ``P[m]`` not far outside the map:
+    every sample's map cell ``row, col`` (flat index ``idx`` into the padded map ``flat``), its value ``vals`` and
+    kind (``kind``: obstacle), and ``last``, the samples that wrote their cell last (one per marked cell).
+
+    At a grid pose (integer cell) the samples are rasterised exactly as the search's stamps (the heading modulo 90°
+    in float32, then the quarter turn on integer offsets); off the grid the fractional part of the position is
+    added before rounding. Poses more than ``4(H + W)`` cells out are skipped.
     """
     H, W = Mv.shape
+    free, obs = samples.free, samples.obs
     pts = np.vstack([free.reshape(-1, 2), obs.reshape(-1, 2)])
     n_free = free.shape[0]
-    vals = np.concatenate([np.full(n_free, float(a_c)), np.broadcast_to(np.asarray(a_p, dtype=float),
-                                                                         (obs.shape[0],))])
+    vals = np.concatenate([np.full(n_free, float(samples.free_value)),
+                           np.broadcast_to(np.asarray(samples.obs_value, dtype=float), (obs.shape[0],))])
     kind = np.arange(pts.shape[0]) >= n_free
-    P = np.asarray(poses, dtype=float).reshape(-1, 3)
     reach = float(np.sqrt(np.max(np.sum(pts ** 2, axis=1)))) if pts.size else 0.0
     pad = int(np.ceil(reach)) + 3
     Mp = np.zeros((H + 2 * pad, W + 2 * pad))
@@ -456,7 +174,7 @@ def _pose_marks(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a
         fx, fy = x - tx, y - ty
         for _ in range(q):  # the fractional offset in the base heading's frame: R_q⁻¹ (x, y) = (y, -x)
             fx, fy = fy, -fx
-        if fx == 0.0 and fy == 0.0:  # a grid pose: float32 rounding, as _stamp
+        if fx == 0.0 and fy == 0.0:  # a grid pose: float32 rounding, as the stamps
             i = np.floor(xr + np.float32(0.5)).astype(np.int64)
             j = np.floor(yr + np.float32(0.5)).astype(np.int64)
         else:
@@ -470,4 +188,73 @@ def _pose_marks(Mv: np.ndarray, free: np.ndarray, obs: np.ndarray, a_c: float, a
         seen[idx] = order  # the last write of a cell wins, as in the stamp
         last = (seen[idx] == order) & inside
         seen[idx] = -1
-        yield m, _Marks(last, row, col, idx, vals, kind, flat)
+        yield m, last, row, col, idx, vals, kind, flat
+
+
+def pose_scores(M_values, samples: ScanSamples, poses) -> np.ndarray:
+    """The correlation ``Σ T·M`` of a scan's samples at any poses, by the definition (ours, issue 25; 004 §7).
+
+    The samples are drawn at each pose into the map's cells (free ones first, obstacle ones over them, each cell
+    counted once; the map is 0 = ``a_n`` outside). At a pose on the search's grid (integer cell, a candidate
+    heading) the value equals the search's ``D[n, row, col]`` (:func:`score_maps`) up to its FFT rounding; off
+    the grid a sample counts in the cell it falls in.
+
+    Parameters
+    ----------
+    M_values : array_like, shape (H, W)
+        The map in 004's values (:func:`slamlab.scans.grid_to_values`), ``a_n`` = 0.
+    samples : ScanSamples
+        From :func:`~slamlab.correlation.samples.scan_samples` or :func:`~slamlab.correlation.samples.joined_samples`.
+    poses : array_like, shape (m, 3)
+        ``(x = col, y = row, heading_rad)`` [cells, rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+        The scores (float64); NaN for a pose that is not finite or lies more than ``4(H + W)`` cells out.
+
+    Examples
+    --------
+    >>> from slamlab.correlation.samples import scan_samples
+    >>> from slamlab.scans import Scan
+    >>> M = np.zeros((1, 6)); M[0, 4] = 1.0  # one obstacle cell, 3 cells right of the robot at column 1
+    >>> pose_scores(M, scan_samples(Scan([0.0], [2.5], [True])), [[1, 0, 0.0], [1, 0, np.pi], [np.nan, 0, 0]])
+    array([ 1.,  0., nan])
+    """
+    Mv, P = _check_pose_args(M_values, samples, poses)
+    out = np.full(P.shape[0], np.nan)
+    for m, last, _row, _col, idx, vals, _kind, flat in _marks_at(Mv, samples, P):
+        out[m] = float(np.dot(vals[last], flat[idx[last]]))
+    return out
+
+
+def pose_marks(M_values, samples: ScanSamples, poses) -> list[PoseMarks | None]:
+    """The marks behind :func:`pose_scores` at each pose: where each lands, its value and the map's (ours, issue 25).
+
+    Parameters
+    ----------
+    M_values : array_like, shape (H, W)
+        The map in 004's values, ``a_n`` = 0.
+    samples : ScanSamples
+        The scan's samples.
+    poses : array_like, shape (m, 3)
+        ``(x = col, y = row, heading_rad)`` [cells, rad].
+
+    Returns
+    -------
+    list of PoseMarks or None
+        One per pose (None where :func:`pose_scores` gives NaN); ``Σ stamp·map`` is the pose's score.
+
+    Examples
+    --------
+    >>> from slamlab.correlation.samples import scan_samples
+    >>> from slamlab.scans import Scan
+    >>> mk = pose_marks(np.zeros((1, 6)), scan_samples(Scan([0.0], [1.5], [True])), [[0, 0, 0.0]])[0]
+    >>> mk.col.tolist(), mk.stamp.tolist(), mk.is_obs.tolist()
+    ([0, 1, 2], [-1.0, -1.0, 1.0], [False, False, True])
+    """
+    Mv, P = _check_pose_args(M_values, samples, poses)
+    out: list[PoseMarks | None] = [None] * P.shape[0]
+    for m, last, row, col, idx, vals, kind, flat in _marks_at(Mv, samples, P):
+        out[m] = PoseMarks(row[last], col[last], vals[last], flat[idx[last]], kind[last])
+    return out

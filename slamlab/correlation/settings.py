@@ -1,5 +1,6 @@
 """Settings and result of correlation localisation (004 §7): 004's constants, :class:`LocaliseParams`,
-:class:`Localisation` (re-exported by :mod:`slamlab.correlation.algorithm`)."""
+:class:`Localisation` (re-exported by :mod:`slamlab.correlation.algorithm`), and the checks of the constants and
+of the score normalisation (:func:`check_score_norm`, ours)."""
 
 from __future__ import annotations
 
@@ -8,25 +9,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
 from .._params import Params, param
+from .._validate import check_choice, check_int, check_positive, check_real
 
-__all__ = ["Localisation", "LocaliseParams", "check_constants"]
-
-
-def _check_real(value, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(value):
-        raise TypeError(f"`{name}` must be a finite real number; got {value!r}")
-    return float(value)
-
-
-def _check_unit(x, name: str) -> float:
-    """A number in [0, 1], named ``name`` in the error."""
-    x = v.check_positive(x, name, allow_zero=True)
-    if x > 1:
-        raise ValueError(f"`{name}` must lie in [0, 1]; got {x}")
-    return x
+__all__ = ["SCORE_NORMS", "Localisation", "LocaliseParams", "check_constants", "check_score_norm"]
 
 
 def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
@@ -46,31 +32,10 @@ def check_constants(a_c, a_p, a_n) -> tuple[float, float, float]:
     tuple of float
         ``(a_c, a_p, a_n)`` as floats.
     """
-    a_c, a_p, a_n = _check_real(a_c, "a_c"), _check_real(a_p, "a_p"), _check_real(a_n, "a_n")
+    a_c, a_p, a_n = check_real(a_c, "a_c"), check_real(a_p, "a_p"), check_real(a_n, "a_n")
     if a_c == a_p:
         raise ValueError(f"`a_c` and `a_p` must differ (free and obstacle must be told apart); got both {a_c}")
     return a_c, a_p, a_n
-
-
-#: Choices of ``score_norm`` (:func:`~slamlab.correlation.localise`; ours, issue 25).
-SCORE_NORMS = ("none", "explored")
-
-
-def _check_score_norm(score_norm, min_explored_fraction, p) -> tuple[str, float]:
-    """Validate ``score_norm`` / ``min_explored_fraction`` (ours, issue 25) against the settings ``p``."""
-    sn = v.check_choice(score_norm, "score_norm", SCORE_NORMS)
-    f = v.check_positive(min_explored_fraction, "min_explored_fraction")
-    if f > 1:
-        raise ValueError(f"`min_explored_fraction` must be <= 1; got {f}")
-    if sn == "explored" and p.a_n in (p.a_c, p.a_p):
-        raise ValueError(f"`score_norm='explored'` needs `a_n` to differ from `a_c` and `a_p` (it tells explored "
-                         f"cells by their value); got a_n = {p.a_n}")
-    return sn, f
-
-
-def _stamp_a_c(p) -> float:
-    """The value of the stamp's free marks: ``a_c`` times :attr:`LocaliseParams.free_mark_weight` (ours)."""
-    return p.a_c * p.free_mark_weight
 
 
 @dataclass(frozen=True)
@@ -221,27 +186,66 @@ class LocaliseParams(Params):
         super().__post_init__()
 
     def check(self) -> None:
-        d = v.check_positive(self.delta_alpha_rad, "delta_alpha_rad")
+        d = check_positive(self.delta_alpha_rad, "delta_alpha_rad")
         if d > np.pi:
             raise ValueError(f"`delta_alpha_rad` must be <= π; got {d}")
         check_constants(self.a_c, self.a_p, self.a_n)
-        v.check_positive(self.delta_l_cells, "delta_l_cells", allow_zero=True)
-        v.check_positive(self.hit_offset_cells, "hit_offset_cells", allow_zero=True)
-        st = v.check_positive(self.step_cells, "step_cells")
+        check_positive(self.delta_l_cells, "delta_l_cells", allow_zero=True)
+        check_positive(self.hit_offset_cells, "hit_offset_cells", allow_zero=True)
+        st = check_positive(self.step_cells, "step_cells")
         if st > 1:
             raise ValueError(f"`step_cells` must be <= 1 (a larger step skips cells); got {st}")
         if not isinstance(self.use_misses, (bool, np.bool_)):
             raise TypeError(f"`use_misses` must be a bool; got {type(self.use_misses).__name__}")
-        v.check_int(self.chunk, "chunk", minimum=1)
-        v.check_choice(self.dtype, "dtype", ("float32", "float64"))
+        check_int(self.chunk, "chunk", minimum=1)
+        check_choice(self.dtype, "dtype", ("float32", "float64"))
         if self.workers is not None:
-            v.check_int(self.workers, "workers", minimum=1)
+            check_int(self.workers, "workers", minimum=1)
         if not isinstance(self.ambiguity, (bool, np.bool_)):
             raise TypeError(f"`ambiguity` must be a bool; got {type(self.ambiguity).__name__}")
-        v.check_positive(self.rival_radius_cells, "rival_radius_cells", allow_zero=True)
+        check_positive(self.rival_radius_cells, "rival_radius_cells", allow_zero=True)
         if not isinstance(self.wall_balance, (bool, np.bool_)):
             raise TypeError(f"`wall_balance` must be a bool; got {type(self.wall_balance).__name__}")
-        v.check_positive(self.free_mark_weight, "free_mark_weight")
-        h = v.check_positive(self.rival_heading_rad, "rival_heading_rad", allow_zero=True)
+        check_positive(self.free_mark_weight, "free_mark_weight")
+        h = check_positive(self.rival_heading_rad, "rival_heading_rad", allow_zero=True)
         if h >= np.pi:
             raise ValueError(f"`rival_heading_rad` must be < π (else no heading is far enough); got {h}")
+
+
+#: Choices of ``score_norm`` (:func:`~slamlab.correlation.localise`; ours, issue 25).
+SCORE_NORMS = ("none", "explored")
+
+
+def check_score_norm(score_norm, min_explored_fraction, params: LocaliseParams) -> tuple[str, float]:
+    """Validate the score normalisation of :func:`~slamlab.correlation.localise` against its settings (ours, issue 25).
+
+    Parameters
+    ----------
+    score_norm : {"none", "explored"}
+        ``"explored"``: a pose scores its correlation per stamp mark on an explored map cell.
+    min_explored_fraction : float
+        The fraction of the stamp's marks that must fall on explored cells, in (0, 1].
+    params : LocaliseParams
+        The settings: ``"explored"`` tells explored cells by their value, so ``a_n`` must differ from ``a_c``
+        and ``a_p``.
+
+    Returns
+    -------
+    tuple
+        ``(score_norm, min_explored_fraction)`` checked, as ``(str, float)``.
+
+    Examples
+    --------
+    >>> check_score_norm("explored", 0.8, LocaliseParams())
+    ('explored', 0.8)
+    """
+    sn = check_choice(score_norm, "score_norm", SCORE_NORMS)
+    f = check_positive(min_explored_fraction, "min_explored_fraction")
+    if f > 1:
+        raise ValueError(f"`min_explored_fraction` must be <= 1; got {f}")
+    if not isinstance(params, LocaliseParams):
+        raise TypeError(f"`params` must be a LocaliseParams; got {type(params).__name__}")
+    if sn == "explored" and params.a_n in (params.a_c, params.a_p):
+        raise ValueError(f"`score_norm='explored'` needs `a_n` to differ from `a_c` and `a_p` (it tells explored "
+                         f"cells by their value); got a_n = {params.a_n}")
+    return sn, f

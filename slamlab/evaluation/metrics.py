@@ -23,11 +23,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from .. import _validate as v
 from .._table import format_table
-from ..geometry import se3_inverse, umeyama
+from .._validate import check_choice, check_int, check_positive
+from ..geometry import rotation_angle, se3_inverse, umeyama
 from .trajectory import Trajectory
 
 __all__ = ["ErrorStats", "align_trajectory", "associate", "ate", "rpe"]
@@ -125,7 +124,7 @@ def associate(ref: Trajectory, est: Trajectory, max_diff_s: float = 0.01):
         if len(ref) != len(est):
             raise ValueError(f"trajectories without timestamps must have equal length; got {len(ref)} and {len(est)}")
         return ref, est
-    max_diff_s = v.check_positive(max_diff_s, "max_diff_s", allow_zero=True)
+    max_diff_s = check_positive(max_diff_s, "max_diff_s", allow_zero=True)
     est_longer = len(est) > len(ref)
     short, long_ = (ref, est) if est_longer else (est, ref)
     s1, s2 = short.timestamps_s, long_.timestamps_s
@@ -168,7 +167,7 @@ def align_trajectory(est: Trajectory, ref: Trajectory, method: str = "se3"):
     transform : RigidTransform or None
         ``R``, ``t``, ``c`` of the alignment; ``None`` for ``method="none"``.
     """
-    v.check_choice(method, "method", ALIGNMENTS)
+    check_choice(method, "method", ALIGNMENTS)
     if len(est) != len(ref):
         raise ValueError(f"`est` and `ref` must be associated first; lengths {len(est)} and {len(ref)}")
     if method == "none":
@@ -200,7 +199,7 @@ def ate(ref: Trajectory, est: Trajectory, *, align: str = "se3", max_diff_s: flo
     ErrorStats
         ``rmse``, ``mean``, ``max``, ... of the position errors [m], ``errors`` per pose.
     """
-    v.check_choice(align, "align", ALIGNMENTS)
+    check_choice(align, "align", ALIGNMENTS)
     r, e = associate(ref, est, max_diff_s)
     e, _ = align_trajectory(e, r, align)
     return ErrorStats.from_errors(np.linalg.norm(e.positions_m - r.positions_m, axis=1), "m")
@@ -209,13 +208,13 @@ def ate(ref: Trajectory, est: Trajectory, *, align: str = "se3", max_diff_s: flo
 def _pairs(traj: Trajectory, delta, delta_unit: str, all_pairs: bool):
     n = len(traj)
     if delta_unit == "frames":
-        d = v.check_int(delta, "delta", minimum=1)
+        d = check_int(delta, "delta", minimum=1)
         if all_pairs:
             i = np.arange(0, n - d)
             return i, i + d
         ids = np.arange(0, n, d)
         return ids[:-1], ids[1:]
-    d = v.check_positive(delta, "delta")
+    d = check_positive(delta, "delta")
     if all_pairs:
         raise ValueError("`all_pairs` is only supported with `delta_unit='frames'`")
     # consecutive pairs whose travelled path reaches delta metres (evo's filter_pairs_by_path)
@@ -269,10 +268,10 @@ def rpe(ref: Trajectory, est: Trajectory, *, delta=1, delta_unit: str = "frames"
     ErrorStats
         Statistics of the per-pair errors, ``unit`` ``"m"`` or ``"deg"``.
     """
-    v.check_choice(delta_unit, "delta_unit", ("frames", "m"))
-    v.check_choice(relation, "relation", ("translation", "rotation_deg"))
-    v.check_choice(align, "align", ALIGNMENTS)
-    v.check_choice(pairs_from, "pairs_from", ("estimate", "reference"))
+    check_choice(delta_unit, "delta_unit", ("frames", "m"))
+    check_choice(relation, "relation", ("translation", "rotation_deg"))
+    check_choice(align, "align", ALIGNMENTS)
+    check_choice(pairs_from, "pairs_from", ("estimate", "reference"))
     r, e = associate(ref, est, max_diff_s)
     e, _ = align_trajectory(e, r, align)
     i, j = _pairs(e if pairs_from == "estimate" else r, delta, delta_unit, all_pairs)
@@ -284,5 +283,7 @@ def rpe(ref: Trajectory, est: Trajectory, *, delta=1, delta_unit: str = "frames"
     E = se3_inverse(Q_rel) @ P_rel
     if relation == "translation":
         return ErrorStats.from_errors(np.linalg.norm(E[:, :3, 3], axis=1), "m")
-    ang = np.linalg.norm(Rotation.from_matrix(E[:, :3, :3]).as_rotvec(), axis=1)
-    return ErrorStats.from_errors(np.rad2deg(ang), "deg")
+    # the angle of the rotation nearest to E's (SVD): rotations read from files are orthonormal to their ~9 digits
+    # only, where the angle depends on how the matrix is taken onto SO(3); evo (scipy) projects the same way
+    U, _, Vt = np.linalg.svd(E[:, :3, :3])
+    return ErrorStats.from_errors(np.rad2deg(rotation_angle(U @ Vt)), "deg")

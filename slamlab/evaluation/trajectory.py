@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_vector, parse_numbers
 
 __all__ = ["Trajectory", "read_kitti", "read_tum", "write_kitti", "write_tum"]
 
@@ -52,16 +52,16 @@ class Trajectory:
     frame_ids: np.ndarray | None = None
 
     def __post_init__(self):
-        p = v.as_finite_array(self.positions_m, "positions_m", ndim=2)
+        p = as_finite_array(self.positions_m, "positions_m", ndim=2)
         if p.shape[1] != 3 or p.shape[0] < 1:
             raise ValueError(f"`positions_m` must have shape (N, 3) with N >= 1; got {p.shape}")
-        R = v.as_finite_array(self.rotations, "rotations", ndim=3)
+        R = as_finite_array(self.rotations, "rotations", ndim=3)
         if R.shape != (p.shape[0], 3, 3):
             raise ValueError(f"`rotations` must have shape ({p.shape[0]}, 3, 3); got {R.shape}")
         object.__setattr__(self, "positions_m", p)
         object.__setattr__(self, "rotations", R)
         if self.timestamps_s is not None:
-            object.__setattr__(self, "timestamps_s", v.as_vector(self.timestamps_s, "timestamps_s", p.shape[0]))
+            object.__setattr__(self, "timestamps_s", as_vector(self.timestamps_s, "timestamps_s", p.shape[0]))
         if self.frame_ids is not None:
             ids = np.asarray(self.frame_ids)
             if ids.shape != (p.shape[0],) or not np.issubdtype(ids.dtype, np.integer):
@@ -98,7 +98,7 @@ class Trajectory:
         -------
         Trajectory
         """
-        P = v.as_finite_array(poses, "poses", ndim=3)
+        P = as_finite_array(poses, "poses", ndim=3)
         if P.shape[1:] not in ((4, 4), (3, 4)):
             raise ValueError(f"`poses` must have shape (N, 4, 4) or (N, 3, 4); got {P.shape}")
         return cls(P[:, :3, 3].copy(), P[:, :3, :3].copy(), timestamps_s, name, frame_ids)
@@ -140,7 +140,7 @@ def _load_rows(path, n_cols, what: str) -> np.ndarray:
                 want = " or ".join(map(str, allowed))
                 raise ValueError(f"{path}:{line_no}: a {what} line needs {want} numbers (the same on every "
                                  f"line); got {len(parts)}")
-            rows.append(v.parse_numbers(parts, f"{path}:{line_no} ({what} line)"))
+            rows.append(parse_numbers(parts, f"{path}:{line_no} ({what} line)"))
     if not rows:
         raise ValueError(f"{path}: no poses found")
     arr = np.asarray(rows, dtype=float)

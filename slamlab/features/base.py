@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_image, check_choice, check_int
 
 __all__ = ["CHANNEL_ORDERS", "Features", "to_gray_float", "to_gray_uint8"]
 
@@ -93,7 +93,7 @@ class Features:
         Features
             The ``n`` strongest keypoints, in their original order.
         """
-        n = v.check_int(n, "n", minimum=0)
+        n = check_int(n, "n", minimum=0)
         order = np.argsort(-self.response, kind="stable")[:n]
         return self.subset(np.sort(order))
 
@@ -152,9 +152,9 @@ def to_gray_float(image, name: str = "image", *, channel_order: str = "rgb") -> 
     >>> round(float(to_gray_float(bgr, channel_order="bgr")[0, 0]), 3)
     0.114
     """
-    img = v.as_image(image, name, allow_color=True)
+    img = as_image(image, name, allow_color=True)
     if img.ndim == 3:
-        w = _BT601 if v.check_choice(channel_order, "channel_order", CHANNEL_ORDERS) == "rgb" else _BT601[::-1]
+        w = _BT601 if check_choice(channel_order, "channel_order", CHANNEL_ORDERS) == "rgb" else _BT601[::-1]
         g = img[..., :3].astype(np.float64) @ w
         scale = 255.0 if np.asarray(image).dtype == np.uint8 else 1.0
         return g / scale
@@ -186,14 +186,14 @@ def to_gray_uint8(image, name: str = "image", *, channel_order: str = "rgb") -> 
     gray : (H, W) uint8
         Grey image (a uint8 grey input is returned as is).
     """
-    img = v.as_image(image, name, allow_color=True)
+    img = as_image(image, name, allow_color=True)
     if img.dtype == np.uint8 and img.ndim == 2:
         return img
     if img.dtype == np.uint8:
         import cv2
 
         code = {"rgb": cv2.COLOR_RGB2GRAY, "bgr": cv2.COLOR_BGR2GRAY}[
-            v.check_choice(channel_order, "channel_order", CHANNEL_ORDERS)]
+            check_choice(channel_order, "channel_order", CHANNEL_ORDERS)]
         return cv2.cvtColor(np.ascontiguousarray(img[..., :3]), code)
     g = to_gray_float(img, name, channel_order=channel_order)
     return np.clip(np.rint(g * 255.0), 0, 255).astype(np.uint8)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_choice, check_int, check_positive
 from .base import Features, to_gray_float, to_gray_uint8
 from .fast import fast_detect
 from .moravec import moravec_detect
@@ -45,7 +45,7 @@ def describe_surf(image, features: Features, *, scale_px: float | None = None, u
     if not isinstance(features, Features):
         raise TypeError(f"`features` must be slamlab.features.Features; got {type(features).__name__}")
     II = integral_image(to_gray_float(image))
-    sigma = features.scale_px if scale_px is None else np.full(len(features), v.check_positive(scale_px, "scale_px"))
+    sigma = features.scale_px if scale_px is None else np.full(len(features), check_positive(scale_px, "scale_px"))
     ori = np.zeros(len(features)) if upright else features.orientation_rad
     desc = surf_describe(II, features.uv, sigma, ori, extended=extended)
     return Features(features.uv, features.scale_px, features.orientation_rad, features.response, features.octave,
@@ -86,7 +86,7 @@ def detect(image, method: str = "surf", *, descriptors: bool = True, max_points:
     Features
         Keypoints with descriptors (None where the method has none or ``descriptors=False``).
     """
-    method = v.check_choice(method, "method", DETECTORS)
+    method = check_choice(method, "method", DETECTORS)
     if np.ndim(image) == 3:  # colour: one conversion, in the stated channel order
         gray = to_gray_float if method in ("surf", "moravec") else to_gray_uint8
         image = gray(image, channel_order=channel_order)
@@ -104,7 +104,7 @@ def detect(image, method: str = "surf", *, descriptors: bool = True, max_points:
         f = moravec_detect(image, **params)
     else:
         f = mser_cv(image, **params)
-    if max_points is not None and len(f) > v.check_int(max_points, "max_points", minimum=1):
+    if max_points is not None and len(f) > check_int(max_points, "max_points", minimum=1):
         f = f.strongest(max_points)  # (fewer points: strongest() would keep them all, in order)
     if descriptors and method == "fast":
         f = describe_surf(image, f, scale_px=2.0, upright=True)

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .. import _validate as v
+from .._validate import as_matrix, as_path, check_int, check_positive
 from ..data import find_data
 from ..geometry.homography import apply_homography as project
 from .base import Features
@@ -66,7 +66,7 @@ def oxford_folder(sequence) -> Path:
     if isinstance(sequence, str) and not any(c in sequence for c in "/\\") and not Path(sequence).exists():
         raise ValueError(f"`sequence` must be one of {OXFORD_SEQUENCES} or the path of an Oxford-layout folder; "
                          f"got {sequence!r}")
-    return v.as_path(sequence, "sequence", kind="dir")
+    return as_path(sequence, "sequence", kind="dir")
 
 
 def oxford_label(sequence) -> str:
@@ -117,14 +117,14 @@ def load_oxford_image(sequence, index: int, *, scale: float = 1.0, size=None) ->
     import cv2
 
     folder = oxford_folder(sequence)
-    index = v.check_int(index, "index", minimum=1)
-    scale = v.check_positive(scale, "scale")
+    index = check_int(index, "index", minimum=1)
+    scale = check_positive(scale, "scale")
     if size is not None:
         if scale != 1.0:
             raise ValueError(f"give `scale` or `size`, not both; got scale={scale}, size={size}")
         if len(size) != 2:
             raise ValueError(f"`size` must be (width_px, height_px); got {size}")
-        size = (v.check_int(size[0], "size[0]", minimum=1), v.check_int(size[1], "size[1]", minimum=1))
+        size = (check_int(size[0], "size[0]", minimum=1), check_int(size[1], "size[1]", minimum=1))
     path = _image_file(folder, index)
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
@@ -161,7 +161,7 @@ def load_oxford_pair(sequence, j: int, *, scale: float = 1.0):
         Homography from img1 pixels to img_j pixels, normalised so that ``H[2, 2] = 1``.
     """
     folder = oxford_folder(sequence)
-    j = v.check_int(j, "j", minimum=2)
+    j = check_int(j, "j", minimum=2)
     img1 = load_oxford_image(folder, 1, scale=scale)
     img2 = load_oxford_image(folder, j, scale=scale)
     h_path = folder / f"H1to{j}p"
@@ -202,7 +202,7 @@ def common_region(f1: Features, f2: Features, H, shape1, shape2, *, margin_px: f
     in2 : (len(f2),) bool
         Image-2 keypoints whose preimage lies inside image 1.
     """
-    H = v.as_matrix(H, "H", (3, 3))
+    H = as_matrix(H, "H", (3, 3))
     in1 = _inside(project(H, f1.uv), shape2, margin_px) if len(f1) else np.zeros(0, dtype=bool)
     in2 = _inside(project(np.linalg.inv(H), f2.uv), shape1, margin_px) if len(f2) else np.zeros(0, dtype=bool)
     return in1, in2
@@ -278,7 +278,7 @@ def repeatability(f1: Features, f2: Features, H, shape1, shape2, *, tol_px: floa
     (3, 1, 1, 1.0)
     """
     f1, f2 = _check_features(f1, "f1"), _check_features(f2, "f2")
-    tol_px = v.check_positive(tol_px, "tol_px")
+    tol_px = check_positive(tol_px, "tol_px")
     in1, in2 = common_region(f1, f2, H, shape1, shape2)
     p1 = project(H, f1.uv[in1]) if in1.any() else np.zeros((0, 2))
     p2 = f2.uv[in2]
@@ -311,7 +311,7 @@ def correct_matches(f1: Features, f2: Features, matches: Matches, H, *, tol_px: 
         True for the correct matches.
     """
     f1, f2 = _check_features(f1, "f1"), _check_features(f2, "f2")
-    tol_px = v.check_positive(tol_px, "tol_px")
+    tol_px = check_positive(tol_px, "tol_px")
     if len(matches) == 0:
         return np.zeros(0, dtype=bool)
     p = project(H, f1.uv[matches.query_idx])

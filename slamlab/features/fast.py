@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from .. import _validate as v
+from .._validate import check_int
 from .base import Features, to_gray_uint8
 
 __all__ = ["CIRCLE_OFFSETS", "fast_corner_mask", "fast_detect", "fast_score"]
@@ -72,8 +72,8 @@ def fast_corner_mask(image, threshold: int = 20, n: int = 9, *, high_speed: bool
         True at the corners.
     """
     img = to_gray_uint8(image)
-    threshold = v.check_int(threshold, "threshold", minimum=0, maximum=255)
-    n = v.check_int(n, "n", minimum=9, maximum=12)
+    threshold = check_int(threshold, "threshold", minimum=0, maximum=255)
+    n = check_int(n, "n", minimum=9, maximum=12)
     if high_speed is None:
         high_speed = n >= 12
     if high_speed and n < 12:
@@ -117,7 +117,7 @@ def fast_score(image, rows, cols, n: int = 9) -> np.ndarray:
     img = to_gray_uint8(image).astype(np.int16)
     rows = np.asarray(rows, dtype=np.int64)
     cols = np.asarray(cols, dtype=np.int64)
-    n = v.check_int(n, "n", minimum=9, maximum=12)
+    n = check_int(n, "n", minimum=9, maximum=12)
     if rows.size == 0:
         return np.zeros(0, dtype=np.int64)
     ring = img[rows[:, None] + CIRCLE_OFFSETS[:, 1], cols[:, None] + CIRCLE_OFFSETS[:, 0]]  # (K, 16)

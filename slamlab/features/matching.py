@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_choice, check_int, check_positive
 from ..kdtree.knn import exact_knn, flann_index, hamming_distances, pad_knn
 from ..kdtree.tree import KDTree
 
@@ -65,7 +65,7 @@ def _as_descriptors(D, name):
         raise ValueError(f"`{name}` must be a 2-D (N, d) descriptor array; got shape {arr.shape}")
     if arr.dtype == np.uint8:
         return arr
-    return v.as_finite_array(arr, name, ndim=2, dtype=np.float32 if arr.dtype == np.float32 else np.float64)
+    return as_finite_array(arr, name, ndim=2, dtype=np.float32 if arr.dtype == np.float32 else np.float64)
 
 
 def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: int = 200,
@@ -94,7 +94,7 @@ def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: 
     """
     Q = _as_descriptors(query, "query")
     T = _as_descriptors(train, "train")
-    method = v.check_choice(method, "method", KNN_METHODS)
+    method = check_choice(method, "method", KNN_METHODS)
     if Q.shape[1] != T.shape[1]:
         raise ValueError(f"`query` and `train` must have the same descriptor length; got {Q.shape[1]} and "
                          f"{T.shape[1]}")
@@ -110,9 +110,9 @@ def knn2(query, train, *, method: str = "brute", max_leaves: int = 200, checks: 
     if method in ("kdtree", "bbf"):
         if tree is None:
             tree = KDTree(T, leaf_size=leaf_size)
-        return tree.query(Q, k=2, max_leaves=None if method == "kdtree" else v.check_int(max_leaves, "max_leaves",
+        return tree.query(Q, k=2, max_leaves=None if method == "kdtree" else check_int(max_leaves, "max_leaves",
                                                                                           minimum=1))
-    checks = v.check_int(checks, "checks", minimum=1)
+    checks = check_int(checks, "checks", minimum=1)
     index = tree if tree is not None else flann_index(T, trees=1)
     k = min(2, T.shape[0])
     idx, d2 = index.knnSearch(np.ascontiguousarray(Q, dtype=np.float32), k, params={"checks": checks})
@@ -201,8 +201,8 @@ def accept_000(dist, *, factor: float = 2.0, max_dist: float = np.inf) -> np.nda
     dist = np.asarray(dist, dtype=np.float64)
     if dist.ndim != 2 or dist.shape[1] < 2:
         raise ValueError(f"`dist` must have shape (M, 2) (nearest, second nearest); got {dist.shape}")
-    factor = v.check_positive(factor, "factor")
-    max_dist = float(max_dist) if np.isinf(max_dist) else v.check_positive(max_dist, "max_dist", allow_zero=True)
+    factor = check_positive(factor, "factor")
+    max_dist = float(max_dist) if np.isinf(max_dist) else check_positive(max_dist, "max_dist", allow_zero=True)
     return (dist[:, 1] >= factor * dist[:, 0]) & (dist[:, 0] <= max_dist)
 
 
@@ -229,7 +229,7 @@ def accept_ratio(dist, ratio: float = 0.8) -> np.ndarray:
     dist = np.asarray(dist, dtype=np.float64)
     if dist.ndim != 2 or dist.shape[1] < 2:
         raise ValueError(f"`dist` must have shape (M, 2) (nearest, second nearest); got {dist.shape}")
-    ratio = v.check_positive(ratio, "ratio")
+    ratio = check_positive(ratio, "ratio")
     return ratio_rule(dist[:, 0], dist[:, 1], ratio)
 
 
@@ -291,7 +291,7 @@ def match_descriptors(query, train, *, rule: str = "000", factor: float = 2.0, r
     Matches
         ``query_idx``, ``train_idx`` of the accepted matches with their ``d1``, ``d2``.
     """
-    rule = v.check_choice(rule, "rule", ("000", "ratio", "none"))
+    rule = check_choice(rule, "rule", ("000", "ratio", "none"))
     d, idx = knn2(query, train, method=method, max_leaves=max_leaves, checks=checks)
     if rule == "000":
         keep = accept_000(d, factor=factor, max_dist=max_dist)

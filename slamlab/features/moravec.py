@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from .. import _validate as v
+from .._validate import check_int, check_positive
 from .base import Features, to_gray_float
 
 __all__ = ["SHIFTS", "moravec_detect", "moravec_response"]
@@ -48,7 +48,7 @@ def moravec_response(image, window: int = 3) -> np.ndarray:
     (4, 4)
     """
     img = to_gray_float(image)
-    window = v.check_int(window, "window", minimum=1)
+    window = check_int(window, "window", minimum=1)
     if window % 2 == 0:
         raise ValueError(f"`window` must be odd (3, 5, 9, ...); got {window}")
     H, W = img.shape
@@ -86,8 +86,8 @@ def moravec_detect(image, threshold: float = 0.1, window: int = 3, *, nms_size: 
     Features
         Corners (``scale_px`` = window / 2, ``response`` = the measure), no descriptors.
     """
-    threshold = v.check_positive(threshold, "threshold")
-    nms_size = v.check_int(nms_size, "nms_size", minimum=1)
+    threshold = check_positive(threshold, "threshold")
+    nms_size = check_int(nms_size, "nms_size", minimum=1)
     R = moravec_response(image, window)
     peak = (ndimage.maximum_filter(R, size=nms_size, mode="constant") == R) & (threshold < R)
     r, c = np.nonzero(peak)

@@ -11,7 +11,7 @@ from operator import attrgetter
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_int, check_positive
 from .base import Features, to_gray_uint8
 
 __all__ = ["fast_cv", "features_from_keypoints", "mser_cv", "orb_cv", "sift_cv"]
@@ -79,10 +79,10 @@ def sift_cv(image, *, n_features: int = 0, contrast_threshold: float = 0.04, edg
     import cv2
 
     img = to_gray_uint8(image)
-    det = cv2.SIFT_create(nfeatures=v.check_int(n_features, "n_features", minimum=0),
-                          contrastThreshold=v.check_positive(contrast_threshold, "contrast_threshold"),
-                          edgeThreshold=v.check_positive(edge_threshold, "edge_threshold"),
-                          sigma=v.check_positive(sigma, "sigma"))
+    det = cv2.SIFT_create(nfeatures=check_int(n_features, "n_features", minimum=0),
+                          contrastThreshold=check_positive(contrast_threshold, "contrast_threshold"),
+                          edgeThreshold=check_positive(edge_threshold, "edge_threshold"),
+                          sigma=check_positive(sigma, "sigma"))
     if descriptors:
         kp, d = det.detectAndCompute(img, None)
     else:
@@ -117,10 +117,10 @@ def orb_cv(image, *, n_features: int = 2000, scale_factor: float = 1.2, n_levels
     import cv2
 
     img = to_gray_uint8(image)
-    det = cv2.ORB_create(nfeatures=v.check_int(n_features, "n_features", minimum=1),
-                         scaleFactor=v.check_positive(scale_factor, "scale_factor"),
-                         nlevels=v.check_int(n_levels, "n_levels", minimum=1),
-                         fastThreshold=v.check_int(fast_threshold, "fast_threshold", minimum=0))
+    det = cv2.ORB_create(nfeatures=check_int(n_features, "n_features", minimum=1),
+                         scaleFactor=check_positive(scale_factor, "scale_factor"),
+                         nlevels=check_int(n_levels, "n_levels", minimum=1),
+                         fastThreshold=check_int(fast_threshold, "fast_threshold", minimum=0))
     if descriptors:
         kp, d = det.detectAndCompute(img, None)
         if d is None:
@@ -150,7 +150,7 @@ def fast_cv(image, *, threshold: int = 20, nonmax: bool = True) -> Features:
     import cv2
 
     img = to_gray_uint8(image)
-    det = cv2.FastFeatureDetector_create(v.check_int(threshold, "threshold", minimum=0, maximum=255),
+    det = cv2.FastFeatureDetector_create(check_int(threshold, "threshold", minimum=0, maximum=255),
                                          bool(nonmax), cv2.FAST_FEATURE_DETECTOR_TYPE_9_16)
     return features_from_keypoints(det.detect(img, None), None, "FAST-cv")
 
@@ -175,9 +175,9 @@ def mser_cv(image, *, delta: int = 5, min_area: int = 60, max_area: int = 14400)
     import cv2
 
     img = to_gray_uint8(image)
-    det = cv2.MSER_create(delta=v.check_int(delta, "delta", minimum=1),
-                          min_area=v.check_int(min_area, "min_area", minimum=1),
-                          max_area=v.check_int(max_area, "max_area", minimum=1))
+    det = cv2.MSER_create(delta=check_int(delta, "delta", minimum=1),
+                          min_area=check_int(min_area, "min_area", minimum=1),
+                          max_area=check_int(max_area, "max_area", minimum=1))
     regions, _ = det.detectRegions(img)
     k = len(regions)
     if k == 0:

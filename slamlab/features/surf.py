@@ -42,17 +42,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_int, check_positive
+from ._padded_ii import PaddedIntegralImage
 from .base import Features, to_gray_float
 from .surf_descriptor import surf_describe, surf_orientation
-from .surf_haar import _PaddedII, haar_xy
-from .surf_response import _extrema, box_sums, filter_sizes, hessian_response, integral_image, threshold_sweep
+from .surf_haar import haar_xy
+from .surf_response import (
+    box_sums,
+    filter_sizes,
+    hessian_maxima,
+    hessian_response,
+    integral_image,
+    threshold_sweep,
+)
 
 __all__ = [
     "SURF",
     "box_sums",
     "filter_sizes",
     "haar_xy",
+    "hessian_maxima",
     "hessian_response",
     "integral_image",
     "surf_describe",
@@ -103,15 +112,16 @@ def surf_detect(image, threshold: float = 0.0004, *, n_octaves: int = 4, init_st
         (None with ``descriptors=False``).
     """
     img = to_gray_float(image)
-    threshold = v.check_positive(threshold, "threshold", allow_zero=True)
-    n_octaves = v.check_int(n_octaves, "n_octaves", minimum=1, maximum=6)
-    init_step = v.check_int(init_step, "init_step", minimum=1)
+    threshold = check_positive(threshold, "threshold", allow_zero=True)
+    n_octaves = check_int(n_octaves, "n_octaves", minimum=1, maximum=6)
+    init_step = check_int(init_step, "init_step", minimum=1)
     if min(img.shape) < 16:
         raise ValueError(f"`image` must be at least 16x16 pixels for SURF; got shape {img.shape}")
-    workers = v.check_int(workers, "workers", minimum=1)
-    P = _PaddedII(image=img, workers=workers)  # the integral image written into its padded array
+    workers = check_int(workers, "workers", minimum=1)
+    P = PaddedIntegralImage(image=img, workers=workers)  # the integral image written into its padded array
     II = P.II
-    ext = _extrema(II, threshold=threshold, n_octaves=n_octaves, init_step=init_step, workers=workers, padded=P)
+    ext = hessian_maxima(II, threshold=threshold, n_octaves=n_octaves, init_step=init_step, workers=workers,
+                         _padded=P)
     uv = np.column_stack([ext["u"], ext["v"]]) if ext["u"].size else np.zeros((0, 2))
     sigma = 1.2 * ext["L"] / 9.0
     # orientations and descriptors in one thread: their numpy calls on chunks of a few dozen keypoints
@@ -149,12 +159,12 @@ class SURF:
 
     def __init__(self, threshold: float = 0.0004, *, n_octaves: int = 4, init_step: int = 2,
                  upright: bool = False, extended: bool = False, workers: int = 2):
-        self.threshold = v.check_positive(threshold, "threshold", allow_zero=True)
-        self.n_octaves = v.check_int(n_octaves, "n_octaves", minimum=1, maximum=6)
-        self.init_step = v.check_int(init_step, "init_step", minimum=1)
+        self.threshold = check_positive(threshold, "threshold", allow_zero=True)
+        self.n_octaves = check_int(n_octaves, "n_octaves", minimum=1, maximum=6)
+        self.init_step = check_int(init_step, "init_step", minimum=1)
         self.upright = bool(upright)
         self.extended = bool(extended)
-        self.workers = v.check_int(workers, "workers", minimum=1)
+        self.workers = check_int(workers, "workers", minimum=1)
 
     def __repr__(self) -> str:
         return (f"SURF(threshold={self.threshold}, n_octaves={self.n_octaves}, init_step={self.init_step}, "

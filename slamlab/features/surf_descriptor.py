@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
-from .surf_haar import _by_chunks, _PaddedII
+from .._validate import check_int
+from ._padded_ii import PaddedIntegralImage, by_chunks
 
 __all__ = ["surf_describe", "surf_orientation"]
 
@@ -106,7 +106,7 @@ def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_ra
         Keypoints per vectorised chunk.
     workers : int
         Threads.
-    _padded : _PaddedII, optional
+    _padded : PaddedIntegralImage, optional
         Private: a padded integral image already built by :func:`surf_detect`.
 
     Returns
@@ -116,16 +116,16 @@ def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_ra
     """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     s = np.maximum(np.rint(np.asarray(scale_px, dtype=np.float64)), 1).astype(np.int64)
-    chunk = v.check_int(chunk, "chunk", minimum=1)
-    workers = v.check_int(workers, "workers", minimum=1)
-    P = _PaddedII(II) if _padded is None else _padded
+    chunk = check_int(chunk, "chunk", minimum=1)
+    workers = check_int(workers, "workers", minimum=1)
+    P = PaddedIntegralImage(II) if _padded is None else _padded
     edges = _window_edges(float(window_rad), float(step_rad))
     fast = P.fits(uv, 7 * s + 1)  # samples at up to 5s, boxes of half-side 2s
 
     def one(idx, f, si):
         return _orientation_chunk(P, uv[idx], si, step_rad, edges, f)
 
-    return _by_chunks(one, fast, s, chunk, workers, np.zeros(uv.shape[0]))
+    return by_chunks(one, fast, s, chunk, workers, np.zeros(uv.shape[0]))
 
 
 _D_OFF = (np.arange(20) - 9.5)  # sample centres in units of σ along each axis
@@ -237,7 +237,7 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
         Keypoints per vectorised chunk.
     workers : int
         Threads.
-    _padded : _PaddedII, optional
+    _padded : PaddedIntegralImage, optional
         Private: a padded integral image already built by :func:`surf_detect`.
 
     Returns
@@ -252,12 +252,12 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
     K = uv.shape[0]
     dim = 128 if extended else 64
     out = np.zeros((K, dim), dtype=np.float32)
-    chunk = v.check_int(chunk, "chunk", minimum=1)
-    workers = v.check_int(workers, "workers", minimum=1)
-    P = _PaddedII(II) if _padded is None else _padded
+    chunk = check_int(chunk, "chunk", minimum=1)
+    workers = check_int(workers, "workers", minimum=1)
+    P = PaddedIntegralImage(II) if _padded is None else _padded
     fast = P.fits(uv, np.ceil(13.44 * sigma) + s_int + 1)  # samples within 9.5·√2·σ, boxes of half-side s
 
     def one(idx, f, si):
         return _describe_chunk(P, uv[idx], sigma[idx], si, th[idx], extended, f)
 
-    return _by_chunks(one, fast, s_int, chunk, workers, out)
+    return by_chunks(one, fast, s_int, chunk, workers, out)

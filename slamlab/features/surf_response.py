@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
 from .._threads import run_tasks
+from .._validate import as_finite_array, as_vector, check_int, check_positive
+from ._padded_ii import PaddedIntegralImage
 from .base import to_gray_float
-from .surf_haar import _PaddedII
 
-__all__ = ["box_sums", "filter_sizes", "hessian_response", "integral_image", "threshold_sweep"]
+__all__ = ["box_sums", "filter_sizes", "hessian_maxima", "hessian_response", "integral_image", "threshold_sweep"]
 
 
 def integral_image(image) -> np.ndarray:
@@ -147,7 +147,7 @@ class _Phases:
     ``Cq``. The corner ``II[r + dr, c + dc]`` over the whole grid is then one contiguous slice of one
     phase, laid out as ``i·Cq + j`` (columns ``j >= nc`` are padding), so every pass of the box
     filters runs on contiguous memory -- 2-3x faster than the strided views of :func:`box_sums`. Phases
-    are strided copies of the padded image ``E`` (:class:`_PaddedII`) where it is large enough,
+    are strided copies of the padded image ``E`` (``PaddedIntegralImage``) where it is large enough,
     gathered from ``II`` otherwise (the coarse octaves of ``n_octaves > 4``).
     """
 
@@ -230,7 +230,7 @@ def _response_stacks(II, n_octaves, init_step, workers=1, padded=None, phase_oct
     """
     H, W = II.shape[0] - 1, II.shape[1] - 1
     L = filter_sizes(n_octaves)
-    E = _PaddedII(II) if padded is None else padded
+    E = PaddedIntegralImage(II) if padded is None else padded
     out, jobs = [], []
     for o in range(n_octaves):
         step = init_step * 2**o
@@ -285,11 +285,52 @@ def _interior_maxima(D, threshold):
     return i, r, c
 
 
-def _extrema(II, *, threshold, n_octaves, init_step, workers=1, padded=None):
-    """Thresholded 3×3×3 maxima, interpolated (Bay 2008 §3.4; Brown & Lowe 2002); octaves in parallel."""
+def hessian_maxima(II, *, threshold: float, n_octaves: int = 4, init_step: int = 2, workers: int = 1,
+                   _padded=None) -> dict:
+    """SURF's keypoints: thresholded 3×3×3 maxima of the Hessian determinant, interpolated (Bay 2008 §3.4).
+
+    The position and scale are refined as Brown & Lowe 2002 do, before any orientation. The response maps of every octave (:func:`hessian_response` on the grid of step ``init_step·2^o``), the
+    points above ``threshold`` that are the largest of their 3×3×3 (interval, row, column) box, and a
+    quadratic fit of position and scale (kept when every offset is below half a grid step). Octaves run in
+    parallel on ``workers`` threads (the same result for any number).
+
+    Parameters
+    ----------
+    II : (H+1, W+1) float
+        Integral image (:func:`integral_image`).
+    threshold : float
+        Minimum Hessian determinant (our response scale: image in [0, 1], filters divided by L²).
+    n_octaves : int
+        Number of octaves, 1..6 (000: 4), 4 intervals each.
+    init_step : int
+        Sampling step of the first octave in pixels (000: 2).
+    workers : int
+        Threads.
+    _padded : PaddedIntegralImage, optional
+        Private: the padded integral image already built by :func:`~slamlab.features.surf.surf_detect`.
+
+    Returns
+    -------
+    dict of (K,) arrays
+        ``u``, ``v`` (pixels), ``L`` (interpolated filter side in pixels; σ = 1.2·L/9), ``det`` (the response
+        at the maximum) and ``octave``.
+
+    Examples
+    --------
+    >>> yy, xx = np.mgrid[0:101, 0:101]
+    >>> blob = np.exp(-((xx - 50.0)**2 + (yy - 50.0)**2) / (2 * 4.0**2))
+    >>> m = hessian_maxima(integral_image(blob), threshold=1e-4)
+    >>> i = np.argmax(m["det"]); round(float(m["u"][i])), round(float(m["v"][i]))
+    (50, 50)
+    """
+    II = as_finite_array(II, "II", ndim=2)
+    threshold = check_positive(threshold, "threshold", allow_zero=True)
+    n_octaves = check_int(n_octaves, "n_octaves", minimum=1, maximum=6)
+    init_step = check_int(init_step, "init_step", minimum=1)
+    workers = check_int(workers, "workers", minimum=1)
     H, W = II.shape[0] - 1, II.shape[1] - 1
     L = filter_sizes(n_octaves)
-    stacks = _response_stacks(II, n_octaves, init_step, workers, padded)
+    stacks = _response_stacks(II, n_octaves, init_step, workers, _padded)
     found = run_tasks([lambda o=o, D=D, step=step: _octave_extrema(D, step, L[o], o, threshold, H, W)
                        for o, (D, step) in enumerate(stacks)], workers)
     found = [f for f in found if f is not None]
@@ -354,8 +395,8 @@ def threshold_sweep(image, thresholds, *, n_octaves: int = 4, init_step: int = 2
         Keypoints with response above each threshold.
     """
     img = to_gray_float(image)
-    th = v.as_vector(thresholds, "thresholds")
+    th = as_vector(thresholds, "thresholds")
     II = integral_image(img)
-    ext = _extrema(II, threshold=float(th.min()) if th.min() > 0 else 0.0, n_octaves=n_octaves,
-                   init_step=init_step)
+    ext = hessian_maxima(II, threshold=float(th.min()) if th.min() > 0 else 0.0, n_octaves=n_octaves,
+                         init_step=init_step)
     return np.array([int(np.count_nonzero(ext["det"] > t)) for t in th])

@@ -1,7 +1,7 @@
 """Recursive filters (000 §1.2, §3.6): KF, EKF, UKF (augmented and additive), landmark filter.
 
 Functions carry the maths (``kf_predict``, ``ekf_update``, ``ukf_predict``…);
-thin classes keep state (``KalmanFilter``, ``ExtendedKalmanFilter``,
+thin classes keep state (``KalmanFilter``, ``LinearisedKalmanFilter``, ``ExtendedKalmanFilter``,
 ``UnscentedKalmanFilter``, ``LandmarkFilter``). The chapter's Monte Carlo studies of them
 are in :mod:`slamlab.studies.filters`.
 """
@@ -10,7 +10,7 @@ from .._lazy import lazy_exports
 from ._linalg import CholeskyError, symmetrize
 from .consistency import chi2_interval, nees, nis
 from .ekf import ExtendedKalmanFilter, check_jacobian, ekf_predict, ekf_update, numerical_jacobian
-from .kalman import KalmanFilter, Update, kf_predict, kf_update
+from .kalman import KalmanFilter, LinearisedKalmanFilter, Update, kf_predict, kf_update
 from .landmark import LandmarkFilter, landmark_predict, landmark_update
 from .ukf import (
     UnscentedKalmanFilter,
@@ -26,6 +26,7 @@ __all__ = [
     "ExtendedKalmanFilter",
     "KalmanFilter",
     "LandmarkFilter",
+    "LinearisedKalmanFilter",
     "UnscentedKalmanFilter",
     "Update",
     "check_jacobian",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_int, check_probability
 
 __all__ = ["chi2_interval", "nees", "nis"]
 
@@ -33,8 +33,8 @@ def nees(err, P):
     >>> float(nees(np.array([1.0, 2.0]), np.diag([1.0, 4.0])))
     2.0
     """
-    err = v.as_finite_array(err, "err")
-    P = v.as_finite_array(P, "P")
+    err = as_finite_array(err, "err")
+    P = as_finite_array(P, "P")
     if err.ndim < 1 or P.shape != err.shape + err.shape[-1:]:
         raise ValueError(f"`P` must have shape {err.shape + err.shape[-1:]} to match `err`; got {P.shape}")
     sol = np.linalg.solve(P, err[..., None])[..., 0]
@@ -89,9 +89,9 @@ def chi2_interval(dof: int, n_runs: int = 1, prob: float = 0.95):
     >>> [round(b, 3) for b in chi2_interval(2, 50)]
     [1.484, 2.591]
     """
-    dof = v.check_int(dof, "dof", minimum=1)
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    prob = v.check_probability(prob, "prob")
+    dof = check_int(dof, "dof", minimum=1)
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
+    prob = check_probability(prob, "prob")
     a = (1.0 - prob) / 2.0
     k = dof * n_runs
     return float(stats.chi2.ppf(a, k) / n_runs), float(stats.chi2.ppf(1.0 - a, k) / n_runs)

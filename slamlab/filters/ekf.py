@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_covariance, as_matrix, as_measurement, as_vector, check_callable
 from ._linalg import gain, symmetrize
 from .kalman import Update
 
@@ -72,14 +72,14 @@ def ekf_predict(x, P, f, F_jac, Q, u=None):
     >>> x, P
     (array([0.]), array([[4.]]))
     """
-    x = v.as_vector(x, "x")
+    x = as_vector(x, "x")
     n = x.shape[0]
-    P = v.as_covariance(P, "P", n)
-    Q = v.as_covariance(Q, "Q", n)
-    v.check_callable(f, "f")
-    v.check_callable(F_jac, "F_jac")
-    F = v.as_matrix(F_jac(x, u), "F_jac(x, u)", (n, n))
-    x_new = v.as_vector(f(x, u), "f(x, u)", n)
+    P = as_covariance(P, "P", n)
+    Q = as_covariance(Q, "Q", n)
+    check_callable(f, "f")
+    check_callable(F_jac, "F_jac")
+    F = as_matrix(F_jac(x, u), "F_jac(x, u)", (n, n))
+    x_new = as_vector(f(x, u), "f(x, u)", n)
     return x_new, symmetrize(F @ P @ F.T + Q)
 
 
@@ -114,16 +114,16 @@ def ekf_update(x, P, z, h, H_jac, R, *, residual=np.subtract) -> Update:
     >>> upd.x, upd.P
     (array([2.2]), array([[0.2]]))
     """
-    x = v.as_vector(x, "x")
+    x = as_vector(x, "x")
     n = x.shape[0]
-    P = v.as_covariance(P, "P", n)
-    z = v.as_vector(z, "z")
+    P = as_covariance(P, "P", n)
+    z = as_vector(z, "z")
     m = z.shape[0]
-    R = v.as_covariance(R, "R", m)
-    v.check_callable(h, "h")
-    v.check_callable(H_jac, "H_jac")
-    v.as_matrix(H_jac(x), "H_jac(x)", (m, n))
-    v.as_vector(h(x), "h(x)", m)
+    R = as_covariance(R, "R", m)
+    check_callable(h, "h")
+    check_callable(H_jac, "H_jac")
+    as_matrix(H_jac(x), "H_jac(x)", (m, n))
+    as_vector(h(x), "h(x)", m)
     return _ekf_update(x, P, z, h, H_jac, R, residual)
 
 
@@ -153,8 +153,8 @@ def numerical_jacobian(fun, x, *args, eps: float | None = None) -> np.ndarray:
     >>> numerical_jacobian(lambda x: np.array([x[0] * x[1]]), np.array([2.0, 3.0])).round(6)
     array([[3., 2.]])
     """
-    x = v.as_vector(x, "x")
-    v.check_callable(fun, "fun")
+    x = as_vector(x, "x")
+    check_callable(fun, "fun")
     h = np.cbrt(np.finfo(float).eps) * np.maximum(1.0, np.abs(x)) if eps is None else np.full(x.shape, eps)
     cols = []
     for j in range(x.shape[0]):
@@ -193,8 +193,8 @@ def check_jacobian(fun, jac, x, *args, rtol: float = 1e-5, atol: float = 1e-7) -
     >>> check_jacobian(lambda x: x**2, lambda x: np.diag(2 * x), np.array([1.0, 2.0])) < 1e-8
     True
     """
-    x = v.as_vector(x, "x")
-    v.check_callable(jac, "jac")
+    x = as_vector(x, "x")
+    check_callable(jac, "jac")
     J = np.atleast_2d(np.asarray(jac(x, *args), dtype=float))
     J_num = np.atleast_2d(numerical_jacobian(fun, x, *args))
     if J.shape != J_num.shape:
@@ -237,13 +237,13 @@ class ExtendedKalmanFilter:
     """
 
     def __init__(self, x, P, f, F_jac, Q, h, H_jac, R, *, residual=np.subtract):
-        self.x = v.as_vector(x, "x")
+        self.x = as_vector(x, "x")
         n = self.x.shape[0]
-        self.P = v.as_covariance(P, "P", n)
-        self.f, self.F_jac = v.check_callable(f, "f"), v.check_callable(F_jac, "F_jac")
-        self.h, self.H_jac = v.check_callable(h, "h"), v.check_callable(H_jac, "H_jac")
-        self.Q = v.as_covariance(Q, "Q", n)
-        self.R = v.as_covariance(R, "R")
+        self.P = as_covariance(P, "P", n)
+        self.f, self.F_jac = check_callable(f, "f"), check_callable(F_jac, "F_jac")
+        self.h, self.H_jac = check_callable(h, "h"), check_callable(H_jac, "H_jac")
+        self.Q = as_covariance(Q, "Q", n)
+        self.R = as_covariance(R, "R")
         self.residual = residual
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
         self.x_post, self.P_post = self.x.copy(), self.P.copy()
@@ -268,7 +268,7 @@ class ExtendedKalmanFilter:
         z : array_like, shape (m,)
             Measurement (validated for shape and finiteness).
         """
-        z = v.as_measurement(z, "z", self.R.shape[0])
+        z = as_measurement(z, "z", self.R.shape[0])
         self.x, self.P, self.y, self.S, self.K = _ekf_update(
             self.x, self.P, z, self.h, self.H_jac, self.R, self.residual)
         self.x_post, self.P_post = self.x.copy(), self.P.copy()

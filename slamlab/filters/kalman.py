@@ -1,4 +1,5 @@
-"""Linear Kalman filter (000 §1.2.1): predict, update (short and Joseph forms).
+"""Linear Kalman filter (000 §1.2.1): predict, update (short and Joseph forms); the same filter on the deviation
+from a nominal path of a nonlinear model (:class:`LinearisedKalmanFilter`, ours).
 
 Index convention (000 mixes ``B_k u_k`` and ``B_k u_{k-1}``): we write the
 prediction as ``x_{k|k-1} = F x_{k-1|k-1} + B u`` where ``u`` is the control
@@ -11,10 +12,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_covariance, as_matrix, as_measurement, as_vector, check_callable, check_choice
 from ._linalg import gain, symmetrize
 
-__all__ = ["KalmanFilter", "Update", "kf_predict", "kf_update", "symmetrize"]
+__all__ = ["KalmanFilter", "LinearisedKalmanFilter", "Update", "kf_predict", "kf_update", "symmetrize"]
 
 
 class Update(NamedTuple):
@@ -98,17 +99,17 @@ def kf_predict(x, P, F, Q, B=None, u=None):
     array([[2.1, 1. ],
            [1. , 1.1]])
     """
-    x = v.as_vector(x, "x")
+    x = as_vector(x, "x")
     n = x.shape[0]
-    P = v.as_covariance(P, "P", n)
-    F = v.as_matrix(F, "F", (n, n))
-    Q = v.as_covariance(Q, "Q", n)
+    P = as_covariance(P, "P", n)
+    F = as_matrix(F, "F", (n, n))
+    Q = as_covariance(Q, "Q", n)
     Bu = None
     if (B is None) != (u is None):
         raise ValueError("`B` and `u` must be given together; got only `" + ("B" if u is None else "u") + "`")
     if B is not None:
-        B = v.as_matrix(B, "B", (n, None))
-        u = v.as_vector(u, "u", B.shape[1])
+        B = as_matrix(B, "B", (n, None))
+        u = as_vector(u, "u", B.shape[1])
         Bu = B @ u
     return _predict(x, P, F, Q, Bu)
 
@@ -139,16 +140,16 @@ def kf_update(x, P, z, H, R, *, form: str = "short", K=None) -> Update:
     >>> upd.x, upd.P
     (array([1.]), array([[0.5]]))
     """
-    x = v.as_vector(x, "x")
+    x = as_vector(x, "x")
     n = x.shape[0]
-    P = v.as_covariance(P, "P", n)
-    H = v.as_matrix(H, "H", (None, n))
+    P = as_covariance(P, "P", n)
+    H = as_matrix(H, "H", (None, n))
     m = H.shape[0]
-    z = v.as_vector(z, "z", m)
-    R = v.as_covariance(R, "R", m)
-    v.check_choice(form, "form", ("short", "joseph"))
+    z = as_vector(z, "z", m)
+    R = as_covariance(R, "R", m)
+    check_choice(form, "form", ("short", "joseph"))
     if K is not None:
-        K = v.as_matrix(K, "K", (n, m))
+        K = as_matrix(K, "K", (n, m))
     return _update(x, P, z - H @ x, H, R, form, K)
 
 
@@ -185,15 +186,15 @@ class KalmanFilter:
     """
 
     def __init__(self, x, P, F, Q, H, R, B=None, *, form: str = "short"):
-        self.x = v.as_vector(x, "x")
+        self.x = as_vector(x, "x")
         n = self.x.shape[0]
-        self.P = v.as_covariance(P, "P", n)
-        self.F = v.as_matrix(F, "F", (n, n))
-        self.Q = v.as_covariance(Q, "Q", n)
-        self.H = v.as_matrix(H, "H", (None, n))
-        self.R = v.as_covariance(R, "R", self.H.shape[0])
-        self.B = None if B is None else v.as_matrix(B, "B", (n, None))
-        self.form = v.check_choice(form, "form", ("short", "joseph"))
+        self.P = as_covariance(P, "P", n)
+        self.F = as_matrix(F, "F", (n, n))
+        self.Q = as_covariance(Q, "Q", n)
+        self.H = as_matrix(H, "H", (None, n))
+        self.R = as_covariance(R, "R", self.H.shape[0])
+        self.B = None if B is None else as_matrix(B, "B", (n, None))
+        self.form = check_choice(form, "form", ("short", "joseph"))
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
         self.x_post, self.P_post = self.x.copy(), self.P.copy()
         m = self.H.shape[0]
@@ -215,7 +216,7 @@ class KalmanFilter:
         if u is not None:
             if self.B is None:
                 raise ValueError("`u` was given but the filter has no control matrix `B`")
-            Bu = self.B @ v.as_vector(u, "u", self.B.shape[1])
+            Bu = self.B @ as_vector(u, "u", self.B.shape[1])
         self.x, self.P = _predict(self.x, self.P, self.F, self.Q, Bu)
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
 
@@ -227,9 +228,99 @@ class KalmanFilter:
         z : array_like, shape (m,)
             Measurement.
         """
-        z = v.as_measurement(z, "z", self.H.shape[0])
+        z = as_measurement(z, "z", self.H.shape[0])
         self.x, self.P, self.y, self.S, self.K = _update(self.x, self.P, z - self.H @ self.x, self.H, self.R, self.form)
         self.x_post, self.P_post = self.x.copy(), self.P.copy()
 
     def __repr__(self) -> str:
         return f"KalmanFilter(dim_x={self.dim_x}, dim_z={self.H.shape[0]}, form={self.form!r})"
+
+
+class LinearisedKalmanFilter:
+    """Linear KF on the deviation ``dx`` from a nominal path, for a nonlinear model (000 §1.2.1 equations; ours).
+
+    The nominal path ``x_nominal`` follows the noise-free model from the initial estimate, ``x_nom <- f(x_nom,
+    u)``; the Jacobians are taken on it, never on the estimate (the EKF's difference), so the filter is the
+    linear KF of :func:`kf_predict` / :func:`kf_update` on ``dx``, with the innovation
+    ``y = residual(z, h(x_nom)) - H dx``. The estimate is ``x = x_nominal + dx`` (through ``x_wrap``, e.g. to
+    wrap a heading). It diverges once the truth leaves the nominal path: the unicycle comparison's "LKF".
+    ``Q`` and ``R`` may be replaced between steps (e.g. a control-dependent ``Q``).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Initial estimate: the start of the nominal path (``dx = 0``).
+    P : array_like, shape (n, n)
+        Initial covariance.
+    f : callable
+        ``f(x, u) -> (n,)`` noise-free motion model.
+    F_jac : callable
+        ``F_jac(x, u) -> (n, n)``, taken on the nominal path.
+    Q : array_like, shape (n, n)
+        Process noise covariance (attribute ``Q``, may be replaced).
+    h : callable
+        ``h(x) -> (m,)`` measurement model.
+    H_jac : callable
+        ``H_jac(x) -> (m, n)``, taken on the nominal path.
+    R : array_like, shape (m, m)
+        Measurement noise covariance.
+    residual : callable, default numpy.subtract
+        ``residual(z, z_pred)``, as in :func:`~slamlab.filters.ekf.ekf_update`.
+    x_wrap : callable, optional
+        ``x_wrap(x) -> (n,)`` applied to ``x_nominal + dx`` (e.g. a heading wrapped to (-π, π]).
+
+    Examples
+    --------
+    >>> lkf = LinearisedKalmanFilter([0.0], [[1.0]], lambda x, u: x, lambda x, u: np.eye(1), [[0.0]],
+    ...                              lambda x: x, lambda x: np.eye(1), [[1.0]])
+    >>> lkf.predict(); lkf.update([2.0]); lkf.x, lkf.dx
+    (array([1.]), array([1.]))
+    """
+
+    def __init__(self, x, P, f, F_jac, Q, h, H_jac, R, *, residual=np.subtract, x_wrap=None):
+        self.x_nominal = as_vector(x, "x")
+        n = self.x_nominal.shape[0]
+        self.dx = np.zeros(n)
+        self.P = as_covariance(P, "P", n)
+        self.f, self.F_jac = check_callable(f, "f"), check_callable(F_jac, "F_jac")
+        self.h, self.H_jac = check_callable(h, "h"), check_callable(H_jac, "H_jac")
+        self.Q = as_covariance(Q, "Q", n)
+        self.R = as_covariance(R, "R")
+        self.residual = check_callable(residual, "residual")
+        self.x_wrap = None if x_wrap is None else check_callable(x_wrap, "x_wrap")
+        self.y = self.S = self.K = None
+
+    @property
+    def x(self) -> np.ndarray:
+        """The estimate ``x_nominal + dx`` (through ``x_wrap``)."""
+        x = self.x_nominal + self.dx
+        return x if self.x_wrap is None else self.x_wrap(x)
+
+    def predict(self, u=None) -> None:
+        """Predict ``dx, P`` with ``F`` and ``Q`` on the nominal path, then move the nominal path by ``f``.
+
+        Parameters
+        ----------
+        u : optional
+            Control passed to ``f`` and ``F_jac``.
+        """
+        F = self.F_jac(self.x_nominal, u)
+        self.dx, self.P = _predict(self.dx, self.P, F, self.Q)
+        self.x_nominal = self.f(self.x_nominal, u)
+
+    def update(self, z) -> None:
+        """Update ``dx, P`` with measurement ``z``; sets ``y, S, K``.
+
+        Parameters
+        ----------
+        z : array_like, shape (m,)
+            Measurement (validated for shape and finiteness).
+        """
+        z = as_measurement(z, "z", self.R.shape[0])
+        H = self.H_jac(self.x_nominal)
+        # y = residual(z, h(x_nom)) - H dx: the innovation of the deviation
+        y = self.residual(z, self.h(self.x_nominal)) - H @ self.dx
+        self.dx, self.P, self.y, self.S, self.K = _update(self.dx, self.P, y, H, self.R)
+
+    def __repr__(self) -> str:
+        return f"LinearisedKalmanFilter(dim_x={self.dx.shape[0]}, dim_z={self.R.shape[0]})"

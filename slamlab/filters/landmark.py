@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_int, check_positive
 
 __all__ = ["LandmarkFilter", "landmark_predict", "landmark_update"]
 
 
 def _batched_cov(C, name, N, k):
-    C = v.as_finite_array(C, name)
+    C = as_finite_array(C, name)
     if C.ndim == 0:
         return np.broadcast_to(C * np.eye(k), (N, k, k))
     if C.shape == (k, k):
@@ -51,7 +51,7 @@ def landmark_predict(P, Q):
     array([[1.5, 0. ],
            [0. , 1.5]])
     """
-    P = v.as_finite_array(P, "P", ndim=3)
+    P = as_finite_array(P, "P", ndim=3)
     N, k, _ = P.shape
     return P + _batched_cov(Q, "Q", N, k)
 
@@ -82,12 +82,12 @@ def landmark_update(X, P, Z, R):
     >>> X, np.diag(P[0])
     (array([[0.5, 0.5, 0.5]]), array([0.5, 0.5, 0.5]))
     """
-    X = v.as_finite_array(X, "X", ndim=2)
+    X = as_finite_array(X, "X", ndim=2)
     N, k = X.shape
-    P = v.as_finite_array(P, "P", ndim=3)
+    P = as_finite_array(P, "P", ndim=3)
     if P.shape != (N, k, k):
         raise ValueError(f"`P` must have shape ({N}, {k}, {k}); got {P.shape}")
-    Z = v.as_finite_array(Z, "Z", ndim=2)
+    Z = as_finite_array(Z, "Z", ndim=2)
     if Z.shape != (N, k):
         raise ValueError(f"`Z` must have shape ({N}, {k}); got {Z.shape}")
     R = _batched_cov(R, "R", N, k)
@@ -129,9 +129,9 @@ class LandmarkFilter:
     """
 
     def __init__(self, state_var: float = 1e-4, obs_var: float = 1e-2, dim: int = 3):
-        self.state_var = v.check_positive(state_var, "state_var", allow_zero=True)
-        self.obs_var = v.check_positive(obs_var, "obs_var")
-        self.dim = v.check_int(dim, "dim", minimum=1)
+        self.state_var = check_positive(state_var, "state_var", allow_zero=True)
+        self.obs_var = check_positive(obs_var, "obs_var")
+        self.dim = check_int(dim, "dim", minimum=1)
         self.X = np.empty((0, self.dim))
         self.P = np.empty((0, self.dim, self.dim))
 
@@ -151,7 +151,7 @@ class LandmarkFilter:
         numpy.ndarray, shape (M,)
             Indices of the new landmarks.
         """
-        Z = v.as_finite_array(Z, "Z", ndim=2)
+        Z = as_finite_array(Z, "Z", ndim=2)
         if Z.shape[1] != self.dim:
             raise ValueError(f"`Z` must have shape (M, {self.dim}); got {Z.shape}")
         start = len(self)
@@ -176,7 +176,7 @@ class LandmarkFilter:
             raise ValueError(f"`idx` must index existing landmarks 0..{len(self) - 1}")
         if np.unique(idx).size != idx.size:
             raise ValueError("`idx` must not repeat a landmark")
-        Z = v.as_finite_array(Z, "Z", ndim=2)
+        Z = as_finite_array(Z, "Z", ndim=2)
         if Z.shape != (idx.size, self.dim):
             raise ValueError(f"`Z` must have shape ({idx.size}, {self.dim}); got {Z.shape}")
         I = np.eye(self.dim)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng, check_int, check_positive
 
 __all__ = ["low_variance_resample", "n_eff", "normalise_log_weights", "systematic_resample"]
 
@@ -121,14 +121,14 @@ def low_variance_resample(weights, n: int | None = None, rng=None, *, offset: fl
     total = w.sum()
     if total <= 0:
         raise ValueError("`weights` must not all be 0")
-    m = w.size if n is None else v.check_int(n, "n", minimum=1)
-    rng = v.as_rng(rng)
+    m = w.size if n is None else check_int(n, "n", minimum=1)
+    rng = as_rng(rng)
     c = np.cumsum(w / total)
     c[-1] = 1.0
     if offset is None:
         r = rng.uniform(0.0, 1.0 / m)
     else:
-        r = v.check_positive(offset, "offset", allow_zero=True)
+        r = check_positive(offset, "offset", allow_zero=True)
         if r >= 1.0 / m:
             raise ValueError(f"`offset` must be in [0, 1/n) = [0, {1.0 / m:g}); got {r}")
     u = r + np.arange(m) / m

@@ -20,7 +20,15 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import block_diag
 
-from .. import _validate as v
+from .._validate import (
+    as_covariance,
+    as_measurement,
+    as_vector,
+    check_callable,
+    check_choice,
+    check_int,
+    check_positive,
+)
 from ._linalg import CholeskyError, cholesky_lower, gain, symmetrize
 from .kalman import Update
 
@@ -64,8 +72,8 @@ def sigma_weights(L: int, alpha: float = 1e-3, beta: float = 2.0, kappa: float =
     >>> Ws, Wc, lam
     (array([0.3333, 0.1667, 0.1667, 0.1667, 0.1667]), array([2.3333, 0.1667, 0.1667, 0.1667, 0.1667]), 1.0)
     """
-    L = v.check_int(L, "L", minimum=1)
-    alpha = v.check_positive(alpha, "alpha")
+    L = check_int(L, "L", minimum=1)
+    alpha = check_positive(alpha, "alpha")
     beta = float(beta)
     kappa = float(kappa)
     lam = alpha**2 * (L + kappa) - L
@@ -116,8 +124,8 @@ def sigma_points(x, P, alpha: float = 1e-3, kappa: float = 0.0) -> np.ndarray:
            [-2.,  0.],
            [ 0., -2.]])
     """
-    x = v.as_vector(x, "x")
-    P = v.as_covariance(P, "P", x.shape[0])
+    x = as_vector(x, "x")
+    P = as_covariance(P, "P", x.shape[0])
     sigma_weights(x.shape[0], alpha, 2.0, kappa)  # validates alpha, kappa
     return _sigma_points(x, P, alpha, kappa, "sigma_points")
 
@@ -218,10 +226,10 @@ def _ukf_update(x, P, z, h, R, form, alpha, beta, kappa, z_mean_fn, z_residual_f
 
 
 def _check_common(x, P, form, alpha, beta, kappa):
-    x = v.as_vector(x, "x")
-    P = v.as_covariance(P, "P", x.shape[0])
-    v.check_choice(form, "form", FORMS)
-    v.check_positive(alpha, "alpha")
+    x = as_vector(x, "x")
+    P = as_covariance(P, "P", x.shape[0])
+    check_choice(form, "form", FORMS)
+    check_positive(alpha, "alpha")
     if not np.isfinite(beta) or not np.isfinite(kappa):
         raise ValueError(f"`beta` and `kappa` must be finite; got beta={beta}, kappa={kappa}")
     return x, P
@@ -260,8 +268,8 @@ def ukf_predict(x, P, f, Q, u=None, *, form: str = "augmented", alpha: float = 1
     x, P : the prior.
     """
     x, P = _check_common(x, P, form, alpha, beta, kappa)
-    v.check_callable(f, "f")
-    Q = v.as_covariance(Q, "Q", None if form == "augmented" else x.shape[0])
+    check_callable(f, "f")
+    Q = as_covariance(Q, "Q", None if form == "augmented" else x.shape[0])
     return _ukf_predict(x, P, f, Q, u, form, alpha, beta, kappa, mean_fn, residual_fn, vectorized)
 
 
@@ -302,9 +310,9 @@ def ukf_update(x, P, z, h, R, *, form: str = "augmented", alpha: float = 1e-3, b
         Posterior ``x, P``, innovation ``y``, ``S = P_zz``, ``K``.
     """
     x, P = _check_common(x, P, form, alpha, beta, kappa)
-    z = v.as_vector(z, "z")
-    R = v.as_covariance(R, "R", None if form == "augmented" else z.shape[0])
-    v.check_callable(h, "h")
+    z = as_vector(z, "z")
+    R = as_covariance(R, "R", None if form == "augmented" else z.shape[0])
+    check_callable(h, "h")
     return _ukf_update(x, P, z, h, R, form, alpha, beta, kappa, z_mean_fn, z_residual_fn, x_residual_fn,
                        vectorized)
 
@@ -345,11 +353,11 @@ class UnscentedKalmanFilter:
                  kappa: float = 0.0, x_mean_fn=None, x_residual_fn=None, z_mean_fn=None, z_residual_fn=None,
                  vectorized: bool = False):
         self.x, self.P = _check_common(x, P, form, alpha, beta, kappa)
-        self.f, self.h = v.check_callable(f, "f"), v.check_callable(h, "h")
+        self.f, self.h = check_callable(f, "f"), check_callable(h, "h")
         self.form = form
         n = self.x.shape[0]
-        self.Q = v.as_covariance(Q, "Q", None if form == "augmented" else n)
-        self.R = v.as_covariance(R, "R")
+        self.Q = as_covariance(Q, "Q", None if form == "augmented" else n)
+        self.R = as_covariance(R, "R")
         self.alpha, self.beta, self.kappa = float(alpha), float(beta), float(kappa)
         self.x_mean_fn, self.x_residual_fn = x_mean_fn, x_residual_fn
         self.z_mean_fn, self.z_residual_fn = z_mean_fn, z_residual_fn
@@ -378,7 +386,7 @@ class UnscentedKalmanFilter:
         z : array_like, shape (m,)
             Measurement.
         """
-        z = v.as_measurement(z, "z", self.R.shape[0])
+        z = as_measurement(z, "z", self.R.shape[0])
         self.x, self.P, self.y, self.S, self.K = _ukf_update(
             self.x, self.P, z, self.h, self.R, self.form, self.alpha, self.beta, self.kappa,
             self.z_mean_fn, self.z_residual_fn, self.x_residual_fn, self.vectorized)

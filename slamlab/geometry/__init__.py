@@ -33,7 +33,7 @@ from .se3 import (
     transform_points,
     yaw_from_R,
 )
-from .so3 import hat, se3_exp, se3_log, so3_exp, so3_log, vee
+from .so3 import hat, rotation_angle, se3_exp, se3_log, so3_exp, so3_log, vee
 from .triangulation import Triangulation, triangulate_midpoint, triangulate_stereo
 
 __all__ += [
@@ -51,6 +51,7 @@ __all__ += [
     "ransac",
     "ransac_refit",
     "rotate_points",
+    "rotation_angle",
     "rotation_xyz",
     "se3",
     "se3_compose",

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_matrix, as_vector, check_int, check_positive
 from .so3 import hat
 
 __all__ = [
@@ -49,8 +49,8 @@ def focal_from_hfov(width_px: int, hfov_rad: float) -> float:
     >>> round(focal_from_hfov(768, np.deg2rad(40.0)), 3)
     1055.031
     """
-    width_px = v.check_int(width_px, "width_px", minimum=1)
-    hfov_rad = v.check_positive(hfov_rad, "hfov_rad")
+    width_px = check_int(width_px, "width_px", minimum=1)
+    hfov_rad = check_positive(hfov_rad, "hfov_rad")
     if hfov_rad >= np.pi:
         raise ValueError(f"`hfov_rad` must be < pi; got {hfov_rad}")
     return float(0.5 * width_px / np.tan(0.5 * hfov_rad))
@@ -83,39 +83,59 @@ def rotation_xyz(rx_rad: float = 0.0, ry_rad: float = 0.0, rz_rad: float = 0.0) 
     return Rz @ Ry @ Rx
 
 
-def project_points(K, X, *, min_depth: float | None = None) -> np.ndarray:
+def project_points(K, X, *, min_depth: float | None = None, jacobian: bool = False):
     """Pixels ``u = fx x / z + cx``, ``v = fy y / z + cy`` of camera-frame points (000 §3.3; 003 §2).
 
-    The one pinhole projection of the library. No checks of ``X`` (hot path: trackers call it
-    every iteration) and no matrix product (element-wise, so the same bits on every machine).
+    The one pinhole projection of the library, batched over leading axes. No checks of ``X`` (hot
+    path: trackers call it every iteration) and no matrix product (element-wise, so the same bits on
+    every machine).
 
     Parameters
     ----------
     K : array_like, shape (3, 3)
         Intrinsic matrix ``[[fx, 0, cx], [0, fy, cy], [0, 0, 1]]`` (the skew ``K[0, 1]`` is not used).
-    X : ndarray, shape (N, 3)
+    X : ndarray, shape (N, 3) or (..., 3)
         Points in the camera frame (``x`` right, ``y`` down, ``z`` forward) [m].
     min_depth : float, optional
         When given, ``z`` is clamped to at least this value (keeps points behind the camera finite).
+    jacobian : bool, default False
+        Also return the derivatives of the pixels with respect to the point,
+        ``[[fx / z, 0, -fx x / z²], [0, fy / z, -fy y / z²]]`` (at the clamped ``z``).
 
     Returns
     -------
-    ndarray, shape (N, 2)
+    uv : ndarray, shape (N, 2) or (..., 2)
         Pixel coordinates ``(u, v)``.
+    J : ndarray, shape (N, 2, 3) or (..., 2, 3)
+        Only with ``jacobian=True``: ``d(u, v) / d(x, y, z)`` [px/m].
 
     Examples
     --------
     >>> K = np.array([[100.0, 0.0, 50.0], [0.0, 100.0, 40.0], [0.0, 0.0, 1.0]])
     >>> project_points(K, np.array([[0.2, -0.1, 2.0]]))
     array([[60., 35.]])
+    >>> uv, J = project_points(K, np.array([[0.2, -0.1, 2.0]]), jacobian=True)
+    >>> J[0]
+    array([[50. ,  0. , -5. ],
+           [ 0. , 50. ,  2.5]])
     """
     K, X = np.asarray(K), np.asarray(X)
     if K.shape != (3, 3):
         raise ValueError(f"`K` must have shape (3, 3); got {K.shape}")
-    if X.ndim != 2 or X.shape[1] != 3:
-        raise ValueError(f"`X` must have shape (N, 3); got {X.shape}")
-    z = X[:, 2] if min_depth is None else np.maximum(X[:, 2], min_depth)
-    return np.column_stack([K[0, 0] * X[:, 0] / z + K[0, 2], K[1, 1] * X[:, 1] / z + K[1, 2]])
+    if X.ndim < 1 or X.shape[-1] != 3:
+        raise ValueError(f"`X` must have shape (N, 3) or (..., 3); got {X.shape}")
+    fx, fy = K[0, 0], K[1, 1]
+    z = X[..., 2] if min_depth is None else np.maximum(X[..., 2], min_depth)
+    uv = np.stack([fx * X[..., 0] / z + K[0, 2], fy * X[..., 1] / z + K[1, 2]], axis=-1)
+    if not jacobian:
+        return uv
+    iz = 1.0 / z
+    J = np.zeros((*X.shape[:-1], 2, 3))
+    J[..., 0, 0] = fx * iz
+    J[..., 0, 2] = -fx * X[..., 0] * iz * iz
+    J[..., 1, 1] = fy * iz
+    J[..., 1, 2] = -fy * X[..., 1] * iz * iz
+    return uv, J
 
 
 def backproject_points(K, uv) -> np.ndarray:
@@ -179,10 +199,10 @@ class PinholeCamera:
     cy: float
 
     def __post_init__(self):
-        v.check_int(self.width_px, "width_px", minimum=1)
-        v.check_int(self.height_px, "height_px", minimum=1)
+        check_int(self.width_px, "width_px", minimum=1)
+        check_int(self.height_px, "height_px", minimum=1)
         for name in ("fx", "fy"):
-            v.check_positive(getattr(self, name), name)
+            check_positive(getattr(self, name), name)
         for name in ("cx", "cy"):
             val = getattr(self, name)
             if isinstance(val, bool) or not np.isfinite(float(val)):
@@ -204,7 +224,7 @@ class PinholeCamera:
         PinholeCamera
         """
         f = focal_from_hfov(width_px, hfov_rad)
-        height_px = v.check_int(height_px, "height_px", minimum=1)
+        height_px = check_int(height_px, "height_px", minimum=1)
         return cls(width_px, height_px, f, f, (width_px - 1) / 2.0, (height_px - 1) / 2.0)
 
     @property
@@ -225,7 +245,7 @@ class PinholeCamera:
         uv : ndarray, shape (N, 2)
             Pixel coordinates ``(u, v)``.
         """
-        P = v.as_finite_array(points_cam, "points_cam", ndim=2)
+        P = as_finite_array(points_cam, "points_cam", ndim=2)
         if P.shape[1] != 3:
             raise ValueError(f"`points_cam` must have shape (N, 3); got {P.shape}")
         if np.any(P[:, 2] <= 0):
@@ -245,7 +265,7 @@ class PinholeCamera:
         rays : ndarray, shape (N, 3)
             Ray directions in the camera frame, ``z = 1`` (not unit length).
         """
-        uv = v.as_finite_array(uv, "uv", ndim=2)
+        uv = as_finite_array(uv, "uv", ndim=2)
         if uv.shape[1] != 2:
             raise ValueError(f"`uv` must have shape (N, 2); got {uv.shape}")
         return backproject_points(self.K, uv)
@@ -284,10 +304,10 @@ def fundamental_matrix(K_left, K_right, R, t) -> np.ndarray:
     >>> float(np.array([0.5, 0.2, 1.0]) @ F @ np.array([0.7, 0.2, 1.0]))
     0.0
     """
-    K_left = v.as_matrix(K_left, "K_left", (3, 3))
-    K_right = v.as_matrix(K_right, "K_right", (3, 3))
-    R = v.as_matrix(R, "R", (3, 3))
-    t = v.as_vector(t, "t", 3)
+    K_left = as_matrix(K_left, "K_left", (3, 3))
+    K_right = as_matrix(K_right, "K_right", (3, 3))
+    R = as_matrix(R, "R", (3, 3))
+    t = as_vector(t, "t", 3)
     E = hat(t) @ R
     return np.linalg.inv(K_right).T @ E @ np.linalg.inv(K_left)
 
@@ -324,11 +344,11 @@ class StereoRig:
     def __post_init__(self):
         if not isinstance(self.left, PinholeCamera) or not isinstance(self.right, PinholeCamera):
             raise TypeError("`left` and `right` must be PinholeCamera instances")
-        R = v.as_matrix(self.R_rl, "R_rl", (3, 3))
+        R = as_matrix(self.R_rl, "R_rl", (3, 3))
         if not np.allclose(R.T @ R, np.eye(3), atol=1e-9) or np.linalg.det(R) <= 0:
             raise ValueError("`R_rl` must be a proper rotation matrix")
         object.__setattr__(self, "R_rl", R)
-        object.__setattr__(self, "t_rl", v.as_vector(self.t_rl, "t_rl", 3))
+        object.__setattr__(self, "t_rl", as_vector(self.t_rl, "t_rl", 3))
 
     @classmethod
     def parallel(
@@ -353,7 +373,7 @@ class StereoRig:
         -------
         StereoRig
         """
-        baseline_m = v.check_positive(baseline_m, "baseline_m")
+        baseline_m = check_positive(baseline_m, "baseline_m")
         cam = PinholeCamera.from_hfov(width_px, height_px, hfov_rad)
         return cls(cam, cam, np.eye(3), np.array([-baseline_m, 0.0, 0.0]))
 
@@ -385,10 +405,46 @@ class StereoRig:
         uv_left, uv_right : ndarray, shape (N, 2)
             Pixel coordinates in the left and right images.
         """
-        P = v.as_finite_array(points_left, "points_left", ndim=2)
+        P = as_finite_array(points_left, "points_left", ndim=2)
         if P.shape[1] != 3:
             raise ValueError(f"`points_left` must have shape (N, 3); got {P.shape}")
         return self.left.project(P), self.right.project(P @ self.R_rl.T + self.t_rl)
+
+    def stereo_pixels(self, points_left, *, jacobian: bool = False):
+        """The stereo measurement ``(u_l, v_l, u_r, v_r)`` of points in the left camera frame (our addition, issue 25).
+
+        Both projections by :func:`project_points` (no checks of the depths: hot path of the pose
+        refinement and the landmark filter in pixels).
+
+        Parameters
+        ----------
+        points_left : array_like, shape (N, 3)
+            Points in the left camera frame [m], in front of both cameras.
+        jacobian : bool, default False
+            Also return the derivatives of the four pixels with respect to the point (left frame).
+
+        Returns
+        -------
+        z : ndarray, shape (N, 4)
+            ``(u_l, v_l, u_r, v_r)`` [px].
+        J : ndarray, shape (N, 4, 3)
+            Only with ``jacobian=True``: ``dz / d(x, y, z)`` [px/m].
+
+        Examples
+        --------
+        >>> cam = PinholeCamera(100, 80, 50.0, 50.0, 50.0, 40.0)
+        >>> rig = StereoRig(cam, cam, np.eye(3), [-0.5, 0.0, 0.0])
+        >>> rig.stereo_pixels([[0.0, 0.0, 5.0]])
+        array([[50., 40., 45., 40.]])
+        """
+        P = np.asarray(points_left, dtype=float)
+        if P.ndim != 2 or P.shape[1] != 3:
+            raise ValueError(f"`points_left` must have shape (N, 3); got {P.shape}")
+        if not jacobian:
+            return np.hstack([project_points(self.left.K, P), project_points(self.right.K, P @ self.R_rl.T + self.t_rl)])
+        uv_l, J_l = project_points(self.left.K, P, jacobian=True)
+        uv_r, J_r = project_points(self.right.K, P @ self.R_rl.T + self.t_rl, jacobian=True)
+        return np.hstack([uv_l, uv_r]), np.concatenate([J_l, J_r @ self.R_rl], axis=1)
 
     def rays(self, uv_left, uv_right) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Both viewing rays in the left frame: ``(c_left, d_left, c_right, d_right)`` (000 §3.3).

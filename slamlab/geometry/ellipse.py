@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_covariance, as_vector, check_int, check_positive
 
 __all__ = ["covariance_ellipse"]
 
@@ -34,10 +34,10 @@ def covariance_ellipse(P, center=(0.0, 0.0), n_std: float = 2.0, n_points: int =
     >>> np.abs(pts).max(axis=0).round(6)  # semi-axes: 1 sigma = 2 in x, 1 in y
     array([2., 1.])
     """
-    P = v.as_covariance(P, "P", 2)
-    c = v.as_vector(center, "center", 2)
-    n_std = v.check_positive(n_std, "n_std")
-    n_points = v.check_int(n_points, "n_points", minimum=3)
+    P = as_covariance(P, "P", 2)
+    c = as_vector(center, "center", 2)
+    n_std = check_positive(n_std, "n_std")
+    n_points = check_int(n_points, "n_points", minimum=3)
     w, U = np.linalg.eigh(P)
     t = np.linspace(0.0, 2.0 * np.pi, n_points, endpoint=False)
     circle = np.stack([np.cos(t), np.sin(t)], axis=1)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_matrix
 
 __all__ = ["apply_homography"]
 
@@ -35,8 +35,8 @@ def apply_homography(H, uv) -> np.ndarray:
     >>> apply_homography(np.diag([2.0, 2.0, 1.0]), [[1.0, 2.0]]).tolist()
     [[2.0, 4.0]]
     """
-    H = v.as_matrix(H, "H", (3, 3))
-    uv = v.as_finite_array(uv, "uv")
+    H = as_matrix(H, "H", (3, 3))
+    uv = as_finite_array(uv, "uv")
     if uv.shape == (2,):
         uv = uv.reshape(1, 2)
     if uv.ndim != 2 or uv.shape[1] != 2:

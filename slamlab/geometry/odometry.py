@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng, check_positive, check_real
 from .se2 import check_poses, se2_integrate, se2_relative
 
 __all__ = ["Odometry", "simulate_odometry"]
@@ -69,13 +69,11 @@ def simulate_odometry(poses, *, trans_std_frac: float = 0.0, rot_std_rad: float 
     [0.0, 1.5, 3.0]
     """
     P = check_poses(poses)
-    sf = v.check_positive(trans_std_frac, "trans_std_frac", allow_zero=True)
-    sr = v.check_positive(rot_std_rad, "rot_std_rad", allow_zero=True)
+    sf = check_positive(trans_std_frac, "trans_std_frac", allow_zero=True)
+    sr = check_positive(rot_std_rad, "rot_std_rad", allow_zero=True)
     for name, val in (("scale_error", scale_error), ("drift_rad_per_cell", drift_rad_per_cell)):
-        if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(val):
-            raise TypeError(f"`{name}` must be a finite real number; got {val!r}")
-    rng = v.as_rng(rng)
+        check_real(val, name)
+    rng = as_rng(rng)
     U = se2_relative(P[:-1], P[1:])
     d = np.hypot(U[:, 0], U[:, 1])
     noise = rng.standard_normal(U.shape)

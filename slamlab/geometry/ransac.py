@@ -23,7 +23,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng, check_callable, check_int, check_positive, check_probability
 
 __all__ = ["RansacResult", "ransac", "ransac_refit"]
 
@@ -184,23 +184,23 @@ def ransac(
     n = data[0].shape[0] if data[0].ndim else 0
     if any(d.ndim == 0 or d.shape[0] != n for d in data):
         raise ValueError(f"`data` arrays must all have the same number of rows; got {[d.shape for d in data]}")
-    v.check_callable(fit, "fit")
-    v.check_callable(residuals, "residuals")
-    sample_size = v.check_int(sample_size, "sample_size", minimum=1)
-    threshold = v.check_positive(threshold, "threshold")
-    max_iters = v.check_int(max_iters, "max_iters", minimum=1)
-    refit_rounds = v.check_int(refit_rounds, "refit_rounds", minimum=0)
-    min_inliers = sample_size if min_inliers is None else v.check_int(min_inliers, "min_inliers", minimum=1)
-    confidence = v.check_probability(confidence, "confidence")
-    stop_ratio = v.check_positive(stop_ratio, "stop_ratio")
+    check_callable(fit, "fit")
+    check_callable(residuals, "residuals")
+    sample_size = check_int(sample_size, "sample_size", minimum=1)
+    threshold = check_positive(threshold, "threshold")
+    max_iters = check_int(max_iters, "max_iters", minimum=1)
+    refit_rounds = check_int(refit_rounds, "refit_rounds", minimum=0)
+    min_inliers = sample_size if min_inliers is None else check_int(min_inliers, "min_inliers", minimum=1)
+    confidence = check_probability(confidence, "confidence")
+    stop_ratio = check_positive(stop_ratio, "stop_ratio")
     if batch_size is not None:
-        batch_size = v.check_int(batch_size, "batch_size", minimum=1)
+        batch_size = check_int(batch_size, "batch_size", minimum=1)
         if refit_rounds:
             raise ValueError(f"`refit_rounds` must be 0 with `batch_size` (refit with `ransac_refit` and a "
                              f"one-model fit); got {refit_rounds}")
     if n < sample_size:
         raise ValueError(f"`data` must have at least `sample_size` = {sample_size} rows; got {n}")
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
 
     # the best hypothesis: most inliers, ties with an earlier one broken by the smaller sum of inlier residuals;
     # within a batch, the first of the most inliers (the preemptive count of 002's extraction, ours)

@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_vector
 
 __all__ = ["RigidTransform", "apply_transform", "umeyama"]
 
@@ -35,14 +35,21 @@ class RigidTransform(NamedTuple):
     c: float = 1.0
 
 
-def umeyama(src, dst, *, with_scale: bool = False, weights=None) -> RigidTransform:
+def umeyama(src, dst, *, with_scale: bool = False, weights=None, check: bool = True) -> RigidTransform:
     """Least-squares rotation, translation (and scale) mapping ``src`` onto ``dst`` (Umeyama 1991).
 
     Parameters
     ----------
-    src, dst : (N, d) corresponding points, ``d`` = 2 or 3, ``N >= d``.
-    with_scale : also estimate a scale ``c`` (Sim(d)); otherwise ``c = 1`` (SE(d)).
-    weights : (N,) non-negative weights, optional.
+    src, dst : array_like, shape (N, d)
+        Corresponding points, ``d`` = 2 or 3, ``N >= d``.
+    with_scale : bool, default False
+        Also estimate a scale ``c`` (Sim(d)); otherwise ``c = 1`` (SE(d)).
+    weights : array_like, shape (N,), optional
+        Non-negative weights with a positive sum (default equal); normalised to sum 1.
+    check : bool, default True
+        Check the arguments. ``False`` skips the checks, for inner loops on rows checked once (a
+        RANSAC's hypotheses, 000 §3.5): the points must then be finite float arrays of a valid shape and
+        the weights positive.
 
     Returns
     -------
@@ -58,8 +65,12 @@ def umeyama(src, dst, *, with_scale: bool = False, weights=None) -> RigidTransfo
     >>> np.allclose(T.R, R), np.round(T.t, 12)
     (True, array([ 1., -2.]))
     """
-    src = v.as_finite_array(src, "src", ndim=2)
-    dst = v.as_finite_array(dst, "dst", ndim=2)
+    if not check:
+        src, dst = np.asarray(src, dtype=float), np.asarray(dst, dtype=float)
+        w = np.full(len(src), 1.0 / len(src)) if weights is None else weights / weights.sum()
+        return _umeyama(src, dst, w, with_scale)
+    src = as_finite_array(src, "src", ndim=2)
+    dst = as_finite_array(dst, "dst", ndim=2)
     if src.shape != dst.shape:
         raise ValueError(f"`src` and `dst` must have the same shape; got {src.shape} and {dst.shape}")
     n, d = src.shape
@@ -70,7 +81,7 @@ def umeyama(src, dst, *, with_scale: bool = False, weights=None) -> RigidTransfo
     if weights is None:
         w = np.full(n, 1.0 / n)
     else:
-        w = v.as_vector(weights, "weights", n)
+        w = as_vector(weights, "weights", n)
         if np.any(w < 0) or w.sum() <= 0:
             raise ValueError("`weights` must be non-negative with a positive sum")
         w = w / w.sum()
@@ -78,21 +89,7 @@ def umeyama(src, dst, *, with_scale: bool = False, weights=None) -> RigidTransfo
 
 
 def _umeyama(src, dst, w, with_scale: bool = False) -> RigidTransform:
-    """:func:`umeyama` without its argument checks, for inner loops (a RANSAC's hypotheses, 000 §3.5).
-
-    Parameters
-    ----------
-    src, dst : numpy.ndarray of float64, shape (N, d)
-        Corresponding finite points, ``d`` = 2 or 3, ``N >= d``.
-    w : numpy.ndarray of float64, shape (N,)
-        Non-negative weights summing to 1.
-    with_scale : bool, default False
-        Also estimate a scale.
-
-    Returns
-    -------
-    RigidTransform
-    """
+    """:func:`umeyama`'s arithmetic on checked float arrays and weights ``w`` summing to 1."""
     d = src.shape[1]
     mu_s, mu_d = w @ src, w @ dst
     xs, xd = src - mu_s, dst - mu_d
@@ -133,5 +130,5 @@ def apply_transform(T: RigidTransform, points) -> np.ndarray:
     >>> apply_transform(RigidTransform(np.eye(2), np.array([1.0, 2.0]), 2.0), [[1.0, 1.0]])
     array([[3., 4.]])
     """
-    pts = v.as_finite_array(points, "points", ndim=2)
+    pts = as_finite_array(points, "points", ndim=2)
     return T.c * pts @ np.asarray(T.R).T + T.t

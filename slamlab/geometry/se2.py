@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_vector
 from .angles import wrap_angle
 
 __all__ = ["check_pose", "check_poses", "se2_compose", "se2_integrate", "se2_inverse", "se2_relative",
@@ -55,7 +55,7 @@ def check_pose(pose, name: str = "pose") -> np.ndarray:
     >>> check_pose([1, 2, 0.5])
     array([1. , 2. , 0.5])
     """
-    return v.as_vector(pose, name, 3)
+    return as_vector(pose, name, 3)
 
 
 def check_poses(poses, name: str = "poses", *, n: int | None = None) -> np.ndarray:
@@ -84,7 +84,7 @@ def check_poses(poses, name: str = "poses", *, n: int | None = None) -> np.ndarr
     ...
     ValueError: `poses` must have shape (n, 3) = (x, y, heading_rad) rows; got shape (3,)
     """
-    arr = v.as_finite_array(poses, name)
+    arr = as_finite_array(poses, name)
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise ValueError(f"`{name}` must have shape (n, 3) = (x, y, heading_rad) rows; got shape {arr.shape}")
     if arr.shape[0] == 0:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_matrix, as_vector
 
 __all__ = ["planar_from_se3", "rotate_points", "se3", "se3_compose", "se3_from_planar", "se3_inverse", "transform_points",
            "yaw_from_R"]
@@ -35,8 +35,8 @@ def se3(R, t) -> np.ndarray:
     >>> se3(np.eye(3), [1.0, 2.0, 3.0])[:3, 3]
     array([1., 2., 3.])
     """
-    R = v.as_matrix(R, "R", (3, 3))
-    t = v.as_vector(t, "t", 3)
+    R = as_matrix(R, "R", (3, 3))
+    t = as_vector(t, "t", 3)
     T = np.eye(4)
     T[:3, :3], T[:3, 3] = R, t
     return T
@@ -63,7 +63,7 @@ def se3_inverse(T) -> np.ndarray:
     >>> T = se3_from_planar(1.0, 2.0, 0.5); np.allclose(se3_inverse(T) @ T, np.eye(4))
     True
     """
-    T = v.as_finite_array(T, "T")
+    T = as_finite_array(T, "T")
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise ValueError(f"`T` must have shape (4, 4) or (..., 4, 4); got {T.shape}")
     out = np.zeros_like(T)
@@ -134,7 +134,7 @@ def rotate_components(R, x, y, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     [[6.123233995736766e-17], [1.0], [0.0]]
     """
     x, y, z = np.asarray(x), np.asarray(y), np.asarray(z)
-    R = v.as_matrix(R, "R", (3, 3)).astype(x.dtype if np.issubdtype(x.dtype, np.floating) else np.float64)
+    R = as_matrix(R, "R", (3, 3)).astype(x.dtype if np.issubdtype(x.dtype, np.floating) else np.float64)
     return tuple(x * R[k, 0] + y * R[k, 1] + z * R[k, 2] for k in range(3))
 
 
@@ -158,7 +158,7 @@ def transform_points(T, points) -> np.ndarray:
     >>> transform_points(se3_from_planar(1.0, 0.0, 0.0), [[0.0, 2.0, 0.0]])
     array([[1., 2., 0.]])
     """
-    T = v.as_matrix(T, "T", (4, 4))
+    T = as_matrix(T, "T", (4, 4))
     out = rotate_points(T[:3, :3], points)
     out += T[:3, 3].astype(out.dtype)
     return out
@@ -240,7 +240,7 @@ def yaw_from_R(R) -> float:
     >>> round(yaw_from_R(se3_from_planar(0, 0, 0.3)[:3, :3]), 12)
     0.3
     """
-    R = v.as_matrix(R, "R", (3, 3))
+    R = as_matrix(R, "R", (3, 3))
     return float(np.arctan2(R[1, 0], R[0, 0]))
 
 
@@ -262,5 +262,5 @@ def planar_from_se3(T) -> np.ndarray:
     >>> planar_from_se3(se3_from_planar(1.0, 2.0, 0.25))
     array([1.  , 2.  , 0.25])
     """
-    T = v.as_matrix(T, "T", (4, 4))
+    T = as_matrix(T, "T", (4, 4))
     return np.array([T[0, 3], T[1, 3], yaw_from_R(T[:3, :3])])

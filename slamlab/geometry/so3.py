@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-__all__ = ["hat", "se3_exp", "se3_log", "so3_exp", "so3_log", "vee"]
+__all__ = ["hat", "rotation_angle", "se3_exp", "se3_log", "so3_exp", "so3_log", "vee"]
 
 #: below this angle [rad] the exponential is taken to first order, ``I + [ω]×`` (the error is below 1e-20)
 _SMALL_RAD = 1e-10
@@ -144,6 +144,42 @@ def so3_exp(w) -> np.ndarray:
     return _rodrigues(w)[0]
 
 
+def _angle_parts(R) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(d, c, s, θ)`` of rotations ``R (..., 3, 3)``: ``d = vee(R − Rᵀ)``, ``c = cos θ``, ``s = sin θ``, ``θ = atan2(s, c)``."""
+    d = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], axis=-1)
+    c = 0.5 * (R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2] - 1.0)
+    s = 0.5 * _norm3(d)
+    return d, c, s, np.arctan2(s, np.clip(c, -1.0, 1.0))
+
+
+def rotation_angle(R) -> np.ndarray:
+    """Angle ``θ = |Log(R)|`` of rotation matrices, in ``[0, π]`` (ModernRobotics §3.2.3.3).
+
+    ``θ = atan2(|vee(R − Rᵀ)| / 2, (tr R − 1) / 2)`` (the angle of :func:`so3_log`): accurate at every angle,
+    where ``arccos((tr R − 1) / 2)`` loses half the digits near 0 and π (ours: the careful form). ``R`` must
+    be a rotation to working precision; project a matrix that is not (one read from a file with 9 digits,
+    say) onto SO(3) first.
+
+    Parameters
+    ----------
+    R : array_like, shape (3, 3) or (..., 3, 3)
+        Rotation matrices (orthonormal, determinant +1; not checked).
+
+    Returns
+    -------
+    float or ndarray, shape (...)
+        Rotation angles [rad]; a NumPy scalar for one matrix.
+
+    Examples
+    --------
+    >>> float(rotation_angle(so3_exp([0.0, 0.3, 0.4])).round(12))
+    0.5
+    >>> rotation_angle(np.stack([np.eye(3), so3_exp([0.0, 0.0, np.pi / 2])])).round(12)
+    array([0.        , 1.57079633])
+    """
+    return _angle_parts(_last_two_axes(R, "R", 3))[3]
+
+
 def so3_log(R) -> np.ndarray:
     """Rotation vector ``w`` with ``Exp(w) = R``, angle in ``[0, π]`` (ModernRobotics §3.2.3.3).
 
@@ -168,10 +204,7 @@ def so3_log(R) -> np.ndarray:
     array([ 0.1, -0.2,  0.3])
     """
     R = _last_two_axes(R, "R", 3)
-    d = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], axis=-1)
-    c = 0.5 * (R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2] - 1.0)
-    s = 0.5 * _norm3(d)
-    theta = np.arctan2(s, np.clip(c, -1.0, 1.0))
+    d, c, s, theta = _angle_parts(R)
     t2 = theta * theta
     factor = np.where(theta < 1e-4, 0.5 * (1.0 + t2 / 6.0), theta / (2.0 * np.where(s > 0, s, 1.0)))
     w = factor[..., None] * d

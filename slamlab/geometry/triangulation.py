@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array
 
 __all__ = ["Triangulation", "triangulate_midpoint", "triangulate_stereo"]
 
@@ -49,7 +49,7 @@ class Triangulation(NamedTuple):
 
 
 def _rays(x, name, n=None):
-    x = v.as_finite_array(x, name)
+    x = as_finite_array(x, name)
     if x.ndim == 1:
         if x.shape != (3,):
             raise ValueError(f"`{name}` must have shape (3,) or (N, 3); got {x.shape}")

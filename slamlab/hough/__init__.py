@@ -4,7 +4,7 @@ Scans are :class:`slamlab.scans.Scan` objects; maps come from :func:`slamlab.sca
 """
 
 from .._lazy import lazy_exports
-from .association import LineHistory, associate, association_probability
+from .association import LineHistory, associate_lines, association_probability
 from .icp import IcpResult, icp, icp_odometry, rigid_fit_2d
 from .lines import (
     Lines,
@@ -43,7 +43,7 @@ __all__ = [
     "Lines",
     "PoseChange",
     "align_lines",
-    "associate",
+    "associate_lines",
     "association_probability",
     "canonical_lines",
     "detect_lines",

@@ -19,10 +19,10 @@ import math
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_int, check_positive
 from .lines import Lines, align_lines, line_difference
 
-__all__ = ["LineHistory", "associate", "association_probability"]
+__all__ = ["LineHistory", "associate_lines", "association_probability"]
 
 
 def _parallel_offsets(rho, theta, tol):
@@ -60,21 +60,16 @@ def association_probability(new: Lines, old: Lines, *, a: float, b: float | None
 
     >>> old = Lines(np.array([1.0, 5.0, 3.0]), np.array([0.0, 0.0, np.pi / 2 - 0.01]), np.ones(3))
     >>> new = Lines(np.array([4.7, 0.7, 3.0]), np.array([0.0, 0.0, np.pi / 2 - 0.01]), np.ones(3))
-    >>> associate(association_probability(new, old, a=1.0)).tolist()
+    >>> associate_lines(association_probability(new, old, a=1.0)).tolist()
     [1, 0, 2]
     """
     for name, lines in (("new", new), ("old", old)):
         if not isinstance(lines, Lines):
             raise TypeError(f"`{name}` must be Lines; got {type(lines).__name__}")
-    a = v.check_positive(a, "a")
-    b = a if b is None else v.check_positive(b, "b")
-    a_theta = v.check_positive(a_theta_rad, "a_theta_rad")
-    tol = v.check_positive(parallel_tol_rad, "parallel_tol_rad")
-    return _association_probability(new, old, a, b, a_theta, tol)
-
-
-def _association_probability(new: Lines, old: Lines, a: float, b: float, a_theta: float, tol: float) -> np.ndarray:
-    """:func:`association_probability` on checked arguments."""
+    a = check_positive(a, "a")
+    b = a if b is None else check_positive(b, "b")
+    a_theta = check_positive(a_theta_rad, "a_theta_rad")
+    tol = check_positive(parallel_tol_rad, "parallel_tol_rad", allow_zero=True)
     if len(new) == 0 or len(old) == 0:
         return np.zeros((len(new), len(old)))
     d_rho, d_theta = line_difference(new.rho[:, None], new.theta_rad[:, None], old.rho[None, :],
@@ -96,7 +91,7 @@ def _association_probability(new: Lines, old: Lines, a: float, b: float, a_theta
     return P
 
 
-def associate(P, *, p_min: float = 0.05, one_to_one: bool = True) -> np.ndarray:
+def associate_lines(P, *, p_min: float = 0.05, one_to_one: bool = True) -> np.ndarray:
     """Row-wise argmax of P (004); ``-1`` where the best P is below ``p_min`` (a new line).
 
     ``one_to_one`` (our addition): when two new lines pick the same old one, the one with
@@ -118,16 +113,11 @@ def associate(P, *, p_min: float = 0.05, one_to_one: bool = True) -> np.ndarray:
 
     Examples
     --------
-    >>> associate(np.array([[0.9, 0.1], [0.8, 0.2], [0.01, 0.02]])).tolist()
+    >>> associate_lines(np.array([[0.9, 0.1], [0.8, 0.2], [0.01, 0.02]])).tolist()
     [0, -1, -1]
     """
-    P = v.as_finite_array(P, "P", ndim=2)
-    p_min = v.check_positive(p_min, "p_min", allow_zero=True)
-    return _associate(P, p_min, one_to_one)
-
-
-def _associate(P: np.ndarray, p_min: float, one_to_one: bool = True) -> np.ndarray:
-    """:func:`associate` on a checked matrix."""
+    P = as_finite_array(P, "P", ndim=2)
+    p_min = check_positive(p_min, "p_min", allow_zero=True)
     match = np.full(P.shape[0], -1, dtype=np.int64)
     if P.size == 0:
         return match
@@ -218,7 +208,7 @@ class LineHistory:
         ids : numpy.ndarray of int
         lines : Lines
         """
-        n = v.check_int(n, "n", minimum=-len(self), maximum=len(self) - 1)
+        n = check_int(n, "n", minimum=-len(self), maximum=len(self) - 1)
         ids, rho, theta, votes = self._rows[n]
         return ids, Lines(rho, theta, votes)
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_vector, check_int, check_positive
 from ..geometry.se2 import se2_compose, se2_transform
 
 __all__ = ["IcpResult", "icp", "icp_odometry", "rigid_fit_2d"]
@@ -46,7 +46,7 @@ class IcpResult:
 
 
 def _points(value, name):
-    arr = v.as_finite_array(value, name)
+    arr = as_finite_array(value, name)
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise ValueError(f"`{name}` must have shape (N, 2); got shape {arr.shape}")
     if arr.shape[0] < 3:
@@ -118,10 +118,10 @@ def icp(source, target, init=(0.0, 0.0, 0.0), *, max_iter: int = 50, tol: float 
     """
     src = _points(source, "source")
     dst = _points(target, "target")
-    pose = v.as_vector(init, "init", 3).copy()
-    max_iter = v.check_int(max_iter, "max_iter", minimum=1)
-    tol = v.check_positive(tol, "tol")
-    max_dist = np.inf if max_dist is None else v.check_positive(max_dist, "max_dist")
+    pose = as_vector(init, "init", 3).copy()
+    max_iter = check_int(max_iter, "max_iter", minimum=1)
+    tol = check_positive(tol, "tol")
+    max_dist = np.inf if max_dist is None else check_positive(max_dist, "max_dist")
     kd = cKDTree(dst) if tree is None else tree
     converged, it, rmse, n_in = False, 0, float("nan"), 0
     for it in range(1, max_iter + 1):  # noqa: B007 - the count is returned
@@ -166,11 +166,11 @@ def icp_odometry(points, start_pose=(0.0, 0.0, 0.0), init_increments=None, *, ma
     pts = list(points)
     if len(pts) < 1:
         raise ValueError("`points` must hold at least one scan; got 0")
-    U = np.zeros((len(pts) - 1, 3)) if init_increments is None else v.as_finite_array(init_increments,
+    U = np.zeros((len(pts) - 1, 3)) if init_increments is None else as_finite_array(init_increments,
                                                                                        "init_increments", ndim=2)
     if U.shape != (len(pts) - 1, 3):
         raise ValueError(f"`init_increments` must have shape ({len(pts) - 1}, 3); got {U.shape}")
-    poses = [v.as_vector(start_pose, "start_pose", 3).copy()]
+    poses = [as_vector(start_pose, "start_pose", 3).copy()]
     conv = np.zeros(len(pts) - 1, dtype=bool)
     tree = None
     for k in range(1, len(pts)):

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
 from .._compiled import numba_enabled
+from .._validate import as_finite_array, as_vector, check_int, check_positive
 from .transform import HoughAccumulator
 
 _MAX_CANDIDATES = 600
@@ -179,22 +179,13 @@ def find_peaks(acc: HoughAccumulator, H_min: int, *, suppress_rho: float | None 
     """
     if not isinstance(acc, HoughAccumulator):
         raise TypeError(f"`acc` must be a HoughAccumulator; got {type(acc).__name__}")
-    H_min = v.check_int(H_min, "H_min", minimum=1)
-    s_rho = 3 * acc.delta_rho if suppress_rho is None else v.check_positive(suppress_rho, "suppress_rho",
+    H_min = check_int(H_min, "H_min", minimum=1)
+    s_rho = 3 * acc.delta_rho if suppress_rho is None else check_positive(suppress_rho, "suppress_rho",
                                                                             allow_zero=True)
     s_theta = (3 * acc.delta_theta_rad if suppress_theta_rad is None
-               else v.check_positive(suppress_theta_rad, "suppress_theta_rad", allow_zero=True))
+               else check_positive(suppress_theta_rad, "suppress_theta_rad", allow_zero=True))
     if max_lines is not None:
-        max_lines = v.check_int(max_lines, "max_lines", minimum=1)
-    return _find_peaks(acc, H_min, s_rho, s_theta, max_lines)
-
-
-_NB_DI = np.array([-1, -1, -1, 0, 0, 1, 1, 1])[:, None]
-_NB_DK = np.array([-1, 0, 1, -1, 1, -1, 0, 1])[:, None]
-
-
-def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float, max_lines: int | None) -> Lines:
-    """:func:`find_peaks` on checked arguments (suppression windows resolved)."""
+        max_lines = check_int(max_lines, "max_lines", minimum=1)
     H = acc.H
     if numba_enabled() and H.dtype == np.intp:  # the same groups, compiled (_kernels.peak_groups; issue 25)
         from ._kernels import peak_groups
@@ -210,6 +201,10 @@ def _find_peaks(acc: HoughAccumulator, H_min: int, s_rho: float, s_theta: float,
                                  acc.theta_rad[0] + centre[:, 1] * acc.delta_theta_rad)
     keep = _greedy_keep(rho, theta, s_rho, s_theta)[:max_lines]
     return Lines(rho[keep].astype(float), theta[keep].astype(float), votes[keep].astype(np.int64))
+
+
+_NB_DI = np.array([-1, -1, -1, 0, 0, 1, 1, 1])[:, None]
+_NB_DK = np.array([-1, 0, 1, -1, 1, -1, 0, 1])[:, None]
 
 
 def _peak_groups(H, H_min: int):
@@ -347,13 +342,8 @@ def merge_duplicates(lines: Lines, *, rho_tol: float, theta_tol_rad: float) -> L
     """
     if not isinstance(lines, Lines):
         raise TypeError(f"`lines` must be Lines; got {type(lines).__name__}")
-    rho_tol = v.check_positive(rho_tol, "rho_tol", allow_zero=True)
-    theta_tol = v.check_positive(theta_tol_rad, "theta_tol_rad", allow_zero=True)
-    return _merge_duplicates(lines, rho_tol, theta_tol)
-
-
-def _merge_duplicates(lines: Lines, rho_tol: float, theta_tol: float) -> Lines:
-    """:func:`merge_duplicates` on checked arguments."""
+    rho_tol = check_positive(rho_tol, "rho_tol", allow_zero=True)
+    theta_tol = check_positive(theta_tol_rad, "theta_tol_rad", allow_zero=True)
     order = np.argsort(-lines.votes, kind="stable")
     keep = order[_greedy_keep(lines.rho[order], lines.theta_rad[order], rho_tol, theta_tol)]
     return Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep])
@@ -406,18 +396,13 @@ def refine_lines(lines: Lines, bearings_rad, ranges, *, band: float = 1.0, n_ite
     """
     if not isinstance(lines, Lines):
         raise TypeError(f"`lines` must be Lines; got {type(lines).__name__}")
-    phi = v.as_finite_array(bearings_rad, "bearings_rad", ndim=1)
-    r = v.as_finite_array(ranges, "ranges", ndim=1)
+    phi = as_finite_array(bearings_rad, "bearings_rad", ndim=1)
+    r = as_finite_array(ranges, "ranges", ndim=1)
     if phi.shape != r.shape:
         raise ValueError(f"`bearings_rad` and `ranges` must have the same length; got {phi.size} and {r.size}")
-    band = v.check_positive(band, "band")
-    n_iter = v.check_int(n_iter, "n_iter", minimum=1)
-    gap = None if max_gap is None else v.check_positive(max_gap, "max_gap")
-    return _refine_lines(lines, phi, r, band, n_iter, gap)
-
-
-def _refine_lines(lines: Lines, phi, r, band: float, n_iter: int, gap: float | None) -> Lines:
-    """:func:`refine_lines` on checked arguments."""
+    band = check_positive(band, "band")
+    n_iter = check_int(n_iter, "n_iter", minimum=1)
+    gap = None if max_gap is None else check_positive(max_gap, "max_gap")
     if len(lines) == 0:
         return lines
     ok = r > 0
@@ -486,13 +471,8 @@ def transform_lines(rho, theta_rad, pose) -> tuple[np.ndarray, np.ndarray]:
     >>> float(r), float(t)
     (7.0, -0.1)
     """
-    rho = v.as_finite_array(rho, "rho")
-    theta = v.as_finite_array(theta_rad, "theta_rad")
-    return _transform_lines(rho, theta, v.as_vector(pose, "pose", 3))
-
-
-def _transform_lines(rho, theta, pose) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`transform_lines` on checked arrays."""
-    dx, dy, dphi = pose
+    rho = as_finite_array(rho, "rho")
+    theta = as_finite_array(theta_rad, "theta_rad")
+    dx, dy, dphi = as_vector(pose, "pose", 3)
     return rho - (dx * np.cos(theta) + dy * np.sin(theta)), theta - dphi
 

@@ -7,7 +7,7 @@ layer, :func:`slamlab.scans.occupancy_grid`; this module scores it.
 
 from __future__ import annotations
 
-from .. import _validate as v
+from .._validate import as_image, check_int
 from ..scans import FREE, OBSTACLE, OccupancyGrid
 
 __all__ = ["map_agreement"]
@@ -46,10 +46,10 @@ def map_agreement(built: OccupancyGrid, reference, *, tolerance_cells: int = 1) 
 
     if not isinstance(built, OccupancyGrid):
         raise TypeError(f"`built` must be an OccupancyGrid; got {type(built).__name__}")
-    ref = v.as_image(reference, "reference")
+    ref = as_image(reference, "reference")
     if ref.shape != built.grid.shape:
         raise ValueError(f"`reference` must have the built map's shape {built.grid.shape}; got {ref.shape}")
-    tol = v.check_int(tolerance_cells, "tolerance_cells", minimum=0)
+    tol = check_int(tolerance_cells, "tolerance_cells", minimum=0)
     size = 2 * tol + 1
     ref_obs = ref == OBSTACLE
     b_obs = built.grid == OBSTACLE

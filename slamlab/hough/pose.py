@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_choice, check_positive
 from ..geometry import wrap_angle
 
-__all__ = ["PoseChange", "pose_from_lines", "pose_from_two_lines", "select_line_pair"]
+__all__ = ["PoseChange", "pose_from_lines", "pose_from_two_lines", "select_line_pair", "weighted_median"]
 
 
 @dataclass(frozen=True)
@@ -52,8 +52,8 @@ class PoseChange:
 
 
 def _pair(line_i, line_j, name):
-    arr = v.as_finite_array(line_i, f"{name}_i")
-    arr2 = v.as_finite_array(line_j, f"{name}_j")
+    arr = as_finite_array(line_i, f"{name}_i")
+    arr2 = as_finite_array(line_j, f"{name}_j")
     if arr.shape != (2,) or arr2.shape != (2,):
         raise ValueError(f"`{name}_i` and `{name}_j` must be (rho, θ) pairs; got shapes {arr.shape} and {arr2.shape}")
     return arr, arr2
@@ -90,8 +90,8 @@ def pose_from_two_lines(line_i1, line_i2, line_j1, line_j2, *, angle_tol_rad: fl
     """
     (r_i1, t_i1), (r_j1, t_j1) = _pair(line_i1, line_j1, "line_1")
     (r_i2, t_i2), (r_j2, t_j2) = _pair(line_i2, line_j2, "line_2")
-    tol = v.check_positive(angle_tol_rad, "angle_tol_rad", allow_zero=True)
-    min_angle = v.check_positive(min_angle_rad, "min_angle_rad", allow_zero=True)
+    tol = check_positive(angle_tol_rad, "angle_tol_rad", allow_zero=True)
+    min_angle = check_positive(min_angle_rad, "min_angle_rad", allow_zero=True)
     return _pose_from_two_lines(r_i1, t_i1, r_i2, t_i2, r_j1, t_j1, r_j2, t_j2, tol, min_angle)
 
 
@@ -141,11 +141,11 @@ def select_line_pair(theta_i_rad, theta_j_rad, votes=None, *, angle_tol_rad: flo
     >>> select_line_pair([0.0, 0.1, 1.6], [0.0, 0.1, 1.6], [50, 80, 40])
     (1, 2)
     """
-    ti = v.as_finite_array(theta_i_rad, "theta_i_rad", ndim=1)
-    tj = v.as_finite_array(theta_j_rad, "theta_j_rad", ndim=1)
+    ti = as_finite_array(theta_i_rad, "theta_i_rad", ndim=1)
+    tj = as_finite_array(theta_j_rad, "theta_j_rad", ndim=1)
     if ti.shape != tj.shape:
         raise ValueError(f"`theta_i_rad` and `theta_j_rad` must have the same length; got {ti.size} and {tj.size}")
-    w = np.ones_like(ti) if votes is None else v.as_finite_array(votes, "votes", ndim=1)
+    w = np.ones_like(ti) if votes is None else as_finite_array(votes, "votes", ndim=1)
     if w.shape != ti.shape:
         raise ValueError(f"`votes` must have one entry per line ({ti.size}); got {w.size}")
     return _select_line_pair(ti, tj, w, angle_tol_rad, min_angle_rad)
@@ -166,7 +166,35 @@ def _select_line_pair(ti, tj, w, angle_tol_rad, min_angle_rad) -> tuple[int, int
     return int(a), int(b)
 
 
-def _weighted_median(x, w):
+def weighted_median(x, weights) -> float:
+    """Weighted median: the first value of sorted ``x`` at which the cumulative weight reaches half the total (ours).
+
+    The robust centre of the per-line heading changes ``θ_i − θ_j`` (weights: votes) in :func:`pose_from_lines`
+    and in Hough SLAM's partial and heading steps.
+
+    Parameters
+    ----------
+    x : array_like, shape (L,)
+        Values (e.g. heading changes θ_i − θ_j [rad]), at least one.
+    weights : array_like, shape (L,)
+        Their weights (e.g. votes), >= 0 with a positive sum.
+
+    Returns
+    -------
+    float
+        The weighted median (one of the values of ``x``).
+
+    Examples
+    --------
+    >>> weighted_median([0.3, 0.1, 0.2], [1.0, 1.0, 5.0])
+    0.2
+    """
+    x = as_finite_array(x, "x", ndim=1)
+    w = as_finite_array(weights, "weights", ndim=1)
+    if w.shape != x.shape or x.size == 0:
+        raise ValueError(f"`x` and `weights` must have one non-zero length; got {x.size} and {w.size}")
+    if np.any(w < 0) or not w.sum() > 0:
+        raise ValueError("`weights` must be >= 0 with a positive sum")
     order = np.argsort(x)
     cw = np.cumsum(w[order])
     return float(x[order][np.searchsorted(cw, 0.5 * cw[-1])])
@@ -216,24 +244,19 @@ def pose_from_lines(rho_i, theta_i_rad, rho_j, theta_j_rad, votes=None, *, metho
     >>> pc.ok, pc.pose.round(12).tolist()
     (True, [0.7, -0.4, 0.15])
     """
-    ri = v.as_finite_array(rho_i, "rho_i", ndim=1)
-    ti = v.as_finite_array(theta_i_rad, "theta_i_rad", ndim=1)
-    rj = v.as_finite_array(rho_j, "rho_j", ndim=1)
-    tj = v.as_finite_array(theta_j_rad, "theta_j_rad", ndim=1)
+    ri = as_finite_array(rho_i, "rho_i", ndim=1)
+    ti = as_finite_array(theta_i_rad, "theta_i_rad", ndim=1)
+    rj = as_finite_array(rho_j, "rho_j", ndim=1)
+    tj = as_finite_array(theta_j_rad, "theta_j_rad", ndim=1)
     if not (ri.shape == ti.shape == rj.shape == tj.shape):
         raise ValueError(f"`rho_i`, `theta_i_rad`, `rho_j`, `theta_j_rad` must have one length; got "
                          f"{ri.size}, {ti.size}, {rj.size}, {tj.size}")
-    method = v.check_choice(method, "method", ("two_lines", "least_squares"))
-    tol = v.check_positive(angle_tol_rad, "angle_tol_rad", allow_zero=True)
-    rho_tol = np.inf if rho_tol is None else v.check_positive(rho_tol, "rho_tol")
-    w = np.ones_like(ri) if votes is None else v.as_finite_array(votes, "votes", ndim=1)
+    method = check_choice(method, "method", ("two_lines", "least_squares"))
+    tol = check_positive(angle_tol_rad, "angle_tol_rad", allow_zero=True)
+    rho_tol = np.inf if rho_tol is None else check_positive(rho_tol, "rho_tol")
+    w = np.ones_like(ri) if votes is None else as_finite_array(votes, "votes", ndim=1)
     if w.shape != ri.shape:
         raise ValueError(f"`votes` must have one entry per line ({ri.size}); got {w.size}")
-    return _pose_from_lines(ri, ti, rj, tj, w, method, tol, min_angle_rad, rho_tol)
-
-
-def _pose_from_lines(ri, ti, rj, tj, w, method, tol, min_angle_rad, rho_tol) -> PoseChange:
-    """:func:`pose_from_lines` on checked arguments (``rho_tol`` = inf for none)."""
     fail = PoseChange(np.full(3, np.nan), False, np.empty(0, dtype=np.int64),
                       message=f"no pair of non-parallel lines with an unchanged angle among {ri.size}")
     if method == "two_lines":
@@ -247,7 +270,7 @@ def _pose_from_lines(ri, ti, rj, tj, w, method, tol, min_angle_rad, rho_tol) -> 
     if ri.size < 2:
         return fail
     dphi_all = ti - tj
-    ref = _weighted_median(dphi_all, w)
+    ref = weighted_median(dphi_all, w)
     use = np.flatnonzero(np.abs(wrap_angle(dphi_all - ref)) <= tol)
     for _ in range(4):
         if _select_line_pair(ti[use], tj[use], w[use], 2 * tol + 1e-12, min_angle_rad) is None:

@@ -23,16 +23,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
 from .._params import Params, param
 from .._progress import progress_bar
+from .._validate import as_finite_array, check_choice, check_int, check_positive, check_probability
 from ..geometry import wrap_angle
 from ..geometry.se2 import check_pose, se2_compose
 from ..scans import Scan
-from .association import LineHistory, _associate, _association_probability
-from .lines import Lines, _find_peaks, _merge_duplicates, _refine_lines, _transform_lines
-from .pose import _pose_from_lines
-from .transform import _hough_polar, theta_axis
+from .association import LineHistory, associate_lines, association_probability
+from .lines import Lines, find_peaks, merge_duplicates, refine_lines, transform_lines
+from .pose import pose_from_lines, weighted_median
+from .transform import hough_polar, theta_axis
 
 __all__ = ["STEP_CAUSES", "HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
 
@@ -54,7 +54,7 @@ _CODE = {name: k for k, name in enumerate(STEP_CAUSES)}
 
 def _optional_positive(value, name):
     if value is not None:
-        v.check_positive(value, name)
+        check_positive(value, name)
 
 
 @dataclass(frozen=True)
@@ -143,29 +143,29 @@ class HoughSlamParams(Params):
     heading: bool = param(False, "ours: no pose from the lines → their heading change, odometry's translation")
 
     def check(self) -> None:
-        v.check_positive(self.delta_rho, "delta_rho")
+        check_positive(self.delta_rho, "delta_rho")
         theta_axis(self.delta_theta_rad)  # > 0 and divides 180°
         for name in ("r_max", "suppress_rho", "suppress_theta_rad", "band", "max_gap", "b", "rho_tol", "gate"):
             _optional_positive(getattr(self, name), name)
-        v.check_int(self.H_min, "H_min", minimum=1)
+        check_int(self.H_min, "H_min", minimum=1)
         if self.H_min_retry is not None:
-            v.check_int(self.H_min_retry, "H_min_retry", minimum=1)
-        v.check_int(self.max_lines, "max_lines", minimum=2)
+            check_int(self.H_min_retry, "H_min_retry", minimum=1)
+        check_int(self.max_lines, "max_lines", minimum=2)
         for name in ("refine", "partial", "heading"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
-        v.check_positive(self.a, "a")
-        v.check_positive(self.a_theta_rad, "a_theta_rad")
-        v.check_positive(self.parallel_tol_rad, "parallel_tol_rad", allow_zero=True)
-        if v.check_probability(self.p_min, "p_min") >= 1.0:
+        check_positive(self.a, "a")
+        check_positive(self.a_theta_rad, "a_theta_rad")
+        check_positive(self.parallel_tol_rad, "parallel_tol_rad", allow_zero=True)
+        if check_probability(self.p_min, "p_min") >= 1.0:
             raise ValueError(f"`p_min` must lie in [0, 1); got {self.p_min}")
-        v.check_choice(self.method, "method", ("two_lines", "least_squares"))
-        v.check_positive(self.angle_tol_rad, "angle_tol_rad", allow_zero=True)
-        v.check_positive(self.min_angle_rad, "min_angle_rad", allow_zero=True)
+        check_choice(self.method, "method", ("two_lines", "least_squares"))
+        check_positive(self.angle_tol_rad, "angle_tol_rad", allow_zero=True)
+        check_positive(self.min_angle_rad, "min_angle_rad", allow_zero=True)
         if self.min_angle_rad > math.pi / 2:
             raise ValueError(f"`min_angle_rad` must be <= π/2; got {self.min_angle_rad}")
-        v.check_int(self.min_common, "min_common", minimum=2)
-        v.check_positive(self.gate_theta_rad, "gate_theta_rad")
+        check_int(self.min_common, "min_common", minimum=2)
+        check_positive(self.gate_theta_rad, "gate_theta_rad")
 
 
 @dataclass(frozen=True)
@@ -255,25 +255,23 @@ def detect_lines(scan: Scan, params: HoughSlamParams | None = None, **overrides)
     >>> round(float(lines.rho[0]), 6), round(float(np.degrees(lines.theta_rad[0])), 6)
     (10.0, 45.0)
     """
-    p = HoughSlamParams.resolve(params, **overrides)
-    return _detect(*_returns(scan), p, theta_axis(p.delta_theta_rad))
+    return _detect(*_returns(scan), HoughSlamParams.resolve(params, **overrides))
 
 
-def _detect(bearings_rad, ranges, params: HoughSlamParams, theta: np.ndarray) -> Lines:
-    """:func:`detect_lines` on checked settings (``theta``: the θ axis of ``params``), once per scan."""
+def _detect(bearings_rad, ranges, params: HoughSlamParams) -> Lines:
+    """:func:`detect_lines` on the returns of a scan: the pipeline of the public steps, once per scan."""
     if bearings_rad.size == 0:
         return Lines(np.empty(0), np.empty(0), np.empty(0, int))
-    r_max = float(ranges.max()) if params.r_max is None else params.r_max
-    acc = _hough_polar(bearings_rad, ranges, params.delta_rho, theta, params.delta_theta_rad, r_max)
-    s_rho = 3 * acc.delta_rho if params.suppress_rho is None else params.suppress_rho
-    s_theta = 3 * acc.delta_theta_rad if params.suppress_theta_rad is None else params.suppress_theta_rad
-    lines = _find_peaks(acc, params.H_min, s_rho, s_theta, params.max_lines)
+    acc = hough_polar(bearings_rad, ranges, delta_rho=params.delta_rho, delta_theta_rad=params.delta_theta_rad,
+                      r_max=params.r_max)
+    lines = find_peaks(acc, params.H_min, suppress_rho=params.suppress_rho,
+                       suppress_theta_rad=params.suppress_theta_rad, max_lines=params.max_lines)
     if params.refine and len(lines):
         band = params.delta_rho if params.band is None else params.band
-        lines = _refine_lines(lines, bearings_rad, ranges, band, 3, params.max_gap)
+        lines = refine_lines(lines, bearings_rad, ranges, band=band, n_iter=3, max_gap=params.max_gap)
         keep = lines.votes >= max(2, params.H_min // 2)  # a peak whose band holds few points is spurious
-        lines = _merge_duplicates(Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep]),
-                                  params.delta_rho, params.delta_theta_rad)
+        lines = merge_duplicates(Lines(lines.rho[keep], lines.theta_rad[keep], lines.votes[keep]),
+                                 rho_tol=params.delta_rho, theta_tol_rad=params.delta_theta_rad)
     return lines
 
 
@@ -284,8 +282,9 @@ def _relative(history, n1, n2, params):
     if common.size < 2:
         return None, common.size
     votes = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
-    pc = _pose_from_lines(l1.rho[i1], l1.theta_rad[i1], l2.rho[i2], l2.theta_rad[i2], votes, params.method,
-                          params.angle_tol_rad, params.min_angle_rad, np.inf if params.rho_tol is None else params.rho_tol)
+    pc = pose_from_lines(l1.rho[i1], l1.theta_rad[i1], l2.rho[i2], l2.theta_rad[i2], votes, method=params.method,
+                         angle_tol_rad=params.angle_tol_rad, min_angle_rad=params.min_angle_rad,
+                         rho_tol=params.rho_tol)
     return (pc.pose if pc.ok else None), common.size
 
 
@@ -305,9 +304,7 @@ def _common_heading(history, n1, n2, prior, params, min_votes):
         return None
     dphi_all = l1.theta_rad[i1] - l2.theta_rad[i2]
     w = np.minimum(l1.votes[i1], l2.votes[i2]).astype(float)
-    order = np.argsort(dphi_all)
-    cw = np.cumsum(w[order])
-    ref = dphi_all[order][np.searchsorted(cw, 0.5 * cw[-1])]
+    ref = weighted_median(dphi_all, w)
     use = np.abs(wrap_angle(dphi_all - ref)) <= params.angle_tol_rad
     if w[use].sum() < min_votes or abs(float(wrap_angle(ref - prior[2]))) > params.gate_theta_rad:
         return None
@@ -390,9 +387,8 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     if len(units) > 1:
         raise ValueError(f"`scans` must all have one unit; got {sorted(units)}")
     returns = [_returns(s, f"scans[{k}]") for k, s in enumerate(scans)]
-    theta = theta_axis(params.delta_theta_rad)  # the settings are checked once, here
     n = len(scans)
-    U = np.zeros((n - 1, 3)) if odometry is None else v.as_finite_array(odometry, "odometry", ndim=2)
+    U = np.zeros((n - 1, 3)) if odometry is None else as_finite_array(odometry, "odometry", ndim=2)
     if U.shape != (n - 1, 3):
         raise ValueError(f"`odometry` must have shape ({n - 1}, 3) = one (dx, dy, dθ) per step; got {U.shape}")
     poses = np.zeros((n, 3))
@@ -407,19 +403,18 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     low = params.H_min_retry is not None and params.H_min_retry < params.H_min  # a retry only below H_min
     retry = params.replace(H_min=params.H_min_retry) if low else None
     for k in progress_bar(range(n), desc="Hough SLAM", progress=progress):
-        lines = _detect(*returns[k], params, theta)
+        lines = _detect(*returns[k], params)
         if len(lines) < 2 and retry is not None:  # ours: a sparse scan, searched again at a lower threshold
-            lines = _detect(*returns[k], retry, theta)
+            lines = _detect(*returns[k], retry)
         n_lines[k] = len(lines)
         if k == 0:
             history.add_scan(lines, np.full(len(lines), -1))
             continue
         prev_ids, prev = history.scan(k - 1)
-        pr, pt = _transform_lines(prev.rho, prev.theta_rad, U[k - 1])
-        P = _association_probability(lines, Lines(pr, pt, prev.votes), params.a,
-                                     params.a if params.b is None else params.b, params.a_theta_rad,
-                                     params.parallel_tol_rad)
-        match = _associate(P, params.p_min)
+        pr, pt = transform_lines(prev.rho, prev.theta_rad, U[k - 1])
+        P = association_probability(lines, Lines(pr, pt, prev.votes), a=params.a, b=params.b,
+                                    a_theta_rad=params.a_theta_rad, parallel_tol_rad=params.parallel_tol_rad)
+        match = associate_lines(P, p_min=params.p_min)
         ids = np.where(match >= 0, prev_ids[np.clip(match, 0, None)] if prev_ids.size else -1, -1)
         history.add_scan(lines, ids)
         guess = se2_compose(poses[k - 1], U[k - 1])

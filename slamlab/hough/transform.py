@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
 from .._compiled import numba_enabled
+from .._validate import as_finite_array, as_image, as_vector, check_int, check_positive
 
 __all__ = [
     "HoughAccumulator",
@@ -106,7 +106,7 @@ def theta_axis(delta_theta_rad: float) -> np.ndarray:
     >>> np.degrees(theta_axis(np.radians(45.0))).round(6).tolist()
     [-90.0, -45.0, 0.0, 45.0]
     """
-    d = v.check_positive(delta_theta_rad, "delta_theta_rad")
+    d = check_positive(delta_theta_rad, "delta_theta_rad")
     n = round(math.pi / d)
     if n < 1 or not math.isclose(n * d, math.pi, rel_tol=1e-9, abs_tol=1e-12):
         raise ValueError(f"`delta_theta_rad` must divide 180 degrees; got {math.degrees(d):.6g} degrees")
@@ -114,8 +114,8 @@ def theta_axis(delta_theta_rad: float) -> np.ndarray:
 
 
 def _check_scan(bearings_rad, ranges):
-    phi = v.as_finite_array(bearings_rad, "bearings_rad", ndim=1)
-    r = v.as_finite_array(ranges, "ranges", ndim=1)
+    phi = as_finite_array(bearings_rad, "bearings_rad", ndim=1)
+    r = as_finite_array(ranges, "ranges", ndim=1)
     if phi.shape != r.shape:
         raise ValueError(f"`bearings_rad` and `ranges` must have the same length; got {phi.size} and {r.size}")
     if np.any(r < 0):
@@ -159,11 +159,11 @@ def hough_polar(bearings_rad, ranges, *, delta_rho: float = 1.0, delta_theta_rad
     (103, 103)
     """
     phi, r = _check_scan(bearings_rad, ranges)
-    d_rho = v.check_positive(delta_rho, "delta_rho")
+    d_rho = check_positive(delta_rho, "delta_rho")
     theta = theta_axis(delta_theta_rad)
     if r_max is None:
         r_max = float(r.max()) if r.size else d_rho
-    r_max = v.check_positive(r_max, "r_max")
+    r_max = check_positive(r_max, "r_max")
     return _hough_polar(phi, r, d_rho, theta, float(delta_theta_rad), r_max)
 
 
@@ -247,11 +247,11 @@ def rasterise_scan(bearings_rad, ranges, *, cell: float = 1.0, r_max: float | No
     ((7, 7), 3, 255, 255)
     """
     phi, r = _check_scan(bearings_rad, ranges)
-    cell = v.check_positive(cell, "cell")
+    cell = check_positive(cell, "cell")
     if r_max is None:
         r_max = float(r.max()) if r.size else cell
-    r_max = v.check_positive(r_max, "r_max")
-    c = math.ceil(r_max / cell - 1e-9) if centre_px is None else v.check_int(centre_px, "centre_px", minimum=1)
+    r_max = check_positive(r_max, "r_max")
+    c = math.ceil(r_max / cell - 1e-9) if centre_px is None else check_int(centre_px, "centre_px", minimum=1)
     keep = (r > 0) & (r <= r_max)
     col = np.rint(r[keep] * np.cos(phi[keep]) / cell).astype(np.intp) + c
     row = np.rint(r[keep] * np.sin(phi[keep]) / cell).astype(np.intp) + c
@@ -293,8 +293,8 @@ def hough_classic(image, *, delta_rho: float = 1.0, delta_theta_rad: float = mat
     >>> float(acc.rho[i]), round(float(np.degrees(acc.theta_rad[k]))), int(acc.H[i, k])
     (5.0, 0, 33)
     """
-    img = v.as_image(image, "image")
-    d_rho = v.check_positive(delta_rho, "delta_rho")
+    img = as_image(image, "image")
+    d_rho = check_positive(delta_rho, "delta_rho")
     theta = theta_axis(delta_theta_rad)
     h, w = img.shape
     n_half = math.ceil(math.hypot(h - 1, w - 1) / d_rho - 1e-9)
@@ -335,10 +335,10 @@ def lines_about_centre(rho, theta_rad, centre_px: int, *, cell: float = 1.0) -> 
     >>> rho.tolist(), theta.tolist()
     ([10.0], [0.0])
     """
-    rho = np.asarray(v.as_finite_array(rho, "rho"))
-    theta = np.asarray(v.as_finite_array(theta_rad, "theta_rad"))
-    c = v.check_int(centre_px, "centre_px", minimum=0)
-    cell = v.check_positive(cell, "cell")
+    rho = np.asarray(as_finite_array(rho, "rho"))
+    theta = np.asarray(as_finite_array(theta_rad, "theta_rad"))
+    c = check_int(centre_px, "centre_px", minimum=0)
+    cell = check_positive(cell, "cell")
     return (rho - c * (np.cos(theta) + np.sin(theta))) * cell, theta.copy()
 
 
@@ -369,13 +369,13 @@ def line_scan(rho: float, theta_rad: float, *, r_max: float, bearings_rad=None,
     >>> phi.size, float(r.min())
     (103, 10.0)
     """
-    rho = v.check_positive(rho, "rho")
-    theta = float(v.as_vector(theta_rad, "theta_rad", 1)[0])
-    r_max = v.check_positive(r_max, "r_max")
+    rho = check_positive(rho, "rho")
+    theta = float(as_vector(theta_rad, "theta_rad", 1)[0])
+    r_max = check_positive(r_max, "r_max")
     if bearings_rad is None:
-        d = v.check_positive(delta_phi_rad, "delta_phi_rad")
+        d = check_positive(delta_phi_rad, "delta_phi_rad")
         bearings_rad = -math.pi + d * np.arange(round(2 * math.pi / d))
-    phi = v.as_finite_array(bearings_rad, "bearings_rad", ndim=1)
+    phi = as_finite_array(bearings_rad, "bearings_rad", ndim=1)
     c = np.cos(phi - theta)
     with np.errstate(divide="ignore"):
         r = np.where(c > 0, rho / np.where(c > 0, c, 1.0), np.inf)
@@ -414,6 +414,6 @@ def hough_cost(*, n_points: int | None = None, r_max: float | None = None, delta
     if (n_points is None) == (r_max is None):
         raise ValueError("give exactly one of `n_points` (polar) and `r_max` (classic)")
     if n_points is not None:
-        return float(v.check_int(n_points, "n_points", minimum=0) * n_theta)
-    ratio = v.check_positive(r_max, "r_max") / v.check_positive(delta_r, "delta_r")
+        return float(check_int(n_points, "n_points", minimum=0) * n_theta)
+    ratio = check_positive(r_max, "r_max") / check_positive(delta_r, "delta_r")
     return float(ratio**2 * n_theta)

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_path, check_int, check_positive
 from ..scans import Scan
 
 __all__ = ["CarmenLog", "flaser_angles", "open_text", "read_carmen"]
@@ -60,8 +60,8 @@ def flaser_angles(n_beams: int, fov_rad: float = np.pi) -> np.ndarray:
     >>> np.degrees(flaser_angles(180))[[0, 1, -1]].round(6).tolist()
     [-90.0, -89.0, 89.0]
     """
-    n = v.check_int(n_beams, "n_beams", minimum=2)
-    fov = v.check_positive(fov_rad, "fov_rad")
+    n = check_int(n_beams, "n_beams", minimum=2)
+    fov = check_positive(fov_rad, "fov_rad")
     if n % 2:
         return np.linspace(-fov / 2, fov / 2, n)
     return -fov / 2 + fov * np.arange(n) / n
@@ -147,7 +147,7 @@ class CarmenLog:
         Scan
             ``ranges``, ``valid``, ``bearings``, ``pose``, ``odom_pose``, ``time_s`` of that scan.
         """
-        i = v.check_int(i, "i", minimum=-self.n_scans, maximum=self.n_scans - 1)
+        i = check_int(i, "i", minimum=-self.n_scans, maximum=self.n_scans - 1)
         return self._scan(i, self.bearings_rad)
 
     def _scan(self, i, bearings):
@@ -171,7 +171,7 @@ class CarmenLog:
             One :class:`~slamlab.scans.Scan` per index, as :meth:`scan` builds it.
         """
         idx = range(self.n_scans) if indices is None else [
-            v.check_int(int(i), "indices[k]", minimum=-self.n_scans, maximum=self.n_scans - 1) for i in indices]
+            check_int(int(i), "indices[k]", minimum=-self.n_scans, maximum=self.n_scans - 1) for i in indices]
         b = self.bearings_rad
         return [self._scan(i, b) for i in idx]
 
@@ -226,9 +226,9 @@ def read_carmen(path, *, max_range_m: float | None = None) -> CarmenLog:
         malformed, or the beam count changes between scans (the message names
         the line number).
     """
-    p = v.as_path(path, "path", kind="file")
+    p = as_path(path, "path", kind="file")
     if max_range_m is not None:
-        max_range_m = v.check_positive(max_range_m, "max_range_m")
+        max_range_m = check_positive(max_range_m, "max_range_m")
     ranges: list[list[float]] = []
     poses: list[list[float]] = []
     odom_p: list[list[float]] = []

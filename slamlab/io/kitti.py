@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_path
 from ..geometry.camera import PinholeCamera, StereoRig
 
 __all__ = ["kitti_rig", "read_kitti_calib", "read_kitti_image"]
@@ -37,7 +37,7 @@ def read_kitti_calib(path) -> dict:
     >>> read_kitti_calib(f)["P1"][0].tolist()
     [7.0, 0.0, 6.0, -3.0]
     """
-    path = v.as_path(path, "path", kind="file")
+    path = as_path(path, "path", kind="file")
     out = {}
     for n, line in enumerate(path.read_text().splitlines(), start=1):
         if not line.strip():
@@ -95,7 +95,7 @@ def read_kitti_image(path) -> np.ndarray:
     """
     import cv2
 
-    path = v.as_path(path, "image", kind="file")
+    path = as_path(path, "image", kind="file")
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
         raise FileNotFoundError(f"could not read the image {path}")

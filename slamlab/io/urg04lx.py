@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_path, check_int, check_positive, parse_numbers
 from ..geometry.se2 import se2_compose, se2_integrate, se2_inverse
 from ..scans import Scan
 
@@ -119,7 +119,7 @@ class UrgLog:
         Scan
             ``ranges``, ``valid``, ``bearings``, ``odom_pose`` of that scan.
         """
-        k = v.check_int(k, "k", minimum=-len(self), maximum=len(self) - 1)
+        k = check_int(k, "k", minimum=-len(self), maximum=len(self) - 1)
         return self._scan(k, self.odometry_poses()[k])
 
     def _scan(self, k, odom_pose):
@@ -143,7 +143,7 @@ class UrgLog:
         """
         odo = self.odometry_poses()
         idx = range(len(self)) if indices is None else [
-            v.check_int(int(i), "indices[k]", minimum=-len(self), maximum=len(self) - 1) for i in indices]
+            check_int(int(i), "indices[k]", minimum=-len(self), maximum=len(self) - 1) for i in indices]
         return [self._scan(k, odo[k]) for k in idx]
 
 
@@ -168,8 +168,8 @@ def urg04lx_bearings(n_beams: int = URG04LX_N_BEAMS, fov_rad: float = URG04LX_FO
     >>> b.size, round(float(np.degrees(b[0])), 3), round(float(np.degrees(b[1] - b[0])), 4)
     (682, -120.0, 0.3524)
     """
-    n = v.check_int(n_beams, "n_beams", minimum=2)
-    fov = v.check_positive(fov_rad, "fov_rad")
+    n = check_int(n_beams, "n_beams", minimum=2)
+    fov = check_positive(fov_rad, "fov_rad")
     return np.linspace(-fov / 2, fov / 2, n)
 
 
@@ -189,8 +189,8 @@ def read_urg04lx_log(path, *, max_range_m: float = 4.0) -> UrgLog:
         When the file is missing, or a line does not have 707 numbers or holds a
         token that is not a number (the message names the file and line).
     """
-    p = v.as_path(path, "path", kind="file")
-    max_range_m = v.check_positive(max_range_m, "max_range_m")
+    p = as_path(path, "path", kind="file")
+    max_range_m = check_positive(max_range_m, "max_range_m")
     rows = []
     with p.open(encoding="ascii", errors="replace") as fh:
         for lineno, line in enumerate(fh, 1):
@@ -199,7 +199,7 @@ def read_urg04lx_log(path, *, max_range_m: float = 4.0) -> UrgLog:
             fields = line.split()
             if len(fields) != _N_FIELDS:
                 raise ValueError(f"{p.name} line {lineno}: expected {_N_FIELDS} numbers; got {len(fields)}")
-            rows.append(v.parse_numbers(fields, f"{p.name} line {lineno}"))
+            rows.append(parse_numbers(fields, f"{p.name} line {lineno}"))
     if not rows:
         raise ValueError(f"{p.name}: no scans")
     data = np.array(rows)
@@ -233,12 +233,12 @@ def urg04lx_odometry(ticks, *, wheel_radius_m: float = 0.077, half_axle_m: float
     >>> u.round(4).tolist()
     [[0.4838, 0.0, 0.0], [0.1129, 0.0433, 0.733]]
     """
-    T = v.as_finite_array(ticks, "ticks", ndim=2)
+    T = as_finite_array(ticks, "ticks", ndim=2)
     if T.shape[1] != 2 or T.shape[0] < 1:
         raise ValueError(f"`ticks` must have shape (n, 2) = (left, right); got shape {T.shape}")
-    R = v.check_positive(wheel_radius_m, "wheel_radius_m")
-    b = v.check_positive(half_axle_m, "half_axle_m")
-    k = v.check_positive(ticks_per_turn, "ticks_per_turn")
+    R = check_positive(wheel_radius_m, "wheel_radius_m")
+    b = check_positive(half_axle_m, "half_axle_m")
+    k = check_positive(ticks_per_turn, "ticks_per_turn")
     dw = np.diff(T, axis=0) * (2 * math.pi / k) * R  # wheel travel (left, right) in metres
     d = dw.mean(axis=1)
     dth = (dw[:, 1] - dw[:, 0]) / (2 * b)
@@ -265,7 +265,7 @@ def urg04lx_sensor_increments(increments, *, offset_m: float = 0.145) -> np.ndar
     >>> urg04lx_sensor_increments([[0.0, 0.0, np.pi / 2]], offset_m=1.0).round(12).tolist()
     [[-1.0, 1.0, 1.570796326795]]
     """
-    U = v.as_finite_array(increments, "increments", ndim=2)
+    U = as_finite_array(increments, "increments", ndim=2)
     if U.shape[1] != 3:
         raise ValueError(f"`increments` must have shape (n, 3); got shape {U.shape}")
     o = np.array([float(offset_m), 0.0, 0.0])

@@ -11,7 +11,8 @@ The generic layer under the features and stereo chapters (it imports neither):
 - :func:`exact_knn` (brute force, Hamming or Euclidean), :func:`pad_knn`, :func:`merge_knn`
   (:mod:`.knn`): the one exact 2-NN and the one "pad to k".
 - :class:`LandmarkStore`, the interface every store implements, the stores of 000 §3.4
-  and §4 and the base rule (:func:`base_rule`, :class:`SightingBook`) in :mod:`.stores`;
+  and §4 and the base rule (:func:`base_rule`, :class:`SightingBook`) in :mod:`.stores`, with their one
+  settings object :class:`StoreParams` (:mod:`.store_params`);
   the multi kd-tree cost model (:mod:`.cost_model`); the 2-D tree plot (loaded on first use).
 """
 
@@ -27,6 +28,7 @@ from .stores import (
     NonBaseBuffer,
     RebuildStore,
     SightingBook,
+    StoreParams,
     base_rule,
     make_store,
 )
@@ -47,6 +49,7 @@ __all__ = [
     "RebuildStore",
     "SearchStats",
     "SightingBook",
+    "StoreParams",
     "base_rule",
     "bbf_trace",
     "build_kdtree",

@@ -1,13 +1,13 @@
-"""Lower bounds of a pending Best-Bin-First branch (our addition, issue 25): the rule of :meth:`KDTree.query`'s
-``bound`` option, shared by the numpy search (``tree.py``) and the teaching trace (``trace.py``); the compiled
-search (``_kernels.py``) writes the same three lines.
+"""Lower bounds of a pending Best-Bin-First branch (package-private; our addition, issue 25): the rule of
+:meth:`KDTree.query`'s ``bound`` option, shared by the numpy search (``tree.py``) and the teaching trace
+(``trace.py``); the compiled search (``_kernels.py``) writes the same three lines.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["BBF_BOUNDS"]
+__all__ = ["BBF_BOUNDS", "cell_bounds", "far_bound"]
 
 #: lower bound of a pending branch (issue 25): ``"max"`` max(parent bound, (q[d] - split)²), ours, the default;
 #: ``"incremental"`` Arya & Mount's incremental distance from the query to the branch's cell (ANN's priority
@@ -17,7 +17,7 @@ __all__ = ["BBF_BOUNDS"]
 BBF_BOUNDS = ("max", "incremental", "sum")
 
 
-def _cell_bounds(t):
+def cell_bounds(t):
     """Per inner node, its cell's interval ``[lo, hi]`` along its own split coordinate (±inf where no ancestor
     splits on it): the nearest ancestor on each side that splits on the same coordinate bounds it (at its
     ``split_hi`` for a right descendant, ``split_lo`` for a left one).
@@ -55,7 +55,7 @@ def _cell_bounds(t):
     return lo, hi
 
 
-def _far_bound(bound, cur_b, diff, qd, lo, hi):
+def far_bound(bound, cur_b, diff, qd, lo, hi):
     """Lower bound of the far child (see :data:`BBF_BOUNDS`; our addition, issue 25).
 
     Parameters

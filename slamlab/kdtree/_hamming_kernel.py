@@ -1,7 +1,7 @@
 """Compiled two-nearest search for binary descriptors by Hamming distance (speed, issue 25).
 
 The numpy versions build every candidate pair's distance (OpenCV's ``batchDistance`` in
-:func:`slamlab.kdtree.knn.exact_knn`; ``_pair_distances`` + ``_two_nearest`` in the stereo matching);
+:func:`slamlab.kdtree.knn.exact_knn`; ``pair_distances`` + ``two_nearest`` of the stereo matching);
 this kernel walks the same candidates in the same order and keeps only the two nearest, so the
 results are the same, ties included (the first in order wins; tested against both).
 Users: :func:`slamlab.kdtree.knn.exact_knn` (binary, k = 2: every stored row a candidate, by

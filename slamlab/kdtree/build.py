@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_choice, check_int
 
 __all__ = ["SPLIT_RULES", "build_kdtree"]
 
@@ -62,12 +62,12 @@ def build_kdtree(points, ids=None, *, leaf_size: int = 1, split: str = "spread-m
     (2.0, 6.0, 4.0)
     """
     keep32 = isinstance(points, np.ndarray) and points.dtype == np.float32
-    X = v.as_finite_array(points, "points", ndim=2, dtype=np.float32 if keep32 else np.float64)
+    X = as_finite_array(points, "points", ndim=2, dtype=np.float32 if keep32 else np.float64)
     n, k = X.shape
     if n == 0 or k == 0:
         raise ValueError(f"`points` must hold at least one point of dimension >= 1; got shape {X.shape}")
-    leaf_size = v.check_int(leaf_size, "leaf_size", minimum=1)
-    split = v.check_choice(split, "split", SPLIT_RULES)
+    leaf_size = check_int(leaf_size, "leaf_size", minimum=1)
+    split = check_choice(split, "split", SPLIT_RULES)
     if not isinstance(gap, (bool, np.bool_)):
         raise TypeError(f"`gap` must be a bool; got {type(gap).__name__}")
     if ids is None:

@@ -38,8 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
 from .._table import format_table
+from .._validate import check_choice, check_positive
 
 __all__ = [
     "P_RULES",
@@ -238,8 +238,8 @@ def iter_time(n1, q, *, n: float = 50000, s: float = 500, m: float = 500, C: flo
     ...     iter_time(3500, 5.5, reading="literal") / iter_time(1200, 2.3, reading="literal")), 3)
     (0.717, 1.45)
     """
-    v.check_choice(p_rule, "p_rule", P_RULES)
-    v.check_choice(reading, "reading", READINGS)
+    check_choice(p_rule, "p_rule", P_RULES)
+    check_choice(reading, "reading", READINGS)
     n1 = np.asarray(n1, dtype=float)
     q = np.asarray(q, dtype=float)
     if np.any(n1 <= 1) or np.any(q <= 1):
@@ -284,8 +284,8 @@ def calibrate_C(s: float, t_search_s: float, m: float, t_modify_s: float, n: flo
     8.98
     """
     for val, name in ((s, "s"), (t_search_s, "t_search_s"), (t_modify_s, "t_modify_s"), (n, "n")):
-        v.check_positive(val, name)
-    v.check_positive(m, "m")
+        check_positive(val, name)
+    check_positive(m, "m")
     return (t_search_s / s) / (t_modify_s / n)
 
 
@@ -404,10 +404,10 @@ def run_cost_model(*, n: float = 50000, s: float = 500, m: float = 500, C: float
     CostModelResult
         ``readings`` (the optimum per reading) and the adjusted surface.
     """
-    n = v.check_positive(n, "n")
-    s = v.check_positive(s, "s")
-    m = v.check_positive(m, "m")
-    C = v.check_positive(C, "C")
+    n = check_positive(n, "n")
+    s = check_positive(s, "s")
+    m = check_positive(m, "m")
+    C = check_positive(C, "C")
     specs = [
         ("Appendix as printed: addKd + C searchKd, p upper (real)", "upper", True, "literal"),
         ("changed search term: addKd + C s T_search", "upper", True, "adjusted"),

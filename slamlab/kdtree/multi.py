@@ -10,19 +10,19 @@ from dataclasses import fields
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_int
+from ._store_parts import PointSet, StaticTree
 from .knn import merge_knn
-from .store_base import (
-    LandmarkStore,
-    SightingBook,
-    StoreCounters,
-    _as_ids,
-    _check_tree_args,
-    _PointSet,
-    _Tree,
-)
+from .store_base import LandmarkStore, SightingBook, StoreCounters
+from .store_params import StoreParams, resolve_store_params
 
 __all__ = ["MultiKDTree", "NonBaseBuffer", "multi_tree_sizes"]
+
+
+def _max_size(n1, q, i):
+    """``MAX_SIZE[i] = floor(n1 q^i)`` (tree index from 0; the 1e-9 absorbs the rounding of ``q^i``)."""
+    return int(np.floor(n1 * q ** i + 1e-9))
+
 
 def multi_tree_sizes(n1: int, q: float, batches) -> list[list[int]]:
     """Tree sizes of a multi kd-tree after each batch (000 §4.1's insertion rule, sizes only).
@@ -50,15 +50,13 @@ def multi_tree_sizes(n1: int, q: float, batches) -> list[list[int]]:
     >>> multi_tree_sizes(4, 2.0, [3, 3, 3])
     [[3], [0, 6], [3, 6, 0]]
     """
-    n1 = v.check_int(n1, "n1", minimum=1)
-    q = v.check_positive(q, "q")
-    if q <= 1:
-        raise ValueError(f"`q` must be > 1; got {q}")
-    cap = lambda i: int(np.floor(n1 * q ** i + 1e-9))
+    p = StoreParams(n1=n1, q=q)  # checks n1 >= 1 and q > 1
+    n1, q = int(p.n1), float(p.q)
+    cap = lambda i: _max_size(n1, q, i)
     sizes: list[int] = []
     out = []
     for b in batches:
-        b = v.check_int(b, "batches", minimum=0)
+        b = check_int(b, "batches", minimum=0)
         if not sizes:
             sizes.append(0)
         sizes[0] += b
@@ -84,18 +82,23 @@ class MultiKDTree(LandmarkStore):
     the trees whose contents changed are rebuilt. A query searches every non-empty
     tree and merges the k-NN lists (exact when the per-tree search is exact).
 
+    The store reads ``n1``, ``q``, ``tree``, ``leaf_size`` and ``checks`` of its :class:`StoreParams`
+    (an insert-only store: the base rule is the buffer's, :class:`NonBaseBuffer`).
+
     Parameters
     ----------
-    n1 : int
-        Maximum size of the first tree (000: 3500).
-    q : float
-        Size ratio between consecutive trees, > 1 (000: 5.5).
-    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
-        Search in each tree (:data:`TREE_KINDS`).
-    leaf_size : int
+    n1 : int, optional
+        Maximum size of the first tree (default from ``params``: 3500, 000 §4.1.2).
+    q : float, optional
+        Size ratio between consecutive trees, > 1 (default from ``params``: 5.5, 000 §4.1.2).
+    params : StoreParams, optional
+        The settings (default :class:`StoreParams`); the arguments that are not None change its fields.
+    tree : {'bbf', 'exact', 'ckdtree', 'brute'}, optional
+        Search in each tree (:data:`~slamlab.kdtree.store_params.TREE_KINDS`).
+    leaf_size : int, optional
         Points per leaf of our trees.
-    checks : int
-        Leaf budget of the BBF search.
+    checks : int, optional
+        Points examined per tree by the BBF search.
 
     Examples
     --------
@@ -111,17 +114,15 @@ class MultiKDTree(LandmarkStore):
 
     name = "multi kd-tree"
 
-    def __init__(self, n1: int = 3500, q: float = 5.5, *, tree: str = "bbf", leaf_size: int = 8,
-                 checks: int = 200):
+    def __init__(self, n1: int | None = None, q: float | None = None, *, params: StoreParams | None = None,
+                 tree: str | None = None, leaf_size: int | None = None, checks: int | None = None):
         super().__init__()
-        self.n1 = v.check_int(n1, "n1", minimum=1)
-        self.q = v.check_positive(q, "q")
-        if self.q <= 1:
-            raise ValueError(f"`q` must be > 1; got {q}")
-        self.tree_kind, self.leaf_size, self.checks = _check_tree_args(tree, leaf_size, checks)
+        self.params = p = resolve_store_params(params, n1=n1, q=q, tree=tree, leaf_size=leaf_size, checks=checks)
+        self.n1, self.q = int(p.n1), float(p.q)
+        self.tree_kind, self.leaf_size, self.checks = p.tree, p.leaf_size, p.checks
         self._X: list[np.ndarray] = []
         self._ids: list[np.ndarray] = []
-        self._trees: list[_Tree | None] = []
+        self._trees: list[StaticTree | None] = []
 
     def max_size(self, i: int) -> int:
         """``MAX_SIZE[i] = floor(n1 q^i)`` (tree index from 0).
@@ -135,7 +136,7 @@ class MultiKDTree(LandmarkStore):
         -------
         int
         """
-        return int(np.floor(self.n1 * self.q ** i + 1e-9))
+        return _max_size(self.n1, self.q, i)
 
     @property
     def max_sizes(self) -> list[int]:
@@ -174,7 +175,7 @@ class MultiKDTree(LandmarkStore):
             self._ensure(len(self._X))
         for j in changed:  # rebuild only the trees whose contents changed
             if self._X[j].shape[0]:
-                self._trees[j] = _Tree(self._X[j], self._ids[j], self.tree_kind, self.leaf_size, self.checks)
+                self._trees[j] = StaticTree(self._X[j], self._ids[j], self.params)
                 self.counters.points_rebuilt += self._X[j].shape[0]
                 self.counters.trees_built += 1
             else:
@@ -222,21 +223,25 @@ class NonBaseBuffer(LandmarkStore):
     point base at once (Table 2). Queries search buffer and base and merge the
     k-NN lists (our choice: 000 does not say how the 2-NN rule is merged).
 
+    The buffer reads ``base_seen_times``, ``max_non_base_time``, ``tree``, ``leaf_size`` and ``checks`` of
+    its :class:`StoreParams`; the default base is a :class:`MultiKDTree` of the same settings.
+
     Parameters
     ----------
     base : LandmarkStore, optional
-        Insert-only store for the base points (default a :class:`MultiKDTree` with ``tree``,
-        ``leaf_size``, ``checks``).
-    base_seen_times : int
-        Sightings that make a point base (000: 3).
-    max_non_base_time : int
-        Iterations after its first sighting at which a non-base point is dropped (000: 7).
-    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
+        Insert-only store for the base points (default a :class:`MultiKDTree` with the same settings).
+    params : StoreParams, optional
+        The settings (default :class:`StoreParams`); the arguments that are not None change its fields.
+    base_seen_times : int, optional
+        Sightings that make a point base (default from ``params``: 3, 000 §3.4).
+    max_non_base_time : int, optional
+        Iterations after its first sighting at which a non-base point is dropped (default: 7, 000 §3.4).
+    tree : {'bbf', 'exact', 'ckdtree', 'brute'}, optional
         Search in the buffer tree (and the default base).
-    leaf_size : int
+    leaf_size : int, optional
         Points per leaf of our trees.
-    checks : int
-        Leaf budget of the BBF search.
+    checks : int, optional
+        Points examined per tree by the BBF search.
 
     Examples
     --------
@@ -252,20 +257,22 @@ class NonBaseBuffer(LandmarkStore):
     name = "buffer + multi kd-tree"
     insert_only = False
 
-    def __init__(self, base: LandmarkStore | None = None, *, base_seen_times: int = 3, max_non_base_time: int = 7,
-                 tree: str = "bbf", leaf_size: int = 8, checks: int = 200):
+    def __init__(self, base: LandmarkStore | None = None, *, params: StoreParams | None = None,
+                 base_seen_times: int | None = None, max_non_base_time: int | None = None, tree: str | None = None,
+                 leaf_size: int | None = None, checks: int | None = None):
         super().__init__()
+        self.params = p = resolve_store_params(params, base_seen_times=base_seen_times,
+                                               max_non_base_time=max_non_base_time, tree=tree, leaf_size=leaf_size,
+                                               checks=checks)
         if base is None:
-            base = MultiKDTree(tree=tree, leaf_size=leaf_size, checks=checks)
+            base = MultiKDTree(params=p)
         if not isinstance(base, LandmarkStore):
             raise TypeError(f"`base` must be a LandmarkStore; got {type(base).__name__}")
         self.base = base
-        self.tree_kind, self.leaf_size, self.checks = _check_tree_args(tree, leaf_size, checks)
-        bst = v.check_int(base_seen_times, "base_seen_times", minimum=1)
-        mnt = v.check_int(max_non_base_time, "max_non_base_time", minimum=1)
-        self._book = SightingBook(bst, mnt)
-        self._pts = _PointSet()
-        self._tree: _Tree | None = None
+        self.tree_kind, self.leaf_size, self.checks = p.tree, p.leaf_size, p.checks
+        self._book = SightingBook(p.base_seen_times, p.max_non_base_time)
+        self._pts = PointSet()
+        self._tree: StaticTree | None = None
         self.n_promoted = 0
         self.n_dropped = 0
 
@@ -277,15 +284,8 @@ class NonBaseBuffer(LandmarkStore):
         self._pts.append(X, ids)
         self._book.add(ids)
 
-    def observe(self, ids):
-        """Record re-sightings of buffered ids (they count towards ``base_seen_times``).
-
-        Parameters
-        ----------
-        ids : (K,) int
-            Ids seen again this iteration (ids not in the buffer are ignored).
-        """
-        self._book.observe(_as_ids(ids, "ids"))
+    def _observe(self, ids):
+        self._book.observe(ids)  # re-sightings of buffered ids count towards base_seen_times
 
     def end_iteration(self):
         promoted, dropped = self._book.step()
@@ -300,8 +300,7 @@ class NonBaseBuffer(LandmarkStore):
         self.base.end_iteration()
         # the buffer tree is rebuilt every iteration
         if self._pts.n:
-            self._tree = _Tree(self._pts.points.copy(), self._pts.point_ids.copy(), self.tree_kind, self.leaf_size,
-                               self.checks)
+            self._tree = StaticTree(self._pts.points.copy(), self._pts.point_ids.copy(), self.params)
             self.counters.points_rebuilt += self._pts.n
             self.counters.trees_built += 1
         else:
@@ -315,15 +314,14 @@ class NonBaseBuffer(LandmarkStore):
         parts = []
         if self._pts.n:
             if self._tree is None or self._tree.n != self._pts.n:
-                self._tree = _Tree(self._pts.points.copy(), self._pts.point_ids.copy(), self.tree_kind,
-                                   self.leaf_size, self.checks)
+                self._tree = StaticTree(self._pts.points.copy(), self._pts.point_ids.copy(), self.params)
             parts.append(self._tree.query(Q, k, self.counters))
         if len(self.base):
             parts.append(self.base.query(Q, k))
         return merge_knn([p[0] for p in parts], [p[1] for p in parts], k)
 
     def _stored(self):
-        X, ids = self.base._stored()
+        X, ids = self.base.stored()
         if not self._pts.n:
             return X, ids
         if not len(self.base):  # an empty base does not know the points' width yet: (0, 0)

@@ -66,7 +66,7 @@ def plot_kdtree_2d(tree, *, query=None, events=None, ax=None, max_depth: int | N
                     continue
                 order += 1
                 for i in range(t["start"][node], t["stop"][node]):
-                    p = tree._P[i]
+                    p = tree.leaf_points[i]
                     ax.annotate(str(order), (p[0], p[1]), textcoords="offset points", xytext=(3, 3), fontsize=8,
                                 color="tab:red")
     ax.set_xlim(lo0[0], hi0[0])

@@ -1,9 +1,9 @@
-"""The landmark store interface, the base rule and the machinery every store shares (000 §3.4, §4).
+"""The landmark store interface, the base rule and the counts every store keeps (000 §3.4, §4).
 
 :class:`LandmarkStore` (the interface every store implements), :func:`base_rule` and :class:`SightingBook`
-(000 §3.4's rule, kept per point), :class:`StoreCounters` (the operation counts), and the private tree and point
-set the stores build on. The stores themselves are in :mod:`slamlab.kdtree.stores` (which re-exports these names)
-and :mod:`slamlab.kdtree.multi`.
+(000 §3.4's rule, kept per point) and :class:`StoreCounters` (the operation counts). The stores themselves are in
+:mod:`slamlab.kdtree.stores` (which re-exports these names) and :mod:`slamlab.kdtree.multi`; their settings in
+:mod:`slamlab.kdtree.store_params`.
 """
 
 from __future__ import annotations
@@ -12,15 +12,11 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass, fields
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from .. import _validate as v
-from .knn import augment_rows, exact_knn, pad_knn
-from .tree import KDTree
+from .._validate import as_finite_array, check_int
+from .knn import exact_knn, pad_knn
 
-__all__ = ["TREE_KINDS", "LandmarkStore", "SightingBook", "StoreCounters", "base_rule"]
-
-TREE_KINDS = ("bbf", "exact", "ckdtree", "brute")
+__all__ = ["LandmarkStore", "SightingBook", "StoreCounters", "base_rule"]
 
 
 @dataclass
@@ -191,7 +187,7 @@ def _as_points(X, name, dim=None, dtype=None, binary_ok=False):
         if X.dtype == np.uint8 and X.ndim == 2 and not binary_ok:
             raise TypeError(f"`{name}`: binary (uint8) descriptors need an exact store (ExactStore, "
                             "BruteForceStore); a kd-tree compares float descriptors")
-        X = v.as_finite_array(X, name, ndim=2, dtype=np.float32)
+        X = as_finite_array(X, name, ndim=2, dtype=np.float32)
     if dim is not None and X.shape[1] != dim:
         raise ValueError(f"`{name}` must have shape (N, {dim}) to match the store; got shape {X.shape}")
     return X
@@ -209,44 +205,11 @@ def _as_ids(ids, name, n=None):
     return ids.astype(np.int64)
 
 
-class _Tree:
-    """Thin adapter: one static tree of the chosen kind with a uniform ``query`` (our addition)."""
-
-    def __init__(self, X, ids, kind, leaf_size, checks):
-        self.n = X.shape[0]
-        self.kind = kind
-        self.ids = ids
-        if kind == "ckdtree":
-            self._t = cKDTree(X, leafsize=leaf_size, balanced_tree=True, compact_nodes=False)
-        elif kind == "brute":
-            self._t = X
-        else:
-            self._t = KDTree(X, ids, leaf_size=leaf_size)
-        self.max_leaves = None if kind != "bbf" else max(1, -(-checks // leaf_size))
-
-    def query(self, Q, k, counters):
-        counters.trees_searched += 1
-        if self.kind == "ckdtree":
-            kk = min(k, self.n)
-            d, i = self._t.query(Q, kk)
-            d, i = d.reshape(Q.shape[0], kk), i.reshape(Q.shape[0], kk)
-            out_i = np.where(np.isfinite(d), self.ids[np.minimum(i, self.n - 1)], -1)
-            return pad_knn(d, out_i, k)
-        if self.kind == "brute":
-            counters.distance_evals += Q.shape[0] * self.n
-            return exact_knn(Q, self._t, k, self.ids)
-        d, i = self._t.query(Q, k, max_leaves=self.max_leaves)
-        st = self._t.last_stats
-        counters.nodes_visited += int(st.nodes_visited.sum())
-        counters.distance_evals += int(st.distance_evals.sum())
-        return d, i
-
-
 class LandmarkStore(ABC):
     """The landmark-store interface (000 §3.4): every store, and the stereo pipeline's, derives from it.
 
     Subclasses implement ``_add(X, ids)`` (checked batch), ``_query(Q, k)`` (checked, non-empty),
-    ``_stored() -> (X, ids)`` (every stored point) and ``__len__``; ``observe`` and
+    ``_stored() -> (X, ids)`` (every stored point) and ``__len__``; ``_observe(ids)`` (checked ids) and
     ``end_iteration`` do nothing unless the store applies the base rule or rebuilds.
     ``query_among`` is exact (brute force over the selected points) for every store.
     """
@@ -283,9 +246,9 @@ class LandmarkStore(ABC):
         Parameters
         ----------
         ids : (K,) int
-            Ids seen again.
+            Ids seen again (ids the store does not hold are ignored).
         """
-        _as_ids(ids, "ids")
+        self._observe(_as_ids(ids, "ids"))
 
     def end_iteration(self) -> None:  # noqa: B027 (a no-op unless the store rebuilds or applies the base rule)
         """Close an iteration (apply the base rule, rebuild what the store rebuilds)."""
@@ -332,10 +295,22 @@ class LandmarkStore(ABC):
         """
         Q, k = self._check_query(Q, k)
         among = _as_ids(np.asarray(among).ravel(), "among")
-        X, ids = self._stored()
+        X, ids = self.stored()
         rows = np.isin(ids, among)
         self.counters.distance_evals += Q.shape[0] * int(rows.sum())
         return exact_knn(Q, X[rows], k, ids[rows])
+
+    def stored(self):
+        """Every stored point and its id, buffer and base alike, in the store's own order (ours).
+
+        Returns
+        -------
+        X : (n, d) array
+            The stored points.
+        ids : (n,) int64
+            Their ids.
+        """
+        return self._stored()
 
     @abstractmethod
     def __len__(self) -> int:
@@ -357,6 +332,9 @@ class LandmarkStore(ABC):
     def _stored(self):
         """``(X (n, d), ids (n,))``: every stored point."""
 
+    def _observe(self, ids) -> None:  # noqa: B027 (a no-op unless the store applies the base rule)
+        """Record re-sightings of checked ``ids (K,) int64``."""
+
     # -- helpers -----------------------------------------------------------------------------------
     def _check_batch(self, X, ids):
         X = _as_points(X, "X", self.dim, self.dtype, self.binary_ok)
@@ -367,75 +345,6 @@ class LandmarkStore(ABC):
 
     def _check_query(self, Q, k):
         Q = _as_points(Q, "Q", self.dim, self.dtype, self.binary_ok)
-        k = v.check_int(k, "k", minimum=1)
+        k = check_int(k, "k", minimum=1)
         self.counters.queries += Q.shape[0]
         return Q, k
-
-
-def _check_tree_args(tree, leaf_size, checks):
-    tree = v.check_choice(tree, "tree", TREE_KINDS)
-    leaf_size = v.check_int(leaf_size, "leaf_size", minimum=1)
-    checks = v.check_int(checks, "checks", minimum=1)
-    return tree, leaf_size, checks
-
-
-class _PointSet:
-    """Points + ids in a growing buffer (capacity doubling; no per-add copy of everything)."""
-
-    def __init__(self):
-        self.X = np.empty((0, 0), dtype=np.float32)
-        self.ids = np.empty(0, dtype=np.int64)
-        self.n = 0
-        self._aug = None  # float rows [x, |x|²/2] for the exact search, rows [0, _aug_n) valid
-        self._aug_n = 0
-
-    def append(self, X, ids):
-        need = self.n + X.shape[0]
-        if self.X.shape[0] < need or self.X.shape[1] != X.shape[1] or self.X.dtype != X.dtype:
-            cap = max(need, 2 * self.X.shape[0], 1024)
-            Xn = np.empty((cap, X.shape[1]), dtype=X.dtype)
-            In = np.empty(cap, dtype=np.int64)
-            if self.n:
-                Xn[:self.n], In[:self.n] = self.X[:self.n], self.ids[:self.n]
-            self.X, self.ids = Xn, In
-        self.X[self.n:need], self.ids[self.n:need] = X, ids
-        self.n = need
-
-    def keep(self, mask):
-        k = int(mask.sum())
-        if self._aug is not None and self._aug_n == self.n:
-            self._aug[:k] = self._aug[:self.n][mask]
-            self._aug_n = k
-        else:
-            self._aug_n = 0
-        self.X[:k], self.ids[:k] = self.X[:self.n][mask], self.ids[:self.n][mask]
-        self.n = k
-
-    @property
-    def augmented(self):
-        """``augment_rows(points)`` (float points only), extended by the rows added since the last call.
-
-        Kept between queries (issue 17): rebuilding it for every query of 65000 points cost a
-        quarter of the GEMM it feeds.
-        """
-        if self.X.dtype == np.uint8:
-            return None
-        if self._aug is None or self._aug.shape != (self.X.shape[0], self.X.shape[1] + 1):
-            old, old_n = self._aug, self._aug_n
-            self._aug = np.empty((self.X.shape[0], self.X.shape[1] + 1), dtype=np.float32)
-            self._aug_n = 0
-            if old is not None and old.shape[1] == self._aug.shape[1] and old_n:
-                self._aug[:old_n] = old[:old_n]
-                self._aug_n = old_n
-        if self._aug_n < self.n:
-            augment_rows(self.X[self._aug_n:self.n], out=self._aug[self._aug_n:self.n])
-            self._aug_n = self.n
-        return self._aug[:self.n]
-
-    @property
-    def points(self):
-        return self.X[:self.n]
-
-    @property
-    def point_ids(self):
-        return self.ids[:self.n]

@@ -18,6 +18,10 @@ after ``BaseSeenTimes = 3`` sightings; a non-base point first seen
 ``MaxNonBaseTime = 7`` iterations ago is dropped), kept per point by
 :class:`SightingBook`; every store and the stereo pipeline use them.
 
+Every store takes its settings from one :class:`~slamlab.kdtree.store_params.StoreParams` (``params=``; the
+keyword arguments a store names change its fields): the base rule, the multi kd-tree's ``n1, q`` and the
+trees' ``tree``, ``leaf_size``, ``checks``, each with one default and its source.
+
 Stores of 000: :class:`RebuildStore` (first method: one static tree rebuilt every
 iteration from kept + new points) and :class:`MultiKDTree` (second method: trees
 of maximum sizes ``n1, q n1, q^2 n1, ...``) behind a :class:`NonBaseBuffer`.
@@ -39,20 +43,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_choice, check_int
+from ._store_parts import PointSet, StaticTree
 from .knn import exact_knn, flann_index, merge_knn, pad_knn
 from .multi import MultiKDTree, NonBaseBuffer, multi_tree_sizes
-from .store_base import (
-    TREE_KINDS,
-    LandmarkStore,
-    SightingBook,
-    StoreCounters,
-    _as_ids,
-    _check_tree_args,
-    _PointSet,
-    _Tree,
-    base_rule,
-)
+from .store_base import LandmarkStore, SightingBook, StoreCounters, base_rule
+from .store_params import TREE_KINDS, StoreParams, resolve_store_params
 
 __all__ = [
     "STORE_NAMES",
@@ -66,6 +62,7 @@ __all__ = [
     "RebuildStore",
     "SightingBook",
     "StoreCounters",
+    "StoreParams",
     "base_rule",
     "make_store",
     "merge_knn",
@@ -78,12 +75,12 @@ class _BaseRuleStore(LandmarkStore):
 
     insert_only = False
 
-    def __init__(self, base_seen_times: int, max_non_base_time: int):
+    def __init__(self, params: StoreParams):
         super().__init__()
-        bst = v.check_int(base_seen_times, "base_seen_times", minimum=1)
-        mnt = v.check_int(max_non_base_time, "max_non_base_time", minimum=1)
-        self._pts = _PointSet()
-        self._book = SightingBook(bst, mnt) if bst > 1 else None
+        self.params = params
+        self._pts = PointSet()
+        self._book = (SightingBook(params.base_seen_times, params.max_non_base_time)
+                      if params.base_seen_times > 1 else None)
         self._dirty = False
         self.dropped_ids = np.empty(0, dtype=np.int64)  # ids that timed out at the last end_iteration
 
@@ -93,8 +90,7 @@ class _BaseRuleStore(LandmarkStore):
             self._book.add(ids)
         self._dirty = True
 
-    def observe(self, ids):
-        ids = _as_ids(ids, "ids")
+    def _observe(self, ids):
         if self._book is not None:
             self._book.observe(ids)
 
@@ -123,21 +119,24 @@ class _BaseRuleStore(LandmarkStore):
 class RebuildStore(_BaseRuleStore):
     """000's first method: one static tree rebuilt every iteration from kept + new points (000 §3.4).
 
-    With ``base_seen_times > 1`` the store applies the base rule itself and drops
-    non-base points that time out (Table 1 scenario), so it holds the same points
-    as :class:`NonBaseBuffer` + :class:`MultiKDTree`.
+    With ``base_seen_times > 1`` (the default, 000 §3.4) the store applies the base rule itself and
+    drops non-base points that time out (Table 1 scenario), so it holds the same points as
+    :class:`NonBaseBuffer` + :class:`MultiKDTree`; ``base_seen_times=1`` keeps every point (Table 2).
+    The store reads ``tree``, ``leaf_size``, ``checks`` and the base rule of its :class:`StoreParams`.
 
     Parameters
     ----------
-    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
+    params : StoreParams, optional
+        The settings (default :class:`StoreParams`); the arguments that are not None change its fields.
+    tree : {'bbf', 'exact', 'ckdtree', 'brute'}, optional
         Search in the tree (:data:`TREE_KINDS`).
-    leaf_size : int
+    leaf_size : int, optional
         Points per leaf of our trees.
-    checks : int
-        Leaf budget of the BBF search.
-    base_seen_times : int
+    checks : int, optional
+        Points examined by the BBF search.
+    base_seen_times : int, optional
         Sightings that make a point base; 1 keeps every point.
-    max_non_base_time : int
+    max_non_base_time : int, optional
         Age in iterations at which a non-base point is dropped.
 
     Examples
@@ -151,11 +150,13 @@ class RebuildStore(_BaseRuleStore):
 
     name = "kd-tree (rebuild)"
 
-    def __init__(self, *, tree: str = "bbf", leaf_size: int = 8, checks: int = 200, base_seen_times: int = 1,
-                 max_non_base_time: int = 7):
-        super().__init__(base_seen_times, max_non_base_time)
-        self.tree_kind, self.leaf_size, self.checks = _check_tree_args(tree, leaf_size, checks)
-        self._tree: _Tree | None = None
+    def __init__(self, *, params: StoreParams | None = None, tree: str | None = None, leaf_size: int | None = None,
+                 checks: int | None = None, base_seen_times: int | None = None,
+                 max_non_base_time: int | None = None):
+        super().__init__(resolve_store_params(params, tree=tree, leaf_size=leaf_size, checks=checks,
+                                              base_seen_times=base_seen_times, max_non_base_time=max_non_base_time))
+        self.tree_kind, self.leaf_size, self.checks = self.params.tree, self.params.leaf_size, self.params.checks
+        self._tree: StaticTree | None = None
 
     def end_iteration(self):
         super().end_iteration()
@@ -167,8 +168,7 @@ class RebuildStore(_BaseRuleStore):
         if self._pts.n == 0:
             self._tree = None
             return
-        self._tree = _Tree(self._pts.points.copy(), self._pts.point_ids.copy(), self.tree_kind, self.leaf_size,
-                           self.checks)
+        self._tree = StaticTree(self._pts.points.copy(), self._pts.point_ids.copy(), self.params)
         self.counters.points_rebuilt += self._pts.n
         self.counters.trees_built += 1
 
@@ -184,14 +184,17 @@ class ExactStore(_BaseRuleStore):
     Hamming distance for binary ``uint8`` descriptors (ORB: a kd-tree does not apply),
     Euclidean for float ones, by :func:`~slamlab.kdtree.knn.exact_knn`. Non-base points
     first seen ``max_non_base_time`` iterations ago are dropped (``dropped_ids``);
-    ``base_seen_times = 1`` keeps every point (:class:`BruteForceStore`).
+    ``base_seen_times = 1`` keeps every point (:class:`BruteForceStore`). The store reads the base
+    rule of its :class:`StoreParams`.
 
     Parameters
     ----------
-    base_seen_times : int
-        Sightings that make a point base (000: 3).
-    max_non_base_time : int
-        Age in iterations at which a non-base point is dropped (000: 7).
+    base_seen_times : int, optional
+        Sightings that make a point base (default from ``params``: 3, 000 §3.4).
+    max_non_base_time : int, optional
+        Age in iterations at which a non-base point is dropped (default from ``params``: 7, 000 §3.4).
+    params : StoreParams, optional
+        The settings (default :class:`StoreParams`); the arguments that are not None change its fields.
 
     Examples
     --------
@@ -204,8 +207,10 @@ class ExactStore(_BaseRuleStore):
     name = "exact (brute force)"
     binary_ok = True
 
-    def __init__(self, base_seen_times: int = 3, max_non_base_time: int = 7):
-        super().__init__(base_seen_times, max_non_base_time)
+    def __init__(self, base_seen_times: int | None = None, max_non_base_time: int | None = None, *,
+                 params: StoreParams | None = None):
+        super().__init__(resolve_store_params(params, base_seen_times=base_seen_times,
+                                              max_non_base_time=max_non_base_time))
 
     @property
     def is_base(self) -> np.ndarray:
@@ -221,8 +226,12 @@ class ExactStore(_BaseRuleStore):
 
 
 class BruteForceStore(ExactStore):
-    """Exact search by brute force, every point kept (no base rule; the reference of Tables 1-2).
+    """Exact search by brute force, every point kept (no base rule; the reference of Tables 1-2; ours).
 
+    An :class:`ExactStore` with ``base_seen_times=1``, said here rather than by a default.
+
+    Examples
+    --------
     >>> rng = np.random.default_rng(0)
     >>> s = BruteForceStore()
     >>> X = rng.random((100, 8)); s.add(X, np.arange(100))
@@ -234,7 +243,7 @@ class BruteForceStore(ExactStore):
     insert_only = True
 
     def __init__(self):
-        super().__init__(base_seen_times=1)
+        super().__init__(base_seen_times=1)  # every point kept: the exact reference
 
 
 class FlannStore(LandmarkStore):
@@ -246,12 +255,17 @@ class FlannStore(LandmarkStore):
     global RNG; ``opencv_seed`` (not None) reseeds it with ``cv2.setRNGSeed`` before each
     build so that runs repeat (a side effect on OpenCV's global RNG).
 
+    The store reads ``checks`` of its :class:`StoreParams` (an insert-only store: the base rule is the
+    buffer's, :class:`NonBaseBuffer`).
+
     Parameters
     ----------
+    params : StoreParams, optional
+        The settings (default :class:`StoreParams`); ``checks`` changes its field.
+    checks : int, optional
+        Leaves checked per query (default from ``params``: 200).
     trees : int
-        Randomised kd-trees in the index.
-    checks : int
-        Leaves checked per query.
+        Randomised kd-trees in the index (ours: OpenCV's default 4).
     opencv_seed : int or None
         Seed of OpenCV's global RNG (``cv2.setRNGSeed``, not a numpy stream) before each build
         (None: not reseeded).
@@ -259,12 +273,14 @@ class FlannStore(LandmarkStore):
 
     name = "FLANN (OpenCV)"
 
-    def __init__(self, *, trees: int = 4, checks: int = 200, opencv_seed: int | None = 0):
+    def __init__(self, *, params: StoreParams | None = None, checks: int | None = None, trees: int = 4,
+                 opencv_seed: int | None = 0):
         super().__init__()
-        self.opencv_seed = None if opencv_seed is None else v.check_int(opencv_seed, "opencv_seed", minimum=0)
-        self.trees = v.check_int(trees, "trees", minimum=1)
-        self.checks = v.check_int(checks, "checks", minimum=1)
-        self._pts = _PointSet()
+        self.params = resolve_store_params(params, checks=checks)
+        self.opencv_seed = None if opencv_seed is None else check_int(opencv_seed, "opencv_seed", minimum=0)
+        self.trees = check_int(trees, "trees", minimum=1)
+        self.checks = self.params.checks
+        self._pts = PointSet()
         self._index = None
         self._dirty = False
 
@@ -305,28 +321,24 @@ class FlannStore(LandmarkStore):
 STORE_NAMES = ("rebuild", "multi", "flann", "brute")
 
 
-def make_store(name: str, *, n1: int = 3500, q: float = 5.5, base_seen_times: int = 1, max_non_base_time: int = 7,
-               tree: str = "bbf", leaf_size: int = 8, checks: int = 200) -> LandmarkStore:
+def make_store(name: str, *, params: StoreParams | None = None, **overrides) -> LandmarkStore:
     """A store by short name, with the base rule applied the same way for all (000 §3.4).
 
     ``"rebuild"`` -- :class:`RebuildStore` (it applies the base rule itself);
     ``"multi"``, ``"flann"``, ``"brute"`` -- :class:`MultiKDTree`,
-    :class:`FlannStore`, :class:`BruteForceStore` behind a :class:`NonBaseBuffer`.
+    :class:`FlannStore`, :class:`BruteForceStore` behind a :class:`NonBaseBuffer`. The settings are
+    resolved once, ``StoreParams.resolve(params, **overrides)``, and given to every part (the buffer in
+    front of ``"brute"`` is searched by brute force whatever ``tree`` says).
 
     Parameters
     ----------
     name : {'rebuild', 'multi', 'flann', 'brute'}
         The store (:data:`STORE_NAMES`).
-    n1, q : int, float
-        Multi kd-tree sizes (``"multi"`` only).
-    base_seen_times, max_non_base_time : int
-        000 §3.4's base rule (:func:`base_rule`).
-    tree : {'bbf', 'exact', 'ckdtree', 'brute'}
-        Search in our trees (the buffer of ``"brute"`` is always brute force).
-    leaf_size : int
-        Points per leaf of our trees.
-    checks : int
-        BBF leaf budget, and FLANN's checks.
+    params : StoreParams, optional
+        The settings (default :class:`StoreParams`: 000's base rule 3 / 7, ``n1 = 3500``, ``q = 5.5``).
+    **overrides
+        :class:`StoreParams` fields to change (``base_seen_times``, ``max_non_base_time``, ``n1``, ``q``,
+        ``tree``, ``leaf_size``, ``checks``).
 
     Returns
     -------
@@ -337,19 +349,19 @@ def make_store(name: str, *, n1: int = 3500, q: float = 5.5, base_seen_times: in
     --------
     >>> make_store("multi", n1=1000, q=4).base
     MultiKDTree(n1=1000, q=4.0, sizes=[])
+    >>> make_store("brute", base_seen_times=1).params.base_seen_times
+    1
     """
-    name = v.check_choice(name, "name", STORE_NAMES)
+    name = check_choice(name, "name", STORE_NAMES)
+    p = StoreParams.resolve(params, **overrides)
     if name == "rebuild":
-        return RebuildStore(tree=tree, leaf_size=leaf_size, checks=checks, base_seen_times=base_seen_times,
-                            max_non_base_time=max_non_base_time)
+        return RebuildStore(params=p)
     if name == "multi":
-        base = MultiKDTree(n1, q, tree=tree, leaf_size=leaf_size, checks=checks)
+        base = MultiKDTree(params=p)
     elif name == "flann":
-        base = FlannStore(checks=checks)
+        base = FlannStore(params=p)
     else:
         base = BruteForceStore()
-    buf = NonBaseBuffer(base, base_seen_times=base_seen_times, max_non_base_time=max_non_base_time,
-                        tree="brute" if name == "brute" else tree,
-                        leaf_size=leaf_size, checks=checks)
+    buf = NonBaseBuffer(base, params=p.replace(tree="brute") if name == "brute" else p)
     buf.name = {"multi": "buffer + multi kd-tree", "flann": "buffer + FLANN", "brute": "buffer + brute force"}[name]
     return buf

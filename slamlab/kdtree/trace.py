@@ -6,8 +6,8 @@ import heapq
 
 import numpy as np
 
-from .. import _validate as v
-from ._bounds import BBF_BOUNDS, _cell_bounds
+from .._validate import as_vector, check_int
+from ._bounds import BBF_BOUNDS, cell_bounds
 from .tree import KDTree
 
 __all__ = ["bbf_trace"]
@@ -50,16 +50,16 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None, bou
     """
     if not isinstance(tree, KDTree):
         raise TypeError(f"`tree` must be a KDTree; got {type(tree).__name__}")
-    q = v.as_vector(q, "q", tree.dim)
-    k = v.check_int(k, "k", minimum=1)
+    q = as_vector(q, "q", tree.dim)
+    k = check_int(k, "k", minimum=1)
     if max_leaves is not None:
-        max_leaves = v.check_int(max_leaves, "max_leaves", minimum=1)
+        max_leaves = check_int(max_leaves, "max_leaves", minimum=1)
     if bound not in BBF_BOUNDS:
         raise ValueError(f"`bound` must be one of {BBF_BOUNDS}; got {bound!r}")
     bound_rule = bound  # `bound` below is the popped branch's bound
     t = tree.nodes
     if bound == "incremental" and "cell_lo" not in t:
-        t["cell_lo"], t["cell_hi"] = _cell_bounds(t)
+        t["cell_lo"], t["cell_hi"] = cell_bounds(t)
     best: list[tuple[float, int]] = []  # (d2, leaf-order index), sorted
     heap = [(0.0, 0)]
     events = []
@@ -89,12 +89,12 @@ def bbf_trace(tree: KDTree, q, *, k: int = 2, max_leaves: int | None = None, bou
                 events.append(("push", int(far), float(fb)))
             node = near
         pts = np.arange(t["start"][node], t["stop"][node])
-        d2 = ((tree._P[pts].astype(np.float64) - q) ** 2).sum(axis=1)
+        d2 = ((tree.leaf_points[pts].astype(np.float64) - q) ** 2).sum(axis=1)
         best = sorted(best + list(zip(d2.tolist(), pts.tolist(), strict=True)))[:k]
         leaves += 1
         events.append(("leaf", int(node), float(min(d2))))
         if max_leaves is not None and leaves >= max_leaves:
             break
     dist = np.array([np.sqrt(b[0]) for b in best] + [np.inf] * (k - len(best)))
-    ids = np.array([tree._ids_leaf[b[1]] for b in best] + [-1] * (k - len(best)), dtype=np.int64)
+    ids = np.array([tree.leaf_ids[b[1]] for b in best] + [-1] * (k - len(best)), dtype=np.int64)
     return dist, ids, events

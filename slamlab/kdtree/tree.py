@@ -35,9 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
 from .._compiled import numba_enabled
-from ._bounds import BBF_BOUNDS, _cell_bounds, _far_bound
+from .._validate import as_finite_array, check_int
+from ._bounds import BBF_BOUNDS, cell_bounds, far_bound
 from .build import SPLIT_RULES, build_kdtree
 
 __all__ = ["BBF_BOUNDS", "SPLIT_RULES", "KDTree", "SearchStats", "build_kdtree"]
@@ -144,6 +144,16 @@ class KDTree:
         """The node arrays (see :func:`build_kdtree`); read-only views for teaching and plots."""
         return self._t
 
+    @property
+    def leaf_points(self) -> np.ndarray:
+        """(N, k) the points in leaf order: leaf node ``i``'s bucket is rows ``nodes["start"][i]:nodes["stop"][i]``."""
+        return self._P
+
+    @property
+    def leaf_ids(self) -> np.ndarray:
+        """(N,) the ids of :attr:`leaf_points`, row for row."""
+        return self._ids_leaf
+
     def __len__(self) -> int:
         return self.n
 
@@ -174,19 +184,19 @@ class KDTree:
         ids : (M, k) int array
             Ids of the neighbours (-1 where missing).
         """
-        Q = v.as_finite_array(Q, "Q")
+        Q = as_finite_array(Q, "Q")
         single = Q.ndim == 1
         if single:
             Q = Q[None, :]
         if Q.ndim != 2 or Q.shape[1] != self.dim:
             raise ValueError(f"`Q` must have shape (M, {self.dim}) to match the tree; got shape {Q.shape}")
-        k = v.check_int(k, "k", minimum=1)
+        k = check_int(k, "k", minimum=1)
         if max_leaves is not None:
-            max_leaves = v.check_int(max_leaves, "max_leaves", minimum=1)
+            max_leaves = check_int(max_leaves, "max_leaves", minimum=1)
         if bound not in BBF_BOUNDS:
             raise ValueError(f"`bound` must be one of {BBF_BOUNDS}; got {bound!r}")
         if bound == "incremental" and "cell_lo" not in self._t:
-            self._t["cell_lo"], self._t["cell_hi"] = _cell_bounds(self._t)
+            self._t["cell_lo"], self._t["cell_hi"] = cell_bounds(self._t)
         Q = Q.astype(self._P.dtype, copy=False)
         if numba_enabled():  # the compiled search: the same results as the numpy one (issue 25)
             from ._kernels import bbf_search
@@ -355,9 +365,9 @@ def _lockstep_search(t, P, Q, k, max_leaves, bound="max"):
             # distance to the far half: its nearest value (= split_val unless the tree keeps the gaps)
             diff = np.where(go_left, split_hi[cn] - qd, qd - split_lo[cn])
             if bound == "incremental":
-                fb = _far_bound(bound, cur_b[a], diff, qd, t["cell_lo"][cn], t["cell_hi"][cn])
+                fb = far_bound(bound, cur_b[a], diff, qd, t["cell_lo"][cn], t["cell_hi"][cn])
             else:
-                fb = _far_bound(bound, cur_b[a], diff, None, None, None)
+                fb = far_bound(bound, cur_b[a], diff, None, None, None)
             nodes_v[a] += 1
             cur[a] = near
             keep = fb < best_d[a, k - 1]

@@ -7,7 +7,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft as sfft
 
-from ..correlation import rasterise_scan, score_maps
+from ..correlation import scan_stamps, score_maps
 from ..scans import Scan, scan_to_points
 from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
@@ -46,7 +46,7 @@ def _points_reference(bearings_rad, ranges, valid, pose):
 
 
 def _stamp_reference(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n):
-    T, _ = rasterise_scan(Scan(bearings_rad, ranges, valid), [heading_rad], l_max=l_max, a_c=a_c, a_p=a_p, a_n=a_n)
+    T, _ = scan_stamps(Scan(bearings_rad, ranges, valid), [heading_rad], l_max=l_max, a_c=a_c, a_p=a_p, a_n=a_n)
     return T[0].astype(float)
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_int, check_positive, check_probability
 from ..localisation import LikelihoodFieldModel, low_variance_resample, odometry_deltas, scan_beams
 from ..localisation.models import motion_from_noise
 from ..scans import Scan
@@ -151,7 +151,7 @@ def survivor_fraction(M: int = EXPLORE_M) -> float:
     float
         ``1 - (1 - 1/M)**M`` (each particle is missed by all M draws with probability ``(1 - 1/M)**M``).
     """
-    M = v.check_int(M, "M", minimum=1)
+    M = check_int(M, "M", minimum=1)
     return float(1.0 - (1.0 - 1.0 / M) ** M)
 
 
@@ -168,7 +168,7 @@ def survivor_sd(M: int = EXPLORE_M) -> float:
     float
         From the occupancy problem: Var(distinct) = M (M-1) (1-2/M)^M + M (1-1/M)^M - M² (1-1/M)^{2M}.
     """
-    M = v.check_int(M, "M", minimum=1)
+    M = check_int(M, "M", minimum=1)
     q1, q2 = (1.0 - 1.0 / M) ** M, (1.0 - 2.0 / M) ** M
     var = M * (M - 1) * q2 + M * q1 - (M * q1) ** 2
     return float(np.sqrt(var) / M)
@@ -194,10 +194,10 @@ def warm_up_steps(alpha_slow: float = EXPLORE_ALPHAS[0], alpha_fast: float = EXP
     int
         The number of steady steps T.
     """
-    alpha_slow, alpha_fast = v.check_probability(alpha_slow, "alpha_slow"), v.check_probability(alpha_fast, "alpha_fast")
+    alpha_slow, alpha_fast = check_probability(alpha_slow, "alpha_slow"), check_probability(alpha_fast, "alpha_fast")
     if not alpha_slow < alpha_fast:
         raise ValueError(f"`alpha_slow` must be smaller than `alpha_fast`; got {alpha_slow} and {alpha_fast}")
-    drop = v.check_positive(drop, "drop", allow_zero=True)
+    drop = check_positive(drop, "drop", allow_zero=True)
     if not drop < 1:
         raise ValueError(f"`drop` must be in [0, 1); got {drop}")
 

@@ -6,7 +6,7 @@ import functools
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_rng, check_int, check_positive
 from ..mono import depth_filter as df
 from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
@@ -128,12 +128,12 @@ def half_converged_observations(rates, *, n_seeds: int = 500, n_obs: int = 40, t
     numpy.ndarray, shape (R,)
         The first observation count with at least half of the seeds converged (``n_obs + 1`` if never).
     """
-    rng = v.as_rng(rng)
-    r = v.as_finite_array(rates, "rates", ndim=1)[:, None]
+    rng = as_rng(rng)
+    r = as_finite_array(rates, "rates", ndim=1)[:, None]
     if r.size == 0 or np.any((r < 0) | (r >= 1)):
         raise ValueError(f"`rates` must be outlier rates in [0, 1); got {np.ravel(r)}")
-    n_seeds, n_obs = v.check_int(n_seeds, "n_seeds", minimum=1), v.check_int(n_obs, "n_obs", minimum=1)
-    tau, depth_min_m = v.check_positive(tau, "tau"), v.check_positive(depth_min_m, "depth_min_m")
+    n_seeds, n_obs = check_int(n_seeds, "n_seeds", minimum=1), check_int(n_obs, "n_obs", minimum=1)
+    tau, depth_min_m = check_positive(tau, "tau"), check_positive(depth_min_m, "depth_min_m")
     rho_range = 1.0 / depth_min_m
     rho = rng.uniform(0.2, rho_range, n_seeds)[None, :]
     mu = np.full((r.shape[0], n_seeds), rho.mean())
@@ -178,7 +178,7 @@ def doubling_rate(rng, *, step: float = EXPLORE_RATE_STEP) -> float:
     float
         The rate.
     """
-    step = v.check_positive(step, "step")
+    step = check_positive(step, "step")
     rates = np.round(np.arange(0.0, 0.9 + step / 2, step), 10)
     k = half_converged_observations(rates, rng=rng)
     return float(rates[np.flatnonzero(k >= 2 * k[0])[0]])
@@ -207,8 +207,8 @@ def tau_relative_depth(z_m: float, *, baseline_m: float = EXPLORE_BASELINE_M, f_
     float
         τ / z.
     """
-    z_m, baseline_m, f_px = v.check_positive(z_m, "z_m"), v.check_positive(baseline_m, "baseline_m"), \
-        v.check_positive(f_px, "f_px")
+    z_m, baseline_m, f_px = check_positive(z_m, "z_m"), check_positive(baseline_m, "baseline_m"), \
+        check_positive(f_px, "f_px")
     delta = 2.0 * np.arctan(0.5 / f_px)
     beta = np.arctan2(z_m, baseline_m)
     return float((baseline_m * np.tan(beta + delta) - z_m) / z_m)
@@ -229,7 +229,7 @@ def depth_for_relative_error(rel: float = EXPLORE_REL_ERROR, **kw) -> float:
     float
         The depth, m.
     """
-    rel = v.check_positive(rel, "rel")
+    rel = check_positive(rel, "rel")
     b, f = kw.get("baseline_m", EXPLORE_BASELINE_M), kw.get("f_px", EXPLORE_F_PX)
     lo, hi = 1e-6 * b, 0.999 * b / np.tan(2.0 * np.arctan(0.5 / f))  # beyond hi the pixel's ray never meets the point's
     for _ in range(200):

@@ -3,16 +3,16 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from .. import _validate as v
+from .._validate import check_int, check_positive
+from ..geometry.so3 import so3_exp
 from ..planes import fit_plane_lsq, frame_transforms, intensity_weights, planes_to_body
 from .core import Case, ExplorationTask, Task, WrongAnswer, allclose, register
 
 
 def _pose(rng, scale=3.0):
     T = np.eye(4)
-    T[:3, :3] = Rotation.from_rotvec(rng.normal(0, 0.8, 3)).as_matrix()
+    T[:3, :3] = so3_exp(rng.normal(0, 0.8, 3))
     T[:3, 3] = rng.normal(0, scale, 3)
     return T
 
@@ -38,7 +38,7 @@ def _body_cases(rng):
                                                                 "R": np.eye(3), "t": np.array([2.0, 0, 0])}))
     cases.append(Case("the vehicle turned 90° about z: the wall's normal turns the other way",
                       {"n_m": np.array([[1.0, 0, 0]]), "p_m": np.array([5.0]),
-                       "R": Rotation.from_euler("z", 90, degrees=True).as_matrix(), "t": np.zeros(3)}))
+                       "R": so3_exp([0.0, 0.0, np.pi / 2]), "t": np.zeros(3)}))
     return cases
 
 
@@ -129,8 +129,8 @@ def normal_rms_error_deg(n_points: int = EXPLORE_N_POINTS, noise_m: float = EXPL
     float
         The RMS angle, degrees.
     """
-    n_points = v.check_int(n_points, "n_points", minimum=3)
-    noise_m, side_m = v.check_positive(noise_m, "noise_m", allow_zero=True), v.check_positive(side_m, "side_m")
+    n_points = check_int(n_points, "n_points", minimum=3)
+    noise_m, side_m = check_positive(noise_m, "noise_m", allow_zero=True), check_positive(side_m, "side_m")
     return float(np.degrees(noise_m * np.sqrt(2.0 / (n_points * side_m**2 / 12.0))))
 
 
@@ -151,7 +151,7 @@ def smallest_safe_angle_deg(offset_error_m: float = EXPLORE_OFFSET_ERROR_M,
     float
         The angle, degrees.
     """
-    offset_error_m, limit_m = v.check_positive(offset_error_m, "offset_error_m"), v.check_positive(limit_m, "limit_m")
+    offset_error_m, limit_m = check_positive(offset_error_m, "offset_error_m"), check_positive(limit_m, "limit_m")
     if not offset_error_m < limit_m:
         raise ValueError(f"`offset_error_m` must be smaller than `limit_m`; got {offset_error_m} and {limit_m}")
     return float(np.degrees(np.arcsin(offset_error_m / limit_m)))

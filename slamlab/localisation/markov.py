@@ -28,8 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .. import _validate as v
 from .._params import param
+from .._validate import check_int, check_positive
 from ..geometry import wrap_angle
 from ..scans import FREE
 from .models import Beams, LikelihoodFieldModel, ModelParams, odometry_deltas, scan_beams
@@ -64,10 +64,10 @@ class MarkovParams(ModelParams):
 
     def check(self) -> None:
         super().check()
-        v.check_int(self.resolution, "resolution", minimum=1)
-        v.check_int(self.n_headings, "n_headings", minimum=4)
-        v.check_positive(self.min_blur, "min_blur", allow_zero=True)
-        e = v.check_positive(self.uniform_floor, "uniform_floor", allow_zero=True)
+        check_int(self.resolution, "resolution", minimum=1)
+        check_int(self.n_headings, "n_headings", minimum=4)
+        check_positive(self.min_blur, "min_blur", allow_zero=True)
+        e = check_positive(self.uniform_floor, "uniform_floor", allow_zero=True)
         if e >= 1:
             raise ValueError(f"`uniform_floor` must be in [0, 1); got {e}")
 
@@ -375,8 +375,8 @@ class MarkovGrid:
         p = np.asarray(pose, dtype=float)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise ValueError(f"`pose` must be three finite numbers (x, y, heading); got {pose!r}")
-        sp = v.check_positive(pos_std, "pos_std")
-        st = v.check_positive(heading_std_rad, "heading_std_rad")
+        sp = check_positive(pos_std, "pos_std")
+        st = check_positive(heading_std_rad, "heading_std_rad")
         P = self.cell_poses()
         d2 = ((P[..., 0] - p[0]) ** 2 + (P[..., 1] - p[1]) ** 2) / sp**2 + wrap_angle(P[..., 2] - p[2]) ** 2 / st**2
         b = np.exp(-0.5 * (d2 - d2.min())) * self.free_mask

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng
 from ..geometry import wrap_angle
 from .mcl_params import AVERAGES, MCLParams
 from .models import (
@@ -247,7 +247,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
         raise TypeError(f"`state` must be an MCLState; got {type(state).__name__}")
     if not isinstance(params, MCLParams):
         raise TypeError(f"`params` must be MCLParams; got {type(params).__name__}")
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     X = check_particles(state.particles, "state.particles")
     beams = scan if isinstance(scan, Beams) else scan_beams(scan, params.max_beams)
     # PR Table 8.2 line 4: x[m] ~ p(x | u, x[m])
@@ -286,7 +286,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     weighted = (X, w)
     mean, cov = pose_estimate(X, w) if params.estimate == "mean" else best_cluster_estimate(X, w, params.kld_bin)
     neff = n_eff(w)
-    M = X.shape[0]
+    M = X.shape[0]  # the set's size, 003 eq 2.11's M (params.n_particles, or fewer after KLD sampling)
     resample = params.resample_threshold >= 1 or neff < params.resample_threshold * M or not ok
     n_inj = 0
     if resample:
@@ -344,18 +344,18 @@ class MCL:
                  init_std=(1.0, 1.0, 0.05), keep_particles: bool = False, **overrides):
         self.params = MCLParams.resolve(params, **overrides)
         self.model = self.params.model(grid, z_max)
-        self.rng = v.as_rng(rng)
+        self.rng = as_rng(rng)
         self.free_xy = free_cell_centres(self.model.grid)
-        M = self.params.n_particles
+        n_particles = self.params.n_particles
         if init_pose is None:
-            X = uniform_free_particles(self.model.grid, M, self.rng, centres=self.free_xy)
+            X = uniform_free_particles(self.model.grid, n_particles, self.rng, centres=self.free_xy)
         else:
             p = check_particles(init_pose, "init_pose")[0]
             sd = np.asarray(init_std, dtype=float)
             if sd.shape != (3,) or np.any(sd < 0) or not np.all(np.isfinite(sd)):
                 raise ValueError(f"`init_std` must be three finite numbers >= 0; got {init_std!r}")
-            X = p + self.rng.standard_normal((M, 3)) * sd
-        self.state = MCLState(X, np.full(M, 1.0 / M))
+            X = p + self.rng.standard_normal((n_particles, 3)) * sd
+        self.state = MCLState(X, np.full(n_particles, 1.0 / n_particles))
         self.records: list[StepRecord] = []
         self._odom_ref = None  # odometry at the last update (update_min_d / update_min_a)
         self.keep_particles = bool(keep_particles)

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
 from .._params import param
+from .._validate import check_choice, check_int, check_positive, check_probability
 from .models import SCORES, LikelihoodFieldModel, ModelParams
 
 __all__ = ["AVERAGES", "ESTIMATES", "MCLParams"]
@@ -108,39 +108,39 @@ class MCLParams(ModelParams):
 
     def check(self) -> None:
         super().check()
-        v.check_int(self.n_particles, "n_particles", minimum=1)
-        v.check_choice(self.score, "score", SCORES)
-        v.check_choice(self.averages, "averages", AVERAGES)
-        v.check_choice(self.estimate, "estimate", ESTIMATES)
-        s = v.check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
-        f = v.check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
+        check_int(self.n_particles, "n_particles", minimum=1)
+        check_choice(self.score, "score", SCORES)
+        check_choice(self.averages, "averages", AVERAGES)
+        check_choice(self.estimate, "estimate", ESTIMATES)
+        s = check_positive(self.alpha_slow, "alpha_slow", allow_zero=True)
+        f = check_positive(self.alpha_fast, "alpha_fast", allow_zero=True)
         if s > 1 or f > 1:
             raise ValueError(f"`alpha_slow` and `alpha_fast` must be in [0, 1]; got {s}, {f}")
         if s > 0 and not f > s:
             raise ValueError(f"`alpha_fast` must be > `alpha_slow` (PR: 0 ≤ α_slow ≪ α_fast); got {f} <= {s}")
-        t = v.check_positive(self.resample_threshold, "resample_threshold", allow_zero=True)
+        t = check_positive(self.resample_threshold, "resample_threshold", allow_zero=True)
         if t > 1:
             raise ValueError(f"`resample_threshold` must be in [0, 1]; got {t}")
         for name in ("use_kld", "beam_skip"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise TypeError(f"`{name}` must be a bool; got {type(getattr(self, name)).__name__}")
-        v.check_positive(self.beam_skip_distance, "beam_skip_distance")
-        v.check_probability(self.beam_skip_threshold, "beam_skip_threshold")
-        v.check_probability(self.beam_skip_error_threshold, "beam_skip_error_threshold")
-        v.check_positive(self.converged_dist, "converged_dist")
+        check_positive(self.beam_skip_distance, "beam_skip_distance")
+        check_probability(self.beam_skip_threshold, "beam_skip_threshold")
+        check_probability(self.beam_skip_error_threshold, "beam_skip_error_threshold")
+        check_positive(self.converged_dist, "converged_dist")
         j = np.asarray(self.jitter, dtype=float) if isinstance(self.jitter, tuple) else np.full(1, np.nan)
         if j.shape != (2,) or not np.all(np.isfinite(j)) or np.any(j < 0):
             raise ValueError(f"`jitter` must be a tuple of two numbers >= 0 (cells, rad); got {self.jitter!r}")
-        v.check_positive(self.update_min_d, "update_min_d", allow_zero=True)
-        v.check_positive(self.update_min_a, "update_min_a", allow_zero=True)
-        v.check_positive(self.kld_epsilon, "kld_epsilon")
-        v.check_probability(self.kld_z, "kld_z")
+        check_positive(self.update_min_d, "update_min_d", allow_zero=True)
+        check_positive(self.update_min_a, "update_min_a", allow_zero=True)
+        check_positive(self.kld_epsilon, "kld_epsilon")
+        check_probability(self.kld_z, "kld_z")
         b = np.asarray(self.kld_bin, dtype=float)
         if b.shape != (3,) or np.any(b <= 0):
             raise ValueError(f"`kld_bin` must be three sizes > 0 (x, y, θ); got {self.kld_bin!r}")
-        v.check_int(self.n_min, "n_min", minimum=1)
-        v.check_positive(self.localised_pos_std, "localised_pos_std")
-        v.check_positive(self.localised_heading_std_rad, "localised_heading_std_rad")
+        check_int(self.n_min, "n_min", minimum=1)
+        check_positive(self.localised_pos_std, "localised_pos_std")
+        check_positive(self.localised_heading_std_rad, "localised_heading_std_rad")
 
     @property
     def injection(self) -> bool:

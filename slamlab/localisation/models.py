@@ -26,11 +26,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import erf
 
-from .. import _validate as v
 from .._params import Params, param
+from .._validate import check_choice, check_int, check_positive
 from ..scans import OBSTACLE, Scan, check_grid, likelihood_field
 from .motion import (  # noqa: F401 (re-exported: moved there unchanged)
-    _check_alpha,
+    check_alpha,
     check_particles,
     motion_density_odometry,
     motion_from_noise,
@@ -44,6 +44,7 @@ __all__ = [
     "LikelihoodFieldModel",
     "ModelParams",
     "beam_model_prob",
+    "check_alpha",
     "check_particles",
     "motion_density_odometry",
     "odometry_deltas",
@@ -88,15 +89,15 @@ class ModelParams(Params):
     def check(self) -> None:
         if not isinstance(self.alpha, tuple):
             raise TypeError(f"`alpha` must be a tuple of four numbers >= 0 (α1…α4); got {type(self.alpha).__name__}")
-        _check_alpha(self.alpha, "alpha must be a tuple of four numbers")
-        v.check_positive(self.z_hit, "z_hit", allow_zero=True)
-        v.check_positive(self.z_rand, "z_rand", allow_zero=True)
+        check_alpha(self.alpha, "alpha")
+        check_positive(self.z_hit, "z_hit", allow_zero=True)
+        check_positive(self.z_rand, "z_rand", allow_zero=True)
         if self.z_hit + self.z_rand <= 0:
             raise ValueError("`z_hit` + `z_rand` must be > 0")
-        v.check_positive(self.sigma_hit, "sigma_hit")
-        v.check_positive(self.max_dist, "max_dist")
-        v.check_int(self.max_beams, "max_beams", minimum=1)
-        v.check_positive(self.gamma, "gamma")
+        check_positive(self.sigma_hit, "sigma_hit")
+        check_positive(self.max_dist, "max_dist")
+        check_int(self.max_beams, "max_beams", minimum=1)
+        check_positive(self.gamma, "gamma")
 
 
 @dataclass(frozen=True)
@@ -159,7 +160,7 @@ def scan_beams(scan: Scan, max_beams: int | None = None, *, keep_max: bool = Fal
     if idx.size == 0:
         raise ValueError("`scan` has no valid beam (no return): nothing to weigh the particles with")
     if max_beams is not None:
-        m = v.check_int(max_beams, "max_beams", minimum=1)
+        m = check_int(max_beams, "max_beams", minimum=1)
         if idx.size > m:
             idx = idx[np.floor(np.arange(m) * idx.size / m).astype(np.int64)]
     b, r = scan.bearings_rad[idx], scan.ranges[idx]
@@ -200,13 +201,13 @@ class LikelihoodFieldModel:
         g = check_grid(grid)
         if not np.any(g == OBSTACLE):
             raise ValueError("`grid` holds no OBSTACLE cell: an empty map cannot localise anything")
-        self.z_hit = v.check_positive(z_hit, "z_hit", allow_zero=True)
-        self.z_rand = v.check_positive(z_rand, "z_rand", allow_zero=True)
+        self.z_hit = check_positive(z_hit, "z_hit", allow_zero=True)
+        self.z_rand = check_positive(z_rand, "z_rand", allow_zero=True)
         if self.z_hit + self.z_rand <= 0:
             raise ValueError("`z_hit` + `z_rand` must be > 0")
-        self.sigma_hit = v.check_positive(sigma_hit, "sigma_hit")
-        self.z_max = v.check_positive(z_max, "z_max")
-        self.max_dist = v.check_positive(max_dist, "max_dist")
+        self.sigma_hit = check_positive(sigma_hit, "sigma_hit")
+        self.z_max = check_positive(z_max, "z_max")
+        self.max_dist = check_positive(max_dist, "max_dist")
         self.grid = g
         self.shape = g.shape
         self.dist = likelihood_field(g, max_dist=self.max_dist)
@@ -422,7 +423,7 @@ class LikelihoodFieldModel:
         -------
         ndarray, shape (N,)
         """
-        v.check_choice(score, "score", SCORES)
+        check_choice(score, "score", SCORES)
         if score == "amcl_cubes":
             d, keep = self.beam_distances(poses, beams)
             p = self.z_hit * np.exp(-0.5 * (d.astype(np.float64) / self.sigma_hit) ** 2) + self.z_rand / self.z_max
@@ -480,11 +481,11 @@ def beam_model_prob(z, z_star, *, z_max: float, z_hit: float = 0.8, z_short: flo
     """
     z = np.asarray(z, dtype=float)
     zs = np.asarray(z_star, dtype=float)
-    zmax = v.check_positive(z_max, "z_max")
+    zmax = check_positive(z_max, "z_max")
     for name, val in (("z_hit", z_hit), ("z_short", z_short), ("z_max_w", z_max_w), ("z_rand", z_rand)):
-        v.check_positive(val, name, allow_zero=True)
-    sig = v.check_positive(sigma_hit, "sigma_hit")
-    lam = v.check_positive(lambda_short, "lambda_short")
+        check_positive(val, name, allow_zero=True)
+    sig = check_positive(sigma_hit, "sigma_hit")
+    lam = check_positive(lambda_short, "lambda_short")
     inside = (z >= 0) & (z < zmax)
     # eq 6.4-6.6: truncated normal
     eta_hit = 1.0 / (0.5 * (erf((zmax - zs) / (np.sqrt(2) * sig)) - erf((0 - zs) / (np.sqrt(2) * sig))))

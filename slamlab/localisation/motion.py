@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng
 from ..geometry import wrap_angle
 
-__all__ = ["check_particles", "motion_density_odometry", "motion_from_noise", "odometry_deltas",
+__all__ = ["check_alpha", "check_particles", "motion_density_odometry", "motion_from_noise", "odometry_deltas",
            "sample_motion_odometry"]
 
 
@@ -43,16 +43,33 @@ def check_particles(poses, name: str = "particles") -> np.ndarray:
     return P
 
 
+def check_alpha(alpha, name: str = "alpha") -> np.ndarray:
+    """The odometry motion model's noise parameters α1…α4 as a checked ``(4,)`` float array (PR Tables 5.5-5.6).
 
+    Parameters
+    ----------
+    alpha : sequence of 4 float
+        α1 (rotation from rotation), α2 (rotation from translation), α3 (translation from translation),
+        α4 (translation from rotation); finite and >= 0.
+    name : str
+        The argument's name in the error message.
 
-def _check_alpha(alpha, what: str = "alpha must be four finite numbers >= 0") -> np.ndarray:
+    Returns
+    -------
+    ndarray, shape (4,)
+        The four values as floats.
+
+    Examples
+    --------
+    >>> check_alpha((0.1, 0, 0.1, 0)).tolist()
+    [0.1, 0.0, 0.1, 0.0]
+    """
     try:
         a = np.asarray(alpha, dtype=float)
     except (TypeError, ValueError):
         a = np.full(1, np.nan)
     if a.shape != (4,) or not np.all(np.isfinite(a)) or np.any(a < 0):
-        name, _, rest = what.partition(" ")
-        raise ValueError(f"`{name}` {rest} (α1…α4); got {alpha!r}")
+        raise ValueError(f"`{name}` must be four finite numbers >= 0 (α1…α4); got {alpha!r}")
     return a
 
 
@@ -117,9 +134,9 @@ def sample_motion_odometry(poses, odom_prev, odom_now, alpha, rng=None) -> np.nd
     [[2.0, 0.0, 0.0]]
     """
     P = check_particles(poses, "poses")
-    a = _check_alpha(alpha)
+    a = check_alpha(alpha)
     rot1, trans, rot2 = (float(d) for d in odometry_deltas(odom_prev, odom_now))
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     return motion_from_noise(P, (rot1, trans, rot2), a, rng.standard_normal((3, P.shape[0])))
 
 
@@ -186,7 +203,7 @@ def motion_density_odometry(poses_now, poses_prev, odom_prev, odom_now, alpha) -
     X0 = check_particles(poses_prev, "poses_prev")
     if X1.shape != X0.shape:
         raise ValueError(f"`poses_now` and `poses_prev` must have the same shape; got {X1.shape} and {X0.shape}")
-    a = _check_alpha(alpha)
+    a = check_alpha(alpha)
     rot1, trans, rot2 = odometry_deltas(odom_prev, odom_now)
     h1, ht, h2 = odometry_deltas(X0, X1)
     p1 = _normal_pdf(wrap_angle(rot1 - h1), a[0] * h1**2 + a[1] * ht**2)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import norm
 
-from .. import _validate as v
+from .._validate import as_rng, check_int, check_positive, check_probability
 from ..filters.particles import low_variance_resample, n_eff, normalise_log_weights
 from ..geometry import wrap_angle
 from ..scans import FREE, check_grid
@@ -73,8 +73,8 @@ def kld_bound(k, epsilon: float = 0.05, z_quantile: float = 0.99):
     >>> int(np.ceil(kld_bound(10, 0.05, 0.99)))
     217
     """
-    eps = v.check_positive(epsilon, "epsilon")
-    zq = float(norm.ppf(v.check_probability(z_quantile, "z_quantile")))
+    eps = check_positive(epsilon, "epsilon")
+    zq = float(norm.ppf(check_probability(z_quantile, "z_quantile")))
     k = np.asarray(k, dtype=float)
     km1 = np.maximum(k - 1, 1e-12)
     a = 2.0 / (9.0 * km1)
@@ -326,7 +326,7 @@ def amcl_converged(particles, dist: float) -> bool:
     P = np.asarray(particles, dtype=float)
     if P.ndim != 2 or P.shape[1] < 2 or P.shape[0] == 0:
         raise ValueError(f"`particles` must have shape (N, 3) with N >= 1; got {P.shape}")
-    d = v.check_positive(dist, "dist")
+    d = check_positive(dist, "dist")
     return bool(np.all(np.abs(P[:, :2] - P[:, :2].mean(axis=0)) <= d))
 
 
@@ -375,8 +375,8 @@ def uniform_free_particles(grid, n: int, rng=None, *, centres=None) -> np.ndarra
     >>> P = uniform_free_particles(g, 5, rng=0); bool(np.all(P[:, 1] >= 0.5))
     True
     """
-    n = v.check_int(n, "n", minimum=1)
+    n = check_int(n, "n", minimum=1)
     xy = free_cell_centres(grid) if centres is None else centres
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     pick = xy[rng.integers(0, xy.shape[0], n)] + rng.uniform(-0.5, 0.5, (n, 2))
     return np.column_stack([pick, rng.uniform(-np.pi, np.pi, n)])

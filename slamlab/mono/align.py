@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_image
 from ..geometry.camera import project_points as project
 from ..geometry.se3 import se3_compose, se3_inverse, transform_points
 from ..geometry.so3 import se3_exp
@@ -107,7 +107,7 @@ def build_pyramid(image, levels: int) -> list[np.ndarray]:
     """
     import cv2
 
-    img = v.as_image(image, "image").astype(np.float32)
+    img = as_image(image, "image").astype(np.float32)
     pyr = [img]
     for _ in range(levels):
         if min(pyr[-1].shape) < 16:

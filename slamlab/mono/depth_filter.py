@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_positive
 
 __all__ = [
     "Seeds",
@@ -157,16 +157,16 @@ def init_seeds(uv, f, depth_mean_m: float, depth_min_m: float, *, ref: int = 0,
     >>> float(s.mu[0]), float(s.rho_range[0]), round(float(s.sigma2[0]), 6)
     (0.5, 2.0, 0.111111)
     """
-    uv = v.as_finite_array(uv, "uv", ndim=2)
-    f = v.as_finite_array(f, "f", ndim=2)
+    uv = as_finite_array(uv, "uv", ndim=2)
+    f = as_finite_array(f, "f", ndim=2)
     if uv.shape[1] != 2:
         raise ValueError(f"`uv` must have shape (N, 2); got {uv.shape}")
     if f.shape != (uv.shape[0], 3):
         raise ValueError(f"`f` must have shape ({uv.shape[0]}, 3); got {f.shape}")
-    depth_mean_m = v.check_positive(depth_mean_m, "depth_mean_m")
-    depth_min_m = v.check_positive(depth_min_m, "depth_min_m")
-    a0 = v.check_positive(a0, "a0")
-    b0 = v.check_positive(b0, "b0")
+    depth_mean_m = check_positive(depth_mean_m, "depth_mean_m")
+    depth_min_m = check_positive(depth_min_m, "depth_min_m")
+    a0 = check_positive(a0, "a0")
+    b0 = check_positive(b0, "b0")
     n = uv.shape[0]
     norms = np.linalg.norm(f, axis=1, keepdims=True)
     if n and np.any(norms <= 0):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, check_positive
 
 __all__ = ["RunScore", "score_run", "sim3_fit"]
 
@@ -120,14 +120,14 @@ def score_run(truth, estimate, claimed, *, tol_frac: float = TRACK_TOL_FRAC, ref
         the fits to all claimed frames, to each half and to each third of them. The ATEs use the plain fit on the claimed
         frames (as ``evo_ape -as``), so that they compare with other tools.
     """
-    truth = v.as_finite_array(truth, "truth", ndim=3)
-    estimate = v.as_finite_array(estimate, "estimate", ndim=3)
+    truth = as_finite_array(truth, "truth", ndim=3)
+    estimate = as_finite_array(estimate, "estimate", ndim=3)
     if truth.shape != estimate.shape or truth.shape[1:] != (4, 4):
         raise ValueError(f"`truth` and `estimate` must both have shape (N, 4, 4); got {truth.shape} and {estimate.shape}")
     claimed = np.asarray(claimed, dtype=bool).reshape(-1)
     if claimed.shape[0] != truth.shape[0]:
         raise ValueError(f"`claimed` must have one flag per frame ({truth.shape[0]}); got {claimed.shape[0]}")
-    tol_frac = v.check_positive(tol_frac, "tol_frac")
+    tol_frac = check_positive(tol_frac, "tol_frac")
     P_ref, P_est = truth[:, :3, 3], estimate[:, :3, 3]
     path_m = float(np.sum(np.linalg.norm(np.diff(P_ref, axis=0), axis=1))) if len(P_ref) > 1 else 0.0
     tol_m = tol_frac * path_m

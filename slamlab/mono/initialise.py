@@ -15,7 +15,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import (
+    as_finite_array,
+    as_image,
+    as_matrix,
+    check_choice,
+    check_int,
+    check_positive,
+    check_probability,
+)
 from .twoview import (
     TwoViewPose,
     polish_homography,
@@ -75,9 +83,9 @@ def track_lk(img0, img1, uv0, *, win_px: int = 21, levels: int = 3, uv1_guess=No
     """
     import cv2
 
-    img0 = v.as_image(img0, "img0")
-    img1 = v.as_image(img1, "img1")
-    uv0 = v.as_finite_array(uv0, "uv0", ndim=2)
+    img0 = as_image(img0, "img0")
+    img1 = as_image(img1, "img1")
+    uv0 = as_finite_array(uv0, "uv0", ndim=2)
     if uv0.shape[1] != 2:
         raise ValueError(f"`uv0` must have shape (N, 2); got {uv0.shape}")
     if uv0.shape[0] == 0:
@@ -206,14 +214,14 @@ class Initialiser:
     counts: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        self.K = v.as_matrix(self.K, "K", (3, 3))
-        v.check_int(self.min_corners, "min_corners", minimum=5)
-        v.check_positive(self.min_disparity_px, "min_disparity_px", allow_zero=True)
-        v.check_probability(self.min_tracked_ratio, "min_tracked_ratio")
-        v.check_choice(self.method, "method", ("homography", "essential", "auto"))
-        v.check_probability(self.plane_share, "plane_share")
-        v.check_positive(self.min_parallax_deg, "min_parallax_deg", allow_zero=True)
-        v.check_positive(self.min_point_parallax_deg, "min_point_parallax_deg", allow_zero=True)
+        self.K = as_matrix(self.K, "K", (3, 3))
+        check_int(self.min_corners, "min_corners", minimum=5)
+        check_positive(self.min_disparity_px, "min_disparity_px", allow_zero=True)
+        check_probability(self.min_tracked_ratio, "min_tracked_ratio")
+        check_choice(self.method, "method", ("homography", "essential", "auto"))
+        check_probability(self.plane_share, "plane_share")
+        check_positive(self.min_parallax_deg, "min_parallax_deg", allow_zero=True)
+        check_positive(self.min_point_parallax_deg, "min_point_parallax_deg", allow_zero=True)
 
     def _count(self, status):
         self.counts[status] = self.counts.get(status, 0) + 1
@@ -255,7 +263,7 @@ class Initialiser:
         status : str
             One of ``INIT_STATUSES``; ``"done"`` sets :attr:`result`.
         """
-        image = v.as_image(image, "image")
+        image = as_image(image, "image")
         self.frame_index += 1
         if self.ref_image is None:
             return self.reset(image, self.frame_index)

@@ -3,8 +3,8 @@
 The first map from the initialiser, new keyframes with their seeds, the choice of seed pixels, the
 pruning of map points and the depth-filter update of every seed. SDVL runs this in its own thread;
 :class:`~slamlab.mono.MonoSLAM` runs it in turn with tracking (see :mod:`slamlab.mono.slam`). The
-methods live on a mixin that ``MonoSLAM`` inherits; they use its state (``self.p``, ``self.seeds``,
-``self.keyframes``, ...).
+methods live on :class:`MappingMixin`, which ``MonoSLAM`` inherits; they use its state (``self.p``,
+``self.seeds``, ``self.keyframes``, ...).
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.se3 import se3_compose, se3_inverse, transform_points
+from ..geometry.so3 import rotation_angle
 from .align import build_pyramid, project
 from .depth_filter import (
     Seeds,
@@ -29,7 +30,7 @@ from .depth_filter import (
 )
 from .epipolar import extract_patches, search_epipolar
 
-__all__ = ["Keyframe", "orthonormalise"]
+__all__ = ["Keyframe", "MappingMixin", "orthonormalise"]
 
 
 def orthonormalise(T) -> np.ndarray:
@@ -83,8 +84,12 @@ class Keyframe:
 
 
 
-class _MonoMapping:
-    """Keyframes, seeds and map points of :class:`~slamlab.mono.MonoSLAM` (its mapping steps)."""
+class MappingMixin:
+    """The mapping steps of :class:`~slamlab.mono.MonoSLAM` (003 §4.1-4.3): keyframes, seeds and map points.
+
+    SDVL's mapping thread as methods of a mixin: :class:`~slamlab.mono.MonoSLAM` inherits them and holds
+    the state they use (its settings ``p``, ``keyframes``, ``seeds``, ``points``...); not used on its own.
+    """
 
     # -- initial map -------------------------------------------------------------------------
     def _start_map(self, image, idx):
@@ -110,7 +115,7 @@ class _MonoMapping:
             tp, tn = pred[:3, 3], res.pose.t
             cos_t = float(np.sum(tp * tn)) / max(float(np.sqrt(np.sum(tp**2) * np.sum(tn**2))), 1e-12)
             dR = np.einsum("ij,kj->ik", R, pred[:3, :3])
-            ang = float(np.degrees(np.arccos(np.clip((np.trace(dR) - 1.0) / 2.0, -1.0, 1.0))))
+            ang = float(np.degrees(rotation_angle(dR)))
             if cos_t < np.cos(np.deg2rad(30.0)) or ang > 5.0:
                 self._count("reinit_rejected")
                 self.init = self._new_initialiser()

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .. import _validate as v
 from .._params import Params, param
+from .._validate import check_choice, check_int, check_positive, check_probability
 
 __all__ = ["MonoParams"]
 
@@ -168,49 +168,49 @@ class MonoParams(Params):
                                "alignment's pose is final)")
 
     def check(self) -> None:
-        v.check_int(self.fast_threshold, "fast_threshold", minimum=1, maximum=254)
-        v.check_int(self.min_corners, "min_corners", minimum=8)
-        v.check_positive(self.init_disparity_px, "init_disparity_px")
-        v.check_probability(self.init_min_tracked, "init_min_tracked")
-        v.check_choice(self.init_method, "init_method", ("homography", "essential", "auto"))
-        v.check_probability(self.init_plane_share, "init_plane_share")
-        v.check_positive(self.init_ransac_px, "init_ransac_px")
-        v.check_positive(self.init_min_parallax_deg, "init_min_parallax_deg", allow_zero=True)
-        v.check_positive(self.init_min_point_parallax_deg, "init_min_point_parallax_deg", allow_zero=True)
-        v.check_choice(self.convergence, "convergence", ("linearity", "sigma"))
-        v.check_positive(self.L_max, "L_max")
-        v.check_positive(self.sigma_fraction, "sigma_fraction")
-        v.check_positive(self.n_sigma, "n_sigma")
-        v.check_positive(self.epi_tol_px, "epi_tol_px")
-        v.check_int(self.patch_px, "patch_px", minimum=3, maximum=31)
+        check_int(self.fast_threshold, "fast_threshold", minimum=1, maximum=254)
+        check_int(self.min_corners, "min_corners", minimum=8)
+        check_positive(self.init_disparity_px, "init_disparity_px")
+        check_probability(self.init_min_tracked, "init_min_tracked")
+        check_choice(self.init_method, "init_method", ("homography", "essential", "auto"))
+        check_probability(self.init_plane_share, "init_plane_share")
+        check_positive(self.init_ransac_px, "init_ransac_px")
+        check_positive(self.init_min_parallax_deg, "init_min_parallax_deg", allow_zero=True)
+        check_positive(self.init_min_point_parallax_deg, "init_min_point_parallax_deg", allow_zero=True)
+        check_choice(self.convergence, "convergence", ("linearity", "sigma"))
+        check_positive(self.L_max, "L_max")
+        check_positive(self.sigma_fraction, "sigma_fraction")
+        check_positive(self.n_sigma, "n_sigma")
+        check_positive(self.epi_tol_px, "epi_tol_px")
+        check_int(self.patch_px, "patch_px", minimum=3, maximum=31)
         if not -1.0 <= float(self.zncc_min) <= 1.0:
             raise ValueError(f"`zncc_min` must be in [-1, 1]; got {self.zncc_min}")
-        v.check_positive(self.px_noise, "px_noise")
-        v.check_int(self.max_seed_fail, "max_seed_fail", minimum=1)
-        v.check_probability(self.min_inlier_ratio, "min_inlier_ratio")
-        v.check_int(self.max_seeds_per_kf, "max_seeds_per_kf", minimum=1)
-        v.check_int(self.kf_min_frames, "kf_min_frames", minimum=1)
-        v.check_probability(self.kf_lost_ratio, "kf_lost_ratio")
-        v.check_probability(self.kf_max_lost_ratio, "kf_max_lost_ratio")
-        v.check_int(self.max_keyframes, "max_keyframes", minimum=2)
-        v.check_choice(self.motion_model, "motion_model", ("constant_position", "constant_velocity"))
-        v.check_int(self.align_patch_px, "align_patch_px", minimum=2, maximum=16)
-        v.check_int(self.align_max_level, "align_max_level", minimum=0, maximum=6)
-        v.check_int(self.align_min_level, "align_min_level", minimum=0, maximum=6)
+        check_positive(self.px_noise, "px_noise")
+        check_int(self.max_seed_fail, "max_seed_fail", minimum=1)
+        check_probability(self.min_inlier_ratio, "min_inlier_ratio")
+        check_int(self.max_seeds_per_kf, "max_seeds_per_kf", minimum=1)
+        check_int(self.kf_min_frames, "kf_min_frames", minimum=1)
+        check_probability(self.kf_lost_ratio, "kf_lost_ratio")
+        check_probability(self.kf_max_lost_ratio, "kf_max_lost_ratio")
+        check_int(self.max_keyframes, "max_keyframes", minimum=2)
+        check_choice(self.motion_model, "motion_model", ("constant_position", "constant_velocity"))
+        check_int(self.align_patch_px, "align_patch_px", minimum=2, maximum=16)
+        check_int(self.align_max_level, "align_max_level", minimum=0, maximum=6)
+        check_int(self.align_min_level, "align_min_level", minimum=0, maximum=6)
         if self.align_min_level > self.align_max_level:
             raise ValueError(f"`align_min_level` must be <= `align_max_level`; got {self.align_min_level} > "
                              f"{self.align_max_level}")
-        v.check_int(self.align_iters, "align_iters", minimum=1)
-        v.check_int(self.align_max_points, "align_max_points", minimum=10)
-        v.check_int(self.max_matches, "max_matches", minimum=6)
-        v.check_int(self.match_win_px, "match_win_px", minimum=5, maximum=51)
-        v.check_positive(self.reproj_inlier_deg, "reproj_inlier_deg")
-        v.check_int(self.min_inliers, "min_inliers", minimum=6)
-        v.check_int(self.max_coast, "max_coast", minimum=0)
-        v.check_int(self.refine_iters, "refine_iters", minimum=1)
-        if not 0.0 <= v.check_positive(self.min_inlier_share, "min_inlier_share", allow_zero=True) <= 1.0:
+        check_int(self.align_iters, "align_iters", minimum=1)
+        check_int(self.align_max_points, "align_max_points", minimum=10)
+        check_int(self.max_matches, "max_matches", minimum=6)
+        check_int(self.match_win_px, "match_win_px", minimum=5, maximum=51)
+        check_positive(self.reproj_inlier_deg, "reproj_inlier_deg")
+        check_int(self.min_inliers, "min_inliers", minimum=6)
+        check_int(self.max_coast, "max_coast", minimum=0)
+        check_int(self.refine_iters, "refine_iters", minimum=1)
+        if not 0.0 <= check_positive(self.min_inlier_share, "min_inlier_share", allow_zero=True) <= 1.0:
             raise ValueError(f"`min_inlier_share` must be in [0, 1]; got {self.min_inlier_share}")
-        v.check_positive(self.max_align_rms, "max_align_rms")
+        check_positive(self.max_align_rms, "max_align_rms")
         for name in ("outlier_rejection", "refine", "prefer_seen", "warp_patches", "reinit_when_lost"):
             if not isinstance(getattr(self, name), bool):
                 raise TypeError(f"`{name}` must be True or False; got {getattr(self, name)!r}")

@@ -23,12 +23,12 @@ import time
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_image, as_matrix
 from ..geometry.se3 import se3_compose, se3_inverse, transform_points
 from .align import build_pyramid, project, refine_pose, sparse_align
 from .depth_filter import init_seeds
 from .initialise import Initialiser, track_lk
-from .mapping import Keyframe, _MonoMapping, orthonormalise
+from .mapping import Keyframe, MappingMixin, orthonormalise
 from .params import MonoParams
 
 __all__ = ["STAGES", "Keyframe", "MonoSLAM"]
@@ -37,7 +37,7 @@ __all__ = ["STAGES", "Keyframe", "MonoSLAM"]
 STAGES = ("detect", "align", "match", "refine", "mapping", "keyframe")
 
 
-class MonoSLAM(_MonoMapping):
+class MonoSLAM(MappingMixin):
     """Monocular mapping and tracking (003 §4). Feed grey images to :meth:`process`.
 
     The world frame is the first keyframe's camera frame; the map's scale is set by the
@@ -55,7 +55,7 @@ class MonoSLAM(_MonoMapping):
     """
 
     def __init__(self, K, *, params: MonoParams | None = None, **overrides):
-        self.K = v.as_matrix(K, "K", (3, 3))
+        self.K = as_matrix(K, "K", (3, 3))
         self.p = MonoParams.resolve(params, **overrides)
         p = self.p
         self.init = self._new_initialiser()
@@ -126,7 +126,7 @@ class MonoSLAM(_MonoMapping):
             ``frame``, ``status``, ``tracked``, ``T_wc`` (4, 4), ``n_inliers``, ``n_matched``, ``align_rms``,
             ``n_points``, ``n_seeds``, ``n_keyframes``, ``times`` (seconds per stage).
         """
-        image = v.as_image(image, "image")
+        image = as_image(image, "image")
         if image.ndim == 3:
             raise ValueError(f"`image` must be a grey image (H, W); got shape {image.shape}")
         if self.records and image.shape != self._shape:

@@ -11,15 +11,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_matrix
 from ..geometry.homography import apply_homography
 
 __all__ = ["TwoViewPose", "polish_homography", "relative_pose_essential", "relative_pose_homography", "triangulate_two_view"]
 
 
 def _check_uv_pair(uv0, uv1):
-    uv0 = v.as_finite_array(uv0, "uv0", ndim=2)
-    uv1 = v.as_finite_array(uv1, "uv1", ndim=2)
+    uv0 = as_finite_array(uv0, "uv0", ndim=2)
+    uv1 = as_finite_array(uv1, "uv1", ndim=2)
     if uv0.shape[1] != 2 or uv1.shape != uv0.shape:
         raise ValueError(f"`uv0` and `uv1` must both have shape (N, 2); got {uv0.shape} and {uv1.shape}")
     return uv0, uv1
@@ -93,7 +93,7 @@ def triangulate_two_view(K, R, t, uv0, uv1):
     """
     import cv2
 
-    K = v.as_matrix(K, "K", (3, 3))
+    K = as_matrix(K, "K", (3, 3))
     P0 = np.einsum("ij,jk->ik", K, np.hstack([np.eye(3), np.zeros((3, 1))]))  # einsum: no BLAS, same bits anywhere
     P1 = np.einsum("ij,jk->ik", K, np.hstack([np.asarray(R, float), np.asarray(t, float).reshape(3, 1)]))
     if len(uv0) == 0:
@@ -234,7 +234,7 @@ def relative_pose_homography(uv0, uv1, K, *, ransac_px: float = 2.0, min_points:
     import cv2
 
     uv0, uv1 = _check_uv_pair(uv0, uv1)
-    K = v.as_matrix(K, "K", (3, 3))
+    K = as_matrix(K, "K", (3, 3))
     n = uv0.shape[0]
     if n < max(4, min_points):
         return _fail(n, "too_few_points")
@@ -290,7 +290,7 @@ def relative_pose_essential(uv0, uv1, K, *, ransac_px: float = 1.0, prob: float 
     import cv2
 
     uv0, uv1 = _check_uv_pair(uv0, uv1)
-    K = v.as_matrix(K, "K", (3, 3))
+    K = as_matrix(K, "K", (3, 3))
     n = uv0.shape[0]
     if n < max(5, min_points):
         return _fail(n, "too_few_points")

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_vector, check_positive
 
 __all__ = ["Plane", "cell_keys", "describe_plane", "lookup_mean_intensity", "plane_frame"]
 
@@ -80,8 +80,50 @@ class Plane:
         object.__setattr__(self, "keys", cell_keys(self.ij))
         object.__setattr__(self, "mean_intensity", self.sums / self.counts)   # I_k = sum I / N_k per cell
 
+    @classmethod
+    def from_cells(cls, n, p: float, T, cell_m: float, ij, counts, sums) -> Plane:
+        """The plane whose parts ``A`` sum ``counts`` and intensity ``sums`` per cell index (002 Fig. 6).
+
+        Entries that share a cell index are added up (a bincount on the cells' bounding box, no sort); the
+        cells come out in ascending key order (:func:`cell_keys`), as :func:`lookup_mean_intensity` needs.
+        One entry per point (``counts`` all 1: :func:`describe_plane`) or per cell of several planes
+        (their counts: :func:`~slamlab.planes.merge_planes`).
+
+        Parameters
+        ----------
+        n, p, T, cell_m
+            The plane's normal, distance term [m], frame and cell side [m], as the attributes of :class:`Plane`.
+        ij : (K, 2) int
+            Cell index of each entry in the plane frame's x, y (K >= 1).
+        counts : (K,) float or int
+            Points behind each entry.
+        sums : (K,) float
+            Intensity sum of each entry.
+
+        Returns
+        -------
+        Plane
+            One cell per distinct index of ``ij``.
+
+        Examples
+        --------
+        >>> pl = Plane.from_cells(np.array([0, 0, 1.0]), 1.0, np.eye(4), 0.5, [[0, 0], [1, 0], [0, 0]],
+        ...                       [1, 1, 1], [10.0, 40.0, 20.0])
+        >>> pl.ij.tolist(), pl.counts.tolist(), pl.mean_intensity.tolist()
+        ([[0, 0], [1, 0]], [2, 1], [15.0, 40.0])
+        """
+        ij = np.asarray(ij, dtype=np.int64)
+        lo = ij.min(axis=0)
+        w = int(ij[:, 1].max() - lo[1]) + 1
+        flat = (ij[:, 0] - lo[0]) * w + (ij[:, 1] - lo[1])
+        c = np.bincount(flat, weights=counts)
+        keep = np.flatnonzero(c)
+        s = np.bincount(flat, weights=sums)[keep]
+        return cls(n, float(p), T, cell_m, np.c_[keep // w + lo[0], keep % w + lo[1]], c[keep].astype(np.int64), s)
+
     @property
     def n_points(self) -> int:
+        """Points behind the plane (the sum of the cells' counts)."""
         return int(self.counts.sum())
 
     def cell_centres(self) -> np.ndarray:
@@ -186,36 +228,22 @@ def describe_plane(points, intensities, n, p: float, *, cell_m: float = 0.25, ra
     >>> pl.counts.tolist(), pl.mean_intensity.tolist()
     ([2, 1], [15.0, 40.0])
     """
-    X = v.as_finite_array(points, "points", ndim=2)
+    X = as_finite_array(points, "points", ndim=2)
     if X.shape[1] != 3 or X.shape[0] < 1:
         raise ValueError(f"`points` must have shape (K >= 1, 3); got {X.shape}")
-    I = v.as_vector(intensities, "intensities", X.shape[0])
-    n = v.as_vector(n, "n", 3)
-    cell_m = v.check_positive(cell_m, "cell_m")
+    I = as_vector(intensities, "intensities", X.shape[0])
+    n = as_vector(n, "n", 3)
+    cell_m = check_positive(cell_m, "cell_m")
     if incidence_correction:
         if rays is None:
             raise ValueError("`rays` are needed for the incidence-angle correction (or incidence_correction=False)")
-        d = v.as_finite_array(rays, "rays", ndim=2)
+        d = as_finite_array(rays, "rays", ndim=2)
         if d.shape != X.shape:
             raise ValueError(f"`rays` must have shape {X.shape}; got {d.shape}")
         I = I / np.maximum(np.abs(d @ n), cos_min)
     T = plane_frame(n, p, X.mean(axis=0))
     local = (X - T[:3, 3]) @ T[:3, :2]
-    ij = np.floor(local / cell_m).astype(np.int64)
-    ij_u, counts, sums = _bin_cells(ij, np.ones(len(ij)), I)
-    return Plane(n, float(p), T, cell_m, ij_u, counts.astype(np.int64), sums)
-
-
-def _bin_cells(ij, counts, sums):
-    """Sum ``counts`` and ``sums`` per cell ``ij (K, 2)`` on a dense grid (a bincount, no sort); cells come out
-    in the order of their keys (ascending), as :func:`lookup_mean_intensity` needs."""
-    lo = ij.min(axis=0)
-    w = int(ij[:, 1].max() - lo[1]) + 1
-    flat = (ij[:, 0] - lo[0]) * w + (ij[:, 1] - lo[1])
-    c = np.bincount(flat, weights=counts)
-    keep = np.flatnonzero(c)
-    s = np.bincount(flat, weights=sums)[keep]
-    return np.c_[keep // w + lo[0], keep % w + lo[1]], c[keep], s
+    return Plane.from_cells(n, p, T, cell_m, np.floor(local / cell_m).astype(np.int64), np.ones(len(X)), I)
 
 
 def lookup_mean_intensity(plane: Plane, points) -> np.ndarray:

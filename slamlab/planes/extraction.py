@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_rng, as_vector, check_int, check_positive
 from ..geometry.ransac import ransac, ransac_refit
 
 __all__ = ["Frame", "build_frame", "extract_planes", "fit_plane_lsq", "frame_transforms", "plane_distances"]
@@ -47,7 +47,7 @@ def frame_transforms(odometry) -> np.ndarray:
     >>> frame_transforms(T)[0, :3, 3].tolist()
     [1.0, 0.0, 0.0]
     """
-    T = v.as_finite_array(odometry, "odometry", ndim=3)
+    T = as_finite_array(odometry, "odometry", ndim=3)
     if T.shape[1:] != (4, 4) or T.shape[0] < 1:
         raise ValueError(f"`odometry` must have shape (N >= 1, 4, 4); got {T.shape}")
     RN, tN = T[-1, :3, :3], T[-1, :3, 3]
@@ -109,7 +109,7 @@ def build_frame(points, intensities, odometry, *, origin_m=(0.0, 0.0, 0.0)) -> F
     T = frame_transforms(odometry)
     if T.shape[0] != P.shape[0]:
         raise ValueError(f"`odometry` must hold one pose per line ({P.shape[0]}); got {T.shape[0]}")
-    o = v.as_vector(origin_m, "origin_m", 3)
+    o = as_vector(origin_m, "origin_m", 3)
     ok = np.isfinite(P).all(axis=2) & np.isfinite(I)
     line = np.nonzero(ok)[0]
     pb = P[ok]
@@ -142,7 +142,7 @@ def fit_plane_lsq(points) -> tuple[np.ndarray, float]:
     >>> np.round(n, 12).tolist(), round(p, 12)
     ([0.0, 0.0, 1.0], 2.0)
     """
-    X = v.as_finite_array(points, "points", ndim=2)
+    X = as_finite_array(points, "points", ndim=2)
     if X.shape[1] != 3 or X.shape[0] < 3:
         raise ValueError(f"`points` must have shape (K >= 3, 3); got {X.shape}")
     c = X.mean(axis=0)
@@ -223,17 +223,17 @@ def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, 
     >>> len(planes), np.round(planes[0][0], 9).tolist(), round(planes[0][1], 9), int(rest.sum())
     (1, [0.0, 0.0, 1.0], 1.5, 0)
     """
-    X = v.as_finite_array(points, "points", ndim=2)
+    X = as_finite_array(points, "points", ndim=2)
     if X.shape[1] != 3:
         raise ValueError(f"`points` must have shape (K, 3); got {X.shape}")
-    tol = v.check_positive(tolerance_m, "tolerance_m")
-    iters = v.check_int(iterations, "iterations", minimum=1)
-    min_support = v.check_int(min_support, "min_support", minimum=3)
-    max_planes = v.check_int(max_planes, "max_planes", minimum=0)
-    sample_points = v.check_int(sample_points, "sample_points", minimum=3)
-    refit_rounds = v.check_int(refit_rounds, "refit_rounds", minimum=0)
-    min_width_m = v.check_positive(min_width_m, "min_width_m", allow_zero=True)
-    rng = v.as_rng(rng)
+    tol = check_positive(tolerance_m, "tolerance_m")
+    iters = check_int(iterations, "iterations", minimum=1)
+    min_support = check_int(min_support, "min_support", minimum=3)
+    max_planes = check_int(max_planes, "max_planes", minimum=0)
+    sample_points = check_int(sample_points, "sample_points", minimum=3)
+    refit_rounds = check_int(refit_rounds, "refit_rounds", minimum=0)
+    min_width_m = check_positive(min_width_m, "min_width_m", allow_zero=True)
+    rng = as_rng(rng)
     remaining = np.arange(X.shape[0])
     planes, rejected = [], []
     while len(planes) + len(rejected) < 2 * max_planes and len(planes) < max_planes and remaining.size >= max(min_support, 3):

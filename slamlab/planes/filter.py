@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
 from .._params import Params, param
+from .._validate import as_matrix, as_rng, check_int, check_positive
 from ..filters.particles import systematic_resample  # the shared particle toolbox (re-exported here)
 from ..geometry import se3_inverse
 from .description import Plane, describe_plane, lookup_local
@@ -126,15 +126,15 @@ class PlaneSLAMParams(Params):
     voxel_m: float = param(0.1, "ours")
 
     def check(self) -> None:
-        v.check_int(self.n_particles, "n_particles", minimum=1)
+        check_int(self.n_particles, "n_particles", minimum=1)
         for name in ("V_xyz_m2", "V_rpy_deg2"):
-            v.check_positive(getattr(self, name), name, allow_zero=True)
+            check_positive(getattr(self, name), name, allow_zero=True)
         for name in ("ransac_tolerance_m", "cell_m", "pair_angle_deg", "pair_dist_m", "lm_lambda",
                      "merge_angle_deg", "merge_dist_m", "voxel_m"):
-            v.check_positive(getattr(self, name), name)
+            check_positive(getattr(self, name), name)
         for name, lo in (("ransac_iterations", 1), ("ransac_min_support", 3), ("ransac_sample_points", 3),
                          ("max_planes", 1), ("thin", 1), ("lm_iters", 1), ("min_normal_rank", 1)):
-            v.check_int(getattr(self, name), name, minimum=lo)
+            check_int(getattr(self, name), name, minimum=lo)
         if self.min_normal_rank > 3:
             raise ValueError(f"`min_normal_rank` must be 1, 2 or 3; got {self.min_normal_rank}")
         for name in ("intensity_weights", "incidence_correction", "lm_prior"):
@@ -196,8 +196,8 @@ class PlaneSLAM:
 
     def __init__(self, initial_pose=None, *, params: PlaneSLAMParams | None = None, rng=None, **overrides):
         self.params = p = PlaneSLAMParams.resolve(params, **overrides)
-        self.rng = v.as_rng(rng)
-        T0 = np.eye(4) if initial_pose is None else v.as_matrix(initial_pose, "initial_pose", (4, 4))
+        self.rng = as_rng(rng)
+        T0 = np.eye(4) if initial_pose is None else as_matrix(initial_pose, "initial_pose", (4, 4))
         self.X = np.repeat(T0[None], p.n_particles, axis=0)
         self.map = PlaneMap(angle_deg=p.merge_angle_deg, dist_m=p.merge_dist_m, voxel_m=p.voxel_m)
         self.pose = T0.copy()
@@ -370,7 +370,7 @@ class PlaneSLAM:
         """
         if not isinstance(frame, Frame):
             raise TypeError(f"`frame` must be a Frame (see build_frame); got {type(frame).__name__}")
-        U = v.as_matrix(odometry_increment, "odometry_increment", (4, 4))
+        U = as_matrix(odometry_increment, "odometry_increment", (4, 4))
         p = self.params
         times = dict.fromkeys(STAGES, 0.0)
         clock = time.perf_counter

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .description import Plane, _bin_cells, cell_keys, lookup_mean_intensity, plane_frame
+from .description import Plane, cell_keys, lookup_mean_intensity, plane_frame
 
 __all__ = ["PlaneMap", "VoxelStore", "merge_planes", "planes_touch"]
 
@@ -118,8 +118,7 @@ def merge_planes(planes: list[Plane]) -> Plane:
     counts = np.concatenate([pl.counts for pl in planes])
     sums = np.concatenate([pl.sums for pl in planes])
     local = (centres - T[:3, 3]) @ T[:3, :2]
-    ij, c, s = _bin_cells(np.floor(local / cell).astype(np.int64), counts, sums)
-    return Plane(n, p, T, cell, ij, c.astype(np.int64), s)
+    return Plane.from_cells(n, p, T, cell, np.floor(local / cell).astype(np.int64), counts, sums)
 
 
 class PlaneMap:

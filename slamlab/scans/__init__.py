@@ -18,7 +18,7 @@ from .grid import (
     world_to_cell,
 )
 from .logmap import leave_out_grid, log_counts, log_grid
-from .occupancy import RULES, OccupancyGrid, likelihood_field, occupancy_grid
+from .occupancy import RULES, OccupancyGrid, free_space_samples, likelihood_field, occupancy_grid
 from .raycast import cast_rays
 from .scan import UNITS, Scan, scan_to_points
 
@@ -34,6 +34,7 @@ __all__ = [
     "cast_rays",
     "cell_to_world",
     "check_grid",
+    "free_space_samples",
     "grid_to_values",
     "leave_out_grid",
     "likelihood_field",

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_image, as_matrix, check_int, check_positive, check_real
 
 __all__ = [
     "CELL_CHARS",
@@ -75,7 +75,7 @@ def world_to_cell(xy) -> np.ndarray:
     >>> world_to_cell([[3.4, 7.6], [0.0, -0.5]]).tolist()
     [[8, 3], [0, 0]]
     """
-    xy = v.as_finite_array(xy, "xy")
+    xy = as_finite_array(xy, "xy")
     if xy.ndim == 0 or xy.shape[-1] != 2:
         raise ValueError(f"`xy` must have shape (..., 2); got shape {xy.shape}")
     rc = np.floor(xy[..., ::-1] + 0.5)
@@ -100,7 +100,7 @@ def cell_to_world(rc) -> np.ndarray:
     >>> cell_to_world([[8, 3]]).tolist()
     [[3.0, 8.0]]
     """
-    rc = v.as_finite_array(rc, "rc")
+    rc = as_finite_array(rc, "rc")
     if rc.ndim == 0 or rc.shape[-1] != 2:
         raise ValueError(f"`rc` must have shape (..., 2); got shape {rc.shape}")
     return rc[..., ::-1].copy()
@@ -127,8 +127,8 @@ def make_grid(n_rows: int, n_cols: int, fill: int = FREE) -> np.ndarray:
     array([[-1, -1, -1],
            [-1, -1, -1]], dtype=int8)
     """
-    n_rows = v.check_int(n_rows, "n_rows", minimum=1)
-    n_cols = v.check_int(n_cols, "n_cols", minimum=1)
+    n_rows = check_int(n_rows, "n_rows", minimum=1)
+    n_cols = check_int(n_cols, "n_cols", minimum=1)
     if fill not in CELL_CHARS:
         raise ValueError(f"`fill` must be FREE (0), OBSTACLE (1) or UNEXPLORED (-1); got {fill!r}")
     return np.full((n_rows, n_cols), fill, dtype=np.int8)
@@ -154,7 +154,7 @@ def check_grid(grid, name: str = "grid") -> np.ndarray:
     >>> check_grid([[0, 1], [-1, 0]]).dtype
     dtype('int8')
     """
-    arr = v.as_image(grid, name)
+    arr = as_image(grid, name)
     if not (np.issubdtype(arr.dtype, np.integer) or arr.dtype == np.bool_):
         if np.issubdtype(arr.dtype, np.floating) and np.all(arr == np.round(arr)):
             arr = arr.astype(np.int64)
@@ -192,9 +192,7 @@ def grid_to_values(grid, a_c: float = -1.0, a_p: float = 1.0, a_n: float = 0.0, 
     """
     g = check_grid(grid)
     for name, val in (("a_c", a_c), ("a_p", a_p), ("a_n", a_n)):
-        if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(val):
-            raise TypeError(f"`{name}` must be a finite real number; got {val!r}")
+        check_real(val, name)
     lut = np.array([a_n, a_c, a_p], dtype=dtype)  # index = code + 1
     return lut[g.astype(np.intp) + 1]
 
@@ -228,11 +226,11 @@ class GridFrame:
     shape: tuple[int, int]
 
     def __post_init__(self):
-        v.check_positive(self.cell_m, "cell_m")
+        check_positive(self.cell_m, "cell_m")
         if not (isinstance(self.shape, tuple) and len(self.shape) == 2):
             raise TypeError(f"`shape` must be a (rows, cols) tuple; got {self.shape!r}")
-        v.check_int(self.shape[0], "shape[0]", minimum=1)
-        v.check_int(self.shape[1], "shape[1]", minimum=1)
+        check_int(self.shape[0], "shape[0]", minimum=1)
+        check_int(self.shape[1], "shape[1]", minimum=1)
 
     @classmethod
     def around(cls, points_m, cell_m: float, margin_m: float = 1.0) -> GridFrame:
@@ -256,10 +254,10 @@ class GridFrame:
         >>> GridFrame.around([[0.0, 0.0], [2.0, 1.0]], 0.5, margin_m=0.0)
         GridFrame(x0_m=0.0, y0_m=0.0, cell_m=0.5, shape=(3, 5))
         """
-        P = v.as_matrix(points_m, "points_m", (None, 2))
+        P = as_matrix(points_m, "points_m", (None, 2))
         if P.shape[0] == 0:
             raise ValueError("`points_m` must hold at least one point; got 0")
-        cell = v.check_positive(cell_m, "cell_m")
+        cell = check_positive(cell_m, "cell_m")
         lo = P.min(axis=0) - margin_m
         hi = P.max(axis=0) + margin_m
         n = np.ceil((hi - lo) / cell).astype(int) + 1
@@ -278,7 +276,7 @@ class GridFrame:
         poses_cells : ndarray, shape (n, 3)
             ``(x, y)`` in cell units relative to the frame's origin, heading unchanged.
         """
-        P = v.as_matrix(poses_m, "poses_m", (None, 3))
+        P = as_matrix(poses_m, "poses_m", (None, 3))
         return np.column_stack([(P[:, 0] - self.x0_m) / self.cell_m, (P[:, 1] - self.y0_m) / self.cell_m, P[:, 2]])
 
     def to_metres(self, poses_cells) -> np.ndarray:
@@ -294,5 +292,5 @@ class GridFrame:
         poses_m : ndarray, shape (n, 3)
             ``(x_m, y_m, heading_rad)``.
         """
-        P = v.as_matrix(poses_cells, "poses_cells", (None, 3))
+        P = as_matrix(poses_cells, "poses_cells", (None, 3))
         return np.column_stack([P[:, 0] * self.cell_m + self.x0_m, P[:, 1] * self.cell_m + self.y0_m, P[:, 2]])

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_positive
 from .grid import GridFrame
 from .occupancy import OccupancyGrid, label_counts, occupancy_grid
 from .scan import Scan
@@ -68,8 +68,8 @@ def log_counts(log, *, cell_m: float = 0.2, max_range_m: float = 10.0):
         Hits and passes of all scans (rule ``"count"``).
     """
     _check_log(log)
-    cell_m = v.check_positive(cell_m, "cell_m")
-    max_range_m = v.check_positive(max_range_m, "max_range_m")
+    cell_m = check_positive(cell_m, "cell_m")
+    max_range_m = check_positive(max_range_m, "max_range_m")
     scans_m = [_limited(s, max_range_m) for s in log.scans()]
     pts = np.vstack([s.points(q) for s, q in zip(log.scans(range(0, log.n_scans, 10)), log.poses[::10],
                                                     strict=True)])

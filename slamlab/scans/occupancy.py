@@ -7,6 +7,9 @@ API summary
   its return falls in (``np.bincount`` over all beams of all scans, in chunks);
   the cell-labelling ``rule`` turns the counts into FREE / OBSTACLE / UNEXPLORED.
 - :class:`OccupancyGrid`: ``grid`` (int8 codes), ``hits``, ``passes``.
+- :func:`free_space_samples` ``(bearings_rad, ranges, hit, *, step_cells, ...) -> (points, beam)``:
+  the points every ``step_cells`` along each beam before its end (the free space a beam
+  crossed), written once for the occupancy grid's pass votes and correlation's free marks.
 - :func:`likelihood_field` ``(grid, *, cell_m, max_dist) -> (H, W)``: distance from
   every cell to the nearest obstacle cell (``scipy.ndimage.distance_transform_edt``),
   clipped at ``max_dist``: the precomputed table of the likelihood-field sensor model.
@@ -24,12 +27,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
-from .. import _validate as v
+from .._validate import as_vector, check_choice, check_int, check_positive
 from ..geometry.se2 import check_poses
 from .grid import FREE, OBSTACLE, UNEXPLORED, check_grid
 from .scan import Scan
 
-__all__ = ["RULES", "OccupancyGrid", "label_counts", "likelihood_field", "occupancy_grid"]
+__all__ = ["RULES", "OccupancyGrid", "free_space_samples", "label_counts", "likelihood_field", "occupancy_grid"]
 
 #: Cell-labelling rules of :func:`occupancy_grid`.
 RULES = ("count", "endpoints")
@@ -59,6 +62,62 @@ class OccupancyGrid:
     def __str__(self) -> str:
         return (f"Occupancy grid {self.grid.shape[0]}×{self.grid.shape[1]} ({self.rule}): "
                 f"{int((self.grid == OBSTACLE).sum())} obstacle, {int((self.grid == FREE).sum())} free cells")
+
+
+def free_space_samples(bearings_rad, ranges, hit, *, step_cells: float, hit_margin_cells: float = 0.0,
+                       misses: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Points every ``step_cells`` along each beam through the free space before its end (ours; 004 §7's free cells).
+
+    A beam with a return (``hit``) is sampled at ``t = 0, step, 2·step, …`` while
+    ``t < range − hit_margin_cells − 10⁻⁶`` (just short of the return, so a range that ends on a cell's face does
+    not sample the cell behind it); a beam without a return over ``t < range`` when ``misses``, else not at all.
+    The one beam sampler of the 2-D layer: :func:`occupancy_grid` votes "pass" in the cells of these points,
+    correlation localisation marks them ``a_c`` in its stamps (:func:`slamlab.correlation.scan_stamps`).
+
+    Parameters
+    ----------
+    bearings_rad : array_like, shape (n,)
+        Beam directions [rad], in the frame the points are wanted in.
+    ranges : array_like, shape (n,)
+        Beam lengths [cells] (or any unit of ``step_cells``), at least 0.
+    hit : array_like of bool, shape (n,)
+        Beams with a return.
+    step_cells : float
+        Spacing of the samples along a beam (> 0), in the unit of ``ranges``.
+    hit_margin_cells : float, default 0
+        A beam with a return stops this much before it (004's ±Δl; ≥ 0).
+    misses : bool, default True
+        Sample beams without a return over their whole range.
+
+    Returns
+    -------
+    points : numpy.ndarray, shape (k, 2)
+        ``t·(cos α, sin α)`` of each sample, relative to the beams' origin; ordered by beam, then by ``t``.
+    beam : numpy.ndarray of int, shape (k,)
+        The index of each sample's beam.
+
+    Examples
+    --------
+    >>> pts, beam = free_space_samples([0.0, np.pi / 2], [1.5, 1.0], [True, False], step_cells=0.5)
+    >>> pts.round(12).tolist(), beam.tolist()
+    ([[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.5]], [0, 0, 0, 1, 1])
+    """
+    a = as_vector(bearings_rad, "bearings_rad")
+    r = as_vector(ranges, "ranges", a.size)
+    if np.any(r < 0):
+        raise ValueError(f"`ranges` must be >= 0; got minimum {r.min()}")
+    h = np.asarray(hit)
+    if h.dtype != bool or h.shape != a.shape:
+        raise ValueError(f"`hit` must be a bool array of shape {a.shape}; got {h.dtype} {h.shape}")
+    step = check_positive(step_cells, "step_cells")
+    margin = check_positive(hit_margin_cells, "hit_margin_cells", allow_zero=True)
+    if not isinstance(misses, (bool, np.bool_)):
+        raise TypeError(f"`misses` must be a bool; got {type(misses).__name__}")
+    length = np.where(h, np.maximum(r - margin - 1e-6, 0.0), r if misses else 0.0)
+    t = step * np.arange(int(np.ceil(float(length.max()) / step)) + 1 if length.size else 1)
+    beam, k = np.nonzero(t[None, :] < length[:, None])
+    d = t[k]
+    return np.column_stack([d * np.cos(a[beam]), d * np.sin(a[beam])]), beam
 
 
 def _beam_table(scans, P):
@@ -135,13 +194,13 @@ def occupancy_grid(scans: Sequence[Scan], poses, shape: tuple[int, int], *, rule
     P = check_poses(poses, "poses", n=len(scans))
     if not (isinstance(shape, tuple) and len(shape) == 2):
         raise TypeError(f"`shape` must be a (rows, cols) tuple; got {shape!r}")
-    n_rows = v.check_int(shape[0], "shape[0]", minimum=1)
-    n_cols = v.check_int(shape[1], "shape[1]", minimum=1)
-    rule = v.check_choice(rule, "rule", RULES)
-    ratio = v.check_positive(hit_ratio, "hit_ratio")
-    min_hits = v.check_int(min_hits, "min_hits", minimum=1)
-    st = v.check_positive(step_cells, "step_cells")
-    off = v.check_positive(hit_offset_cells, "hit_offset_cells", allow_zero=True)
+    n_rows = check_int(shape[0], "shape[0]", minimum=1)
+    n_cols = check_int(shape[1], "shape[1]", minimum=1)
+    rule = check_choice(rule, "rule", RULES)
+    ratio = check_positive(hit_ratio, "hit_ratio")
+    min_hits = check_int(min_hits, "min_hits", minimum=1)
+    st = check_positive(step_cells, "step_cells")
+    off = check_positive(hit_offset_cells, "hit_offset_cells", allow_zero=True)
     size = n_rows * n_cols
 
     def flat_index(x, y):
@@ -155,15 +214,11 @@ def occupancy_grid(scans: Sequence[Scan], poses, shape: tuple[int, int], *, rule
     hits = np.bincount(flat_index(x0[ok] + c[ok] * (r[ok] + off), y0[ok] + s[ok] * (r[ok] + off)), minlength=size)
     passes = np.zeros(size, dtype=np.int64)
     if rule == "count":
-        end = np.where(ok, r - 1e-6, np.where(misses_free, r, 0.0))
-        t = st * np.arange(int(np.ceil(max(float(end.max()), 0.0) / st)) + 1)
-        per = max(1, int(2e6 // t.size))
-        for b0 in range(0, r.size, per):  # bounded memory: (beams, samples) per chunk
+        per = max(1, int(2e6 // (np.ceil(float(r.max()) / st) + 1)))  # beams per chunk: bounded (beams, samples)
+        for b0 in range(0, r.size, per):
             sl = slice(b0, b0 + per)
-            m = t[None, :] < end[sl, None]
-            bi, ki = np.nonzero(m)
-            passes += np.bincount(flat_index(x0[sl][bi] + c[sl][bi] * t[ki], y0[sl][bi] + s[sl][bi] * t[ki]),
-                                  minlength=size)
+            pts, beam = free_space_samples(th[sl], r[sl], ok[sl], step_cells=st, misses=bool(misses_free))
+            passes += np.bincount(flat_index(x0[sl][beam] + pts[:, 0], y0[sl][beam] + pts[:, 1]), minlength=size)
     hits, passes = hits.reshape(n_rows, n_cols), passes.reshape(n_rows, n_cols)
     return OccupancyGrid(label_counts(hits, passes, rule=rule, hit_ratio=ratio, min_hits=min_hits), hits, passes,
                          rule)
@@ -196,7 +251,7 @@ def label_counts(hits, passes, *, rule: str = "count", hit_ratio: float = 0.25, 
     >>> label_counts(np.array([[0, 1, 1]]), np.array([[0, 2, 8]])).tolist()
     [[-1, 1, 0]]
     """
-    rule = v.check_choice(rule, "rule", RULES)
+    rule = check_choice(rule, "rule", RULES)
     hits = np.asarray(hits)
     passes = np.asarray(passes)
     if hits.shape != passes.shape:
@@ -238,8 +293,8 @@ def likelihood_field(grid, *, cell_m: float = 1.0, max_dist: float | None = None
     [[0.0, 0.5, 1.0, 1.5, 1.5]]
     """
     g = check_grid(grid)
-    cell = v.check_positive(cell_m, "cell_m")
-    clip = np.inf if max_dist is None else v.check_positive(max_dist, "max_dist", allow_zero=True)
+    cell = check_positive(cell_m, "cell_m")
+    clip = np.inf if max_dist is None else check_positive(max_dist, "max_dist", allow_zero=True)
     obstacle = g == OBSTACLE
     if not obstacle.any():
         return np.full(g.shape, clip, dtype=float)

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_vector, check_positive
 from ..geometry.se2 import check_pose, check_poses
 from .grid import OBSTACLE, check_grid
 
@@ -68,8 +68,8 @@ def cast_rays(grid, poses, angles_rad, max_range: float) -> tuple[np.ndarray, np
     g = check_grid(grid)
     one = np.ndim(poses) == 1
     P = check_pose(poses, "poses")[None, :] if one else check_poses(poses, "poses")
-    ang = v.as_vector(angles_rad, "angles_rad")
-    rmax = v.check_positive(max_range, "max_range")
+    ang = as_vector(angles_rad, "angles_rad")
+    rmax = check_positive(max_range, "max_range")
     H, W = g.shape
     solid = (g == OBSTACLE).ravel()
     # one ray per pose × beam: origin, direction, the cell it starts in, its steps ±1

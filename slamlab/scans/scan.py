@@ -31,7 +31,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_vector, check_choice, check_positive
 from ..geometry.se2 import check_pose, se2_transform
 
 __all__ = ["UNITS", "Scan", "scan_to_points"]
@@ -86,8 +86,8 @@ class Scan:
     pose: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
-        b = v.as_vector(self.bearings_rad, "bearings_rad")
-        r = v.as_vector(self.ranges, "ranges")
+        b = as_vector(self.bearings_rad, "bearings_rad")
+        r = as_vector(self.ranges, "ranges")
         if b.shape != r.shape:
             raise ValueError(f"`bearings_rad` and `ranges` must have the same length; got {b.size} and {r.size}")
         if np.any(r < 0):
@@ -95,7 +95,7 @@ class Scan:
         ok = np.asarray(self.valid)
         if ok.dtype != bool or ok.shape != b.shape:
             raise ValueError(f"`valid` must be a bool array of shape {b.shape}; got {ok.dtype} {ok.shape}")
-        unit = v.check_choice(self.unit, "unit", UNITS)
+        unit = check_choice(self.unit, "unit", UNITS)
         rmax = float(self.max_range)
         if not rmax > 0:
             raise ValueError(f"`max_range` must be > 0; got {self.max_range!r}")
@@ -162,7 +162,7 @@ class Scan:
         >>> Scan([0.0], [0.5], [True], unit="m", max_range=4.0).to_cells(0.1).ranges.tolist()
         [5.0]
         """
-        cell = v.check_positive(cell_m, "cell_m")
+        cell = check_positive(cell_m, "cell_m")
         return self if self.unit == "cell" else self._scaled(1.0 / cell, "cell")
 
     def to_metres(self, cell_m: float) -> Scan:
@@ -178,7 +178,7 @@ class Scan:
         Scan
             The scan with ``unit="m"``.
         """
-        cell = v.check_positive(cell_m, "cell_m")
+        cell = check_positive(cell_m, "cell_m")
         return self if self.unit == "m" else self._scaled(cell, "m")
 
 
@@ -202,8 +202,8 @@ def scan_to_points(bearings_rad, ranges, pose=None, valid=None) -> np.ndarray:
     >>> scan_to_points([0.0, np.pi / 2], [2.0, 3.0], [1.0, 1.0, 0.0]).round(12).tolist()
     [[3.0, 1.0], [1.0, 4.0]]
     """
-    a = v.as_vector(bearings_rad, "bearings_rad")
-    rr = v.as_vector(ranges, "ranges")
+    a = as_vector(bearings_rad, "bearings_rad")
+    rr = as_vector(ranges, "ranges")
     if a.shape != rr.shape:
         raise ValueError(f"`bearings_rad` and `ranges` must have the same length; got {a.size} and {rr.size}")
     p = np.zeros(3) if pose is None else check_pose(pose)

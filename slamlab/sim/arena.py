@@ -21,8 +21,8 @@ import functools
 
 import numpy as np
 
-from .. import _validate as v
 from .._threads import run_tasks
+from .._validate import as_finite_array, as_matrix, as_rng, as_vector, check_int, check_positive
 from ..geometry.camera import PinholeCamera, StereoRig, rotation_xyz
 from ..geometry.se3 import rotate_components, se3, se3_from_planar
 from .textures import lunar_texture
@@ -155,14 +155,14 @@ class StereoArena:
         sky: float = 0.12,
         texture_seed: int = 0,
     ):
-        self.width_m = v.check_positive(width_m, "width_m")
-        self.length_m = v.check_positive(length_m, "length_m")
-        self.fence_height_m = v.check_positive(fence_height_m, "fence_height_m")
-        self.texel_m = v.check_positive(texel_m, "texel_m")
-        self.floor_texel_m = v.check_positive(floor_texel_m, "floor_texel_m")
-        self.floor_contrast = v.check_positive(floor_contrast, "floor_contrast")
-        self.sky = float(np.clip(v.check_positive(sky, "sky", allow_zero=True), 0.0, 1.0))
-        self.seed = v.check_int(texture_seed, "texture_seed", minimum=0)
+        self.width_m = check_positive(width_m, "width_m")
+        self.length_m = check_positive(length_m, "length_m")
+        self.fence_height_m = check_positive(fence_height_m, "fence_height_m")
+        self.texel_m = check_positive(texel_m, "texel_m")
+        self.floor_texel_m = check_positive(floor_texel_m, "floor_texel_m")
+        self.floor_contrast = check_positive(floor_contrast, "floor_contrast")
+        self.sky = float(np.clip(check_positive(sky, "sky", allow_zero=True), 0.0, 1.0))
+        self.seed = check_int(texture_seed, "texture_seed", minimum=0)
         self.wall_texture, self.floor_texture, self._wall_mips, self._floor_mips = _arena_textures(
             self.width_m, self.length_m, self.fence_height_m, self.texel_m, self.floor_texel_m, self.floor_contrast,
             self.seed)
@@ -185,7 +185,7 @@ class StereoArena:
         -------
         numpy.ndarray of bool, shape (N,)
         """
-        xy = v.as_finite_array(xy_m, "xy_m", ndim=2)
+        xy = as_finite_array(xy_m, "xy_m", ndim=2)
         return (xy[:, 0] > 0) & (xy[:, 0] < self.width_m) & (xy[:, 1] > 0) & (xy[:, 1] < self.length_m)
 
     def _rays(self, camera: PinholeCamera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -226,7 +226,7 @@ class StereoArena:
         """``surface``, ``t``, the world ray directions ``(dx, dy, dz)`` (float32) and the camera centre ``o``."""
         if not isinstance(camera, PinholeCamera):
             raise TypeError(f"`camera` must be a PinholeCamera; got {type(camera).__name__}")
-        T = v.as_matrix(T_world_cam, "T_world_cam", (4, 4))
+        T = as_matrix(T_world_cam, "T_world_cam", (4, 4))
         o = T[:3, 3]
         if not (0 < o[0] < self.width_m and 0 < o[1] < self.length_m and o[2] > 0):
             raise ValueError(f"the camera must be inside the arena above the floor; got position {np.round(o, 3).tolist()}")
@@ -260,7 +260,7 @@ class StereoArena:
         numpy.ndarray, shape (N,)
             Arc length [m].
         """
-        P = v.as_finite_array(points_m, "points_m", ndim=2)
+        P = as_finite_array(points_m, "points_m", ndim=2)
         return self._wall_coordinate(P[:, 0], P[:, 1])[0]
 
     def _wall_coordinate(self, x, y):
@@ -360,12 +360,12 @@ class StereoSim:
         self.rig = StereoRig.parallel() if rig is None else rig
         if not isinstance(self.rig, StereoRig):
             raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
-        self.camera_height_m = v.check_positive(camera_height_m, "camera_height_m")
+        self.camera_height_m = check_positive(camera_height_m, "camera_height_m")
         if self.camera_height_m >= arena.fence_height_m * 4:
             raise ValueError(f"`camera_height_m` must be below {4 * arena.fence_height_m} m; got {camera_height_m}")
-        self.noise_std = v.check_positive(noise_std, "noise_std", allow_zero=True)
-        self.drift_std_rad = v.check_positive(drift_std_rad, "drift_std_rad", allow_zero=True)
-        self.rng = v.as_rng(rng)
+        self.noise_std = check_positive(noise_std, "noise_std", allow_zero=True)
+        self.drift_std_rad = check_positive(drift_std_rad, "drift_std_rad", allow_zero=True)
+        self.rng = as_rng(rng)
         self.drift_rad = np.zeros(3)
         # left camera: baseline/2 to the left of the body origin; right camera from the rig
         b = self.rig.baseline_m
@@ -401,7 +401,7 @@ class StereoSim:
         -------
         left, right : numpy.ndarray of uint8, shape (H, W)
         """
-        pose = v.as_vector(pose, "pose", 3)
+        pose = as_vector(pose, "pose", 3)
         T_wb = se3_from_planar(*pose)
         if self.drift_std_rad > 0:
             self.drift_rad = self.drift_rad + self.rng.normal(0.0, self.drift_std_rad, 3)
@@ -428,4 +428,4 @@ class StereoSim:
         -------
         numpy.ndarray, shape (4, 4)
         """
-        return se3_from_planar(*v.as_vector(pose, "pose", 3))
+        return se3_from_planar(*as_vector(pose, "pose", 3))

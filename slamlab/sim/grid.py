@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import check_int
 from ..scans.grid import (
     CHAR_CODES,
     FREE,
@@ -95,7 +95,7 @@ def free_cells(grid, margin_cells: int = 0) -> np.ndarray:
     [[2, 2]]
     """
     g = check_grid(grid)
-    m = v.check_int(margin_cells, "margin_cells", minimum=0)
+    m = check_int(margin_cells, "margin_cells", minimum=0)
     ok = g == FREE
     if m:
         # erosion by a (2m+1)² square, separable, via cumulative sums; outside the grid counts as not free

@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_rng, as_vector, check_int, check_positive
 from ..features.base import Features
-from ..geometry.camera import PinholeCamera, StereoRig
+from ..geometry.camera import PinholeCamera, StereoRig, project_points
 from ..geometry.se3 import se3_from_planar
 from .arena import R_BODY_CAM
 
@@ -64,8 +64,8 @@ def highway_path(n_frames: int = 51, *, step_m: float = 1.0, curvature_per_m: fl
     >>> p.tolist()
     [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
     """
-    n = v.check_int(n_frames, "n_frames", minimum=2)
-    step = v.check_positive(step_m, "step_m")
+    n = check_int(n_frames, "n_frames", minimum=2)
+    step = check_positive(step_m, "step_m")
     kappa = float(curvature_per_m)
     if not np.isfinite(kappa):
         raise ValueError(f"`curvature_per_m` must be finite; got {curvature_per_m}")
@@ -153,27 +153,27 @@ class HighwayScene:
                  pyramid_scale: float = 1.2, level_ref_m: float | None = None, disparity_locking: float = 0.0,
                  disparity_bias_px: float = 0.0, n_oncoming: int = 0, n_ahead: int = 0, vehicle_speed: float = 1.0,
                  rng=None):
-        length = v.check_positive(length_m, "length_m")
-        spacing = v.check_positive(post_spacing_m, "post_spacing_m")
-        rails = v.as_finite_array(rail_offsets_m, "rail_offsets_m", ndim=1)
-        n_far = v.check_int(n_far, "n_far", minimum=0)
-        n_near = v.check_int(n_near, "n_near", minimum=0)
-        n_looks = v.check_int(n_post_looks, "n_post_looks", minimum=1)
-        self.pyramid_levels = v.check_int(pyramid_levels, "pyramid_levels", minimum=1)
-        self.pyramid_scale = v.check_positive(pyramid_scale, "pyramid_scale")
+        length = check_positive(length_m, "length_m")
+        spacing = check_positive(post_spacing_m, "post_spacing_m")
+        rails = as_finite_array(rail_offsets_m, "rail_offsets_m", ndim=1)
+        n_far = check_int(n_far, "n_far", minimum=0)
+        n_near = check_int(n_near, "n_near", minimum=0)
+        n_looks = check_int(n_post_looks, "n_post_looks", minimum=1)
+        self.pyramid_levels = check_int(pyramid_levels, "pyramid_levels", minimum=1)
+        self.pyramid_scale = check_positive(pyramid_scale, "pyramid_scale")
         if self.pyramid_scale <= 1:
             raise ValueError(f"`pyramid_scale` must exceed 1; got {pyramid_scale}")
-        self.level_ref_m = None if level_ref_m is None else v.check_positive(level_ref_m, "level_ref_m")
-        self.disparity_locking = v.check_positive(disparity_locking, "disparity_locking", allow_zero=True)
+        self.level_ref_m = None if level_ref_m is None else check_positive(level_ref_m, "level_ref_m")
+        self.disparity_locking = check_positive(disparity_locking, "disparity_locking", allow_zero=True)
         if self.disparity_locking > 1:
             raise ValueError(f"`disparity_locking` must be in [0, 1]; got {disparity_locking}")
         self.disparity_bias_px = float(disparity_bias_px)
         if not np.isfinite(self.disparity_bias_px):
             raise ValueError(f"`disparity_bias_px` must be finite; got {disparity_bias_px}")
-        n_oncoming = v.check_int(n_oncoming, "n_oncoming", minimum=0)
-        n_ahead = v.check_int(n_ahead, "n_ahead", minimum=0)
-        speed = v.check_positive(vehicle_speed, "vehicle_speed", allow_zero=True)
-        g = v.as_rng(rng)
+        n_oncoming = check_int(n_oncoming, "n_oncoming", minimum=0)
+        n_ahead = check_int(n_ahead, "n_ahead", minimum=0)
+        speed = check_positive(vehicle_speed, "vehicle_speed", allow_zero=True)
+        g = as_rng(rng)
         f, b, h = 718.856, 0.537, 1.65
         cam = PinholeCamera(1226, 370, f, f, 607.19, 185.22)
         self.rig = StereoRig(cam, cam, np.eye(3), np.array([-b, 0.0, 0.0]))
@@ -221,7 +221,7 @@ class HighwayScene:
         -------
         numpy.ndarray, shape (K, 3)
         """
-        x = v.as_vector(pose, "pose", 3)[0]
+        x = as_vector(pose, "pose", 3)[0]
         if not self.velocity.any():
             return self.points_m
         out = self.points_m.copy()
@@ -249,7 +249,7 @@ class HighwayScene:
         -------
         numpy.ndarray, shape (4, 4)
         """
-        x, y, yaw = v.as_vector(pose, "pose", 3)
+        x, y, yaw = as_vector(pose, "pose", 3)
         return se3_from_planar(x, y, yaw)
 
     def observe(self, pose, *, pixel_std: float = 0.3, detect_prob: float = 0.9, descriptor_noise: float = 0.05,
@@ -278,12 +278,12 @@ class HighwayScene:
         -------
         left, right : Features
         """
-        sigma = v.check_positive(pixel_std, "pixel_std", allow_zero=True)
-        p_det = v.check_positive(detect_prob, "detect_prob")
+        sigma = check_positive(pixel_std, "pixel_std", allow_zero=True)
+        p_det = check_positive(detect_prob, "detect_prob")
         if p_det > 1:
             raise ValueError(f"`detect_prob` must be in (0, 1]; got {detect_prob}")
-        d_noise = v.check_positive(descriptor_noise, "descriptor_noise", allow_zero=True)
-        g = v.as_rng(rng)
+        d_noise = check_positive(descriptor_noise, "descriptor_noise", allow_zero=True)
+        g = as_rng(rng)
         T_wl = self.ground_truth_se3(pose) @ self.T_body_left
         points = self.points_at(pose)
         level = np.zeros(len(points), int)
@@ -296,7 +296,7 @@ class HighwayScene:
             z = Xc[:, 2]
             front = z > 0.5
             uv = np.full((len(Xc), 2), -1.0)
-            uv[front] = Xc[front, :2] / z[front, None] * [cam.fx, cam.fy] + [cam.cx, cam.cy]
+            uv[front] = project_points(cam.K, Xc[front])
             uv += sigma * g.standard_normal(uv.shape)
             if uv_left is None:
                 uv_left = uv

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng, as_vector, check_int
 from ..geometry import wrap_angle
 from ..geometry.se2 import check_pose
 from .grid import free_cells
@@ -66,8 +66,8 @@ def piecewise_path(start_pose, segments: Sequence[tuple]) -> np.ndarray:
         if not (isinstance(seg, tuple) and len(seg) == 3 and seg[0] in ("turn", "line")):
             raise ValueError(f"`segments[{i}]` must be ('turn', dθ_rad, n) or ('line', length, n); got {seg!r}")
         kind, amount, n = seg
-        n = v.check_int(n, f"segments[{i}] n_steps", minimum=1)
-        amount = float(v.as_vector(amount, f"segments[{i}] amount", 1)[0])
+        n = check_int(n, f"segments[{i}] n_steps", minimum=1)
+        amount = float(as_vector(amount, f"segments[{i}] amount", 1)[0])
         k = np.arange(1, n + 1) / n
         if kind == "turn":
             pts = np.column_stack([np.full(n, p[0]), np.full(n, p[1]), p[2] + amount * k])
@@ -104,7 +104,7 @@ def path_004(n_poses: int = 121) -> np.ndarray:
     >>> P.shape, P[0].round(3).tolist(), P[-1].round(3).tolist()
     ((121, 3), [70.0, 30.0, -3.142], [150.0, 110.0, 0.0])
     """
-    n = v.check_int(n_poses, "n_poses", minimum=5)
+    n = check_int(n_poses, "n_poses", minimum=5)
     steps = np.array([s[2] for s in PATH_004_SEGMENTS], dtype=float)
     if n != 1 + int(steps.sum()):
         scaled = np.maximum(1, np.round(steps * (n - 1) / steps.sum())).astype(int)
@@ -141,11 +141,11 @@ def random_free_poses(grid, n: int, *, margin_cells: int = 3, rng=None) -> np.nd
     >>> P.shape, bool(np.all(P[:, :2] == np.round(P[:, :2])))
     ((3, 3), True)
     """
-    n = v.check_int(n, "n", minimum=1)
+    n = check_int(n, "n", minimum=1)
     cells = free_cells(grid, margin_cells)
     if cells.shape[0] == 0:
         raise ValueError(f"`grid` has no free cell at least {margin_cells} cells from an obstacle")
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     pick = cells[rng.integers(0, cells.shape[0], n)]
     heading = rng.uniform(0.0, 2 * np.pi, n)
     return np.column_stack([pick[:, 1].astype(float), pick[:, 0].astype(float), heading])

@@ -24,9 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .. import _validate as v
 from .._params import Params, param
-from .room_of_planes import _RAY_CHUNK, PlaneRoom, build_corridor, build_plane_room, cast_rays_planes
+from .._validate import as_finite_array, as_rng, as_vector, check_positive
+from ..geometry.so3 import so3_exp
+from .room_of_planes import RAY_CHUNK, PlaneRoom, build_corridor, build_plane_room, cast_rays_planes
 
 __all__ = [
     "Flight",
@@ -76,16 +77,16 @@ class PlaneScanner(Params):
     mount_m: tuple = param((0.0, 0.0, 0.1), "ours: scanner origin in the body frame")
 
     def check(self) -> None:
-        v.check_positive(self.fov_deg, "fov_deg")
+        check_positive(self.fov_deg, "fov_deg")
         if self.fov_deg > 360:
             raise ValueError(f"`fov_deg` must be <= 360; got {self.fov_deg}")
-        v.check_positive(self.step_deg, "step_deg")
-        v.check_positive(self.lines_per_s, "lines_per_s")
-        v.check_positive(self.range_max_m, "range_max_m")
-        v.check_positive(self.sigma_range_m, "sigma_range_m", allow_zero=True)
-        v.check_positive(self.intensity_gain, "intensity_gain")
-        v.check_positive(self.sigma_intensity, "sigma_intensity", allow_zero=True)
-        v.as_vector(self.mount_m, "mount_m", 3)
+        check_positive(self.step_deg, "step_deg")
+        check_positive(self.lines_per_s, "lines_per_s")
+        check_positive(self.range_max_m, "range_max_m")
+        check_positive(self.sigma_range_m, "sigma_range_m", allow_zero=True)
+        check_positive(self.intensity_gain, "intensity_gain")
+        check_positive(self.sigma_intensity, "sigma_intensity", allow_zero=True)
+        as_vector(self.mount_m, "mount_m", 3)
 
     @property
     def n_beams(self) -> int:
@@ -146,13 +147,13 @@ def quad_flight(duration_s: float = 20.0, *, rate_hz: float = 40.0, yaw_rate_deg
     >>> t, T = quad_flight(1.0); T.shape, float(t[-1])
     ((40, 4, 4), 0.975)
     """
-    duration_s = v.check_positive(duration_s, "duration_s")
-    rate_hz = v.check_positive(rate_hz, "rate_hz")
-    speed = v.check_positive(speed_m_s, "speed_m_s", allow_zero=True)
+    duration_s = check_positive(duration_s, "duration_s")
+    rate_hz = check_positive(rate_hz, "rate_hz")
+    speed = check_positive(speed_m_s, "speed_m_s", allow_zero=True)
     if waypoints_m is None:
         waypoints_m = [[2.5, 2.5, 1.5], [9.0, 3.0, 1.6], [13.0, 3.5, 1.4], [17.5, 5.0, 1.6], [17.0, 8.0, 1.5],
                        [10.0, 8.0, 1.7], [3.0, 7.5, 1.5]]
-    wp = v.as_finite_array(waypoints_m, "waypoints_m", ndim=2)
+    wp = as_finite_array(waypoints_m, "waypoints_m", ndim=2)
     if wp.shape[1] != 3 or wp.shape[0] < 2:
         raise ValueError(f"`waypoints_m` must have shape (N >= 2, 3); got {wp.shape}")
     t = np.arange(round(duration_s * rate_hz)) / rate_hz
@@ -197,15 +198,15 @@ def simulate_odometry_3d(poses, *, sigma_trans_m: float = 0.002, sigma_rot_deg: 
     -------
     numpy.ndarray, shape (N, 4, 4)
     """
-    T = v.as_finite_array(poses, "poses", ndim=3)
+    T = as_finite_array(poses, "poses", ndim=3)
     if T.shape[1:] != (4, 4):
         raise ValueError(f"`poses` must have shape (N, 4, 4); got {T.shape}")
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     n = T.shape[0]
     inc = np.linalg.inv(T[:-1]) @ T[1:]
     noise_rot = rng.normal(0.0, np.deg2rad(sigma_rot_deg), (n - 1, 3))
     noise_rot[:, 2] += np.deg2rad(bias_yaw_deg_per_step)
-    dR = Rotation.from_rotvec(noise_rot).as_matrix()
+    dR = so3_exp(noise_rot)
     inc[:, :3, :3] = inc[:, :3, :3] @ dR
     inc[:, :3, 3] += rng.normal(0.0, sigma_trans_m, (n - 1, 3)) + np.asarray(bias_m_per_step, float)
     out = np.empty_like(T)
@@ -305,12 +306,12 @@ def simulate_flight(duration_s: float = 20.0, *, room: PlaneRoom | None = None, 
     -------
     Flight
     """
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     room = build_plane_room() if room is None else room
     if not isinstance(room, PlaneRoom):
         raise TypeError(f"`room` must be a PlaneRoom; got {type(room).__name__}")
     scanner = PlaneScanner.resolve(scanner)
-    k = v.check_positive(odometry_noise, "odometry_noise", allow_zero=True)
+    k = check_positive(odometry_noise, "odometry_noise", allow_zero=True)
     t, T = quad_flight(duration_s, rate_hz=scanner.lines_per_s, yaw_rate_deg_s=yaw_rate_deg_s, speed_m_s=speed_m_s,
                        waypoints_m=waypoints_m)
     d_body = scanner_beam_directions(scanner)
@@ -319,7 +320,7 @@ def simulate_flight(duration_s: float = 20.0, *, room: PlaneRoom | None = None, 
     o_line = (T[:, :3, :3] @ np.asarray(scanner.mount_m) + T[:, :3, 3])
     r, k_plane, cos_inc = np.empty(n * b), np.empty(n * b, dtype=np.intp), np.empty(n * b)
     refl = np.zeros(n * b)
-    step = 8 * _RAY_CHUNK   # a multiple of the caster's chunk: the same chunks, less memory (60 s: 495 -> ~250 MiB)
+    step = 8 * RAY_CHUNK   # a multiple of the caster's chunk: the same chunks, less memory (60 s: 495 -> ~250 MiB)
     for a in range(0, n * b, step):
         s = slice(a, min(a + step, n * b))
         o_map = o_line[np.arange(s.start, s.stop) // b]           # each ray's origin (its line's scanner)

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng, check_int, check_positive
 from ..geometry.odometry import Odometry, simulate_odometry  # one place: geometry (re-exported here)
 from ..geometry.se2 import check_pose, check_poses
 from ..scans import Scan, check_grid
@@ -69,8 +69,8 @@ def beam_angles(n_beams: int = 360, fov_rad: float = 2 * np.pi) -> np.ndarray:
     >>> np.degrees(beam_angles(3, np.pi)).tolist()
     [-90.0, 0.0, 90.0]
     """
-    n = v.check_int(n_beams, "n_beams", minimum=1)
-    fov = v.check_positive(fov_rad, "fov_rad")
+    n = check_int(n_beams, "n_beams", minimum=1)
+    fov = check_positive(fov_rad, "fov_rad")
     if fov > 2 * np.pi + 1e-9:
         raise ValueError(f"`fov_rad` must be <= 2π; got {fov}")
     if fov >= 2 * np.pi - 1e-9:
@@ -113,9 +113,9 @@ class Rangefinder:
 
     def __post_init__(self):
         beam_angles(self.n_beams, self.fov_rad)  # validates both
-        v.check_positive(self.max_range_cells, "max_range_cells")
-        v.check_positive(self.range_std_cells, "range_std_cells", allow_zero=True)
-        v.check_positive(self.quantum_cells, "quantum_cells", allow_zero=True)
+        check_positive(self.max_range_cells, "max_range_cells")
+        check_positive(self.range_std_cells, "range_std_cells", allow_zero=True)
+        check_positive(self.quantum_cells, "quantum_cells", allow_zero=True)
 
     @property
     def angles_rad(self) -> np.ndarray:
@@ -138,7 +138,7 @@ class Rangefinder:
         -------
         numpy.ndarray, shape (n_beams,)
         """
-        rng = v.as_rng(rng)
+        rng = as_rng(rng)
         out = np.asarray(true_ranges, dtype=float).copy()
         if self.range_std_cells > 0:
             out[hit] += rng.normal(0.0, self.range_std_cells, int(np.count_nonzero(hit)))
@@ -199,5 +199,5 @@ def simulate_scans(grid, poses, rangefinder: Rangefinder | None = None, rng=None
         raise TypeError(f"`rangefinder` must be a Rangefinder; got {type(rf).__name__}")
     P = check_poses(poses)
     g = check_grid(grid)
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     return [rf.scan(g, p, rng) for p in P]

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_rng, as_vector, check_positive
 from ..geometry import angle_mean, wrap_angle
 
 __all__ = ["RangeBearingSensor", "UnicycleModel", "simulate_unicycle"]
@@ -36,9 +36,9 @@ class UnicycleModel:
     omega_std_radps: float = 0.05
 
     def __post_init__(self):
-        v.check_positive(self.dt_s, "dt_s")
-        v.check_positive(self.v_std_mps, "v_std_mps", allow_zero=True)
-        v.check_positive(self.omega_std_radps, "omega_std_radps", allow_zero=True)
+        check_positive(self.dt_s, "dt_s")
+        check_positive(self.v_std_mps, "v_std_mps", allow_zero=True)
+        check_positive(self.omega_std_radps, "omega_std_radps", allow_zero=True)
 
     @property
     def M(self) -> np.ndarray:
@@ -179,12 +179,12 @@ class RangeBearingSensor:
     bearing_std_rad: float = np.deg2rad(2.0)
 
     def __post_init__(self):
-        lm = v.as_finite_array(self.landmarks_m, "landmarks_m", ndim=2)
+        lm = as_finite_array(self.landmarks_m, "landmarks_m", ndim=2)
         if lm.shape[1] != 2 or lm.shape[0] < 1:
             raise ValueError(f"`landmarks_m` must have shape (M, 2) with M >= 1; got {lm.shape}")
         object.__setattr__(self, "landmarks_m", lm)
-        v.check_positive(self.range_std_m, "range_std_m")
-        v.check_positive(self.bearing_std_rad, "bearing_std_rad")
+        check_positive(self.range_std_m, "range_std_m")
+        check_positive(self.bearing_std_rad, "bearing_std_rad")
 
     @property
     def dim_z(self) -> int:
@@ -303,9 +303,9 @@ def simulate_unicycle(model: UnicycleModel, sensor: RangeBearingSensor, x0, cont
     X : numpy.ndarray, shape (K, 3)
     Z : numpy.ndarray, shape (K, 2M)
     """
-    rng = v.as_rng(rng)
-    x = v.as_vector(x0, "x0", 3)
-    U = v.as_finite_array(controls, "controls", ndim=2)
+    rng = as_rng(rng)
+    x = as_vector(x0, "x0", 3)
+    U = as_finite_array(controls, "controls", ndim=2)
     if U.shape[1] != 2:
         raise ValueError(f"`controls` must have shape (K, 2); got {U.shape}")
     K = U.shape[0]

@@ -8,9 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_rng, check_positive, check_probability
 
-__all__ = ["PlaneRoom", "build_corridor", "build_plane_room", "cast_rays_planes"]
+__all__ = ["RAY_CHUNK", "PlaneRoom", "build_corridor", "build_plane_room", "cast_rays_planes"]
+
+#: Rays per chunk of :func:`cast_rays_planes` (a (chunk, planes, 3) float64 temporary: ~6 MB for 15 planes). A
+#: caller that splits its own rays in multiples of it gets the same chunks, so the same results to the last bit.
+RAY_CHUNK = 16384
 
 
 @dataclass(frozen=True)
@@ -122,12 +126,12 @@ def build_plane_room(length_m: float = 20.0, width_m: float = 10.0, height_m: fl
     >>> room = build_plane_room(); len(room), float(room.half_u[0] * 2 * room.half_v[0] * 2)
     (15, 30.0)
     """
-    L = v.check_positive(length_m, "length_m")
-    W = v.check_positive(width_m, "width_m")
-    H = v.check_positive(height_m, "height_m")
-    panel_m = v.check_positive(panel_m, "panel_m")
-    lo_r, hi_r = v.check_probability(rho_low, "rho_low"), v.check_probability(rho_high, "rho_high")
-    rng = v.as_rng(rng)
+    L = check_positive(length_m, "length_m")
+    W = check_positive(width_m, "width_m")
+    H = check_positive(height_m, "height_m")
+    panel_m = check_positive(panel_m, "panel_m")
+    lo_r, hi_r = check_probability(rho_low, "rho_low"), check_probability(rho_high, "rho_high")
+    rng = as_rng(rng)
     faces = [("room " + f[0], *f[1:]) for f in _box_faces((0, 0, 0), (L, W, H), inward=True)]
     # a pillar (floor to ceiling, its top and bottom hidden) and a box on the floor (its bottom hidden)
     pil_lo, pil_hi = (0.62 * L, 0.55 * W, 0.0), (0.62 * L + 0.8, 0.55 * W + 0.8, H)
@@ -168,7 +172,7 @@ def build_corridor(length_m: float = 12.0, width_m: float = 3.0, height_m: float
     >>> c = build_corridor(); len(c), c.names
     (4, ('y-', 'y+', 'z-', 'z+'))
     """
-    L, W, H = (v.check_positive(a, n) for a, n in ((length_m, "length_m"), (width_m, "width_m"),
+    L, W, H = (check_positive(a, n) for a, n in ((length_m, "length_m"), (width_m, "width_m"),
                                                       (height_m, "height_m")))
     room = build_plane_room(L, W, H, panel_m=panel_m, rng=rng)
     keep = [i for i, n in enumerate(room.names) if n in ("room y-", "room y+", "room z-", "room z+")]
@@ -202,20 +206,17 @@ def cast_rays_planes(room: PlaneRoom, origins, directions, range_max_m: float = 
     >>> float(r[0]), room.names[k[0]], float(c[0])
     (1.0, 'room z-', 1.0)
     """
-    d = v.as_finite_array(directions, "directions", ndim=2)
+    d = as_finite_array(directions, "directions", ndim=2)
     if d.shape[1] != 3:
         raise ValueError(f"`directions` must have shape (K, 3); got {d.shape}")
-    o = v.as_finite_array(origins, "origins")
+    o = as_finite_array(origins, "origins")
     o = np.broadcast_to(o, d.shape) if o.shape == (3,) else o
     if o.shape != d.shape:
         raise ValueError(f"`origins` must have shape (3,) or {d.shape}; got {o.shape}")
-    out = [_cast_chunk(room, o[i:i + _RAY_CHUNK], d[i:i + _RAY_CHUNK], range_max_m)
-           for i in range(0, max(len(d), 1), _RAY_CHUNK)]  # chunks: the (K, P, 3) temporaries stay small
+    out = [_cast_chunk(room, o[i:i + RAY_CHUNK], d[i:i + RAY_CHUNK], range_max_m)
+           for i in range(0, max(len(d), 1), RAY_CHUNK)]  # chunks: the (K, P, 3) temporaries stay small
     return tuple(np.concatenate(parts) for parts in zip(*out, strict=True))
 
-
-#: Rays per chunk of :func:`cast_rays_planes` (a (chunk, planes, 3) float64 temporary: ~6 MB for 15 planes).
-_RAY_CHUNK = 16384
 
 
 def _cast_chunk(room: PlaneRoom, o: np.ndarray, d: np.ndarray, range_max_m: float):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_vector, check_positive
 from ..geometry import wrap_angle
 
 __all__ = [
@@ -59,9 +59,9 @@ def turn_in_place(step_rad: float = np.deg2rad(5.0), *, center_m=(3.0, 4.0), sta
     >>> np.round(np.rad2deg(p[:, 2])).tolist()
     [0.0, 90.0, 180.0, 270.0, 360.0]
     """
-    step_rad = v.check_positive(step_rad, "step_rad")
-    turns = v.check_positive(turns, "turns")
-    c = v.as_vector(center_m, "center_m", 2)
+    step_rad = check_positive(step_rad, "step_rad")
+    turns = check_positive(turns, "turns")
+    c = as_vector(center_m, "center_m", 2)
     n = int(np.ceil(turns * 2 * np.pi / step_rad - 1e-9))
     yaw = start_yaw_rad + np.minimum(np.arange(n + 1) * step_rad, turns * 2 * np.pi)
     return np.column_stack([np.full(n + 1, c[0]), np.full(n + 1, c[1]), yaw])
@@ -94,15 +94,15 @@ def waypoint_path(waypoints_m, *, step_m: float = 0.1, turn_step_rad: float = np
     >>> np.round(p, 3).tolist()
     [[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 1.571], [1.0, 0.5, 1.571], [1.0, 1.0, 1.571]]
     """
-    W = v.as_finite_array(waypoints_m, "waypoints_m", ndim=2)
+    W = as_finite_array(waypoints_m, "waypoints_m", ndim=2)
     if W.shape[0] < 2 or W.shape[1] != 2:
         raise ValueError(f"`waypoints_m` must have shape (K, 2) with K >= 2; got {W.shape}")
     seg = np.diff(W, axis=0)
     length = np.hypot(seg[:, 0], seg[:, 1])
     if np.any(length == 0):
         raise ValueError("`waypoints_m` must not repeat a point consecutively")
-    step_m = v.check_positive(step_m, "step_m")
-    turn_step_rad = v.check_positive(turn_step_rad, "turn_step_rad")
+    step_m = check_positive(step_m, "step_m")
+    turn_step_rad = check_positive(turn_step_rad, "turn_step_rad")
     headings = np.arctan2(seg[:, 1], seg[:, 0])
     yaw = headings[0] if start_yaw_rad is None else float(start_yaw_rad)
     poses = [np.array([W[0, 0], W[0, 1], yaw])]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_covariance, as_matrix, as_rng, as_vector, check_int, check_positive
 
 __all__ = ["constant_velocity_model", "simulate_linear"]
 
@@ -40,10 +40,10 @@ def constant_velocity_model(dt_s: float = 1.0, accel_std: float = 0.1, pos_std_m
     (array([[1., 1.],
            [0., 1.]]), array([[1., 0.]]))
     """
-    dt_s = v.check_positive(dt_s, "dt_s")
-    accel_std = v.check_positive(accel_std, "accel_std", allow_zero=True)
-    pos_std_m = v.check_positive(pos_std_m, "pos_std_m")
-    dims = v.check_int(dims, "dims", minimum=1, maximum=3)
+    dt_s = check_positive(dt_s, "dt_s")
+    accel_std = check_positive(accel_std, "accel_std", allow_zero=True)
+    pos_std_m = check_positive(pos_std_m, "pos_std_m")
+    dims = check_int(dims, "dims", minimum=1, maximum=3)
     F1 = np.array([[1.0, dt_s], [0.0, 1.0]])
     Q1 = accel_std**2 * np.array([[dt_s**3 / 3, dt_s**2 / 2], [dt_s**2 / 2, dt_s]])
     H1 = np.array([[1.0, 0.0]])
@@ -79,14 +79,14 @@ def simulate_linear(F, Q, H, R, x0, n_steps: int, rng=None):
     X : numpy.ndarray, shape (n_steps, n)
     Z : numpy.ndarray, shape (n_steps, m)
     """
-    rng = v.as_rng(rng)
-    x = v.as_vector(x0, "x0")
+    rng = as_rng(rng)
+    x = as_vector(x0, "x0")
     n = x.shape[0]
-    F = v.as_matrix(F, "F", (n, n))
-    Q = v.as_covariance(Q, "Q", n)
-    H = v.as_matrix(H, "H", (None, n))
-    R = v.as_covariance(R, "R", H.shape[0])
-    n_steps = v.check_int(n_steps, "n_steps", minimum=1)
+    F = as_matrix(F, "F", (n, n))
+    Q = as_covariance(Q, "Q", n)
+    H = as_matrix(H, "H", (None, n))
+    R = as_covariance(R, "R", H.shape[0])
+    n_steps = check_int(n_steps, "n_steps", minimum=1)
     W = rng.multivariate_normal(np.zeros(n), Q, size=n_steps, method="eigh")
     V = rng.multivariate_normal(np.zeros(H.shape[0]), R, size=n_steps, method="eigh")
     X = np.empty((n_steps, n))

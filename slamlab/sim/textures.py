@@ -18,7 +18,7 @@ import itertools
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_rng, as_vector, check_int, check_positive
 
 __all__ = ["crater_heightfield", "fractal_noise", "lunar_texture"]
 
@@ -29,7 +29,7 @@ BLOCK_ELEMENTS = 1 << 18
 def _shape(shape, name="shape"):
     if not isinstance(shape, tuple | list) or len(shape) != 2:
         raise ValueError(f"`{name}` must be (rows, cols); got {shape!r}")
-    return tuple(v.check_int(s, name, minimum=2) for s in shape)
+    return tuple(check_int(s, name, minimum=2) for s in shape)
 
 
 def _blocks(n: int, other: int) -> list[slice]:
@@ -64,8 +64,8 @@ def fractal_noise(shape, beta: float = 2.0, rng=None) -> np.ndarray:
     ((32, 64), 0.0, 1.0)
     """
     rows, cols = _shape(shape)
-    beta = v.check_positive(beta, "beta", allow_zero=True)
-    rng = v.as_rng(rng)
+    beta = check_positive(beta, "beta", allow_zero=True)
+    rng = as_rng(rng)
     fy = np.fft.fftfreq(rows)[:, None]
     fx = np.fft.rfftfreq(cols)[None, :]
     n_freq = fx.shape[1]
@@ -128,12 +128,12 @@ def crater_heightfield(shape, n_craters: int = 300, radius_px=(3.0, 40.0), slope
     True
     """
     rows, cols = _shape(shape)
-    n_craters = v.check_int(n_craters, "n_craters", minimum=0)
-    r_lo, r_hi = (v.check_positive(r, "radius_px") for r in v.as_vector(radius_px, "radius_px", 2))
+    n_craters = check_int(n_craters, "n_craters", minimum=0)
+    r_lo, r_hi = (check_positive(r, "radius_px") for r in as_vector(radius_px, "radius_px", 2))
     if r_hi < r_lo:
         raise ValueError(f"`radius_px` must be (min, max) with min <= max; got {tuple(radius_px)}")
-    slope = v.check_positive(slope, "slope")
-    rng = v.as_rng(rng)
+    slope = check_positive(slope, "slope")
+    rng = as_rng(rng)
     h = np.zeros((rows, cols))
     if n_craters == 0:
         return h
@@ -236,9 +236,9 @@ def lunar_texture(
     True
     """
     rows, cols = _shape(shape)
-    noise_amp_px = v.check_positive(noise_amp_px, "noise_amp_px", allow_zero=True)
-    contrast = v.check_positive(contrast, "contrast")
-    rng = v.as_rng(rng)
+    noise_amp_px = check_positive(noise_amp_px, "noise_amp_px", allow_zero=True)
+    contrast = check_positive(contrast, "contrast")
+    rng = as_rng(rng)
     r_noise, r_crater, r_albedo = rng.spawn(3)
     h = fractal_noise((rows, cols), noise_beta, r_noise)
     h *= noise_amp_px

@@ -7,7 +7,7 @@ Plots load on first use.
 """
 
 from .._lazy import lazy_exports
-from .noise_estimate import disparity_noise_px, robust_pixel_std, stereo_residuals_px
+from .noise_estimate import disparity_noise_px, disparity_residuals_px, robust_pixel_std, stereo_residuals_px
 from .params import STEREO_DETECTORS, RenderParams, StereoParams
 from .slam import STAGES, FrameRecord, StereoSLAM, default_store
 from .stages import (
@@ -16,8 +16,11 @@ from .stages import (
     PoseEstimate,
     StereoMatches,
     detect_features,
+    detect_pair,
     estimate_pose,
     is_rectified,
+    match_in_window,
+    match_to_landmarks,
     match_to_map,
     pose_std,
     refine_pose_stereo,
@@ -44,9 +47,13 @@ __all__ = [
     "StereoSLAM",
     "default_store",
     "detect_features",
+    "detect_pair",
     "disparity_noise_px",
+    "disparity_residuals_px",
     "estimate_pose",
     "is_rectified",
+    "match_in_window",
+    "match_to_landmarks",
     "match_to_map",
     "pose_std",
     "refine_pose_stereo",

@@ -1,6 +1,9 @@
-"""The two nearest targets of each query among candidate pairs, by descriptor distance (000 §3.3-3.4): the numpy
-versions of the stereo matching's and the window search's two-nearest selection, and the dispatch of binary
-descriptors to the compiled kernel. Split from :mod:`slamlab.stereo.local_stages` (module size)."""
+"""The two nearest targets of each query among candidate pairs, by descriptor distance (000 §3.3-3.4).
+
+Package-private machinery of the stereo matching (:mod:`slamlab.stereo.local_stages`) and the map matching
+(:mod:`slamlab.stereo.map_stages`): the numpy two-nearest selection, the descriptor distances of pairs, and the
+dispatch of binary descriptors to the compiled kernel. The module's underscore marks its names private.
+"""
 
 from __future__ import annotations
 
@@ -9,10 +12,12 @@ import numpy as np
 from .._compiled import numba_enabled
 from .window_kernel import ranges_hamming_2nn
 
+__all__ = ["pair_distances", "pairs_two_nearest", "two_nearest"]
 
-def _pairs_two_nearest(A, B, qi, ti):
+
+def pairs_two_nearest(A, B, qi, ti):
     """Nearest and second-nearest target of each query among the candidate pairs ``(qi, ti)`` (grouped by
-    ascending query index), by descriptor distance: ``(query, nearest, d1, d2, second)`` as :func:`_two_nearest`.
+    ascending query index), by descriptor distance: ``(query, nearest, d1, d2, second)`` as :func:`two_nearest`.
     Binary descriptors take the compiled kernel when numba is enabled (same result, tested), otherwise numpy."""
     if A.dtype == np.uint8 and A.shape[1] % 8 == 0 and numba_enabled():
         cnt = np.bincount(qi, minlength=len(A))
@@ -20,10 +25,10 @@ def _pairs_two_nearest(A, B, qi, ti):
         r1, d1, d2, r2 = ranges_hamming_2nn(A.view(np.uint64), B.view(np.uint64), ti, hi - cnt, hi)
         q = np.flatnonzero(r1 >= 0)
         return q, r1[q], d1[q], d2[q], r2[q]
-    return _two_nearest(qi, ti, _pair_distances(A, B, qi, ti))
+    return two_nearest(qi, ti, pair_distances(A, B, qi, ti))
 
 
-def _two_nearest(qi, ti, d):
+def two_nearest(qi, ti, d):
     """Nearest and second-nearest target of each query from candidate pairs ``(qi, ti)`` with distances
     ``d``, the pairs grouped by ascending query index: ``(query, nearest, d1, d2, second)``, one row per
     query with candidates (``d2 = inf`` and ``second = -1`` for a single candidate; with a tie, d2 = d1)."""
@@ -42,7 +47,7 @@ def _two_nearest(qi, ti, d):
     return qi[first_min], ti[first_min], d1, d2, second
 
 
-def _pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
+def pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
     """Descriptor distance of each pair ``(A[ia], B[ib])``: Hamming for uint8, Euclidean otherwise."""
     out = np.empty(ia.size)
     for s0 in range(0, ia.size, block):

@@ -2,6 +2,8 @@
 observation covariance, the gated update in the map frame or in the stereo pixels, the landmarks in view.
 
 The maths of :class:`slamlab.stereo.StereoSLAM`'s map update, as functions on arrays (the class keeps the state).
+They run on every frame and check only what the loop does not (shapes of their own making): give them
+finite arrays of the documented shapes.
 """
 
 from __future__ import annotations
@@ -9,55 +11,159 @@ from __future__ import annotations
 import numpy as np
 
 from ..filters.landmark import landmark_predict, landmark_update
+from ..geometry.camera import PinholeCamera, StereoRig
 from .local_stages import stereo_point_cov
-from .pose_stages import _stereo_project
+from .params import StereoParams
 
-__all__: list[str] = []
+__all__ = ["duplicate_mask", "gated_update", "in_view", "landmark_observations", "pixel_update"]
 
 
-def _observations(pts_body, cov_body, T_body, T_body_left, rig, p, true_cam=None, X_map=None):
-    """The map-frame observations ``Z`` of landmarks ``X_map`` by this frame's points ``pts_body`` (covariances
-    ``cov_body``, body frame) at body pose ``T_body``: ``(Z, pose_var, Rz)``, ``pose_var`` the pose's variance per
-    point [m²] (``params.pose_std_m``, ``pose_std_rad``), ``Rz`` the ``(K, 3, 3)`` covariances
-    (``params.update_cov_depth``): 'measured' the points' own, 'map' the stereo covariance at the landmark seen
-    from the pose, 'true' at the point's true left-camera position ``true_cam`` (the ablation oracle); each plus
-    ``pose_var`` per axis."""
+def landmark_observations(points_body, cov_body, T_body, T_body_left, rig: StereoRig, *, true_cam=None,
+                          landmarks_map=None, params: StereoParams | None = None, **overrides):
+    """Map-frame observations of landmarks by this frame's stereo points, with their covariances (000 §3.6; issue 25).
+
+    ``Z = R p + t`` for the points ``p`` at body pose ``T_body``; the pose's own uncertainty adds
+    ``pose_var = pose_std_m² + (pose_std_rad |p|)²`` per axis. The covariance's depth comes from
+    ``update_cov_depth``: 'measured' the points' own covariances ``cov_body``; 'map' the stereo covariance at the
+    landmark (``landmarks_map``) seen from the pose, not at the measured point, so that a measurement's weight
+    does not depend on its own error; 'true' at the point's true left-camera position ``true_cam`` (an ablation
+    oracle).
+
+    Parameters
+    ----------
+    points_body : numpy.ndarray, shape (K, 3)
+        The frame's stereo points in the body frame [m].
+    cov_body : numpy.ndarray, shape (K, 3, 3)
+        Their covariances [m²].
+    T_body : numpy.ndarray, shape (4, 4)
+        Body pose in the map.
+    T_body_left : numpy.ndarray, shape (4, 4)
+        Left camera in the body frame.
+    rig : StereoRig
+        The calibrated pair (focal length and baseline of the stereo covariance).
+    true_cam : numpy.ndarray, shape (K, 3), optional
+        True left-camera positions of the points (``update_cov_depth='true'`` only).
+    landmarks_map : numpy.ndarray, shape (K, 3), optional
+        The matched landmarks in the map frame (``update_cov_depth='map'`` only).
+    params : StereoParams, optional
+        Pipeline settings (``update_cov_depth``, ``pose_std_m``, ``pose_std_rad``, ``pixel_std``, ``min_depth_m``).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    Z : numpy.ndarray, shape (K, 3)
+        Observations in the map frame [m].
+    pose_var : numpy.ndarray, shape (K,)
+        The pose's variance per point and axis [m²].
+    Rz : numpy.ndarray, shape (K, 3, 3)
+        Their covariances [m²], ``pose_var`` included.
+
+    Examples
+    --------
+    >>> Z, pose_var, Rz = landmark_observations(np.array([[0.0, 0.0, 2.0]]), np.eye(3)[None] * 1e-4, np.eye(4),
+    ...                                         np.eye(4), StereoRig.parallel(), pose_std_m=0.0, pose_std_rad=0.0)
+    >>> Z.tolist(), pose_var.tolist(), float(Rz[0, 0, 0])
+    ([[0.0, 0.0, 2.0]], [0.0], 0.0001)
+    """
+    p = StereoParams.resolve(params, **overrides)
     R, t = T_body[:3, :3], T_body[:3, 3]
-    Z = pts_body @ R.T + t
-    pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(pts_body, axis=1)) ** 2
-    depth_source, pixel_std, min_depth_m = p.update_cov_depth, p.pixel_std, p.min_depth_m
-    if depth_source == "true":  # the ablation oracle: the covariance at the point's true position
+    Z = points_body @ R.T + t
+    pose_var = p.pose_std_m**2 + (p.pose_std_rad * np.linalg.norm(points_body, axis=1)) ** 2
+    if p.update_cov_depth == "true":  # the ablation oracle: the covariance at the point's true position
+        if true_cam is None:
+            raise ValueError("`true_cam` is needed with update_cov_depth='true'")
         Rwc = (T_body @ T_body_left)[:3, :3]
-        Rz = Rwc @ stereo_point_cov(true_cam, rig.left.fx, rig.baseline_m, pixel_std) @ Rwc.T
+        Rz = Rwc @ stereo_point_cov(true_cam, rig.left.fx, rig.baseline_m, p.pixel_std) @ Rwc.T
         Rz += pose_var[:, None, None] * np.eye(3)
-    elif depth_source == "map":
+    elif p.update_cov_depth == "map":
         # the observation's covariance at the landmark's position seen from the new pose, not at the
         # measured one: a measurement's weight then does not depend on its own error (issue 25)
+        if landmarks_map is None:
+            raise ValueError("`landmarks_map` is needed with update_cov_depth='map'")
         T_wc = T_body @ T_body_left
-        Xc = (X_map - T_wc[:3, 3]) @ T_wc[:3, :3]
-        Xc[:, 2] = np.maximum(Xc[:, 2], min_depth_m)
+        Xc = (landmarks_map - T_wc[:3, 3]) @ T_wc[:3, :3]
+        Xc[:, 2] = np.maximum(Xc[:, 2], p.min_depth_m)
         Rwc = T_wc[:3, :3]
-        Rz = Rwc @ stereo_point_cov(Xc, rig.left.fx, rig.baseline_m, pixel_std) @ Rwc.T
+        Rz = Rwc @ stereo_point_cov(Xc, rig.left.fx, rig.baseline_m, p.pixel_std) @ Rwc.T
         Rz += pose_var[:, None, None] * np.eye(3)
     else:
         Rz = R @ cov_body @ R.T + pose_var[:, None, None] * np.eye(3)
     return Z, pose_var, Rz
 
 
-def _duplicates(pts_body, nearest, X, T_body, gap_m):
-    """Mask of the body-frame points ``pts_body`` whose nearest landmark by descriptor (``nearest``, -1: none)
-    lies within ``gap_m`` of them in the map at body pose ``T_body``: that landmark again (``duplicate_gap_m``)."""
+def duplicate_mask(points_body, nearest, landmarks_map, T_body, gap_m: float) -> np.ndarray:
+    """Mask of the points whose nearest landmark by descriptor lies within ``gap_m`` of them (ours, ``duplicate_gap_m``).
+
+    Such a point is that landmark seen again (its match was missed), not a new landmark.
+
+    Parameters
+    ----------
+    points_body : numpy.ndarray, shape (K, 3)
+        Unmatched points of the frame in the body frame [m].
+    nearest : numpy.ndarray of int, shape (K,)
+        Each point's nearest landmark id by descriptor (-1: none).
+    landmarks_map : numpy.ndarray, shape (n, 3)
+        Landmark positions by id in the map frame [m].
+    T_body : numpy.ndarray, shape (4, 4)
+        Body pose in the map.
+    gap_m : float
+        Largest distance of a duplicate [m].
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (K,)
+
+    Examples
+    --------
+    >>> duplicate_mask(np.array([[0.0, 0, 1], [5.0, 0, 1]]), np.array([0, -1]), np.array([[0.01, 0, 1]]),
+    ...                np.eye(4), 0.05).tolist()
+    [True, False]
+    """
     R, t = T_body[:3, :3], T_body[:3, 3]
     has = nearest >= 0
     gap = np.full(len(nearest), np.inf)
-    gap[has] = np.linalg.norm(pts_body[has] @ R.T + t - X[nearest[has]], axis=1)
+    gap[has] = np.linalg.norm(points_body[has] @ R.T + t - landmarks_map[nearest[has]], axis=1)
     return gap <= gap_m
 
 
-def _gated_update(X, P, Z, Rz, state_var, gate):
-    """The static-landmark Kalman update of landmarks ``X`` (covariances ``P``) by map-frame observations ``Z``
-    (``Rz``) (000 §3.6), observations whose innovation's Mahalanobis² exceeds ``gate`` (None: none) left out.
-    ``(ok, X_new, P_new)``: the mask of the updated landmarks and their new means and covariances."""
+def gated_update(X, P, Z, Rz, state_var: float, gate: float | None):
+    """The static-landmark Kalman update of 000 §3.6, with an innovation gate (ours, ``update_gate``).
+
+    Each landmark ``X`` (covariance ``P``) is predicted with process variance ``state_var`` and updated by its
+    map-frame observation ``Z`` (covariance ``Rz``); observations whose innovation's Mahalanobis² exceeds
+    ``gate`` are left out (their landmark unchanged).
+
+    Parameters
+    ----------
+    X : numpy.ndarray, shape (M, 3)
+        Landmark positions [m].
+    P : numpy.ndarray, shape (M, 3, 3)
+        Their covariances [m²].
+    Z : numpy.ndarray, shape (M, 3)
+        Observations [m].
+    Rz : numpy.ndarray, shape (M, 3, 3)
+        Their covariances [m²].
+    state_var : float
+        Process variance per axis [m²].
+    gate : float or None
+        Largest Mahalanobis² of an innovation (None: no gate).
+
+    Returns
+    -------
+    ok : numpy.ndarray of bool, shape (M,)
+        The updated landmarks.
+    X_new : numpy.ndarray, shape (M_ok, 3)
+        Their new positions.
+    P_new : numpy.ndarray, shape (M_ok, 3, 3)
+        Their new covariances.
+
+    Examples
+    --------
+    >>> ok, X_new, P_new = gated_update(np.zeros((1, 3)), np.eye(3)[None], np.ones((1, 3)), np.eye(3)[None], 0.0, None)
+    >>> ok.tolist(), X_new.tolist()
+    ([True], [[0.5, 0.5, 0.5]])
+    """
     P_pred = landmark_predict(P, state_var)
     ok = np.ones(len(X), dtype=bool)
     if gate is not None and len(X):
@@ -67,22 +173,56 @@ def _gated_update(X, P, Z, Rz, state_var, gate):
     return ok, X_new, P_new
 
 
-def _pixel_update(X, P, pts_left, T_wc, pose_var, rig, state_var, pixel_std, min_depth_m, gate):
-    """``filter_space='pixels'`` (our option; issue 25): the static-landmark Kalman update of 000 §3.6 in the
-    stereo pixels ``(u_l, v_l, u_r)`` of the left camera at ``T_wc``, where every observation has the same
-    noise ``pixel_std`` (plus the pose's, ``pose_var`` m² per point): the landmark's mean (``X``, map frame) is
-    projected there exactly, its covariance ``P`` through the projection's Jacobian, the fused pixels are
-    triangulated back. Weights then do not depend on a noisy depth and the disparities are averaged (unbiased
-    for Gaussian pixel noise, where depths are not). Rectified rigs only. ``pts_left``: this frame's points in
-    the left camera. ``(ok, X_new, P_new)`` as :func:`_gated_update` (innovation gate ``gate``)."""
+def pixel_update(X, P, points_left, T_wc, pose_var, rig: StereoRig, state_var: float, pixel_std: float,
+                 min_depth_m: float, gate: float | None):
+    """The static-landmark Kalman update of 000 §3.6 in the stereo pixels ``(u_l, v_l, u_r)`` (ours, issue 25).
+
+    ``filter_space='pixels'``: every observation has the same noise ``pixel_std`` there (plus the pose's,
+    ``pose_var`` m² per point); the landmark's mean ``X`` (map frame) is projected exactly into the left camera
+    at ``T_wc``, its covariance ``P`` through the projection's Jacobian, and the fused pixels are triangulated
+    back. Weights then do not depend on a noisy depth and the disparities are averaged (unbiased for Gaussian
+    pixel noise, where depths are not). Rectified rigs only.
+
+    Parameters
+    ----------
+    X : numpy.ndarray, shape (M, 3)
+        Landmark positions in the map frame [m].
+    P : numpy.ndarray, shape (M, 3, 3)
+        Their covariances [m²].
+    points_left : numpy.ndarray, shape (M, 3)
+        This frame's stereo points of those landmarks in the left camera frame [m].
+    T_wc : numpy.ndarray, shape (4, 4)
+        Left camera in the map.
+    pose_var : numpy.ndarray, shape (M,)
+        The pose's variance per point and axis [m²].
+    rig : StereoRig
+        The rectified pair.
+    state_var : float
+        Process variance per axis [m²].
+    pixel_std : float
+        Keypoint noise [px].
+    min_depth_m : float
+        Landmarks nearer than this to the camera (or behind it) are not updated [m].
+    gate : float or None
+        Largest Mahalanobis² of an innovation (None: no gate).
+
+    Returns
+    -------
+    ok : numpy.ndarray of bool, shape (M,)
+        The updated landmarks.
+    X_new : numpy.ndarray, shape (M_ok, 3)
+        Their new positions in the map frame.
+    P_new : numpy.ndarray, shape (M_ok, 3, 3)
+        Their new covariances.
+    """
     cam = rig.left
     R, t = T_wc[:3, :3], T_wc[:3, 3]
     P_pred = landmark_predict(P, state_var)
     Xc = (X - t) @ R
     ok = Xc[:, 2] > min_depth_m
-    h, J = _stereo_project(rig, np.where(ok[:, None], Xc, [0.0, 0.0, 1.0]))
+    h, J = rig.stereo_pixels(np.where(ok[:, None], Xc, [0.0, 0.0, 1.0]), jacobian=True)
     h, J = h[:, :3], J[:, :3]
-    z = _stereo_project(rig, pts_left)[0][:, :3]
+    z = rig.stereo_pixels(points_left)[:, :3]
     C_lm = J @ (R.T @ P_pred @ R) @ np.swapaxes(J, 1, 2)
     C_z = pixel_std**2 * np.eye(3) + pose_var[:, None, None] * (J @ np.swapaxes(J, 1, 2))
     if gate is not None and len(X):
@@ -95,15 +235,38 @@ def _pixel_update(X, P, pts_left, T_wc, pose_var, rig, state_var, pixel_std, min
     m, C = m[good], C[good]
     zc = cam.fx * rig.baseline_m / disp[good]
     Xn = np.column_stack([(m[:, 0] - cam.cx) * zc / cam.fx, (m[:, 1] - cam.cy) * zc / cam.fy, zc])
-    Ji = np.linalg.inv(_stereo_project(rig, Xn)[1][:, :3])
+    Ji = np.linalg.inv(rig.stereo_pixels(Xn, jacobian=True)[1][:, :3])
     return ok, Xn @ R.T + t, R @ (Ji @ C @ np.swapaxes(Ji, 1, 2)) @ R.T
 
 
-def _in_view(X, T_wc, cam, margin_deg, max_range_m):
-    """Mask of the points ``X`` (map frame) in front of ``cam`` at ``T_wc``, within its horizontal field of view
-    widened by ``margin_deg`` per side and at most ``max_range_m`` away."""
+def in_view(X, T_wc, camera: PinholeCamera, margin_deg: float, max_range_m: float) -> np.ndarray:
+    """Mask of the points in front of a camera, within its horizontal field of view and range (ours, ``view_margin_deg``).
+
+    Parameters
+    ----------
+    X : numpy.ndarray, shape (N, 3)
+        Points in the map frame [m].
+    T_wc : numpy.ndarray, shape (4, 4)
+        The camera in the map.
+    camera : PinholeCamera
+        Its intrinsics (the horizontal field of view from ``cx``, ``width_px`` and ``fx``).
+    margin_deg : float
+        Widening of the field of view per side [deg].
+    max_range_m : float
+        Largest distance from the camera [m].
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (N,)
+
+    Examples
+    --------
+    >>> cam = PinholeCamera(100, 80, 50.0, 50.0, 50.0, 40.0)  # 90 deg wide
+    >>> in_view(np.array([[0.0, 0, 5], [6.0, 0, 5], [0.0, 0, -5], [0.0, 0, 50]]), np.eye(4), cam, 0.0, 20.0).tolist()
+    [True, False, False, False]
+    """
     Xc = (X - T_wc[:3, 3]) @ T_wc[:3, :3]
-    half = np.arctan2(max(cam.cx, cam.width_px - cam.cx), cam.fx) + np.deg2rad(margin_deg)
+    half = np.arctan2(max(camera.cx, camera.width_px - camera.cx), camera.fx) + np.deg2rad(margin_deg)
     z = Xc[:, 2]
     keep = (z > 0) & (np.abs(np.arctan2(Xc[:, 0], z)) <= half)
     keep &= np.einsum("ij,ij->i", Xc, Xc) <= max_range_m**2

@@ -6,18 +6,19 @@ Part of :mod:`slamlab.stereo.stages` (which re-exports every name; its docstring
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
 import numpy as np
 
-from .. import _validate as v
 from .._compiled import numba_enabled
+from .._validate import as_finite_array, check_int, check_positive
 from ..features.base import Features
 from ..features.detect import detect
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.camera import StereoRig
 from ..geometry.triangulation import triangulate_stereo
-from ._pairs import _pairs_two_nearest
+from ._pairs import pairs_two_nearest
 from ._sad_kernel import MAX_SAD_TERMS, sad_costs
 from .params import StereoParams
 from .window_kernel import epipolar_hamming_2nn
@@ -25,7 +26,9 @@ from .window_kernel import epipolar_hamming_2nn
 __all__ = [
     "LocalCloud",
     "StereoMatches",
+    "check_features",
     "detect_features",
+    "detect_pair",
     "epipolar_pairs",
     "is_rectified",
     "stereo_match",
@@ -69,6 +72,46 @@ def detect_features(image, *, params: StereoParams | None = None, **overrides) -
     return detect(image, p.detector, **p.detect_kwargs())
 
 
+_EXECUTOR: ThreadPoolExecutor | None = None
+
+
+def detect_pair(left, right, *, params: StereoParams | None = None, **overrides) -> tuple[Features, Features]:
+    """Keypoints and descriptors of both images of a stereo pair with the pipeline's settings (000 §3.3).
+
+    :func:`detect_features` on each image; with ``parallel_detect`` (the default) in two threads, which gives the
+    same features in about half the time (OpenCV and numpy release the GIL).
+
+    Parameters
+    ----------
+    left, right : array_like
+        The two images, grey or colour.
+    params : StereoParams, optional
+        Pipeline settings (default :class:`StereoParams`).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    left_features, right_features : Features
+
+    Examples
+    --------
+    >>> img = (np.indices((64, 64)).sum(0) % 16 < 8).astype(np.uint8) * 255
+    >>> fl, fr = detect_pair(img, img, detector="orb", n_features=50)
+    >>> bool(np.array_equal(fl.uv, fr.uv))
+    True
+    """
+    global _EXECUTOR
+    p = StereoParams.resolve(params, **overrides)
+    kwargs = p.detect_kwargs()
+    if not p.parallel_detect:
+        return detect(left, p.detector, **kwargs), detect(right, p.detector, **kwargs)
+    if _EXECUTOR is None:
+        _EXECUTOR = ThreadPoolExecutor(max_workers=2, thread_name_prefix="slamlab-detect")
+    fut = _EXECUTOR.submit(detect, right, p.detector, **kwargs)
+    return detect(left, p.detector, **kwargs), fut.result()
+
+
 class StereoMatches(NamedTuple):
     """Indices ``left (M,)`` / ``right (M,)`` into the two keypoint sets and descriptor ``distance (M,)``.
 
@@ -85,13 +128,34 @@ class StereoMatches(NamedTuple):
     distance: np.ndarray
 
 
-def _check_features(f, name):
-    if not isinstance(f, Features):
+def check_features(features, name: str = "features") -> Features:
+    """Check that ``features`` are keypoints with descriptors, what every matching stage needs (000 §3.3-3.4).
+
+    Parameters
+    ----------
+    features : Features
+        Keypoints and descriptors (from :func:`slamlab.features.detect`).
+    name : str, default "features"
+        The argument's name in the messages.
+
+    Returns
+    -------
+    Features
+        ``features`` itself.
+
+    Raises
+    ------
+    TypeError
+        When ``features`` is not a :class:`~slamlab.features.Features`.
+    ValueError
+        When it has no descriptors.
+    """
+    if not isinstance(features, Features):
         raise TypeError(f"`{name}` must be slamlab.features.Features (from `slamlab.features.detect`); "
-                        f"got {type(f).__name__}")
-    if f.descriptors is None:
+                        f"got {type(features).__name__}")
+    if features.descriptors is None:
         raise ValueError(f"`{name}` must have descriptors (detect with descriptors=True)")
-    return f
+    return features
 
 
 def stereo_match(left: Features, right: Features, rig: StereoRig, *, params: StereoParams | None = None,
@@ -122,26 +186,22 @@ def stereo_match(left: Features, right: Features, rig: StereoRig, *, params: Ste
     StereoMatches
     """
     p = StereoParams.resolve(params, **overrides)
-    _check_features(left, "left")
-    _check_features(right, "right")
+    check_features(left, "left")
+    check_features(right, "right")
     if not isinstance(rig, StereoRig):
         raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
     if len(left.uv) and len(right.uv) and (left.descriptors.dtype != right.descriptors.dtype
                                            or left.descriptors.shape[1] != right.descriptors.shape[1]):
         raise ValueError("`left` and `right` descriptors must have the same type and length")
-    max_distance = None if max_distance is None else v.check_positive(max_distance, "max_distance")
-    return _stereo_match(left, right, rig.F, p.ratio, p.epi_tol_px, max_distance)
-
-
-def _stereo_match(left, right, F, ratio, epi_tol_px, max_distance=None) -> StereoMatches:
-    """:func:`stereo_match` on checked arguments (the per-frame core)."""
+    max_distance = None if max_distance is None else check_positive(max_distance, "max_distance")
     empty = StereoMatches(np.empty(0, np.intp), np.empty(0, np.intp), np.empty(0))
     if len(left.uv) == 0 or len(right.uv) == 0:
         return empty
-    li, ri, d1, d2, _ = _epipolar_two_nearest(left.descriptors, right.descriptors, left.uv, right.uv, F, epi_tol_px)
+    li, ri, d1, d2, _ = _epipolar_two_nearest(left.descriptors, right.descriptors, left.uv, right.uv, rig.F,
+                                              p.epi_tol_px)
     if li.size == 0:
         return empty
-    keep = ratio_rule(d1, d2, ratio)
+    keep = ratio_rule(d1, d2, p.ratio)
     if max_distance is not None:
         keep &= d1 <= max_distance
     li, ri, d1 = li[keep], ri[keep], d1[keep]
@@ -206,7 +266,7 @@ def _epipolar_ranges(uv_left, uv_right, F, tol_px):
 
 
 def _epipolar_two_nearest(A, B, uv_left, uv_right, F, tol_px):
-    """:func:`epipolar_pairs` and then ``_pairs_two_nearest`` on them: ``(query, nearest, d1, d2, second)``.
+    """:func:`epipolar_pairs` and then ``pairs_two_nearest`` on them: ``(query, nearest, d1, d2, second)``.
     Binary descriptors on a nearly rectified rig take one compiled kernel for both when numba is enabled (the
     same pairs in the same order, the same distance test; same result, tested), otherwise numpy."""
     if A.dtype == np.uint8 and A.shape[1] % 8 == 0 and len(uv_right) and numba_enabled():
@@ -220,7 +280,7 @@ def _epipolar_two_nearest(A, B, uv_left, uv_right, F, tol_px):
     li, ri = epipolar_pairs(uv_left, uv_right, F, tol_px)
     if li.size == 0:
         return li, ri, np.empty(0), np.empty(0), ri
-    return _pairs_two_nearest(A, B, li, ri)
+    return pairs_two_nearest(A, B, li, ri)
 
 
 # --- sub-pixel disparity along the rows of a rectified pair (our addition) -------------------------
@@ -285,14 +345,14 @@ def subpixel_disparity(left_image, right_image, uv_left, uv_right, *, half_px: i
     """
     from ..features.base import to_gray_uint8
 
-    h = v.check_int(half_px, "half_px", minimum=1)
-    s = v.check_int(search_px, "search_px", minimum=1)
+    h = check_int(half_px, "half_px", minimum=1)
+    s = check_int(search_px, "search_px", minimum=1)
     IL = to_gray_uint8(left_image, "left_image")
     IR = to_gray_uint8(right_image, "right_image")
     if IL.shape != IR.shape:
         raise ValueError(f"`left_image` and `right_image` must have the same shape; got {IL.shape} and {IR.shape}")
-    uvl = v.as_finite_array(uv_left, "uv_left", ndim=2)
-    uvr = v.as_finite_array(uv_right, "uv_right", ndim=2)
+    uvl = as_finite_array(uv_left, "uv_left", ndim=2)
+    uvr = as_finite_array(uv_right, "uv_right", ndim=2)
     if uvl.shape != uvr.shape or uvl.shape[1:] != (2,):
         raise ValueError(f"`uv_left` and `uv_right` must both have shape (M, 2); got {uvl.shape} and {uvr.shape}")
     return _subpixel_disparity(IL, IR, uvl, uvr, h, s)
@@ -399,8 +459,8 @@ def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: 
     p = StereoParams.resolve(params, **overrides)
     if not isinstance(rig, StereoRig):
         raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
-    _check_features(left, "left")
-    _check_features(right, "right")
+    check_features(left, "left")
+    check_features(right, "right")
     if not isinstance(matches, StereoMatches):
         raise TypeError(f"`matches` must be StereoMatches; got {type(matches).__name__}")
     if images is not None and (not isinstance(images, (tuple, list)) or len(images) != 2):

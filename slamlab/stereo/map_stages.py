@@ -1,5 +1,10 @@
-"""Stereo SLAM stage 3: local landmarks matched to the map through a store (000 §3.4); the pose (stage 4) is in
+"""Stereo SLAM stage 3: local landmarks matched to the map (000 §3.4); the pose (stage 4) is in
 :mod:`slamlab.stereo.pose_stages`.
+
+Three searches, one set of rules (2-NN by descriptor, the ratio rule, one local point per landmark):
+:func:`match_to_map` through the landmark store (000), :func:`match_to_landmarks` against a given set of
+landmarks by brute force, and :func:`match_in_window`, each point against the landmarks a predicted pose
+projects near it (the last two: the window search, our addition).
 
 Part of :mod:`slamlab.stereo.stages` (which re-exports every name; its docstring gives the pipeline's order).
 """
@@ -10,16 +15,17 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import _validate as v
 from .._compiled import numba_enabled
+from .._validate import as_finite_array, as_matrix, check_positive
 from ..features.matching import best_per_target, ratio_rule
-from ..geometry.camera import project_points
+from ..geometry.camera import PinholeCamera, project_points
+from ..kdtree.knn import exact_knn
 from ..kdtree.stores import LandmarkStore
-from ._pairs import _pair_distances, _two_nearest
+from ._pairs import pair_distances, two_nearest
 from .params import StereoParams
 from .window_kernel import window_hamming_2nn
 
-__all__ = ["MapMatches", "match_to_map"]
+__all__ = ["MapMatches", "match_in_window", "match_to_landmarks", "match_to_map"]
 
 
 # --- local landmarks to map landmarks through a store (000 §3.4) -----------------------------------
@@ -56,11 +62,11 @@ def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | No
     """Match local descriptors to the stored landmarks: 2-NN query + ratio rule, one local per landmark (000 §3.4).
 
     The ratio is ``map_ratio`` of ``params`` / ``overrides`` (:class:`StereoParams`). With
-    ``positions`` ((n, 3) landmark positions indexed by id) and ``same_point_m``, two nearest
-    landmarks closer than ``same_point_m`` to each other count as one physical point (a duplicate
-    added when a sighting was missed), so the ratio rule does not reject them (our addition:
-    without it, duplicates make every later sighting of a place ambiguous and the map stops
-    closing loops).
+    ``positions`` ((n, 3) landmark positions indexed by id) and ``same_point_m`` (in use:
+    :attr:`StereoParams.twin_gap_m`), two nearest landmarks closer than that to each other count as
+    one physical point (a duplicate added when a sighting was missed), so the ratio rule does not
+    reject them (our addition: without it, duplicates make every later sighting of a place ambiguous
+    and the map stops closing loops).
 
     With ``candidates`` (landmark ids), only those landmarks are searched
     (:meth:`~slamlab.kdtree.LandmarkStore.query_among`, exact for every store).
@@ -72,7 +78,7 @@ def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | No
     store : LandmarkStore
         The map's descriptor store.
     params : StereoParams, optional
-        Pipeline settings (``map_ratio``, ``same_point_m``).
+        Pipeline settings (``map_ratio``, ``same_point_m``, ``map_search``).
     positions : array_like, shape (n, 3), optional
         Landmark positions by id [m] (for the same-point rule).
     candidates : array_like of int, optional
@@ -95,27 +101,151 @@ def match_to_map(descriptors, store: LandmarkStore, *, params: StereoParams | No
     ([0], [7], [1])
     """
     p = StereoParams.resolve(params, **overrides)
-    D = np.asarray(descriptors)
-    if D.ndim != 2:
-        raise ValueError(f"`descriptors` must be 2-D (K, D); got shape {D.shape}")
+    D = _check_descriptors(descriptors)
     if not isinstance(store, LandmarkStore):
         raise TypeError(f"`store` must be a slamlab.kdtree.LandmarkStore; got {type(store).__name__}")
-    X = None if positions is None else v.as_finite_array(positions, "positions", ndim=2)
+    X = None if positions is None else _check_positions(positions)
     cand = None if candidates is None else np.asarray(candidates, dtype=np.int64).ravel()
-    max_distance = None if max_distance is None else v.check_positive(max_distance, "max_distance")
-    return _match_to_map(D, store, p.map_ratio, X, p.same_point_m or None, cand, max_distance)
-
-
-def _match_to_map(D, store, ratio, positions=None, same_point_m=None, candidates=None, max_distance=None):
-    """:func:`match_to_map` on checked arguments (the per-frame core)."""
+    max_distance = None if max_distance is None else check_positive(max_distance, "max_distance")
     k = D.shape[0]
     if k == 0 or len(store) == 0:
-        return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
-    if candidates is not None:
-        dist, ids = store.query_among(D, candidates, k=2)
+        return _no_matches(k)
+    if cand is not None:
+        dist, ids = store.query_among(D, cand, k=2)
     else:
         dist, ids = store.query(D, k=2)
-    return _matches_from_knn(dist, ids, ratio, positions, same_point_m, max_distance)
+    return _matches_from_knn(dist, ids, p.map_ratio, X, p.twin_gap_m, max_distance)
+
+
+def match_to_landmarks(descriptors, landmark_ids, landmark_descriptors, *, positions=None,
+                       params: StereoParams | None = None, **overrides) -> MapMatches:
+    """Match local descriptors to a given set of landmarks by brute force (our addition to 000 §3.4).
+
+    The first step of the window search (``map_search='window'``): the landmarks of the last located
+    frame, searched exactly (:func:`slamlab.kdtree.knn.exact_knn`), with the rules of
+    :func:`match_to_map` (ratio ``map_ratio``, the same-point rule, one local point per landmark).
+
+    Parameters
+    ----------
+    descriptors : array_like, shape (K, D)
+        Descriptors of the local points.
+    landmark_ids : array_like of int, shape (L,)
+        Ids of the landmarks to search.
+    landmark_descriptors : array_like, shape (L, D)
+        Their descriptors, in the order of ``landmark_ids``.
+    positions : array_like, shape (n, 3), optional
+        Landmark positions by id [m] (for the same-point rule).
+    params : StereoParams, optional
+        Pipeline settings (``map_ratio``, ``same_point_m``, ``map_search``).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    MapMatches
+
+    Examples
+    --------
+    >>> m = match_to_landmarks(np.array([[0.1, 0.0], [2.4, 0.0]]), [7, 8], np.array([[0.0, 0.0], [5.0, 0.0]]))
+    >>> m.local.tolist(), m.ids.tolist(), m.unmatched.tolist()
+    ([0], [7], [1])
+    """
+    p = StereoParams.resolve(params, **overrides)
+    D = _check_descriptors(descriptors)
+    ids = np.asarray(landmark_ids, dtype=np.int64).ravel()
+    D_lm = _check_descriptors(landmark_descriptors, "landmark_descriptors", len(ids))
+    X = None if positions is None else _check_positions(positions)
+    if len(D) == 0 or len(ids) == 0:
+        return _no_matches(len(D))
+    dist, nn = exact_knn(D, D_lm, 2, ids)
+    return _matches_from_knn(dist, nn, p.map_ratio, X, p.twin_gap_m)
+
+
+def match_in_window(descriptors, uv, landmark_ids, landmark_descriptors, positions, T_wc, camera: PinholeCamera, *,
+                    params: StereoParams | None = None, **overrides) -> tuple[MapMatches, int]:
+    """Map matching by projection (our addition to 000 §3.4): each point only against the landmarks projected near it.
+
+    The landmarks ``landmark_ids`` (positions ``positions[landmark_ids]``) are projected into ``camera`` at the
+    predicted pose ``T_wc``; those whose row lies within ``window_px`` of the image are candidates. Each local
+    point (left keypoint ``uv``, descriptor ``descriptors``) is compared only with the candidates within
+    ``window_px`` of it; the nearest and second nearest of those decide by the ratio rule ``map_ratio`` (two
+    neighbours closer than ``same_point_m`` count as one), the nearest must be within ``window_max_hamming``
+    (binary descriptors; no bound for float ones), one local point per landmark.
+
+    Parameters
+    ----------
+    descriptors : array_like, shape (K, D)
+        Descriptors of the local points.
+    uv : array_like, shape (K, 2)
+        Their left keypoints [px].
+    landmark_ids : array_like of int, shape (L,)
+        Ids of the landmarks to search (those in view of the predicted pose).
+    landmark_descriptors : array_like, shape (L, D)
+        Their descriptors, in the order of ``landmark_ids``.
+    positions : array_like, shape (n, 3)
+        Landmark positions by id in the map frame [m].
+    T_wc : array_like, shape (4, 4)
+        Predicted pose of the left camera in the map.
+    camera : PinholeCamera
+        The left camera.
+    params : StereoParams, optional
+        Pipeline settings (``window_px``, ``window_max_hamming``, ``map_ratio``, ``same_point_m``).
+    **overrides
+        :class:`StereoParams` fields to change.
+
+    Returns
+    -------
+    matches : MapMatches
+    n_pairs : int
+        Descriptor distances computed.
+
+    Examples
+    --------
+    >>> from slamlab.geometry import PinholeCamera
+    >>> cam = PinholeCamera(100, 80, 50.0, 50.0, 50.0, 40.0)
+    >>> X = np.array([[0.0, 0.0, 5.0], [2.0, 0.0, 5.0]])  # projected at u = 50 and u = 70
+    >>> m, n = match_in_window(np.array([[0.1, 0.0]]), [[51.0, 40.0]], [0, 1], np.array([[0.0, 0.0], [0.1, 0.0]]),
+    ...                        X, np.eye(4), cam, window_px=5.0)
+    >>> m.ids.tolist(), n
+    ([0], 1)
+    """
+    p = StereoParams.resolve(params, **overrides)
+    D = _check_descriptors(descriptors)
+    uv = as_finite_array(uv, "uv", ndim=2)
+    if uv.shape != (len(D), 2):
+        raise ValueError(f"`uv` must have shape ({len(D)}, 2), one pixel per descriptor; got {uv.shape}")
+    ids = np.asarray(landmark_ids, dtype=np.int64).ravel()
+    D_lm = _check_descriptors(landmark_descriptors, "landmark_descriptors", len(ids))
+    X = _check_positions(positions)
+    T_wc = as_matrix(T_wc, "T_wc", (4, 4))
+    if not isinstance(camera, PinholeCamera):
+        raise TypeError(f"`camera` must be a PinholeCamera; got {type(camera).__name__}")
+    Xc = (X[ids] - T_wc[:3, 3]) @ T_wc[:3, :3]
+    uv_lm = project_points(camera.K, Xc)
+    inside = (uv_lm[:, 1] >= -p.window_px) & (uv_lm[:, 1] <= camera.height_px + p.window_px)
+    max_d = p.window_max_hamming if p.binary else np.inf
+    return _window_match(D, uv, D_lm[inside], uv_lm[inside], ids[inside], p.window_px, p.map_ratio, max_d, X,
+                         p.twin_gap_m)
+
+
+def _check_descriptors(D, name="descriptors", n=None):
+    D = np.asarray(D)
+    if D.ndim != 2:
+        raise ValueError(f"`{name}` must be 2-D (K, D); got shape {D.shape}")
+    if n is not None and len(D) != n:
+        raise ValueError(f"`{name}` must have one row per landmark id ({n}); got {len(D)}")
+    return D
+
+
+def _check_positions(positions):
+    X = as_finite_array(positions, "positions", ndim=2)
+    if X.shape[1] != 3:
+        raise ValueError(f"`positions` must have shape (n, 3); got {X.shape}")
+    return X
+
+
+def _no_matches(k) -> MapMatches:
+    return MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
 
 
 def _accept_twins(ok, first, second, positions, same_point_m):
@@ -178,7 +308,7 @@ def _radius_pairs(uv_q, uv_t, radius):
 
 def _window_two_nearest(D, uv, desc_lm, uv_lm, radius_px):
     """Nearest and second-nearest landmark by descriptor among those within ``radius_px`` of each keypoint:
-    ``(query, nearest, d1, d2, second)`` as :func:`_two_nearest`, and the number of pairs compared. Binary
+    ``(query, nearest, d1, d2, second)`` as ``two_nearest``, and the number of pairs compared. Binary
     descriptors take the compiled kernel when numba is enabled (same result, tested), otherwise numpy."""
     if D.dtype == np.uint8 and D.shape[1] % 8 == 0 and numba_enabled():
         order, lo, hi = _radius_cells(uv, uv_lm, radius_px)
@@ -189,8 +319,8 @@ def _window_two_nearest(D, uv, desc_lm, uv_lm, radius_px):
     qi, rows = _radius_pairs(uv, uv_lm, radius_px)
     if qi.size == 0:
         return qi, qi, np.empty(0), np.empty(0), qi, 0
-    d = _pair_distances(D, desc_lm, qi, rows)
-    return (*_two_nearest(qi, rows, d), int(qi.size))
+    d = pair_distances(D, desc_lm, qi, rows)
+    return (*two_nearest(qi, rows, d), int(qi.size))
 
 
 def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance, positions=None,
@@ -202,7 +332,7 @@ def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance,
     must be within ``max_distance``, one local point per landmark. Returns the matches and the number of
     descriptor distances computed."""
     k = D.shape[0]
-    none = MapMatches(np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0), np.arange(k), np.full(k, -1))
+    none = _no_matches(k)
     if k == 0 or len(ids_lm) == 0:
         return none, 0
     q, r1, d1, d2, r2, n_pairs = _window_two_nearest(D, uv, desc_lm, uv_lm, radius_px)
@@ -218,12 +348,3 @@ def _window_match(D, uv, desc_lm, uv_lm, ids_lm, radius_px, ratio, max_distance,
     claimed = np.zeros(k, dtype=bool)
     claimed[loc] = True
     return MapMatches(loc[sel], lid[sel], dd[sel], np.flatnonzero(~claimed), nearest), n_pairs
-
-
-def _window_candidates(X, ids, T_wc, cam, window_px):
-    """The landmarks ``X`` (ids ``ids``) projected into ``cam`` at ``T_wc`` whose row lies within ``window_px`` of
-    the image: ``(ids, uv)`` of those (the window search's candidates)."""
-    Xc = (X - T_wc[:3, 3]) @ T_wc[:3, :3]
-    uv_lm = project_points(cam.K, Xc)
-    inside = (uv_lm[:, 1] >= -window_px) & (uv_lm[:, 1] <= cam.height_px + window_px)
-    return ids[inside], uv_lm[inside]

@@ -19,11 +19,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_matrix
+from ..geometry.camera import StereoRig
 from .params import StereoParams
-from .pose_stages import _refine_body_pose, _stereo_project
 
-__all__ = ["CHI2_1_MEDIAN", "MAD_TO_STD", "disparity_noise_px", "robust_pixel_std", "stereo_residuals_px"]
+__all__ = ["CHI2_1_MEDIAN", "MAD_TO_STD", "KeypointNoiseTracker", "disparity_noise_px", "disparity_residuals_px",
+           "robust_pixel_std", "stereo_residuals_px"]
 
 #: 1 / Φ⁻¹(3/4): the median absolute deviation of a normal sample times this is its standard deviation
 MAD_TO_STD = 1.4826
@@ -58,24 +59,29 @@ def stereo_residuals_px(T_body, landmarks_map, points_left, rig, T_body_left=Non
     numpy.ndarray, shape (M, 4)
         Residuals [px]; rows whose landmark lies behind the left camera are NaN.
     """
-    Tb = v.as_matrix(T_body, "T_body", (4, 4))
-    X = v.as_finite_array(landmarks_map, "landmarks_map", ndim=2)
-    Pl = v.as_finite_array(points_left, "points_left", ndim=2)
+    X, Pl, _, Xc = _landmarks_in_left_camera(T_body, landmarks_map, points_left, rig, T_body_left)
+    r = np.full((len(X), 4), np.nan)
+    ok = Xc[:, 2] > 0
+    r[ok] = rig.stereo_pixels(Pl[ok]) - rig.stereo_pixels(Xc[ok])
+    return r
+
+
+def _landmarks_in_left_camera(T_body, landmarks_map, points_left, rig, T_body_left):
+    """The checked landmarks ``X`` and points ``Pl``, the map-to-left-camera rotation ``R`` and the landmarks in the left
+    camera ``Xc``: ``(X, Pl, R, Xc)``."""
+    Tb = as_matrix(T_body, "T_body", (4, 4))
+    X = as_finite_array(landmarks_map, "landmarks_map", ndim=2)
+    Pl = as_finite_array(points_left, "points_left", ndim=2)
     if X.shape[1:] != (3,) or Pl.shape != X.shape:
         raise ValueError(f"`landmarks_map` and `points_left` must both have shape (M, 3); got {X.shape} and {Pl.shape}")
     if np.any(Pl[:, 2] <= 0):
         raise ValueError("`points_left` must lie in front of the left camera (z > 0)")
-    Tbl = np.eye(4) if T_body_left is None else v.as_matrix(T_body_left, "T_body_left", (4, 4))
-    return _residuals(Tb, X, Pl, rig, Tbl)
-
-
-def _residuals(T_body, X_map, pts_left, rig, T_body_left):
-    T_cw = np.linalg.inv(T_body @ T_body_left)
-    Xc = X_map @ T_cw[:3, :3].T + T_cw[:3, 3]
-    r = np.full((len(X_map), 4), np.nan)
-    ok = Xc[:, 2] > 0
-    r[ok] = _stereo_project(rig, pts_left[ok])[0] - _stereo_project(rig, Xc[ok])[0]
-    return r
+    if not isinstance(rig, StereoRig):
+        raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
+    Tbl = np.eye(4) if T_body_left is None else as_matrix(T_body_left, "T_body_left", (4, 4))
+    T_cw = np.linalg.inv(Tb @ Tbl)
+    R = T_cw[:3, :3]
+    return X, Pl, R, X @ R.T + T_cw[:3, 3]
 
 
 def robust_pixel_std(residuals_px) -> float:
@@ -156,19 +162,45 @@ def disparity_noise_px(disparity_residuals_px, landmark_var_px2=None) -> float:
     return float(0.5 * (lo + hi))
 
 
-class _NoiseTracker:
-    """The running keypoint-noise estimate of one :class:`~slamlab.stereo.StereoSLAM` (``pixel_std_estimate``).
+class KeypointNoiseTracker:
+    """The running keypoint-noise estimate of one :class:`~slamlab.stereo.StereoSLAM` (``pixel_std_estimate``; ours, issue 25).
 
-    ``current(params)`` is ``params`` with ``pixel_std`` raised to the estimate (``params`` itself when the
-    option is off); ``refine`` runs the pose refinement and feeds its disparity residuals to the estimate.
-    ``history`` holds each frame's raw estimate."""
+    Each frame's disparity residuals (:func:`disparity_residuals_px`) give an estimate
+    (:func:`disparity_noise_px`), smoothed into :attr:`sigma_px`; :meth:`current` is the settings with
+    ``pixel_std`` raised to it.
+
+    Parameters
+    ----------
+    params : StereoParams
+        The pipeline's settings (``pixel_std``: the start and the floor of the estimate).
+
+    Attributes
+    ----------
+    sigma_px : float
+        The running estimate [px].
+    history : list of float
+        Each frame's raw estimate [px].
+    """
 
     def __init__(self, params: StereoParams):
+        if not isinstance(params, StereoParams):
+            raise TypeError(f"`params` must be a StereoParams; got {type(params).__name__}")
         self.sigma_px = params.pixel_std
         self.history: list[float] = []
         self._cache: tuple = (None, None, None)
 
     def current(self, params: StereoParams) -> StereoParams:
+        """``params`` with ``pixel_std`` raised to the estimate (``params`` itself when ``pixel_std_estimate`` is off).
+
+        Parameters
+        ----------
+        params : StereoParams
+            The nominal settings.
+
+        Returns
+        -------
+        StereoParams
+        """
         if not params.pixel_std_estimate:
             return params
         sigma = max(params.pixel_std, self.sigma_px)
@@ -176,17 +208,18 @@ class _NoiseTracker:
             self._cache = (params, sigma, params.replace(pixel_std=sigma))
         return self._cache[2]
 
-    def refine(self, slam, T_body, ids, pts_left):
-        """The refined pose of ``slam``'s landmarks ``ids`` matched by the left-camera points ``pts_left``."""
-        p, rig, T_bl = slam.params, slam.rig, slam.T_body_left
-        X = slam.X[ids]
-        T = _refine_body_pose(T_body, X, pts_left, rig, T_bl, p.refine_iters, p.refine_huber_px, p.min_depth_m)
-        if p.pixel_std_estimate:
-            self.observe(*_disparity_residuals(T, X, slam.P[ids], pts_left, rig, T_bl), smoothing=p.pixel_std_smoothing)
-        return T
+    def observe(self, disparity_residuals_px, landmark_var_px2=None, smoothing: float = 0.2) -> None:
+        """Update the estimate with one frame's disparity residuals (frames with fewer than 20 are skipped).
 
-    def observe(self, disparity_residuals_px, landmark_var_px2=None, smoothing=0.2):
-        """One frame's disparity residuals [px] (and their landmarks' variances [px²]): update the estimate."""
+        Parameters
+        ----------
+        disparity_residuals_px : array_like, shape (K,)
+            Disparity residuals [px] (NaNs are left out).
+        landmark_var_px2 : array_like, shape (K,), optional
+            Their landmarks' predicted disparity variances [px²] (default 0).
+        smoothing : float, default 0.2
+            Weight of this frame's estimate in the running one (``pixel_std_smoothing``).
+        """
         r = np.asarray(disparity_residuals_px, dtype=float)
         if np.isfinite(r).sum() < MIN_RESIDUALS:
             return
@@ -195,17 +228,52 @@ class _NoiseTracker:
         self.sigma_px = (1.0 - smoothing) * self.sigma_px + smoothing * s
 
 
-def _disparity_residuals(T_body, X_map, P_map, pts_left, rig, T_body_left):
-    """Disparity residuals ``(u_l - u_r)`` [px] of the points ``pts_left`` against landmarks ``X_map`` at
-    ``T_body``, and the variance [px²] of each landmark's predicted disparity (covariances ``P_map``)."""
-    T_cw = np.linalg.inv(T_body @ T_body_left)
-    R = T_cw[:3, :3]
-    Xc = X_map @ R.T + T_cw[:3, 3]
+def disparity_residuals_px(T_body, landmarks_map, landmark_cov, points_left, rig: StereoRig, T_body_left=None):
+    """Disparity residuals ``u_l - u_r`` [px] of stereo points against their landmarks, and the landmarks' variances (issue 25).
+
+    Each residual is the disparity of a stereo point of this frame (``points_left``) minus that of its landmark
+    seen from ``T_body``; beside it, the variance [px²] of the landmark's predicted disparity from its covariance
+    (``J P Jᵀ``, ``J`` the disparity's derivative): the input of :func:`disparity_noise_px`.
+
+    Parameters
+    ----------
+    T_body : array_like, shape (4, 4)
+        Body-to-map pose.
+    landmarks_map : array_like, shape (M, 3)
+        Landmarks in the map frame [m].
+    landmark_cov : array_like, shape (M, 3, 3)
+        Their covariances [m²].
+    points_left : array_like, shape (M, 3)
+        Their stereo points in the left-camera frame [m] (``z`` > 0).
+    rig : StereoRig
+        The calibrated pair.
+    T_body_left : array_like, shape (4, 4), optional
+        Left camera in the body frame (default identity).
+
+    Returns
+    -------
+    r : numpy.ndarray, shape (M,)
+        Disparity residuals [px]; NaN where the landmark lies behind the left camera.
+    q : numpy.ndarray, shape (M,)
+        The landmarks' predicted disparity variances [px²] (NaN there too).
+
+    Examples
+    --------
+    >>> rig = StereoRig.parallel(baseline_m=0.5)
+    >>> X = np.array([[0.0, 0.0, 10.0]])
+    >>> r, q = disparity_residuals_px(np.eye(4), X, np.zeros((1, 3, 3)), X, rig)
+    >>> r.tolist(), q.tolist()
+    ([0.0], [0.0])
+    """
+    X, Pl, R, Xc = _landmarks_in_left_camera(T_body, landmarks_map, points_left, rig, T_body_left)
+    P = as_finite_array(landmark_cov, "landmark_cov", ndim=3)
+    if P.shape != (len(X), 3, 3):
+        raise ValueError(f"`landmark_cov` must have shape ({len(X)}, 3, 3); got {P.shape}")
     ok = Xc[:, 2] > 0
-    r, q = np.full(len(X_map), np.nan), np.full(len(X_map), np.nan)
-    h, J = _stereo_project(rig, Xc[ok])
-    z = _stereo_project(rig, pts_left[ok])[0]
+    r, q = np.full(len(X), np.nan), np.full(len(X), np.nan)
+    h, J = rig.stereo_pixels(Xc[ok], jacobian=True)
+    z = rig.stereo_pixels(Pl[ok])
     r[ok] = (z[:, 0] - z[:, 2]) - (h[:, 0] - h[:, 2])
     Jd = (J[:, 0] - J[:, 2]) @ R  # d(disparity) / d(X_map)
-    q[ok] = np.einsum("ki,kij,kj->k", Jd, P_map[ok], Jd)
+    q[ok] = np.einsum("ki,kij,kj->k", Jd, P[ok], Jd)
     return r, q

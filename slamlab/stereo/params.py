@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _validate as v
 from .._params import Params, param
+from .._validate import check_choice, check_int, check_positive, check_probability
 
 __all__ = ["STEREO_DETECTORS", "RenderParams", "StereoParams"]
 
@@ -28,14 +28,14 @@ DEPTH_SOURCES = ("measured", "map", "true")  # "true": an ablation oracle (run_s
 
 def _fraction(value, name):
     """A share in [0, 1]."""
-    value = v.check_positive(value, name, allow_zero=True)
+    value = check_positive(value, name, allow_zero=True)
     if value > 1:
         raise ValueError(f"`{name}` must be in [0, 1]; got {value}")
     return value
 
 
 def _optional_positive(value, name, allow_zero=False):
-    return None if value is None else v.check_positive(value, name, allow_zero=allow_zero)
+    return None if value is None else check_positive(value, name, allow_zero=allow_zero)
 
 
 @dataclass(frozen=True)
@@ -253,72 +253,72 @@ class StereoParams(Params):
                                             "an ablation oracle; issue 25)")
 
     def check(self) -> None:
-        v.check_choice(self.detector, "detector", STEREO_DETECTORS)
-        v.check_int(self.n_features, "n_features", minimum=10)
-        v.check_int(self.orb_fast_threshold, "orb_fast_threshold", minimum=0, maximum=255)
-        v.check_int(self.orb_levels, "orb_levels", minimum=1)
-        v.check_choice(self.channel_order, "channel_order", ("rgb", "bgr"))
+        check_choice(self.detector, "detector", STEREO_DETECTORS)
+        check_int(self.n_features, "n_features", minimum=10)
+        check_int(self.orb_fast_threshold, "orb_fast_threshold", minimum=0, maximum=255)
+        check_int(self.orb_levels, "orb_levels", minimum=1)
+        check_choice(self.channel_order, "channel_order", ("rgb", "bgr"))
         if not isinstance(self.parallel_detect, bool):
             raise TypeError(f"`parallel_detect` must be a bool; got {type(self.parallel_detect).__name__}")
-        v.check_probability(self.ratio, "ratio")
-        v.check_positive(self.epi_tol_px, "epi_tol_px")
-        v.check_positive(self.min_depth_m, "min_depth_m")
-        if v.check_positive(self.max_depth_m, "max_depth_m") <= self.min_depth_m:
+        check_probability(self.ratio, "ratio")
+        check_positive(self.epi_tol_px, "epi_tol_px")
+        check_positive(self.min_depth_m, "min_depth_m")
+        if check_positive(self.max_depth_m, "max_depth_m") <= self.min_depth_m:
             raise ValueError(f"`max_depth_m` must exceed `min_depth_m` = {self.min_depth_m}; got {self.max_depth_m}")
-        v.check_positive(self.pixel_std, "pixel_std")
+        check_positive(self.pixel_std, "pixel_std")
         if not isinstance(self.pixel_std_estimate, bool):
             raise TypeError(f"`pixel_std_estimate` must be a bool; got {type(self.pixel_std_estimate).__name__}")
-        if not 0 < v.check_positive(self.pixel_std_smoothing, "pixel_std_smoothing") <= 1:
+        if not 0 < check_positive(self.pixel_std_smoothing, "pixel_std_smoothing") <= 1:
             raise ValueError(f"`pixel_std_smoothing` must be in (0, 1]; got {self.pixel_std_smoothing}")
         if self.pixel_std_estimate and self.pose_refine != "reprojection":
             raise ValueError("`pixel_std_estimate` needs `pose_refine='reprojection'` (its residuals give the estimate)")
-        if v.check_positive(self.reobserve_depth_factor, "reobserve_depth_factor") < 1:
+        if check_positive(self.reobserve_depth_factor, "reobserve_depth_factor") < 1:
             raise ValueError(f"`reobserve_depth_factor` must be at least 1; got {self.reobserve_depth_factor}")
         if self.subpixel_stereo is not None and not isinstance(self.subpixel_stereo, bool):
             raise TypeError(f"`subpixel_stereo` must be a bool or None; got {type(self.subpixel_stereo).__name__}")
-        v.check_int(self.subpixel_half_px, "subpixel_half_px", minimum=1)
-        v.check_int(self.subpixel_search_px, "subpixel_search_px", minimum=1)
-        v.check_probability(self.map_ratio, "map_ratio")
+        check_int(self.subpixel_half_px, "subpixel_half_px", minimum=1)
+        check_int(self.subpixel_search_px, "subpixel_search_px", minimum=1)
+        check_probability(self.map_ratio, "map_ratio")
         _optional_positive(self.same_point_m, "same_point_m", allow_zero=True)
         _optional_positive(self.duplicate_gap_m, "duplicate_gap_m")
         if self.map_search is not None:
-            v.check_choice(self.map_search, "map_search", MAP_SEARCHES)
-        v.check_positive(self.window_px, "window_px")
-        v.check_int(self.window_max_hamming, "window_max_hamming", minimum=0)
+            check_choice(self.map_search, "map_search", MAP_SEARCHES)
+        check_positive(self.window_px, "window_px")
+        check_int(self.window_max_hamming, "window_max_hamming", minimum=0)
         _fraction(self.window_min_share, "window_min_share")
         _optional_positive(self.view_margin_deg, "view_margin_deg", allow_zero=True)
-        v.check_positive(self.view_depth_factor, "view_depth_factor")
-        v.check_int(self.base_seen_times, "base_seen_times", minimum=1)
-        v.check_int(self.max_non_base_time, "max_non_base_time", minimum=1)
-        v.check_choice(self.policy, "policy", POLICIES)
-        v.check_int(self.ransac_iters, "ransac_iters", minimum=1)
-        v.check_positive(self.threshold_m, "threshold_m")
-        v.check_positive(self.depth_ref_m, "depth_ref_m")
-        v.check_int(self.min_inliers, "min_inliers", minimum=3)
-        v.check_choice(self.weight_depth, "weight_depth", DEPTH_SOURCES)
-        v.check_choice(self.update_cov_depth, "update_cov_depth", DEPTH_SOURCES)
-        v.check_choice(self.init_cov_depth, "init_cov_depth", ("measured", "true"))
-        v.check_choice(self.filter_space, "filter_space", ("xyz", "pixels"))
-        v.check_choice(self.pose_refine, "pose_refine", ("none", "reprojection"))
-        v.check_int(self.refine_iters, "refine_iters", minimum=1)
-        v.check_positive(self.refine_huber_px, "refine_huber_px")
-        v.check_int(self.refine_min_seen, "refine_min_seen", minimum=1)
+        check_positive(self.view_depth_factor, "view_depth_factor")
+        check_int(self.base_seen_times, "base_seen_times", minimum=1)
+        check_int(self.max_non_base_time, "max_non_base_time", minimum=1)
+        check_choice(self.policy, "policy", POLICIES)
+        check_int(self.ransac_iters, "ransac_iters", minimum=1)
+        check_positive(self.threshold_m, "threshold_m")
+        check_positive(self.depth_ref_m, "depth_ref_m")
+        check_int(self.min_inliers, "min_inliers", minimum=3)
+        check_choice(self.weight_depth, "weight_depth", DEPTH_SOURCES)
+        check_choice(self.update_cov_depth, "update_cov_depth", DEPTH_SOURCES)
+        check_choice(self.init_cov_depth, "init_cov_depth", ("measured", "true"))
+        check_choice(self.filter_space, "filter_space", ("xyz", "pixels"))
+        check_choice(self.pose_refine, "pose_refine", ("none", "reprojection"))
+        check_int(self.refine_iters, "refine_iters", minimum=1)
+        check_positive(self.refine_huber_px, "refine_huber_px")
+        check_int(self.refine_min_seen, "refine_min_seen", minimum=1)
         if not isinstance(self.drop_first_sighting, bool):
             raise TypeError(f"`drop_first_sighting` must be a bool; got {type(self.drop_first_sighting).__name__}")
-        v.check_int(self.n_oldest, "n_oldest", minimum=3)
-        if v.check_positive(self.oldest_fraction, "oldest_fraction") > 1:
+        check_int(self.n_oldest, "n_oldest", minimum=3)
+        if check_positive(self.oldest_fraction, "oldest_fraction") > 1:
             raise ValueError(f"`oldest_fraction` must be in (0, 1]; got {self.oldest_fraction}")
         _fraction(self.keep_fraction, "keep_fraction")
-        v.check_positive(self.loose_factor, "loose_factor")
+        check_positive(self.loose_factor, "loose_factor")
         _fraction(self.still_fraction, "still_fraction")
         _optional_positive(self.max_std_factor, "max_std_factor")
         _optional_positive(self.max_correction_rad, "max_correction_rad", allow_zero=True)
         _optional_positive(self.max_correction_m, "max_correction_m", allow_zero=True)
         _optional_positive(self.max_rot_std_rad, "max_rot_std_rad")
-        v.check_choice(self.degenerate_pose, "degenerate_pose", ("last", "constant_velocity"))
-        v.check_positive(self.state_var, "state_var", allow_zero=True)
-        v.check_positive(self.pose_std_m, "pose_std_m", allow_zero=True)
-        v.check_positive(self.pose_std_rad, "pose_std_rad", allow_zero=True)
+        check_choice(self.degenerate_pose, "degenerate_pose", ("last", "constant_velocity"))
+        check_positive(self.state_var, "state_var", allow_zero=True)
+        check_positive(self.pose_std_m, "pose_std_m", allow_zero=True)
+        check_positive(self.pose_std_rad, "pose_std_rad", allow_zero=True)
         _optional_positive(self.update_gate, "update_gate")
 
     @property
@@ -380,7 +380,7 @@ class RenderParams(Params):
     drift_std_rad: float = param(0.0, "ours: random-walk step of the right camera per frame (000 §3.2)")
 
     def check(self) -> None:
-        v.check_int(self.arena_seed, "arena_seed", minimum=0)
-        v.check_positive(self.camera_height_m, "camera_height_m")
-        v.check_positive(self.noise_std, "noise_std", allow_zero=True)
-        v.check_positive(self.drift_std_rad, "drift_std_rad", allow_zero=True)
+        check_int(self.arena_seed, "arena_seed", minimum=0)
+        check_positive(self.camera_height_m, "camera_height_m")
+        check_positive(self.noise_std, "noise_std", allow_zero=True)
+        check_positive(self.drift_std_rad, "drift_std_rad", allow_zero=True)

@@ -10,11 +10,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_finite_array, as_matrix, as_rng, as_vector, check_int, check_positive
 from ..geometry.camera import StereoRig
 from ..geometry.ransac import ransac
-from ..geometry.registration import RigidTransform, _umeyama
-from ..geometry.so3 import hat, se3_exp
+from ..geometry.registration import RigidTransform, umeyama
+from ..geometry.so3 import hat, rotation_angle, se3_exp
 from .params import StereoParams
 
 __all__ = [
@@ -56,7 +56,7 @@ def select_oldest(first_seen, n_min: int) -> np.ndarray:
     fs = np.asarray(first_seen)
     if fs.ndim != 1:
         raise ValueError(f"`first_seen` must be 1-D; got shape {fs.shape}")
-    n_min = v.check_int(n_min, "n_min", minimum=1)
+    n_min = check_int(n_min, "n_min", minimum=1)
     if fs.size <= n_min:
         return np.arange(fs.size)
     cut = np.sort(fs)[n_min - 1]
@@ -92,7 +92,7 @@ def pose_std(points_map, cov_map, center=None) -> np.ndarray:
     >>> bool(np.all(np.isfinite(pose_std(P, np.tile(np.eye(3) * 1e-4, (4, 1, 1))))))
     True
     """
-    P = v.as_finite_array(points_map, "points_map", ndim=2)
+    P = as_finite_array(points_map, "points_map", ndim=2)
     C = np.asarray(cov_map, dtype=float)
     if C.shape != (len(P), 3, 3):
         raise ValueError(f"`cov_map` must have shape ({len(P)}, 3, 3); got {C.shape}")
@@ -146,8 +146,8 @@ class PoseEstimate(NamedTuple):
 
 
 def _fit(src, dst, w):
-    # a RANSAC hypothesis or refit: umeyama's arithmetic without its argument checks (the rows are checked once)
-    return _umeyama(np.asarray(src, dtype=float), np.asarray(dst, dtype=float), w / w.sum())
+    # a RANSAC hypothesis or refit: the rows were checked once, by estimate_pose
+    return umeyama(src, dst, weights=w, check=False)
 
 
 def _residuals(T: RigidTransform, src, dst, w):
@@ -208,8 +208,8 @@ def estimate_pose(local_points, map_points, first_seen=None, *, depth_m=None, co
     (True, 30)
     """
     p = StereoParams.resolve(params, **overrides)
-    src = v.as_finite_array(local_points, "local_points", ndim=2)
-    dst = v.as_finite_array(map_points, "map_points", ndim=2)
+    src = as_finite_array(local_points, "local_points", ndim=2)
+    dst = as_finite_array(map_points, "map_points", ndim=2)
     if src.shape != dst.shape or src.shape[1:] != (3,):
         raise ValueError(f"`local_points` and `map_points` must both have shape (M, 3); got {src.shape} and {dst.shape}")
     m = src.shape[0]
@@ -219,16 +219,11 @@ def estimate_pose(local_points, map_points, first_seen=None, *, depth_m=None, co
         cov = np.asarray(cov, dtype=float)
         if cov.shape != (m, 3, 3) or not np.all(np.isfinite(cov)):
             raise ValueError(f"`cov` must be a finite ({m}, 3, 3) array; got shape {cov.shape}")
-    depth = np.linalg.norm(src, axis=1) if depth_m is None else v.as_vector(depth_m, "depth_m", m)
+    depth = np.linalg.norm(src, axis=1) if depth_m is None else as_vector(depth_m, "depth_m", m)
     first_seen = np.zeros(m, dtype=np.int64) if first_seen is None else np.asarray(first_seen)
     if first_seen.shape != (m,):
         raise ValueError(f"`first_seen` must have shape ({m},); got {first_seen.shape}")
-    return _estimate_pose(src, dst, first_seen, depth, cov, p, v.as_rng(rng))
-
-
-def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> PoseEstimate:
-    """:func:`estimate_pose` on checked arguments (the per-frame core)."""
-    m = src.shape[0]
+    rng = as_rng(rng)
     threshold_m, min_inliers, max_iters = p.threshold_m, p.min_inliers, p.ransac_iters
     loose_factor, max_std_factor = p.loose_factor, p.max_std_factor
     scale = np.maximum(1.0, (depth / p.depth_ref_m) ** 2)
@@ -273,7 +268,7 @@ def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> Po
                 T_old = r_old.model
                 still = _residuals(T_old, src[loose], dst[loose], w[loose]) <= loose_factor * threshold_m
                 # the old landmarks may correct the consensus pose by a bounded amount only
-                d_rot = np.arccos(np.clip((np.trace(T_old.R @ Tm.R.T) - 1.0) / 2.0, -1.0, 1.0))
+                d_rot = rotation_angle(T_old.R @ Tm.R.T)
                 d_pos = np.linalg.norm(T_old.t - Tm.t)
                 bounded = (p.max_correction_rad is None or d_rot <= p.max_correction_rad) and (
                     p.max_correction_m is None or d_pos <= p.max_correction_m
@@ -289,48 +284,6 @@ def _estimate_pose(src, dst, first_seen, depth, cov, p: StereoParams, rng) -> Po
 # --- pose refinement on the stereo reprojection error (our option; issue 25) -------------------------
 
 
-def _weight_depth(source, depth, true_depth, X_map, T_wc, min_depth_m):
-    """The depth behind each match's RANSAC threshold and weight (``weight_depth``): 'measured' the point's own
-    ``depth``, 'true' ``true_depth`` (the ablation oracle: its true depth in this frame), 'map' the depth of the
-    landmark ``X_map`` seen from the left camera at ``T_wc`` (the last pose), at least ``min_depth_m``."""
-    if source == "true":  # the ablation oracle: the point's true depth in this frame
-        return true_depth
-    if source == "map":
-        # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
-        return np.maximum(((X_map - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], min_depth_m)
-    return depth
-
-
-def _refine_matches(ids, loc, n_seen, p: StereoParams):
-    """The inliers ``(ids, loc)`` the reprojection refinement uses: those whose landmark was seen at least
-    ``p.refine_min_seen`` times, or all when fewer than ``p.min_inliers`` were."""
-    seen = n_seen[ids] >= p.refine_min_seen
-    if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
-        ids, loc = ids[seen], loc[seen]
-    return ids, loc
-
-
-def _project_jac(X, fx, fy, cx, cy):
-    """Pixels ``(K, 2)`` of camera-frame points ``X`` and their Jacobians ``(K, 2, 3)`` w.r.t. ``X``."""
-    iz = 1.0 / X[:, 2]
-    u = fx * X[:, 0] * iz + cx
-    v = fy * X[:, 1] * iz + cy
-    J = np.zeros((len(X), 2, 3))
-    J[:, 0, 0] = fx * iz
-    J[:, 0, 2] = -fx * X[:, 0] * iz * iz
-    J[:, 1, 1] = fy * iz
-    J[:, 1, 2] = -fy * X[:, 1] * iz * iz
-    return np.column_stack([u, v]), J
-
-
-def _stereo_project(rig, Xc):
-    """``(K, 4)`` pixels ``(u_l, v_l, u_r, v_r)`` of left-camera points and their ``(K, 4, 3)`` Jacobians."""
-    L, Rr = rig.left, rig.right
-    uv_l, J_l = _project_jac(Xc, L.fx, L.fy, L.cx, L.cy)
-    uv_r, J_r = _project_jac(Xc @ rig.R_rl.T + rig.t_rl, Rr.fx, Rr.fy, Rr.cx, Rr.cy)
-    return np.hstack([uv_l, uv_r]), np.concatenate([J_l, J_r @ rig.R_rl], axis=1)
-
-
 def _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m):
     """Gauss-Newton on ``T_cw`` (map to left camera): the stereo pixels ``z_px`` (K, 4) of landmarks ``X_map``;
     left-multiplied twist updates ``T ← exp(δ) T``; Huber weights on each point's pixel residual norm."""
@@ -340,7 +293,7 @@ def _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m):
         ok = Xc[:, 2] > min_depth_m
         if ok.sum() < 3:
             break
-        h, J3 = _stereo_project(rig, Xc[ok])
+        h, J3 = rig.stereo_pixels(Xc[ok], jacobian=True)
         r = z_px[ok] - h
         # d(Xc)/d(δ) for δ = (v, ω): [I, -[Xc]x]
         D = np.zeros((ok.sum(), 3, 6))
@@ -359,14 +312,6 @@ def _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m):
         if np.linalg.norm(delta) < 1e-10:
             break
     return T
-
-
-def _refine_body_pose(T_body, X_map, pts_left, rig, T_body_left, iters, huber_px, min_depth_m):
-    """:func:`refine_pose_stereo` without the checks (``StereoSLAM``'s ``pose_refine='reprojection'``)."""
-    z_px = _stereo_project(rig, pts_left)[0]
-    T_cw = np.linalg.inv(T_body @ T_body_left)
-    T_cw = _refine_pose_stereo(T_cw, X_map, z_px, rig, iters, huber_px, min_depth_m)
-    return np.linalg.inv(T_cw) @ np.linalg.inv(T_body_left)
 
 
 def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_body_left=None, *, iters: int = 5,
@@ -415,9 +360,9 @@ def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_bod
     >>> bool(np.allclose(T_est, T, atol=1e-9))
     True
     """
-    Tb = v.as_matrix(T_body, "T_body", (4, 4))
-    X = v.as_finite_array(landmarks_map, "landmarks_map", ndim=2)
-    Pl = v.as_finite_array(points_left, "points_left", ndim=2)
+    Tb = as_matrix(T_body, "T_body", (4, 4))
+    X = as_finite_array(landmarks_map, "landmarks_map", ndim=2)
+    Pl = as_finite_array(points_left, "points_left", ndim=2)
     if X.shape[1:] != (3,) or Pl.shape != X.shape:
         raise ValueError(f"`landmarks_map` and `points_left` must both have shape (M, 3); got {X.shape} and {Pl.shape}")
     if len(X) < 3:
@@ -426,8 +371,9 @@ def refine_pose_stereo(T_body, landmarks_map, points_left, rig: StereoRig, T_bod
         raise ValueError("`points_left` must lie in front of the left camera (z > 0)")
     if not isinstance(rig, StereoRig):
         raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
-    Tbl = np.eye(4) if T_body_left is None else v.as_matrix(T_body_left, "T_body_left", (4, 4))
-    iters = v.check_int(iters, "iters", minimum=1)
-    huber_px = v.check_positive(huber_px, "huber_px")
-    min_depth_m = v.check_positive(min_depth_m, "min_depth_m")
-    return _refine_body_pose(Tb, X, Pl, rig, Tbl, iters, huber_px, min_depth_m)
+    Tbl = np.eye(4) if T_body_left is None else as_matrix(T_body_left, "T_body_left", (4, 4))
+    iters = check_int(iters, "iters", minimum=1)
+    huber_px = check_positive(huber_px, "huber_px")
+    min_depth_m = check_positive(min_depth_m, "min_depth_m")
+    T_cw = _refine_pose_stereo(np.linalg.inv(Tb @ Tbl), X, rig.stereo_pixels(Pl), rig, iters, huber_px, min_depth_m)
+    return np.linalg.inv(T_cw) @ np.linalg.inv(Tbl)

@@ -9,34 +9,175 @@ landmark store (000 §3.4).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 
 import numpy as np
 
-from .. import _validate as v
+from .._validate import as_matrix, as_rng
 from ..geometry.camera import StereoRig
 from ..geometry.se3 import planar_from_se3
-from ..kdtree.knn import exact_knn
-from ..kdtree.stores import base_rule
-from .frame import (
-    STAGES,
-    FrameRecord,
-    _append_rows,
-    _check_pair,
-    _detect_pair,
-    _frame_points,
-    _resolve_store,
-    _StageClock,
-    default_store,
+from ..kdtree.stores import ExactStore, LandmarkStore, base_rule, make_store
+from .landmark_filter import duplicate_mask, gated_update, in_view, landmark_observations, pixel_update
+from .local_stages import (
+    check_features,
+    detect_pair,
+    is_rectified,
+    stereo_match,
+    stereo_point_cov,
+    triangulate_local,
 )
-from .landmark_filter import _duplicates, _gated_update, _in_view, _observations, _pixel_update
-from .local_stages import _check_features, _stereo_match, is_rectified
-from .map_stages import _match_to_map, _matches_from_knn, _window_candidates, _window_match
-from .noise_estimate import _NoiseTracker
+from .map_stages import match_in_window, match_to_landmarks, match_to_map
+from .noise_estimate import KeypointNoiseTracker, disparity_residuals_px
 from .params import StereoParams
-from .pose_stages import _estimate_pose, _refine_matches, _weight_depth, pose_std
+from .pose_stages import estimate_pose, pose_std, refine_pose_stereo
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
+
+
+#: the per-frame stages whose times are recorded
+STAGES = ("detect", "stereo", "triangulate", "map_match", "pose", "update")
+
+
+class _StageClock:
+    """Wall-clock and process CPU time per stage: ``lap(stage)`` adds the time since the last lap."""
+
+    def __init__(self):
+        self.wall = dict.fromkeys(STAGES, 0.0)
+        self.cpu = dict.fromkeys(STAGES, 0.0)
+        self._w, self._c = time.perf_counter(), time.process_time()
+
+    def lap(self, stage):
+        w, c = time.perf_counter(), time.process_time()
+        self.wall[stage] += w - self._w
+        self.cpu[stage] += c - self._c
+        self._w, self._c = w, c
+
+
+class FrameRecord(dict):
+    """Counts of one frame (a plain dict with attribute access)."""
+
+    __getattr__ = dict.__getitem__
+
+
+def default_store(params: StereoParams | None = None) -> LandmarkStore:
+    """The landmark store the pipeline uses unless told otherwise (000 §3.4, §4).
+
+    Float descriptors (SURF, SIFT): 000's multi kd-tree (n1 = 3500, q = 5.5, BBF with 200
+    checks) behind the non-base buffer (:func:`slamlab.kdtree.make_store`). Binary descriptors
+    (ORB, Hamming distance): a kd-tree does not apply, so :class:`~slamlab.kdtree.ExactStore`
+    (brute force). Both apply the base rule with ``params``' ``base_seen_times`` / ``max_non_base_time``.
+
+    Parameters
+    ----------
+    params : StereoParams, optional
+        Settings (``detector``, ``base_seen_times``, ``max_non_base_time``); default :class:`StereoParams`.
+
+    Returns
+    -------
+    LandmarkStore
+    """
+    p = StereoParams.resolve(params)
+    if p.binary:
+        return ExactStore(p.base_seen_times, p.max_non_base_time)
+    return make_store("multi", base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
+
+
+def _resolve_store(store, p: StereoParams) -> LandmarkStore:
+    """``StereoSLAM``'s ``store`` argument: None (:func:`default_store`), a store, or a class / factory of one."""
+    if store is None:
+        store = default_store(p)
+    elif isinstance(store, type) or (callable(store) and not isinstance(store, LandmarkStore)):
+        store = store()  # a class or a factory
+    if not isinstance(store, LandmarkStore):
+        raise TypeError(f"`store` must be a slamlab.kdtree.LandmarkStore or a factory of one; "
+                        f"got {type(store).__name__}")
+    return store
+
+
+def _check_pair(left, right, image_shape):
+    """The images' shapes: equal to each other and to the rig's image size (grey or colour)."""
+    sl, sr = np.shape(left), np.shape(right)
+    if len(sl) not in (2, 3) or len(sr) not in (2, 3):
+        raise ValueError(f"`left` and `right` must be (H, W) or (H, W, 3) images; got shapes {sl} and {sr}")
+    if sl != sr:
+        raise ValueError(f"`left` and `right` must have the same shape; got {sl} and {sr}")
+    if sl[:2] != image_shape:
+        raise ValueError(f"images must be {image_shape[0]}x{image_shape[1]} (rows x columns) like "
+                         f"the rig's cameras; got {sl[0]}x{sl[1]}")
+
+
+def _frame_points(rig, T_body_left, fl, fr, sm, p: StereoParams, images, oracle, truth):
+    """The frame's stereo points (000 §3.3) in the body frame: ``(cloud, may_be_new, pts_body, cov_body, cov_init,
+    true_cam)``. ``may_be_new``: the points that may become landmarks (within ``max_depth_m``; beyond it, up to
+    ``reobserve_depth_factor`` times deeper, a point may match a landmark but not become one); ``cov_init`` the new
+    landmarks' first covariances; ``true_cam`` the points' true left-camera positions (from ``truth``, the ablation
+    oracle; None when no setting asks for them). ``images``: the ``(left, right)`` pair whose disparities are
+    refined first (None: not refined); ``oracle`` 'cut': the depth cut on the true depths ``truth``."""
+    if "cut" in oracle and truth is not None:  # the depth cut on the true depth (ablation)
+        cloud = triangulate_local(rig, fl, fr, sm, images=images, params=p, max_depth_m=1e12)
+        zt = truth[cloud.left, 2]
+        keep = (zt >= p.min_depth_m) & (zt <= p.max_depth_m)
+        cloud = type(cloud)(cloud.points[keep], cloud.cov[keep], cloud.left[keep], cloud.gap_m[keep])
+        may_be_new = np.ones(len(cloud.points), bool)  # the oracle's cut replaces the one below
+    else:
+        cloud = triangulate_local(rig, fl, fr, sm, images=images, params=p,
+                                  max_depth_m=p.max_depth_m * p.reobserve_depth_factor)
+        may_be_new = cloud.points[:, 2] <= p.max_depth_m
+    Rb, tb = T_body_left[:3, :3], T_body_left[:3, 3]
+    pts_body = cloud.points @ Rb.T + tb
+    cov_body = Rb @ cloud.cov @ Rb.T
+    true_cam = None
+    if "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or oracle:
+        if truth is None or len(truth) != len(fl.uv):
+            raise ValueError("a depth source 'true' (an ablation oracle) needs `truth_left_cam_m`: the true "
+                             "left-camera position of every left keypoint, set before each frame")
+        true_cam = np.asarray(truth, dtype=float)[cloud.left]
+    cov_init = cov_body
+    if p.init_cov_depth == "true":
+        cov_init = Rb @ stereo_point_cov(true_cam, rig.left.fx, rig.baseline_m, p.pixel_std) @ Rb.T
+    return cloud, may_be_new, pts_body, cov_body, cov_init, true_cam
+
+
+def _weight_depth(source, depth, true_depth, X_map, T_wc, min_depth_m):
+    """The depth behind each match's RANSAC threshold and weight (``weight_depth``): 'measured' the point's own
+    ``depth``, 'true' ``true_depth`` (the ablation oracle: its true depth in this frame), 'map' the depth of the
+    landmark ``X_map`` seen from the left camera at ``T_wc`` (the last pose), at least ``min_depth_m``."""
+    if source == "true":  # the ablation oracle: the point's true depth in this frame
+        return true_depth
+    if source == "map":
+        # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
+        return np.maximum(((X_map - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], min_depth_m)
+    return depth
+
+
+def _refine_matches(ids, loc, n_seen, p: StereoParams):
+    """The inliers ``(ids, loc)`` the reprojection refinement uses: those whose landmark was seen at least
+    ``p.refine_min_seen`` times, or all when fewer than ``p.min_inliers`` were."""
+    seen = n_seen[ids] >= p.refine_min_seen
+    if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
+        ids, loc = ids[seen], loc[seen]
+    return ids, loc
+
+
+def _append_rows(buffers, name, old, rows):
+    """``old`` (None: empty) with ``rows`` appended, as a view of the first rows of ``buffers[name]``, a buffer that
+    doubles when full (the landmark arrays grow every frame; concatenating copied all of them each time). An ``old``
+    that is not a view of that buffer (set from outside) starts a new one."""
+    n = 0 if old is None else len(old)
+    buf = buffers.get(name)
+    if old is not None and (buf is None or old.base is not buf):
+        buf = None
+    need = n + len(rows)
+    dtype = rows.dtype if old is None else np.result_type(old, rows)
+    if buf is None or len(buf) < need or buf.dtype != dtype or buf.shape[1:] != rows.shape[1:]:
+        new = np.empty((max(need, 2 * len(buf) if buf is not None else 0, 256), *rows.shape[1:]), dtype)
+        if n:
+            new[:n] = old
+        buf = buffers[name] = new
+    buf[n:need] = rows
+    return buf[:need]
+
 
 class StereoSLAM:
     """Stereo SLAM with a landmark map (000 §3.3-3.6).
@@ -72,12 +213,11 @@ class StereoSLAM:
         if not isinstance(rig, StereoRig):
             raise TypeError(f"`rig` must be a StereoRig; got {type(rig).__name__}")
         self.rig = rig
-        self.T_body_left = np.eye(4) if T_body_left is None else v.as_matrix(T_body_left, "T_body_left", (4, 4))
+        self.T_body_left = np.eye(4) if T_body_left is None else as_matrix(T_body_left, "T_body_left", (4, 4))
         self.params = p = StereoParams.resolve(params, **overrides)
         self.store = _resolve_store(store, p)
-        self._noise = _NoiseTracker(p)  # pixel_std: the nominal, or raised to the online estimate (pixel_std_estimate)
-        self.rng = v.as_rng(rng)
-        self._detect_kwargs = p.detect_kwargs()
+        self._noise = KeypointNoiseTracker(p)  # pixel_std: the nominal, or raised to the online estimate
+        self.rng = as_rng(rng)
         self._image_shape = (rig.left.height_px, rig.left.width_px)
         self._refine = p.refine_disparity and is_rectified(rig)
         # the landmark filter in stereo pixels needs a rectified rig with one focal length (else: in x, y, z)
@@ -90,7 +230,7 @@ class StereoSLAM:
         self.n_seen = np.empty(0, dtype=np.int64)
         self.alive = np.empty(0, dtype=bool)
         self.desc: np.ndarray | None = None  # descriptor of each landmark (the window search's copy)
-        self._buffers: dict[str, np.ndarray] = {}  # the arrays above are views of these (frame._append_rows)
+        self._buffers: dict[str, np.ndarray] = {}  # the arrays above are views of these (_append_rows)
         self._last_ids = np.empty(0, dtype=np.int64)  # landmarks matched or added by the last located frame
         self.T = np.eye(4)  # current pose of the body in the map
         self.poses: list[np.ndarray] = []
@@ -105,7 +245,10 @@ class StereoSLAM:
         #: 'true' (``weight_depth``, ``update_cov_depth``, ``init_cov_depth``) and cleared after the frame
         self.truth_left_cam_m: np.ndarray | None = None
         self._true_cam = None
-        self._oracle = frozenset()  # exploratory oracles (ablation only): 'cut', 'init_position', 'pose_points'
+        #: exploratory oracles (issue 25; set by :func:`~slamlab.studies.stereo.run_scale_ablation`, never a user):
+        #: 'cut' (the depth cut on the true depth), 'init_position' (new landmarks at their true position),
+        #: 'pose_points' (the pose from the exact local points); each reads ``truth_left_cam_m``
+        self.oracles: frozenset = frozenset()
 
     # -- the loop ------------------------------------------------------------------------------------
     def process(self, left, right) -> FrameRecord:
@@ -125,9 +268,8 @@ class StereoSLAM:
             Counts per stage, ``status``, the pose.
         """
         _check_pair(left, right, self._image_shape)
-        p = self.params
         clock = _StageClock()
-        fl, fr = _detect_pair(left, right, p.detector, self._detect_kwargs, p.parallel_detect)
+        fl, fr = detect_pair(left, right, params=self.params)
         return self._process(fl, fr, left, right, clock)
 
     def process_features(self, left_features, right_features) -> FrameRecord:
@@ -146,20 +288,20 @@ class StereoSLAM:
         FrameRecord
             Counts per stage, ``status``, the pose.
         """
+        check_features(left_features, "left_features")
+        check_features(right_features, "right_features")
         return self._process(left_features, right_features, None, None, _StageClock())
 
     def _process(self, fl, fr, left, right, clock) -> FrameRecord:
         """The stages after detection; ``left``/``right`` images (None: no disparity refinement)."""
         p = self._noise.current(self.params)
-        _check_features(fl, "left features")
-        _check_features(fr, "right features")
         clock.lap("detect")
-        sm = _stereo_match(fl, fr, self.rig.F, p.ratio, p.epi_tol_px)
+        sm = stereo_match(fl, fr, self.rig, params=p)
         clock.lap("stereo")
         images = (left, right) if self._refine and left is not None else None
         truth, self.truth_left_cam_m, self._true_cam = self.truth_left_cam_m, None, None
         cloud, self._may_be_new, pts_body, cov_body, cov_init, self._true_cam = _frame_points(
-            self.rig, self.T_body_left, fl, fr, sm, p, images, self._oracle, truth)
+            self.rig, self.T_body_left, fl, fr, sm, p, images, self.oracles, truth)
         desc = fl.descriptors[cloud.left]
         clock.lap("triangulate")
         rec = FrameRecord(
@@ -219,8 +361,8 @@ class StereoSLAM:
         ids = mm.ids[est.inliers]
         loc = mm.local[est.inliers]
         true_cam = self._true_cam[loc] if p.update_cov_depth == "true" else None
-        Z, pose_var, Rz = _observations(pts_body[loc], cov_body[loc], est.T, self.T_body_left, self.rig, p, true_cam,
-                                        self.X[ids])
+        Z, pose_var, Rz = landmark_observations(pts_body[loc], cov_body[loc], est.T, self.T_body_left, self.rig,
+                                                true_cam=true_cam, landmarks_map=self.X[ids], params=p)
         if p.drop_first_sighting:
             # a landmark's first triangulation passed the depth cut on its own noisy depth (selected too near):
             # its second sighting replaces it instead of being fused with it (our option; issue 25)
@@ -241,12 +383,12 @@ class StereoSLAM:
         # unmatched local points become new (non-base) landmarks
         new = mm.unmatched[self._may_be_new[mm.unmatched]]
         if p.duplicate_gap_m is not None and new.size:
-            dup = _duplicates(pts_body[new], mm.nearest[new], self.X, est.T, p.duplicate_gap_m)
+            dup = duplicate_mask(pts_body[new], mm.nearest[new], self.X, est.T, p.duplicate_gap_m)
             rec["n_duplicates"] = int(dup.sum())
             new = new[~dup]
         first_new = len(self.X)
         pts_new = pts_body[new]
-        if "init_position" in self._oracle:
+        if "init_position" in self.oracles:
             pts_new = self._true_cam[new] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
         self._add_landmarks(pts_new, (cov_body if cov_init is None else cov_init)[new], desc[new], est.T)
         rec["n_new"] = len(new)
@@ -262,8 +404,7 @@ class StereoSLAM:
         the pose of those matches is the frame's. ``(matches, estimate)`` as :meth:`_locate`."""
         p = self.params
         last = self._last_ids[self.alive[self._last_ids]]
-        dist, ids = exact_knn(desc, self.desc[last], 2, last)
-        mm = _matches_from_knn(dist, ids, p.map_ratio, self.X, p.twin_gap_m)
+        mm = match_to_landmarks(desc, last, self.desc[last], positions=self.X, params=p)
         clock.lap("map_match")
         rec["n_searched"] += len(last)
         rec["n_compared"] += len(last) * len(desc)
@@ -271,10 +412,8 @@ class StereoSLAM:
         if est is None:
             return mm, None
         cand = self.landmarks_in_view(np.rad2deg(p.window_px / self.rig.left.fx), T_body=est.T)
-        cand, uv_lm = _window_candidates(self.X[cand], cand, est.T @ self.T_body_left, self.rig.left, p.window_px)
-        max_d = p.window_max_hamming if p.binary else np.inf
-        mm, n_pairs = _window_match(desc, uv, self.desc[cand], uv_lm, cand, p.window_px, p.map_ratio, max_d, self.X,
-                                    p.twin_gap_m)
+        mm, n_pairs = match_in_window(desc, uv, cand, self.desc[cand], self.X, est.T @ self.T_body_left, self.rig.left,
+                                      params=p)
         clock.lap("map_match")
         rec["n_compared"] += n_pairs
         if len(mm.local) < p.window_min_share * len(desc):
@@ -287,7 +426,7 @@ class StereoSLAM:
         """Match to the map (the landmarks ``cand``, or all) and estimate the pose (000 §3.4-3.5);
         ``(matches, estimate)``, the estimate None (and ``rec.status`` saying why) when the frame gives no pose."""
         p = self.params
-        mm = _match_to_map(desc, self.store, p.map_ratio, self.X, p.twin_gap_m, cand)
+        mm = match_to_map(desc, self.store, params=p, positions=self.X, candidates=cand)
         clock.lap("map_match")
         n = len(self.store) if cand is None else len(cand)
         rec["n_searched"] += n
@@ -306,15 +445,13 @@ class StereoSLAM:
             d_use = _weight_depth(p.weight_depth, depth[mm.local], true_z, self.X[mm.ids], self.T @ self.T_body_left,
                                   p.min_depth_m)
             src = pts_body[mm.local]
-            if "pose_points" in self._oracle:
+            if "pose_points" in self.oracles:
                 src = self._true_cam[mm.local] @ self.T_body_left[:3, :3].T + self.T_body_left[:3, 3]
-            est = _estimate_pose(src, self.X[mm.ids], self.first_seen[mm.ids], d_use,
-                                 cov_body[mm.local], p, self.rng)
+            est = estimate_pose(src, self.X[mm.ids], self.first_seen[mm.ids], depth_m=d_use, cov=cov_body[mm.local],
+                                params=p, rng=self.rng)
             rec["n_used"] = est.n_used
             if est.converged and p.pose_refine == "reprojection":
-                ids, loc = _refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
-                pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
-                est = est._replace(T=self._noise.refine(self, est.T, ids, pts_left))
+                est = est._replace(T=self._refine_pose(est, mm, pts_body))
             if not est.converged:
                 rec["status"], est = "ransac_failed", None
             elif p.max_rot_std_rad is not None:
@@ -326,6 +463,21 @@ class StereoSLAM:
         std = "" if np.isnan(rec["rot_std_rad"]) else f" (rot std {np.rad2deg(rec['rot_std_rad']):.2f} deg)"
         rec["trail"] += f"{search} {len(mm.local)} {rec['status'] if est is None else 'ok'}{std}; "
         return mm, est
+
+    def _refine_pose(self, est, mm, pts_body) -> np.ndarray:
+        """``pose_refine='reprojection'``: the pose ``est`` refined on the stereo reprojection error of its inliers
+        (:func:`~slamlab.stereo.refine_pose_stereo`), whose disparity residuals feed the keypoint-noise estimate
+        (``pixel_std_estimate``)."""
+        p = self.params
+        ids, loc = _refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
+        pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
+        X = self.X[ids]
+        T = refine_pose_stereo(est.T, X, pts_left, self.rig, self.T_body_left, iters=p.refine_iters,
+                               huber_px=p.refine_huber_px, min_depth_m=p.min_depth_m)
+        if p.pixel_std_estimate:
+            r, q = disparity_residuals_px(T, X, self.P[ids], pts_left, self.rig, self.T_body_left)
+            self._noise.observe(r, q, smoothing=p.pixel_std_smoothing)
+        return T
 
     def landmarks_in_view(self, margin_deg: float = 0.0, T_body=None) -> np.ndarray:
         """Ids of live landmarks in front of the left camera at ``T_body`` (default: the last pose),
@@ -344,11 +496,11 @@ class StereoSLAM:
         numpy.ndarray of int
             Landmark ids.
         """
-        T = self.T if T_body is None else v.as_matrix(T_body, "T_body", (4, 4))
+        T = self.T if T_body is None else as_matrix(T_body, "T_body", (4, 4))
         live = np.flatnonzero(self.alive)
         p = self.params
-        return live[_in_view(self.X[live], T @ self.T_body_left, self.rig.left, margin_deg,
-                             p.view_depth_factor * p.max_depth_m)]
+        return live[in_view(self.X[live], T @ self.T_body_left, self.rig.left, margin_deg,
+                            p.view_depth_factor * p.max_depth_m)]
 
     def refine_landmarks(self, ids, Z, Rz) -> np.ndarray:
         """Kalman-update landmarks ``ids`` with map-frame observations ``Z`` (covariances ``Rz``) (000 §3.6).
@@ -369,16 +521,16 @@ class StereoSLAM:
         -------
         numpy.ndarray of bool, shape (M,)
         """
-        ok, X_new, P_new = _gated_update(self.X[ids], self.P[ids], Z, Rz, self.params.state_var, self.params.update_gate)
+        ok, X_new, P_new = gated_update(self.X[ids], self.P[ids], Z, Rz, self.params.state_var, self.params.update_gate)
         self.X[ids[ok]], self.P[ids[ok]] = X_new, P_new
         return ok
 
     def _refine_landmarks_in_pixels(self, ids, pts_left, T_wc, pose_var) -> np.ndarray:
         """``filter_space='pixels'``: landmarks ``ids`` updated in the stereo pixels of the left camera at
-        ``T_wc`` (``landmark_filter._pixel_update``); returns the mask of the updated ones."""
+        ``T_wc`` (:func:`~slamlab.stereo.landmark_filter.pixel_update`); returns the mask of the updated ones."""
         p = self._noise.current(self.params)
-        ok, X_new, P_new = _pixel_update(self.X[ids], self.P[ids], pts_left, T_wc, pose_var, self.rig, p.state_var,
-                                         p.pixel_std, p.min_depth_m, p.update_gate)
+        ok, X_new, P_new = pixel_update(self.X[ids], self.P[ids], pts_left, T_wc, pose_var, self.rig, p.state_var,
+                                        p.pixel_std, p.min_depth_m, p.update_gate)
         self.X[ids[ok]], self.P[ids[ok]] = X_new, P_new
         return ok
 

@@ -1,9 +1,10 @@
 """Compiled kernels of the two-nearest search for binary descriptors (speed, issue 25).
 
 The teaching versions are numpy: they build every candidate pair as arrays, then their Hamming
-distances (``_pair_distances``), then the two nearest per query (``_two_nearest``). The kernels walk
-the same pairs in the same order and keep only the two nearest, so nothing of size "pairs" is
-allocated; the results are the same, bit for bit (tested against the numpy versions):
+distances (``pair_distances`` of the stereo package's private ``_pairs`` module), then the two nearest
+per query (``two_nearest``). The kernels walk the same pairs in the same order and keep only the two
+nearest, so nothing of size "pairs" is allocated; the results are the same, bit for bit (tested against
+the numpy versions):
 
 - :func:`window_hamming_2nn`: the window search of the map matching (our addition to 000 §3.4), the
   pairs of ``_radius_pairs`` in :mod:`slamlab.stereo.map_stages`;

@@ -60,7 +60,7 @@ def test_rasterise_matches_plain_reference():
     s = S.Rangefinder(n_beams=120, max_range_cells=80).scan(M, [70, 30, 0.0])
     # headings off the axes: beams at multiples of 3° put no sample exactly on a cell face
     headings = np.radians([1.0, 37.0, 91.0, 269.0, 359.0])
-    T, o = C.rasterise_scan(s, headings)
+    T, o = C.scan_stamps(s, headings)
     assert T.shape[1] == 2 * o
     for n, th in enumerate(headings):
         ref = _reference_stamp(s.bearings_rad[s.valid], s.ranges[s.valid], th, T.shape[1], o)
@@ -72,7 +72,7 @@ def test_rasterise_matches_plain_reference():
 def test_quarter_turns_are_grid_rotations():
     M = S.test_room_200()
     s = S.Rangefinder(n_beams=90, max_range_cells=60).scan(M, [70, 30, 0.0])
-    T, o = C.rasterise_scan(s, np.radians([10.0, 100.0, 190.0, 280.0]))
+    T, o = C.scan_stamps(s, np.radians([10.0, 100.0, 190.0, 280.0]))
     # a quarter turn maps the robot-frame offset (dx, dy) to (-dy, dx): T'[o + dx, o - dy] = T[o + dy, o + dx]
     for q in range(1, 4):
         ref = np.zeros_like(T[0])
@@ -159,7 +159,7 @@ def test_bad_input():
     with pytest.raises(ValueError, match="`scan` must be in cell units; got unit 'm'"):
         C.localise(M, Scan([0.0], [5.0], [True], unit="m"))
     with pytest.raises(ValueError, match="`step_cells` must be <= 1"):
-        C.rasterise_scan(Scan([0.0], [1.0], [True]), [0.0], step_cells=2.0)
+        C.scan_stamps(Scan([0.0], [1.0], [True]), [0.0], step_cells=2.0)
     with pytest.raises(ValueError, match="`step_cells` must be <= 1"):
         C.localise(M, scan, step_cells=2.0)
     with pytest.raises(ValueError, match="`dtype` must be one of"):
@@ -169,7 +169,7 @@ def test_bad_input():
     with pytest.raises(TypeError, match="`params` must be a LocaliseParams or None; got dict"):
         C.localise(M, scan, params={"a_c": 0.0})
     with pytest.raises(ValueError, match="`l_max` must cover the longest beam"):
-        C.rasterise_scan(Scan([0.0], [10.0], [True]), [0.0], l_max=3)
+        C.scan_stamps(Scan([0.0], [10.0], [True]), [0.0], l_max=3)
     with pytest.raises(ValueError, match=r"`T` must have shape \(n, S, S\)"):
         C.score_maps(np.zeros((4, 4)), np.zeros((3, 4)), 1)
     with pytest.raises(ValueError, match="`method` must be one of"):
@@ -189,7 +189,7 @@ def test_quarter_turn_search_equals_plain_stack_on_a_non_square_map():
     M = S.test_room_200()[10:130, 5:190]
     s = S.Rangefinder(n_beams=180, max_range_cells=60, range_std_cells=0.2).scan(M, [90, 60, 1.0], rng=3)
     loc = C.localise(M, s, delta_alpha_rad=np.radians(3.0), dtype="float64")
-    T, o = C.rasterise_scan(s, loc.headings_rad)
+    T, o = C.scan_stamps(s, loc.headings_rad)
     D = C.score_maps(S.grid_to_values(M), T, o, method="fftconvolve")
     np.testing.assert_allclose(loc.best_per_heading, D.reshape(D.shape[0], -1).max(axis=1), atol=1e-8)
     np.testing.assert_allclose(loc.score_map, D[loc.heading_index], atol=1e-8)
@@ -224,14 +224,14 @@ def test_localise_params_object_equals_overrides():
 
 def test_wall_balance_weights_corridor_walls_less():
     """Issue 25 (ours): returns on a corridor's long walls weigh less than those on its end wall; mean 1, cap 4."""
-    from slamlab.correlation.algorithm import _wall_weights
-    from slamlab.correlation.scoring import _stamp
+    from slamlab.correlation._fft import write_marks
+    from slamlab.correlation.samples import scan_samples
 
-    p = C.LocaliseParams(wall_balance=True)
     a = np.radians(np.arange(-90.0, 91.0))  # a corridor 4 cells wide along x, its end wall at x = 30
     r = np.minimum(np.abs(2.0 / np.where(np.sin(a) == 0, 1e-9, np.sin(a))), 30.0 / np.maximum(np.cos(a), 1e-9))
     h = np.ones(a.size, bool)
-    w = _wall_weights([(a, r, h)], np.zeros((1, 3)), p)
+    w = scan_samples(Scan(a, r, h), wall_balance=True, a_p=2.0).obs_value / 2.0  # a_p times each sample's weight
+    assert scan_samples(Scan(a, r, h), a_p=2.0).obs_value == 2.0  # no weights without wall_balance
     n_obs = w.size // a.size
     wb = w[::n_obs]
     end = np.abs(r * np.cos(a) - 30.0) < 1e-6
@@ -244,8 +244,8 @@ def test_wall_balance_weights_corridor_walls_less():
     T1 = np.zeros((3, 80, 80), np.float32)
     T2 = np.zeros((3, 80, 80), np.float32)
     hd = np.radians([0.0, 10.0, 45.0])
-    _stamp(T1, hd, pts[:0], pts, -1.0, 1.0, 40)
-    _stamp(T2, hd, pts[:0], pts, -1.0, np.ones(a.size), 40)
+    write_marks(T1, hd, pts[:0], pts, -1.0, 1.0, 40)
+    write_marks(T2, hd, pts[:0], pts, -1.0, np.ones(a.size), 40)
     assert np.array_equal(T1, T2)
     with pytest.raises(TypeError, match="`wall_balance` must be a bool"):
         C.LocaliseParams(wall_balance=1)
@@ -275,7 +275,7 @@ def test_score_norm_explored_matches_definition(min_fraction):
     M[:, 35:] = -1  # the right part unexplored (a leave-out's hole)
     scan = S.Rangefinder(n_beams=90, max_range_cells=25.0).scan(S.test_room_200(), [50.0, 45.0, np.radians(20)])
     hd = C.heading_candidates(np.radians(30.0))
-    T, o = C.rasterise_scan(scan, hd, dtype="float64")
+    T, o = C.scan_stamps(scan, hd, dtype="float64")
     floor = -1.0 / min_fraction - 1.0  # the documented floor: -max|T|·max|M| / min_fraction - 1, here |T|, |M| <= 1
     ref = _explored_reference(M, T, o, min_fraction, floor)
     loc = C.localise(M, scan, delta_alpha_rad=np.radians(30.0), dtype="float64", ambiguity=False,
@@ -315,7 +315,7 @@ def test_score_norm_floor_lies_below_every_score_with_heavy_free_marks():
     hd = C.heading_candidates(np.radians(30.0))
     loc = C.localise(M, scan, delta_alpha_rad=np.radians(30.0), dtype="float64", ambiguity=False,
                      score_norm="explored", min_explored_fraction=0.8, free_mark_weight=5.0)
-    T, o = C.rasterise_scan(scan, hd, a_c=-5.0, a_p=1.0, dtype="float64")
+    T, o = C.scan_stamps(scan, hd, a_c=-5.0, a_p=1.0, dtype="float64")
     marks = np.argwhere(T[loc.heading_index] != 0) - o + [loc.row, loc.col]
     inside = np.all((marks >= 0) & (marks < 160), axis=1)
     assert inside.mean() >= 0.8
@@ -350,8 +350,8 @@ def test_free_mark_weight_scales_the_stamps_free_marks_only():
     M = S.test_room_200()[20:100, 0:90]
     scan = S.Rangefinder(n_beams=90, max_range_cells=25.0).scan(M, [40.0, 30.0, np.radians(33.0)])
     hs = C.heading_candidates(np.radians(10.0))
-    T1, o = C.rasterise_scan(scan, hs, dtype="float64")
-    Tl, _ = C.rasterise_scan(scan, hs, dtype="float64", free_mark_weight=0.25)
+    T1, o = C.scan_stamps(scan, hs, dtype="float64")
+    Tl, _ = C.scan_stamps(scan, hs, dtype="float64", free_mark_weight=0.25)
     assert np.array_equal(Tl, np.where(T1 == -1.0, -0.25, T1))
     D = C.score_maps(S.grid_to_values(M), Tl, o, method="direct")
     loc = C.localise(M, scan, delta_alpha_rad=np.radians(10.0), free_mark_weight=0.25, dtype="float64",

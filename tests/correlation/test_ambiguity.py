@@ -23,7 +23,7 @@ def _corner() -> np.ndarray:
 def _rival_by_definition(grid, scan, loc, params):
     """Best score of a pose > rival_radius_cells or > rival_heading_rad from the peak, from the full stack
     computed per heading by ``scipy.signal.fftconvolve`` (independent of the streamed search)."""
-    T, o = C.rasterise_scan(scan, loc.headings_rad, params=params)
+    T, o = C.scan_stamps(scan, loc.headings_rad, params=params)
     D = C.score_maps(S.grid_to_values(grid), T, o, method="fftconvolve")
     rows, cols = np.indices(D.shape[1:])
     near_cells = np.hypot(rows - loc.row, cols - loc.col) <= params.rival_radius_cells
@@ -138,8 +138,8 @@ def test_corridor_tie_run_reports_both_modes():
     assert "2 scans + odometry" in t
     assert "1.000" in t
     assert str(r).startswith("corridor: one scan 180° off")
-    with pytest.raises(ValueError, match="`step_cells` must be"):
-        CS.run_corridor_tie(step_cells=-1.0)
+    with pytest.raises(ValueError, match="`spacing_cells` must be"):
+        CS.run_corridor_tie(spacing_cells=-1.0)
 
 
 def test_margin_edge_cases():

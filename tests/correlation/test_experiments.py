@@ -173,7 +173,7 @@ def _sequential_reference(n, rng, clutter=0, n_beams=360, range_std_cells=0.3):
 
 def test_monte_carlo_on_sweep_equals_the_sequential_loop_for_one_and_two_workers():
     poses, est = _sequential_reference(3, 21, clutter=5)
-    ea, ex, ey = CS.studies._errors(poses, est)
+    ea, ex, ey = CS.studies.absolute_errors(poses, est)
     one = CS.run_monte_carlo(3, extra_clutter=5, rng=21, n_jobs=1)
     two = CS.run_monte_carlo(3, extra_clutter=5, rng=21, n_jobs=2)
     for r in (one, two):
@@ -197,7 +197,7 @@ def test_localisation_table_has_one_row_per_choice_and_pose():
     scans = [S.Rangefinder(n_beams=90, max_range_cells=40.0).scan(S.test_room_200(), [60.0, 40.0, 0.5])] * 2
     settings = (C.LocaliseParams(delta_alpha_rad=np.radians(10.0)),
                 C.LocaliseParams(delta_alpha_rad=np.radians(10.0), a_c=0.0))
-    table = CS.studies._localise_scans(S.test_room_200(), scans, settings, margins=True, progress=False)
+    table = CS.experiments._localise_scans(S.test_room_200(), scans, settings, margins=True, progress=False)
     assert table.columns.tolist() == ["choice", "pose_index", "x", "y", "heading_rad", "half_max_area",
                                       "heading_margin"]
     assert table[["choice", "pose_index"]].to_numpy().tolist() == [[0, 0], [0, 1], [1, 0], [1, 1]]

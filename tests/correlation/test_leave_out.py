@@ -7,16 +7,16 @@ from slamlab.io import read_carmen
 from slamlab.scans.logmap import log_counts
 from slamlab.scans.occupancy import label_counts, occupancy_grid
 from slamlab.studies import correlation as CS
-from slamlab.studies.correlation.log_truth import _leave_sets, _mode_grids
+from slamlab.studies.correlation._log_scan import leave_sets, mode_grids
 
 
 def test_leave_sets_by_definition():
     # "used": mode k leaves out scans i-k+1 .. i and nothing else; "window": i-2 .. i+2 for every mode
-    used = _leave_sets(100, (1, 3), 2, 500, "used")
+    used = leave_sets(100, (1, 3), 2, 500, "used")
     assert {k: list(s) for k, s in used.items()} == {1: [100], 3: [98, 99, 100]}
-    window = _leave_sets(100, (1, 3), 2, 500, "window")
+    window = leave_sets(100, (1, 3), 2, 500, "window")
     assert {k: list(s) for k, s in window.items()} == {1: [98, 99, 100, 101, 102], 3: [98, 99, 100, 101, 102]}
-    assert list(_leave_sets(1, (1,), 2, 500)[1]) == [0, 1, 2, 3]  # clipped at the log's start
+    assert list(leave_sets(1, (1,), 2, 500)[1]) == [0, 1, 2, 3]  # clipped at the log's start
 
 
 @pytest.mark.realdata
@@ -27,14 +27,14 @@ def test_used_mode_grids_are_the_other_scans_grids(real_data, hit_ratio):
     log = read_carmen(real_data / "carmen-radish-corrected" / "orebro-corrected.log.gz")
     _frame, scans_c, Pc, full = log_counts(log, cell_m=0.2, max_range_m=10.0)
     i = 150
-    grids = _mode_grids(_leave_sets(i, (1, 3), 2, log.n_scans, "used"), full, scans_c, Pc, hit_ratio)
+    grids = mode_grids(leave_sets(i, (1, 3), 2, log.n_scans, "used"), full, scans_c, Pc, hit_ratio)
     for k, left in ((1, [i]), (3, [i - 2, i - 1, i])):
         keep = [j for j in range(log.n_scans) if j not in left]
         og = occupancy_grid([scans_c[j] for j in keep], Pc[keep], full.grid.shape)
         np.testing.assert_array_equal(grids[k], label_counts(og.hits, og.passes, hit_ratio=hit_ratio))
     assert not np.array_equal(grids[1], grids[3])  # scans i-2, i-1 drew cells: the two modes' grids differ
     # "window": one grid for every mode
-    win = _mode_grids(_leave_sets(i, (1, 3), 2, log.n_scans, "window"), full, scans_c, Pc, hit_ratio)
+    win = mode_grids(leave_sets(i, (1, 3), 2, log.n_scans, "window"), full, scans_c, Pc, hit_ratio)
     assert win[1] is win[3]
 
 
@@ -77,3 +77,20 @@ def test_leave_out_bad_values(real_data):
         CS.run_log_localisation(log, (100,), leave_out="used", exclude=2)
     with pytest.raises(ValueError, match="`exclude` must be >= 2"):
         CS.run_log_localisation(log, (100,), joined=(3,), leave_out="window", exclude=1)
+
+
+def test_log_points_name_a_scan_without_a_return():
+    # the sweep's points carry the test scan and the scans joined before it; one without a return is named here,
+    # before any worker runs
+    from slamlab.scans import Scan
+    from slamlab.studies.correlation._log_scan import log_points
+
+    hit = Scan([0.0, 1.0], [3.0, 4.0], [True, True], max_range=10.0)
+    miss = Scan([0.0, 1.0], [10.0, 10.0], [False, False], max_range=10.0)
+    scans_c, Pc = [hit, miss, hit, hit], np.zeros((4, 3))
+    (pt,) = log_points(np.array([3]), (1, 2), scans_c, Pc, np.zeros((1, 1, 3)))
+    assert pt["index"] == 3
+    assert pt["scans"] == [scans_c[3], scans_c[2]]
+    np.testing.assert_array_equal(pt["rel"], np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="`scan 1` has no return"):
+        log_points(np.array([2]), (1, 2), scans_c, Pc, np.zeros((1, 1, 3)))

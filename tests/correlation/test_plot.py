@@ -17,10 +17,10 @@ def test_plots_draw():
     assert len(fig.axes) == 4  # three panels + the colour bar
     ax = C.plot_grid(M)
     assert ax.images[0].get_array().shape == (200, 200)
-    T, o = C.rasterise_scan(scan, [0.0])
+    T, o = C.scan_stamps(scan, [0.0])
     ax = C.plot_stamp(T[0], o)
     assert ax.images[0].get_array().shape == T[0].shape
-    T3, _ = C.rasterise_scan(scan, np.radians([0.0, 30.0, 60.0]))
+    T3, _ = C.scan_stamps(scan, np.radians([0.0, 30.0, 60.0]))
     fig = C.plot_stamps(T3, o, (0, 2))
     assert [ax.get_title()[:14] for ax in fig.axes] == ["T_n at α0n = 0", "T_n at α0n = 2"]
     fig = C.plot_grids([M, M[:100]], ["a", "b"])

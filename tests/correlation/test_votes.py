@@ -7,17 +7,17 @@ import pytest
 from slamlab.geometry.se2 import se2_compose
 from slamlab.io import read_carmen
 from slamlab.studies import correlation as CS
-from slamlab.studies.correlation.log_truth import _leave_sets, _vote_leave, _votes
+from slamlab.studies.correlation._log_scan import count_votes, leave_sets, vote_leave
 
 
 def test_vote_leave_by_definition():
     # the voters' grid lacks the largest mode's scans and the voters i-2 .. i: with the ±2 window, the window
-    window = _leave_sets(100, (1, 3), 2, 500, "window")
-    assert _vote_leave(100, window) == tuple(range(98, 103))
-    assert _vote_leave(100, _leave_sets(100, (1,), 0, 500, "window")) == (98, 99, 100)
-    assert _vote_leave(100, _leave_sets(100, (1,), 2, 500, "used")) == (98, 99, 100)
-    assert _vote_leave(100, _leave_sets(100, (1, 3), 2, 500, "used")) == (98, 99, 100)
-    assert _vote_leave(100, _leave_sets(100, (1, 5), 2, 500, "used")) == (96, 97, 98, 99, 100)
+    window = leave_sets(100, (1, 3), 2, 500, "window")
+    assert vote_leave(100, window) == tuple(range(98, 103))
+    assert vote_leave(100, leave_sets(100, (1,), 0, 500, "window")) == (98, 99, 100)
+    assert vote_leave(100, leave_sets(100, (1,), 2, 500, "used")) == (98, 99, 100)
+    assert vote_leave(100, leave_sets(100, (1, 3), 2, 500, "used")) == (98, 99, 100)
+    assert vote_leave(100, leave_sets(100, (1, 5), 2, 500, "used")) == (96, 97, 98, 99, 100)
 
 
 def test_votes_count_agreeing_voters_by_geometry():
@@ -30,11 +30,11 @@ def test_votes_count_agreeing_voters_by_geometry():
     v2 = se2_compose(P, rel[2]) + np.array([0.0, 0.0, np.radians(6.0)])
     far = P + np.array([3.0, 0, 0])                     # 3 cells from v0, 1.5 from v1, and 6° from v2
     turned = P + np.radians([0.0, 0.0, 4.0])            # 4° from v0 and v1, 2° and ≈ 1 cell from v2
-    out = _votes([v0, v1, v2], rel, {1: P, 3: far, 2: turned})
+    out = count_votes([v0, v1, v2], rel, {1: P, 3: far, 2: turned})
     assert out == {"vote1": 2, "vote3": 1, "vote2": 3}
     # a wrapped heading still agrees: 359.5° against -0.5°
     Q = np.array([10.0, 10.0, np.radians(-0.5)])
-    assert _votes([Q + np.array([0, 0, 2 * np.pi])], rel[:1], {1: Q}) == {"vote1": 1}
+    assert count_votes([Q + np.array([0, 0, 2 * np.pi])], rel[:1], {1: Q}) == {"vote1": 1}
 
 
 @pytest.mark.realdata

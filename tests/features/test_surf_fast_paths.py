@@ -21,7 +21,7 @@ from slamlab.features import (
     surf_describe,
     surf_orientation,
 )
-from slamlab.features.surf_haar import _PaddedII
+from slamlab.features._padded_ii import PaddedIntegralImage
 from slamlab.features.surf_response import _interior_maxima, _response_stacks
 
 
@@ -143,7 +143,7 @@ def test_interior_maxima_equal_maximum_filter(levels):
 def test_padded_integral_image_from_the_image_equals_padded_integral_image(shape):
     img = np.random.default_rng(9).random(shape)
     II = integral_image(img)
-    P = _PaddedII(image=img, pad=20, extra=7, workers=2)
+    P = PaddedIntegralImage(image=img, pad=20, extra=7, workers=2)
     np.testing.assert_array_equal(P.E, np.pad(II, ((20, 27), (20, 27)), mode="edge"))
     np.testing.assert_array_equal(P.II, II)
 
@@ -151,7 +151,7 @@ def test_padded_integral_image_from_the_image_equals_padded_integral_image(shape
 def test_clipped_haar_on_the_padded_image_equals_haar_xy():
     rng = np.random.default_rng(10)
     II = integral_image(rng.random((50, 70)))
-    P = _PaddedII(II, pad=8)
+    P = PaddedIntegralImage(II, pad=8)
     rows, cols = rng.integers(-40, 90, (6, 30)), rng.integers(-40, 110, (6, 30))
     half = rng.integers(1, 30, (6, 1))
     for got, ref in zip(P.haar_clipped(rows, cols, half), haar_xy(II, rows, cols, half), strict=True):

@@ -134,3 +134,20 @@ def test_monte_carlo_runs_are_the_same_on_two_workers():
     from_gen = E.run_cv_target(n_runs=3, n_steps=5, rng=np.random.default_rng(7))
     from_int = E.run_cv_target(n_runs=3, n_steps=5, rng=7)
     np.testing.assert_array_equal(from_gen.anees, from_int.anees)
+
+
+def test_mean_nees_is_over_the_finite_steps_and_feeds_the_tables():
+    """The finite-step mean (issue 42: one property for the tables, the stabilising study and the closing table)."""
+    res = E.run_unicycle_comparison(n_runs=3, n_steps=20, filters=("EKF", "LKF"), rng=6)
+    for i in range(len(res.filters)):
+        a = res.anees[i]
+        assert res.mean_nees[i] == pytest.approx(a[np.isfinite(a)].mean(), rel=1e-15)
+        assert f"{res.mean_nees[i]:.2f}" in res.table().splitlines()[2 + i]
+    stab = E.run_stabilising_noise((1.0, 4.0), n_runs=3, n_steps=20, rng=6)
+    np.testing.assert_array_equal(stab.mean_nees[0], res.mean_nees[0])  # the same runs, the same EKF
+    cv = E.run_cv_target(n_runs=4, n_steps=10, rng=2)
+    assert cv.mean_nees == cv.anees.mean()
+    assert cv.mean_nis == cv.anis.mean()
+    blank = E.UnicycleResult(("EKF",), 1, 2, {}, np.array([np.nan]), np.array([np.nan]), np.full((1, 2), np.nan),
+                             np.array([1]), np.full((1, 1), np.nan), (1.0, 5.0), None, None, None, None)
+    assert np.isnan(blank.mean_nees[0])  # a filter that failed in every run: NaN, without a warning

@@ -142,8 +142,51 @@ def test_project_points_min_depth_clamps_z():
 def test_project_points_bad_input():
     with pytest.raises(ValueError, match=r"`K` must have shape \(3, 3\); got \(2, 2\)"):
         project_points(np.eye(2), np.ones((3, 3)))
-    with pytest.raises(ValueError, match=r"`X` must have shape \(N, 3\); got \(3, 2\)"):
+    with pytest.raises(ValueError, match=r"`X` must have shape \(N, 3\) or \(\.\.\., 3\); got \(3, 2\)"):
         project_points(np.eye(3), np.ones((3, 2)))
+
+
+def test_project_points_is_batched_over_leading_axes():
+    K = np.array([[500.0, 0.0, 320.0], [0.0, 480.0, 240.0], [0.0, 0.0, 1.0]])
+    X = np.random.default_rng(0).uniform([-1, -1, 1], [1, 1, 5], (4, 5, 3))
+    uv = project_points(K, X)
+    assert uv.shape == (4, 5, 2)
+    np.testing.assert_array_equal(uv.reshape(-1, 2), project_points(K, X.reshape(-1, 3)))  # same bits
+    # independent reference: the homogeneous product K X, divided by its last row
+    h = X @ K.T
+    np.testing.assert_allclose(uv, h[..., :2] / h[..., 2:], rtol=1e-13)
+
+
+def test_project_points_jacobian_matches_finite_differences():
+    K = np.array([[500.0, 0.0, 320.0], [0.0, 480.0, 240.0], [0.0, 0.0, 1.0]])
+    X = np.array([[0.3, -0.2, 2.0], [-1.0, 0.5, 5.0]])
+    uv, J = project_points(K, X, jacobian=True)
+    np.testing.assert_array_equal(uv, project_points(K, X))
+    assert J.shape == (2, 2, 3)
+    eps = 1e-6
+    for k in range(3):
+        d = np.zeros(3)
+        d[k] = eps
+        num = (project_points(K, X + d) - project_points(K, X - d)) / (2 * eps)
+        np.testing.assert_allclose(J[:, :, k], num, rtol=1e-7, atol=1e-6)
+
+
+def test_stereo_pixels_are_both_projections_with_their_jacobian():
+    rig = StereoRig(PinholeCamera(640, 480, 500.0, 500.0, 320.0, 240.0), PinholeCamera(640, 480, 510.0, 505.0, 318.0, 242.0),
+                    rotation_xyz(0.01, -0.02, 0.005), [-0.3, 0.01, 0.0])
+    X = np.array([[0.3, -0.2, 4.0], [-1.0, 0.5, 9.0]])
+    z, J = rig.stereo_pixels(X, jacobian=True)
+    uv_l, uv_r = rig.project(X)
+    np.testing.assert_allclose(z, np.hstack([uv_l, uv_r]), rtol=1e-14)
+    np.testing.assert_array_equal(rig.stereo_pixels(X), z)
+    eps = 1e-6
+    for k in range(3):
+        d = np.zeros(3)
+        d[k] = eps
+        num = (rig.stereo_pixels(X + d) - rig.stereo_pixels(X - d)) / (2 * eps)
+        np.testing.assert_allclose(J[:, :, k], num, rtol=1e-6, atol=1e-5)
+    with pytest.raises(ValueError, match=r"`points_left` must have shape \(N, 3\); got \(2, 2\)"):
+        rig.stereo_pixels(np.ones((2, 2)))
 
 
 

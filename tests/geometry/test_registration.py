@@ -47,3 +47,19 @@ def test_bad_input():
         umeyama(np.full((3, 2), np.nan), np.zeros((3, 2)))
     with pytest.raises(ValueError, match="`src` points must not all coincide"):
         umeyama(np.ones((4, 3)), np.ones((4, 3)), with_scale=True)
+
+
+def test_unchecked_umeyama_is_the_checked_one_bit_for_bit():
+    rng = np.random.default_rng(4)
+    src = rng.normal(size=(6, 3))
+    dst = src @ Rotation.from_rotvec([0.2, 0.1, -0.4]).as_matrix().T + 0.01 * rng.normal(size=(6, 3))
+    w = rng.uniform(0.1, 1.0, 6)
+    for with_scale in (False, True):
+        a = umeyama(src, dst, with_scale=with_scale, weights=w)
+        b = umeyama(src, dst, with_scale=with_scale, weights=w, check=False)
+        np.testing.assert_array_equal(a.R, b.R)
+        np.testing.assert_array_equal(a.t, b.t)
+        assert a.c == b.c
+    np.testing.assert_array_equal(umeyama(src, dst).R, umeyama(src, dst, check=False).R)
+    with pytest.raises(ValueError, match="`src` must be finite; got 9 NaN"):
+        umeyama(np.full((3, 3), np.nan), dst[:3])

@@ -5,7 +5,7 @@ import pytest
 from scipy.linalg import expm, logm
 from scipy.spatial.transform import Rotation
 
-from slamlab.geometry import hat, se3_exp, se3_log, so3_exp, so3_log, vee
+from slamlab.geometry import hat, rotation_angle, se3_exp, se3_log, so3_exp, so3_log, vee
 
 
 def _rotvecs(seed=0):
@@ -94,3 +94,26 @@ def test_batched_is_the_same_bits_as_one_at_a_time():
 def test_bad_shapes_name_the_argument(fn, arg, match):
     with pytest.raises(ValueError, match=match):
         fn(arg)
+
+
+def test_rotation_angle_matches_scipy_and_is_batched():
+    w = _rotvecs(3)
+    R = so3_exp(w)
+    angle = rotation_angle(R)
+    assert angle.shape == (len(w),)
+    np.testing.assert_allclose(angle, np.linalg.norm(Rotation.from_matrix(R).as_rotvec(), axis=1), atol=1e-12)
+    np.testing.assert_array_equal(rotation_angle(R.reshape(7, 7, 3, 3)), angle.reshape(7, 7))
+    assert rotation_angle(R[5]) == angle[5]
+
+
+def test_rotation_angle_keeps_its_digits_where_arccos_loses_them():
+    # 1e-9 rad: arccos((tr R - 1) / 2) rounds the cosine to 1 and returns 0 (or ~1e-8); atan2 keeps the angle
+    small = so3_exp([0.0, 0.0, 1e-9])
+    assert abs(rotation_angle(small) - 1e-9) < 1e-20
+    assert np.arccos(np.clip((np.trace(small) - 1) / 2, -1, 1)) == 0.0
+    np.testing.assert_allclose(rotation_angle(so3_exp([np.pi - 1e-6, 0.0, 0.0])), np.pi - 1e-6, rtol=1e-12)
+
+
+def test_rotation_angle_bad_input():
+    with pytest.raises(ValueError, match=r"`R` must have shape \(3, 3\) or \(\.\.\., 3, 3\); got \(2, 2\)"):
+        rotation_angle(np.eye(2))

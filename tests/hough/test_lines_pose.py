@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import slamlab.hough as h
+from slamlab.hough.pose import weighted_median
 
 
 def room_scan(pose, walls=((5.0, 0.0), (4.0, math.pi / 2), (6.0, math.pi), (3.0, -math.pi / 2)), n=720):
@@ -153,7 +154,7 @@ def test_association_follows_a_move_and_uses_parallel_distances():
     P = h.association_probability(new, old, a=1.0)
     assert P.shape == (3, 3)
     assert np.all((P >= 0) & (P <= 1))
-    assert h.associate(P).tolist() == [0, 1, 2]
+    assert h.associate_lines(P).tolist() == [0, 1, 2]
     # ... with the parallel-distance term the right pairing scores higher than the swapped one
     assert P[1, 1] > 0.5
 
@@ -161,7 +162,17 @@ def test_association_follows_a_move_and_uses_parallel_distances():
 def test_association_handles_flipped_representation():
     old = h.Lines(np.array([2.0, 5.0]), np.array([math.radians(89.5), math.radians(89.5)]), np.ones(2, int))
     new = h.Lines(np.array([-2.1, -5.1]), np.array([math.radians(-90.0), math.radians(-90.0)]), np.ones(2, int))
-    assert h.associate(h.association_probability(new, old, a=0.5)).tolist() == [0, 1]
+    assert h.associate_lines(h.association_probability(new, old, a=0.5)).tolist() == [0, 1]
+
+
+def test_weighted_median_is_where_half_the_weight_is_reached():
+    assert weighted_median([0.3, 0.1, 0.2], [1.0, 1.0, 5.0]) == 0.2
+    assert weighted_median([0.3, 0.1, 0.2], [1.0, 1.0, 1.0]) == 0.2
+    assert weighted_median([5.0], [2.0]) == 5.0
+    with pytest.raises(ValueError, match="`x` and `weights` must have one non-zero length"):
+        weighted_median([1.0, 2.0], [1.0])
+    with pytest.raises(ValueError, match="`weights` must be >= 0 with a positive sum"):
+        weighted_median([1.0, 2.0], [1.0, -1.0])
 
 
 def test_line_history_matrix():
@@ -194,7 +205,7 @@ def test_line_history_matrix():
         (lambda: h.association_probability(h.Lines(np.ones(1), np.ones(1), np.ones(1)),
                                            h.Lines(np.ones(1), np.ones(1), np.ones(1)), a=0.0), ValueError,
          "`a` must be > 0"),
-        (lambda: h.associate(np.ones(3)), ValueError, "`P` must be 2-dimensional"),
+        (lambda: h.associate_lines(np.ones(3)), ValueError, "`P` must be 2-dimensional"),
         (lambda: h.refine_lines(h.Lines(np.ones(1), np.ones(1), np.ones(1)), [0.0], [1.0, 2.0]), ValueError,
          "same length"),
         (lambda: h.transform_lines([1.0], [0.0], (1.0, 2.0)), ValueError, "`pose` must"),

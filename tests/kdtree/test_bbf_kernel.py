@@ -17,8 +17,8 @@ def _clustered(rng, n, dim, dtype):
 
 
 def _assert_same(tree, Q, k, max_leaves):
-    d_np, i_np, st = tree_mod._lockstep_search(tree._t, tree._P, Q, k, max_leaves)
-    d_c, i_c, nodes, leaves, dists = bbf_search(tree._t, tree._P, Q, k, max_leaves)
+    d_np, i_np, st = tree_mod._lockstep_search(tree._t, tree.leaf_points, Q, k, max_leaves)
+    d_c, i_c, nodes, leaves, dists = bbf_search(tree._t, tree.leaf_points, Q, k, max_leaves)
     np.testing.assert_array_equal(d_c, d_np)  # bit for bit: same summation order as numpy's einsum
     np.testing.assert_array_equal(i_c, i_np)  # same leaf order and tie-breaking
     np.testing.assert_array_equal(nodes, st.nodes_visited)
@@ -40,7 +40,7 @@ def test_kernel_equals_numpy_lockstep(dtype, kind, n, dim, leaf_size):
     tree = KDTree(X, leaf_size=leaf_size)
     for k in (1, 2, 3):
         for m in (1, 7, 200, None):
-            _assert_same(tree, Q.astype(tree._P.dtype), k, m)
+            _assert_same(tree, Q.astype(tree.leaf_points.dtype), k, m)
 
 
 def test_kernel_reproduces_the_pending_table_compaction(monkeypatch):
@@ -93,8 +93,8 @@ def test_kernel_equals_numpy_with_the_other_bounds(bound):
     tree = KDTree(X, leaf_size=2)
     tree.query(Q[:1], bound=bound)  # computes the cells' intervals
     for m in (5, 60, None):
-        d_np, i_np, st = tree_mod._lockstep_search(tree._t, tree._P, Q, 2, m, bound)
-        d_c, i_c, _, leaves, _ = bbf_search(tree._t, tree._P, Q, 2, m, bound)
+        d_np, i_np, st = tree_mod._lockstep_search(tree._t, tree.leaf_points, Q, 2, m, bound)
+        d_c, i_c, _, leaves, _ = bbf_search(tree._t, tree.leaf_points, Q, 2, m, bound)
         np.testing.assert_array_equal(d_c, d_np)
         np.testing.assert_array_equal(i_c, i_np)
         np.testing.assert_array_equal(leaves, st.leaves_visited)

@@ -99,7 +99,7 @@ def test_exact_search_equals_ckdtree(split):
                 d, i = tree.query(Q, k=3, bound=bound)  # compiled where numba is enabled
                 np.testing.assert_allclose(d, d_ref, rtol=1e-12, atol=1e-12)
                 if bound == "incremental":  # the numpy search too (the kernel equals it: the test below)
-                    d_np, _i_np, _ = tree_mod._lockstep_search(tree._t, tree._P, Q, 3, None, bound)
+                    d_np, _i_np, _ = tree_mod._lockstep_search(tree._t, tree.leaf_points, Q, 3, None, bound)
                     np.testing.assert_allclose(np.sqrt(d_np), d_ref, rtol=1e-12, atol=1e-12)
                 if kind != "ties":  # equal distances: any of the tied ids is right
                     np.testing.assert_array_equal(i, i_ref)
@@ -117,8 +117,8 @@ def test_kernel_equals_numpy_on_split_trees(split):
         for bound in ("max", "incremental", "sum"):
             tree.query(Q[:1], bound=bound)  # the cell bounds, for "incremental"
             for max_leaves in (7, 200):
-                d_np, i_np, st = tree_mod._lockstep_search(tree._t, tree._P, Q, 2, max_leaves, bound)
-                d_c, i_c, nodes, leaves, _ = bbf_search(tree._t, tree._P, Q, 2, max_leaves, bound)
+                d_np, i_np, st = tree_mod._lockstep_search(tree._t, tree.leaf_points, Q, 2, max_leaves, bound)
+                d_c, i_c, nodes, leaves, _ = bbf_search(tree._t, tree.leaf_points, Q, 2, max_leaves, bound)
                 np.testing.assert_array_equal(d_c, d_np)
                 np.testing.assert_array_equal(i_c, i_np)
                 np.testing.assert_array_equal(nodes, st.nodes_visited)

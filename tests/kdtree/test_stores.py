@@ -79,7 +79,7 @@ def test_multi_bbf_unlimited_checks_equals_exact():
 def test_rebuild_store_exact(tree):
     rng = np.random.default_rng(5)
     X = rng.random((600, 5)).astype(np.float32)
-    s = RebuildStore(tree=tree, leaf_size=3)
+    s = RebuildStore(tree=tree, leaf_size=3, base_seen_times=1)
     s.add(X[:300], np.arange(300))
     s.end_iteration()
     s.add(X[300:], np.arange(300, 600))
@@ -215,7 +215,7 @@ def test_flann_store_recall():
 
 def test_counters_multi_rebuilds_less_than_rebuild_store():
     X, _ = surf_like_descriptors(6000, rng=14)
-    a, b = RebuildStore(), MultiKDTree(500, 3.0)
+    a, b = RebuildStore(base_seen_times=1), MultiKDTree(500, 3.0)  # every point kept, as in the multi kd-tree
     for s in range(0, 6000, 300):
         for st in (a, b):
             st.add(X[s:s + 300], np.arange(s, s + 300))

@@ -62,8 +62,12 @@ def test_params_checks():
         L.MCLParams(n_particles=2.5)
     with pytest.raises(ValueError, match="`alpha_fast` must be > `alpha_slow`"):
         L.MCLParams(alpha_slow=0.2, alpha_fast=0.1)
-    with pytest.raises(ValueError, match="`alpha` must be a tuple of four"):
+    with pytest.raises(ValueError, match="`alpha` must be four finite numbers >= 0"):
         L.MCLParams(alpha=(0.1, 0.1))
+    with pytest.raises(TypeError, match="`alpha` must be a tuple of four"):
+        L.MCLParams(alpha=[0.1, 0.1, 0.1, 0.1])
+    with pytest.raises(ValueError, match="`alpha_ref` must be four finite numbers >= 0"):
+        L.check_alpha((0.1, -1.0, 0.1, 0.1), "alpha_ref")
     with pytest.raises(ValueError, match="`sigma_hit` must be > 0"):
         L.MCLParams(sigma_hit=0.0)
     with pytest.raises(TypeError, match="has no field"):
@@ -118,3 +122,16 @@ def test_log_with_too_few_scans_names_the_length(tmp_path):
         LS.run_log_mcl(log, n_scans=40)
     with pytest.raises(ValueError, match=r"`start` \+ `n_scans` must be <= the 5 scans of log 'tiny.log'; got 4 \+ 3"):
         LS.run_log_mcl(log, start=4, n_scans=3)
+
+
+def test_carmen_path_takes_a_log_name_or_any_file(tmp_path):
+    f = tmp_path / "mine.log"
+    f.write_text("PARAM robot_front_laser_max 10\n")
+    assert LS.carmen_path(f) == f
+    assert LS.carmen_path(str(f)) == f
+    with pytest.raises(FileNotFoundError, match="no file"):
+        LS.carmen_path(tmp_path / "missing.log")
+    with pytest.raises(TypeError, match=r"`path` must be a str or os\.PathLike"):
+        LS.carmen_path(3)
+    with pytest.raises(ValueError, match="`cell_m` must be > 0"):
+        LS.log_map(f, cell_m=0.0)

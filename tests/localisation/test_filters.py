@@ -198,7 +198,7 @@ def test_markov_vs_mcl_methods_share_the_runs():
 
     res = run_markov_vs_mcl(markov=((8, 12),), particle_counts=(50, 60), n_runs=3, n_steps=3, rng=4)
     df = res.table_df
-    starts = {m: g[["start_x", "start_y"]].to_numpy() for m, g in df.groupby(["method", "size"], sort=False)}
+    starts = {m: g[["start_x", "start_y"]].to_numpy() for m, g in df.groupby("variant", sort=False)}
     first = next(iter(starts.values()))
     assert len(starts) == 3
     assert len({tuple(map(tuple, v)) for v in starts.values()}) == 1  # every method ran the same 3 runs
@@ -214,11 +214,15 @@ def test_studies_take_params_and_any_rng():
     ref = run_markov_vs_mcl(**kw, rng=4).table_df[cols]
     assert ref.equals(run_markov_vs_mcl(**kw, rng=np.random.SeedSequence(4)).table_df[cols])
     assert ref.equals(run_markov_vs_mcl(**kw, rng=np.random.default_rng(4)).table_df[cols])
-    # params= and the same settings as overrides are one run; the particle counts replace params.n_particles
-    p = L.MCLParams(sigma_hit=3.0, n_particles=999)
-    a = run_markov_vs_mcl(**kw, params=p, rng=4).table_df[cols]
+    # params= and the same settings as overrides are one run; the study's own axis (the counts) is refused in both
+    a = run_markov_vs_mcl(**kw, params=L.MCLParams(sigma_hit=3.0), rng=4).table_df[cols]
     b = run_markov_vs_mcl(**kw, sigma_hit=3.0, rng=4).table_df[cols]
     assert a.equals(b)
+    assert not a.equals(ref)
+    with pytest.raises(ValueError, match=r"`n_particles` is set by this study itself .*`particle_counts`.* 999"):
+        run_markov_vs_mcl(**kw, params=L.MCLParams(sigma_hit=3.0, n_particles=999))
+    with pytest.raises(ValueError, match="`n_particles` is set by this study itself"):
+        run_markov_vs_mcl(**kw, n_particles=999)
     with pytest.raises(TypeError, match="`params` must be a MCLParams or None; got dict"):
         run_markov_vs_mcl(**kw, params={"sigma_hit": 3.0})
 

@@ -25,7 +25,7 @@ _SCRIPT = r"""
 import hashlib, numpy as np
 from slamlab.studies.mono import experiments as ex
 rng = np.random.default_rng(np.random.SeedSequence(2019).spawn(6)[3])
-imgs, Ts, K, _ = ex._case_frames("normal", "tiny", 16, rng)
+imgs, Ts, K, _ = ex.failure_case_frames("normal", "tiny", 16, rng=rng)
 r = ex.run_mono(imgs, Ts, K, name="t", progress=False, max_keyframes=3, kf_min_frames=10)
 print(hashlib.sha256(imgs.tobytes()).hexdigest(), hashlib.sha256(r.estimate.tobytes()).hexdigest(),
       r.claimed.sum(), r.n_points)

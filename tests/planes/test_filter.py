@@ -5,6 +5,7 @@ import pytest
 
 from slamlab.planes import (
     Frame,
+    Plane,
     PlaneMap,
     PlaneSLAM,
     PlaneSLAMParams,
@@ -196,3 +197,15 @@ def test_reconfigure_changes_the_next_prediction_and_refuses_fixed_fields():
         s.reconfigure(V_xyz_m2=-1.0)
     with pytest.raises(TypeError, match="no field"):
         s.reconfigure(sigma_xyz_m=0.1)
+
+
+def test_plane_from_cells_sums_the_entries_of_each_cell_in_key_order():
+    ij = np.array([[2, -1], [0, 0], [2, -1], [-3, 5]])
+    pl = Plane.from_cells(np.array([0, 0, 1.0]), 1.5, np.eye(4), 0.25, ij, [1, 2, 3, 4], [10.0, 20.0, 30.0, 40.0])
+    assert pl.ij.tolist() == [[-3, 5], [0, 0], [2, -1]]          # ascending keys: i first, then j
+    assert pl.counts.tolist() == [4, 2, 4]
+    assert pl.counts.dtype == np.int64
+    np.testing.assert_array_equal(pl.sums, [40.0, 20.0, 40.0])
+    assert np.all(np.diff(pl.keys) > 0)
+    assert pl.p == 1.5
+    assert isinstance(pl.p, float)

@@ -147,8 +147,28 @@ def test_ray_casting_in_chunks_equals_one_pass(monkeypatch):
     one = pr.cast_rays_planes(room, o, d, 30.0)
     import slamlab.sim.room_of_planes as rp  # the caster and its chunk size live there (re-exported by planes_room)
 
-    monkeypatch.setattr(rp, "_RAY_CHUNK", 333)
+    monkeypatch.setattr(rp, "RAY_CHUNK", 333)
     chunked = pr.cast_rays_planes(room, o, d, 30.0)
     for a, b in zip(one, chunked, strict=True):
         np.testing.assert_array_equal(a, b)
     assert np.isfinite(one[0]).sum() > 4000  # most rays hit a plane
+
+
+def test_odometry_rotation_noise_is_the_exponential_of_the_drawn_vectors():
+    """The per-step rotation noise is Exp(ε) of the drawn rotation vectors (slamlab.geometry.so3, one place for
+    every chapter), the same rotation as scipy's to the last bits."""
+    from scipy.spatial.transform import Rotation
+
+    from slamlab.geometry import so3_exp
+
+    T = np.tile(np.eye(4), (4, 1, 1))
+    odo = simulate_odometry_3d(T, sigma_trans_m=0.0, sigma_rot_deg=2.0, bias_m_per_step=(0, 0, 0),
+                               bias_yaw_deg_per_step=0.0, rng=8)
+    eps = np.random.default_rng(8).normal(0.0, np.deg2rad(2.0), (3, 3))
+    expected = np.eye(3)
+    for k in range(3):
+        expected = expected @ so3_exp(eps[k])
+        np.testing.assert_array_equal(odo[k + 1][:3, :3], expected)
+        np.testing.assert_allclose(expected, np.linalg.multi_dot([Rotation.from_rotvec(e).as_matrix()
+                                                                   for e in [np.zeros(3), *eps[:k + 1]]]),
+                                   atol=1e-14)

@@ -16,11 +16,10 @@ from slamlab.stereo import (
 )
 from slamlab.stereo.noise_estimate import (
     MIN_RESIDUALS,
-    _disparity_residuals,
-    _NoiseTracker,
+    KeypointNoiseTracker,
     disparity_noise_px,
+    disparity_residuals_px,
 )
-from slamlab.stereo.pose_stages import _stereo_project
 from slamlab.studies.stereo import KITTI_PARAMS
 from slamlab.studies.stereo.scale_ablation import ABLATION_BASE, PROPOSED_FIX, run_scale_ablation
 
@@ -62,12 +61,12 @@ def test_estimate_of_injected_keypoint_noise_with_exact_landmarks():
     for sigma in (0.5, 1.0):
         Pt = np.column_stack([g.uniform(-10, 10, 3000), g.uniform(-1.5, 2, 3000), g.uniform(5, 40, 3000)])
         X = Pt @ T[:3, :3].T + T[:3, 3]
-        z_px = _stereo_project(rig, Pt)[0][:, :3] + sigma * g.standard_normal((3000, 3))
+        z_px = rig.stereo_pixels(Pt)[:, :3] + sigma * g.standard_normal((3000, 3))
         P = _triangulate(rig, z_px)
         keep = P[:, 2] > 0.5
         X, P = X[keep], P[keep]
         T_est = refine_pose_stereo(se3_from_planar(0.9, 0.0, 0.0), X, P, rig, iters=10, huber_px=100.0)
-        r, q = _disparity_residuals(T_est, X, np.zeros((len(X), 3, 3)), P, rig, np.eye(4))
+        r, q = disparity_residuals_px(T_est, X, np.zeros((len(X), 3, 3)), P, rig, np.eye(4))
         assert np.allclose(q, 0.0)
         assert disparity_noise_px(r, q) == pytest.approx(sigma, rel=0.05)
         assert robust_pixel_std(stereo_residuals_px(T_est, X, P, rig)[:, [0, 2]]) == pytest.approx(sigma, rel=0.05)
@@ -84,10 +83,10 @@ def test_estimate_with_noisy_landmarks_of_known_covariance():
     Pt = np.column_stack([g.uniform(-10, 10, n), g.uniform(-1.5, 2, n), g.uniform(5, 40, n)])
     C = stereo_point_cov(Pt, rig.left.fx, rig.baseline_m, s_lm)
     X = Pt + np.einsum("kij,kj->ki", np.linalg.cholesky(C), g.standard_normal((n, 3)))
-    z_px = _stereo_project(rig, Pt)[0][:, :3] + sigma * g.standard_normal((n, 3))
+    z_px = rig.stereo_pixels(Pt)[:, :3] + sigma * g.standard_normal((n, 3))
     P = _triangulate(rig, z_px)
     keep = P[:, 2] > 0.5
-    r, q = _disparity_residuals(np.eye(4), X[keep], C[keep], P[keep], rig, np.eye(4))  # the true pose
+    r, q = disparity_residuals_px(np.eye(4), X[keep], C[keep], P[keep], rig, np.eye(4))  # the true pose
     assert disparity_noise_px(r, q) == pytest.approx(sigma, rel=0.05)
     assert disparity_noise_px(r) == pytest.approx(sigma * np.sqrt(1 + s_lm**2), rel=0.05)
     assert disparity_noise_px(r, 10 * q) == 0.0  # the landmarks' variance alone explains the residuals
@@ -114,7 +113,7 @@ def test_tracker_smooths_and_floors_the_estimate():
     nominal pixel_std a floor; frames with fewer than MIN_RESIDUALS matches are skipped. Disparity residuals of
     keypoint noise sigma have the std sqrt(2) sigma."""
     p = ABLATION_BASE.replace(**PROPOSED_FIX, pixel_std_estimate=True, pixel_std_smoothing=0.2)
-    tr = _NoiseTracker(p)
+    tr = KeypointNoiseTracker(p)
     g = np.random.default_rng(3)
     for _ in range(40):  # 0.8^40 = 1e-4 of the start left
         tr.observe(np.sqrt(2) * g.normal(0.0, 1.2, 4000), smoothing=0.2)
@@ -163,7 +162,7 @@ def test_kitti_params_meet_the_goal_at_one_pixel_noise():
     """Issue 25's goal (path and displacement within 1 %) on the simulated highway with 1 px keypoint noise, the
     mean over 6 scenes of 51 frames (bound from the goal), with today's KITTI_PARAMS (the noise estimated online)."""
     a = run_scale_ablation(lambda rng: HighwayScene(rng=rng), highway_path(51), {"KITTI_PARAMS": {}},
-                           params=KITTI_PARAMS, n_seeds=6, pixel_std=1.0, rng=0)
+                           params=KITTI_PARAMS, n_seeds=6, pixel_std_obs=1.0, rng=0)
     assert abs(a.path_ratio.mean() - 1) <= 0.01
     assert abs(a.end_ratio.mean() - 1) <= 0.01
     assert a.n_degenerate.sum() == 0

@@ -39,7 +39,7 @@ def test_plots():
 def test_widget_runs_the_same_run_as_the_tests(capsys):
     from slamlab.stereo import RenderParams
     from slamlab.stereo.params import STEREO_DETECTORS
-    from slamlab.studies.stereo import run_turn_in_place
+    from slamlab.studies.stereo import run_experiment
     from slamlab.studies.stereo.widgets import explore_stereo_slam
 
     w = explore_stereo_slam(policy="oldest", n_frames=3)
@@ -52,7 +52,7 @@ def test_widget_runs_the_same_run_as_the_tests(capsys):
     sliders = {"experiment": "turn in place", "policy": "oldest", "ransac_iters": 200}
     w.f(**sliders, detector="orb", noise_std=1.0, drift_mrad=0.5)  # what the button calls
     out = capsys.readouterr().out
-    ref = run_turn_in_place(n_frames=3, detector="orb", render=RenderParams(noise_std=1.0, drift_std_rad=0.5e-3))
+    ref = run_experiment("turn in place", n_frames=3, detector="orb", render=RenderParams(noise_std=1.0, drift_std_rad=0.5e-3))
     assert ref.table() in out
     plt.close("all")
     w.f(**{**sliders, "ransac_iters": 0}, detector="orb", noise_std=0.0, drift_mrad=0.0)  # a message, not a traceback

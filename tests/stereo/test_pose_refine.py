@@ -7,7 +7,7 @@ from slamlab.geometry import StereoRig, se3_from_planar
 from slamlab.geometry.camera import PinholeCamera
 from slamlab.geometry.registration import umeyama
 from slamlab.stereo import StereoParams, StereoSLAM
-from slamlab.stereo.pose_stages import _stereo_project, refine_pose_stereo
+from slamlab.stereo.pose_stages import refine_pose_stereo
 
 
 def _kitti_like_rig():
@@ -52,7 +52,7 @@ def test_refinement_is_unbiased_where_the_depth_weighted_3d_fit_is_not():
     for _ in range(300):
         Pt = np.column_stack([g.uniform(-10, 10, 80), g.uniform(-1.5, 2, 80), np.exp(g.uniform(np.log(5), np.log(40), 80))])
         X = Pt @ T[:3, :3].T + T[:3, 3]  # landmarks in the map = the first camera frame
-        z_px = _stereo_project(rig, Pt)[0][:, :3] + 0.5 * g.standard_normal((80, 3))
+        z_px = rig.stereo_pixels(Pt)[:, :3] + 0.5 * g.standard_normal((80, 3))
         P = _triangulate(rig, z_px)
         w = 1.0 / np.maximum(1.0, (P[:, 2] / 3.0) ** 2) ** 2
         fit = umeyama(P, X, weights=w)
@@ -105,7 +105,7 @@ def test_pixel_filter_averages_disparities_not_depths():
     c = rig.left
     z1, z2, sigma = 30.0, 20.0, slam.params.pixel_std
     X1 = np.array([[2.0 * z1 / c.fx, 1.0 * z1 / c.fy, z1]])  # pixel (cx + 2, cy + 1)
-    J = _stereo_project(rig, X1)[1][:, :3]
+    J = rig.stereo_pixels(X1, jacobian=True)[1][:, :3]
     Ji = np.linalg.inv(J[0])
     slam.X, slam.P = X1.copy(), (sigma**2 * Ji @ Ji.T)[None]
     obs = np.array([[2.0 * z2 / c.fx, 1.0 * z2 / c.fy, z2]])

@@ -2,19 +2,19 @@
 
 from __future__ import annotations
 
-from slamlab.studies.stereo import run_turn_in_place
+from slamlab.studies.stereo import run_experiment
 
 
 def test_bar_only_when_asked_and_callback_per_frame(capsys, monkeypatch):
     monkeypatch.setenv("SLAMLAB_PROGRESS", "0")
-    quiet = run_turn_in_place(n_frames=3, detector="orb")
+    quiet = run_experiment("turn in place", n_frames=3, detector="orb")
     assert capsys.readouterr().err == ""
-    shown = run_turn_in_place(n_frames=3, detector="orb", progress=True)
+    shown = run_experiment("turn in place", n_frames=3, detector="orb", progress=True)
     err = capsys.readouterr().err
     assert "stereo SLAM: turn in place" in err
     assert "/3 " in err
     seen = []
-    called = run_turn_in_place(n_frames=3, detector="orb", progress=seen.append)
+    called = run_experiment("turn in place", n_frames=3, detector="orb", progress=seen.append)
     assert seen == [0, 1, 2]
     assert capsys.readouterr().err == ""
     # the bar changes nothing in the result

@@ -44,7 +44,7 @@ def test_process_features_runs_the_stages_after_detection():
     assert rec.status == "ok"
     assert rec.n_inliers > 30
     assert np.linalg.norm(slam.trajectory[-1, :3, 3]) == pytest.approx(2.0, abs=0.1)
-    with pytest.raises(TypeError, match="left features"):
+    with pytest.raises(TypeError, match=r"`left_features` must be slamlab\.features\.Features"):
         slam.process_features(np.zeros((3, 2)), None)
 
 

@@ -170,11 +170,11 @@ def test_calibration_drift_costs_stereo_matches():
 
 def test_drift_study_on_sweep_equals_the_sequential_loop_for_one_and_two_workers():
     from slamlab.stereo import RenderParams
-    from slamlab.studies.stereo import run_drift_study, run_turn_in_place
+    from slamlab.studies.stereo import run_drift_study, run_experiment
 
     levels = (0.0, 2e-3)
     # the study as it was: one run per level, in order, every level with the same seed
-    ref = [run_turn_in_place(n_frames=3, detector="orb", render=RenderParams(drift_std_rad=d), rng=5) for d in levels]
+    ref = [run_experiment("turn in place", n_frames=3, detector="orb", render=RenderParams(drift_std_rad=d), rng=5) for d in levels]
     one = run_drift_study(levels, n_frames=3, detector="orb", rng=5, n_jobs=1, progress=False)
     two = run_drift_study(levels, n_frames=3, detector="orb", rng=5, n_jobs=2, progress=False)
     for study in (one, two):
@@ -259,7 +259,7 @@ def test_ill_conditioned_poses_are_not_trusted():
 def test_params_are_one_frozen_object_shared_by_the_loop_and_the_runs():
     import dataclasses
 
-    from slamlab.studies.stereo import run_turn_in_place
+    from slamlab.studies.stereo import run_experiment
 
     p = StereoParams()
     with pytest.raises(dataclasses.FrozenInstanceError):
@@ -268,12 +268,12 @@ def test_params_are_one_frozen_object_shared_by_the_loop_and_the_runs():
     assert all(src.startswith(("000 §", "ours")) for src in StereoParams.sources().values())
     rig = StereoRig.parallel()
     assert StereoSLAM(rig, detector="orb").params == StereoParams(detector="orb")
-    res = run_turn_in_place(n_frames=2, params=StereoParams(detector="orb"), policy="all")
+    res = run_experiment("turn in place", n_frames=2, params=StereoParams(detector="orb"), policy="all")
     assert res.params == StereoParams(detector="orb", policy="all")
     # the run's default equals the pipeline's default
     import inspect
 
-    assert inspect.signature(run_turn_in_place).parameters["params"].default is None
+    assert inspect.signature(run_experiment).parameters["params"].default is None
 
 
 def test_colour_frames_follow_the_channel_order():

@@ -502,9 +502,9 @@ def test_radius_pairs_are_every_pair_within_the_radius():
 
 
 def test_two_nearest_per_query():
-    from slamlab.stereo._pairs import _two_nearest
+    from slamlab.stereo._pairs import two_nearest
 
-    q, t1, d1, d2, t2 = _two_nearest(np.array([0, 0, 0, 2, 3, 3]), np.array([5, 6, 7, 8, 9, 10]),
+    q, t1, d1, d2, t2 = two_nearest(np.array([0, 0, 0, 2, 3, 3]), np.array([5, 6, 7, 8, 9, 10]),
                                      np.array([3.0, 1.0, 2.0, 4.0, 1.0, 1.0]))
     assert q.tolist() == [0, 2, 3]
     assert t1.tolist() == [6, 8, 9]

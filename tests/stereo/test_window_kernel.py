@@ -7,7 +7,7 @@ import pytest
 
 from slamlab._compiled import numba_enabled
 from slamlab.kdtree.knn import exact_knn
-from slamlab.stereo._pairs import _pair_distances, _pairs_two_nearest, _two_nearest
+from slamlab.stereo._pairs import pair_distances, pairs_two_nearest, two_nearest
 from slamlab.stereo.local_stages import _epipolar_two_nearest, epipolar_pairs
 from slamlab.stereo.map_stages import _radius_pairs, _window_two_nearest
 
@@ -29,7 +29,7 @@ def test_window_kernel_matches_numpy(trial):
     qi, rows = _radius_pairs(uv, uv_t, 15.0)
     q, r1, d1, d2, r2, n_pairs = _window_two_nearest(D, uv, Dt, uv_t, 15.0)
     assert n_pairs == qi.size
-    ref = _two_nearest(qi, rows, _pair_distances(D, Dt, qi, rows))
+    ref = two_nearest(qi, rows, pair_distances(D, Dt, qi, rows))
     for a, b in zip(ref, (q, r1, d1, d2, r2), strict=True):
         np.testing.assert_array_equal(a, b)
 
@@ -65,8 +65,8 @@ def test_stereo_kernel_matches_numpy(trial):
     uv_r = np.round(rng.uniform(0, 576, (n, 2))) if trial % 2 else rng.uniform(0, 576, (n, 2))
     F = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # rectified: the epipolar lines are rows
     qi, ti = epipolar_pairs(uv_l, uv_r, F, 2.0)
-    ref = _two_nearest(qi, ti, _pair_distances(D, Dt, qi, ti))
-    for a, b in zip(ref, _pairs_two_nearest(D, Dt, qi, ti), strict=True):
+    ref = two_nearest(qi, ti, pair_distances(D, Dt, qi, ti))
+    for a, b in zip(ref, pairs_two_nearest(D, Dt, qi, ti), strict=True):
         np.testing.assert_array_equal(a, b)
 
 
@@ -89,7 +89,7 @@ def test_fused_epipolar_kernel_matches_numpy(trial):
         e = 0.01 * (trial - 3)
         F = F @ np.array([[np.cos(e), -np.sin(e), 0.0], [np.sin(e), np.cos(e), 0.0], [0.0, 0.0, 1.0]])
     qi, ti = epipolar_pairs(uv_l, uv_r, F, 2.0)
-    ref = _two_nearest(qi, ti, _pair_distances(D, Dt, qi, ti))
+    ref = two_nearest(qi, ti, pair_distances(D, Dt, qi, ti))
     for a, b in zip(ref, _epipolar_two_nearest(D, Dt, uv_l, uv_r, F, 2.0), strict=True):
         np.testing.assert_array_equal(a, b)
 
@@ -129,7 +129,7 @@ def test_numpy_paths_without_numba(monkeypatch):
     D = np.zeros((2, 32), np.uint8)
     Dt = np.zeros((3, 32), np.uint8)
     Dt[1, 0] = 0b111
-    q, r1, d1, d2, r2 = _pairs_two_nearest(D, Dt, np.array([1, 1]), np.array([1, 2]))
+    q, r1, d1, d2, r2 = pairs_two_nearest(D, Dt, np.array([1, 1]), np.array([1, 2]))
     assert (q.tolist(), r1.tolist(), d1.tolist(), d2.tolist(), r2.tolist()) == ([1], [2], [0.0], [3.0], [1])
     dist, ids = exact_knn(D, Dt, 2, np.array([5, 6, 7]))
     assert dist.tolist() == [[0.0, 0.0]] * 2

@@ -1,6 +1,7 @@
 """Studies of chapter 06, correlation localisation (004 §7): its runs, tables, figures and widgets."""
 
 from ..._lazy import lazy_exports
+from .carmen_logs import DEFAULT_CARMEN_LOG, SHARED_CARMEN_LOGS
 from .experiments import (
     SOURCE_TABLE1,
     ConstantsResult,
@@ -15,8 +16,8 @@ from .experiments import (
     run_table1,
     time_localise,
 )
-from .log_experiments import DEFAULT_CARMEN_LOG, LogLocalisationResult, run_log_localisation
-from .log_suite import SHARED_CARMEN_LOGS, LogSuiteResult, more_confident, run_log_suite
+from .log_experiments import LogLocalisationResult, run_log_localisation
+from .log_suite import LogSuiteResult, more_confident, run_log_suite
 from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
 from .source_table import ours_vs_source
 from .terms import TERM_NAMES, score_terms

@@ -11,9 +11,9 @@ nbval compares); arrays for plotting live in fields, timings in ``time_s``
 (never in the table).
 
 This module builds the simulated worlds (the test room, its clutter, the rangefinder) and runs the
-experiments on them; the result dataclasses live in :mod:`~slamlab.studies.correlation.study_results`, the sim-free helpers (the sweep of
-localisations, errors, margins, Table 1's source values, the corridor, the timing) in :mod:`~slamlab.studies.correlation.studies` (all
-re-exported here).
+experiments on them, each localisation on :func:`slamlab.sweep.sweep`; the result dataclasses live in
+:mod:`~slamlab.studies.correlation.study_results`, the sim-free helpers (the success criterion, errors, Table 1's
+source values, the corridor, the timing) in :mod:`~slamlab.studies.correlation.studies` (re-exported here).
 """
 
 from __future__ import annotations
@@ -22,13 +22,8 @@ import time
 
 import numpy as np
 
-from ... import _validate as v
-from ...correlation.algorithm import (
-    LocaliseParams,
-    heading_error,
-    localise,
-    localise_joined,
-)
+from ..._validate import as_rng, check_choice, check_int, check_positive
+from ...correlation.algorithm import LocaliseParams, heading_error, localise, localise_joined
 from ...scans.logmap import log_grid  # log_grid re-exported (one place: scans)
 from ...sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
 from ...sim.paths import random_free_poses
@@ -37,16 +32,15 @@ from .studies import (
     FAIL_CELLS,
     FAIL_DEG,
     SOURCE_TABLE1,
-    _errors,
-    _estimates,
-    _localise_scans,
-    _within_tolerance,
+    absolute_errors,
     corridor_grid,
     time_localise,
+    within_tolerance,
 )
 from .study_results import ConstantsResult, CorridorResult, MonteCarloResult, Table1Result
 
 __all__ = [
+    "CORRIDOR_PARAMS",
     "FAIL_CELLS",
     "FAIL_DEG",
     "SOURCE_TABLE1",
@@ -78,6 +72,52 @@ def _worlds(clutter: bool, extra_clutter: int, rng):
     return M, W
 
 
+def _localise_one(*, scan, choice: int, grid, settings, margins: bool = False, pose_index: int = 0) -> dict:
+    """One sweep task: localise one ``scan`` on ``grid`` with ``settings[choice]`` (deterministic)."""
+    loc = localise(grid, scan, params=settings[choice])
+    row = {"x": float(loc.pose[0]), "y": float(loc.pose[1]), "heading_rad": float(loc.pose[2])}
+    if margins:
+        row["half_max_area"], row["heading_margin"] = _margins(loc)
+    return row
+
+
+def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 1, progress: bool | None = None):
+    """Localise every scan with every setting on :func:`slamlab.sweep.sweep`: one task per (setting, scan).
+
+    The scans were drawn by the caller (the random part stays in the parent, in its order); a
+    localisation draws nothing (``rng_arg=None``), so the table is the same for any ``n_jobs``.
+    The rival search is switched off (``ambiguity=False``): these runs report no ambiguity. Returns the table
+    (columns ``choice``, ``pose_index``, ``x``, ``y``, ``heading_rad`` and with ``margins`` ``half_max_area``,
+    ``heading_margin``), setting-major.
+    """
+    from ...sweep import sweep
+
+    settings = tuple(q.replace(ambiguity=False) for q in settings)
+    points = [{"choice": j, "pose_index": i, "scan": s} for j in range(len(settings)) for i, s in enumerate(scans)]
+    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress, on_error="raise",
+                  desc="correlation localisation", fixed={"grid": M, "settings": settings, "margins": margins})
+    return table.drop(columns=["scan", "replicate", "error"])
+
+
+def _estimates(table) -> np.ndarray:
+    """``(n, 3)`` estimated poses (x, y, heading) of a :func:`_localise_scans` table."""
+    return table[["x", "y", "heading_rad"]].to_numpy(dtype=float)
+
+
+def _margins(loc, heading_window=3):
+    """Half-maximum area of the score map [cells] and relative heading margin of one localisation."""
+    dmap = loc.score_map
+    med = float(np.median(dmap))
+    area = float(np.count_nonzero(dmap >= med + 0.5 * (loc.score - med)))
+    b = loc.best_per_heading
+    n = b.size
+    idx = (np.arange(n) - loc.heading_index) % n
+    far = np.minimum(idx, n - idx) >= heading_window
+    bmed = float(np.median(b))
+    head = (loc.score - b[far].max()) / max(loc.score - bmed, 1e-12)
+    return area, head
+
+
 def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int = 3, rng=None) -> list[tuple]:
     """``n`` extra unmapped discs ("people's legs", bins) on free cells of ``grid`` (our addition).
 
@@ -104,9 +144,9 @@ def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int
     >>> len(random_clutter(test_room_200(), 5, rng=0))
     5
     """
-    n = v.check_int(n, "n", minimum=0)
-    r = v.check_positive(radius_cells, "radius_cells")
-    rng = v.as_rng(rng)
+    n = check_int(n, "n", minimum=0)
+    r = check_positive(radius_cells, "radius_cells")
+    rng = as_rng(rng)
     cells = free_cells(grid, margin_cells)
     pick = cells[rng.integers(0, cells.shape[0], n)]
     return [("disc", int(c), int(rw), r) for rw, c in pick]
@@ -152,15 +192,15 @@ def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int 
     Table1Result
     """
     p = LocaliseParams.resolve(params, **overrides)
-    n = v.check_int(n_poses, "n_poses", minimum=1)
+    n = check_int(n_poses, "n_poses", minimum=1)
     rf = _sensor(n_beams, max_range_cells, range_std_cells)
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     M, W = _worlds(clutter, 0, rng)
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
     est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
-    ea, ex, ey = _errors(poses, est)
+    ea, ex, ey = absolute_errors(poses, est)
     return Table1Result(poses, est, ea, ex, ey, float(range_std_cells), int(n_beams), p, time.perf_counter() - t0)
 
 _SIZES = {"small": 12, "full": 200}
@@ -207,20 +247,20 @@ def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, 
     MonteCarloResult
     """
     p = LocaliseParams.resolve(params, **overrides)
-    n = _SIZES[v.check_choice(size, "size", _SIZES)] if isinstance(size, str) else v.check_int(size, "size",
+    n = _SIZES[check_choice(size, "size", _SIZES)] if isinstance(size, str) else check_int(size, "size",
                                                                                                  minimum=1)
-    ec = v.check_int(extra_clutter, "extra_clutter", minimum=0)
+    ec = check_int(extra_clutter, "extra_clutter", minimum=0)
     rf = _sensor(n_beams, max_range_cells, range_std_cells)
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     M, W = _worlds(True, ec, rng)
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
     est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
-    ea, ex, ey = _errors(poses, est)
+    ea, ex, ey = absolute_errors(poses, est)
     ep = np.hypot(ex, ey)
-    failed = ~_within_tolerance(ep, ea)
-    return MonteCarloResult(n, ea, ep, failed, float(range_std_cells), ec, time.perf_counter() - t0)
+    failed = ~within_tolerance(ep, ea)
+    return MonteCarloResult(n, ea, ep, failed, float(range_std_cells), ec, time.perf_counter() - t0, params=p)
 
 
 def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std_cells: float = 0.3,
@@ -236,7 +276,8 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     best heading (cells scoring at least halfway from the median to the peak), the
     heading margin (peak minus the best score ≥ 3° away, over peak minus the median
     over headings), and the failure rate. ``params`` / ``**overrides``: the other
-    :class:`LocaliseParams` fields (each choice replaces ``a_c, a_p, a_n``).
+    :class:`LocaliseParams` fields; ``a_c, a_p, a_n`` are this study's axis (``choices``), so setting one of
+    them there is a ``ValueError``.
 
     The scans are drawn here; the ``len(choices) × n_poses`` localisations run on
     :func:`slamlab.sweep.sweep` with ``n_jobs`` workers (same result for any ``n_jobs``)
@@ -257,7 +298,8 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     choices : sequence of tuple of float
         ``(a_c, a_p, a_n)`` triples to compare.
     params : LocaliseParams, optional
-        Settings of every localisation (default :class:`LocaliseParams`).
+        Settings of every localisation (default :class:`LocaliseParams`) but ``a_c, a_p, a_n``, which must keep
+        their defaults (each choice sets them).
     rng : int or numpy.random.Generator, default 2012
         Seed or generator of clutter, poses and scan noise.
     n_jobs : int, default 1
@@ -265,21 +307,26 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     progress : bool or None
         Progress bar: None shows one in a notebook only.
     **overrides
-        :class:`LocaliseParams` fields to change.
+        :class:`LocaliseParams` fields to change (not ``a_c, a_p, a_n``).
 
     Returns
     -------
     ConstantsResult
     """
     base = LocaliseParams.resolve(params, **overrides)
-    n = v.check_int(n_poses, "n_poses", minimum=1)
-    ec = v.check_int(extra_clutter, "extra_clutter", minimum=0)
+    default = LocaliseParams()
+    for name in ("a_c", "a_p", "a_n"):
+        if getattr(base, name) != getattr(default, name):
+            raise ValueError(f"`{name}` is set by `choices` in run_constants_study (each choice is one "
+                             f"(a_c, a_p, a_n)); got {name} = {getattr(base, name)} in the settings")
+    n = check_int(n_poses, "n_poses", minimum=1)
+    ec = check_int(extra_clutter, "extra_clutter", minimum=0)
     settings = tuple(base.replace(a_c=float(c[0]), a_p=float(c[1]), a_n=float(c[2])) for c in choices)
     consts = tuple((q.a_c, q.a_p, q.a_n) for q in settings)
     if not consts:
         raise ValueError("`choices` must hold at least one (a_c, a_p, a_n) triple")
     rf = _sensor(n_beams, max_range_cells, range_std_cells)
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     M, W = _worlds(True, ec, rng)
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, p, rng) for p in poses]
@@ -290,32 +337,36 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     pm = table["half_max_area"].to_numpy(dtype=float).reshape(k, n)
     hm = table["heading_margin"].to_numpy(dtype=float).reshape(k, n)
     ep = np.hypot(est[..., 0] - poses[:, 0], est[..., 1] - poses[:, 1])
-    failed = ~_within_tolerance(ep, heading_error(est[..., 2], poses[:, 2]))
+    failed = ~within_tolerance(ep, heading_error(est[..., 2], poses[:, 2]))
     h0 = np.radians(np.round(np.degrees(poses[0, 2])))
     maps = [localise(M, scans[0], params=q, prior_heading_rad=h0, window_rad=0.0).score_map for q in settings]
     labels = tuple(f"a_c={c[0]:g}, a_p={c[1]:g}, a_n={c[2]:g}" for c in consts)
     return ConstantsResult(labels, consts, pm, hm, failed.mean(axis=1), ep, ec, tuple(maps), poses[0].copy(),
-                           time.perf_counter() - t0)
+                           time.perf_counter() - t0, params=base)
 
 
-def run_corridor_tie(*, max_range_cells: float = 25.0, step_cells: float = 30.0,
+#: The settings of :func:`run_corridor_tie` when it is given no ``params``: float64 FFTs and Δα = 10° (ours).
+CORRIDOR_PARAMS = LocaliseParams(dtype="float64", delta_alpha_rad=float(np.radians(10.0)))
+
+
+def run_corridor_tie(*, max_range_cells: float = 25.0, spacing_cells: float = 30.0,
                      params: LocaliseParams | None = None, **overrides) -> CorridorResult:
     """The half-turn tie of one scan in a corridor, broken by joining the scan before it (ours).
 
     The robot drives towards −x along :func:`corridor_grid`; the last scan, at (100, 25), sees a plain
     corridor (every shift and the half turn score alike: ambiguity 1, and the tie rule picks heading 0°,
-    180° off); the scan ``step_cells`` before it sees the dead end, which pins the pose once both are
-    joined by (exact) odometry. ``params`` / ``**overrides``: :class:`LocaliseParams` (default float64,
-    Δα = 10°, for exact scores).
+    180° off); the scan ``spacing_cells`` before it sees the dead end, which pins the pose once both are
+    joined by (exact) odometry. ``params`` / ``**overrides``: :class:`LocaliseParams`; without ``params`` the
+    study's own, :data:`CORRIDOR_PARAMS` (float64 and Δα = 10°, for exact scores).
 
     Parameters
     ----------
     max_range_cells : float, default 25.0
         Range limit of the noise-free scans [cells].
-    step_cells : float, default 30.0
+    spacing_cells : float, default 30.0
         Distance between the two scans [cells].
     params : LocaliseParams, optional
-        Settings of every localisation (default :class:`LocaliseParams`).
+        Settings of both localisations, used as given (default :data:`CORRIDOR_PARAMS`).
     **overrides
         :class:`LocaliseParams` fields to change.
 
@@ -323,13 +374,12 @@ def run_corridor_tie(*, max_range_cells: float = 25.0, step_cells: float = 30.0,
     -------
     CorridorResult
     """
-    p = LocaliseParams.resolve(params, **{"dtype": "float64", "delta_alpha_rad": float(np.radians(10.0)),
-                                          **overrides})
-    rmax = v.check_positive(max_range_cells, "max_range_cells")
-    step = v.check_positive(step_cells, "step_cells")
+    p = LocaliseParams.resolve(CORRIDOR_PARAMS if params is None else params, **overrides)
+    rmax = check_positive(max_range_cells, "max_range_cells")
+    step = check_positive(spacing_cells, "spacing_cells")
     g = corridor_grid()
     poses = np.array([[100.0, 25.0, np.pi], [100.0 + step, 25.0, np.pi]])
     rf = Rangefinder(n_beams=360, max_range_cells=rmax, quantum_cells=0.0)
     scans = [rf.scan(g, q) for q in poses]
     return CorridorResult(poses[0].copy(), poses, localise(g, scans[0], params=p),
-                          localise_joined(g, scans, poses, params=p))
+                          localise_joined(g, scans, poses, params=p), params=p)

@@ -1,70 +1,44 @@
 """Ch. 5 experiments (004 §7) on real data: correlation localisation along a CARMEN log with corrected poses.
 
-Part of the chapter's experiments (:mod:`slamlab.studies.correlation.experiments` holds the simulated ones and the helpers used here;
-:mod:`slamlab.studies.correlation.log_truth` the per-scan task and the truth check).
+Part of the chapter's experiments (:mod:`slamlab.studies.correlation.experiments` holds the simulated ones;
+:mod:`slamlab.studies.correlation.carmen_logs` the logs). The run and its result live here: the per-scan task
+(leave-out grids, joined localisation, votes, the truth check) runs on :func:`slamlab.sweep.sweep`, and
+:class:`LogLocalisationResult` tabulates its columns.
 """
 
 from __future__ import annotations
 
 import itertools
-import os
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_finite_array, as_rng, as_vector, check_int, check_positive
 from ...correlation.algorithm import LocaliseParams, heading_candidates, heading_error
-from ...correlation.settings import _check_score_norm, _check_unit
+from ...correlation.settings import check_score_norm
 from ...geometry import wrap_angle
 from ...scans import GridFrame
 from ...scans.logmap import log_counts
-from .experiments import (
-    FAIL_CELLS,
-    FAIL_DEG,
-)
-from .log_truth import (
-    _TRUTH_COLUMNS,
-    VOTE_SCANS,
-    _check_leave,
-    _describe,
-    _failure_table,
-    _leave_text,
-    _localise_log_scan,
-    _log_points,
-    _terms_table,
-    _truth_frame,
-)
-from .studies import _within_tolerance
+from ._log_scan import TRUTH_COLUMNS, VOTE_SCANS, check_leave, localise_log_scan, log_points
+from .carmen_logs import as_carmen_log
+from .studies import FAIL_CELLS, FAIL_DEG, within_tolerance
+from .terms import TERM_NAMES
 
 __all__ = [
-    "DEFAULT_CARMEN_LOG",
     "ODOM_STD",
     "LogLocalisationResult",
     "run_log_localisation",
 ]
 
 
-# --- real data: a CARMEN log with (corrected) poses ----------------------------------------------------
-
-#: The default log of :func:`run_log_localisation` (found by :func:`slamlab.data.find_data`).
-DEFAULT_CARMEN_LOG = "carmen-radish-corrected/intel-corrected.log.gz"
-
-
-def _carmen_log(path):
-    """A :class:`~slamlab.io.CarmenLog` from a path (str / os.PathLike; default the Intel log) or a read log."""
-    from ...io import CarmenLog, read_carmen
-
-    if isinstance(path, CarmenLog):
-        return path
-    if path is None:
-        from ...data import find_data
-
-        path = find_data(DEFAULT_CARMEN_LOG)
-    elif isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"`path` must be a str, os.PathLike or CarmenLog; got {type(path).__name__}")
-    return read_carmen(path)
+def _check_unit(x, name: str) -> float:
+    """A number in [0, 1], named ``name`` in the error."""
+    x = check_positive(x, name, allow_zero=True)
+    if x > 1:
+        raise ValueError(f"`{name}` must lie in [0, 1]; got {x}")
+    return x
 
 
 #: Default odometry noise of the joined modes: σ_xy [m], σ_θ [rad] per step between consecutive scans (ours).
@@ -151,7 +125,7 @@ class LogLocalisationResult:
     @property
     def success(self) -> np.ndarray:
         """``(modes, n)``: within 2 cells and 5° of the logged pose."""
-        return _within_tolerance(self.err_pos_m, self.err_heading_rad, self.cell_m)
+        return within_tolerance(self.err_pos_m, self.err_heading_rad, self.cell_m)
 
     def flagged(self, min_votes: int = 2) -> np.ndarray:
         """``(modes, n)``: answers fewer than ``min_votes`` of the three single-scan voters agree with (ours, issue
@@ -166,15 +140,33 @@ class LogLocalisationResult:
         -------
         numpy.ndarray of bool
         """
-        t = v.check_int(min_votes, "min_votes", minimum=0)
+        t = check_int(min_votes, "min_votes", minimum=0)
         if t > VOTE_SCANS:
             raise ValueError(f"`min_votes` must lie in 0..{VOTE_SCANS}; got {t}")
         if self.votes is None:
             raise ValueError("this result has no votes: run run_log_localisation(..., votes=True)")
         return self.votes < t
 
-    def _mode(self, k: int) -> str:
+    def mode_name(self, k: int) -> str:
+        """The name of mode ``k`` in the tables: ``"1 scan"`` or ``"k scans + odometry"``.
+
+        Parameters
+        ----------
+        k : int
+            Scans joined (one of :attr:`joined`).
+
+        Returns
+        -------
+        str
+        """
         return "1 scan" if k == 1 else f"{k} scans + odometry"
+
+    @property
+    def leave_out_text(self) -> str:
+        """What each test scan's grid lacks, in words: ``"±2 scans"`` or ``"each mode's own scans"``."""
+        if self.leave_out == "used":
+            return "each mode's own scans"
+        return f"±{self.exclude} scans"
 
     def truth_check(self):
         """Per scan and mode: is a failure a score failure or a search failure? (ours, issue 25)
@@ -200,7 +192,26 @@ class LogLocalisationResult:
             obstacle cells of the scan's leave-out grid at the logged poses / at the estimate), ``kind``
             (``"ok"`` for a success), and the columns of :meth:`terms_table`.
         """
-        return _truth_frame(self)
+        import pandas as pd
+
+        if self.truth is None:
+            raise ValueError("this result has no truth check: run run_log_localisation(..., truth_check=True)")
+        rows = []
+        for m, k in enumerate(self.joined):
+            for j, i in enumerate(self.scan_indices):
+                t = {c: float(self.truth[c][m, j]) for c in TRUTH_COLUMNS}
+                ok = bool(self.success[m, j])
+                if ok:
+                    kind = "ok"
+                elif t["score_truth"] >= t["score_est"]:
+                    kind = "search"
+                elif t["score_truth_fine"] > t["score_est_fine"]:
+                    kind = "grid"
+                else:
+                    kind = "score"
+                rows.append({"scan": int(i), "joined": k, "ok": ok, "err_m": float(self.err_pos_m[m, j]),
+                             "err_deg": float(np.degrees(self.err_heading_rad[m, j])), **t, "kind": kind})
+        return pd.DataFrame(rows)
 
     def failure_table(self) -> str:
         """The failures of :meth:`~slamlab.studies.correlation.LogLocalisationResult.truth_check`: errors, scores at the
@@ -210,14 +221,24 @@ class LogLocalisationResult:
         -------
         str
         """
-        return _failure_table(self)
+        d = self.truth_check()
+        d = d[~d["ok"]]
+        rows = [[int(r.scan), self.mode_name(int(r.joined)), f"{r.err_m:.2f}", f"{r.err_deg:.1f}",
+                 f"{r.score_est:.0f}", f"{r.score_truth:.0f}", f"{r.score_truth - r.score_est:+.0f}",
+                 f"{r.score_est_fine:.0f}", f"{r.score_truth_fine:.0f}", f"{r.walls_truth:.2f}", f"{r.walls_est:.2f}", r.kind]
+                for r in d.itertuples()]
+        return format_table(["scan", "mode", "err [m]", "err [°]", "score est.", "truth (grid)", "truth - est.",
+                             "est. fine", "truth fine", "walls at truth", "walls at est.", "kind"], rows,
+                            title=(f"{self.name}: failures, the search's score at its estimate and the best within "
+                                   f"{FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the logged pose (grid; fine = every "
+                                   "0.5 cell and 0.5°); walls = end points on obstacle cells of the leave-out grid"))
 
     def terms_table(self, scans=None) -> str:
-        """The score's four terms (:func:`~slamlab.studies.correlation.score_terms`) and marks on unexplored cells at the
-        estimate and at the best grid pose near the truth, and their difference (ours, issue 25; ``truth_check=True``;
-        columns ``est_…`` / ``truth_…`` of :meth:`truth_check`); for the truth also where its marks on unexplored
-        cells and its obstacle marks on map free cells come from (``unex_…``, ``conf_obs_…``: ``1`` / ``2`` = a
-        left-out scan that many steps away saw / hit the cell, ``none`` = no other scan).
+        """The score's four terms (:func:`~slamlab.studies.correlation.score_terms`) and marks on unexplored cells at
+        the estimate and at the best grid pose near the truth, and their difference (ours, issue 25;
+        ``truth_check=True``; columns ``est_…`` / ``truth_…`` of :meth:`truth_check`); for the truth also where its
+        marks on unexplored cells and its obstacle marks on map free cells come from (``unex_…``, ``conf_obs_…``:
+        ``1`` / ``2`` = a left-out scan that many steps away saw / hit the cell, ``none`` = no other scan).
 
         Parameters
         ----------
@@ -228,17 +249,54 @@ class LogLocalisationResult:
         -------
         str
         """
-        return _terms_table(self, scans)
+        d = self.truth_check()
+        cases = []
+        for k in self.joined:
+            dk = d[d["joined"] == k]
+            sel = dk[~dk["ok"]] if scans is None else dk[dk["scan"].isin(list(scans))]
+            cases += [(r, "failure" if not r.ok else "success") for _i, r in sel.iterrows()]
+            med = _median_success(dk)
+            if scans is None and med is not None:
+                cases.append((med, "median success"))
+        rows = []
+        for r, case in cases:
+            vals = {}
+            for who in ("est", "truth"):
+                vals[who] = [r[f"{who}_{t}"] for t in TERM_NAMES] + [r[f"{who}_n_obs_unexplored"],
+                                                                      r[f"{who}_n_free_unexplored"]]
+                n_obs = r[f"{who}_n_obs_on_obs"] + r[f"{who}_n_obs_on_free"] + r[f"{who}_n_obs_unexplored"]
+                vals[who].append(n_obs)
+            score = {"est": r["score_est"], "truth": r["score_truth"]}
+            head = [int(r["scan"]), self.mode_name(int(r["joined"])), case, f"{r['err_m']:.1f} m {r['err_deg']:.0f}°"]
+            origin = "; ".join(" / ".join(str(int(r[f"{what}_{w}"])) for w in ("1", "2", "none"))
+                               for what in ("unex_obs", "unex_free", "conf_obs"))
+            for who, label in (("est", "estimate"), ("truth", "truth (best near)")):
+                rows.append([*head, label, f"{score[who]:.0f}", *(f"{x:+.0f}" for x in vals[who][:4]),
+                             *(f"{x:.0f}" for x in vals[who][4:]), origin if who == "truth" else ""])
+            diff = [vals["truth"][i] - vals["est"][i] for i in range(7)]
+            rows.append([*head, "truth - est.", f"{score['truth'] - score['est']:+.0f}", *(f"{x:+.0f}" for x in diff),
+                         ""])
+        return format_table(["scan", "mode", "case", "error", "pose", "score", "obs. on obs.", "obs. on free",
+                             "free on free", "free on obs.", "obs. marks unexpl.", "free marks unexpl.", "obs. marks",
+                             "origin ±1 / ±2 / none: unexpl. obs.; unexpl. free; obs. on free"], rows,
+                            title=(f"{self.name}: the score's terms (a_c = {self.params.a_c:g}, "
+                                   f"a_p = {self.params.a_p:g}; score = the four signed terms) at the estimate and at "
+                                   f"the best grid pose within {FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the "
+                                   "logged pose; unexpl. = on unexplored cells of the leave-out grid "
+                                   f"({self.leave_out_text} left out), which count 0; origin: the truth's obstacle and "
+                                   "free marks on unexplored cells that a left-out scan 1 or 2 steps away saw (the "
+                                   "leave-out removed them) or no other scan saw, and its obstacle marks on map free "
+                                   "cells that such a scan hit"))
 
     def __str__(self) -> str:
         ok = self.success
-        rates = ", ".join(f"{self._mode(k)} {ok[m].sum()}/{ok.shape[1]}" for m, k in enumerate(self.joined))
+        rates = ", ".join(f"{self.mode_name(k)} {ok[m].sum()}/{ok.shape[1]}" for m, k in enumerate(self.joined))
         return (f"{self.name}: scans localised within {FAIL_CELLS * self.cell_m:.1f} m and {FAIL_DEG:g}° "
                 f"from no prior: {rates}")
 
     def _title(self) -> str:
         return (f"{self.name} (CARMEN, logged laser poses): grid {self.grid.shape[0]}x{self.grid.shape[1]} cells of "
-                f"{self.cell_m:g} m from the other scans ({_leave_text(self)} left out), ranges < "
+                f"{self.cell_m:g} m from the other scans ({self.leave_out_text} left out), ranges < "
                 f"{self.max_range_m:g} m, Δα = {np.degrees(self.params.delta_alpha_rad):g}°, no prior")
 
     def table(self) -> str:
@@ -265,7 +323,7 @@ class LogLocalisationResult:
                 row += [f"{self.err_pos_m[m, j]:.2f}", f"{np.degrees(self.err_heading_rad[m, j]):.1f}",
                         f"{self.ambiguity[m, j]:.3f}", "yes" if self.success[m, j] else "NO"]
             rows.append(row)
-        modes = "" if one else "; modes " + ", ".join(f"({k}) {self._mode(k)}" for k in self.joined)
+        modes = "" if one else "; modes " + ", ".join(f"({k}) {self.mode_name(k)}" for k in self.joined)
         return format_table(head, rows, title=self._title() + modes)
 
     def summary_table(self) -> str:
@@ -276,7 +334,7 @@ class LogLocalisationResult:
         str
         """
         ok = self.success
-        rows = [[self._mode(k), f"{ok[m].sum()}/{ok.shape[1]}", f"{ok[m].mean():.1%}",
+        rows = [[self.mode_name(k), f"{ok[m].sum()}/{ok.shape[1]}", f"{ok[m].mean():.1%}",
                  f"{np.median(self.err_pos_m[m][ok[m]]) if ok[m].any() else float('nan'):.3f}",
                  f"{np.median(np.degrees(self.err_heading_rad[m][ok[m]])) if ok[m].any() else float('nan'):.2f}"]
                 for m, k in enumerate(self.joined)]
@@ -303,7 +361,7 @@ class LogLocalisationResult:
         -------
         str
         """
-        b = v.as_vector(bins, "bins")
+        b = as_vector(bins, "bins")
         if b.size < 2 or np.any(np.diff(b) <= 0):
             raise ValueError(f"`bins` must be at least two increasing edges; got {bins!r}")
         t = _check_unit(threshold, "threshold")
@@ -317,11 +375,29 @@ class LogLocalisationResult:
                 idx = np.clip(np.searchsorted(b, a[sel], side="right") - 1, 0, b.size - 2)
                 counts = np.bincount(idx, minlength=b.size - 1)
                 flag = f"{np.sum(a[sel] >= t)}/{sel.sum()}"
-                rows.append([self._mode(k), label, *(str(c) for c in counts), flag])
+                rows.append([self.mode_name(k), label, *(str(c) for c in counts), flag])
         title = (f"Ambiguity = (rival - base) / (best - base), rival = best score of a pose > "
                  f"{self.params.rival_radius_cells * self.cell_m:g} m or > {np.degrees(self.params.rival_heading_rad):g}° "
                  "away, base = median of the headings' best scores; scans per bin")
         return format_table(head, rows, title=title)
+
+
+def _describe(idx) -> str:
+    """The scans of a run in words, for the tables' titles."""
+    d = np.diff(idx)
+    if idx.size > 2 and np.all(d == d[0]):
+        return f"every {int(d[0])}th from {int(idx[0])} to {int(idx[-1])}"
+    return "scans " + ", ".join(str(int(i)) for i in idx)
+
+
+def _median_success(d):
+    """The row of ``d`` (one mode's :meth:`truth_check` rows) that is the success with the median wall fraction
+    at the truth (the lower middle one; first scan on ties); None without a success."""
+    ok = d[d["ok"]]
+    if ok.empty:
+        return None
+    order = ok.sort_values(["walls_truth", "scan"], kind="stable")
+    return order.iloc[(len(order) - 1) // 2]
 
 
 def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 650, 750, 850), *,
@@ -416,28 +492,28 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     from ...sweep import sweep
 
     p = LocaliseParams.resolve(params, **overrides)
-    log = _carmen_log(path)
-    cell = v.check_positive(cell_m, "cell_m")
-    rmax = v.check_positive(max_range_m, "max_range_m")
+    log = as_carmen_log(path)
+    cell = check_positive(cell_m, "cell_m")
+    rmax = check_positive(max_range_m, "max_range_m")
     modes = tuple(int(k) for k in np.atleast_1d(np.asarray(joined)))
     if not modes or any(k not in (1, 2, 3, 4, 5) for k in modes) or len(set(modes)) != len(modes):
         raise ValueError(f"`joined` must be distinct numbers of scans from {{1, ..., 5}}; got {joined!r}")
     kmax = max(modes)
-    lo, ex = _check_leave(leave_out, exclude, kmax)
+    lo, ex = check_leave(leave_out, exclude, kmax)
     hr = _check_unit(hit_ratio, "hit_ratio")
     for name, flag in (("truth_check", truth_check), ("votes", votes)):
         if not isinstance(flag, (bool, np.bool_)):
             raise TypeError(f"`{name}` must be a bool; got {type(flag).__name__}")
-    rf = v.check_int(refine, "refine", minimum=0)
-    rfh = v.check_positive(refine_heading_rad, "refine_heading_rad", allow_zero=True)
+    rf = check_int(refine, "refine", minimum=0)
+    rfh = check_positive(refine_heading_rad, "refine_heading_rad", allow_zero=True)
     if (truth_check or rf) and p.a_n != 0:
         raise ValueError(f"`truth_check` and `refine` score by the definition with a_n = 0 (004's value); got a_n = "
                          f"{p.a_n}")
-    sn, frac = _check_score_norm(score_norm, min_explored_fraction, p)
+    sn, frac = check_score_norm(score_norm, min_explored_fraction, p)
     if (truth_check or rf) and sn != "none":
         raise ValueError(f"`truth_check` and `refine` score by the raw correlation; got score_norm = {sn!r} (use "
                          f"'none')")
-    sd = v.as_finite_array(odom_std, "odom_std")
+    sd = as_finite_array(odom_std, "odom_std")
     if sd.shape != (2,) or np.any(sd < 0):
         raise ValueError(f"`odom_std` must be (σ_xy_m, σ_θ_rad) >= 0; got {odom_std!r}")
     idx = np.asarray(scan_indices)
@@ -447,18 +523,18 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     if idx.min() < back - 1 or idx.max() >= log.n_scans:
         raise ValueError(f"`scan_indices` must lie in [{back - 1}, {log.n_scans - 1}] (the {back - 1} scans before "
                          f"each are joined or vote); got {idx.min()}..{idx.max()}")
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     t0 = time.perf_counter()
     frame, scans_c, Pc, full = log_counts(log, cell_m=cell, max_range_m=rmax)
     scale = np.array([sd[0] / cell, sd[0] / cell, sd[1]])
     # one noise draw per step of the log (row m: scan m-1 -> m), so a scan's odometry is the same in any list
     steps = rng.normal(size=(log.n_scans, 3)) * scale
     noise = steps[idx[:, None] - np.arange(back - 1)[None, :]]  # (n, back - 1): steps i -> i-1, i-1 -> i-2, …
-    points = _log_points(idx, modes, scans_c, Pc, noise, lo, ex, votes=bool(votes))
+    points = log_points(idx, modes, scans_c, Pc, noise, lo, ex, votes=bool(votes))
     fixed = {"full": full, "scans_c": scans_c, "Pc": Pc, "p": p, "headings": heading_candidates(p.delta_alpha_rad),
              "joined": modes, "hit_ratio": hr, "truth_check": bool(truth_check),
              "refine": rf, "refine_heading_rad": rfh, "score_norm": sn, "min_explored_fraction": frac}
-    table = sweep(_localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed,
+    table = sweep(localise_log_scan, points, rng_arg=None, n_jobs=n_jobs, progress=progress, fixed=fixed,
                   on_error="raise", desc="localise log scans")
     true_m = log.poses[idx]
     est_m = np.stack([frame.to_metres(table[[f"x{k}", f"y{k}", f"h{k}"]].to_numpy(dtype=float)) for k in modes])
@@ -467,7 +543,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     amb = np.stack([table[f"amb{k}"].to_numpy(dtype=float) for k in modes])
     margin = np.stack([table[f"mar{k}"].to_numpy(dtype=float) for k in modes])
     example = log.scan(int(idx[0])).points(est_m[0, 0])
-    truth = ({c: np.stack([table[f"{c}{k}"].to_numpy(dtype=float) for k in modes]) for c in _TRUTH_COLUMNS}
+    truth = ({c: np.stack([table[f"{c}{k}"].to_numpy(dtype=float) for k in modes]) for c in TRUTH_COLUMNS}
              if truth_check else None)
     vote = np.stack([table[f"vote{k}"].to_numpy(dtype=int) for k in modes]) if votes else None
     return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, amb, cell, rmax,

@@ -14,23 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import check_int, check_positive
 from ...correlation.settings import LocaliseParams
-from .experiments import FAIL_CELLS, FAIL_DEG
+from .carmen_logs import SHARED_CARMEN_LOGS, as_carmen_log, short_log_name
 from .log_experiments import LogLocalisationResult, run_log_localisation
-from .log_truth import _leave_text
+from .studies import FAIL_CELLS, FAIL_DEG
 
-__all__ = ["SHARED_CARMEN_LOGS", "LogSuiteResult", "more_confident", "run_log_suite"]
-
-#: The five corrected Radish logs of the shared data (found by :func:`slamlab.data.find_data`).
-SHARED_CARMEN_LOGS = tuple(f"carmen-radish-corrected/{n}-corrected.log.gz"
-                           for n in ("csail", "fhw", "intel", "orebro", "seattle"))
-
-
-def _short(name: str) -> str:
-    return name.removesuffix(".gz").removesuffix(".log").removesuffix("-corrected")
-
+__all__ = ["LogSuiteResult", "more_confident", "run_log_suite"]
 
 @dataclass(frozen=True)
 class LogSuiteResult:
@@ -50,7 +41,7 @@ class LogSuiteResult:
     @property
     def names(self) -> tuple[str, ...]:
         """Short log names (``"intel"`` for ``intel-corrected.log.gz``)."""
-        return tuple(_short(r.name) for r in self.results)
+        return tuple(short_log_name(r.name) for r in self.results)
 
     def rates(self) -> np.ndarray:
         """``(logs, modes)`` success rates (success: within 2 cells and 5° of the logged pose).
@@ -71,7 +62,7 @@ class LogSuiteResult:
         r0 = self.results[0]
         head = ["log", "scans"]
         for k in r0.joined:
-            head += [f"{r0._mode(k)}", "rate", "median err [m] / [°]"]
+            head += [f"{r0.mode_name(k)}", "rate", "median err [m] / [°]"]
         rows = []
         for name, r in zip(self.names, self.results, strict=True):
             ok = r.success
@@ -88,7 +79,7 @@ class LogSuiteResult:
                                                                  f"{tot[m].mean():.1%}", "")])
         title = (f"Every {self.every}th scan of each log from no prior; success = within {FAIL_CELLS:g} cells "
                  f"({FAIL_CELLS * r0.cell_m:.1f} m) and {FAIL_DEG:g}° of the logged pose; cells {r0.cell_m:g} m, "
-                 f"ranges < {r0.max_range_m:g} m, {_leave_text(r0)} left out of each grid")
+                 f"ranges < {r0.max_range_m:g} m, {r0.leave_out_text} left out of each grid")
         return format_table(head, rows, title=title)
 
     def ambiguity_table(self, threshold: float = 0.75) -> str:
@@ -104,7 +95,7 @@ class LogSuiteResult:
         -------
         str
         """
-        t = v.check_positive(threshold, "threshold", allow_zero=True)
+        t = check_positive(threshold, "threshold", allow_zero=True)
         if t > 1:
             raise ValueError(f"`threshold` must lie in [0, 1]; got {t}")
         return self._flag_table([r.ambiguity for r in self.results], lambda a: a >= t, f">= {t:g}", "amb.",
@@ -124,7 +115,7 @@ class LogSuiteResult:
         -------
         str
         """
-        t = v.check_positive(threshold, "threshold", allow_zero=True)
+        t = check_positive(threshold, "threshold", allow_zero=True)
         if any(r.margin is None for r in self.results):
             raise ValueError("every result must carry its margins (run by run_log_localisation)")
         return self._flag_table([r.margin for r in self.results], lambda a: a <= t, f"<= {t:g}", "margin",
@@ -176,10 +167,11 @@ class LogSuiteResult:
         n = sum(r.success.shape[1] for r in self.results)
         rows.append(["all", str(n), *(f"{c}/{n}" for c in tot), ""])
         r0 = self.results[0]
-        return format_table(["log", "scans", r0._mode(a), r0._mode(b), "more confident of the two",
-                             f"answers kept from {r0._mode(a)}"], rows,
-                            title=(f"Per scan the answer with the larger margin ({r0._mode(a)} or {r0._mode(b)}; a tie "
-                                   f"keeps {r0._mode(b)}); {_leave_text(r0)} left out of each grid"))
+        return format_table(["log", "scans", r0.mode_name(a), r0.mode_name(b), "more confident of the two",
+                             f"answers kept from {r0.mode_name(a)}"], rows,
+                            title=(f"Per scan the answer with the larger margin ({r0.mode_name(a)} or "
+                                   f"{r0.mode_name(b)}; a tie keeps {r0.mode_name(b)}); {r0.leave_out_text} left out "
+                                   "of each grid"))
 
     def _flag_table(self, values, flag, rule: str, short: str, title: str) -> str:
         """Rows per log and mode, then pooled: failures and successes ``flag``-ged, and their median ``values``."""
@@ -188,10 +180,10 @@ class LogSuiteResult:
             return [name, mode, f"{np.sum(f[~ok])}/{np.sum(~ok)}", f"{np.sum(f[ok])}/{ok.sum()}",
                     f"{np.median(a[~ok]):.2f}" if (~ok).any() else "-", f"{np.median(a[ok]):.2f}" if ok.any() else "-"]
 
-        rows = [row(name, r._mode(k), a[m], r.success[m])
+        rows = [row(name, r.mode_name(k), a[m], r.success[m])
                 for name, r, a in zip(self.names, self.results, values, strict=True) for m, k in enumerate(r.joined)]
         for m, k in enumerate(self.results[0].joined):  # pooled over the logs
-            rows.append(row("all", self.results[0]._mode(k), np.concatenate([a[m] for a in values]),
+            rows.append(row("all", self.results[0].mode_name(k), np.concatenate([a[m] for a in values]),
                             np.concatenate([r.success[m] for r in self.results])))
         return format_table(["log", "mode", f"failures flagged ({rule})", "successes flagged",
                              f"median {short} (failures)", f"median {short} (successes)"], rows, title=title)
@@ -212,7 +204,7 @@ class LogSuiteResult:
                 dk = d[d["joined"] == k]
                 fail = dk[~dk["ok"]]
                 sc = fail[fail["kind"] == "score"]
-                rows.append([name, r._mode(k), f"{len(fail)}/{len(dk)}", str(int((fail["kind"] == "score").sum())),
+                rows.append([name, r.mode_name(k), f"{len(fail)}/{len(dk)}", str(int((fail["kind"] == "score").sum())),
                              str(int((fail["kind"] == "search").sum())), str(int((fail["kind"] == "grid").sum())),
                              ", ".join(f"{s}: {w:.2f}" for s, w in zip(sc["scan"], sc["walls_truth"], strict=True))
                              or "-",
@@ -277,8 +269,8 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: Loca
     Parameters
     ----------
     paths : sequence of (str, os.PathLike or CarmenLog), optional
-        The logs; default :data:`SHARED_CARMEN_LOGS` (the five corrected Radish logs, found by
-        :func:`slamlab.data.find_data`).
+        The logs; default :data:`~slamlab.studies.correlation.carmen_logs.SHARED_CARMEN_LOGS` (the five corrected
+        Radish logs, found by :func:`slamlab.data.find_data`).
     every : int, default 25
         Localise every ``every``-th scan (at least 3, so the joined scans come before).
     joined : sequence of int in {1, ..., 5}
@@ -303,7 +295,7 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: Loca
         One :class:`LogLocalisationResult` per log; :meth:`LogSuiteResult.table` prints the per-log rates.
     """
     from ...data import find_data
-    from ...io import CarmenLog, read_carmen
+    from ...io import CarmenLog
 
     if paths is None:
         paths = [find_data(p) for p in SHARED_CARMEN_LOGS]
@@ -311,12 +303,12 @@ def run_log_suite(paths=None, every: int = 25, *, joined=(1, 2, 3), params: Loca
         raise TypeError(f"`paths` must be a list or tuple of logs (paths or CarmenLog); got {type(paths).__name__}")
     if len(paths) == 0:
         raise ValueError("`paths` must hold at least one log; got 0")
-    ev = v.check_int(every, "every", minimum=3)
+    ev = check_int(every, "every", minimum=3)
     results = []
     for p in paths:
         if isinstance(p, bool) or not isinstance(p, (str, os.PathLike, CarmenLog)):
             raise TypeError(f"`paths` must hold str, os.PathLike or CarmenLog; got {type(p).__name__}")
-        log = p if isinstance(p, CarmenLog) else read_carmen(p)
+        log = as_carmen_log(p)
         idx = np.arange(ev, log.n_scans, ev)
         if idx.size == 0:
             raise ValueError(f"`every` ({ev}) leaves no scan of {log.name} ({log.n_scans} scans)")

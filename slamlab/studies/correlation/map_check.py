@@ -15,12 +15,13 @@ import os
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import check_int, check_positive
 from ...scans import OBSTACLE, UNEXPLORED, Scan
 from ...scans.logmap import leave_out_grid, log_counts
+from .carmen_logs import SHARED_CARMEN_LOGS, as_carmen_log, short_log_name
 
-__all__ = ["MAP_CHECK_LAYOUTS", "endpoint_agreement", "map_check"]
+__all__ = ["MAP_CHECK_LAYOUTS", "endpoint_agreement", "endpoints_on_walls", "map_check"]
 
 #: The layouts :func:`map_check` compares: label → :func:`endpoint_agreement` keywords (CARMEN's first).
 MAP_CHECK_LAYOUTS = (
@@ -114,29 +115,53 @@ def endpoint_agreement(log, *, fov_rad: float = np.pi, reverse: bool = False, of
     """
     if not all(hasattr(log, a) for a in ("poses", "n_scans", "n_beams", "scan")):
         raise TypeError(f"`log` must be a CarmenLog; got {type(log).__name__}")
-    fov = v.check_positive(fov_rad, "fov_rad")
+    fov = check_positive(fov_rad, "fov_rad")
     if fov > 2 * np.pi:
         raise ValueError(f"`fov_rad` must be <= 2π; got {fov}")
     if not isinstance(reverse, (bool, np.bool_)):
         raise TypeError(f"`reverse` must be a bool; got {type(reverse).__name__}")
     off = _finite(offset_rad, "offset_rad")
     dx = _finite(laser_x_m, "laser_x_m")
-    k = v.check_positive(range_scale, "range_scale")
-    ex = v.check_int(exclude, "exclude", minimum=0)
-    ev = v.check_int(every, "every", minimum=1)
+    k = check_positive(range_scale, "range_scale")
+    ex = check_int(exclude, "exclude", minimum=0)
+    ev = check_int(every, "every", minimum=1)
     view = _LaidOut(log, fov, bool(reverse), off, dx, k)
     _frame, sc, Pc, full = log_counts(view, cell_m=cell_m, max_range_m=max_range_m)
     on = seen = total = 0
     for i in range(ev, view.n_scans, ev):
         g = leave_out_grid(full, sc, Pc, range(max(0, i - ex), min(view.n_scans, i + ex + 1)))
-        o, sn, t = _endpoints_on_walls(g, sc[i], Pc[i])
+        o, sn, t = endpoints_on_walls(g, sc[i], Pc[i])
         on, seen, total = on + o, seen + sn, total + t
     return on / max(total, 1), on / max(seen, 1)
 
 
-def _endpoints_on_walls(grid, scan, pose) -> tuple[int, int, int]:
-    """End points of a cell-unit ``scan`` at ``pose`` (cells, rad): on obstacle cells of ``grid``, on seen cells
-    (obstacle or free), and in all (its returns; outside the grid counts as unseen)."""
+def endpoints_on_walls(grid, scan, pose) -> tuple[int, int, int]:
+    """How many end points of a scan fall on obstacle cells of a grid, on seen cells, and in all (ours, issue 25).
+
+    Parameters
+    ----------
+    grid : numpy.ndarray of int, shape (H, W)
+        Cell codes (:mod:`slamlab.scans.grid`).
+    scan : Scan
+        In cell units; its returns are the end points.
+    pose : array_like, shape (3,)
+        The scan's pose ``(x = col, y = row, heading_rad)`` [cells, rad].
+
+    Returns
+    -------
+    on_walls : int
+        End points on obstacle cells (each in the cell :func:`~slamlab.scans.occupancy_grid` votes its hit in).
+    on_seen : int
+        End points on seen cells, obstacle or free (outside the grid counts as unseen).
+    total : int
+        The scan's returns.
+
+    Examples
+    --------
+    >>> g = np.array([[0, 0, 1, -1]], dtype=np.int8)
+    >>> endpoints_on_walls(g, Scan([0.0, 0.0], [2.0, 3.0], [True, True]), [0, 0, 0.0])
+    (1, 1, 2)
+    """
     H, W = grid.shape
     th = pose[2] + scan.bearings_rad[scan.valid]
     r = scan.ranges[scan.valid] + 0.01  # the hit cell, as occupancy_grid votes it
@@ -153,7 +178,8 @@ def map_check(paths=None, layouts=MAP_CHECK_LAYOUTS, **settings) -> str:
     Parameters
     ----------
     paths : sequence of (str, os.PathLike or CarmenLog), optional
-        The logs; default the five shared corrected Radish logs (:data:`SHARED_CARMEN_LOGS`).
+        The logs; default the five shared corrected Radish logs
+        (:data:`~slamlab.studies.correlation.carmen_logs.SHARED_CARMEN_LOGS`).
     layouts : sequence of (str, dict)
         Label and :func:`endpoint_agreement` keywords of each layout (default :data:`MAP_CHECK_LAYOUTS`).
     **settings
@@ -165,8 +191,7 @@ def map_check(paths=None, layouts=MAP_CHECK_LAYOUTS, **settings) -> str:
         Per cell ``on walls / on walls of seen cells``, the best layout of each log marked ``*``.
     """
     from ...data import find_data
-    from ...io import CarmenLog, read_carmen
-    from .log_suite import SHARED_CARMEN_LOGS, _short
+    from ...io import CarmenLog
 
     if paths is None:
         paths = [find_data(p) for p in SHARED_CARMEN_LOGS]
@@ -178,11 +203,11 @@ def map_check(paths=None, layouts=MAP_CHECK_LAYOUTS, **settings) -> str:
     for p in paths:
         if isinstance(p, bool) or not isinstance(p, (str, os.PathLike, CarmenLog)):
             raise TypeError(f"`paths` must hold str, os.PathLike or CarmenLog; got {type(p).__name__}")
-        logs.append(p if isinstance(p, CarmenLog) else read_carmen(p))
+        logs.append(as_carmen_log(p))
     vals = np.array([[endpoint_agreement(log, **kw, **settings) for log in logs] for _lb, kw in layouts])
     best = vals[..., 0].argmax(axis=0)
     rows = [[lb] + [f"{vals[j, c, 0]:.3f} / {vals[j, c, 1]:.3f}{' *' if best[c] == j else ''}"
                     for c in range(len(logs))] for j, (lb, _kw) in enumerate(layouts)]
-    return format_table(["layout"] + [_short(log.name) for log in logs], rows,
+    return format_table(["layout"] + [short_log_name(log.name) for log in logs], rows,
                         title="Scan end points on obstacle cells of the other scans' grid (all / on seen cells); "
                               "* = the log's best layout")

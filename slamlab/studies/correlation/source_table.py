@@ -19,7 +19,7 @@ from .experiments import (
     Table1Result,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
-from .studies import _errors
+from .studies import source_table1_errors
 
 if TYPE_CHECKING:
     from .log_experiments import LogLocalisationResult
@@ -55,7 +55,7 @@ def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = 
     if not isinstance(table1, Table1Result):
         raise TypeError(f"`table1` must be a Table1Result; got {type(table1).__name__}")
     src = SOURCE_TABLE1
-    s_ea, s_ex, s_ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
+    s_ea, s_ex, s_ey = source_table1_errors()
     t = table1
     rows = [
         ["Table 1: poses", f"{src.shape[0]}", f"{t.true_poses.shape[0]}"],
@@ -78,7 +78,7 @@ def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = 
             rows.append([f"{lb}: failures in the crowded room", "not measured", f"{c.failure_rate[k]:.0%}"])
     if log is not None:
         for m, k in enumerate(log.joined):
-            rows.append([(f"real log {log.name}, {log._mode(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
+            rows.append([(f"real log {log.name}, {log.mode_name(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
                           f"and {FAIL_DEG:g}°"), "none (simulation only)",
                          f"{int(log.success[m].sum())}/{log.success.shape[1]}"])
     return format_table(["quantity", "004", "ours"], rows, title="Ours vs the source (004 §7)")

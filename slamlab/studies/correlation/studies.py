@@ -1,6 +1,8 @@
-"""Ch. 5 study helpers that need no simulated world (004 §7): the failure thresholds, localising a batch of scans on
-:func:`slamlab.sweep.sweep` with their errors and margins, 004's Table 1, the constructed corridor and the timing of
-:func:`~slamlab.correlation.localise` (the simulated runs live in :mod:`~slamlab.studies.correlation.experiments`)."""
+"""Ch. 5 study helpers that need no simulated world (004 §7): the success criterion, the pose errors, 004's Table 1,
+the constructed corridor and the timing of :func:`~slamlab.correlation.localise` (the simulated runs live in
+:mod:`~slamlab.studies.correlation.experiments`, the real-log runs in
+:mod:`~slamlab.studies.correlation.log_experiments`).
+"""
 
 from __future__ import annotations
 
@@ -8,80 +10,67 @@ import time
 
 import numpy as np
 
-from ...correlation.algorithm import (
-    _localise,
-    _scan_beams,
-    heading_candidates,
-    heading_error,
-    localise,
-)
-from ...scans import FREE, OBSTACLE, UNEXPLORED, grid_to_values
+from ...correlation.algorithm import heading_error, localise
+from ...scans import FREE, OBSTACLE, UNEXPLORED
 
-FAIL_CELLS = 2.0  # a localisation farther than this from the truth (or > FAIL_DEG off) is a failure
+__all__ = ["FAIL_CELLS", "FAIL_DEG", "SOURCE_TABLE1", "absolute_errors", "corridor_grid", "source_table1_errors",
+           "time_localise", "within_tolerance"]
 
+#: A localisation farther than this from the truth [cells] (or more than ``FAIL_DEG`` off) is a failure (ours).
+FAIL_CELLS = 2.0
+#: A localisation whose heading is more than this off [deg] is a failure (ours).
 FAIL_DEG = 5.0
 
 
-def _within_tolerance(err_pos, err_heading_rad, cell_m: float = 1.0) -> np.ndarray:
-    """A success by the chapter's criterion: position error ``err_pos`` within ``FAIL_CELLS`` cells (in the units of
-    ``cell_m``: cells by default, metres with the cell size) and absolute heading error within ``FAIL_DEG``."""
+def within_tolerance(err_pos, err_heading_rad, cell_m: float = 1.0) -> np.ndarray:
+    """The chapter's success: position error within ``FAIL_CELLS`` cells and heading error within ``FAIL_DEG`` (ours).
+
+    Parameters
+    ----------
+    err_pos : array_like
+        Position errors, in cells (``cell_m`` = 1) or in metres (``cell_m`` the cell size [m]).
+    err_heading_rad : array_like
+        Heading errors [rad] (their absolute values count), broadcast with ``err_pos``.
+    cell_m : float, default 1
+        The cell size in the unit of ``err_pos``.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        A success per error pair.
+
+    Examples
+    --------
+    >>> within_tolerance([1.0, 3.0, 0.2], np.radians([4.0, 0.0, -6.0])).tolist()
+    [True, False, False]
+    """
     return (np.asarray(err_pos) <= FAIL_CELLS * cell_m) & (np.degrees(np.abs(err_heading_rad)) <= FAIL_DEG)
 
 
-def _localise_one(*, beams, choice: int, Mvs, settings, headings, margins: bool = False, pose_index: int = 0) -> dict:
-    """One sweep task: localise one scan's ``beams`` on map ``Mvs[choice]`` with ``settings[choice]`` (deterministic)."""
-    loc = _localise(Mvs[choice], *beams, headings, settings[choice], tracking=False)
-    row = {"x": float(loc.pose[0]), "y": float(loc.pose[1]), "heading_rad": float(loc.pose[2])}
-    if margins:
-        row["half_max_area"], row["heading_margin"] = _margins(loc)
-    return row
+def absolute_errors(true_poses, est_poses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Absolute errors of estimated poses: wrapped heading, ``|Δx|`` and ``|Δy|``, 004's Table 1 columns (004 §7).
 
+    Parameters
+    ----------
+    true_poses, est_poses : numpy.ndarray, shape (n, 3)
+        ``(x, y, heading_rad)`` rows [cells, rad].
 
-def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 1, progress: bool | None = None):
-    """Localise every scan with every setting on :func:`slamlab.sweep.sweep`: one task per (setting, scan).
+    Returns
+    -------
+    err_heading_rad : numpy.ndarray, shape (n,)
+        ``|wrap(est - true)|`` of the headings [rad].
+    err_x, err_y : numpy.ndarray, shape (n,)
+        ``|Δx|``, ``|Δy|`` [cells].
 
-    The scans were drawn by the caller (the random part stays in the parent, in its order); a
-    localisation draws nothing (``rng_arg=None``), so the table is the same for any ``n_jobs``.
-    The map is turned into 004's values once per setting. Returns the table (columns ``choice``,
-    ``pose_index``, ``x``, ``y``, ``heading_rad`` and with ``margins`` ``half_max_area``,
-    ``heading_margin``), setting-major.
+    Examples
+    --------
+    >>> [e.round(6).tolist() for e in absolute_errors(np.array([[1.0, 2.0, 0.1]]), np.array([[2.0, 2.0, -0.1]]))]
+    [[0.2], [1.0], [0.0]]
     """
-    from ...sweep import sweep
-
-    beams = [_scan_beams(s) for s in scans]
-    settings = tuple(q.replace(ambiguity=False) for q in settings)  # these runs report no ambiguity: no rival search
-    Mvs = tuple(grid_to_values(M, q.a_c, q.a_p, q.a_n) for q in settings)
-    headings = heading_candidates(settings[0].delta_alpha_rad)
-    points = [{"choice": j, "pose_index": i, "beams": b} for j in range(len(settings)) for i, b in enumerate(beams)]
-    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress, on_error="raise", desc="correlation localisation",
-                  fixed={"Mvs": Mvs, "settings": tuple(settings), "headings": headings, "margins": margins})
-    return table.drop(columns=["beams", "replicate", "error"])
-
-
-def _estimates(table) -> np.ndarray:
-    """``(n, 3)`` estimated poses (x, y, heading) of a :func:`_localise_scans` table."""
-    return table[["x", "y", "heading_rad"]].to_numpy(dtype=float)
-
-
-def _errors(true, est):
-    ea = heading_error(est[:, 2], true[:, 2])
-    ex = np.abs(est[:, 0] - true[:, 0])
-    ey = np.abs(est[:, 1] - true[:, 1])
+    ea = heading_error(est_poses[:, 2], true_poses[:, 2])
+    ex = np.abs(est_poses[:, 0] - true_poses[:, 0])
+    ey = np.abs(est_poses[:, 1] - true_poses[:, 1])
     return ea, ex, ey
-
-
-def _margins(loc, heading_window=3):
-    """Half-maximum area of the score map [cells] and relative heading margin of one localisation."""
-    dmap = loc.score_map
-    med = float(np.median(dmap))
-    area = float(np.count_nonzero(dmap >= med + 0.5 * (loc.score - med)))
-    b = loc.best_per_heading
-    n = b.size
-    idx = (np.arange(n) - loc.heading_index) % n
-    far = np.minimum(idx, n - idx) >= heading_window
-    bmed = float(np.median(b))
-    head = (loc.score - b[far].max()) / max(loc.score - bmed, 1e-12)
-    return area, head
 
 
 #: 004 Table 1: α0, α0 est [rad], X, X est, Y, Y est [cells].
@@ -97,6 +86,25 @@ SOURCE_TABLE1 = np.array([
     [2.1229, 2.1293, 30, 30, 171, 171],
     [5.2929, 5.2883, 105, 105, 45, 45],
 ])
+
+
+def source_table1_errors() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """004's Table 1 errors per pose, by :func:`absolute_errors` of its printed values (004 §7, Table 1).
+
+    Returns
+    -------
+    err_heading_rad : numpy.ndarray, shape (10,)
+        ``|α0 est - α0|`` [rad].
+    err_x, err_y : numpy.ndarray, shape (10,)
+        ``|X est - X|``, ``|Y est - Y|`` [cells].
+
+    Examples
+    --------
+    >>> [round(float(e.max()), 6) for e in source_table1_errors()]
+    [0.0098, 0.0, 1.0]
+    """
+    src = SOURCE_TABLE1
+    return absolute_errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
 
 
 def corridor_grid() -> np.ndarray:

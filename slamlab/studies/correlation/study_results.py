@@ -13,7 +13,7 @@ from ...correlation.algorithm import (
     LocaliseParams,
     heading_error,
 )
-from .studies import SOURCE_TABLE1, _errors
+from .studies import SOURCE_TABLE1, source_table1_errors
 
 
 @dataclass(frozen=True)
@@ -67,8 +67,7 @@ class Table1Result:
                          f"{self.err_y_cells[i]:.0f}"])
         rows.append(["max (ours)", "", "", "", "", "", "", f"{self.err_heading_rad.max():.4f}",
                      f"{self.err_x_cells.max():.0f}", f"{self.err_y_cells.max():.0f}"])
-        src = SOURCE_TABLE1
-        s_ea, s_ex, s_ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
+        s_ea, s_ex, s_ey = source_table1_errors()
         rows.append(["max (004)", "", "", "", "", "", "", f"{s_ea.max():.4f}", f"{s_ex.max():.0f}",
                      f"{s_ey.max():.0f}"])
         head = ["#", "α0", "α0 est", "X", "X est", "Y", "Y est", "err α0", "err X", "err Y"]
@@ -84,7 +83,7 @@ class Table1Result:
         str
         """
         src = SOURCE_TABLE1
-        ea, ex, ey = _errors(src[:, [2, 4, 0]], src[:, [3, 5, 1]])
+        ea, ex, ey = source_table1_errors()
         rows = [[i + 1, f"{r[0]:.4f}", f"{r[1]:.4f}", f"{r[2]:.0f}", f"{r[3]:.0f}", f"{r[4]:.0f}", f"{r[5]:.0f}",
                  f"{ea[i]:.4f}", f"{ex[i]:.0f}", f"{ey[i]:.0f}"] for i, r in enumerate(src)]
         head = ["#", "α0", "α0 est", "X", "X est", "Y", "Y est", "err α0", "err X", "err Y"]
@@ -111,6 +110,8 @@ class MonteCarloResult:
         Random discs added to 004's clutter.
     time_s : float
         Wall time of the localisations [s] (not compared).
+    params : LocaliseParams
+        Settings of the localisations.
     """
 
     n_poses: int
@@ -120,6 +121,7 @@ class MonteCarloResult:
     range_std_cells: float
     extra_clutter: int
     time_s: float = field(default=0.0, compare=False)
+    params: LocaliseParams = field(default_factory=LocaliseParams, repr=False)
 
     @property
     def failure_rate(self) -> float:
@@ -182,6 +184,8 @@ class ConstantsResult:
         The first scan's true pose.
     time_s : float
         Wall time [s] (not compared).
+    params : LocaliseParams
+        Settings of the localisations but ``a_c, a_p, a_n`` (each choice sets them).
     """
 
     labels: tuple[str, ...]
@@ -194,6 +198,7 @@ class ConstantsResult:
     example_maps: tuple = field(default=(), repr=False)  # score maps at the truth's heading, one per choice
     example_pose: np.ndarray = field(default=None, repr=False)
     time_s: float = field(default=0.0, compare=False)
+    params: LocaliseParams = field(default_factory=LocaliseParams, repr=False)
 
     def __str__(self) -> str:
         return "; ".join(f"{lb}: failures {fr:.0%}" for lb, fr in zip(self.labels, self.failure_rate, strict=True))
@@ -229,12 +234,15 @@ class CorridorResult:
         The last scan alone.
     joined : Localisation
         The scans joined by odometry.
+    params : LocaliseParams
+        Settings of both localisations.
     """
 
     true_pose: np.ndarray  # (3,) cells, rad: the pose of the last scan
     odom_poses: np.ndarray  # (k, 3) the scans' poses, last scan first
     single: Localisation
     joined: Localisation
+    params: LocaliseParams = field(default_factory=LocaliseParams, repr=False)
 
     def __str__(self) -> str:
         e1 = np.degrees(heading_error(self.single.pose[2], self.true_pose[2]))

@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...correlation.algorithm import LocaliseParams, _beam_samples, _scan_beams
-from ...correlation.settings import _stamp_a_c
+from ...correlation.samples import scan_samples
+from ...correlation.scoring import PoseMarks, pose_marks
+from ...correlation.settings import LocaliseParams
 from ...geometry.se2 import check_poses
 from ...scans import check_grid, grid_to_values
 
-__all__ = ["TERM_NAMES", "score_terms"]
+__all__ = ["COUNT_NAMES", "TERM_NAMES", "mark_terms", "score_terms"]
 
 #: The four signed terms of the score (:func:`score_terms`): ``obs_on_obs + obs_on_free + free_on_free +
 #: free_on_obs`` = score.
@@ -31,9 +32,29 @@ COUNT_NAMES = ("n_obs_on_obs", "n_obs_on_free", "n_obs_unexplored", "n_free_on_f
                "n_free_unexplored")
 
 
-def _terms_of(marks, a_c: float, a_p: float) -> dict:
-    """The four terms and six counts of one pose's marks (:class:`~slamlab.correlation.scoring._Marks`);
-    map cells are told by their value: ``a_p`` obstacle, ``a_c`` free, anything else unexplored."""
+def mark_terms(marks: PoseMarks, a_c: float, a_p: float) -> dict:
+    """The four terms and six counts of one pose's marks (:data:`TERM_NAMES`, :data:`COUNT_NAMES`; ours, issue 25).
+
+    Parameters
+    ----------
+    marks : PoseMarks
+        One pose's marks (:func:`~slamlab.correlation.scoring.pose_marks`).
+    a_c, a_p : float
+        The map's values of free and obstacle cells (any other value is an unexplored cell).
+
+    Returns
+    -------
+    dict
+        The terms and counts by name, and ``score`` (``Σ stamp·map``).
+
+    Examples
+    --------
+    >>> from slamlab.correlation.scoring import PoseMarks
+    >>> mk = PoseMarks(np.zeros(3, int), np.arange(3), np.array([-1.0, -1.0, 1.0]), np.array([-1.0, 1.0, 0.0]),
+    ...                np.array([False, False, True]))
+    >>> t = mark_terms(mk, -1.0, 1.0); t["free_on_free"], t["free_on_obs"], t["n_obs_unexplored"], t["score"]
+    (1.0, -1.0, 1, 0.0)
+    """
     on_obs, on_free = marks.map == a_p, marks.map == a_c
     o, f = marks.is_obs, ~marks.is_obs
     prod = marks.stamp * marks.map
@@ -47,24 +68,10 @@ def _terms_of(marks, a_c: float, a_p: float) -> dict:
     return out
 
 
-def _score_terms(Mv, free, obs, a_c: float, a_p, poses, map_a_c: float, map_a_p: float) -> list[dict]:
-    """:func:`score_terms` on robot-frame samples (``a_p``: scalar or one weight-scaled value per obstacle
-    sample) and a value map ``Mv`` whose free / obstacle cells hold ``map_a_c`` / ``map_a_p`` (else 0)."""
-    from ...correlation.scoring import _pose_marks
-
-    P = np.asarray(poses, dtype=float).reshape(-1, 3)
-    rows = [None] * P.shape[0]
-    for m, marks in _pose_marks(Mv, free, obs, a_c, a_p, P):
-        rows[m] = _terms_of(marks, map_a_c, map_a_p)
-    if any(r is None for r in rows):
-        raise ValueError("`poses` must be finite and near the map")
-    return rows
-
-
 def score_terms(grid, scan, poses, *, params: LocaliseParams | None = None, **overrides):
     """The correlation score of one scan at some poses, split into its four non-zero terms (ours, issue 25; 004 §7).
 
-    The stamp is :func:`~slamlab.correlation.rasterise_scan`'s (free marks ``a_c`` along each beam, the obstacle
+    The stamp is :func:`~slamlab.correlation.scan_stamps`'s (free marks ``a_c`` along each beam, the obstacle
     mark ``a_p`` at its end, each cell once, the obstacle mark last); the map holds ``a_c`` (free), ``a_p``
     (obstacle) and ``a_n = 0`` (unexplored, and outside the map). So ``score = obs_on_obs + obs_on_free +
     free_on_free + free_on_obs`` exactly; marks on unexplored cells add nothing and are only counted.
@@ -78,7 +85,8 @@ def score_terms(grid, scan, poses, *, params: LocaliseParams | None = None, **ov
     poses : array_like, shape (m, 3)
         ``(x = col, y = row, heading_rad)`` [cells, rad], on the search's grid or off it.
     params, **overrides
-        :class:`LocaliseParams` (its constants and rasterisation); ``a_n`` must be 0 (004's value).
+        :class:`LocaliseParams` (its constants and rasterisation; with ``wall_balance`` the obstacle marks carry
+        their wall weights, as in :func:`~slamlab.correlation.localise`); ``a_n`` must be 0 (004's value).
 
     Returns
     -------
@@ -102,13 +110,12 @@ def score_terms(grid, scan, poses, *, params: LocaliseParams | None = None, **ov
     if p.a_n != 0:
         raise ValueError(f"`a_n` must be 0 (004's value: unexplored cells and the outside count nothing); got {p.a_n}")
     g = check_grid(grid)
-    a, r, h = _scan_beams(scan)
+    samples = scan_samples(scan, params=p)
     P = check_poses(poses, "poses")
-    free, obs = _beam_samples(a, r, h, delta_l_cells=p.delta_l_cells, hit_offset_cells=p.hit_offset_cells,
-                              step_cells=p.step_cells, use_misses=p.use_misses)
     lim = 4 * (g.shape[0] + g.shape[1])
     if np.any(np.abs(P[:, :2]) > lim):
         raise ValueError(f"`poses` must lie within {lim} cells of the map; got {np.abs(P[:, :2]).max():.0f}")
-    rows = _score_terms(grid_to_values(g, p.a_c, p.a_p, p.a_n), free, obs, _stamp_a_c(p), p.a_p, P, p.a_c, p.a_p)
+    marks = pose_marks(grid_to_values(g, p.a_c, p.a_p, p.a_n), samples, P)
+    rows = [mark_terms(mk, p.a_c, p.a_p) for mk in marks]
     return pd.DataFrame(rows, columns=[*TERM_NAMES, *COUNT_NAMES, "score"])
 

@@ -13,9 +13,10 @@ from ...scans import log_grid
 from ...sim.grid import add_clutter, measurement_room_200, test_room_200
 from ...sim.rangefinder import Rangefinder
 from ...widgets import STYLE as _STYLE
+from ...widgets import show_run
 from ...widgets import slider as _slider
+from .carmen_logs import as_carmen_log as _carmen_log
 from .experiments import random_clutter
-from .log_experiments import _carmen_log
 
 __all__ = ["explore_localisation", "explore_log_scan"]
 
@@ -45,7 +46,7 @@ def explore_localisation(**defaults):
     M = test_room_200()
 
     def show(x, y, heading_deg, range_std_cells, clutter, extra_clutter, delta_alpha_deg, a_c, a_p, n_beams):
-        try:
+        def run():
             W = measurement_room_200() if clutter else M.copy()
             if extra_clutter:
                 W = add_clutter(W, random_clutter(W, int(extra_clutter), rng=d["rng"]))
@@ -55,12 +56,14 @@ def explore_localisation(**defaults):
             rf = Rangefinder(n_beams=int(n_beams), max_range_cells=100.0, range_std_cells=range_std_cells)
             scan = rf.scan(W, truth, rng=d["rng"])
             loc = localise(M, scan, delta_alpha_rad=float(np.radians(delta_alpha_deg)), a_c=a_c, a_p=a_p)
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        err = np.hypot(*(loc.pose[:2] - truth[:2]))
-        print(f"{loc}; error {err:.2f} cells, {np.degrees(heading_error(loc.pose[2], truth[2])):.2f}°")
-        localisation_figure(W, scan, loc, truth)
+            return W, scan, loc, truth  # localisation_figure's arguments
+
+        def table(out):
+            _, _, loc, truth = out
+            err = np.hypot(*(loc.pose[:2] - truth[:2]))
+            return f"{loc}; error {err:.2f} cells, {np.degrees(heading_error(loc.pose[2], truth[2])):.2f}°"
+
+        show_run(run, lambda out: localisation_figure(*out), table=table)
 
     return widgets.interactive(
         show,
@@ -104,20 +107,22 @@ def explore_log_scan(path=None, **defaults):
     log = _log(path)
 
     def show(scan, a_c, a_p, exclude, joined):
-        try:
+        def run():
             js = [scan - j for j in range(joined) if scan - j >= 0]
             ex = max(exclude, len(js) - 1)  # the joined scans never draw the map they are matched against
             leave = range(max(0, scan - ex), min(log.n_scans, scan + ex + 1))
             G, frame, scans_c, Pc = log_grid(log, cell_m=d["cell_m"], max_range_m=d["max_range_m"], leave_out=leave)
             loc = localise_joined(G, [scans_c[j] for j in js], Pc[js], a_c=a_c, a_p=a_p)
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        est = frame.to_metres(loc.pose[None])[0]
-        err = np.hypot(*(est[:2] - log.poses[scan, :2]))
-        print(f"{log.name} scan {scan} ({len(js)} scan(s) joined by the logged odometry): error {err:.2f} m, "
-              f"{np.degrees(heading_error(est[2], log.poses[scan, 2])):.1f}°, ambiguity {loc.ambiguity:.3f}")
-        localisation_figure(G, scans_c[scan], loc, Pc[scan])
+            return len(js), frame, (G, scans_c[scan], loc, Pc[scan])  # the last: localisation_figure's arguments
+
+        def table(out):
+            n_joined, frame, (_, _, loc, _) = out
+            est = frame.to_metres(loc.pose[None])[0]
+            err = np.hypot(*(est[:2] - log.poses[scan, :2]))
+            return (f"{log.name} scan {scan} ({n_joined} scan(s) joined by the logged odometry): error {err:.2f} m, "
+                    f"{np.degrees(heading_error(est[2], log.poses[scan, 2])):.1f}°, ambiguity {loc.ambiguity:.3f}")
+
+        show_run(run, lambda out: localisation_figure(*out[2]), table=table)
 
     return widgets.interactive(
         show,

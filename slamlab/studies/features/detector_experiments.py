@@ -9,8 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_vector, check_int
 from ...features.detect import detect
 from ...features.evaluation import load_oxford_image, oxford_label
 from ...features.surf import threshold_sweep
@@ -116,9 +116,9 @@ def run_detector_summary(sequence: str = "graf", index: int = 1, *, size=(768, 5
     import cv2
 
     img = load_oxford_image(sequence, index)
-    w, h = (v.check_int(s, "size", minimum=16) for s in size)
+    w, h = (check_int(s, "size", minimum=16) for s in size)
     img = cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA)
-    repeats = v.check_int(repeats, "repeats", minimum=1)
+    repeats = check_int(repeats, "repeats", minimum=1)
     names, counts, dims, times = [], [], [], {}
     for name, (method, params) in _SUMMARY.items():
         params = dict(params)
@@ -219,9 +219,9 @@ def run_surf_threshold(sequence: str = "graf", index: int = 1, *, size=(768, 576
     import cv2
 
     img = load_oxford_image(sequence, index)
-    w, h = (v.check_int(s, "size", minimum=16) for s in size)
+    w, h = (check_int(s, "size", minimum=16) for s in size)
     img = cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA)
-    th = np.sort(v.as_vector(thresholds, "thresholds"))
+    th = np.sort(as_vector(thresholds, "thresholds"))
     counts = threshold_sweep(img, th)
     src = int(threshold_sweep(img, [0.05])[0])
     return SurfThresholdResult(f"{oxford_label(sequence)}/img{index} {w}x{h}", th, counts, 0.05, src)
@@ -287,8 +287,8 @@ def run_blob_scale(sizes_px=(3.0, 4.0, 5.0, 6.0, 8.0), *, threshold: float = 1e-
     """
     from ...features.surf import surf_detect
 
-    sizes = v.as_vector(sizes_px, "sizes_px")
-    size_px = v.check_int(size_px, "size_px", minimum=16)
+    sizes = as_vector(sizes_px, "sizes_px")
+    size_px = check_int(size_px, "size_px", minimum=16)
     c = (size_px - 1) / 2.0
     yy, xx = np.mgrid[0:size_px, 0:size_px]
     uv, sig = [], []

@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import check_choice, check_int, check_positive
 from ...features.detect import detect
 from ...features.evaluation import (
     correct_matches,
@@ -42,6 +42,7 @@ __all__ = [
     "DetectorSummaryResult",
     "PairEvaluationResult",
     "SurfThresholdResult",
+    "detect_for_evaluation",
     "ours_vs_source",
     "run_blob_scale",
     "run_detector_summary",
@@ -58,7 +59,29 @@ EVAL_DETECTORS = {
 }
 
 
-def _detect_named(img, name, n_points):
+def detect_for_evaluation(img, name: str, n_points: int):
+    """The strongest ``n_points`` keypoints by one of :data:`EVAL_DETECTORS` with its settings, timed (003 §3.1).
+
+    Ours: ORB is asked for at least ``2·n_points`` features, so that ``n_points`` survive.
+
+    Parameters
+    ----------
+    img : (H, W) array
+        Grey image (uint8, or float in [0, 1]).
+    name : {'SIFT', 'SURF', 'ORB', 'FAST'}
+        A key of :data:`EVAL_DETECTORS`.
+    n_points : int
+        Keypoints kept (the strongest), >= 1.
+
+    Returns
+    -------
+    features : Features
+        At most ``n_points`` keypoints with descriptors.
+    seconds : float
+        Wall time of the detection (machine dependent).
+    """
+    check_choice(name, "name", EVAL_DETECTORS)
+    n_points = check_int(n_points, "n_points", minimum=1)
     method, params = EVAL_DETECTORS[name]
     params = dict(params)
     if name == "ORB":
@@ -206,14 +229,14 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
         sequences = (sequences,)
     folders = tuple(oxford_folder(s) for s in sequences)
     labels = tuple(oxford_label(s) for s in sequences)
-    steps = tuple(v.check_int(j, "steps", minimum=2) for j in steps)
-    detectors = tuple(v.check_choice(d, "detectors", tuple(EVAL_DETECTORS)) for d in detectors)
+    steps = tuple(check_int(j, "steps", minimum=2) for j in steps)
+    detectors = tuple(check_choice(d, "detectors", tuple(EVAL_DETECTORS)) for d in detectors)
     if not sequences or not steps or not detectors:
         raise ValueError("`sequences`, `steps` and `detectors` must not be empty")
-    scale = v.check_positive(scale, "scale")
-    n_points = v.check_int(n_points, "n_points", minimum=10)
-    tol_px = v.check_positive(tol_px, "tol_px")
-    rule = v.check_choice(rule, "rule", ("000", "ratio"))
+    scale = check_positive(scale, "scale")
+    n_points = check_int(n_points, "n_points", minimum=10)
+    tol_px = check_positive(tol_px, "tol_px")
+    rule = check_choice(rule, "rule", ("000", "ratio"))
     shape = (len(sequences), len(steps), len(detectors))
     rep, prec, rec = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
     n_m, n_c = np.zeros(shape, dtype=int), np.zeros(shape, dtype=int)
@@ -226,11 +249,11 @@ def run_pair_evaluation(sequences=("graf", "boat"), steps=(2, 3, 4, 5, 6), *,
             img1, img2, H = load_oxford_pair(seq, st, scale=scale)
             for k, name in enumerate(detectors):
                 if name not in first:
-                    first[name], dt = _detect_named(img1, name, n_points)
+                    first[name], dt = detect_for_evaluation(img1, name, n_points)
                     times[name] += dt
                     n_det[name] += 1
                 f1 = first[name]
-                f2, dt = _detect_named(img2, name, n_points)
+                f2, dt = detect_for_evaluation(img2, name, n_points)
                 times[name] += dt
                 n_det[name] += 1
                 r = repeatability(f1, f2, H, img1.shape, img2.shape, tol_px=tol_px)

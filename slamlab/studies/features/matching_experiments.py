@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import as_vector, check_choice, check_int
 from ...features.evaluation import (
     correct_matches,
     load_oxford_pair,
@@ -24,8 +24,8 @@ from ...features.evaluation import (
 )
 from ...features.matching import accept_000, accept_ratio, knn2
 from ...kdtree.knn import flann_index
-from .experiments import EVAL_DETECTORS, _detect_named
-from .matching_workload import _matching_workload, descriptor_pool, surf_features
+from .experiments import EVAL_DETECTORS, detect_for_evaluation
+from .matching_workload import descriptor_pool, matching_workload, surf_features
 
 __all__ = [
     "KnnComparisonResult",
@@ -166,12 +166,12 @@ def run_knn_comparison(sizes=(2000, 13000), *, n_queries: int = 500, max_leaves:
 
     from ...kdtree import KDTree
 
-    sizes = tuple(v.check_int(n, "sizes", minimum=10) for n in sizes)
-    n_queries = v.check_int(n_queries, "n_queries", minimum=1)
+    sizes = tuple(check_int(n, "sizes", minimum=10) for n in sizes)
+    n_queries = check_int(n_queries, "n_queries", minimum=1)
     shape = (len(sizes), len(KNN_LABELS))
     rec, prec, nm, ev, tm = (np.full(shape, np.nan) for _ in range(5))
     for i, n in enumerate(progress_bar(sizes, desc="kNN comparison", progress=progress)):
-        f1, q, train, H = _matching_workload(n, n_queries, sequence, j, scale, threshold)
+        f1, q, train, H = matching_workload(n, n_queries, sequence, j, scale, threshold)
         Q = q.descriptors
         t0 = time.perf_counter()
         d_ref, i_ref = knn2(Q, train, method="brute")
@@ -300,8 +300,8 @@ def run_recall_vs_leaves(budgets=(1, 2, 5, 10, 20, 50, 100, 200, 500, 1000), *, 
 
     from ...kdtree import KDTree
 
-    budgets = np.array([v.check_int(b, "budgets", minimum=1) for b in budgets])
-    _, q, train, _ = _matching_workload(n_stored, n_queries, sequence, j, scale, threshold)
+    budgets = np.array([check_int(b, "budgets", minimum=1) for b in budgets])
+    _, q, train, _ = matching_workload(n_stored, n_queries, sequence, j, scale, threshold)
     Q = q.descriptors
     _, i_ref = knn2(Q, train, method="brute")
     tree = KDTree(train)
@@ -401,11 +401,11 @@ def run_ratio_tradeoff(ratios=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), *, detec
     RatioTradeoffResult
         Precision, recall and matches per ratio plus 000's rule in ``source_row``.
     """
-    detector = v.check_choice(detector, "detector", tuple(EVAL_DETECTORS))
-    ratios = np.sort(v.as_vector(ratios, "ratios"))
+    detector = check_choice(detector, "detector", tuple(EVAL_DETECTORS))
+    ratios = np.sort(as_vector(ratios, "ratios"))
     img1, img2, H = load_oxford_pair(sequence, j, scale=scale)
-    f1, _ = _detect_named(img1, detector, n_points)
-    f2, _ = _detect_named(img2, detector, n_points)
+    f1, _ = detect_for_evaluation(img1, detector, n_points)
+    f2, _ = detect_for_evaluation(img2, detector, n_points)
     r = repeatability(f1, f2, H, img1.shape, img2.shape, tol_px=tol_px)
     d, idx = knn2(f1.descriptors, f2.descriptors)
     from ...features.matching import Matches

@@ -8,12 +8,12 @@ from functools import lru_cache
 
 import numpy as np
 
-from ... import _validate as v
+from ..._validate import check_int
 from ...features.base import Features
 from ...features.detect import detect
 from ...features.evaluation import OXFORD_SEQUENCES, load_oxford_image, load_oxford_pair
 
-__all__ = ["descriptor_pool", "surf_features"]
+__all__ = ["descriptor_pool", "matching_workload", "surf_features"]
 
 
 @lru_cache(maxsize=64)
@@ -59,7 +59,7 @@ def descriptor_pool(n: int, *, exclude: str = "graf", scale: float = 0.5, thresh
     (n, 64) float32
         Descriptors, taken sequence by sequence, image 1..6.
     """
-    n = v.check_int(n, "n", minimum=0)
+    n = check_int(n, "n", minimum=0)
     out, have = [], 0
     for seq in OXFORD_SEQUENCES:
         if seq == exclude:
@@ -76,7 +76,40 @@ def descriptor_pool(n: int, *, exclude: str = "graf", scale: float = 0.5, thresh
     return np.concatenate(out) if out else np.zeros((0, 64), np.float32)
 
 
-def _matching_workload(n_stored, n_queries, sequence, j, scale, threshold):
+def matching_workload(n_stored: int, n_queries: int, sequence: str = "graf", j: int = 2, scale: float = 0.5,
+                      threshold: float = 5e-5):
+    """Ch. 3's matching workload: image 1's SURF descriptors and distractors to search, image j's to query (000 §1.4.3).
+
+    Ours: the distractors, from the other Oxford sequences, grow the store to ``n_stored``.
+
+    Parameters
+    ----------
+    n_stored : int
+        Descriptors to search: image 1's strongest (at most all of them), then distractors (>= 1).
+    n_queries : int
+        Query keypoints: image ``j``'s strongest (>= 1).
+    sequence : str or os.PathLike
+        Oxford sequence: a name of :data:`~slamlab.features.evaluation.OXFORD_SEQUENCES` or its folder.
+    j : int
+        The query image (>= 2).
+    scale : float
+        Image resize factor.
+    threshold : float
+        SURF Hessian threshold on our scale.
+
+    Returns
+    -------
+    f1 : Features
+        Image 1's keypoints among the stored descriptors (the first ``len(f1)`` rows of ``train``).
+    queries : Features
+        Image ``j``'s keypoints (the queries).
+    train : (n_stored, 64) float32
+        The descriptors searched.
+    H : (3, 3) float
+        The homography from image 1 to image ``j`` (at ``scale``).
+    """
+    n_stored = check_int(n_stored, "n_stored", minimum=1)
+    n_queries = check_int(n_queries, "n_queries", minimum=1)
     img1, img2, H = load_oxford_pair(sequence, j, scale=scale)
     f1 = surf_features(img1, threshold)
     f2 = surf_features(img2, threshold)

@@ -10,8 +10,11 @@ from ...features.evaluation import OXFORD_SEQUENCES, correct_matches, load_oxfor
 from ...features.matching import Matches, accept_ratio, knn2
 from ...features.plot import plot_keypoint_pair, plot_matches
 from ...widgets import STYLE as _STYLE
+from ...widgets import show_run
 
 __all__ = ["explore_detectors", "explore_matching"]
+
+_ERRORS = (ValueError, TypeError, FileNotFoundError)  # FileNotFoundError: the Oxford images are data files
 
 
 # detector -> (method, threshold parameter name, default, min, max, step, log scale)
@@ -56,19 +59,25 @@ def explore_detectors(**defaults):
         _, _, _, lo, hi, _, _ = _DETECTOR_KNOBS[detector]
         value = lo + threshold_fraction * (hi - lo)
         method, params = _params(detector, value)
-        try:
+
+        def run():
             img1, img2, H = load_oxford_pair(sequence, step, scale=d["scale"])
             f1 = detect(img1, method, descriptors=False, **params)
             f2 = detect(img2, method, descriptors=False, **params)
-        except (ValueError, TypeError, FileNotFoundError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        r = repeatability(f1, f2, H, img1.shape, img2.shape)
-        shown = f"{10 ** value:.2g}" if _DETECTOR_KNOBS[detector][6] else f"{params[next(iter(params))]}"
-        print(f"{detector}, {next(iter(params))} = {shown}: img1 {len(f1)} points, img{step} {len(f2)} points, "
-              f"repeatability {r.repeatability:.2f} ({r.correspondences} of min({r.n1}, {r.n2}))")
-        if draw:
+            return img1, img2, H, f1, f2
+
+        def table(out):
+            img1, img2, H, f1, f2 = out
+            r = repeatability(f1, f2, H, img1.shape, img2.shape)
+            shown = f"{10 ** value:.2g}" if _DETECTOR_KNOBS[detector][6] else f"{params[next(iter(params))]}"
+            return (f"{detector}, {next(iter(params))} = {shown}: img1 {len(f1)} points, img{step} {len(f2)} points, "
+                    f"repeatability {r.repeatability:.2f} ({r.correspondences} of min({r.n1}, {r.n2}))")
+
+        def plot(out):
+            img1, img2, _, f1, f2 = out
             plot_keypoint_pair(img1, f1, img2, f2, (f"{sequence} img1", f"{sequence} img{step}"))
+
+        show_run(run, plot if draw else None, table=table, errors=_ERRORS)
 
     return widgets.interactive(
         show,
@@ -116,24 +125,23 @@ def explore_matching(**defaults):
         return cache[key]
 
     def show(ratio, max_leaves, detector, sequence, step, draw):
-        try:
+        def run():
             img1, img2, H, f1, f2 = features(detector, sequence, step)
-            binary = f1.is_binary
-            method = "brute" if (max_leaves == 0 or binary) else "bbf"
+            method = "brute" if (max_leaves == 0 or f1.is_binary) else "bbf"
             dist, idx = knn2(f1.descriptors, f2.descriptors, method=method, max_leaves=max(int(max_leaves), 1))
-        except (ValueError, TypeError, FileNotFoundError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        keep = np.flatnonzero(accept_ratio(dist, ratio) & (idx[:, 0] >= 0))
-        m = Matches(keep, idx[keep, 0], dist[keep, 0], dist[keep, 1])
-        c = correct_matches(f1, f2, m, H)
-        r = repeatability(f1, f2, H, img1.shape, img2.shape)
-        note = " (binary: brute-force Hamming)" if binary and max_leaves else ""
-        print(f"{detector}, ratio {ratio:.2f}, {'exact' if method == 'brute' else f'BBF {max_leaves} leaves'}"
-              f"{note}: {len(m)} matches, precision {c.mean() if len(m) else float('nan'):.2f}, "
-              f"recall {c.sum() / max(r.correspondences, 1):.2f}")
-        if draw:
-            plot_matches(img1, img2, f1, f2, m, c)
+            keep = np.flatnonzero(accept_ratio(dist, ratio) & (idx[:, 0] >= 0))
+            m = Matches(keep, idx[keep, 0], dist[keep, 0], dist[keep, 1])
+            return method, H, (img1, img2, f1, f2, m, correct_matches(f1, f2, m, H))  # the last: plot_matches's
+
+        def table(out):
+            method, H, (img1, img2, f1, f2, m, c) = out
+            r = repeatability(f1, f2, H, img1.shape, img2.shape)
+            note = " (binary: brute-force Hamming)" if f1.is_binary and max_leaves else ""
+            return (f"{detector}, ratio {ratio:.2f}, {'exact' if method == 'brute' else f'BBF {max_leaves} leaves'}"
+                    f"{note}: {len(m)} matches, precision {c.mean() if len(m) else float('nan'):.2f}, "
+                    f"recall {c.sum() / max(r.correspondences, 1):.2f}")
+
+        show_run(run, (lambda out: plot_matches(*out[2])) if draw else None, table=table, errors=_ERRORS)
 
     return widgets.interactive(
         show,

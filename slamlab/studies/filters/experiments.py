@@ -5,8 +5,8 @@ Each ``run_*`` returns a frozen dataclass: ``str(result)`` is a one-line summary
 nbval compares); arrays for plotting are kept in fields.
 
 This module builds the simulated worlds and runs the experiments on them (constant-velocity target,
-sigma-point weight, unicycle filter comparison, stabilising noise); the result dataclasses and the Monte
-Carlo loop live in :mod:`~slamlab.studies.filters.results`, the sim-free studies in
+sigma-point weight, unicycle filter comparison, stabilising noise) in a seeded Monte Carlo loop; the result
+dataclasses live in :mod:`~slamlab.studies.filters.results`, the sim-free studies in
 :mod:`~slamlab.studies.filters.studies`, the closing table in :mod:`~slamlab.studies.filters.source_table`
 (all re-exported here).
 """
@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import _validate as v
+from ..._validate import as_vector, check_choice, check_int, check_positive
 from ...filters.consistency import chi2_interval, nees
 from ...filters.ekf import ExtendedKalmanFilter
-from ...filters.kalman import KalmanFilter, _predict, _update
+from ...filters.kalman import KalmanFilter, LinearisedKalmanFilter
 from ...filters.ukf import UnscentedKalmanFilter, sigma_weights, ukf_predict, ukf_update
 from ...sim import (
     RangeBearingSensor,
@@ -36,8 +36,6 @@ from .results import (
     SigmaAlphaResult,
     StabilisingNoiseResult,
     UnicycleResult,
-    _monte_carlo,
-    _nanmean,
 )
 from .source_table import ours_vs_source
 from .studies import default_landmarks, run_joseph_vs_short, run_landmark_filter
@@ -60,6 +58,15 @@ __all__ = [
     "run_stabilising_noise",
     "run_unicycle_comparison",
 ]
+
+
+def _monte_carlo(run, n_runs: int, rng, n_jobs: int, progress, **fixed):
+    """``n_runs`` seeded runs of ``run`` on :func:`slamlab.sweep.sweep` (run r draws from child r of ``rng``)."""
+    from ...sweep import root_seed_sequence, sweep
+
+    table = sweep(run, None, seeds=n_runs, rng=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress, fixed=fixed,
+                  on_error="raise", desc=f"Monte Carlo ({run.__name__.strip('_').replace('_', ' ')})")
+    return table
 
 
 def _cv_run(*, F, Q, H, R, P0, n_steps: int, rng: np.random.Generator) -> dict:
@@ -109,8 +116,8 @@ def run_cv_target(n_runs: int = 50, n_steps: int = 50, *, dt_s: float = 1.0, acc
     -------
     CVTargetResult
     """
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    n_steps = v.check_int(n_steps, "n_steps", minimum=1)
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
+    n_steps = check_int(n_steps, "n_steps", minimum=1)
     F, Q, H, R = constant_velocity_model(dt_s, accel_std, pos_std_m, dims=2)
     P0 = np.diag([pos_std_m**2, 1.0, pos_std_m**2, 1.0])
     runs = _monte_carlo(_cv_run, n_runs, rng, n_jobs, progress, F=F, Q=Q, H=H, R=R, P0=P0, n_steps=n_steps)
@@ -145,24 +152,24 @@ def run_sigma_alpha_study(alphas=(1e-5, 1e-4, 1e-3, 1e-2, 0.1, 1.0), n_steps: in
     -------
     SigmaAlphaResult
     """
-    alphas = v.as_vector(alphas, "alphas")
+    alphas = as_vector(alphas, "alphas")
     F, Q, H, R = constant_velocity_model(1.0, 0.5, 1.0, dims=1)
     _, Z = simulate_linear(F, Q, H, R, [100.0, 1.0], n_steps, rng=rng)
     w0, eP, ex = [], [], []
     for a in alphas:
         w0.append(sigma_weights(2, float(a))[0][0])
-        xk, Pk = np.array([100.0, 1.0]), 10 * np.eye(2)
-        xu, Pu = xk.copy(), Pk.copy()
+        kf = KalmanFilter(np.array([100.0, 1.0]), 10 * np.eye(2), F, Q, H, R)
+        xu, Pu = kf.x.copy(), kf.P.copy()
         worst_P = worst_x = 0.0
         try:
             for z in Z:
-                xk, Pk = _predict(xk, Pk, F, Q)
+                kf.predict()
                 xu, Pu = ukf_predict(xu, Pu, lambda x, u: x @ F.T, Q, form="additive", alpha=float(a),
                                      vectorized=True)
-                upk = _update(xk, Pk, z - H @ xk, H, R)
+                kf.update(z)
                 upu = ukf_update(xu, Pu, z, lambda x: x @ H.T, R, form="additive", alpha=float(a),
                                  vectorized=True)
-                xk, Pk, xu, Pu = upk.x, upk.P, upu.x, upu.P
+                xk, Pk, xu, Pu = kf.x, kf.P, upu.x, upu.P
                 worst_P = max(worst_P, np.max(np.abs(Pu - Pk)) / np.max(np.abs(Pk)))
                 worst_x = max(worst_x, np.max(np.abs(xu - xk)) / np.max(np.abs(xk)))
         except np.linalg.LinAlgError:
@@ -175,7 +182,11 @@ def run_sigma_alpha_study(alphas=(1e-5, 1e-4, 1e-3, 1e-2, 0.1, 1.0), n_steps: in
 def _make_filters(names, x0, P0, model, sensor, u0, alpha, beta, kappa, q_scale):
     filt = {}
     for name in names:
-        if name == "EKF":
+        if name == "LKF":  # the KF of a nonlinear robot: linear about the nominal (noise-free, commanded) path
+            filt[name] = LinearisedKalmanFilter(x0, P0, model.f, model.F_jac, q_scale * model.Q(x0, u0), sensor.h,
+                                                sensor.H_jac, sensor.R, residual=sensor.residual,
+                                                x_wrap=lambda x: model.residual(x, np.zeros(3)))
+        elif name == "EKF":
             filt[name] = ExtendedKalmanFilter(x0, P0, model.f, model.F_jac, q_scale * model.Q(x0, u0), sensor.h,
                                               sensor.H_jac, sensor.R, residual=sensor.residual)
         elif name == "UKF-aug":
@@ -193,30 +204,6 @@ def _make_filters(names, x0, P0, model, sensor, u0, alpha, beta, kappa, q_scale)
     return filt
 
 
-class _LinearisedKF:
-    """KF on the error about the nominal (noise-free, commanded) path: a *linear* filter for a nonlinear robot."""
-
-    def __init__(self, x0, P0, model, sensor, q_scale):
-        self.model, self.sensor, self.q_scale = model, sensor, q_scale
-        self.x_nom, self.dx, self.P = np.array(x0, float), np.zeros(3), np.array(P0, float)
-
-    @property
-    def x(self):
-        """Estimate = nominal + estimated deviation (heading wrapped)."""
-        return self.model.residual(self.x_nom + self.dx, np.zeros(3))
-
-    def predict(self, u):
-        F = self.model.F_jac(self.x_nom, u)
-        Q = self.q_scale * self.model.Q(self.x_nom, u)
-        self.dx, self.P = _predict(self.dx, self.P, F, Q)
-        self.x_nom = self.model.f(self.x_nom, u)
-
-    def update(self, z):
-        H = self.sensor.H_jac(self.x_nom)
-        y = self.sensor.residual(z, self.sensor.h(self.x_nom)) - H @ self.dx
-        self.dx, self.P, *_ = _update(self.dx, self.P, y, H, self.sensor.R)
-
-
 def _unicycle_run(*, filters, model, sensor, U, P0, alpha, beta, kappa, q_scale, rng) -> dict:
     """One Monte Carlo run of every filter on the same simulated unicycle path (see run_unicycle_comparison)."""
     n_steps, nf = U.shape[0], len(filters)
@@ -224,8 +211,6 @@ def _unicycle_run(*, filters, model, sensor, U, P0, alpha, beta, kappa, q_scale,
     X, Z = simulate_unicycle(model, sensor, x_true0, U, rng=rng)
     x0 = x_true0 + rng.multivariate_normal(np.zeros(3), P0)
     filt = _make_filters(filters, x0, P0, model, sensor, U[0], alpha, beta, kappa, q_scale)
-    if "LKF" in filters:
-        filt["LKF"] = _LinearisedKF(x0, P0, model, sensor, q_scale)
     est = np.full((nf, n_steps, 3), np.nan)
     cov = np.full((nf, n_steps, 3, 3), np.nan)
     err = np.full((nf, n_steps, 3), np.nan)
@@ -237,6 +222,8 @@ def _unicycle_run(*, filters, model, sensor, U, P0, alpha, beta, kappa, q_scale,
             for k in range(n_steps):
                 if name in ("EKF", "UKF-add"):
                     f.Q = q_scale * model.Q(f.x, U[k])
+                elif name == "LKF":  # Q on the nominal path, like the Jacobians
+                    f.Q = q_scale * model.Q(f.x_nominal, U[k])
                 f.predict(U[k])
                 f.update(Z[k])
                 est[i, k] = f.x
@@ -311,12 +298,12 @@ def run_unicycle_comparison(n_runs: int = 30, n_steps: int = 60, *, filters=FILT
     -------
     UnicycleResult
     """
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    n_steps = v.check_int(n_steps, "n_steps", minimum=1)
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
+    n_steps = check_int(n_steps, "n_steps", minimum=1)
     filters = tuple(filters)
     for name in filters:
-        v.check_choice(name, "filters", FILTER_NAMES)
-    q_scale = v.check_positive(stabilising_noise, "stabilising_noise")
+        check_choice(name, "filters", FILTER_NAMES)
+    q_scale = check_positive(stabilising_noise, "stabilising_noise")
     lm = default_landmarks() if landmarks_m is None else landmarks_m
     model = UnicycleModel(dt_s, v_std_mps, np.deg2rad(omega_std_degps))
     sensor = RangeBearingSensor(lm, range_std_m, np.deg2rad(bearing_std_deg))
@@ -369,13 +356,13 @@ def run_stabilising_noise(scales=(1.0, 2.0, 4.0, 8.0), n_runs: int = 30, n_steps
     -------
     StabilisingNoiseResult
     """
-    scales = v.as_vector(scales, "scales")
+    scales = as_vector(scales, "scales")
     rm, nn = [], []
     bounds = (0.0, 0.0)
     for s in scales:
         res = run_unicycle_comparison(n_runs, n_steps, filters=("EKF",), stabilising_noise=float(s), rng=rng,
                                       **scenario)
         rm.append(res.rmse_pos_m[0])
-        nn.append(_nanmean(res.anees[0]))
+        nn.append(res.mean_nees[0])
         bounds = res.nees_bounds
     return StabilisingNoiseResult(scales, np.array(rm), np.array(nn), bounds, n_runs)

@@ -1,6 +1,5 @@
-"""Ch. 1 experiment results (000 §1.2, §3.6): the printable result dataclasses with their tables, the filter names,
-the divergence threshold and the seeded Monte Carlo loop (no simulator here: the runs live in
-:mod:`~slamlab.studies.filters.experiments`)."""
+"""Ch. 1 experiment results (000 §1.2, §3.6): the printable result dataclasses with their tables, the filter names
+and the divergence threshold (no simulator here: the runs live in :mod:`~slamlab.studies.filters.experiments`)."""
 
 from __future__ import annotations
 
@@ -20,15 +19,6 @@ def _nanmean(a) -> float:
     a = np.asarray(a, dtype=float)
     ok = np.isfinite(a)
     return float(a[ok].mean()) if ok.any() else float("nan")
-
-
-def _monte_carlo(run, n_runs: int, rng, n_jobs: int, progress, **fixed):
-    """``n_runs`` seeded runs of ``run`` on :func:`slamlab.sweep.sweep` (run r draws from child r of ``rng``)."""
-    from ...sweep import root_seed_sequence, sweep
-
-    table = sweep(run, None, seeds=n_runs, rng=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress, fixed=fixed,
-                  on_error="raise", desc=f"Monte Carlo ({run.__name__.strip('_').replace('_', ' ')})")
-    return table
 
 
 @dataclass(frozen=True)
@@ -70,10 +60,20 @@ class CVTargetResult:
     example_meas: np.ndarray = field(default=None, repr=False)
     example_est: np.ndarray = field(default=None, repr=False)
 
+    @property
+    def mean_nees(self) -> float:
+        """The run-averaged NEES averaged over the steps (over the finite ones; consistent: 4)."""
+        return _nanmean(self.anees)
+
+    @property
+    def mean_nis(self) -> float:
+        """The run-averaged NIS averaged over the steps (over the finite ones; consistent: 2)."""
+        return _nanmean(self.anis)
+
     def __str__(self) -> str:
         return (f"CV target, {self.n_runs} runs x {self.n_steps} steps: KF position RMSE "
                 f"{self.rmse_pos_m:.3f} m vs raw measurements {self.rmse_meas_m:.3f} m; "
-                f"mean NEES {self.anees.mean():.2f} (dim 4), mean NIS {self.anis.mean():.2f} (dim 2)")
+                f"mean NEES {self.mean_nees:.2f} (dim 4), mean NIS {self.mean_nis:.2f} (dim 2)")
 
     def table(self) -> str:
         """Fixed-precision table: RMSEs, predicted std, mean NEES/NIS and the share of steps inside their bounds.
@@ -90,9 +90,9 @@ class CVTargetResult:
             ["position RMSE, KF [m]", f"{self.rmse_pos_m:.3f}"],
             ["position RMSE, raw measurement [m]", f"{self.rmse_meas_m:.3f}"],
             ["predicted position std, KF [m]", f"{self.predicted_pos_std_m:.3f}"],
-            ["mean NEES (expect 4)", f"{self.anees.mean():.2f}"],
+            ["mean NEES (expect 4)", f"{self.mean_nees:.2f}"],
             [f"steps with run-averaged NEES in [{lo:.2f}, {hi:.2f}]", f"{inside_nees:.0%}"],
-            ["mean NIS (expect 2)", f"{self.anis.mean():.2f}"],
+            ["mean NIS (expect 2)", f"{self.mean_nis:.2f}"],
             [f"steps with run-averaged NIS in [{nlo:.2f}, {nhi:.2f}]", f"{inside_nis:.0%}"],
         ]
         return format_table(["quantity", "value"], rows)
@@ -238,6 +238,13 @@ class UnicycleResult:
                 + ", ".join(f"{f} {r:.3f} m" for f, r in zip(self.filters, self.rmse_pos_m, strict=True)))
 
     @property
+    def mean_nees(self) -> np.ndarray:
+        """(n_filters,) run-averaged NEES averaged over the finite steps (consistent: 3).
+
+        NaN for a filter that failed in every run."""
+        return np.array([_nanmean(a) for a in self.anees])
+
+    @property
     def diverged(self) -> np.ndarray:
         """Runs per filter whose position RMSE exceeds ``DIVERGED_RMSE_M`` (failed runs not included)."""
         return np.sum(np.nan_to_num(self.run_rmse_pos_m, nan=0.0) > DIVERGED_RMSE_M, axis=1)
@@ -256,7 +263,7 @@ class UnicycleResult:
             ok = np.isfinite(self.run_rmse_pos_m[i])
             med = np.median(self.run_rmse_pos_m[i, ok]) if ok.any() else np.nan
             rows.append([name, f"{self.rmse_pos_m[i]:.3f}", f"{med:.3f}",
-                         f"{np.rad2deg(self.rmse_heading_rad[i]):.2f}", f"{_nanmean(a):.2f}",
+                         f"{np.rad2deg(self.rmse_heading_rad[i]):.2f}", f"{self.mean_nees[i]:.2f}",
                          f"{_nanmean(np.where(np.isfinite(a), (a >= lo) & (a <= hi), np.nan)):.0%}",
                          f"{int(self.diverged[i])}",
                          f"{int(self.failures[i])}"])

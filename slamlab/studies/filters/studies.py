@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import _validate as v
+from ..._validate import as_rng, as_vector, check_int, check_positive
 from ...filters.kalman import kf_update
 from .results import JosephResult, LandmarkDemoResult
 
@@ -30,9 +30,9 @@ def run_joseph_vs_short(gain_scales=(0.0, 0.5, 0.8, 1.0, 1.2, 1.5, 2.0), *, n_sa
     -------
     JosephResult
     """
-    g = v.as_rng(rng)
-    n_samples = v.check_int(n_samples, "n_samples", minimum=100)
-    scales = v.as_vector(gain_scales, "gain_scales")
+    g = as_rng(rng)
+    n_samples = check_int(n_samples, "n_samples", minimum=100)
+    scales = as_vector(gain_scales, "gain_scales")
     P = np.array([[4.0, 1.0], [1.0, 1.0]])
     H, R = np.array([[1.0, 0.0]]), np.array([[1.0]])
     x = np.zeros(2)
@@ -89,10 +89,10 @@ def run_landmark_filter(n_landmarks: int = 500, n_sightings: int = 20, *, obs_st
     """
     from ...filters.landmark import LandmarkFilter
 
-    g = v.as_rng(rng)
-    n_landmarks = v.check_int(n_landmarks, "n_landmarks", minimum=1)
-    n_sightings = v.check_int(n_sightings, "n_sightings", minimum=1)
-    obs_std_m = v.check_positive(obs_std_m, "obs_std_m")
+    g = as_rng(rng)
+    n_landmarks = check_int(n_landmarks, "n_landmarks", minimum=1)
+    n_sightings = check_int(n_sightings, "n_sightings", minimum=1)
+    obs_std_m = check_positive(obs_std_m, "obs_std_m")
     report = [int(r) for r in report if 1 <= r <= n_sightings]
     truth = g.uniform(-5.0, 5.0, size=(n_landmarks, 3))
     lf = LandmarkFilter(state_var=state_std_m**2, obs_var=obs_std_m**2, dim=3)

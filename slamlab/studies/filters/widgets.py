@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ipywidgets as widgets
 
+from ...widgets import show_run
 from ...widgets import slider as _slider
 from .experiments import run_cv_target, run_unicycle_comparison
 from .plot import cv_figure, unicycle_figure
@@ -36,16 +37,10 @@ def explore_unicycle(**defaults):
 
     def show(n_runs, range_std_m, bearing_std_deg, omega_std_degps, init_heading_std_deg, alpha, beta, kappa,
              stabilising_noise):
-        try:
-            res = run_unicycle_comparison(int(n_runs), d["n_steps"], range_std_m=range_std_m,
-                                          bearing_std_deg=bearing_std_deg, omega_std_degps=omega_std_degps,
-                                          init_heading_std_deg=init_heading_std_deg, alpha=alpha, beta=beta,
-                                          kappa=kappa, stabilising_noise=stabilising_noise, rng=d["rng"])
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(res.table())
-        unicycle_figure(res)
+        show_run(lambda: run_unicycle_comparison(
+            int(n_runs), d["n_steps"], range_std_m=range_std_m, bearing_std_deg=bearing_std_deg,
+            omega_std_degps=omega_std_degps, init_heading_std_deg=init_heading_std_deg, alpha=alpha, beta=beta,
+            kappa=kappa, stabilising_noise=stabilising_noise, rng=d["rng"]), unicycle_figure)
 
     return widgets.interactive(
         show,
@@ -80,13 +75,8 @@ def explore_cv_target(**defaults):
     d.update(defaults)
 
     def show(accel_std, pos_std_m):
-        try:
-            res = run_cv_target(d["n_runs"], d["n_steps"], accel_std=accel_std, pos_std_m=pos_std_m, rng=d["rng"])
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(res.table())
-        cv_figure(res)
+        show_run(lambda: run_cv_target(d["n_runs"], d["n_steps"], accel_std=accel_std, pos_std_m=pos_std_m,
+                                           rng=d["rng"]), cv_figure)
 
     return widgets.interactive(
         show,

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_rng, check_int
 from ...hough.lines import canonical_lines, find_peaks
 from ...hough.transform import (
     HoughAccumulator,
@@ -127,7 +127,7 @@ def run_example_line(rho: float = 10.0, theta_deg: float = 45.0, r_max: float = 
     ExampleLineResult
     """
     phi, r = line_scan(rho, math.radians(theta_deg), r_max=r_max, delta_phi_rad=math.radians(delta_phi_deg))
-    n_repeat = v.check_int(n_repeat, "n_repeat", minimum=1)
+    n_repeat = check_int(n_repeat, "n_repeat", minimum=1)
     polar = hough_polar(phi, r, r_max=r_max)
     img, c = rasterise_scan(phi, r, r_max=r_max)
     classic = hough_classic(img)
@@ -173,8 +173,8 @@ def check_pose_from_two_lines(n_cases: int = 1000, *, rng=2010) -> float:
     from ...hough.lines import align_lines, transform_lines
     from ...hough.pose import pose_from_two_lines
 
-    n_cases = v.check_int(n_cases, "n_cases", minimum=1)
-    g = v.as_rng(rng)
+    n_cases = check_int(n_cases, "n_cases", minimum=1)
+    g = as_rng(rng)
     worst = 0.0
     for _ in range(n_cases):  # a closed-form check per case, cheap
         pose = g.uniform([-2, -2, -0.5], [2, 2, 0.5])
@@ -215,14 +215,14 @@ def time_polar_vs_opencv(*, cell_m: float = 0.05, r_max_m: float = 30.0, room_ha
     """
     import cv2
 
-    phi = np.linspace(-0.75 * np.pi, 0.75 * np.pi, v.check_int(n_beams, "n_beams", minimum=2))
+    phi = np.linspace(-0.75 * np.pi, 0.75 * np.pi, check_int(n_beams, "n_beams", minimum=2))
     r = room_half_m / np.maximum(np.abs(np.cos(phi)), np.abs(np.sin(phi)))
     img, _ = rasterise_scan(phi, r, cell=cell_m, r_max=r_max_m)
 
     def median_s(fn):
         fn()
         t = []
-        for _ in range(v.check_int(repeats, "repeats", minimum=1)):
+        for _ in range(check_int(repeats, "repeats", minimum=1)):
             t0 = time.perf_counter()
             fn()
             t.append(time.perf_counter() - t0)

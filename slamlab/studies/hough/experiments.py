@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_finite_array, check_choice, check_int, check_positive
 from ...geometry import wrap_angle
 from ...hough.icp import icp_odometry
 from ...hough.mapping import map_agreement
@@ -60,8 +60,8 @@ def pose_errors(estimate, truth) -> np.ndarray:
     >>> pose_errors([[1.0, 2.0, 0.1]], [[0.5, 2.0, 2 * np.pi]]).round(6).tolist()
     [[0.5, 0.0, 0.1]]
     """
-    E = v.as_finite_array(estimate, "estimate", ndim=2)
-    T = v.as_finite_array(truth, "truth", ndim=2)
+    E = as_finite_array(estimate, "estimate", ndim=2)
+    T = as_finite_array(truth, "truth", ndim=2)
     if E.shape != T.shape or E.shape[1] != 3:
         raise ValueError(f"`estimate` and `truth` must both have shape (n, 3); got {E.shape} and {T.shape}")
     err = E - T
@@ -196,10 +196,10 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
     """
     from ... import sim
 
-    n_poses = v.check_int(n_poses, "n_poses", minimum=5)
-    sigma = v.check_positive(range_std_cells, "range_std_cells", allow_zero=True)
-    start = v.check_choice(start, "start", ("truth", "correlation"))
-    noise = v.check_positive(odometry_noise, "odometry_noise", allow_zero=True)
+    n_poses = check_int(n_poses, "n_poses", minimum=5)
+    sigma = check_positive(range_std_cells, "range_std_cells", allow_zero=True)
+    start = check_choice(start, "start", ("truth", "correlation"))
+    noise = check_positive(odometry_noise, "odometry_noise", allow_zero=True)
     from ...sweep import root_seed_sequence
 
     # a Generator spawns its own children; an int seed, a SeedSequence or None: SeedSequence(rng)'s
@@ -241,10 +241,10 @@ def run_sim_slam(n_poses: int = 121, *, range_std_cells: float = 0.1, clutter: b
 
 
 def _noise_run(*, range_std_cells: float, n_poses: int, clutter: bool, rng: np.random.Generator,
-               params: HoughSlamParams | None = None, overrides: dict | None = None) -> dict:
+               params: HoughSlamParams) -> dict:
     """One seeded Hough SLAM run of the noise study: its worst and final errors (cells, degrees)."""
     r = run_sim_slam(n_poses, range_std_cells=range_std_cells, clutter=clutter, with_icp=False, params=params,
-                     rng=rng, progress=False, **(overrides or {}))
+                     rng=rng, progress=False)
     e = r.errors["Hough SLAM"]
     pos = np.hypot(e[:, 0], e[:, 1])
     return {"max_pos_err": float(pos.max()), "final_pos_err": float(pos[-1]),
@@ -331,16 +331,16 @@ def run_noise_study(range_std_cells=(0.0, 0.1, 0.3, 0.5), n_runs: int = 4, *, n_
     """
     from ...sweep import root_seed_sequence, sweep
 
-    HoughSlamParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
-    sigmas = [v.check_positive(s, "range_std_cells", allow_zero=True) for s in np.atleast_1d(range_std_cells)]
+    p = HoughSlamParams.resolve(params, **overrides)
+    sigmas = [check_positive(s, "range_std_cells", allow_zero=True) for s in np.atleast_1d(range_std_cells)]
     if not sigmas:
         raise ValueError("`range_std_cells` must hold at least one noise level")
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    n_poses = v.check_int(n_poses, "n_poses", minimum=5)
-    bad = v.check_positive(bad_pos_cells, "bad_pos_cells")
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
+    n_poses = check_int(n_poses, "n_poses", minimum=5)
+    bad = check_positive(bad_pos_cells, "bad_pos_cells")
     table = sweep(_noise_run, {"range_std_cells": sigmas}, seeds=n_runs, rng=root_seed_sequence(rng, "rng"),
                   n_jobs=n_jobs, progress=progress,
-                  fixed={"n_poses": n_poses, "clutter": bool(clutter), "params": params, "overrides": dict(overrides)},
+                  fixed={"n_poses": n_poses, "clutter": bool(clutter), "params": p},
                   on_error="raise", desc="Hough SLAM noise study")
     return NoiseStudyResult(table, n_poses, bool(clutter), bad)
 

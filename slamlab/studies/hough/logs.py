@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_path, check_choice, check_int, check_positive
 from ...geometry import wrap_angle
 from ...geometry.se2 import se2_relative
 from ...hough.slam import HoughSlamParams, HoughSlamResult, hough_slam
@@ -208,7 +208,7 @@ def log_format(path) -> str:
     """
     from ...io import open_text  # plain text or gzip, told apart by the magic bytes
 
-    p = v.as_path(path, "path", kind="file")
+    p = as_path(path, "path", kind="file")
     with open_text(p) as fh:
         for line in fh:
             tok = line.split()
@@ -270,16 +270,16 @@ def run_real_log(path=None, *, fmt: str | None = None, n_scans: int | None = Non
         path = find_data(SHARED_LOGS["urg04lx"])
     elif isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"`path` must be a str or os.PathLike; got {type(path).__name__}")
-    fmt = log_format(path) if fmt is None else v.check_choice(fmt, "fmt", tuple(LOG_PARAMS))
-    step = v.check_int(step, "step", minimum=1)
-    cell_m = v.check_positive(cell_m, "cell_m")
+    fmt = log_format(path) if fmt is None else check_choice(fmt, "fmt", tuple(LOG_PARAMS))
+    step = check_int(step, "step", minimum=1)
+    cell_m = check_positive(cell_m, "cell_m")
     timing = {}
     t0 = time.perf_counter()
     scans, odo, max_range_m = _load_log(path, fmt)
     timing["read"] = time.perf_counter() - t0
     idx = np.arange(0, len(scans), step)
     if n_scans is not None:
-        idx = idx[: v.check_int(n_scans, "n_scans", minimum=2)]
+        idx = idx[: check_int(n_scans, "n_scans", minimum=2)]
     scans = [scans[k] for k in idx]
     odo = odo[idx]
     U = se2_relative(odo[:-1], odo[1:])

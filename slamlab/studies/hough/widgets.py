@@ -11,6 +11,7 @@ from ...hough.plot import accumulator_figure
 from ...hough.slam import detect_lines
 from ...hough.transform import hough_polar
 from ...widgets import STYLE as _STYLE
+from ...widgets import show_run
 from ...widgets import slider as _slider
 from .experiments import SHARED_LOGS, run_real_log, run_sim_slam
 from .plot import real_log_figure, sim_figure
@@ -44,7 +45,7 @@ def explore_accumulator(**defaults):
     path = sim.path_004()
 
     def show(pose_index, range_std_cells, clutter, delta_theta_deg, delta_rho, H_min):
-        try:
+        def run():
             world = sim.measurement_room_200() if clutter else sim.test_room_200()
             rf = sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=range_std_cells)
             s = rf.scan(world, path[int(pose_index)], rng=d["rng"])
@@ -53,12 +54,14 @@ def explore_accumulator(**defaults):
             peaks = find_peaks(acc, int(H_min), max_lines=12)
             lines = detect_lines(s, delta_rho=delta_rho, delta_theta_rad=math.radians(delta_theta_deg),
                                  H_min=int(H_min))
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(f"pose {int(pose_index)}: {phi.size} returns, accumulator {acc.size_theta_rho[0]}×"
-              f"{acc.size_theta_rho[1]} (θ×ρ), {len(peaks)} peaks, {len(lines)} lines after the refit")
-        accumulator_figure(acc, peaks, phi, r, lines)
+            return acc, peaks, phi, r, lines  # accumulator_figure's arguments
+
+        def table(out):
+            acc, peaks, phi, _, lines = out
+            return (f"pose {int(pose_index)}: {phi.size} returns, accumulator {acc.size_theta_rho[0]}×"
+                    f"{acc.size_theta_rho[1]} (θ×ρ), {len(peaks)} peaks, {len(lines)} lines after the refit")
+
+        show_run(run, lambda out: accumulator_figure(*out), table=table)
 
     return widgets.interactive(
         show,
@@ -89,15 +92,10 @@ def explore_hough_slam(**defaults):
     d.update(defaults)
 
     def show(n_poses, range_std_cells, clutter, delta_theta_deg, delta_rho, H_min, method, refine):
-        try:
-            res = run_sim_slam(int(n_poses), range_std_cells=range_std_cells, clutter=clutter, with_icp=True,
-                               rng=d["rng"], delta_theta_rad=math.radians(delta_theta_deg), delta_rho=delta_rho,
-                               H_min=int(H_min), method=method, refine=refine)
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(res.table())
-        sim_figure(res)
+        show_run(lambda: run_sim_slam(
+            int(n_poses), range_std_cells=range_std_cells, clutter=clutter, with_icp=True, rng=d["rng"],
+            delta_theta_rad=math.radians(delta_theta_deg), delta_rho=delta_rho, H_min=int(H_min), method=method,
+            refine=refine), sim_figure)
 
     return widgets.interactive(
         show,
@@ -130,16 +128,13 @@ def explore_real_log(**defaults):
     d.update(defaults)
 
     def show(name, n_scans, step, H_min, delta_rho_cm):
-        try:
+        def run():
             from ...data import find_data
 
-            res = run_real_log(find_data(SHARED_LOGS[name]), n_scans=int(n_scans), step=int(step), H_min=int(H_min),
-                               delta_rho=delta_rho_cm / 100.0)
-        except (ValueError, TypeError, FileNotFoundError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(res.table())
-        real_log_figure(res)
+            return run_real_log(find_data(SHARED_LOGS[name]), n_scans=int(n_scans), step=int(step), H_min=int(H_min),
+                                delta_rho=delta_rho_cm / 100.0)
+
+        show_run(run, real_log_figure, errors=(ValueError, TypeError, FileNotFoundError))  # the logs are files
 
     return widgets.interactive(
         show,

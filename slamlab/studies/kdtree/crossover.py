@@ -9,20 +9,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import as_rng, check_choice, check_int
+from ...kdtree.store_params import StoreParams
 from ...kdtree.stores import STORE_NAMES, BruteForceStore, make_store
 from .tree_studies import recall_at_1
 from .workloads import surf_like_descriptors
 
-__all__ = ["CrossoverResult", "run_crossover"]
+__all__ = ["STORE_LABELS", "CrossoverResult", "run_crossover"]
 
-_LABEL = {"rebuild": "kd-tree", "multi": "multi", "flann": "FLANN", "brute": "brute"}
+#: the stores' short labels in the chapter's tables (keys: :data:`~slamlab.kdtree.stores.STORE_NAMES`)
+STORE_LABELS = {"rebuild": "kd-tree", "multi": "multi", "flann": "FLANN", "brute": "brute"}
 
-
-def _store_kwargs(n1, q, checks, leaf_size):
-    return {"n1": n1, "q": q, "checks": checks, "leaf_size": leaf_size}
+#: the fields of :class:`~slamlab.kdtree.store_params.StoreParams` that :func:`run_crossover` sets itself
+_CROSSOVER_FIXED = ("base_seen_times", "max_non_base_time")
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,8 @@ class CrossoverResult:
         New points per iteration.
     add_s, search_s : dict
         Store → (S,) add and search seconds per iteration at each size (machine dependent).
+    params : StoreParams or None
+        The settings every store ran with.
     """
 
     sizes: np.ndarray
@@ -52,6 +55,7 @@ class CrossoverResult:
     n_new: int
     add_s: dict = field(repr=False, default_factory=dict)  # store -> (S,) mean add time at that size (volatile)
     search_s: dict = field(repr=False, default_factory=dict)
+    params: StoreParams | None = field(repr=False, default=None)
 
     def iteration_s(self, store: str) -> np.ndarray:
         """Seconds per iteration (add + search) of ``store`` at each size.
@@ -106,7 +110,7 @@ class CrossoverResult:
         str
             Fixed-precision text table.
         """
-        heads = ["stored points", *(f"recall {_LABEL[s]}" for s in self.stores)]
+        heads = ["stored points", *(f"recall {STORE_LABELS[s]}" for s in self.stores)]
         rows = [[f"{int(n)}", *(f"{self.recall[s][i]:.2f}" for s in self.stores)] for i, n in enumerate(self.sizes)]
         return format_table(heads, rows)
 
@@ -118,7 +122,7 @@ class CrossoverResult:
         str
             Text table and one line on the crossover.
         """
-        heads = ["stored points", *(f"{_LABEL[s]} ms" for s in self.stores)]
+        heads = ["stored points", *(f"{STORE_LABELS[s]} ms" for s in self.stores)]
         rows = [[f"{int(n)}", *(f"{1e3 * self.iteration_s(s)[i]:.0f}" for s in self.stores)]
                 for i, n in enumerate(self.sizes)]
         out = format_table(heads, rows)
@@ -130,8 +134,8 @@ class CrossoverResult:
 
 
 def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", "multi", "brute"),
-                  n_queries: int = 400, n_new: int = 500, n1: int = 3500, q: float = 5.5, checks: int = 200,
-                  leaf_size: int = 8, repeats: int = 3, rng=2010, progress: bool | None = None) -> CrossoverResult:
+                  n_queries: int = 400, n_new: int = 500, repeats: int = 3, rng=2010, progress: bool | None = None,
+                  params: StoreParams | None = None, **overrides) -> CrossoverResult:
     """Mean iteration time (``n_queries`` searches + ``n_new`` inserts) vs stored points (000 §4.3).
 
     Rebuild, FLANN and brute-force stores have no history: each is filled with
@@ -141,6 +145,11 @@ def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", 
     ``n/2`` and ``n`` (the amortised cost of 000's Tables). Timed repeats give
     their median (the machine is shared; one untimed warm-up query runs first). ``progress``: a
     bar over the stores (None: on unless ``$SLAMLAB_PROGRESS=0``).
+
+    The stores run with ``StoreParams.resolve(params, **overrides)`` except the base rule, which the
+    study sets itself: the points are added without re-sightings, so every point is base at once
+    (``base_seen_times = 1``); ``base_seen_times`` or ``max_non_base_time`` set to anything but their
+    default is a ``ValueError``.
 
     Parameters
     ----------
@@ -152,40 +161,45 @@ def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", 
         Queries per iteration (90 % noisy re-observations, 10 % clutter).
     n_new : int
         Points added per iteration.
-    n1, q : int, float
-        Multi kd-tree sizes.
-    checks : int
-        BBF leaf budget.
-    leaf_size : int
-        Points per leaf of our trees.
     repeats : int
         Timed iterations per size (their median is kept).
     rng : numpy.random.Generator, int or None
         Randomness of the descriptors and queries.
     progress : bool, callable or None
         Progress bar over the stores.
+    params : StoreParams, optional
+        The stores' settings (default :class:`~slamlab.kdtree.store_params.StoreParams`: ``n1 = 3500``,
+        ``q = 5.5``, BBF with 200 checks, leaves of 8).
+    **overrides
+        :class:`~slamlab.kdtree.store_params.StoreParams` fields to change (``n1``, ``q``, ``tree``,
+        ``leaf_size``, ``checks``).
 
     Returns
     -------
     CrossoverResult
-        ``recall`` (stable) and ``add_s``/``search_s`` (timings) per store and size.
+        ``recall`` (stable) and ``add_s``/``search_s`` (timings) per store and size, and the settings.
     """
     sizes = np.asarray(sizes)
     if sizes.ndim != 1 or sizes.size == 0 or np.any(sizes < 1) or np.any(np.diff(sizes) <= 0):
         raise ValueError(f"`sizes` must be increasing positive integers; got {sizes.tolist()}")
     sizes = sizes.astype(np.int64)
     for s in stores:
-        v.check_choice(s, "stores", STORE_NAMES)
-    n_queries = v.check_int(n_queries, "n_queries", minimum=1)
-    n_new = v.check_int(n_new, "n_new", minimum=1)
-    repeats = v.check_int(repeats, "repeats", minimum=1)
-    rng = v.as_rng(rng)
+        check_choice(s, "stores", STORE_NAMES)
+    n_queries = check_int(n_queries, "n_queries", minimum=1)
+    n_new = check_int(n_new, "n_new", minimum=1)
+    repeats = check_int(repeats, "repeats", minimum=1)
+    p = StoreParams.resolve(params, **overrides)
+    for name in _CROSSOVER_FIXED:
+        if getattr(p, name) != getattr(StoreParams(), name):
+            raise ValueError(f"`{name}` is set by run_crossover itself: it adds points without re-sightings, so "
+                             f"every point is base at once (base_seen_times = 1); got {name}={getattr(p, name)!r}")
+    p = p.replace(base_seen_times=1)  # every point base at once
+    rng = as_rng(rng)
     total = int(sizes[-1]) + n_new * (repeats + 1)
     X, protos = surf_like_descriptors(total, rng=rng)
     ids = np.arange(total, dtype=np.int64)
     # queries: noisy re-observations of stored points (the first n) plus 10 % clutter
     noise = 0.08 / 8.0
-    kw = _store_kwargs(n1, q, checks, leaf_size)
     recall, add_s, search_s = {}, {}, {}
     qsets = []
     for n in sizes:
@@ -196,14 +210,14 @@ def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", 
         ref = BruteForceStore()
         ref.add(X[:n], ids[:n])
         qsets.append((Q, ref.query(Q)[0]))
-    warm = make_store("multi", **kw)
+    warm = make_store("multi", params=p)
     warm.add(X[:n_new], ids[:n_new])
     warm.end_iteration()
     warm.query(qsets[0][0])
     for s in progress_bar(stores, desc="crossover: stores", progress=progress):
         rec, a_s, s_s = np.zeros(sizes.size), np.zeros(sizes.size), np.zeros(sizes.size)
         if s == "multi":
-            store = make_store("multi", **kw)
+            store = make_store("multi", params=p)
             fill_t, fill_n, pos = [], [], 0
             for i, n in enumerate(sizes):
                 while pos < n:
@@ -225,7 +239,7 @@ def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", 
                 s_s[i], rec[i] = np.median(ts), recall_at_1(d, e)
         else:
             for i, n in enumerate(sizes):
-                store = make_store(s, **kw)
+                store = make_store(s, params=p)
                 store.add(X[:n], ids[:n])
                 store.end_iteration()
                 Q, e = qsets[i]
@@ -244,4 +258,4 @@ def run_crossover(sizes=(1000, 2000, 5000, 10000, 20000), *, stores=("rebuild", 
                         rec[i] = recall_at_1(d, e)
                 a_s[i], s_s[i] = np.median(ta), np.median(ts)
         recall[s], add_s[s], search_s[s] = rec, a_s, s_s
-    return CrossoverResult(sizes, tuple(stores), recall, n_queries, n_new, add_s, search_s)
+    return CrossoverResult(sizes, tuple(stores), recall, n_queries, n_new, add_s, search_s, p)

@@ -14,14 +14,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import check_choice, check_int
 from ...kdtree.cost_model import calibrate_C
+from ...kdtree.store_params import StoreParams
 from ...kdtree.stores import STORE_NAMES, FlannStore, make_store
-from .crossover import _LABEL, CrossoverResult, _store_kwargs, run_crossover
+from .crossover import STORE_LABELS, CrossoverResult, run_crossover
 from .tree_studies import CFitResult, DimensionStudyResult, fit_C, recall_at_1, run_dimension_study
-from .workloads import Scenario, Workload, make_workload
+from .workloads import SCENARIO_FIELDS, Scenario, Workload, make_workload
 
 __all__ = [
     "TABLES_000",
@@ -67,8 +68,8 @@ class StoreComparisonResult:
     ops : dict
         Store → per-iteration operation counts (``rebuilt_mean``, ``rebuilt_max``, ``evals_mean``,
         ``evals_max``, ``trees_mean``).
-    n1, q, checks : int, float, int
-        Multi kd-tree sizes and BBF budget used.
+    params : StoreParams
+        The settings every store ran with (the base rule is the scenario's).
     add_s, search_s : dict
         Store → (T,) add and search seconds per iteration (machine dependent).
     """
@@ -80,14 +81,27 @@ class StoreComparisonResult:
     queries_per_iteration: float
     recall: dict  # store -> recall@1 over all queries
     ops: dict  # store -> dict of per-iteration operation counts (mean/max rebuilt points, evals per query, trees)
-    n1: int
-    q: float
-    checks: int
+    params: StoreParams
     add_s: dict = field(repr=False, default_factory=dict)  # store -> (T,) seconds (volatile)
     search_s: dict = field(repr=False, default_factory=dict)
 
+    @property
+    def n1(self) -> int:
+        """The multi kd-tree's ``n1`` the stores ran with."""
+        return int(self.params.n1)
+
+    @property
+    def q(self) -> float:
+        """The multi kd-tree's ``q`` the stores ran with."""
+        return float(self.params.q)
+
+    @property
+    def checks(self) -> int:
+        """The BBF budget (and FLANN's checks) the stores ran with."""
+        return int(self.params.checks)
+
     def __str__(self) -> str:
-        r = ", ".join(f"{_LABEL[s]} {self.recall[s]:.3f}" for s in self.stores)
+        r = ", ".join(f"{STORE_LABELS[s]} {self.recall[s]:.3f}" for s in self.stores)
         return (f"{self.scenario}: {self.n_iterations} iterations, {self.stored_end} points at the end, "
                 f"recall@1 {r}")
 
@@ -99,7 +113,7 @@ class StoreComparisonResult:
         str
             Fixed-precision text table.
         """
-        heads = ["per iteration", *(_LABEL[s] for s in self.stores)]
+        heads = ["per iteration", *(STORE_LABELS[s] for s in self.stores)]
         rows = []
         for key, label, fmt in (("rebuilt_mean", "mean points rebuilt (add)", "{:.0f}"),
                                 ("rebuilt_max", "max points rebuilt (add)", "{:.0f}"),
@@ -144,7 +158,7 @@ class StoreComparisonResult:
         str
         """
         ref = TABLES_000.get(self.scenario) if with_000 else None
-        heads = ["ms", *(f"000 {k}" for k in (ref or {})), *(f"ours {_LABEL[s]}" for s in self.stores)]
+        heads = ["ms", *(f"000 {k}" for k in (ref or {})), *(f"ours {STORE_LABELS[s]}" for s in self.stores)]
         ours = {s: self.times_ms(s) for s in self.stores}
         rows = []
         for r, name in enumerate(_ROWS):
@@ -153,16 +167,16 @@ class StoreComparisonResult:
         out = format_table(heads, rows)
         if "rebuild" in self.stores:
             base = ours["rebuild"][4]
-            ratios = ", ".join(f"{_LABEL[s]} {base / ours[s][4]:.1f}x" for s in self.stores if s != "rebuild")
+            ratios = ", ".join(f"{STORE_LABELS[s]} {base / ours[s][4]:.1f}x" for s in self.stores if s != "rebuild")
             out += f"\nmean iteration speed-up over the rebuilt kd-tree: {ratios}"
             if ref:
                 out += f" (000: multi {ref['kd-tree'][4] / ref['multi kd-tree'][4]:.1f}x)"
         return out
 
 
-def _exact_stream(iterations, base_seen_times, max_non_base_time):
+def _exact_stream(iterations, params):
     """Exact first-neighbour distances of every iteration's queries over the points stored then."""
-    ref = make_store("brute", base_seen_times=base_seen_times, max_non_base_time=max_non_base_time)
+    ref = make_store("brute", params=params)
     out = []
     for it in iterations:
         out.append(ref.query(it.queries)[0])
@@ -208,17 +222,24 @@ def _counters(store):
     return c.as_dict()
 
 
-def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flann", "brute"), n1: int = 3500,
-                         q: float = 5.5, checks: int = 200, leaf_size: int = 8, n_iterations: int | None = None,
-                         rng=2010, progress: bool | None = None, **scenario_changes) -> StoreComparisonResult:
+#: the fields of :class:`~slamlab.kdtree.store_params.StoreParams` that the scenario sets (its base rule)
+_SCENARIO_RULE = ("base_seen_times", "max_non_base_time")
+
+
+def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flann", "brute"),
+                         params: StoreParams | None = None, n_iterations: int | None = None, rng=2010,
+                         progress: bool | None = None, **changes) -> StoreComparisonResult:
     """Run 000's Table 1 (``"table1"``) or Table 2 (``"table2"``) workload through every store (000 §4.2).
 
     ``scenario`` may also be a recorded :class:`~slamlab.studies.kdtree.workloads.Workload`
     (:class:`~slamlab.studies.kdtree.workloads.RecordingStore`), replayed as recorded.
 
-    ``n_iterations`` shortens the run (the notebook's small size). The base rule
-    of the scenario is applied by every store (:func:`~slamlab.kdtree.stores.make_store`).
-    ``progress``: a bar over the stores (None: on unless ``$SLAMLAB_PROGRESS=0``).
+    ``n_iterations`` shortens the run (the notebook's small size). The stores run with
+    ``StoreParams.resolve(params, **store_changes)`` and the base rule of the scenario (Table 1: 3 sightings
+    within 7 iterations; Table 2: every point base at once), applied by every store
+    (:func:`~slamlab.kdtree.stores.make_store`): the base rule is changed as a scenario field
+    (``base_seen_times=``, ``max_non_base_time=``); in ``params`` anything but the defaults is a
+    ``ValueError``. ``progress``: a bar over the stores (None: on unless ``$SLAMLAB_PROGRESS=0``).
 
     Parameters
     ----------
@@ -226,52 +247,62 @@ def run_store_comparison(scenario="table2", *, stores=("rebuild", "multi", "flan
         "table1", "table2" or a recorded :class:`~slamlab.studies.kdtree.workloads.Workload`.
     stores : sequence of str
         Stores to run (:data:`~slamlab.kdtree.stores.STORE_NAMES`).
-    n1 : int
-        Maximum size of the multi kd-tree's first tree.
-    q : float
-        Size ratio of the multi kd-tree.
-    checks : int
-        BBF leaf budget (and FLANN's checks).
-    leaf_size : int
-        Points per leaf of our trees.
+    params : StoreParams, optional
+        The stores' settings (default :class:`~slamlab.kdtree.store_params.StoreParams`: ``n1 = 3500``,
+        ``q = 5.5``, BBF with 200 checks, leaves of 8).
     n_iterations : int, optional
         Shorten the generated stream to this many iterations.
     rng : numpy.random.Generator, int or None
         Randomness of the generated stream.
     progress : bool, callable or None
         Progress bar over the stores.
-    **scenario_changes
-        :class:`~slamlab.studies.kdtree.workloads.Scenario` fields to replace.
+    **changes
+        :class:`~slamlab.kdtree.store_params.StoreParams` fields (``n1``, ``q``, ``tree``, ``leaf_size``,
+        ``checks``) and :class:`~slamlab.studies.kdtree.workloads.Scenario` fields (the base rule among them)
+        to change.
 
     Returns
     -------
     StoreComparisonResult
-        ``recall`` and ``ops`` per store (stable), ``add_s``/``search_s`` (timings).
+        ``recall`` and ``ops`` per store (stable), ``add_s``/``search_s`` (timings), the settings.
     """
     stores = tuple(stores)
     if not stores:
         raise ValueError("`stores` must name at least one store")
     for s in stores:
-        v.check_choice(s, "stores", STORE_NAMES)
+        check_choice(s, "stores", STORE_NAMES)
+    store_fields = set(StoreParams.field_names()) - set(_SCENARIO_RULE)
+    unknown = sorted(set(changes) - store_fields - set(SCENARIO_FIELDS))
+    if unknown:
+        raise TypeError(f"run_store_comparison got unknown keyword(s) {', '.join(map(repr, unknown))}; the changes "
+                        f"are StoreParams fields ({', '.join(sorted(store_fields))}) or Scenario fields "
+                        f"({', '.join(SCENARIO_FIELDS)})")
+    store_changes = {k: changes.pop(k) for k in list(changes) if k in store_fields}
+    if params is not None:
+        StoreParams.resolve(params)  # a `params` of the wrong type fails here, naming it
+        for name in _SCENARIO_RULE:
+            if getattr(params, name) != getattr(StoreParams(), name):
+                raise ValueError(f"`{name}` is the scenario's (its base rule): change it as a scenario field, "
+                                 f"run_store_comparison(..., {name}=...), not in `params`; got "
+                                 f"params.{name}={getattr(params, name)!r}")
     if isinstance(scenario, Workload):  # a recorded stream (e.g. RecordingStore.workload() of a stereo run)
-        if n_iterations is not None or scenario_changes:
+        if n_iterations is not None or changes:
             raise ValueError("a recorded Workload is replayed as it is: no `n_iterations` or scenario changes")
         w = scenario
     else:
         if n_iterations is not None:
-            scenario_changes["n_iterations"] = v.check_int(n_iterations, "n_iterations", minimum=1)
-        w = make_workload(scenario, rng=rng, **scenario_changes)
+            changes["n_iterations"] = check_int(n_iterations, "n_iterations", minimum=1)
+        w = make_workload(scenario, rng=rng, **changes)
     sc: Scenario = w.scenario
-    kw = _store_kwargs(n1, q, checks, leaf_size)
+    p = StoreParams.resolve(params, **store_changes, base_seen_times=sc.base_seen_times,
+                            max_non_base_time=sc.max_non_base_time)
     recall, ops, add_s, search_s = {}, {}, {}, {}
-    exact = _exact_stream(w.iterations, sc.base_seen_times, sc.max_non_base_time)
+    exact = _exact_stream(w.iterations, p)
     for s in progress_bar(stores, desc=f"{sc.name}: stores", progress=progress):
-        store = make_store(s, base_seen_times=sc.base_seen_times, max_non_base_time=sc.max_non_base_time, **kw)
-        a, se, o, r = _run_stream(store, w.iterations, exact)
+        a, se, o, r = _run_stream(make_store(s, params=p), w.iterations, exact)
         add_s[s], search_s[s], ops[s], recall[s] = a, se, o, r
     qpi = float(np.mean([it.queries.shape[0] for it in w.iterations]))
-    return StoreComparisonResult(sc.name, stores, len(w), int(w.stored[-1]), qpi, recall, ops, int(n1), float(q),
-                                 int(checks), add_s, search_s)
+    return StoreComparisonResult(sc.name, stores, len(w), int(w.stored[-1]), qpi, recall, ops, p, add_s, search_s)
 
 
 def ours_vs_source(cost, dimension: DimensionStudyResult, table1: StoreComparisonResult,

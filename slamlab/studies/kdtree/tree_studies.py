@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_rng, check_int
 from ...kdtree.cost_model import calibrate_C, minimise_iter_time
 from ...kdtree.tree import KDTree
 from .workloads import surf_like_descriptors
@@ -112,10 +112,10 @@ def fit_C(*, n: int = 44828, s: int = 526, m: int = 678, checks: int = 200, leaf
     CFitResult
         ``C`` and the optimum ``n1``, ``q``.
     """
-    n = v.check_int(n, "n", minimum=2)
-    s = v.check_int(s, "s", minimum=1)
-    m = v.check_int(m, "m", minimum=1)
-    rng = v.as_rng(rng)
+    n = check_int(n, "n", minimum=2)
+    s = check_int(s, "s", minimum=1)
+    m = check_int(m, "m", minimum=1)
+    rng = as_rng(rng)
     X, _protos = surf_like_descriptors(n + m, rng=rng)
     Q = X[rng.integers(0, n, s)] + 0.01 * rng.standard_normal((s, X.shape[1])).astype(np.float32)
     tree = KDTree(X[:n], leaf_size=leaf_size)
@@ -197,12 +197,12 @@ def run_dimension_study(dims=(2, 8, 16, 64), *, n: int = 5000, n_queries: int = 
     -------
     DimensionStudyResult
     """
-    n = v.check_int(n, "n", minimum=10)
-    n_queries = v.check_int(n_queries, "n_queries", minimum=1)
-    checks = v.check_int(checks, "checks", minimum=1)
-    leaf_size = v.check_int(leaf_size, "leaf_size", minimum=1)
-    dims = [v.check_int(d, "dims", minimum=1) for d in dims]
-    rng = v.as_rng(rng)
+    n = check_int(n, "n", minimum=10)
+    n_queries = check_int(n_queries, "n_queries", minimum=1)
+    checks = check_int(checks, "checks", minimum=1)
+    leaf_size = check_int(leaf_size, "leaf_size", minimum=1)
+    dims = [check_int(d, "dims", minimum=1) for d in dims]
+    rng = as_rng(rng)
     cases = []
     for d in dims:
         X = rng.standard_normal((n + n_queries, d))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import ipywidgets as widgets
 
 from ...kdtree.cost_model import iter_time, run_cost_model
+from ...widgets import show_run
 from ...widgets import slider as _slider
 from .experiments import run_store_comparison
 from .store_plot import plot_cost_contour, plot_iteration_times
@@ -33,18 +34,21 @@ def explore_cost_model(**defaults):
     d.update(defaults)
 
     def show(n1, q, s, m, n, C):
-        try:
-            res = run_cost_model(n=n, s=s, m=m, C=C)
-            here = float(iter_time(n1, q, n=n, s=s, m=m, C=C))
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        _, bn1, bq, best, _ = res.optimum
-        print(f"iterTime at n1 = {n1:.0f}, q = {q:.2f}: {here:.3g} steps, {here / best:.3f} x the optimum "
-              f"(n1 = {bn1:.0f}, q = {bq:.2f})")
-        ax = plot_cost_contour(res)
-        ax.plot(n1, q, "s", color="orange", markersize=8, label="sliders")
-        ax.legend(loc="upper right", facecolor="0.85")
+        def run():
+            return run_cost_model(n=n, s=s, m=m, C=C), float(iter_time(n1, q, n=n, s=s, m=m, C=C))
+
+        def table(out):
+            res, here = out
+            _, bn1, bq, best, _ = res.optimum
+            return (f"iterTime at n1 = {n1:.0f}, q = {q:.2f}: {here:.3g} steps, {here / best:.3f} x the optimum "
+                    f"(n1 = {bn1:.0f}, q = {bq:.2f})")
+
+        def draw(out):
+            ax = plot_cost_contour(out[0])
+            ax.plot(n1, q, "s", color="orange", markersize=8, label="sliders")
+            ax.legend(loc="upper right", facecolor="0.85")
+
+        show_run(run, draw, table=table)
 
     return widgets.interactive(
         show,
@@ -78,16 +82,10 @@ def explore_stores(**defaults):
 
     def show(n1, q, s, m, n_iterations, checks):
         n_old = int(0.9 * s)
-        try:
-            res = run_store_comparison("table2", stores=("rebuild", "multi"), n1=int(n1), q=q, checks=int(checks),
-                                       n_iterations=int(n_iterations), n_new=int(m), p_track=0.0, n_old=n_old,
-                                       n_clutter=int(s) - n_old, rng=d["rng"])
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(res.table())
-        print(res.timed_table())
-        plot_iteration_times(res)
+        show_run(lambda: run_store_comparison(
+            "table2", stores=("rebuild", "multi"), n1=int(n1), q=q, checks=int(checks), n_iterations=int(n_iterations),
+            n_new=int(m), p_track=0.0, n_old=n_old, n_clutter=int(s) - n_old, rng=d["rng"]),
+            plot_iteration_times, table=lambda res: f"{res.table()}\n{res.timed_table()}")
 
     return widgets.interactive(
         show,

@@ -23,14 +23,16 @@ the case where Best-Bin-First recall collapses.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from ... import _validate as v
+from ..._validate import as_rng, check_choice, check_int
+from ...kdtree.store_params import StoreParams, resolve_store_params
 from ...kdtree.stores import LandmarkStore, SightingBook
 
-__all__ = ["SCENARIOS", "Iteration", "Scenario", "Workload", "make_workload", "scenario", "surf_like_descriptors"]
+__all__ = ["SCENARIOS", "SCENARIO_FIELDS", "Iteration", "Scenario", "Workload", "make_workload", "scenario",
+           "surf_like_descriptors"]
 
 DIM = 64
 
@@ -54,9 +56,9 @@ class Scenario:
     n_clutter : int
         Queries of features that are not stored landmarks, per iteration.
     base_seen_times : int
-        000's BaseSeenTimes (3 in Table 1; 1 = all base at once).
+        000's BaseSeenTimes (3 in Table 1; 1 = all base at once): given by each scenario.
     max_non_base_time : int
-        000's MaxNonBaseTime in iterations.
+        000's MaxNonBaseTime in iterations (default :class:`~slamlab.kdtree.store_params.StoreParams`' 7).
     n_clusters : int
         Texture prototypes the descriptors are drawn around.
     sigma_cluster : float
@@ -74,14 +76,18 @@ class Scenario:
     n_old: int  # queries re-observing older base landmarks per iteration
     n_clutter: int  # queries of features that are not stored landmarks
     base_seen_times: int  # 000: BaseSeenTimes (3 in Table 1; 1 = all base at once)
-    max_non_base_time: int = 7  # 000: MaxNonBaseTime
+    max_non_base_time: int = StoreParams().max_non_base_time  # 000: MaxNonBaseTime (its one default)
     n_clusters: int = 256
     sigma_cluster: float = 0.35  # spread of landmarks around their prototype (before normalising)
     sigma_obs: float = 0.08  # descriptor noise of a re-observation (before normalising)
     clustered: bool = True
 
 
-#: 000's two runs. Table 1: ~13000 stored points at the end; Table 2: ~65000.
+#: the fields of :class:`Scenario` (the changes :func:`make_workload` takes)
+SCENARIO_FIELDS = tuple(f.name for f in fields(Scenario))
+
+#: 000's two runs. Table 1: ~13000 stored points at the end, points base after 3 sightings within 7 iterations;
+#: Table 2: ~65000, every point base at once (000 §4.2).
 SCENARIOS = {
     "table1": Scenario("table1", n_iterations=150, n_new=300, p_track=0.5, n_old=60, n_clutter=40,
                        base_seen_times=3),
@@ -109,7 +115,7 @@ def scenario(name: str = "table2", **changes) -> Scenario:
     >>> scenario("table1", n_iterations=5).n_iterations
     5
     """
-    v.check_choice(name, "name", SCENARIOS)
+    check_choice(name, "name", SCENARIOS)
     try:
         return replace(SCENARIOS[name], **changes)
     except TypeError as e:
@@ -155,12 +161,12 @@ def surf_like_descriptors(n: int, *, n_clusters: int = 256, sigma_cluster: float
     >>> X.shape, X.dtype.name, bool(np.allclose(np.linalg.norm(X, axis=1), 1, atol=1e-5))
     ((5, 64), 'float32', True)
     """
-    n = v.check_int(n, "n", minimum=0)
-    rng = v.as_rng(rng)
+    n = check_int(n, "n", minimum=0)
+    rng = as_rng(rng)
     if not clustered:
         return _normalise(rng.standard_normal((n, DIM))).astype(np.float32), None
     if prototypes is None:
-        n_clusters = v.check_int(n_clusters, "n_clusters", minimum=1)
+        n_clusters = check_int(n_clusters, "n_clusters", minimum=1)
         g = rng.standard_normal((n_clusters, 16, 2)) * rng.gamma(2.0, 0.5, (n_clusters, 16, 1))
         absg = np.abs(g) + np.abs(rng.standard_normal((n_clusters, 16, 2))) * 0.5
         prototypes = _normalise(np.concatenate([g, absg], axis=2).reshape(n_clusters, DIM))
@@ -267,15 +273,14 @@ def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload
     else:
         raise TypeError(f"`name_or_scenario` must be a scenario name or a Scenario; got "
                         f"{type(name_or_scenario).__name__}")
-    v.check_int(sc.n_iterations, "n_iterations", minimum=1)
-    v.check_int(sc.n_new, "n_new", minimum=1)
-    v.check_int(sc.n_old, "n_old", minimum=0)
-    v.check_int(sc.n_clutter, "n_clutter", minimum=0)
-    v.check_int(sc.base_seen_times, "base_seen_times", minimum=1)
-    v.check_int(sc.max_non_base_time, "max_non_base_time", minimum=1)
+    check_int(sc.n_iterations, "n_iterations", minimum=1)
+    check_int(sc.n_new, "n_new", minimum=1)
+    check_int(sc.n_old, "n_old", minimum=0)
+    check_int(sc.n_clutter, "n_clutter", minimum=0)
+    StoreParams(base_seen_times=sc.base_seen_times, max_non_base_time=sc.max_non_base_time)  # checks the rule
     if not 0 <= sc.p_track < 1:
         raise ValueError(f"`p_track` must be in [0, 1); got {sc.p_track}")
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     total = sc.n_iterations * sc.n_new
     desc, protos = surf_like_descriptors(total, n_clusters=sc.n_clusters, sigma_cluster=sc.sigma_cluster,
                                          clustered=sc.clustered, rng=rng)
@@ -415,7 +420,7 @@ class RecordingStore(LandmarkStore):
         return self.store.query(Q, k)
 
     def _stored(self):
-        return self.store._stored()
+        return self.store.stored()
 
     def end_iteration(self) -> None:
         self.store.end_iteration()
@@ -426,21 +431,27 @@ class RecordingStore(LandmarkStore):
         self.iterations.append(Iteration(Q, np.full(len(Q), -1, np.int64), X, ids, obs))
         self._q, self._obs, self._X, self._ids = [], [], [], []
 
-    def workload(self, name: str = "recorded", *, base_seen_times: int = 3, max_non_base_time: int = 7) -> Workload:
+    def workload(self, name: str = "recorded", *, params: StoreParams | None = None,
+                 base_seen_times: int | None = None, max_non_base_time: int | None = None) -> Workload:
         """The recording as a :class:`Workload` (points stored per iteration counted by the base rule).
 
         Parameters
         ----------
         name : str
             Name of the workload's scenario.
-        base_seen_times, max_non_base_time : int
-            The base rule used to count the stored points (000: 3 and 7).
+        params : StoreParams, optional
+            Settings whose base rule counts the stored points (default
+            :class:`~slamlab.kdtree.store_params.StoreParams`: 000's 3 and 7).
+        base_seen_times, max_non_base_time : int, optional
+            Change the base rule of ``params`` (the recorded store's rule, to count what it kept).
 
         Returns
         -------
         Workload
             The recorded iterations (empty ones dropped).
         """
+        p = resolve_store_params(params, base_seen_times=base_seen_times, max_non_base_time=max_non_base_time)
+        base_seen_times, max_non_base_time = p.base_seen_times, p.max_non_base_time
         its = tuple(it for it in self.iterations if it.queries.size or it.new_X.size)
         if not its:
             raise ValueError("nothing was recorded: run the SLAM loop with this store first")

@@ -19,11 +19,19 @@ from .logs import (
     LogMCLResult,
     carmen_path,
     global_log_settings,
+    log_map,
+    log_params,
     log_settings,
     logs_table,
     run_log_mcl,
 )
-from .markov_study import MARKOV_PRIORS, MarkovStudyResult, run_markov_kidnap, run_markov_prior
+from .markov_study import (
+    MARKOV_PRIORS,
+    MARKOV_STUDY_PARAMS,
+    MarkovStudyResult,
+    run_markov_kidnap,
+    run_markov_prior,
+)
 from .side_by_side import SideBySideResult, run_correlation_side_by_side
 from .studies import (
     ABLATION,
@@ -53,6 +61,7 @@ __all__ = [
     "CHAPTER_BEFORE",
     "KIDNAP_VARIANTS",
     "MARKOV_PRIORS",
+    "MARKOV_STUDY_PARAMS",
     "SCORE_VARIANTS",
     "AblationResult",
     "FilterRun",
@@ -69,6 +78,8 @@ __all__ = [
     "carmen_path",
     "demo_run",
     "global_log_settings",
+    "log_map",
+    "log_params",
     "log_settings",
     "logs_table",
     "ours_vs_source",

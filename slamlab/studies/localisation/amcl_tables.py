@@ -125,6 +125,6 @@ def ours_vs_source(global_result=None, kidnap=None, ablation=None) -> str:
     if ablation is not None and "defaults" in ablation.labels:
         s = ablation.summary()
         k = f"success@{ablation.n_steps}"
-        rows.append(["cause of issue 12's figures", "—", (f"{s[k].iloc[0]:.2f} before → {s.loc['defaults', k]:.2f} "
+        rows.append(["cause of the first set-up's figures", "—", (f"{s[k].iloc[0]:.2f} before → {s.loc['defaults', k]:.2f} "
                                                          f"with the defaults ({ablation.n_particles} particles)")])
     return format_table(["item", "003", "ours"], rows, title="Ours vs the source (003 §1.2.4, §2.2)")

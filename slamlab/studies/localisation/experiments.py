@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_rng, check_choice, check_int
 from ...geometry import se2_integrate, se2_relative, wrap_angle
-from ...localisation.markov import MarkovGrid
+from ...localisation.markov import MarkovGrid, MarkovParams
 from ...localisation.mcl import MCL, MCLParams
 from ...localisation.particles import FAIL_DEG, FAIL_POS_CELLS, uniform_free_particles
 from ...scans import Scan, cast_rays
@@ -118,23 +118,23 @@ def simulate_run(n_steps: int = 40, start: int | None = None, *, kidnap_step: in
     -------
     SimRun
     """
-    v.check_choice(world, "world", ("map", "cluttered"))
-    rng = v.as_rng(rng)
-    n = v.check_int(n_steps, "n_steps", minimum=2)
+    check_choice(world, "world", ("map", "cluttered"))
+    rng = as_rng(rng)
+    n = check_int(n_steps, "n_steps", minimum=2)
     P = path_004(121)
     n_path = P.shape[0]
     if n > n_path:
         raise ValueError(f"`n_steps` must be <= {n_path} (004's path); got {n}")
-    s0 = int(rng.integers(0, n_path - n + 1)) if start is None else v.check_int(start, "start", minimum=0,
+    s0 = int(rng.integers(0, n_path - n + 1)) if start is None else check_int(start, "start", minimum=0,
                                                                                  maximum=n_path - n)
     idx = np.arange(s0, s0 + n)
     if kidnap_step is not None:
-        k = v.check_int(kidnap_step, "kidnap_step", minimum=1, maximum=n - 1)
+        k = check_int(kidnap_step, "kidnap_step", minimum=1, maximum=n - 1)
         rest = n - k
         if kidnap_to is None:
             far = [j for j in range(n_path - rest + 1) if abs(j - idx[k]) >= 40]
             kidnap_to = int(far[int(rng.integers(0, len(far)))])
-        j0 = v.check_int(kidnap_to, "kidnap_to", minimum=0, maximum=n_path - rest)
+        j0 = check_int(kidnap_to, "kidnap_to", minimum=0, maximum=n_path - rest)
         idx = np.concatenate([idx[:k], np.arange(j0, j0 + rest)])
     true = P[idx]
     inc = se2_relative(true[:-1], true[1:])
@@ -209,7 +209,7 @@ class FilterRun:
         return k if k < ok.size else None
 
 
-def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params=None, rng=None,
+def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params: MCLParams | MarkovParams | None = None, rng=None,
                keep_particles: bool = False, **overrides) -> FilterRun:
     """Run MCL (``method="mcl"``) or the Markov grid (``"markov"``) along ``run`` from no prior
     (``init="global"``) or from the true start (``"tracking"``, MCL only).
@@ -235,9 +235,9 @@ def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params
     -------
     FilterRun
     """
-    v.check_choice(method, "method", ("mcl", "markov"))
-    v.check_choice(init, "init", ("global", "tracking"))
-    rng = v.as_rng(rng)
+    check_choice(method, "method", ("mcl", "markov"))
+    check_choice(init, "init", ("global", "tracking"))
+    rng = as_rng(rng)
     t0 = time.perf_counter()
     est = np.empty((run.n_steps, 3))
     if method == "mcl":
@@ -264,14 +264,17 @@ def run_filter(run: SimRun, *, method: str = "mcl", init: str = "global", params
 # --- Markov grid vs MCL -------------------------------------------------------------------------------
 
 
-def _compare_task(method: str, size: int, n_headings: int, rng, n_steps: int, overrides: dict):
+def _compare_task(method: str, rng, n_steps: int, params: MCLParams, variant: str = "", n_particles: int = 0,
+                  resolution: int = 0, n_headings: int = 0):
+    """One run of :func:`run_markov_vs_mcl`: a Markov grid (``resolution``, ``n_headings``) or MCL (``params`` with
+    ``n_particles``) on the run that ``rng`` simulates."""
     run = simulate_run(n_steps, rng=rng)
     if method == "markov":
-        r = run_filter(run, method="markov", resolution=size, n_headings=n_headings)
+        r = run_filter(run, method="markov", resolution=resolution, n_headings=n_headings)
         mem = r.records[0]
     else:
-        r = run_filter(run, rng=rng, **{**overrides, "n_particles": size})
-        mem = size * 4 * 8  # particles (x, y, θ) and weights, float64
+        r = run_filter(run, rng=rng, params=params.replace(n_particles=n_particles))
+        mem = n_particles * 4 * 8  # particles (x, y, θ) and weights, float64
     return {"start_x": float(run.true_poses[0, 0]), "start_y": float(run.true_poses[0, 1]),
             "success": bool(r.ok[-1]), "final_err_cells": float(r.err_pos[-1]),
             "final_err_deg": float(np.degrees(r.err_heading_rad[-1])), "memory_bytes": int(mem),
@@ -285,7 +288,8 @@ class MarkovVsMclResult:
     Parameters
     ----------
     table_df : pandas.DataFrame
-        One row per (method, size, run).
+        One row per (variant, run): ``method``, ``variant`` (the label), the grid's ``resolution`` and
+        ``n_headings`` or MCL's ``n_particles``, the run's results.
     n_runs, n_steps : int
         Runs per method, steps per run.
     """
@@ -295,22 +299,18 @@ class MarkovVsMclResult:
     n_steps: int = 0
 
     def _groups(self):
-        return self.table_df.groupby(["method", "size", "n_headings"], sort=False)
-
-    @staticmethod
-    def _label(method, size, nh):
-        return f"Markov, {size}-cell grid, {nh} headings" if method == "markov" else f"MCL, {size} particles"
+        return self.table_df.groupby("variant", sort=False)
 
     def table(self) -> str:
-        rows = [[self._label(*key), f"{g['success'].mean():.2f}", f"{g['final_err_cells'].median():.2f}",
+        rows = [[label, f"{g['success'].mean():.2f}", f"{g['final_err_cells'].median():.2f}",
                  f"{g['final_err_deg'].median():.1f}", f"{g['memory_bytes'].iloc[0] / 2**20:.2f}"]
-                for key, g in self._groups()]
+                for label, g in self._groups()]
         return format_table(["method", "success", "median err [cells]", "median err [°]", "memory [MiB]"], rows,
                             title=f"Markov grid vs MCL: the same {self.n_runs} runs of {self.n_steps} steps, "
                                   "global start")
 
     def timing_table(self) -> str:
-        rows = [[self._label(*key), f"{1e3 * g['time_per_step_s'].median():.1f}"] for key, g in self._groups()]
+        rows = [[label, f"{1e3 * g['time_per_step_s'].median():.1f}"] for label, g in self._groups()]
         return format_table(["method", "median ms per step"], rows, title="Time per step (wall clock)")
 
     def __str__(self) -> str:
@@ -323,16 +323,20 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
     """Markov grids (belief cell size in map cells, headings) and MCL (particle counts) on the same seeded
     runs (every method's run ``i`` uses the same stream, so the same path, scans and odometry).
 
+    The study varies the particle count itself (one MCL run per count of ``particle_counts``): ``params`` and the
+    overrides must leave ``n_particles`` at its default (a ``ValueError`` names it otherwise).
+
     Parameters
     ----------
     markov : sequence of (int, int)
-        Markov grids: (belief cell size in map cells, number of headings).
+        Markov grids: (belief cell size in map cells, number of headings), each with the other
+        :class:`~slamlab.localisation.markov.MarkovParams` at their defaults.
     particle_counts : sequence of int
-        MCL particle counts (each replaces ``params.n_particles``).
+        MCL particle counts, one variant each (the study's own axis: not ``params.n_particles``).
     n_runs, n_steps : int
         Runs per method and steps per run.
     params : MCLParams, optional
-        Settings of the MCL runs (default: the defaults); the Markov grids keep theirs.
+        Settings of the MCL runs (default: the defaults), but for ``n_particles``.
     rng : int, SeedSequence or Generator
         Where every run's stream is spawned from (run ``i`` the same for every method).
     n_jobs : int
@@ -348,50 +352,51 @@ def run_markov_vs_mcl(markov=((4, 36), (2, 72)), particle_counts=(1000, 4000), *
     """
     import pandas as pd
 
+    from ..._params import refuse_set_fields
     from ...sweep import fresh_seed_sequence, sweep
 
-    ov = MCLParams.as_overrides(params, **overrides)
-    pts = [{"method": "markov", "size": int(s), "n_headings": int(h)} for s, h in markov]
-    pts += [{"method": "mcl", "size": int(n), "n_headings": 0} for n in particle_counts]
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
+    p = MCLParams.resolve(params, **overrides)
+    refuse_set_fields(p, ["n_particles"], "one MCL run per count of `particle_counts`")
+    pts = [{"method": "markov", "variant": f"Markov, {int(s)}-cell grid, {int(h)} headings", "resolution": int(s),
+            "n_headings": int(h)} for s, h in markov]
+    pts += [{"method": "mcl", "variant": f"MCL, {int(n_particles)} particles",
+             "n_particles": check_int(n_particles, "particle_counts[]", minimum=1)} for n_particles in particle_counts]
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
     # one stream per run index, shared by all methods: one sweep per method from a fresh copy of the same
     # SeedSequence (spawn() is stateful: the same object would give each sweep the next children)
-    frames = [sweep(_compare_task, [p], seeds=n_runs, rng=fresh_seed_sequence(rng), n_jobs=n_jobs,
-                    progress=progress, fixed={"n_steps": n_steps, "overrides": ov}, on_error="raise",
-                    desc="Markov grid vs MCL") for p in pts]
+    frames = [sweep(_compare_task, [pt], seeds=n_runs, rng=fresh_seed_sequence(rng), n_jobs=n_jobs,
+                    progress=progress, fixed={"n_steps": n_steps, "params": p}, on_error="raise",
+                    desc="Markov grid vs MCL") for pt in pts]
     df = pd.concat(frames, ignore_index=True)
     return MarkovVsMclResult(df, n_runs, n_steps)
 
 
-def demo_run(n_particles: int = 2000, *, kidnap_step: int | None = 25, n_steps: int = 60,
-             params: MCLParams | None = None, rng=7, **overrides):
-    """One recorded global run (with an optional kidnap) for the plots and the time slider.
+def demo_run(*, kidnap_step: int | None = 25, n_steps: int = 60, params: MCLParams | None = None, rng=7,
+             **overrides):
+    """One recorded global run (with an optional kidnap) for the plots and the time slider (003 §2.2).
 
     Parameters
     ----------
-    n_particles : int
-        MCL particles (replaces ``params.n_particles``).
     kidnap_step : int or None
         Step at which the robot is carried elsewhere (None: no kidnap).
     n_steps : int
         Steps of the run.
     params : MCLParams, optional
-        Settings of MCL (default: the defaults).
+        Settings of MCL (default: the defaults, 2000 particles).
     rng : int, SeedSequence or Generator
         The one stream of the simulated run and then of the filter.
     **overrides
-        :class:`MCLParams` fields.
+        :class:`MCLParams` fields (e.g. ``n_particles=5000``).
 
     Returns
     -------
     (SimRun, FilterRun)
         The simulated run and the recorded filter run.
     """
-
-    rng = v.as_rng(rng)
+    p = MCLParams.resolve(params, **overrides)
+    rng = as_rng(rng)
     run = simulate_run(n_steps, start=0, kidnap_step=kidnap_step, rng=rng)
-    return run, run_filter(run, n_particles=n_particles, rng=rng, keep_particles=True,
-                           **MCLParams.as_overrides(params, **overrides))
+    return run, run_filter(run, params=p, rng=rng, keep_particles=True)
 
 
 __all__ += ["demo_run", "uniform_free_particles"]

@@ -17,13 +17,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import check_int
 from ...geometry import wrap_angle
 from ...geometry.odometry import simulate_odometry
 from ...localisation.mcl import MCL, MCLParams
 from ...localisation.particles import FAIL_DEG, FAIL_POS_CELLS
-from .logs import CARMEN_LOGS, REAL_DEG, REAL_POS_M, _log_map, _resolve, global_log_settings, log_settings
+from ._tables import fmt
+from .logs import CARMEN_LOGS, REAL_DEG, REAL_POS_M, carmen_path, log_map, log_params
 
 __all__ = ["LogProtocolResult", "run_log_protocol"]
 
@@ -40,8 +41,9 @@ def _final_errors(est_m, true_m):
     return e, h
 
 
-def _run_stretch(G, frame, scans_c, idx, odo, rng, n_particles: int, kw: dict) -> np.ndarray:
-    f = MCL(G, kw.pop("z_max"), rng=rng, n_particles=n_particles, **kw)
+def _run_stretch(G, frame, scans_c, idx, odo, rng, params: MCLParams, z_max: float, **init) -> np.ndarray:
+    """MCL with ``params`` over the scans ``idx`` (``init``: the tracking start, else global); poses in metres."""
+    f = MCL(G, z_max, params=params, rng=rng, **init)
     out = np.empty((idx.size, 3))
     for k, i in enumerate(idx):
         prev, now = (odo[k - 1], odo[k]) if k else (None, None)
@@ -50,9 +52,11 @@ def _run_stretch(G, frame, scans_c, idx, odo, rng, n_particles: int, kw: dict) -
 
 
 def _protocol_task(log: str, run: int, n_particles: int, n_runs: int, n_scans: int, cell_m: float,
-                   max_range_m: float, odo_trans_frac: float, odo_rot_std_deg: float, seed: int, overrides: dict,
-                   track_particles: int):
-    lg, G, frame, scans_c, Pc = _log_map(log, cell_m, max_range_m)
+                   max_range_m: float, odo_trans_frac: float, odo_rot_std_deg: float, seed: int, params: MCLParams,
+                   track_particles: int, track_params: MCLParams):
+    """One stretch of ``log``: a global run with ``params`` and ``n_particles`` (and the tracking ceiling with
+    ``track_particles`` when > 0)."""
+    lg, G, frame, scans_c, Pc = log_map(log, cell_m, max_range_m)
     if lg.n_scans < n_scans:
         raise ValueError(f"`n_scans` must be <= the {lg.n_scans} scans of log {lg.name!r}; got {n_scans}")
     s0 = round(run * (lg.n_scans - n_scans) / max(1, n_runs - 1)) if n_runs > 1 else 0
@@ -61,10 +65,10 @@ def _protocol_task(log: str, run: int, n_particles: int, n_runs: int, n_scans: i
     odo = simulate_odometry(Pc[idx], trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
                             rng=_stream(seed, log, s0, 0)).poses
     true = lg.poses[idx]
-    base = {**log_settings(cell_m), "z_max": max_range_m / cell_m}
+    z_max = max_range_m / cell_m
     t0 = time.perf_counter()
-    est = _run_stretch(G, frame, scans_c, idx, odo, _stream(seed, log, s0, 1, n_particles), n_particles,
-                       {**base, **global_log_settings(cell_m), **overrides})
+    est = _run_stretch(G, frame, scans_c, idx, odo, _stream(seed, log, s0, 1, n_particles),
+                       params.replace(n_particles=n_particles), z_max)
     dt = time.perf_counter() - t0
     e, h = _final_errors(est, true)
     ok = (e < FAIL_POS_CELLS * cell_m) & (h < FAIL_DEG)
@@ -77,9 +81,9 @@ def _protocol_task(log: str, run: int, n_particles: int, n_runs: int, n_scans: i
            "final_err_m": float(e[-1]), "final_err_deg": float(h[-1]), "time_per_step_s": dt / n_scans,
            "track_success": float("nan"), "track_within_tracking_bound": float("nan")}
     if track_particles:
-        tr = _run_stretch(G, frame, scans_c, idx, odo, _stream(seed, log, s0, 2), track_particles,
-                          {**base, "init_pose": Pc[idx[0]], "init_std": (0.1 / cell_m, 0.1 / cell_m,
-                                                                         float(np.radians(2)))})
+        tr = _run_stretch(G, frame, scans_c, idx, odo, _stream(seed, log, s0, 2),
+                          track_params.replace(n_particles=track_particles), z_max,
+                          init_pose=Pc[idx[0]], init_std=(0.1 / cell_m, 0.1 / cell_m, float(np.radians(2))))
         te, th = _final_errors(tr, true)
         row["track_success"] = float(te[-1] < FAIL_POS_CELLS * cell_m and th[-1] < FAIL_DEG)
         row["track_within_tracking_bound"] = float(te[-1] < REAL_POS_M and th[-1] < REAL_DEG)
@@ -106,8 +110,8 @@ class LogProtocolResult:
         ``track_within_tracking_bound`` (the same run within 0.2 m and 2°).
     n_runs, n_scans : int
         Stretches per log, scans per stretch.
-    overrides : dict
-        The MCLParams fields given on top of the log settings.
+    params : MCLParams
+        The settings of the global runs (their ``n_particles`` replaced by each count).
     cell_m : float
         The map's cell size [m].
     track_particles : int
@@ -117,7 +121,7 @@ class LogProtocolResult:
     table_df: object = field(repr=False)
     n_runs: int = 0
     n_scans: int = 0
-    overrides: dict = field(default_factory=dict)
+    params: MCLParams = field(default_factory=MCLParams)
     cell_m: float = 0.1
     track_particles: int = 0
 
@@ -183,16 +187,16 @@ class LogProtocolResult:
 
     def table(self) -> str:
         s = self.summary()
-        rows = [[name, int(n), f"{r.success:.2f}", f"{r.within_tracking_bound:.2f}", _fmt2(r.track_success),
-                 _fmt2(r.track_within), "-" if np.isnan(r.median_converged_step) else f"{r.median_converged_step:.0f}",
-                 _fmt3(r.median_err_after_m)] for (name, n), r in s.iterrows()]
+        rows = [[name, int(n), f"{r.success:.2f}", f"{r.within_tracking_bound:.2f}", fmt(r.track_success),
+                 fmt(r.track_within), fmt(r.median_converged_step, 0), fmt(r.median_err_after_m, 3)]
+                for (name, n), r in s.iterrows()]
         top = self.table_df["n_particles"].max()
         for n in sorted(self.table_df["n_particles"].unique()):  # the ceiling is run once, with the largest count
-            track = [_fmt2(self.track_success()), _fmt2(self.track_success("track_within_tracking_bound"))] \
+            track = [fmt(self.track_success()), fmt(self.track_success("track_within_tracking_bound"))] \
                 if n == top else ["-", "-"]
             rows.append(["all logs", int(n), f"{self.success(n):.2f}", f"{self.within_tracking_bound(n):.2f}",
                          *track, "", ""])
-        p = {**log_settings(self.cell_m), **global_log_settings(self.cell_m), **self.overrides}
+        p = self.params
         track = (f"; tracking: {self.track_particles} particles from the corrected start pose, same odometry"
                  if self.track_particles else "")
         return format_table(
@@ -203,26 +207,18 @@ class LogProtocolResult:
                   f"({FAIL_POS_CELLS * self.cell_m:g} m) and {FAIL_DEG:g}° of the corrected pose at the last scan (the "
                   f"simulated study's criterion); converged: success from that step to the end{track}\n"
                   f"settings: {self.cell_m:g} m cells, odometry noise 10 % + 1°/step, σ_hit "
-                  f"{p['sigma_hit'] * self.cell_m:g} m, (z_hit, z_rand) = ({p['z_hit']:g}, {p['z_rand']:g}), α2 "
-                  f"{p['alpha'][1] / self.cell_m**2:g} rad²/m², (α_slow, α_fast) = ({p['alpha_slow']:g}, "
-                  f"{p['alpha_fast']:g}), averages {p['averages']}")
+                  f"{p.sigma_hit * self.cell_m:g} m, (z_hit, z_rand) = ({p.z_hit:g}, {p.z_rand:g}), α2 "
+                  f"{p.alpha[1] / self.cell_m**2:g} rad²/m², (α_slow, α_fast) = ({p.alpha_slow:g}, "
+                  f"{p.alpha_fast:g}), averages {p.averages}")
 
     def __str__(self) -> str:
         return f"Real-log protocol: success {self.success():.2f} ({self.n_runs} runs per log)"
 
 
-def _fmt2(x) -> str:
-    return "-" if x is None or np.isnan(x) else f"{x:.2f}"
-
-
-def _fmt3(x) -> str:
-    return "-" if x is None or np.isnan(x) else f"{x:.3f}"
-
-
 def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs: int = 10, n_scans: int = 30,
                      odo_trans_frac: float = 0.1, odo_rot_std_deg: float = 1.0, track_particles: int = 3000,
-                     params: MCLParams | None = None, rng=0, n_jobs: int = 1, progress=None,
-                     **overrides) -> LogProtocolResult:
+                     params: MCLParams | None = None, track_params: MCLParams | None = None, rng=0,
+                     n_jobs: int = 1, progress=None, **overrides) -> LogProtocolResult:
     """Global localisation from no prior on ``n_runs`` stretches of ``n_scans`` scans of every log, spread evenly
     over the log, for every particle count (the same stretches and odometry noise for every count), beside
     tracking from the corrected start pose (the ceiling); on :func:`slamlab.sweep.sweep`. Settings as the global
@@ -230,24 +226,28 @@ def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs:
 
     Every stretch's odometry noise and filter stream are keyed by (seed, the log's file name, the stretch's first
     scan, the particle count): a stretch gives the same run whichever logs, stretches and counts share the call.
+    The study varies the particle count itself: ``params`` and the overrides must leave ``n_particles`` at its
+    default (a ``ValueError`` names it otherwise).
 
     Parameters
     ----------
     logs : str, os.PathLike or a sequence of them
         Names of :data:`~slamlab.studies.localisation.logs.CARMEN_LOGS` or paths of any CARMEN log.
     particle_counts : sequence of int
-        Particle counts (each replaces ``params.n_particles``).
+        Particle counts of the global runs, one variant each (the study's own axis: not ``params.n_particles``).
     n_runs, n_scans : int
         Stretches per log, scans per stretch.
     odo_trans_frac, odo_rot_std_deg : float
         The odometry noise we add: share of each step's length, degrees per step.
     track_particles : int
-        Particles of the tracking run from the corrected start pose (σ 0.1 m, 2°) with the tracking settings
-        (:func:`~slamlab.studies.localisation.logs.log_settings`); 0: no tracking run.
+        Particles of the tracking run from the corrected start pose (σ 0.1 m, 2°) with ``track_params``;
+        0: no tracking run.
     params : MCLParams, optional
-        Settings on top of :func:`~slamlab.studies.localisation.logs.log_settings` and
-        :func:`~slamlab.studies.localisation.logs.global_log_settings` (only the fields that differ from the
-        :class:`MCLParams` defaults count); the global runs only.
+        Settings of the global runs, lengths in 0.1 m cells (default:
+        :func:`log_params(0.1, "global") <slamlab.studies.localisation.logs.log_params>`), but for ``n_particles``.
+    track_params : MCLParams, optional
+        Settings of the tracking runs (default: ``log_params(0.1, "track")``), but for ``n_particles``
+        (``track_particles``); the overrides do not apply to them.
     rng : int, SeedSequence or Generator
         The seed of every stream (a SeedSequence or Generator gives it as its first generated word).
     n_jobs : int
@@ -263,25 +263,29 @@ def run_log_protocol(logs=CARMEN_LOGS, particle_counts=(5000, 20000), *, n_runs:
     """
     import numbers
 
+    from ..._params import refuse_set_fields
     from ...sweep import root_seed_sequence, sweep
 
+    cell_m = 0.1
     root = root_seed_sequence(rng, "rng")
     key = int(rng) if isinstance(rng, numbers.Integral) else int(root.generate_state(1, np.uint64)[0])
-    overrides = MCLParams.as_overrides(params, **overrides)
-    overrides.pop("n_particles", None)  # each count of `particle_counts` replaces it
+    p = MCLParams.resolve(log_params(cell_m, "global") if params is None else params, **overrides)
+    refuse_set_fields(p, ["n_particles"], "one variant per count of `particle_counts`")
+    tp = MCLParams.resolve(log_params(cell_m, "track") if track_params is None else track_params)
+    refuse_set_fields(tp, ["n_particles"], "the tracking runs use `track_particles`")
     if isinstance(logs, (str, bytes)) or not hasattr(logs, "__iter__"):
         logs = [logs]
-    paths = [_resolve(p) for p in logs]
-    counts = [v.check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    n_scans = v.check_int(n_scans, "n_scans", minimum=2)
-    track_particles = v.check_int(track_particles, "track_particles", minimum=0)
+    paths = [str(carmen_path(path)) for path in logs]
+    counts = [check_int(c, "particle_counts[]", minimum=1) for c in particle_counts]
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
+    n_scans = check_int(n_scans, "n_scans", minimum=2)
+    track_particles = check_int(track_particles, "track_particles", minimum=0)
     # the tracking run (the ceiling) once per stretch: with the largest count's row
-    pts = [{"log": p, "run": r, "n_particles": c, "track_particles": track_particles if c == max(counts) else 0}
-           for p in paths for c in counts for r in range(n_runs)]
+    pts = [{"log": path, "run": r, "n_particles": c, "track_particles": track_particles if c == max(counts) else 0}
+           for path in paths for c in counts for r in range(n_runs)]
     df = sweep(_sweep_task, pts, seeds=1, rng=root, n_jobs=n_jobs, progress=progress,
                on_error="raise", desc="MCL log protocol",
-               fixed={"n_runs": n_runs, "n_scans": n_scans, "cell_m": 0.1, "max_range_m": 10.0,
+               fixed={"n_runs": n_runs, "n_scans": n_scans, "cell_m": cell_m, "max_range_m": 10.0,
                       "odo_trans_frac": odo_trans_frac, "odo_rot_std_deg": odo_rot_std_deg, "seed": key,
-                      "overrides": dict(overrides)})
-    return LogProtocolResult(df, n_runs, n_scans, dict(overrides), 0.1, track_particles)
+                      "params": p, "track_params": tp})
+    return LogProtocolResult(df, n_runs, n_scans, p, cell_m, track_particles)

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_path, as_rng, check_choice, check_int, check_positive
 from ...geometry import wrap_angle
 from ...geometry.odometry import simulate_odometry
 from ...localisation.mcl import MCL, MCLParams
@@ -76,35 +76,42 @@ def global_log_settings(cell_m: float) -> dict:
             "alpha_slow": 0.05, "alpha_fast": 0.5, "averages": "debiased"}
 
 
+def log_params(cell_m: float, run: str = "track") -> MCLParams:
+    """The MCL settings of a run on a real log (ours): :func:`log_settings` for tracking, and
+    :func:`global_log_settings` on top of them for a global run.
+
+    Parameters
+    ----------
+    cell_m : float
+        The map's cell size [m].
+    run : {"track", "global"}
+        Which run.
+
+    Returns
+    -------
+    MCLParams
+        The settings (the default particle count).
+    """
+    fields = log_settings(cell_m)
+    if check_choice(run, "run", ("track", "global")) == "global":
+        fields.update(global_log_settings(cell_m))
+    return MCLParams(**fields)
+
+
 #: The global runs' MCLParams overrides before issue 27's real-log ablation, at 0.1 m cells (on top of
 #: :func:`log_settings` and :func:`global_log_settings`): success 0.68 against 0.74 now (10 stretches of 30 scans
 #: per log, 20 000 particles, ``rng=0``).
 GLOBAL_BEFORE = {"z_hit": 0.9, "z_rand": 0.1, "alpha": (0.05, 0.002, 0.05, 0.005), "averages": "003"}
 
 
-def _resolve(path) -> str:
-    """A log name of :data:`CARMEN_LOGS` or a path → the path of an existing file, as a str (a cache key)."""
-    if isinstance(path, str) and path in CARMEN_LOGS:
-        path = carmen_path(path)
-    return str(v.as_path(path, "path", kind="file"))
-
-
-@functools.lru_cache(maxsize=6)
-def _log_map(path: str, cell_m: float, max_range_m: float):
-    """The log read and its map built once per (path, cell size, range): ``(log, grid, frame, scans, poses)``."""
-    from ...io import read_carmen
-
-    log = read_carmen(path)
-    return (log, *log_grid(log, cell_m=cell_m, max_range_m=max_range_m))
-
-
-def carmen_path(name: str):
-    """Path of ``<name>-corrected.log.gz`` in the shared data (via :func:`slamlab.data.find_data`).
+def carmen_path(path):
+    """Path of a CARMEN log: ``<path>-corrected.log.gz`` in the shared data for a name of :data:`CARMEN_LOGS`
+    (via :func:`slamlab.data.find_data`), else ``path`` itself, which must be an existing file (ours).
 
     Parameters
     ----------
-    name : str
-        One of :data:`CARMEN_LOGS`.
+    path : str or os.PathLike
+        One of :data:`CARMEN_LOGS`, or the path of any CARMEN log.
 
     Returns
     -------
@@ -112,8 +119,47 @@ def carmen_path(name: str):
     """
     from ...data import find_data
 
-    v.check_choice(name, "name", CARMEN_LOGS)
-    return find_data(f"carmen-radish-corrected/{name}-corrected.log.gz")
+    if isinstance(path, str) and path in CARMEN_LOGS:
+        return find_data(f"carmen-radish-corrected/{path}-corrected.log.gz")
+    return as_path(path, "path", kind="file")
+
+
+def log_map(path, cell_m: float = 0.1, max_range_m: float = 10.0):
+    """A CARMEN log read and its occupancy map built from all scans at the corrected poses, once per (file,
+    cell size, range) (:func:`slamlab.scans.log_grid`; ours: the map of every run on the log).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        One of :data:`CARMEN_LOGS`, or the path of any CARMEN log (see :func:`carmen_path`).
+    cell_m : float
+        The map's cell size [m].
+    max_range_m : float
+        Ranges at or beyond this [m] are not used.
+
+    Returns
+    -------
+    log : CarmenLog
+        The log.
+    grid : ndarray of int, shape (H, W)
+        The map.
+    frame : GridFrame
+        Cells ↔ metres.
+    scans : list of Scan
+        The scans in cells.
+    poses : ndarray, shape (n, 3)
+        The corrected poses in cells.
+    """
+    return _read_log_map(str(carmen_path(path)), check_positive(cell_m, "cell_m"),
+                         check_positive(max_range_m, "max_range_m"))
+
+
+@functools.lru_cache(maxsize=6)
+def _read_log_map(path: str, cell_m: float, max_range_m: float):
+    from ...io import read_carmen
+
+    log = read_carmen(path)
+    return (log, *log_grid(log, cell_m=cell_m, max_range_m=max_range_m))
 
 
 @dataclass(frozen=True)
@@ -199,22 +245,23 @@ class LogMCLResult:
 
 def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1, max_range_m: float = 10.0,
                 n_particles_track: int = 3000, n_particles_global: int = 20000, odo_trans_frac: float = 0.1,
-                odo_rot_std_deg: float = 1.0, rng=0, params: MCLParams | None = None, global_overrides=None,
-                **overrides) -> LogMCLResult:
-    """MCL on ``n_scans`` consecutive scans of a corrected CARMEN log (path: str / os.PathLike, or a log name).
+                odo_rot_std_deg: float = 1.0, rng=0, params: MCLParams | None = None,
+                global_params: MCLParams | None = None, **overrides) -> LogMCLResult:
+    """MCL on ``n_scans`` consecutive scans of a corrected CARMEN log (path: str / os.PathLike, or a log name; 003
+    §2.2 on real data, ours).
 
     The map is the occupancy grid of all the log's scans at their corrected poses
     (:func:`slamlab.scans.log_grid`, ``cell_m`` cells, ranges below ``max_range_m``);
     the odometry is the corrected path with Gaussian noise, ``odo_trans_frac`` of each step's
     length and ``odo_rot_std_deg`` per step (ours: the corrected logs carry no raw odometry).
     Tracking starts from the corrected first pose (σ 0.1 m, 2°), global from particles uniform on
-    the free cells. Sensor settings: σ_hit 0.2 m, distance cap 1 m (ROS's σ_hit; ours otherwise); the motion
-    noise α = (0.05, 0.002, 0.05, 0.005) in cells, weights p^1, no jitter and the averages from 0 (003: no injection
-    while tracking): :func:`log_settings`.
-    ``global_overrides``: MCLParams fields for the global run only; default :func:`global_log_settings` (ours)
-    σ_hit 0.4 m, z_hit = z_rand = 0.5, α2 0.01 rad²/m² and random injection with (α_slow, α_fast) = (0.05, 0.5)
-    on the bias-corrected averages. Tracking, global and the odometry noise draw from
-    three independent streams spawned from ``rng``.
+    the free cells. Tracking settings by default :func:`log_settings`: σ_hit 0.2 m, distance cap 1 m (ROS's σ_hit;
+    ours otherwise); the motion noise α = (0.05, 0.002, 0.05, 0.005) in cells, weights p^1, no jitter and the
+    averages from 0 (003: no injection while tracking). Global settings by default those and
+    :func:`global_log_settings` (ours): σ_hit 0.4 m, z_hit = z_rand = 0.5, α2 0.01 rad²/m² and random injection
+    with (α_slow, α_fast) = (0.05, 0.5) on the bias-corrected averages. Tracking, global and the odometry noise
+    draw from three independent streams spawned from ``rng``. The particle counts are ``n_particles_track`` and
+    ``n_particles_global``: the settings must leave ``n_particles`` at its default (a ``ValueError`` names it).
 
     Parameters
     ----------
@@ -233,9 +280,9 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     rng : int, SeedSequence or Generator
         Where the three streams are spawned from.
     params : MCLParams, optional
-        Settings on top of :func:`log_settings`.
-    global_overrides : dict, optional
-        MCLParams fields for the global run only (default :func:`global_log_settings`).
+        Settings of the tracking run, lengths in cells (default: ``log_params(cell_m, "track")``).
+    global_params : MCLParams, optional
+        Settings of the global run (default: ``log_params(cell_m, "global")``).
     **overrides
         MCLParams fields for both runs.
 
@@ -243,41 +290,48 @@ def run_log_mcl(path, *, start: int = 0, n_scans: int = 60, cell_m: float = 0.1,
     -------
     LogMCLResult
     """
+    from ..._params import refuse_set_fields
     from ...io import CarmenLog
 
-    cell = v.check_positive(cell_m, "cell_m")
+    cell = check_positive(cell_m, "cell_m")
+    settings = {"track": MCLParams.resolve(log_params(cell, "track") if params is None else params, **overrides),
+                "global": MCLParams.resolve(log_params(cell, "global") if global_params is None else global_params,
+                                            **overrides)}
+    for p in settings.values():
+        refuse_set_fields(p, ["n_particles"], "`n_particles_track` and `n_particles_global`")
+    counts = {"track": check_int(n_particles_track, "n_particles_track", minimum=1),
+              "global": check_int(n_particles_global, "n_particles_global", minimum=1)}
     if isinstance(path, CarmenLog):
         log = path
         G, frame, scans_c, Pc = log_grid(log, cell_m=cell, max_range_m=max_range_m)
     else:
-        log, G, frame, scans_c, Pc = _log_map(_resolve(path), cell, float(max_range_m))
-    n = v.check_int(n_scans, "n_scans", minimum=2)
+        log, G, frame, scans_c, Pc = log_map(path, cell, max_range_m)
+    n = check_int(n_scans, "n_scans", minimum=2)
     if n > log.n_scans:
         raise ValueError(f"`n_scans` must be <= the {log.n_scans} scans of log {log.name!r}; got {n}")
-    s0 = v.check_int(start, "start", minimum=0)
+    s0 = check_int(start, "start", minimum=0)
     if s0 + n > log.n_scans:
         raise ValueError(f"`start` + `n_scans` must be <= the {log.n_scans} scans of log {log.name!r}; got "
                          f"{s0} + {n} = {s0 + n}")
-    rng_odo, rng_track, rng_global = v.as_rng(rng).spawn(3)
+    rng_odo, rng_track, rng_global = as_rng(rng).spawn(3)
     t0 = time.perf_counter()
     idx = np.arange(s0, s0 + n)
     true_c = Pc[idx]
     odo = simulate_odometry(true_c, trans_std_frac=odo_trans_frac, rot_std_rad=float(np.radians(odo_rot_std_deg)),
                             rng=rng_odo).poses
-    base = {**log_settings(cell), **overrides}
     zmax = max_range_m / cell
     est = {}
-    for mode, count, r in (("track", n_particles_track, rng_track), ("global", n_particles_global, rng_global)):
+    for mode, r in (("track", rng_track), ("global", rng_global)):
         kw = {"init_pose": true_c[0], "init_std": (0.1 / cell, 0.1 / cell, float(np.radians(2)))} \
-            if mode == "track" else dict(global_log_settings(cell) if global_overrides is None else global_overrides)
-        f = MCL(G, zmax, params=params, rng=r, n_particles=count, **{**base, **kw})
+            if mode == "track" else {}
+        f = MCL(G, zmax, params=settings[mode].replace(n_particles=counts[mode]), rng=r, **kw)
         out = np.empty((n, 3))
         for k, i in enumerate(idx):
             prev, now = (odo[k - 1], odo[k]) if k else (None, None)
             out[k] = f.step(prev, now, scans_c[i]).mean
         est[mode] = frame.to_metres(out)
     return LogMCLResult(log.name, idx, log.poses[idx].copy(), est["track"], est["global"], frame.to_metres(odo), cell,
-                        G.shape, int(n_particles_track), int(n_particles_global), float(odo_trans_frac),
+                        G.shape, counts["track"], counts["global"], float(odo_trans_frac),
                         float(odo_rot_std_deg), G, frame, time.perf_counter() - t0)
 
 
@@ -310,4 +364,4 @@ def logs_table(results) -> str:
 
 
 __all__ += ["CARMEN_LOGS", "GLOBAL_BEFORE", "REAL_DEG", "REAL_POS_M", "LogMCLResult", "carmen_path",
-            "global_log_settings", "log_settings", "logs_table", "run_log_mcl"]
+            "global_log_settings", "log_map", "log_params", "log_settings", "logs_table", "run_log_mcl"]

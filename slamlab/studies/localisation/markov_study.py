@@ -12,13 +12,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import check_int, check_positive
 from ...geometry import wrap_angle
-from ...localisation.markov import MarkovGrid
+from ...localisation.markov import MarkovGrid, MarkovParams
 from .experiments import FAIL_DEG, FAIL_POS_CELLS, simulate_run
 
-__all__ = ["MARKOV_PRIORS", "MarkovStudyResult", "run_markov_kidnap", "run_markov_prior"]
+__all__ = ["MARKOV_PRIORS", "MARKOV_STUDY_PARAMS", "MarkovStudyResult", "run_markov_kidnap", "run_markov_prior"]
 
 #: Priors of the prior experiment: (label, kind, offset of the prior's centre from the true start in cells).
 MARKOV_PRIORS = (
@@ -26,6 +26,9 @@ MARKOV_PRIORS = (
     ("Gaussian at the true start (σ 10 cells, 20°)", "gaussian", 0.0),
     ("Gaussian 30 cells off the true start", "gaussian", 30.0),
 )
+
+#: The Markov studies' grid when no ``params`` is given: belief cells of 4 map cells, 36 headings (10°).
+MARKOV_STUDY_PARAMS = MarkovParams(resolution=4, n_headings=36)
 
 
 def _errors(est, true):
@@ -39,11 +42,13 @@ def _ok_bits(est, true) -> str:
     return "".join("1" if a else "0" for a in ((e < FAIL_POS_CELLS) & (h < FAIL_DEG)))
 
 
-def _markov_task(rng, kind: str, offset: float, floor: float, n_steps: int, resolution: int, n_headings: int,
-                 kidnap_step: int | None, variant: str = "", overrides: dict | None = None):
+def _markov_task(rng, kind: str, offset: float, n_steps: int, kidnap_step: int | None, params: MarkovParams,
+                 variant: str = "", uniform_floor: float | None = None):
+    """One run of a Markov study: the grid of ``params`` (its floor replaced by ``uniform_floor`` when given, the
+    kidnap study's axis) from a uniform or a Gaussian prior, on the run that ``rng`` simulates."""
     run = simulate_run(n_steps, start=None if kidnap_step is None else 0, kidnap_step=kidnap_step, rng=rng)
-    g = MarkovGrid(run.grid, run.max_range, resolution=resolution, n_headings=n_headings, uniform_floor=floor,
-                   **(overrides or {}))
+    p = params if uniform_floor is None else params.replace(uniform_floor=uniform_floor)
+    g = MarkovGrid(run.grid, run.max_range, params=p)
     if kind == "gaussian":
         t = run.true_poses[0]
         a = float(rng.uniform(-np.pi, np.pi))  # the direction of the offset
@@ -142,22 +147,20 @@ def _run(points, fixed, *, n_runs, rng, n_jobs, progress):
     return pd.concat(frames, ignore_index=True)
 
 
-def _study_overrides(params, overrides: dict) -> dict:
-    """``params`` + ``overrides`` as MarkovParams overrides, without the study's own knobs (its arguments)."""
-    from ...localisation.markov import MarkovParams
-
-    ov = MarkovParams.as_overrides(params, **overrides)
-    for own in ("resolution", "n_headings", "uniform_floor"):
-        if own in ov:
-            raise TypeError(f"`{own}` is an argument of this study (or its variants), not an override; "
-                            f"pass it directly")
-    return ov
+def _settings(params, overrides: dict) -> MarkovParams:
+    """The studies' grid: ``params`` (default :data:`MARKOV_STUDY_PARAMS`) with ``overrides``."""
+    return MarkovParams.resolve(MARKOV_STUDY_PARAMS if params is None else params, **overrides)
 
 
-def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10, resolution: int = 4,
-                     n_headings: int = 36, params=None, rng=5, n_jobs: int = 1, progress=None,
-                     **overrides) -> MarkovStudyResult:
-    """The Markov grid from a uniform prior and from Gaussian priors; the same runs for every prior.
+def _title_extra(params, overrides: dict) -> str:
+    """The settings given to the prior study besides its grid, for its title (e.g. "max_beams 3")."""
+    given = MarkovParams.as_overrides(params, **overrides)
+    return ", ".join(f"{k} {val}" for k, val in given.items() if k not in ("resolution", "n_headings"))
+
+
+def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10, params: MarkovParams | None = None, rng=5,
+                     n_jobs: int = 1, progress=None, **overrides) -> MarkovStudyResult:
+    """The Markov grid from a uniform prior and from Gaussian priors; the same runs for every prior (003 §2.2.1).
 
     Parameters
     ----------
@@ -165,11 +168,8 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
         (label, kind, offset of the prior's centre from the true start [cells]).
     n_runs, n_steps : int
         Runs per prior, steps per run.
-    resolution, n_headings : int
-        The grid's map cells per belief cell and heading bins.
     params : MarkovParams, optional
-        Settings of the grid (default: the defaults); ``resolution``, ``n_headings`` and the floor are this
-        study's own arguments.
+        Settings of the grid (default: :data:`MARKOV_STUDY_PARAMS`, 4-cell belief cells and 36 headings).
     rng : int, SeedSequence or Generator
         Where every run's stream is spawned from (run ``i`` the same for every prior).
     n_jobs : int
@@ -183,40 +183,38 @@ def run_markov_prior(priors=MARKOV_PRIORS, *, n_runs: int = 5, n_steps: int = 10
     -------
     MarkovStudyResult
     """
-
-    overrides = _study_overrides(params, overrides)
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    n_steps = v.check_int(n_steps, "n_steps", minimum=2)
+    p = _settings(params, overrides)
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
+    n_steps = check_int(n_steps, "n_steps", minimum=2)
     pts = []
     for item in priors:
         if not (isinstance(item, tuple) and len(item) == 3 and item[1] in ("uniform", "gaussian")):
             raise ValueError(f"`priors` must hold (label, 'uniform' or 'gaussian', offset) triples; got {item!r}")
         pts.append({"variant": item[0], "kind": item[1], "offset": float(item[2])})
-    df = _run(pts, {"floor": 0.0, "n_steps": n_steps, "resolution": resolution, "n_headings": n_headings,
-                    "kidnap_step": None, "overrides": dict(overrides)}, n_runs=n_runs, rng=rng, n_jobs=n_jobs,
+    df = _run(pts, {"n_steps": n_steps, "kidnap_step": None, "params": p}, n_runs=n_runs, rng=rng, n_jobs=n_jobs,
               progress=progress)
-    extra = ", ".join(f"{k} {val}" for k, val in overrides.items())
-    return MarkovStudyResult(df, tuple(p["variant"] for p in pts), n_runs, n_steps, resolution, n_headings, None,
-                             "Markov grid, priors" + (f" ({extra})" if extra else ""))
+    extra = _title_extra(params, overrides)
+    return MarkovStudyResult(df, tuple(pt["variant"] for pt in pts), n_runs, n_steps, p.resolution, p.n_headings,
+                             None, "Markov grid, priors" + (f" ({extra})" if extra else ""))
 
 
 def run_markov_kidnap(floors=(0.0, 1e-6, 1e-3), *, n_runs: int = 5, n_steps: int = 24, kidnap_step: int = 8,
-                      resolution: int = 4, n_headings: int = 36, params=None, rng=6, n_jobs: int = 1,
-                      progress=None, **overrides) -> MarkovStudyResult:
+                      params: MarkovParams | None = None, rng=6, n_jobs: int = 1, progress=None, **overrides) -> MarkovStudyResult:
     """The kidnapped robot on the Markov grid: tracking from a prior at the true start, carried elsewhere at
-    ``kidnap_step``; per uniform floor ε (0: PR Table 8.1 as it is).
+    ``kidnap_step``; per uniform floor ε (0: PR Table 8.1 as it is; 003 §2.2.1).
+
+    The study varies the floor itself (one variant per value of ``floors``): ``params`` and the overrides must
+    leave ``uniform_floor`` at its default (a ``ValueError`` names it otherwise).
 
     Parameters
     ----------
     floors : sequence of float
-        The uniform floors ε, one variant each.
+        The uniform floors ε, one variant each (the study's own axis: not ``params.uniform_floor``).
     n_runs, n_steps, kidnap_step : int
         Runs per floor, steps per run, the step of the kidnap.
-    resolution, n_headings : int
-        The grid's map cells per belief cell and heading bins.
     params : MarkovParams, optional
-        Settings of the grid (default: the defaults); ``resolution``, ``n_headings`` and the floor are this
-        study's own arguments.
+        Settings of the grid (default: :data:`MARKOV_STUDY_PARAMS`, 4-cell belief cells and 36 headings), but for
+        ``uniform_floor``.
     rng : int, SeedSequence or Generator
         Where every run's stream is spawned from (run ``i`` the same for every floor).
     n_jobs : int
@@ -231,12 +229,14 @@ def run_markov_kidnap(floors=(0.0, 1e-6, 1e-3), *, n_runs: int = 5, n_steps: int
     MarkovStudyResult
     """
 
-    overrides = _study_overrides(params, overrides)
-    n_runs = v.check_int(n_runs, "n_runs", minimum=1)
-    pts = [{"variant": f"uniform floor ε = {v.check_positive(f, 'floors[]', allow_zero=True):g}", "kind": "gaussian",
-            "offset": 0.0, "floor": float(f)} for f in floors]
-    df = _run(pts, {"n_steps": n_steps, "resolution": resolution, "n_headings": n_headings,
-                    "kidnap_step": kidnap_step, "overrides": dict(overrides)}, n_runs=n_runs, rng=rng, n_jobs=n_jobs,
-              progress=progress)
-    return MarkovStudyResult(df, tuple(p["variant"] for p in pts), n_runs, n_steps, resolution, n_headings,
+    from ..._params import refuse_set_fields
+
+    p = _settings(params, overrides)
+    refuse_set_fields(p, ["uniform_floor"], "one variant per value of `floors`")
+    n_runs = check_int(n_runs, "n_runs", minimum=1)
+    pts = [{"variant": f"uniform floor ε = {check_positive(f, 'floors[]', allow_zero=True):g}", "kind": "gaussian",
+            "offset": 0.0, "uniform_floor": float(f)} for f in floors]
+    df = _run(pts, {"n_steps": n_steps, "kidnap_step": kidnap_step, "params": p}, n_runs=n_runs, rng=rng,
+              n_jobs=n_jobs, progress=progress)
+    return MarkovStudyResult(df, tuple(pt["variant"] for pt in pts), n_runs, n_steps, p.resolution, p.n_headings,
                              kidnap_step, f"Markov grid, kidnapped at step {kidnap_step}")

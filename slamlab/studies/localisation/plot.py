@@ -7,7 +7,6 @@ import numpy as np
 
 from ...localisation.plot import plot_averages, plot_map, plot_particles, plot_weights
 from ...plotting import STYLE, new_axes
-from .studies import _per_step
 
 __all__ = [
     "mcl_figure",
@@ -90,13 +89,12 @@ def plot_global(result, *, ax=None):
     matplotlib Axes
     """
     ax = new_axes(ax, xlabel="step", ylabel="share of runs", title="Global localisation")
-    df = result.table_df
-    for i, n in enumerate(sorted(df["n_particles"].unique())):
-        g = df[df["n_particles"] == n]
-        k = np.arange(1, result.n_steps + 1)
+    k = np.arange(1, result.n_steps + 1)
+    for i, n in enumerate(sorted(result.table_df["n_particles"].unique())):
+        ok, converged = result.step_shares(n)
         c = f"C{i}"
-        ax.plot(k, _per_step(g, "ok").mean(axis=0), "-", color=c, label=f"{n} particles: within 3 cells, 5°")
-        ax.plot(k, _per_step(g, "conv").mean(axis=0), ":", color=c, label=f"{n}: amcl converged")
+        ax.plot(k, ok, "-", color=c, label=f"{n} particles: within 3 cells, 5°")
+        ax.plot(k, converged, ":", color=c, label=f"{n}: amcl converged")
     ax.set_ylim(-0.05, 1.05)
     ax.legend(fontsize=7, loc="lower right")
     return ax

@@ -1,6 +1,6 @@
 """MCL and chapter 06's correlation search (one scan, no prior) on the same final scans of simulated runs.
 
-Moved unchanged from :mod:`slamlab.studies.localisation.experiments`; :mod:`slamlab.studies.localisation` exports its names.
+:mod:`slamlab.studies.localisation` exports its names.
 """
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import check_int
 from ...geometry import wrap_angle
 from ...localisation.mcl import MCLParams
 from .experiments import FAIL_DEG, FAIL_POS_CELLS, run_filter, simulate_run
@@ -22,11 +22,13 @@ __all__ = []
 # --- Ch. 5's correlation method on the same scans -----------------------------------------------------
 
 
-def _side_task(rng, n_steps: int, n_particles: int, delta_alpha_deg: float, overrides: dict):
+def _side_task(rng, n_steps: int, delta_alpha_deg: float, params: MCLParams):
+    """One run: global MCL with ``params`` over the run that ``rng`` simulates, and Ch. 5's correlation search on
+    its last scan."""
     from ...correlation import localise
 
     run = simulate_run(n_steps, rng=rng)
-    r = run_filter(run, rng=rng, **{**overrides, "n_particles": n_particles})
+    r = run_filter(run, rng=rng, params=params)
     t0 = time.perf_counter()
     loc = localise(run.grid, run.scans[-1], delta_alpha_rad=float(np.radians(delta_alpha_deg)))
     t_corr = time.perf_counter() - t0
@@ -77,21 +79,19 @@ class SideBySideResult:
         return f"MCL vs correlation on {self.n_runs} runs"
 
 
-def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_particles: int = 2000,
-                                 delta_alpha_deg: float = 5.0, params: MCLParams | None = None, rng=3,
-                                 n_jobs: int = 1, progress=None, **overrides) -> SideBySideResult:
-    """Global MCL over each run and Ch. 5's correlation localisation of the run's last scan (on sweep).
+def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, delta_alpha_deg: float = 5.0,
+                                 params: MCLParams | None = None, rng=3, n_jobs: int = 1, progress=None,
+                                 **overrides) -> SideBySideResult:
+    """Global MCL over each run and Ch. 5's correlation localisation of the run's last scan (on sweep; 003 §2.2).
 
     Parameters
     ----------
     n_runs, n_steps : int
         Runs, and steps per run.
-    n_particles : int
-        MCL particles (replaces ``params.n_particles``).
     delta_alpha_deg : float
         The correlation search's heading step.
     params : MCLParams, optional
-        Settings of MCL (default: the defaults).
+        Settings of MCL (default: the defaults, 2000 particles).
     rng : int, SeedSequence or Generator
         Where every run's stream is spawned from.
     n_jobs : int
@@ -99,7 +99,7 @@ def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_parti
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
     **overrides
-        :class:`MCLParams` fields.
+        :class:`MCLParams` fields (e.g. ``n_particles``).
 
     Returns
     -------
@@ -107,12 +107,11 @@ def run_correlation_side_by_side(*, n_runs: int = 10, n_steps: int = 25, n_parti
     """
     from ...sweep import root_seed_sequence, sweep
 
-    ov = MCLParams.as_overrides(params, **overrides)
-    df = sweep(_side_task, None, seeds=v.check_int(n_runs, "n_runs", minimum=1), rng=root_seed_sequence(rng, "rng"),
+    p = MCLParams.resolve(params, **overrides)
+    df = sweep(_side_task, None, seeds=check_int(n_runs, "n_runs", minimum=1), rng=root_seed_sequence(rng, "rng"),
                n_jobs=n_jobs, progress=progress, on_error="raise", desc="MCL vs correlation",
-               fixed={"n_steps": n_steps, "n_particles": n_particles, "delta_alpha_deg": delta_alpha_deg,
-                      "overrides": ov})
-    return SideBySideResult(df, n_runs, n_steps, n_particles, float(delta_alpha_deg))
+               fixed={"n_steps": n_steps, "delta_alpha_deg": delta_alpha_deg, "params": p})
+    return SideBySideResult(df, n_runs, n_steps, p.n_particles, float(delta_alpha_deg))
 
 
 __all__ += ["SideBySideResult", "run_correlation_side_by_side"]

@@ -8,6 +8,7 @@ import ipywidgets as widgets
 import numpy as np
 
 from ...localisation.plot import plot_belief
+from ...widgets import show_run
 from ...widgets import slider as _slider
 from .experiments import demo_run
 from .logs import CARMEN_LOGS, run_log_mcl
@@ -38,17 +39,18 @@ def explore_mcl(**defaults):
     d.update(defaults)
 
     def show(n_particles, alpha_slow, alpha_fast, z_hit, sigma_hit, odo_noise, kidnap_step):
-        try:
+        def run():
             alpha = tuple(float(a * odo_noise) for a in p0.alpha)
-            run, res = demo_run(int(n_particles), kidnap_step=int(kidnap_step) or None, alpha_slow=alpha_slow,
-                                alpha_fast=alpha_fast, rng=d["seed"], z_hit=z_hit, z_rand=1.0 - z_hit,
-                                sigma_hit=sigma_hit, max_dist=3 * sigma_hit, alpha=alpha)
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(f"final error {res.err_pos[-1]:.2f} cells, {np.degrees(res.err_heading_rad[-1]):.1f}°; "
-              f"injected {sum(r.n_injected for r in res.records)} particles in {run.n_steps} steps")
-        mcl_figure(run, res)
+            return demo_run(n_particles=int(n_particles), kidnap_step=int(kidnap_step) or None, alpha_slow=alpha_slow,
+                            alpha_fast=alpha_fast, rng=d["seed"], z_hit=z_hit, z_rand=1.0 - z_hit,
+                            sigma_hit=sigma_hit, max_dist=3 * sigma_hit, alpha=alpha)
+
+        def table(out):
+            sim_run, res = out
+            return (f"final error {res.err_pos[-1]:.2f} cells, {np.degrees(res.err_heading_rad[-1]):.1f}°; "
+                    f"injected {sum(r.n_injected for r in res.records)} particles in {sim_run.n_steps} steps")
+
+        show_run(run, lambda out: mcl_figure(*out), table=table)
 
     return widgets.interactive(
         show,
@@ -109,13 +111,8 @@ def explore_log(**defaults):
     d.update(defaults)
 
     def show(log, start, n_scans, n_global):
-        try:
-            r = _log_run(log, int(n_scans), int(start), int(n_global))
-        except (ValueError, TypeError, FileNotFoundError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(r)
-        plot_log_run(r)
+        show_run(lambda: _log_run(log, int(n_scans), int(start), int(n_global)), plot_log_run, table=str,
+                     errors=(ValueError, TypeError, FileNotFoundError))  # the logs are data files
 
     return widgets.interactive(
         show,
@@ -148,28 +145,30 @@ def explore_markov(**defaults):
     d.update(defaults)
 
     def show(resolution, n_headings, n_steps, prior, kidnap_step, uniform_floor):
-        try:
+        def run():
             k = int(kidnap_step) or None
             if k is not None and k >= n_steps:
                 raise ValueError(f"the kidnap step ({k}) must come before the last step ({n_steps - 1})")
             rng = np.random.default_rng(d["seed"])
-            run = simulate_run(int(n_steps), start=0, kidnap_step=k, rng=rng)
-            g = MarkovGrid(run.grid, run.max_range, resolution=int(resolution), n_headings=int(n_headings),
+            sim_run = simulate_run(int(n_steps), start=0, kidnap_step=k, rng=rng)
+            g = MarkovGrid(sim_run.grid, sim_run.max_range, resolution=int(resolution), n_headings=int(n_headings),
                            uniform_floor=float(uniform_floor))
             if prior != "uniform":
                 off = 0.0 if prior == "Gaussian at the start" else 30.0
-                g.belief = g.gaussian_prior(run.true_poses[0] + [off, 0.0, 0.0], 10.0, np.radians(20))
+                g.belief = g.gaussian_prior(sim_run.true_poses[0] + [off, 0.0, 0.0], 10.0, np.radians(20))
             errs = []
-            for i in range(run.n_steps):
-                prev, now = (run.odom_poses[i - 1], run.odom_poses[i]) if i else (None, None)
-                m = g.step(prev, now, run.scans[i])
-                errs.append(float(np.hypot(*(m[:2] - run.true_poses[i, :2]))))
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(f"belief {g.belief.shape} ({g.nbytes / 2**20:.2f} MiB); position error per step [cells]: "
-              + ", ".join(f"{e:.1f}" for e in errs))
-        plot_belief(g, true_pose=run.true_poses[-1])
+            for i in range(sim_run.n_steps):
+                prev, now = (sim_run.odom_poses[i - 1], sim_run.odom_poses[i]) if i else (None, None)
+                m = g.step(prev, now, sim_run.scans[i])
+                errs.append(float(np.hypot(*(m[:2] - sim_run.true_poses[i, :2]))))
+            return g, errs, sim_run.true_poses[-1]
+
+        def table(out):
+            g, errs, _ = out
+            return (f"belief {g.belief.shape} ({g.nbytes / 2**20:.2f} MiB); position error per step [cells]: "
+                    + ", ".join(f"{e:.1f}" for e in errs))
+
+        show_run(run, lambda out: plot_belief(out[0], true_pose=out[2]), table=table)
 
     return widgets.interactive(
         show,

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_rng, check_int, check_positive
 from ...mono.depth_filter import (
     compute_tau,
     converged_sigma,
@@ -123,10 +123,10 @@ def run_depth_filter_convergence(outlier_rates=(0.0, 0.2, 0.4, 0.6), *, n_obs: i
     """
     from ...mono.depth_filter import converged_sigma, init_seeds, inlier_ratio, update_seeds
 
-    rng = v.as_rng(rng)
-    n_obs = v.check_int(n_obs, "n_obs", minimum=1)
-    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
-    tau = v.check_positive(tau, "tau")
+    rng = as_rng(rng)
+    n_obs = check_int(n_obs, "n_obs", minimum=1)
+    n_seeds = check_int(n_seeds, "n_seeds", minimum=1)
+    tau = check_positive(tau, "tau")
     rates = tuple(float(r) for r in outlier_rates)
     if not rates or any(not 0.0 <= r < 1.0 for r in rates):
         raise ValueError(f"`outlier_rates` must be rates in [0, 1); got {outlier_rates!r}")
@@ -263,11 +263,11 @@ def run_convergence_tests(outlier_rates=(0.0, 0.2, 0.4), *, n_obs: int = 30, n_s
     ConvergenceTests
         ``conv_L``, ``conv_svo``, ``err_L``, ``err_svo`` per rate.
     """
-    rng = v.as_rng(rng)
-    n_obs = v.check_int(n_obs, "n_obs", minimum=1)
-    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
-    step_m = v.check_positive(step_m, "step_m")
-    L_max = v.check_positive(L_max, "L_max")
+    rng = as_rng(rng)
+    n_obs = check_int(n_obs, "n_obs", minimum=1)
+    n_seeds = check_int(n_seeds, "n_seeds", minimum=1)
+    step_m = check_positive(step_m, "step_m")
+    L_max = check_positive(L_max, "L_max")
     rates = tuple(float(r) for r in outlier_rates)
     if not rates or any(not 0.0 <= r < 1.0 for r in rates):
         raise ValueError(f"`outlier_rates` must be rates in [0, 1); got {outlier_rates!r}")

@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import _validate as v
+from ..._params import refuse_set_fields
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import as_finite_array, check_choice, check_int, check_positive
 from ...geometry.camera import StereoRig
 from ...geometry.se3 import se3_compose, se3_from_planar
 from ...mono.params import MonoParams
@@ -23,9 +24,12 @@ from .runs import MonoRunResult, run_mono, trajectory_errors
 __all__ = [
     "FAILURE_CASES",
     "FAILURE_CONSTRUCTIONS",
+    "FAILURE_SETTINGS",
     "SEQUENCES",
+    "SWEPT_FIELDS",
     "ConvergenceStudy",
     "MonoRunResult",
+    "failure_case_frames",
     "failure_table",
     "mono_sim",
     "render_sequence",
@@ -55,6 +59,8 @@ FAILURE_CONSTRUCTIONS = {
     "kidnap": "carried 2 m and 0.6 rad at mid-run",
     "bad_initial_map": "initialised after 2 px",
 }
+#: the settings a failure case makes itself (ours): :class:`MonoParams` overrides of its run
+FAILURE_SETTINGS = {"bad_initial_map": {"init_disparity_px": 2.0, "init_min_parallax_deg": 0.0}}
 
 
 def sequence_poses(name: str, n_frames: int = 60, *, step_m: float = 0.02) -> np.ndarray:
@@ -79,9 +85,9 @@ def sequence_poses(name: str, n_frames: int = 60, *, step_m: float = 0.02) -> np
     poses : ndarray, shape (n_frames, 3)
         ``(x_m, y_m, yaw_rad)`` per frame.
     """
-    v.check_choice(name, "name", (*SEQUENCES, "turn"))
-    n = v.check_int(n_frames, "n_frames", minimum=2)
-    step_m = v.check_positive(step_m, "step_m")
+    check_choice(name, "name", (*SEQUENCES, "turn"))
+    n = check_int(n_frames, "n_frames", minimum=2)
+    step_m = check_positive(step_m, "step_m")
     k = np.arange(n)
     if name == "strafe":
         x = 1.5 + step_m * k
@@ -119,7 +125,7 @@ def mono_sim(size: str = "small", *, arena: StereoArena | None = None, noise_std
     StereoSim
         The simulator (its ``rig.left`` is the monocular camera).
     """
-    w, h = SIZES[v.check_choice(size, "size", tuple(SIZES))]
+    w, h = SIZES[check_choice(size, "size", tuple(SIZES))]
     return StereoSim(StereoArena(texture_seed=0, floor_contrast=1.0) if arena is None else arena,
                      StereoRig.parallel(0.2, w, h), noise_std=noise_std, camera_height_m=camera_height_m, rng=rng)
 
@@ -158,7 +164,7 @@ def render_sequence(sim: StereoSim, poses, *, blur_px: float = 0.0, contrast: fl
     """
     import cv2
 
-    poses = v.as_finite_array(poses, "poses", ndim=2)
+    poses = as_finite_array(poses, "poses", ndim=2)
     cam = sim.rig.left
     c, s_ = np.cos(pitch_down_rad), np.sin(pitch_down_rad)
     tilt = np.eye(4)
@@ -218,12 +224,33 @@ STAGE_NAMES = STAGES
 
 
 # -- failure cases (003 §5.3) as rendered sequences ---------------------------------------------
-def _case_frames(case: str, size: str, n_frames: int, rng):
-    from ...sim.arena import StereoArena
+def failure_case_frames(case: str, size: str = "tiny", n_frames: int = 30, *, rng=0):
+    """The rendered frames of one of 003 §5.3's failure cases (our constructions, :data:`FAILURE_CONSTRUCTIONS`).
 
+    Parameters
+    ----------
+    case : str
+        ``"normal"`` or one of :data:`FAILURE_CASES`.
+    size : str
+        Image size (:func:`mono_sim`; default ``"tiny"``).
+    n_frames : int
+        Frames (default 30).
+    rng : Generator, int or None
+        Randomness of the image noise (default 0).
+
+    Returns
+    -------
+    images : ndarray, shape (n_frames, H, W)
+        Grey frames.
+    truth_T_wc : ndarray, shape (n_frames, 4, 4)
+        True camera poses.
+    K : ndarray, shape (3, 3)
+        Intrinsic matrix.
+    overrides : dict
+        The :class:`MonoParams` fields the case sets itself (:data:`FAILURE_SETTINGS`).
+    """
     render = {}
     arena = None
-    overrides = {}
     if case == "normal":
         poses = sequence_poses("strafe", n_frames)
     elif case == "little_texture":
@@ -247,12 +274,11 @@ def _case_frames(case: str, size: str, n_frames: int, rng):
         poses[half:, 2] += 0.6
     elif case == "bad_initial_map":
         poses = sequence_poses("strafe", n_frames)
-        overrides = {"init_disparity_px": 2.0, "init_min_parallax_deg": 0.0}
     else:
         raise ValueError(f"`case` must be one of {('normal', *FAILURE_CASES)}; got {case!r}")
     sim = mono_sim(size, arena=arena, rng=rng)
     imgs, Ts = render_sequence(sim, poses, progress=False, **render)
-    return imgs, Ts, sim.rig.left.K, overrides
+    return imgs, Ts, sim.rig.left.K, dict(FAILURE_SETTINGS.get(case, {}))
 
 
 def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n_frames: int = 30,
@@ -262,7 +288,8 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
     ``normal`` strafe; ``little_texture`` blurred, low-contrast images; ``fast_motion`` 15 cm per
     frame; ``pure_rotation`` 2° per frame in place; ``distant_points`` a 60×60 m arena seen from
     its middle; ``kidnap`` carried 2 m between two frames; ``bad_initial_map`` initialised after
-    2 px of displacement. Returns ``{case: MonoRunResult}``.
+    2 px of displacement (it sets ``init_disparity_px`` and ``init_min_parallax_deg`` itself,
+    :data:`FAILURE_SETTINGS`: ``params`` may not set them when it runs). Returns ``{case: MonoRunResult}``.
 
     Parameters
     ----------
@@ -286,13 +313,16 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
     dict
         Case → :class:`MonoRunResult`.
     """
-    out = {}
     from ...sweep import fresh_seed_sequence
 
+    p = MonoParams.resolve(params, **overrides)
+    for case in cases:
+        refuse_set_fields(p, list(FAILURE_SETTINGS.get(case, {})), f"the failure case {case!r} sets it")
+    out = {}
     seeds = fresh_seed_sequence(rng).spawn(len(cases))  # an int seed: SeedSequence(seed)'s children as before
     for case, ss in zip(progress_bar(cases, desc="failure cases", progress=progress), seeds, strict=True):
-        imgs, Ts, K, ov = _case_frames(case, size, n_frames, np.random.default_rng(ss))
-        out[case] = run_mono(imgs, Ts, K, name=case, params=params, progress=False, **{**overrides, **ov})
+        imgs, Ts, K, ov = failure_case_frames(case, size, n_frames, rng=np.random.default_rng(ss))
+        out[case] = run_mono(imgs, Ts, K, name=case, params=p, progress=False, **ov)
     return out
 
 
@@ -322,9 +352,13 @@ def failure_table(results: dict) -> str:
 
 
 # -- the parameters 003 tuned (003 §5.1.1) on slamlab.sweep ---------------------------------------
+#: the fields :func:`run_parameter_sweep` sets itself: 003 §5.1.1's four (its grid) and ``kf_min_frames`` (10)
+SWEPT_FIELDS = ("init_disparity_px", "max_keyframes", "kf_max_lost_ratio", "max_matches", "kf_min_frames")
+
+
 def _sweep_run(init_disparity_px, max_keyframes, kf_max_lost_ratio, max_matches, rng, size="tiny", n_frames=30,
                params=None):
-    imgs, Ts, K, _ = _case_frames("normal", size, n_frames, rng)
+    imgs, Ts, K, _ = failure_case_frames("normal", size, n_frames, rng=rng)
     r = run_mono(imgs, Ts, K, name="sweep", params=params, progress=False, init_disparity_px=init_disparity_px,
                  max_keyframes=max_keyframes, kf_max_lost_ratio=kf_max_lost_ratio, max_matches=max_matches,
                  kf_min_frames=10)
@@ -348,7 +382,8 @@ def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_fra
     n_frames : int
         Frames per run.
     params : MonoParams, optional
-        The settings the grid changes (default: the defaults; ``kf_min_frames`` is 10 in these runs).
+        The settings the grid changes (default: the defaults). The sweep sets :data:`SWEPT_FIELDS` itself
+        (``kf_min_frames`` is 10 in these runs): ``params`` and ``overrides`` may not set them.
     rng : int, SeedSequence or Generator
         Where every run's stream is spawned from.
     progress : bool, callable or None
@@ -363,7 +398,10 @@ def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_fra
     """
     from ...sweep import root_seed_sequence, sweep
 
-    p = MonoParams.resolve(params, **overrides) if (params is not None or overrides) else None
+    p = MonoParams.resolve(params, **overrides)
+    refuse_set_fields(p, SWEPT_FIELDS, "the sweep's grid sets it")
+    if params is None and not overrides:
+        p = None
     base = {"init_disparity_px": 15.0, "max_keyframes": 10, "kf_max_lost_ratio": 0.3, "max_matches": 120}
     if grid is None:
         grid = [base, {**base, "init_disparity_px": 5.0}, {**base, "init_disparity_px": 30.0},

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_finite_array, as_matrix, as_path, as_vector, check_positive
 from ...mono.depth_filter import compute_tau, init_seeds, tau_inverse
 
 __all__ = ["chapter_cameras", "inverse_depth_point_table", "pinhole_table", "tau_table"]
@@ -34,7 +34,7 @@ def chapter_cameras(kitti_folder=None) -> dict:
     w, h = SIZES["tiny"]
     cams = {"rendered (tiny)": (mono_sim("tiny").rig.left.K, w, h)}
     d = find_data("kitti-odometry-06-stereo") if kitti_folder is None else \
-        v.as_path(kitti_folder, "kitti_folder", kind="dir")
+        as_path(kitti_folder, "kitti_folder", kind="dir")
     cams["KITTI 06 left"] = (read_kitti_calib(d / "calib.txt")["P0"][:, :3], 1226, 370)
     return cams
 
@@ -55,7 +55,7 @@ def pinhole_table(X_cam=(0.5, -0.2, 4.0), cameras=None) -> str:
     str
         One row per camera: ``fx``, ``fy``, ``u0``, ``v0``, field of view and the point's pixel.
     """
-    X = v.as_vector(X_cam, "X_cam", 3)
+    X = as_vector(X_cam, "X_cam", 3)
     if X[2] <= 0:
         raise ValueError(f"`X_cam` must lie in front of the camera (Z > 0); got Z = {X[2]}")
     cams = chapter_cameras() if cameras is None else cameras
@@ -99,12 +99,12 @@ def inverse_depth_point_table(K=None, uv=(150.0, 40.0), rhos=(0.5, 0.2, 0.05, 1e
     str
         One row per ρ: the world point and its reprojection into F.
     """
-    from ...geometry.camera import rotation_xyz
+    from ...geometry.camera import project_points, rotation_xyz
     from ...mono.depth_filter import Seeds, seed_points
 
-    K = chapter_cameras()["rendered (tiny)"][0] if K is None else v.as_matrix(K, "K", (3, 3))
-    uv = v.as_vector(uv, "uv", 2)
-    rhos = v.as_finite_array(rhos, "rhos", ndim=1)
+    K = chapter_cameras()["rendered (tiny)"][0] if K is None else as_matrix(K, "K", (3, 3))
+    uv = as_vector(uv, "uv", 2)
+    rhos = as_finite_array(rhos, "rhos", ndim=1)
     if np.any(rhos <= 0):
         raise ValueError("`rhos` must be positive inverse depths (1/m)")
     ray = np.array([(uv[0] - K[0, 2]) / K[0, 0], (uv[1] - K[1, 2]) / K[1, 1], 1.0])
@@ -113,13 +113,11 @@ def inverse_depth_point_table(K=None, uv=(150.0, 40.0), rhos=(0.5, 0.2, 0.05, 1e
     s = init_seeds(np.tile(uv, (n, 1)), np.tile(f, (n, 1)), 1.0, 1.0)
     s = Seeds(**{**s.__dict__, "mu": rhos.copy()})
     T = np.eye(4)
-    T[:3, :3], T[:3, 3] = rotation_xyz(0.0, np.deg2rad(yaw_deg), 0.0), v.as_vector(T_F_m, "T_F_m", 3)
+    T[:3, :3], T[:3, 3] = rotation_xyz(0.0, np.deg2rad(yaw_deg), 0.0), as_vector(T_F_m, "T_F_m", 3)
     X = seed_points(s, T[None])
     Xc = np.einsum("ji,nj->ni", T[:3, :3], X - T[:3, 3])  # back into F
     rows = []
-    for rho, Xi, Xci in zip(rhos, X, Xc, strict=True):
-        u = K[0, 0] * Xci[0] / Xci[2] + K[0, 2]
-        v_ = K[1, 1] * Xci[1] / Xci[2] + K[1, 2]
+    for rho, Xi, (u, v_) in zip(rhos, X, project_points(K, Xc), strict=True):
         big = np.max(np.abs(Xi)) > 1e4
         xs = ", ".join(f"{c:.3g}" if big else f"{c:.3f}" for c in Xi)
         rows.append([f"{rho:g}", f"{1 / rho:.4g}", f"({xs})", f"({u:.2f}, {v_:.2f})"])
@@ -154,7 +152,7 @@ def tau_table(depths_m=(2.0, 5.0, 10.0), baselines_m=(0.02, 0.1, 0.5), *, f_px: 
     str
         One row per (depth, baseline): ``τ`` [m], ``τ_ρ`` [1/m] and its first-order form.
     """
-    f_px = float(chapter_cameras()["rendered (tiny)"][0][0, 0]) if f_px is None else v.check_positive(f_px, "f_px")
+    f_px = float(chapter_cameras()["rendered (tiny)"][0][0, 0]) if f_px is None else check_positive(f_px, "f_px")
     ang = 2 * np.arctan(px_noise / (2 * f_px))
     rows = []
     for z in depths_m:

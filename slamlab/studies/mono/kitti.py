@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import _validate as v
+from ..._validate import as_path, check_int
 from ...geometry.se3 import se3_inverse
 from ...mono.evaluate import TRACK_TOL_FRAC
 from ...mono.params import MonoParams
@@ -42,10 +42,10 @@ def load_kitti(folder=None, n_frames: int | None = None):
     from ...evaluation import read_kitti
     from ...io.kitti import read_kitti_calib, read_kitti_image
 
-    d = find_data("kitti-odometry-06-stereo") if folder is None else v.as_path(folder, "folder", kind="dir")
+    d = find_data("kitti-odometry-06-stereo") if folder is None else as_path(folder, "folder", kind="dir")
     K = read_kitti_calib(d / "calib.txt")["P0"][:, :3]
     gt = read_kitti(d / "poses.txt").poses
-    n = len(gt) if n_frames is None else min(len(gt), v.check_int(n_frames, "n_frames", minimum=2))
+    n = len(gt) if n_frames is None else min(len(gt), check_int(n_frames, "n_frames", minimum=2))
     imgs = [read_kitti_image(d / "image_0" / f"{i:06d}.png") for i in range(n)]
     return imgs, gt[:n], K, d.name
 
@@ -99,7 +99,8 @@ def run_kitti_ablation(folder=None, configs=None, *, n_frames: int | None = None
     n_frames : int, optional
         Keep the first frames only.
     params : MonoParams, optional
-        The settings every configuration changes (default: the defaults).
+        The settings every configuration changes (default: the defaults); not the fields a configuration
+        sets itself (``ValueError`` naming them).
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
     **overrides
@@ -112,11 +113,16 @@ def run_kitti_ablation(folder=None, configs=None, *, n_frames: int | None = None
     """
     from ..._progress import progress_bar
 
-    imgs, gt, K, name = load_kitti(folder, n_frames)
     configs = KITTI_ABLATIONS if configs is None else dict(configs)
-    MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
-    return {(label, name): run_mono(imgs, gt, K, name=f"{name}, {label}", params=params, progress=False,
-                                    **{**overrides, **ov})
+    p = MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
+    for o in configs.values():
+        p.replace(**o)  # and a bad configuration
+    clash = sorted({k for o in configs.values() for k in o if getattr(p, k) != getattr(MonoParams(), k)})
+    if clash:
+        raise ValueError(f"`params` / overrides set {', '.join(map(repr, clash))}, which the configurations of "
+                         "run_kitti_ablation set themselves; leave them at the default")
+    imgs, gt, K, name = load_kitti(folder, n_frames)
+    return {(label, name): run_mono(imgs, gt, K, name=f"{name}, {label}", params=p, progress=False, **ov)
             for label, ov in progress_bar(list(configs.items()), desc="KITTI ablation", progress=progress)}
 
 
@@ -154,7 +160,7 @@ def epipolar_demo(folder=None, *, frames=(0, 1, 2), n_seeds: int = 60, depth_mea
     from ...mono.depth_filter import compute_tau, init_seeds, tau_inverse, update_seeds
     from ...mono.epipolar import extract_patches, search_epipolar
 
-    d = find_data("kitti-odometry-06-stereo") if folder is None else v.as_path(folder, "folder", kind="dir")
+    d = find_data("kitti-odometry-06-stereo") if folder is None else as_path(folder, "folder", kind="dir")
     K = read_kitti_calib(d / "calib.txt")["P0"][:, :3]
     gt = read_kitti(d / "poses.txt").poses
     imgs = {i: read_kitti_image(d / "image_0" / f"{i:06d}.png") for i in frames}

@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import as_finite_array, as_image
 from ...geometry.se3 import se3_inverse
 from ...mono.evaluate import TRACK_TOL_FRAC, RunScore, score_run
 from ...mono.params import MonoParams
@@ -180,7 +180,7 @@ def _check_frames(images) -> list:
         raise TypeError(f"`images` must be a sequence of grey images; got {type(images).__name__}") from None
     if not images:
         raise ValueError("`images` must hold at least one frame; got none")
-    out = [v.as_image(img, f"images[{i}]") for i, img in enumerate(images)]
+    out = [as_image(img, f"images[{i}]") for i, img in enumerate(images)]
     shape0 = out[0].shape
     for i, img in enumerate(out):
         if img.shape != shape0:
@@ -191,7 +191,7 @@ def _check_frames(images) -> list:
 
 def _check_truth(truth_T_wc, n: int) -> np.ndarray:
     """``truth_T_wc`` as an (n, 4, 4) array, or a ValueError naming ``truth_T_wc``."""
-    T = v.as_finite_array(truth_T_wc, "truth_T_wc", ndim=3)
+    T = as_finite_array(truth_T_wc, "truth_T_wc", ndim=3)
     if T.shape[1:] != (4, 4):
         raise ValueError(f"`truth_T_wc` must have shape (N, 4, 4); got {T.shape}")
     if T.shape[0] != n:

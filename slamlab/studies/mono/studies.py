@@ -17,15 +17,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_rng
 from ...geometry.se3 import se3_from_planar, se3_inverse
 from ...mono.params import MonoParams
 from .convergence import ConvergenceTests, run_convergence_tests
 from .experiments import (
+    FAILURE_SETTINGS,
     PITCH_DOWN_RAD,
     ConvergenceStudy,
     MonoRunResult,
+    failure_case_frames,
     mono_sim,
     render_sequence,
     run_mono,
@@ -78,7 +80,8 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
     n_frames : int
         Frames per case.
     params : MonoParams, optional
-        The settings every configuration changes (default: the defaults).
+        The settings every configuration changes (default: the defaults); not the fields a configuration
+        or a case sets itself (``ValueError`` naming them).
     rng : int, SeedSequence or Generator
         One stream per case is spawned from it (the renders).
     progress : bool, callable or None
@@ -93,17 +96,22 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
     """
     from ..._progress import progress_bar
     from ...sweep import fresh_seed_sequence
-    from .experiments import _case_frames, run_mono
 
     configs = ABLATIONS if configs is None else dict(configs)
-    MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
+    p = MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
+    for o in configs.values():
+        p.replace(**o)  # and a bad configuration
+    varied = {k for o in (*configs.values(), *(FAILURE_SETTINGS.get(c, {}) for c in cases)) for k in o}
+    clash = sorted(k for k in varied if getattr(p, k) != getattr(MonoParams(), k))
+    if clash:
+        raise ValueError(f"`params` / overrides set {', '.join(map(repr, clash))}, which the configurations or cases "
+                         "of run_ablation set themselves; leave them at the default")
     seeds = fresh_seed_sequence(rng).spawn(len(cases))  # an int seed: SeedSequence(seed)'s children as before
     out = {}
     for case, ss in zip(cases, seeds, strict=True):
-        imgs, Ts, K, ov = _case_frames(case, size, n_frames, np.random.default_rng(ss))
+        imgs, Ts, K, ov = failure_case_frames(case, size, n_frames, rng=np.random.default_rng(ss))
         for label, o in progress_bar(list(configs.items()), desc=case, progress=progress):
-            out[(label, case)] = run_mono(imgs, Ts, K, name=f"{case}, {label}", params=params, progress=False,
-                                          **{**overrides, **ov, **o})
+            out[(label, case)] = run_mono(imgs, Ts, K, name=f"{case}, {label}", params=p, progress=False, **{**ov, **o})
     return out
 
 
@@ -207,10 +215,11 @@ def compare_init_methods(*, n_points: int = 200, noise_px: float = 0.5, n_trials
     str
         One row per (scene, method): median rotation and translation-direction errors [deg].
     """
-    from ...geometry.camera import rotation_xyz
+    from ...geometry.camera import project_points, rotation_xyz
+    from ...geometry.so3 import rotation_angle
     from ...mono.initialise import relative_pose_essential, relative_pose_homography
 
-    rng = v.as_rng(rng)
+    rng = as_rng(rng)
     K = np.array([[500.0, 0, 320], [0, 500.0, 240], [0, 0, 1]])
     R = rotation_xyz(0.02, -0.05, 0.01)
     t = np.array([0.4, -0.05, 0.1])
@@ -225,17 +234,14 @@ def compare_init_methods(*, n_points: int = 200, noise_px: float = 0.5, n_trials
             else:
                 X0 = np.column_stack([rng.uniform(-2, 2, (n_points, 2)), rng.uniform(2.5, 8.0, n_points)])
             X1 = X0 @ R.T + t
-            uv0 = X0 @ K.T
-            uv1 = X1 @ K.T
-            uv0 = uv0[:, :2] / uv0[:, 2:] + rng.normal(0, noise_px, (n_points, 2))
-            uv1 = uv1[:, :2] / uv1[:, 2:] + rng.normal(0, noise_px, (n_points, 2))
+            uv0 = project_points(K, X0) + rng.normal(0, noise_px, (n_points, 2))
+            uv1 = project_points(K, X1) + rng.normal(0, noise_px, (n_points, 2))
             for name, fn in (("homography", relative_pose_homography), ("essential", relative_pose_essential)):
                 pose = fn(uv0, uv1, K, ransac_px=1.5)
                 if not pose.ok:
                     errs[name].append((np.inf, np.inf))
                     continue
-                dR = pose.R @ R.T
-                e_r = np.degrees(np.arccos(np.clip((np.trace(dR) - 1) / 2, -1, 1)))
+                e_r = np.degrees(rotation_angle(pose.R @ R.T))
                 e_t = np.degrees(np.arccos(np.clip(pose.t @ t_dir, -1, 1)))
                 errs[name].append((e_r, e_t))
         for name, e in errs.items():

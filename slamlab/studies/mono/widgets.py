@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import ipywidgets as widgets
 
+from ...widgets import show_run
 from ...widgets import slider as _slider
 from .experiments import (
     FAILURE_CASES,
@@ -23,8 +24,7 @@ from .plot import plot_convergence, plot_map_top
 __all__ = ["explore_depth_filter", "explore_failure_cases", "explore_mono", "explore_motion_prior"]
 
 
-def _show_run(r):
-    print(r)
+def _draw_run(r):
     if r.claimed.sum() >= 3:
         plot_map_top(r)
     else:
@@ -51,16 +51,14 @@ def explore_mono(**defaults):
     d.update(defaults)
 
     def show(init_disparity_px, kf_min_frames, kf_max_lost_ratio, patch_px, noise_std):
-        try:
+        def run():
             sim = mono_sim(d["size"], noise_std=noise_std, rng=d["rng"])
             imgs, Ts = render_sequence(sim, sequence_poses("strafe", d["n_frames"]), progress=False)
-            r = run_mono(imgs, Ts, sim.rig.left.K, name="strafe", progress=False,
-                         init_disparity_px=init_disparity_px, kf_min_frames=int(kf_min_frames),
-                         kf_max_lost_ratio=kf_max_lost_ratio, patch_px=int(patch_px) | 1)
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        _show_run(r)
+            return run_mono(imgs, Ts, sim.rig.left.K, name="strafe", progress=False,
+                            init_disparity_px=init_disparity_px, kf_min_frames=int(kf_min_frames),
+                            kf_max_lost_ratio=kf_max_lost_ratio, patch_px=int(patch_px) | 1)
+
+        show_run(run, _draw_run, table=str)
 
     return widgets.interactive(
         show,
@@ -88,13 +86,9 @@ def explore_failure_cases(**defaults):
     d.update(defaults)
 
     def show(case, motion_model):
-        try:
-            res = run_failure_cases((case,), size=d["size"], n_frames=d["n_frames"], rng=d["rng"], progress=False,
-                                    motion_model=motion_model)
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        _show_run(res[case])
+        show_run(lambda: run_failure_cases((case,), size=d["size"], n_frames=d["n_frames"], rng=d["rng"],
+                                               progress=False, motion_model=motion_model)[case],
+                     _draw_run, table=str)
 
     return widgets.interactive(
         show,
@@ -120,15 +114,13 @@ def explore_motion_prior(**defaults):
     d.update(defaults)
 
     def show(sequence, motion_model, n_frames):
-        try:
+        def run():
             sim = mono_sim(d["size"], rng=d["rng"])
             imgs, Ts = render_sequence(sim, sequence_poses(sequence, int(n_frames)), progress=False)
-            r = run_mono(imgs, Ts, sim.rig.left.K, name=f"{sequence}, {motion_model}", progress=False,
-                         motion_model=motion_model)
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        _show_run(r)
+            return run_mono(imgs, Ts, sim.rig.left.K, name=f"{sequence}, {motion_model}", progress=False,
+                            motion_model=motion_model)
+
+        show_run(run, _draw_run, table=str)
 
     return widgets.interactive(
         show,
@@ -155,13 +147,8 @@ def explore_depth_filter(**defaults):
     d.update(defaults)
 
     def show(outlier_rate, tau, n_obs):
-        try:
-            c = run_depth_filter_convergence((outlier_rate,), n_obs=int(n_obs), tau=tau, rng=d["rng"])
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(c.table(at=tuple(sorted({0, 5, 10, 20, int(n_obs)}))))
-        plot_convergence(c)
+        show_run(lambda: run_depth_filter_convergence((outlier_rate,), n_obs=int(n_obs), tau=tau, rng=d["rng"]),
+                     plot_convergence, table=lambda c: c.table(at=tuple(sorted({0, 5, 10, 20, int(n_obs)}))))
 
     return widgets.interactive(
         show,

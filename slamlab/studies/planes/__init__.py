@@ -27,6 +27,7 @@ from .experiments import (
     timing_table,
 )
 from .figures import (
+    FIG4_PARAMS,
     IntensityResult,
     IntensitySpread,
     IntensityStudy,
@@ -44,6 +45,7 @@ _WIDGETS = ("explore_flight", "explore_intensity_figure")
 __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
 
 __all__ = [
+    "FIG4_PARAMS",
     "GOAL_S",
     "PAIR_VARIANTS",
     "POSE_SOURCES",

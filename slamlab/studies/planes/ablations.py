@@ -11,11 +11,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..._params import refuse_set_fields
 from ..._table import format_table
+from ..._validate import check_int
 from ...planes.filter import PlaneSLAMParams
 from ...sweep import fresh_seed_sequence
 from .experiments import FlightResult, flight_or_simulate, in_frame_rotation_error_deg, run_flight
-from .figures import IntensityResult, run_intensity_figure
+from .figures import FIG4_PARAMS, IntensityResult, run_intensity_figure
 
 __all__ = [
     "PAIR_VARIANTS",
@@ -34,6 +36,9 @@ PAIR_VARIANTS = (
     ("2 largest planes, one pair is enough", 2, 1),
     ("largest plane only: one pair (002's minimum)", 1, 1),
 )
+
+#: The settings of the pairs and incidence ablations' flights when no ``params`` is given: 200 particles.
+_ABLATION_PARAMS = PlaneSLAMParams(n_particles=200)
 
 
 def _fmt_rms(r: FlightResult) -> list[str]:
@@ -112,14 +117,14 @@ class FlightComparison:
         return tab + (f"\n{self.note}" if self.note else "")
 
 
-def run_pairs_ablation(flight=None, *, duration_s: float = 20.0, n_particles: int = 200,
-                       variants=PAIR_VARIANTS, params: PlaneSLAMParams | None = None, rng=0,
-                       **overrides) -> FlightComparison:
+def run_pairs_ablation(flight=None, *, duration_s: float = 20.0, variants=PAIR_VARIANTS,
+                       params: PlaneSLAMParams | None = None, rng=0, **overrides) -> FlightComparison:
     """002 says the filter works "even with only one pair of planes"; ours asks for two normal directions.
 
     Each variant limits the planes of a frame (``max_planes``: the largest ones RANSAC finds) and sets
     ``min_normal_rank`` (1: any pair corrects, as 002; 2: frames whose normals span one direction keep the
-    prediction). Same flight and seed for every variant.
+    prediction). Same flight and seed for every variant. The variants set those two fields: ``params`` and the
+    overrides must leave them at their defaults (a ``ValueError`` names the field otherwise).
 
     Parameters
     ----------
@@ -127,32 +132,33 @@ def run_pairs_ablation(flight=None, *, duration_s: float = 20.0, n_particles: in
         A ready flight (default: simulated from ``rng``).
     duration_s : float
         The simulated flight's length.
-    n_particles : int
-        Particles (replaces ``params.n_particles``).
     variants : sequence of (str, int, int)
         (label, ``max_planes``, ``min_normal_rank``).
     params : PlaneSLAMParams, optional
-        Filter settings under each run's own (default: the defaults).
+        Filter settings every variant changes (default: the defaults with ``n_particles=200``).
     rng : int, SeedSequence or Generator
         The flight's and the filter's seed, the same for every run.
     **overrides
-        :class:`PlaneSLAMParams` fields under each run's own.
+        :class:`PlaneSLAMParams` fields under every variant (e.g. ``n_particles``).
 
     Returns
     -------
     FlightComparison
     """
+    refuse_set_fields(PlaneSLAMParams.resolve(params, **overrides), ["max_planes", "min_normal_rank"],
+                      "each of `variants` sets them")
+    p = PlaneSLAMParams.resolve(_ABLATION_PARAMS if params is None else params, **overrides)
     fl = flight_or_simulate(flight, duration_s, rng)
     labels, res = [], []
     for lab, mp, rank in variants:
         labels.append(lab)
-        res.append(run_flight(flight=fl, rng=rng, params=params, progress=False,
-                              **{**overrides, "n_particles": n_particles, "max_planes": mp, "min_normal_rank": rank}))
+        res.append(run_flight(flight=fl, rng=rng, params=p.replace(max_planes=mp, min_normal_rank=rank),
+                              progress=False))
     return FlightComparison("One plane pair vs two normal directions", tuple(labels), tuple(res))
 
 
-def run_frame_source_ablation(flight=None, *, duration_s: float = 8.0, n_particles: int = 400,
-                              params: PlaneSLAMParams | None = None, rng=0, **overrides) -> FlightComparison:
+def run_frame_source_ablation(flight=None, *, duration_s: float = 8.0, params: PlaneSLAMParams | None = None,
+                              rng=0, **overrides) -> FlightComparison:
     """Where the flight's error comes from (ours): frames built and particles predicted with the odometry (002),
     or with the true poses in one place or the other.
 
@@ -162,26 +168,25 @@ def run_frame_source_ablation(flight=None, *, duration_s: float = 8.0, n_particl
         A ready flight (default: simulated from ``rng``).
     duration_s : float
         The simulated flight's length.
-    n_particles : int
-        Particles (replaces ``params.n_particles``).
     params : PlaneSLAMParams, optional
-        Filter settings under each run's own (default: the defaults).
+        Filter settings of every run (default: the defaults, 400 particles).
     rng : int, SeedSequence or Generator
         The flight's and the filter's seed, the same for every run.
     **overrides
-        :class:`PlaneSLAMParams` fields under each run's own.
+        :class:`PlaneSLAMParams` fields (e.g. ``n_particles``).
 
     Returns
     -------
     FlightComparison
     """
+    p = PlaneSLAMParams.resolve(params, **overrides)
     fl = flight_or_simulate(flight, duration_s, rng)
     cases = (("002: frames and prediction from the odometry", "odometry", "odometry"),
              ("frames from the true poses, prediction from the odometry", "truth", "odometry"),
              ("frames from the odometry, prediction from the true poses", "odometry", "truth"),
              ("both from the true poses", "truth", "truth"))
-    res = tuple(run_flight(flight=fl, rng=rng, params=params, frame_poses=a, increment_poses=b, progress=False,
-                           **{**overrides, "n_particles": n_particles}) for _, a, b in cases)
+    res = tuple(run_flight(flight=fl, rng=rng, params=p, frame_poses=a, increment_poses=b, progress=False)
+                for _, a, b in cases)
     e = in_frame_rotation_error_deg(fl)
     tilt = [map_normal_error_deg(r, fl.room) for r in res]
     note = ("odometry's rotation error inside a frame (each line against the frame's last line), RMS about x / y / "
@@ -229,10 +234,13 @@ class IncidenceResult:
                                   f"{self.flights[0].n_frames} frames, {self.flights[0].params.n_particles} particles)")
 
 
-def run_incidence_ablation(flight=None, *, duration_s: float = 20.0, n_particles: int = 200,
-                           fig4_particles: int = 400, params: PlaneSLAMParams | None = None, rng=0,
-                           **overrides) -> IncidenceResult:
-    """Fig. 4 (one cycle) and a flight with the incidence-angle correction on and off (same seeds).
+def run_incidence_ablation(flight=None, *, duration_s: float = 20.0, fig4_particles: int = 400,
+                           params: PlaneSLAMParams | None = None, fig4_params: PlaneSLAMParams | None = None,
+                           rng=0, **overrides) -> IncidenceResult:
+    """Fig. 4 (one cycle) and a flight with the incidence-angle correction on and off (same seeds; 002 after [17]).
+
+    The ablation sets ``incidence_correction`` itself: ``params`` and the overrides must leave it at its default
+    (a ``ValueError`` names it otherwise).
 
     Parameters
     ----------
@@ -240,24 +248,32 @@ def run_incidence_ablation(flight=None, *, duration_s: float = 20.0, n_particles
         A ready flight (default: simulated from ``rng``).
     duration_s : float
         The simulated flight's length.
-    n_particles, fig4_particles : int
-        Particles of the flight and of Fig. 4 (each replaces ``params.n_particles``).
+    fig4_particles : int
+        Particles of Fig. 4 (its ``n_particles``).
     params : PlaneSLAMParams, optional
-        Filter settings under each run's own (default: the defaults).
+        Filter settings of the flights (default: the defaults with ``n_particles=200``).
+    fig4_params : PlaneSLAMParams, optional
+        Settings of Fig. 4's cycle (default: :data:`~slamlab.studies.planes.figures.FIG4_PARAMS`), but for
+        ``n_particles`` (``fig4_particles``) and ``incidence_correction``; the overrides do not apply to it.
     rng : int, SeedSequence or Generator
         The flight's and the filter's seed, the same for every run.
     **overrides
-        :class:`PlaneSLAMParams` fields under each run's own.
+        :class:`PlaneSLAMParams` fields of the flights (e.g. ``n_particles``).
 
     Returns
     -------
     IncidenceResult
     """
+    refuse_set_fields(PlaneSLAMParams.resolve(params, **overrides), ["incidence_correction"],
+                      "each part runs with the correction and without it")
+    p = PlaneSLAMParams.resolve(_ABLATION_PARAMS if params is None else params, **overrides)
+    fig4 = FIG4_PARAMS if fig4_params is None else PlaneSLAMParams.resolve(fig4_params)
+    refuse_set_fields(fig4_params or PlaneSLAMParams(), ["n_particles", "incidence_correction"],
+                      "Fig. 4 runs with `fig4_particles`, with the correction and without it")
+    fig4 = fig4.replace(n_particles=check_int(fig4_particles, "fig4_particles", minimum=1))
     fl = flight_or_simulate(flight, duration_s, rng)
-    f4: list[IntensityResult] = [run_intensity_figure(n_particles=fig4_particles, params=params,
-                                                      rng=fresh_seed_sequence(rng),
-                                                      **{**overrides, "incidence_correction": c})
-                                 for c in (True, False)]
-    fls = [run_flight(flight=fl, rng=rng, params=params, progress=False,
-                      **{**overrides, "n_particles": n_particles, "incidence_correction": c}) for c in (True, False)]
+    f4: list[IntensityResult] = [run_intensity_figure(params=fig4.replace(incidence_correction=c),
+                                                      rng=fresh_seed_sequence(rng)) for c in (True, False)]
+    fls = [run_flight(flight=fl, rng=rng, params=p.replace(incidence_correction=c), progress=False)
+           for c in (True, False)]
     return IncidenceResult(tuple(f4), tuple(fls))

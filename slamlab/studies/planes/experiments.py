@@ -16,10 +16,11 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ... import _validate as v
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import as_rng, check_choice, check_int, check_positive
 from ...evaluation import Trajectory, ate, rpe
+from ...geometry.so3 import so3_log
 from ...planes.extraction import Frame, build_frame
 from ...planes.filter import STAGES, PlaneSLAM, PlaneSLAMParams
 from ...sim.planes_room import Flight, PlaneRoom, build_corridor, simulate_flight
@@ -50,7 +51,7 @@ POSE_SOURCES = ("odometry", "truth")
 
 
 def _poses(flight: Flight, source: str, name: str) -> np.ndarray:
-    v.check_choice(source, name, POSE_SOURCES)
+    check_choice(source, name, POSE_SOURCES)
     return flight.odometry if source == "odometry" else flight.poses
 
 
@@ -84,7 +85,7 @@ def flight_frames(flight: Flight, frame_lines: int = 40, *, frame_poses: str = "
     true_pose : (4, 4) float
         True pose of the frame's last line.
     """
-    frame_lines = v.check_int(frame_lines, "frame_lines", minimum=1)
+    frame_lines = check_int(frame_lines, "frame_lines", minimum=1)
     T_frame = _poses(flight, frame_poses, "frame_poses")
     T_inc = _poses(flight, increment_poses, "increment_poses")
     prev = None
@@ -113,7 +114,7 @@ def flight_head(flight: Flight, duration_s: float) -> Flight:
     """
     if not isinstance(flight, Flight):
         raise TypeError(f"`flight` must be a Flight; got {type(flight).__name__}")
-    n = round(v.check_positive(duration_s, "duration_s") * flight.scanner.lines_per_s)
+    n = round(check_positive(duration_s, "duration_s") * flight.scanner.lines_per_s)
     if n > len(flight):
         raise ValueError(f"`duration_s` = {duration_s} s is longer than the flight ({len(flight)} lines)")
     return dataclasses.replace(flight, times_s=flight.times_s[:n], poses=flight.poses[:n],
@@ -157,13 +158,13 @@ def in_frame_rotation_error_deg(flight: Flight, frame_lines: int = 40) -> np.nda
     (3,) float
         RMS rotation-vector error per axis in degrees.
     """
-    frame_lines = v.check_int(frame_lines, "frame_lines", minimum=1)
+    frame_lines = check_int(frame_lines, "frame_lines", minimum=1)
     n = (len(flight) // frame_lines) * frame_lines
     last = (np.arange(n) // frame_lines + 1) * frame_lines - 1
     To, Tt = flight.odometry, flight.poses
     Ro = np.swapaxes(To[last, :3, :3], 1, 2) @ To[:n, :3, :3]
     Rt = np.swapaxes(Tt[last, :3, :3], 1, 2) @ Tt[:n, :3, :3]
-    e = np.rad2deg(Rotation.from_matrix(np.swapaxes(Rt, 1, 2) @ Ro).as_rotvec())
+    e = np.rad2deg(so3_log(np.swapaxes(Rt, 1, 2) @ Ro))
     return np.sqrt(np.mean(e**2, axis=0))
 
 
@@ -189,7 +190,7 @@ def flight_or_simulate(flight: Flight | None, duration_s: float, rng) -> Flight:
 
     if flight is None:
         seed = fresh_seed_sequence(rng).spawn(2)[0]
-        return simulate_flight(v.check_positive(duration_s, "duration_s"), rng=np.random.default_rng(seed))
+        return simulate_flight(check_positive(duration_s, "duration_s"), rng=np.random.default_rng(seed))
     if not isinstance(flight, Flight):
         raise TypeError(f"`flight` must be a Flight or None; got {type(flight).__name__}")
     return flight
@@ -243,7 +244,7 @@ def offset_frames(offset_m: float, rng) -> tuple[list[Flight], list[Frame]]:
     frames : list of 2 Frame
         The first frame of each flight.
     """
-    g = v.as_rng(rng)
+    g = as_rng(rng)
     room = three_plane_room(rng=g.integers(2**31))
     start = np.array([5.0, 1.5, 1.5])
     flights = []
@@ -293,13 +294,13 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
     """
     p = PlaneSLAMParams.resolve(params, **overrides)
     if duration_s is None:
-        v.check_choice(size, "size", tuple(SIZES))
+        check_choice(size, "size", tuple(SIZES))
         duration_s = SIZES[size]
     from ...sweep import fresh_seed_sequence
 
     seeds = fresh_seed_sequence(rng).spawn(2)  # a fresh copy: the same streams on every call with this `rng`
     flight = flight_or_simulate(flight, duration_s, rng)
-    n_frames = len(flight) // v.check_int(frame_lines, "frame_lines", minimum=1)
+    n_frames = len(flight) // check_int(frame_lines, "frame_lines", minimum=1)
     if n_frames < 2:
         raise ValueError(f"the flight has {len(flight)} lines: fewer than two frames of `frame_lines` = {frame_lines}")
     frames = flight_frames(flight, frame_lines, frame_poses=frame_poses, increment_poses=increment_poses)
@@ -347,7 +348,7 @@ def setup_table(flight: Flight, frame_lines: int = 40) -> str:
     """
     if not isinstance(flight, Flight):
         raise TypeError(f"`flight` must be a Flight; got {type(flight).__name__}")
-    frame_lines = v.check_int(frame_lines, "frame_lines", minimum=1)
+    frame_lines = check_int(frame_lines, "frame_lines", minimum=1)
     sc = flight.scanner
     R = flight.poses[:, :3, :3]
     z = R[:, :, 0]                                                   # body x axis in the map

@@ -11,18 +11,18 @@ import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_rng, check_int, check_positive
+from ...geometry.so3 import so3_exp
 from ...planes.extraction import Frame
 from ...planes.filter import PlaneSLAM, PlaneSLAMParams
 from ...planes.mapping import PlaneMap
 from ...planes.transform import lm_pose, planes_to_body
 from .experiments import offset_frames
 
-__all__ = ["IntensityResult", "IntensitySpread", "IntensityStudy", "PairsResult", "run_intensity_figure",
-           "run_intensity_spread", "run_intensity_study", "run_pairs_figure"]
+__all__ = ["FIG4_PARAMS", "IntensityResult", "IntensitySpread", "IntensityStudy", "PairsResult",
+           "run_intensity_figure", "run_intensity_spread", "run_intensity_study", "run_pairs_figure"]
 
 
 # --- 002 Fig. 2: the locus of the solved particles for one, two, three pairs --------------------------------
@@ -87,15 +87,15 @@ def run_pairs_figure(n_particles: int = 300, sigma_m: float = 0.3, *, rng=0) -> 
     PairsResult
         Positions and their spread per number of pairs.
     """
-    n_particles = v.check_int(n_particles, "n_particles", minimum=2)
-    sigma_m = v.check_positive(sigma_m, "sigma_m")
-    g = v.as_rng(rng)
+    n_particles = check_int(n_particles, "n_particles", minimum=2)
+    sigma_m = check_positive(sigma_m, "sigma_m")
+    g = as_rng(rng)
     n_m = np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
     p_m = np.array([4.0, 3.0, 2.5])
     R_true, t_true = np.eye(3), np.array([1.0, 1.0, 1.0])
     n_b, p_b = planes_to_body(n_m, p_m, R_true, t_true)
     t0 = t_true + g.normal(0, sigma_m, (n_particles, 3))
-    R0 = Rotation.from_rotvec(g.normal(0, np.deg2rad(1.0), (n_particles, 3))).as_matrix()
+    R0 = so3_exp(g.normal(0, np.deg2rad(1.0), (n_particles, 3)))
     before, after, sb, sa = [], [], [], []
     for k in (1, 2, 3):
         res = lm_pose(R0, t0, np.broadcast_to(n_m[:k], (n_particles, k, 3)),
@@ -110,6 +110,21 @@ def run_pairs_figure(n_particles: int = 300, sigma_m: float = 0.3, *, rng=0) -> 
 # --- 002 Fig. 4: three planes, two parallel; the intensities pick the point -----------------------------------
 #: the bins of |x - x_true| [m] of the weight profile (Fig. 4)
 PROFILE_BINS_M = (0.0, 0.1, 0.2, 0.4, 0.7, np.inf)
+
+#: Fig. 4's filter settings when no ``params`` is given (ours, 002 gives none but the 400 particles): the prediction's
+#: variances V = 0.09 m² and 0.25 deg² (the particles spread along the walls), frames of two normal directions,
+#: planes paired within 1.5 m (the spread particles still pair the walls).
+FIG4_PARAMS = PlaneSLAMParams(n_particles=400, V_xyz_m2=0.09, V_rpy_deg2=0.25, min_normal_rank=2, pair_dist_m=1.5)
+
+
+def _fig4_settings(params, overrides: dict) -> PlaneSLAMParams:
+    """Fig. 4's settings: ``params`` (default :data:`FIG4_PARAMS`) with ``overrides``; the figure runs with the
+    intensity weights and without them, so the caller's settings must leave ``intensity_weights`` alone."""
+    from ..._params import refuse_set_fields
+
+    refuse_set_fields(PlaneSLAMParams.resolve(params, **overrides), ["intensity_weights"],
+                      "the figure runs with the intensity weights and, as its ablation, without them")
+    return PlaneSLAMParams.resolve(FIG4_PARAMS if params is None else params, **overrides)
 
 
 @dataclass(frozen=True)
@@ -232,8 +247,7 @@ class IntensityResult:
                             title="Fig. 4, first cycle: SAD and weight along the line of uncertainty (ours)")
 
 
-def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz_m2: float = 0.09,
-                         V_rpy_deg2: float = 0.25, rounds: int = 1, V_later_xyz_m2: float = 4e-4,
+def run_intensity_figure(offset_m: float = 0.4, *, rounds: int = 1, V_later_xyz_m2: float = 4e-4,
                          V_later_rpy_deg2: float = 0.04, params: PlaneSLAMParams | None = None, rng=0,
                          **overrides) -> IntensityResult:
     """002 Fig. 4: three planes, two of them parallel; one cycle of the filter (002 "Intensity weights").
@@ -242,7 +256,8 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz
     floor); the vehicle then moves ``offset_m`` along the walls while the odometry says it did not. The particles
     are predicted with ``ε ~ N(0, V)`` (``V_xyz_m2`` [m²], ``V_rpy_deg2`` [deg²]: variances, as in 002), the LM
     puts them on the line the planes leave free (``x``), the intensity weights and one importance resampling
-    pick a point on it. The ablation runs the same particles with ``intensity_weights=False``.
+    pick a point on it. The ablation runs the same particles with ``intensity_weights=False``: the figure sets
+    that field itself, and ``params`` and the overrides must leave it at its default (a ``ValueError`` names it).
 
     ``rounds`` > 1 (ours, not 002's figure) repeats the cycle on the same frame; those later cycles use
     ``V_later_xyz_m2``, ``V_later_rpy_deg2`` (default (2 cm)² and (0.2°)²: a re-run should not undo the first).
@@ -251,42 +266,34 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz
     ----------
     offset_m : float
         True motion along the walls between the two frames, metres (the odometry says 0).
-    n_particles : int
-        Particles.
-    V_xyz_m2 : float
-        Prediction variance of the position, m².
-    V_rpy_deg2 : float
-        Prediction variance of roll, pitch, yaw, deg².
     rounds : int
         Cycles on the second frame.
     V_later_xyz_m2, V_later_rpy_deg2 : float
         Prediction variances of the cycles after the first.
     params : PlaneSLAMParams, optional
-        Filter settings under the figure's own.
+        Filter settings (default :data:`FIG4_PARAMS`: 400 particles, ``V_xyz_m2`` 0.09 m², ``V_rpy_deg2``
+        0.25 deg², ``min_normal_rank`` 2, ``pair_dist_m`` 1.5 m).
     rng : numpy.random.Generator, int or None
         Randomness of the room, flights and particles.
     **overrides
-        :class:`PlaneSLAMParams` fields that replace the figure's settings.
+        :class:`PlaneSLAMParams` fields that replace those of ``params`` (e.g. ``n_particles``, ``V_xyz_m2``).
 
     Returns
     -------
     IntensityResult
         The first cycle's particles and weights and the errors with and without the weights.
     """
-    g = v.as_rng(rng)
+    p = _fig4_settings(params, overrides)
+    g = as_rng(rng)
     offset_m = float(offset_m)
-    rounds = v.check_int(rounds, "rounds", minimum=1)
-    for name, val in (("V_xyz_m2", V_xyz_m2), ("V_rpy_deg2", V_rpy_deg2), ("V_later_xyz_m2", V_later_xyz_m2),
-                      ("V_later_rpy_deg2", V_later_rpy_deg2)):
-        v.check_positive(val, name, allow_zero=True)
+    rounds = check_int(rounds, "rounds", minimum=1)
+    for name, val in (("V_later_xyz_m2", V_later_xyz_m2), ("V_later_rpy_deg2", V_later_rpy_deg2)):
+        check_positive(val, name, allow_zero=True)
     flights, frames = offset_frames(offset_m, g)
     slam_seed = int(g.integers(2**31))           # the same particles for the run and its ablation
     out = {}
     for use in (True, False):
-        p = PlaneSLAMParams.resolve(params, **{"n_particles": n_particles, "V_xyz_m2": V_xyz_m2,
-                                              "V_rpy_deg2": V_rpy_deg2, "min_normal_rank": 2, "pair_dist_m": 1.5,
-                                              "intensity_weights": use, **overrides})
-        slam = PlaneSLAM(flights[0].poses[-1], params=p, rng=slam_seed)
+        slam = PlaneSLAM(flights[0].poses[-1], params=p.replace(intensity_weights=use), rng=slam_seed)
         slam.step(frames[0], np.eye(4))
         slam.update_map = False
         first = None
@@ -300,7 +307,7 @@ def run_intensity_figure(offset_m: float = 0.4, *, n_particles: int = 400, V_xyz
     (pred, solved, sad, w, res, rep), err_on, slam_on = out[True]
     return IntensityResult(pred, solved, sad, w, res, flights[1].poses[-1][:3, 3], float(err_on),
                            float(out[False][1]), solved.std(axis=0), rep.n_planes, rep.normal_rank,
-                           float(V_xyz_m2), rounds, frames[1], slam_on.map)
+                           float(p.V_xyz_m2), rounds, frames[1], slam_on.map)
 
 
 @dataclass(frozen=True)
@@ -338,44 +345,46 @@ class IntensitySpread:
                             title="Fig. 4, one cycle, over the prediction's V (ours)")
 
 
-def run_intensity_spread(V_values_m2=(0.01, 0.09, 0.36), offset_m: float = 0.4, *, n_particles: int = 400,
+def run_intensity_spread(V_values_m2=(0.01, 0.09, 0.36), offset_m: float = 0.4, *,
                          params: PlaneSLAMParams | None = None, rng=0, **overrides) -> IntensitySpread:
     """:func:`run_intensity_figure` (one cycle) for each V in ``V_values_m2`` with the same seed (ours).
+
+    The study varies ``V_xyz_m2`` itself: ``params`` and the overrides must leave it (and ``intensity_weights``)
+    at the default (a ``ValueError`` names the field otherwise).
 
     Parameters
     ----------
     V_values_m2 : sequence of float
-        The prediction's position variances [m²], one run each.
+        The prediction's position variances [m²], one run each (the study's own axis: not ``params.V_xyz_m2``).
     offset_m : float
         How far the vehicle moves along the walls while the odometry says it did not.
-    n_particles : int
-        Particles (replaces ``params.n_particles``).
     params : PlaneSLAMParams, optional
-        Filter settings under Fig. 4's (see :func:`run_intensity_figure`).
+        Filter settings (default :data:`FIG4_PARAMS`, see :func:`run_intensity_figure`), but for ``V_xyz_m2``.
     rng : int, SeedSequence or Generator
         The seed every run starts from (the same for every V).
     **overrides
-        :class:`PlaneSLAMParams` fields.
+        :class:`PlaneSLAMParams` fields (e.g. ``n_particles``).
 
     Returns
     -------
     IntensitySpread
     """
+    from ..._params import refuse_set_fields
     from ...sweep import fresh_seed_sequence
 
-    vals = [v.check_positive(x, "V_values_m2") for x in np.atleast_1d(np.asarray(V_values_m2, dtype=float))]
+    refuse_set_fields(PlaneSLAMParams.resolve(params, **overrides), ["V_xyz_m2"], "one run per value of `V_values_m2`")
+    p = _fig4_settings(params, overrides)
+    vals = [check_positive(x, "V_values_m2") for x in np.atleast_1d(np.asarray(V_values_m2, dtype=float))]
     if not vals:
         raise ValueError("`V_values_m2` must hold at least one variance")
     # a fresh copy of the same SeedSequence per V (an int seed: the stream of default_rng(seed) each time)
-    return IntensitySpread(tuple(run_intensity_figure(offset_m, n_particles=n_particles, V_xyz_m2=x, params=params,
-                                                      rng=fresh_seed_sequence(rng), **overrides) for x in vals))
+    return IntensitySpread(tuple(run_intensity_figure(offset_m, params=p.replace(V_xyz_m2=x),
+                                                      rng=fresh_seed_sequence(rng)) for x in vals))
 
 
-def _fig4_trial(offset_m: float, rng, n_particles: int = 400, rounds: int = 1, params=None,
-                overrides: dict | None = None) -> dict:
+def _fig4_trial(offset_m: float, rng, params: PlaneSLAMParams, rounds: int = 1) -> dict:
     """One Fig. 4 run with a seed drawn from ``rng``: the along-corridor errors with and without the weights."""
-    r = run_intensity_figure(offset_m, n_particles=n_particles, rounds=rounds, params=params,
-                             rng=int(rng.integers(2**31)), **(overrides or {}))
+    r = run_intensity_figure(offset_m, rounds=rounds, params=params, rng=int(rng.integers(2**31)))
     return {"error_with_m": r.error_with_m, "error_without_m": r.error_without_m, "peak": r.peak}
 
 
@@ -418,7 +427,7 @@ class IntensityStudy:
                             rows, title=f"002 Fig. 4 over seeds, {cyc} (ours)")
 
 
-def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_particles: int = 400, rounds: int = 1,
+def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, rounds: int = 1,
                         params: PlaneSLAMParams | None = None, rng=0, n_jobs: int = 1, progress=None,
                         **overrides) -> IntensityStudy:
     """Fig. 4 (:func:`run_intensity_figure`) repeated over ``n_seeds`` seeds for each offset, by
@@ -430,10 +439,10 @@ def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_parti
         Runs per offset, each from its own stream.
     offsets_m : sequence of float
         How far the vehicle moves along the walls while the odometry says it did not.
-    n_particles, rounds : int
-        Particles (replaces ``params.n_particles``) and cycles on the second frame.
+    rounds : int
+        Cycles on the second frame.
     params : PlaneSLAMParams, optional
-        Filter settings under Fig. 4's (see :func:`run_intensity_figure`).
+        Filter settings (default :data:`FIG4_PARAMS`, see :func:`run_intensity_figure`).
     rng : int, SeedSequence or Generator
         Where every run's stream is spawned from.
     n_jobs : int
@@ -441,7 +450,7 @@ def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_parti
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
     **overrides
-        :class:`PlaneSLAMParams` fields.
+        :class:`PlaneSLAMParams` fields (e.g. ``n_particles``).
 
     Returns
     -------
@@ -449,11 +458,10 @@ def run_intensity_study(n_seeds: int = 10, offsets_m=(0.2, 0.4, 0.8), *, n_parti
     """
     from ...sweep import root_seed_sequence, sweep
 
-    PlaneSLAMParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
-    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
-    rounds = v.check_int(rounds, "rounds", minimum=1)
+    p = _fig4_settings(params, overrides)
+    n_seeds = check_int(n_seeds, "n_seeds", minimum=1)
+    rounds = check_int(rounds, "rounds", minimum=1)
     table = sweep(_fig4_trial, {"offset_m": [float(o) for o in offsets_m]}, seeds=n_seeds,
                   rng=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, on_error="raise", desc="Fig. 4 study",
-                  fixed={"n_particles": n_particles, "rounds": rounds, "params": params, "overrides": dict(overrides)},
-                  progress=progress)
+                  fixed={"rounds": rounds, "params": p}, progress=progress)
     return IntensityStudy(table, rounds)

@@ -153,7 +153,7 @@ def timing_goal() -> str:
             ["sum of 002's six stages [s]", " + ".join(f"{x:.3f}" for x in parts) + f" = {total:.3f}"],
             ["002's 'total' row [s]", f"{SOURCE_TIMES_S['total']:.3f}"],
             ["half of 002's total [s]", f"{SOURCE_TIMES_S['total'] / 2:.3f}"],
-            ["the goal (ours, issue 13; 002 sets none) [s]", f"{GOAL_S:.2f}"]]
+            ["the goal (ours; 002 sets none) [s]", f"{GOAL_S:.2f}"]]
     return format_table(["quantity", "value"], rows, title="002's timing table and the speed goal")
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import ipywidgets as widgets
 
 from ...widgets import STYLE as _STYLE
+from ...widgets import show_run
 from ...widgets import slider as _slider
 from .experiments import run_flight
 from .figures import run_intensity_figure
@@ -32,17 +33,11 @@ def explore_flight(**defaults):
     d.update(defaults)
 
     def show(n_particles, V_xyz_m2, V_rpy_deg2, ransac_tolerance_m, intensity_weights, frame_lines):
-        try:
-            res = run_flight(d["duration_s"], frame_lines=int(frame_lines), n_particles=int(n_particles),
-                             V_xyz_m2=V_xyz_m2, V_rpy_deg2=V_rpy_deg2,
-                             ransac_tolerance_m=ransac_tolerance_m, intensity_weights=bool(intensity_weights),
-                             rng=d["rng"])
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(res)
-        print(res.table())
-        plot_flight_errors(res)
+        show_run(lambda: run_flight(d["duration_s"], frame_lines=int(frame_lines), n_particles=int(n_particles),
+                                        V_xyz_m2=V_xyz_m2, V_rpy_deg2=V_rpy_deg2,
+                                        ransac_tolerance_m=ransac_tolerance_m,
+                                        intensity_weights=bool(intensity_weights), rng=d["rng"]),
+                     plot_flight_errors, table=lambda res: f"{res}\n{res.table()}")
 
     return widgets.interactive(
         show,
@@ -75,15 +70,9 @@ def explore_intensity_figure(**defaults):
     d.update(defaults)
 
     def show(offset_m, V_xyz_m2, n_particles, incidence_correction):
-        try:
-            r = run_intensity_figure(offset_m, n_particles=int(n_particles), V_xyz_m2=V_xyz_m2,
-                                     incidence_correction=bool(incidence_correction), rng=d["rng"])
-        except (ValueError, TypeError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(r.table())
-        print(r.profile_table())
-        plot_intensity_figure(r)
+        show_run(lambda: run_intensity_figure(offset_m, n_particles=int(n_particles), V_xyz_m2=V_xyz_m2,
+                                                  incidence_correction=bool(incidence_correction), rng=d["rng"]),
+                     plot_intensity_figure, table=lambda r: f"{r.table()}\n{r.profile_table()}")
 
     return widgets.interactive(
         show,

@@ -3,6 +3,8 @@
 from ..._lazy import lazy_exports
 from .experiments import (
     COMPARISON,
+    DISPARITY_PARAMS,
+    EXPERIMENTS,
     SIZES,
     DriftStudy,
     StereoRunResult,
@@ -10,12 +12,11 @@ from .experiments import (
     disparity_errors,
     experiment_poses,
     record_stereo_stream,
-    run_closed_loop,
     run_comparison,
     run_drift_study,
+    run_experiment,
     run_stereo_slam,
     run_stereo_slam_variants,
-    run_turn_in_place,
 )
 from .heading import heading_frames
 from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
@@ -37,6 +38,8 @@ __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [
     "ABLATION_BASE",
     "COMPARISON",
+    "DISPARITY_PARAMS",
+    "EXPERIMENTS",
     "KITTI_PARAMS",
     "PROPOSED_FIX",
     "PROPOSED_FIX_OFF",
@@ -53,13 +56,12 @@ __all__ = [
     "kitti_comparison",
     "ours_vs_source",
     "record_stereo_stream",
-    "run_closed_loop",
     "run_comparison",
     "run_drift_study",
+    "run_experiment",
     "run_kitti",
     "run_scale_ablation",
     "run_stereo_slam",
     "run_stereo_slam_variants",
-    "run_turn_in_place",
 ]
 __all__ += list(_LAZY)

@@ -6,10 +6,14 @@ from __future__ import annotations
 import numpy as np
 
 from ..._table import format_table
+from ...geometry.camera import StereoRig
+from ...stereo.local_stages import detect_pair, stereo_match, subpixel_disparity
 from ...stereo.params import StereoParams
 
+__all__ = ["disparity_error_table"]
 
-def disparity_error_table(left, right, depth, F, focal_baseline_px: float, *, params: StereoParams) -> str:
+
+def disparity_error_table(left, right, depth, rig: StereoRig, *, params: StereoParams) -> str:
     """Stereo disparity errors against the true depth, per pyramid level, before and after
     :func:`~slamlab.stereo.subpixel_disparity` (our addition to 000 §3.3).
 
@@ -23,10 +27,8 @@ def disparity_error_table(left, right, depth, F, focal_baseline_px: float, *, pa
         The stereo pair.
     depth : numpy.ndarray, shape (H, W)
         True depth of each left-image pixel [m].
-    F : numpy.ndarray, shape (3, 3)
-        Fundamental matrix of the pair (left to right).
-    focal_baseline_px : float
-        Focal length times baseline, ``f b`` [px m].
+    rig : StereoRig
+        The calibrated pair (epipolar lines, focal length and baseline).
     params : StereoParams
         Pipeline settings (detector, ratio, epipolar tolerance, sub-pixel window).
 
@@ -34,12 +36,10 @@ def disparity_error_table(left, right, depth, F, focal_baseline_px: float, *, pa
     -------
     str
     """
-    from ...stereo.local_stages import _stereo_match, detect_features, subpixel_disparity
-
     p = params
-    fl, fr = detect_features(left, params=p), detect_features(right, params=p)
-    sm = _stereo_match(fl, fr, F, p.ratio, p.epi_tol_px)
-    fb = focal_baseline_px
+    fl, fr = detect_pair(left, right, params=p)
+    sm = stereo_match(fl, fr, rig, params=p)
+    fb = rig.left.fx * rig.baseline_m
 
     def errors(uvl, uvr):
         c, r = np.rint(uvl).astype(int).T

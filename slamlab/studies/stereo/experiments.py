@@ -1,13 +1,13 @@
 """Ch. 4 experiments (000 §3.7): the stereo SLAM loop on rendered arena runs, against ground truth (KITTI and the
 closing table: :mod:`~slamlab.studies.stereo.kitti_experiments`).
 
-``run_turn_in_place`` (000 §3.7.1) and ``run_closed_loop`` (000 §3.7.2) return a
+``run_experiment`` (the turn in place of 000 §3.7.1, the closed loop of 000 §3.7.2) returns a
 frozen :class:`StereoRunResult`; ``str(result)`` is a one-line summary and
 ``result.table()`` prints our figures beside 000's. Timings live in ``stage_time_s``
 and ``fps`` only, never in the table.
 
-This module renders the arena and runs the pipeline on it (the runner, the turn in place, the closed loop,
-the comparison, the drift study, the recorded store calls, the disparity check); the result dataclasses and
+This module renders the arena and runs the pipeline on it (the runner, the two experiments, the comparison, the
+drift study, the recorded store calls, the disparity check); the result dataclasses and
 tables live in :mod:`~slamlab.studies.stereo.run_results`, the disparity error table in :mod:`~slamlab.studies.stereo.disparity_check` (re-exported here).
 """
 
@@ -17,8 +17,8 @@ import time
 
 import numpy as np
 
-from ... import _validate as v
 from ..._progress import progress_bar
+from ..._validate import as_finite_array, as_vector, check_choice, check_int
 from ...geometry import wrap_angle
 from ...geometry.camera import StereoRig
 from ...geometry.se3 import planar_from_se3, se3_from_planar, se3_inverse
@@ -29,10 +29,12 @@ from ...stereo.params import RenderParams, StereoParams
 from ...stereo.slam import StereoSLAM
 from ..kdtree.workloads import RecordingStore, Workload
 from .disparity_check import disparity_error_table
-from .run_results import COMPARISON, SIZES, DriftStudy, StereoRunResult, _first, comparison_table
+from .run_results import COMPARISON, SIZES, DriftStudy, StereoRunResult, comparison_table
 
 __all__ = [
     "COMPARISON",
+    "DISPARITY_PARAMS",
+    "EXPERIMENTS",
     "SIZES",
     "DriftStudy",
     "StereoRunResult",
@@ -41,13 +43,32 @@ __all__ = [
     "disparity_errors",
     "experiment_poses",
     "record_stereo_stream",
-    "run_closed_loop",
     "run_comparison",
     "run_drift_study",
+    "run_experiment",
     "run_stereo_slam",
     "run_stereo_slam_variants",
-    "run_turn_in_place",
 ]
+
+#: the rendered experiments of 000 §3.7: the turn in place (§3.7.1) and the closed loop (§3.7.2)
+EXPERIMENTS = ("turn in place", "closed loop")
+
+#: the settings of :func:`disparity_errors` (ORB: its pyramid levels are the table's rows)
+DISPARITY_PARAMS = StereoParams(detector="orb")
+
+
+def _first(poses, n_frames):
+    return poses if n_frames is None else poses[: check_int(n_frames, "n_frames", minimum=2)]
+
+
+def _varied_by_params(params, default, varied, who: str) -> None:
+    """Raise ``ValueError`` naming the fields that ``params`` sets (away from ``default``) and ``who`` sets itself."""
+    if params is None:
+        return
+    clash = sorted(k for k in varied if getattr(params, k) != getattr(default, k))
+    if clash:
+        raise ValueError(f"`params` sets {', '.join(map(repr, clash))}, which {who} sets itself; "
+                         f"leave {'it' if len(clash) == 1 else 'them'} at the default in `params`")
 
 
 def run_stereo_slam(poses, *, name: str = "run", params: StereoParams | None = None, store=None,
@@ -108,7 +129,8 @@ def run_stereo_slam_variants(
 
     ``variants`` maps a label to a :class:`StereoParams` or to a dict of overrides of ``params``
     (default ``StereoParams()``); every run gets the same RANSAC seed, so each result equals a
-    separate :func:`run_stereo_slam` call. The frames are rendered once (rendering costs about as
+    separate :func:`run_stereo_slam` call. A field is set by one route: ``params`` may not set a field a
+    variant sets, nor come with a variant that is a whole :class:`StereoParams` (``ValueError`` naming it). The frames are rendered once (rendering costs about as
     much as our SURF). ``store``: a landmark store (one variant only) or a factory (default: each
     run's :func:`~slamlab.stereo.slam.default_store`).
 
@@ -147,7 +169,7 @@ def run_stereo_slam_variants(
     dict
         Label -> :class:`StereoRunResult`.
     """
-    poses = v.as_finite_array(poses, "poses", ndim=2)
+    poses = as_finite_array(poses, "poses", ndim=2)
     if poses.shape[1] != 3 or len(poses) < 2:
         raise ValueError(f"`poses` must have shape (N, 3) with N >= 2; got {poses.shape}")
     if not isinstance(variants, dict) or not variants:
@@ -156,9 +178,13 @@ def run_stereo_slam_variants(
     settings = {}
     for label, var in variants.items():
         if isinstance(var, StereoParams):
+            if params is not None:
+                raise ValueError(f"`variants[{label!r}]` is a StereoParams, which replaces `params`: give a dict of "
+                                 "overrides of `params` instead, or leave `params` out")
             settings[label] = var
         elif isinstance(var, dict):
             settings[label] = base.replace(**var)
+            _varied_by_params(params, StereoParams(), var, f"`variants[{label!r}]`")
         else:
             raise TypeError(f"`variants[{label!r}]` must be a StereoParams or a dict of overrides; got {type(var).__name__}")
     if isinstance(store, LandmarkStore) and len(settings) > 1:
@@ -205,31 +231,36 @@ def experiment_poses(experiment: str, size: str = "small") -> np.ndarray:
     experiment : {"turn in place", "closed loop"}
         The trajectory.
     size : {"small", "full"}
-        Frame step (see :func:`run_turn_in_place`, :func:`run_closed_loop`).
+        Frame step (see :func:`run_experiment`).
 
     Returns
     -------
     numpy.ndarray, shape (N, 3)
         ``(x_m, y_m, yaw_rad)``.
     """
-    v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
-    v.check_choice(size, "size", SIZES)
+    check_choice(experiment, "experiment", EXPERIMENTS)
+    check_choice(size, "size", SIZES)
     turn_deg, step_m, loop_turn_deg = SIZES[size]
     if experiment == "turn in place":
         return turn_in_place(np.deg2rad(turn_deg), center_m=(3.0, 4.0), start_yaw_rad=np.pi / 2)
     return rectangular_loop(step_m, np.deg2rad(loop_turn_deg))
 
 
-def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, params: StereoParams | None = None,
-                    store=None, render: RenderParams | None = None, progress=None, rng=0, **overrides) -> StereoRunResult:
-    """360° turn in place in the 6×8 m arena, facing a wall at the start (000 §3.7.1).
+def run_experiment(experiment: str, size: str = "small", *, n_frames: int | None = None,
+                   params: StereoParams | None = None, store=None, render: RenderParams | None = None, progress=None,
+                   rng=0, **overrides) -> StereoRunResult:
+    """One of 000 §3.7's rendered experiments in the 6×8 m arena: the turn in place or the closed loop.
 
-    ``size="small"``: 10° per frame (37 frames); ``"full"``: 5° per frame (73 frames);
-    ``n_frames`` keeps only the first frames (for quick checks). ``params`` + ``overrides``:
-    :class:`StereoParams`; ``render``: :class:`RenderParams`.
+    ``"turn in place"`` (000 §3.7.1): a 360° turn in place, facing a wall at the start; ``size="small"``:
+    10° per frame (37 frames), ``"full"``: 5° per frame (73 frames). ``"closed loop"`` (000 §3.7.2): the
+    closed, roughly rectangular 4×5 m loop back to the start pose; ``"small"``: 0.5 m and 20° per frame
+    (57 frames), ``"full"``: 0.25 m and 15° per frame. ``n_frames`` keeps only the first frames (for
+    quick checks). ``params`` + ``overrides``: :class:`StereoParams`; ``render``: :class:`RenderParams`.
 
     Parameters
     ----------
+    experiment : {"turn in place", "closed loop"}
+        The trajectory.
     size : {"small", "full"}
         Frame step: see above.
     n_frames : int, optional
@@ -250,48 +281,13 @@ def run_turn_in_place(size: str = "small", *, n_frames: int | None = None, param
     Returns
     -------
     StereoRunResult
+        Named after the experiment.
     """
-    v.check_choice(size, "size", SIZES)
-    poses = _first(experiment_poses("turn in place", size), n_frames)
-    return run_stereo_slam(poses, name="turn in place", params=params, store=store, render=render, progress=progress, rng=rng,
-                           **overrides)
-
-
-def run_closed_loop(size: str = "small", *, n_frames: int | None = None, params: StereoParams | None = None,
-                    store=None, render: RenderParams | None = None, progress=None, rng=0, **overrides) -> StereoRunResult:
-    """The closed, roughly rectangular 4×5 m loop in the 6×8 m arena, back to the start pose (000 §3.7.2).
-
-    ``size="small"``: 0.5 m and 20° per frame (57 frames); ``"full"``: 0.25 m and 15° per frame;
-    ``n_frames`` keeps only the first frames (for quick checks). ``params`` + ``overrides``:
-    :class:`StereoParams`; ``render``: :class:`RenderParams`.
-
-    Parameters
-    ----------
-    size : {"small", "full"}
-        Frame step: see above.
-    n_frames : int, optional
-        Keep only the first frames.
-    params : StereoParams, optional
-        Pipeline settings (default :class:`StereoParams`).
-    store : LandmarkStore or callable, optional
-        Landmark store or a factory (default :func:`~slamlab.stereo.slam.default_store`).
-    render : RenderParams, optional
-        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
-    progress : bool, None or callable
-        A bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``), or ``progress(i)`` after frame ``i``.
-    rng : int or numpy.random.Generator, default 0
-        Seed of the RANSAC stream (and the image noise).
-    **overrides
-        :class:`StereoParams` fields to change.
-
-    Returns
-    -------
-    StereoRunResult
-    """
-    v.check_choice(size, "size", SIZES)
-    poses = _first(experiment_poses("closed loop", size), n_frames)
-    return run_stereo_slam(poses, name="closed loop", params=params, store=store, render=render, progress=progress, rng=rng,
-                           **overrides)
+    check_choice(experiment, "experiment", EXPERIMENTS)
+    check_choice(size, "size", SIZES)
+    poses = _first(experiment_poses(experiment, size), n_frames)
+    return run_stereo_slam(poses, name=experiment, params=params, store=store, render=render, progress=progress,
+                           rng=rng, **overrides)
 
 
 def run_comparison(
@@ -301,7 +297,8 @@ def run_comparison(
     """The turn or the loop once per pipeline setting, on the same rendered frames (000 §3.5, §3.7).
 
     ``variants`` maps a label to a :class:`StereoParams` or to overrides of ``params`` (default
-    :data:`COMPARISON`); ``render``: :class:`RenderParams` (``noise_std``, ``drift_std_rad``, ...).
+    :data:`COMPARISON`, which sets ``detector`` and ``policy`` itself: ``params`` may not set them);
+    ``render``: :class:`RenderParams` (``noise_std``, ``drift_std_rad``, ...).
     Returns label -> :class:`StereoRunResult`; :func:`comparison_table` prints them side by side.
 
     Parameters
@@ -328,13 +325,11 @@ def run_comparison(
     dict
         Label -> :class:`StereoRunResult`.
     """
-    v.check_choice(size, "size", SIZES)
-    v.check_choice(experiment, "experiment", ("turn in place", "closed loop"))
+    check_choice(size, "size", SIZES)
+    check_choice(experiment, "experiment", EXPERIMENTS)
     poses = _first(experiment_poses(experiment, size), n_frames)
     return run_stereo_slam_variants(poses, COMPARISON if variants is None else variants, name=experiment,
                                     params=params, render=render, progress=progress, rng=rng)
-
-_RUNNERS = {"turn in place": "run_turn_in_place", "closed loop": "run_closed_loop"}
 
 
 def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, params: StereoParams,
@@ -363,9 +358,8 @@ def drift_level(*, drift_std_rad: float, experiment: str, size: str, n_frames, p
     dict
         ``{"run": StereoRunResult}``.
     """
-    runner = globals()[_RUNNERS[experiment]]
-    return {"run": runner(size, n_frames=n_frames, params=params, render=render.replace(drift_std_rad=drift_std_rad),
-                          progress=False, rng=rng)}
+    return {"run": run_experiment(experiment, size, n_frames=n_frames, params=params,
+                                  render=render.replace(drift_std_rad=drift_std_rad), progress=False, rng=rng)}
 
 
 def run_drift_study(
@@ -377,7 +371,8 @@ def run_drift_study(
 
     The right camera's orientation takes a random-walk step of ``drift_std_rad`` per axis and
     frame while the pipeline keeps the nominal calibration; ``params`` + ``overrides`` set the
-    pipeline (``detector``, ``policy``, ...), ``render`` the rest of the renderer. Every level uses
+    pipeline (``detector``, ``policy``, ...), ``render`` the rest of the renderer (the study sets its
+    ``drift_std_rad`` itself: a ``render`` that sets it is a ``ValueError``). Every level uses
     the same seed ``rng`` (common random numbers: the level is the only change), so each task is
     deterministic and the sweep gives it no stream of its own (``rng_arg=None``); the study is
     the same for any ``n_jobs``. ``progress``: a bar over the levels (default: on unless
@@ -396,7 +391,7 @@ def run_drift_study(
     params : StereoParams, optional
         Pipeline settings (default :class:`StereoParams`).
     render : RenderParams, optional
-        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``, ``drift_std_rad``).
+        Renderer settings (``arena_seed``, ``camera_height_m``, ``noise_std``; not ``drift_std_rad``).
     rng : int, numpy.random.Generator or SeedSequence, default 0
         Seed shared by every level.
     n_jobs : int, default 1
@@ -412,14 +407,17 @@ def run_drift_study(
     """
     from ...sweep import fresh_seed_sequence, sweep
 
-    v.check_choice(experiment, "experiment", _RUNNERS)
-    v.check_choice(size, "size", SIZES)
-    levels = tuple(float(d) for d in np.atleast_1d(v.as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
+    check_choice(experiment, "experiment", EXPERIMENTS)
+    check_choice(size, "size", SIZES)
+    levels = tuple(float(d) for d in np.atleast_1d(as_finite_array(drift_std_rad, "drift_std_rad", ndim=1)))
     if min(levels) < 0:
         raise ValueError(f"`drift_std_rad` must be >= 0; got {levels}")
     root = fresh_seed_sequence(rng)  # every level's run from the same (fresh) SeedSequence
     p = StereoParams.resolve(params, **overrides)
     render = RenderParams.resolve(render)
+    if render.drift_std_rad != RenderParams().drift_std_rad:
+        raise ValueError(f"`render` sets 'drift_std_rad' = {render.drift_std_rad}, which run_drift_study varies itself "
+                         "(its first argument); leave it at the default in `render`")
     table = sweep(drift_level, {"drift_std_rad": levels}, rng_arg=None, n_jobs=n_jobs, progress=progress,
                   on_error="raise", desc=f"calibration drift study ({experiment})",
                   fixed={"experiment": experiment, "size": size, "n_frames": n_frames, "params": p, "render": render,
@@ -456,7 +454,7 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
     """
     p = StereoParams(detector=detector, map_search="global")
     rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
-    run_closed_loop("small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
+    run_experiment("closed loop", "small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
     n = len(rec.iterations)
     return rec.workload(f"stereo closed loop, {n} frames ({detector.upper()}, recorded)",
                         base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
@@ -467,8 +465,8 @@ def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, 
     """Stereo disparity errors against the renderer's depth, per ORB pyramid level, before and after
     :func:`~slamlab.stereo.subpixel_disparity` (our addition to 000 §3.3).
 
-    One rendered pair at ``pose`` in ``arena`` (default the 6×8 m arena): keypoints (``params`` +
-    ``overrides``, default ORB), stereo matches, and for each match the disparity minus the true one
+    One rendered pair at ``pose`` in ``arena`` (default the 6×8 m arena): keypoints (``params``, default
+    :data:`DISPARITY_PARAMS`, i.e. ORB, + ``overrides``), stereo matches, and for each match the disparity minus the true one
     ``f b / z`` (``z``: the renderer's depth at the left keypoint's pixel). Returns a table of the
     median absolute error and the share above 1 px per level.
 
@@ -479,7 +477,7 @@ def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, 
     arena : StereoArena, optional
         Scene (default the 6×8 m arena, seed 0).
     params : StereoParams, optional
-        Pipeline settings (default :class:`StereoParams`).
+        Pipeline settings (default :data:`DISPARITY_PARAMS`: ORB).
     rng : int or numpy.random.Generator, default 0
         Seed of the simulator.
     **overrides
@@ -489,10 +487,10 @@ def disparity_errors(pose=(3.0, 4.0, 1.2), *, arena: StereoArena | None = None, 
     -------
     str
     """
-    p = StereoParams.resolve(params, **({"detector": "orb"} | overrides))
+    p = StereoParams.resolve(DISPARITY_PARAMS if params is None else params, **overrides)
     arena = StereoArena(texture_seed=0) if arena is None else arena
     sim = StereoSim(arena, rng=rng)
-    pose = v.as_vector(pose, "pose", 3)
+    pose = as_vector(pose, "pose", 3)
     left, right = sim.render_pair(pose)
     _, depth, _ = arena.cast(sim.rig.left, se3_from_planar(*pose) @ sim.T_body_left)
-    return disparity_error_table(left, right, depth, sim.rig.F, sim.rig.left.fx * sim.rig.baseline_m, params=p)
+    return disparity_error_table(left, right, depth, sim.rig, params=p)

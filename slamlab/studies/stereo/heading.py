@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_finite_array, check_positive
 from ...geometry import wrap_angle
 
 __all__ = ["heading_frames"]
@@ -43,10 +43,10 @@ def heading_frames(slam, truth, min_deg: float = 5.0) -> str:
         The table (one row per listed frame; a line saying none when there is none).
     """
     est = slam.planar_trajectory
-    truth = v.as_finite_array(truth, "truth", ndim=2)
+    truth = as_finite_array(truth, "truth", ndim=2)
     if truth.shape != est.shape:
         raise ValueError(f"`truth` must have shape {est.shape} (one (x, y, yaw) per processed frame); got {truth.shape}")
-    min_deg = v.check_positive(min_deg, "min_deg")
+    min_deg = check_positive(min_deg, "min_deg")
     yaw = np.rad2deg(np.asarray(wrap_angle(est[:, 2] - truth[:, 2])))
     pos = np.hypot(*(est[:, :2] - truth[:, :2]).T)
     big = np.abs(yaw) > min_deg

@@ -10,9 +10,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._progress import progress_bar
 from ..._table import format_table
+from ..._validate import as_path, check_int
 from ...stereo.params import StereoParams
 from ...stereo.slam import StereoSLAM
 from .experiments import (
@@ -174,10 +174,10 @@ def run_kitti(folder=None, *, n_frames: int | None = None, params: StereoParams 
     from ...evaluation import Trajectory, ate, read_kitti, rpe
     from ...io.kitti import kitti_rig, read_kitti_image
 
-    d = find_data("kitti-odometry-06-stereo") if folder is None else v.as_path(folder, "folder", kind="dir")
+    d = find_data("kitti-odometry-06-stereo") if folder is None else as_path(folder, "folder", kind="dir")
     p = StereoParams.resolve(KITTI_PARAMS if params is None else params, **overrides)
     gt34 = read_kitti(d / "poses.txt").poses[:, :3, :]
-    n = len(gt34) if n_frames is None else min(len(gt34), v.check_int(n_frames, "n_frames", minimum=2))
+    n = len(gt34) if n_frames is None else min(len(gt34), check_int(n_frames, "n_frames", minimum=2))
     gt34 = gt34[:n]
     left0 = read_kitti_image(d / "image_0" / f"{0:06d}.png")
     rig = kitti_rig(d / "calib.txt", left0.shape[1], left0.shape[0])
@@ -209,14 +209,14 @@ def ours_vs_source(turn: StereoRunResult, loops: dict, drift: DriftStudy | None 
                    kitti: KittiRunResult | None = None) -> str:
     """000's figures (§3.1 requirements, §3.7 results) beside ours, from the chapter's runs.
 
-    ``turn``: :func:`run_turn_in_place`; ``loops``: :func:`run_comparison` of the closed loop
+    ``turn``: :func:`run_experiment` of the turn in place; ``loops``: :func:`run_comparison` of the closed loop
     (label -> result; the first is 000's pipeline); ``drift``: :func:`run_drift_study`;
     ``kitti``: :func:`run_kitti`. Frame rates are timings and stay out (``timing_table``).
 
     Parameters
     ----------
     turn : StereoRunResult
-        From :func:`run_turn_in_place`.
+        From :func:`run_experiment` ("turn in place").
     loops : dict
         Label -> :class:`StereoRunResult` of the closed loop, 000's pipeline first.
     drift : DriftStudy, optional

@@ -7,7 +7,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
 from ...geometry import wrap_angle
 from ...stereo.params import StereoParams
@@ -15,10 +14,6 @@ from ...stereo.slam import STAGES
 
 #: frame steps per size: (turn step deg, loop step m, loop turn step deg)
 SIZES = {"small": (10.0, 0.5, 20.0), "full": (5.0, 0.25, 15.0)}
-
-
-def _first(poses, n_frames):
-    return poses if n_frames is None else poses[: v.check_int(n_frames, "n_frames", minimum=2)]
 
 
 @dataclass(frozen=True)

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import _validate as v
 from ..._table import format_table
+from ..._validate import as_finite_array, as_rng, check_int, check_positive
 from ...stereo.params import StereoParams
 from ...stereo.slam import StereoSLAM
 from .kitti_experiments import KITTI_PARAMS
@@ -33,7 +33,7 @@ _FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_firs
 SCALE_ABLATION = {
     "KITTI_PARAMS of stop 36 (both at the landmark's depth)": {},
     "no keypoint noise": {"pixel_std_obs": 0.0},
-    "both at the measured depth (before issue 25)": {"weight_depth": "measured", "update_cov_depth": "measured"},
+    "both at the measured depth": {"weight_depth": "measured", "update_cov_depth": "measured"},
     "pose weight at the measured depth only": {"weight_depth": "measured"},
     "filter covariance at the measured depth only": {"update_cov_depth": "measured"},
     "depth cut 80 m": {"max_depth_m": 80.0},
@@ -110,7 +110,7 @@ class ScaleAblation:
         ATE RMSE (no alignment: both start at frame 0) [m].
     path_length_m : float
         True path length [m].
-    pixel_std : float
+    pixel_std_obs : float
         Keypoint noise of the scene [px] (settings may override it).
     n_degenerate : numpy.ndarray, shape (S, n_seeds)
         Frames that kept the last pose.
@@ -124,7 +124,7 @@ class ScaleAblation:
     step_ratios: np.ndarray = field(repr=False)
     ate_m: np.ndarray = field(repr=False)
     path_length_m: float
-    pixel_std: float
+    pixel_std_obs: float
     n_degenerate: np.ndarray = field(repr=False)
     end_ratio: np.ndarray | None = field(default=None, repr=False)
 
@@ -167,11 +167,11 @@ class ScaleAblation:
         n_seeds, n_steps = self.step_ratios.shape[1:]
         return format_table(head,
                             rows, title=(f"scale ablation: {n_seeds} seeds x {n_steps + 1} frames, {self.path_length_m:.1f} m, "
-                                         f"keypoint noise {self.pixel_std:g} px (simulated)"))
+                                         f"keypoint noise {self.pixel_std_obs:g} px (simulated)"))
 
 
 def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, params: StereoParams | None = None,
-                       n_seeds: int = 3, pixel_std: float = 0.5, rng=0) -> ScaleAblation:
+                       n_seeds: int = 3, pixel_std_obs: float = 0.5, rng=0) -> ScaleAblation:
     """StereoSLAM on a simulated scene's keypoints once per setting and seed: the scale bias and its causes (issue 25).
 
     Every setting sees the same scenes and the same keypoints for a given seed (the noise streams are
@@ -187,18 +187,19 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         Body poses ``(x_m, y_m, yaw_rad)``, N ≥ 3 (:func:`slamlab.sim.highway.highway_path`).
     variants : dict, optional
         Label -> overrides of ``params`` (default :data:`SCALE_ABLATION`); the key ``pixel_std_obs``
-        sets the keypoint noise instead. Oracles (ablation only): a depth source ``'true'``
+        sets the scene's keypoint noise instead (of the argument ``pixel_std_obs``). Oracles (ablation only): a depth source ``'true'``
         (``weight_depth``, ``update_cov_depth``, ``init_cov_depth``) takes the true depth of each point
         from the scene (``last_observed``); the key ``_oracle``, a tuple of ``'cut'`` (the depth cut on
         the true depth), ``'init_position'`` (new landmarks at their true position seen from the
         estimated pose) and ``'pose_points'`` (the pose fit from the exact local points), replaces
         one noisy quantity by the truth.
     params : StereoParams, optional
-        Base settings (default :data:`ABLATION_BASE`).
+        Base settings (default :data:`ABLATION_BASE`). A field that a setting of ``variants`` sets must keep
+        ``ABLATION_BASE``'s value here (``ValueError`` naming it otherwise): the setting would replace it.
     n_seeds : int, default 3
         Scenes (layouts and noise) per setting.
-    pixel_std : float, default 0.5
-        Keypoint noise [px] of the scene's observations.
+    pixel_std_obs : float, default 0.5
+        Keypoint noise [px] of the scene's observations (not the pipeline's ``pixel_std``, its noise model).
     rng : int or numpy.random.Generator, default 0
         Root of the seeds.
 
@@ -208,22 +209,26 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
     """
     if not callable(scene_factory):
         raise TypeError(f"`scene_factory` must be callable (rng -> scene); got {type(scene_factory).__name__}")
-    P = v.as_finite_array(poses, "poses", ndim=2)
+    P = as_finite_array(poses, "poses", ndim=2)
     if P.shape[1] != 3 or P.shape[0] < 3:
         raise ValueError(f"`poses` must have shape (N, 3) with N >= 3; got {P.shape}")
     variants = SCALE_ABLATION if variants is None else variants
     if not isinstance(variants, dict) or not variants:
         raise TypeError("`variants` must be a non-empty dict of label -> dict of overrides")
-    n_seeds = v.check_int(n_seeds, "n_seeds", minimum=1)
-    sigma = v.check_positive(pixel_std, "pixel_std", allow_zero=True)
+    n_seeds = check_int(n_seeds, "n_seeds", minimum=1)
+    sigma = check_positive(pixel_std_obs, "pixel_std_obs", allow_zero=True)
     base = ABLATION_BASE if params is None else StereoParams.resolve(params)
     resolved = {}
     for label, over in variants.items():
         over = dict(over)
         oracle_items = frozenset(over.pop("_oracle", ()))
-        noise = v.check_positive(over.pop("pixel_std_obs", sigma), "pixel_std_obs", allow_zero=True)
+        noise = check_positive(over.pop("pixel_std_obs", sigma), "pixel_std_obs", allow_zero=True)
+        clash = sorted(k for k in over if k in StereoParams.field_names() and getattr(base, k) != getattr(ABLATION_BASE, k))
+        if clash:
+            raise ValueError(f"`params` sets {', '.join(map(repr, clash))}, which the setting {label!r} of `variants` "
+                             "sets itself; leave it as in ABLATION_BASE, or drop that setting")
         resolved[label] = (StereoParams.resolve(base, **over), noise, oracle_items)
-    seeds = np.random.SeedSequence(int(v.as_rng(rng).integers(2**32))).spawn(n_seeds)
+    seeds = np.random.SeedSequence(int(as_rng(rng).integers(2**32))).spawn(n_seeds)
     S, n = len(variants), len(P)
     path_ratio, ate_m, n_deg = np.empty((S, n_seeds)), np.empty((S, n_seeds)), np.zeros((S, n_seeds), int)
     end_ratio = np.empty((S, n_seeds))
@@ -239,7 +244,7 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         for i, (p, noise, oracle_items) in enumerate(resolved.values()):
             g = np.random.default_rng(s_noise)  # the same keypoints for every setting
             slam = StereoSLAM(scene.rig, scene.T_body_left, params=p, rng=np.random.default_rng(s_slam))
-            slam._oracle = oracle_items
+            slam.oracles = oracle_items
             oracle = "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or bool(oracle_items)
             for pose in P:
                 fl, fr = scene.observe(pose, pixel_std=noise, rng=g)
@@ -286,7 +291,7 @@ class ConditionAblation:
         rows = []
         for cond, a in zip(self.conditions, self.results, strict=True):
             ms = a.step_mean_se()
-            rows += [[cond, lab, f"{a.pixel_std:g}", f"{a.path_ratio[i].mean():.3f}", f"{a.end_ratio[i].mean():.3f}",
+            rows += [[cond, lab, f"{a.pixel_std_obs:g}", f"{a.path_ratio[i].mean():.3f}", f"{a.end_ratio[i].mean():.3f}",
                       f"{ms[i, 0]:.3f} ± {ms[i, 1]:.3f}",
                       f"{100 * a.ate_m[i].mean() / a.path_length_m:.2f}", f"{int(a.n_degenerate[i].sum())}"]
                      for i, lab in enumerate(a.labels)]
@@ -332,7 +337,7 @@ def run_condition_ablation(conditions: dict, poses, variants: dict | None = None
             raise TypeError(f"`conditions`[{label!r}] must be a pair (scene_factory, pixel_std); got {c!r}")
     variants = CONDITION_SETTINGS if variants is None else variants
     # an int seed goes to every condition as it is (the plain scene's rows then equal run_scale_ablation's)
-    root = int(rng) if isinstance(rng, (int, np.integer)) else int(v.as_rng(rng).integers(2**32))
-    results = tuple(run_scale_ablation(f, poses, variants, params=params, n_seeds=n_seeds, pixel_std=sigma, rng=root)
+    root = int(rng) if isinstance(rng, (int, np.integer)) else int(as_rng(rng).integers(2**32))
+    results = tuple(run_scale_ablation(f, poses, variants, params=params, n_seeds=n_seeds, pixel_std_obs=sigma, rng=root)
                     for f, sigma in conditions.values())
     return ConditionAblation(tuple(conditions), results)

@@ -7,7 +7,8 @@ from IPython.display import display
 
 from ...stereo.params import STEREO_DETECTORS, RenderParams
 from ...widgets import STYLE as _STYLE
-from .experiments import experiment_poses, run_closed_loop, run_turn_in_place
+from ...widgets import show_run
+from .experiments import experiment_poses, run_experiment
 from .plot import run_figure
 
 __all__ = ["explore_stereo_slam"]
@@ -36,22 +37,18 @@ def explore_stereo_slam(**defaults):
     d.update(defaults)
 
     def show(experiment, detector, policy, ransac_iters, noise_std, drift_mrad):
-        run = run_turn_in_place if experiment == "turn in place" else run_closed_loop
         n = len(experiment_poses(experiment, "small")) if d["n_frames"] is None else d["n_frames"]
         bar = widgets.IntProgress(min=0, max=n, description="frames")
         display(bar)
-        try:
-            render = RenderParams(noise_std=float(noise_std), drift_std_rad=float(drift_mrad) * 1e-3)
-            res = run(
-                "small", n_frames=d["n_frames"], detector=detector, policy=policy, ransac_iters=int(ransac_iters),
-                render=render, rng=d["rng"], progress=lambda i: setattr(bar, "value", i + 1),
-            )  # fmt: skip
-        except (ValueError, TypeError, ImportError) as exc:
-            print(f"Cannot run with these settings: {exc}")
-            return
-        print(res.table())
-        print(res.timing_table())
-        run_figure(res)
+        show_run(
+            lambda: run_experiment(
+                experiment, "small", n_frames=d["n_frames"], detector=detector, policy=policy,
+                ransac_iters=int(ransac_iters),
+                render=RenderParams(noise_std=float(noise_std), drift_std_rad=float(drift_mrad) * 1e-3),
+                rng=d["rng"], progress=lambda i: setattr(bar, "value", i + 1),
+            ),
+            run_figure, table=lambda res: f"{res.table()}\n{res.timing_table()}",
+        )  # fmt: skip
 
     return widgets.interactive(
         show,
