@@ -119,7 +119,7 @@ class Params:
         return format_table(["parameter", "value", "source"], rows, title=type(self).__name__)
 
 
-def refuse_set_fields(params: Params, names: Sequence[str], how: str) -> None:
+def refuse_set_fields(params: Params, names: Sequence[str], how: str, *, default: Params | None = None) -> None:
     """Refuse settings that change a field a study varies itself (ours: one route per setting).
 
     A study whose grid runs over fields of its settings object (particle counts, the two arms of an ablation)
@@ -135,6 +135,9 @@ def refuse_set_fields(params: Params, names: Sequence[str], how: str) -> None:
         The fields the study varies itself.
     how : str
         How the study sets them (e.g. "one run per count of `particle_counts`").
+    default : Params, optional
+        The settings the study starts from, which ``params`` must leave the fields at (default: the class
+        defaults).
 
     Returns
     -------
@@ -154,7 +157,7 @@ def refuse_set_fields(params: Params, names: Sequence[str], how: str) -> None:
     ...
     ValueError: `n_particles` is set by this study itself (one run per count); `params` or an override sets it to 50 (leave the default 2000)
     """
-    default = type(params)()
+    default = type(params)() if default is None else default
     clash = [(n, getattr(params, n), getattr(default, n)) for n in names if getattr(params, n) != getattr(default, n)]
     if clash:
         fields = ", ".join(f"`{n}`" for n, _, _ in clash)

@@ -48,13 +48,13 @@ def test_parameter_sweep_refuses_the_fields_it_sweeps():
 
 
 def test_ablations_refuse_the_fields_their_configurations_set():
-    with pytest.raises(ValueError, match=r"'refine', which the configurations or cases of run_ablation set"):
+    with pytest.raises(ValueError, match=r"`refine` is set by this study itself \(the configurations or cases of run_ablation set it\)"):
         studies.run_ablation(params=MonoParams(refine=False))
-    with pytest.raises(ValueError, match="'init_disparity_px'"):  # the case sets it
+    with pytest.raises(ValueError, match="`init_disparity_px`"):  # the case sets it
         studies.run_ablation(cases=("bad_initial_map",), init_disparity_px=5.0)
     with pytest.raises(TypeError, match="has no field"):
         studies.run_ablation(configs={"x": {"typo": 1}})
-    with pytest.raises(ValueError, match=r"'warp_patches', which the configurations of run_kitti_ablation set"):
+    with pytest.raises(ValueError, match=r"`warp_patches` is set by this study itself \(the configurations of run_kitti_ablation set it\)"):
         kitti.run_kitti_ablation("/nonexistent", params=MonoParams(warp_patches=False))  # refused before loading
 
 

@@ -183,11 +183,11 @@ def test_disparity_errors_takes_its_detector_from_params(monkeypatch):
 
 def test_variants_refuse_a_second_route_for_a_field():
     poses = np.zeros((2, 3))
-    with pytest.raises(ValueError, match=r"`params` sets 'policy', which `variants\['b'\]` sets itself"):
+    with pytest.raises(ValueError, match=r"`policy` is set by this study itself \(`variants\['b'\]` sets it\)"):
         E.run_stereo_slam_variants(poses, {"a": {}, "b": {"policy": "all"}}, params=StereoParams(policy="all"))
     with pytest.raises(ValueError, match=r"`variants\['a'\]` is a StereoParams, which replaces `params`"):
         E.run_stereo_slam_variants(poses, {"a": StereoParams()}, params=StereoParams(ratio=0.7))
-    with pytest.raises(ValueError, match=r"`params` sets 'detector', which `variants\['ORB, oldest'\]` sets itself"):
+    with pytest.raises(ValueError, match=r"`detector` is set by this study itself \(`variants\['ORB, oldest'\]` sets it\)"):
         E.run_comparison("turn in place", params=StereoParams(detector="sift"))
     with pytest.raises(TypeError, match="has no field"):
         E.run_stereo_slam_variants(poses, {"a": {"typo": 1}}, params=StereoParams(policy="all"))
@@ -213,7 +213,7 @@ def test_drift_study_refuses_a_render_that_sets_the_drift():
 
 
 def test_scale_ablation_refuses_a_field_a_setting_sets():
-    with pytest.raises(ValueError, match=r"`params` sets 'weight_depth', which the setting 'w' of `variants` sets"):
+    with pytest.raises(ValueError, match=r"`weight_depth` is set by this study itself \(the setting 'w' of `variants` sets it\)"):
         S.run_scale_ablation(lambda rng: HighwayScene(rng=rng), highway_path(3), {"w": {"weight_depth": "map"}},
                              params=S.ABLATION_BASE.replace(weight_depth="measured"))
     with pytest.raises(ValueError, match="`pixel_std_obs` must be"):

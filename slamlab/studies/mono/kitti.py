@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._params import refuse_set_fields
 from ..._validate import as_path, check_int
 from ...geometry.se3 import se3_inverse
 from ...mono.evaluate import TRACK_TOL_FRAC
@@ -117,10 +118,8 @@ def run_kitti_ablation(folder=None, configs=None, *, n_frames: int | None = None
     p = MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
     for o in configs.values():
         p.replace(**o)  # and a bad configuration
-    clash = sorted({k for o in configs.values() for k in o if getattr(p, k) != getattr(MonoParams(), k)})
-    if clash:
-        raise ValueError(f"`params` / overrides set {', '.join(map(repr, clash))}, which the configurations of "
-                         "run_kitti_ablation set themselves; leave them at the default")
+    refuse_set_fields(p, sorted({k for o in configs.values() for k in o}),
+                      "the configurations of run_kitti_ablation set it")
     imgs, gt, K, name = load_kitti(folder, n_frames)
     return {(label, name): run_mono(imgs, gt, K, name=f"{name}, {label}", params=p, progress=False, **ov)
             for label, ov in progress_bar(list(configs.items()), desc="KITTI ablation", progress=progress)}

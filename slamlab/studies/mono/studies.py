@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._params import refuse_set_fields
 from ..._table import format_table
 from ..._validate import as_rng
 from ...geometry.se3 import se3_from_planar, se3_inverse
@@ -102,10 +103,7 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
     for o in configs.values():
         p.replace(**o)  # and a bad configuration
     varied = {k for o in (*configs.values(), *(FAILURE_SETTINGS.get(c, {}) for c in cases)) for k in o}
-    clash = sorted(k for k in varied if getattr(p, k) != getattr(MonoParams(), k))
-    if clash:
-        raise ValueError(f"`params` / overrides set {', '.join(map(repr, clash))}, which the configurations or cases "
-                         "of run_ablation set themselves; leave them at the default")
+    refuse_set_fields(p, sorted(varied), "the configurations or cases of run_ablation set it")
     seeds = fresh_seed_sequence(rng).spawn(len(cases))  # an int seed: SeedSequence(seed)'s children as before
     out = {}
     for case, ss in zip(cases, seeds, strict=True):

@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from ..._params import refuse_set_fields
 from ..._progress import progress_bar
 from ..._validate import as_finite_array, as_vector, check_choice, check_int
 from ...geometry import wrap_angle
@@ -59,16 +60,6 @@ DISPARITY_PARAMS = StereoParams(detector="orb")
 
 def _first(poses, n_frames):
     return poses if n_frames is None else poses[: check_int(n_frames, "n_frames", minimum=2)]
-
-
-def _varied_by_params(params, default, varied, who: str) -> None:
-    """Raise ``ValueError`` naming the fields that ``params`` sets (away from ``default``) and ``who`` sets itself."""
-    if params is None:
-        return
-    clash = sorted(k for k in varied if getattr(params, k) != getattr(default, k))
-    if clash:
-        raise ValueError(f"`params` sets {', '.join(map(repr, clash))}, which {who} sets itself; "
-                         f"leave {'it' if len(clash) == 1 else 'them'} at the default in `params`")
 
 
 def run_stereo_slam(poses, *, name: str = "run", params: StereoParams | None = None, store=None,
@@ -184,7 +175,8 @@ def run_stereo_slam_variants(
             settings[label] = var
         elif isinstance(var, dict):
             settings[label] = base.replace(**var)
-            _varied_by_params(params, StereoParams(), var, f"`variants[{label!r}]`")
+            if params is not None:
+                refuse_set_fields(params, sorted(var), f"`variants[{label!r}]` sets it")
         else:
             raise TypeError(f"`variants[{label!r}]` must be a StereoParams or a dict of overrides; got {type(var).__name__}")
     if isinstance(store, LandmarkStore) and len(settings) > 1:

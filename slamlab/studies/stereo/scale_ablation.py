@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..._params import refuse_set_fields
 from ..._table import format_table
 from ..._validate import as_finite_array, as_rng, check_int, check_positive
 from ...stereo.params import StereoParams
@@ -223,10 +224,8 @@ def run_scale_ablation(scene_factory, poses, variants: dict | None = None, *, pa
         over = dict(over)
         oracle_items = frozenset(over.pop("_oracle", ()))
         noise = check_positive(over.pop("pixel_std_obs", sigma), "pixel_std_obs", allow_zero=True)
-        clash = sorted(k for k in over if k in StereoParams.field_names() and getattr(base, k) != getattr(ABLATION_BASE, k))
-        if clash:
-            raise ValueError(f"`params` sets {', '.join(map(repr, clash))}, which the setting {label!r} of `variants` "
-                             "sets itself; leave it as in ABLATION_BASE, or drop that setting")
+        refuse_set_fields(base, sorted(k for k in over if k in StereoParams.field_names()),
+                          f"the setting {label!r} of `variants` sets it", default=ABLATION_BASE)
         resolved[label] = (StereoParams.resolve(base, **over), noise, oracle_items)
     seeds = np.random.SeedSequence(int(as_rng(rng).integers(2**32))).spawn(n_seeds)
     S, n = len(variants), len(P)
