@@ -9,49 +9,24 @@ landmark store (000 §3.4).
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import numpy as np
 
 from .._validate import as_matrix, as_rng
 from ..geometry.camera import StereoRig
-from ..geometry.se3 import planar_from_se3
-from ..kdtree.stores import ExactStore, LandmarkStore, base_rule, make_store
+from ..kdtree.stores import base_rule
+from ._frame import STAGES, StageClock, append_rows, check_pair, frame_points, refine_matches, weight_depth
 from .landmark_filter import duplicate_mask, gated_update, in_view, landmark_observations, pixel_update
-from .local_stages import (
-    check_features,
-    detect_pair,
-    is_rectified,
-    stereo_match,
-    stereo_point_cov,
-    triangulate_local,
-)
+from .local_stages import check_features, detect_pair, is_rectified, stereo_match
 from .map_stages import match_in_window, match_to_landmarks, match_to_map
 from .noise_estimate import KeypointNoiseTracker, disparity_residuals_px
 from .params import StereoParams
 from .pose_stages import estimate_pose, pose_std, refine_pose_stereo
+from .results import RunResults
+from .store import default_store, resolve_store
 
 __all__ = ["STAGES", "FrameRecord", "StereoSLAM", "default_store"]
-
-
-#: the per-frame stages whose times are recorded
-STAGES = ("detect", "stereo", "triangulate", "map_match", "pose", "update")
-
-
-class _StageClock:
-    """Wall-clock and process CPU time per stage: ``lap(stage)`` adds the time since the last lap."""
-
-    def __init__(self):
-        self.wall = dict.fromkeys(STAGES, 0.0)
-        self.cpu = dict.fromkeys(STAGES, 0.0)
-        self._w, self._c = time.perf_counter(), time.process_time()
-
-    def lap(self, stage):
-        w, c = time.perf_counter(), time.process_time()
-        self.wall[stage] += w - self._w
-        self.cpu[stage] += c - self._c
-        self._w, self._c = w, c
 
 
 class FrameRecord(dict):
@@ -60,126 +35,7 @@ class FrameRecord(dict):
     __getattr__ = dict.__getitem__
 
 
-def default_store(params: StereoParams | None = None) -> LandmarkStore:
-    """The landmark store the pipeline uses unless told otherwise (000 §3.4, §4).
-
-    Float descriptors (SURF, SIFT): 000's multi kd-tree (n1 = 3500, q = 5.5, BBF with 200
-    checks) behind the non-base buffer (:func:`slamlab.kdtree.make_store`). Binary descriptors
-    (ORB, Hamming distance): a kd-tree does not apply, so :class:`~slamlab.kdtree.ExactStore`
-    (brute force). Both apply the base rule with ``params``' ``base_seen_times`` / ``max_non_base_time``.
-
-    Parameters
-    ----------
-    params : StereoParams, optional
-        Settings (``detector``, ``base_seen_times``, ``max_non_base_time``); default :class:`StereoParams`.
-
-    Returns
-    -------
-    LandmarkStore
-    """
-    p = StereoParams.resolve(params)
-    if p.binary:
-        return ExactStore(p.base_seen_times, p.max_non_base_time)
-    return make_store("multi", base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
-
-
-def _resolve_store(store, p: StereoParams) -> LandmarkStore:
-    """``StereoSLAM``'s ``store`` argument: None (:func:`default_store`), a store, or a class / factory of one."""
-    if store is None:
-        store = default_store(p)
-    elif isinstance(store, type) or (callable(store) and not isinstance(store, LandmarkStore)):
-        store = store()  # a class or a factory
-    if not isinstance(store, LandmarkStore):
-        raise TypeError(f"`store` must be a slamlab.kdtree.LandmarkStore or a factory of one; "
-                        f"got {type(store).__name__}")
-    return store
-
-
-def _check_pair(left, right, image_shape):
-    """The images' shapes: equal to each other and to the rig's image size (grey or colour)."""
-    sl, sr = np.shape(left), np.shape(right)
-    if len(sl) not in (2, 3) or len(sr) not in (2, 3):
-        raise ValueError(f"`left` and `right` must be (H, W) or (H, W, 3) images; got shapes {sl} and {sr}")
-    if sl != sr:
-        raise ValueError(f"`left` and `right` must have the same shape; got {sl} and {sr}")
-    if sl[:2] != image_shape:
-        raise ValueError(f"images must be {image_shape[0]}x{image_shape[1]} (rows x columns) like "
-                         f"the rig's cameras; got {sl[0]}x{sl[1]}")
-
-
-def _frame_points(rig, T_body_left, fl, fr, sm, p: StereoParams, images, oracle, truth):
-    """The frame's stereo points (000 §3.3) in the body frame: ``(cloud, may_be_new, pts_body, cov_body, cov_init,
-    true_cam)``. ``may_be_new``: the points that may become landmarks (within ``max_depth_m``; beyond it, up to
-    ``reobserve_depth_factor`` times deeper, a point may match a landmark but not become one); ``cov_init`` the new
-    landmarks' first covariances; ``true_cam`` the points' true left-camera positions (from ``truth``, the ablation
-    oracle; None when no setting asks for them). ``images``: the ``(left, right)`` pair whose disparities are
-    refined first (None: not refined); ``oracle`` 'cut': the depth cut on the true depths ``truth``."""
-    if "cut" in oracle and truth is not None:  # the depth cut on the true depth (ablation)
-        cloud = triangulate_local(rig, fl, fr, sm, images=images, params=p, max_depth_m=1e12)
-        zt = truth[cloud.left, 2]
-        keep = (zt >= p.min_depth_m) & (zt <= p.max_depth_m)
-        cloud = type(cloud)(cloud.points[keep], cloud.cov[keep], cloud.left[keep], cloud.gap_m[keep])
-        may_be_new = np.ones(len(cloud.points), bool)  # the oracle's cut replaces the one below
-    else:
-        cloud = triangulate_local(rig, fl, fr, sm, images=images, params=p,
-                                  max_depth_m=p.max_depth_m * p.reobserve_depth_factor)
-        may_be_new = cloud.points[:, 2] <= p.max_depth_m
-    Rb, tb = T_body_left[:3, :3], T_body_left[:3, 3]
-    pts_body = cloud.points @ Rb.T + tb
-    cov_body = Rb @ cloud.cov @ Rb.T
-    true_cam = None
-    if "true" in (p.weight_depth, p.update_cov_depth, p.init_cov_depth) or oracle:
-        if truth is None or len(truth) != len(fl.uv):
-            raise ValueError("a depth source 'true' (an ablation oracle) needs `truth_left_cam_m`: the true "
-                             "left-camera position of every left keypoint, set before each frame")
-        true_cam = np.asarray(truth, dtype=float)[cloud.left]
-    cov_init = cov_body
-    if p.init_cov_depth == "true":
-        cov_init = Rb @ stereo_point_cov(true_cam, rig.left.fx, rig.baseline_m, p.pixel_std) @ Rb.T
-    return cloud, may_be_new, pts_body, cov_body, cov_init, true_cam
-
-
-def _weight_depth(source, depth, true_depth, X_map, T_wc, min_depth_m):
-    """The depth behind each match's RANSAC threshold and weight (``weight_depth``): 'measured' the point's own
-    ``depth``, 'true' ``true_depth`` (the ablation oracle: its true depth in this frame), 'map' the depth of the
-    landmark ``X_map`` seen from the left camera at ``T_wc`` (the last pose), at least ``min_depth_m``."""
-    if source == "true":  # the ablation oracle: the point's true depth in this frame
-        return true_depth
-    if source == "map":
-        # the landmark's depth seen from the last pose: its error is not this frame's (issue 25)
-        return np.maximum(((X_map - T_wc[:3, 3]) @ T_wc[:3, :3])[:, 2], min_depth_m)
-    return depth
-
-
-def _refine_matches(ids, loc, n_seen, p: StereoParams):
-    """The inliers ``(ids, loc)`` the reprojection refinement uses: those whose landmark was seen at least
-    ``p.refine_min_seen`` times, or all when fewer than ``p.min_inliers`` were."""
-    seen = n_seen[ids] >= p.refine_min_seen
-    if seen.sum() >= p.min_inliers:  # too few landmarks seen often enough: refine on all inliers
-        ids, loc = ids[seen], loc[seen]
-    return ids, loc
-
-
-def _append_rows(buffers, name, old, rows):
-    """``old`` (None: empty) with ``rows`` appended, as a view of the first rows of ``buffers[name]``, a buffer that
-    doubles when full (the landmark arrays grow every frame; concatenating copied all of them each time). An ``old``
-    that is not a view of that buffer (set from outside) starts a new one."""
-    n = 0 if old is None else len(old)
-    buf = buffers.get(name)
-    if old is not None and (buf is None or old.base is not buf):
-        buf = None
-    need = n + len(rows)
-    dtype = rows.dtype if old is None else np.result_type(old, rows)
-    if buf is None or len(buf) < need or buf.dtype != dtype or buf.shape[1:] != rows.shape[1:]:
-        new = np.empty((max(need, 2 * len(buf) if buf is not None else 0, 256), *rows.shape[1:]), dtype)
-        if n:
-            new[:n] = old
-        buf = buffers[name] = new
-    buf[n:need] = rows
-    return buf[:need]
-
-
-class StereoSLAM:
+class StereoSLAM(RunResults):
     """Stereo SLAM with a landmark map (000 §3.3-3.6).
 
     Parameters
@@ -215,7 +71,7 @@ class StereoSLAM:
         self.rig = rig
         self.T_body_left = np.eye(4) if T_body_left is None else as_matrix(T_body_left, "T_body_left", (4, 4))
         self.params = p = StereoParams.resolve(params, **overrides)
-        self.store = _resolve_store(store, p)
+        self.store = resolve_store(store, p)
         self._noise = KeypointNoiseTracker(p)  # pixel_std: the nominal, or raised to the online estimate
         self.rng = as_rng(rng)
         self._image_shape = (rig.left.height_px, rig.left.width_px)
@@ -230,7 +86,7 @@ class StereoSLAM:
         self.n_seen = np.empty(0, dtype=np.int64)
         self.alive = np.empty(0, dtype=bool)
         self.desc: np.ndarray | None = None  # descriptor of each landmark (the window search's copy)
-        self._buffers: dict[str, np.ndarray] = {}  # the arrays above are views of these (_append_rows)
+        self._buffers: dict[str, np.ndarray] = {}  # the arrays above are views of these (append_rows)
         self._last_ids = np.empty(0, dtype=np.int64)  # landmarks matched or added by the last located frame
         self.T = np.eye(4)  # current pose of the body in the map
         self.poses: list[np.ndarray] = []
@@ -267,8 +123,8 @@ class StereoSLAM:
         FrameRecord
             Counts per stage, ``status``, the pose.
         """
-        _check_pair(left, right, self._image_shape)
-        clock = _StageClock()
+        check_pair(left, right, self._image_shape)
+        clock = StageClock()
         fl, fr = detect_pair(left, right, params=self.params)
         return self._process(fl, fr, left, right, clock)
 
@@ -290,7 +146,7 @@ class StereoSLAM:
         """
         check_features(left_features, "left_features")
         check_features(right_features, "right_features")
-        return self._process(left_features, right_features, None, None, _StageClock())
+        return self._process(left_features, right_features, None, None, StageClock())
 
     def _process(self, fl, fr, left, right, clock) -> FrameRecord:
         """The stages after detection; ``left``/``right`` images (None: no disparity refinement)."""
@@ -300,7 +156,7 @@ class StereoSLAM:
         clock.lap("stereo")
         images = (left, right) if self._refine and left is not None else None
         truth, self.truth_left_cam_m, self._true_cam = self.truth_left_cam_m, None, None
-        cloud, self._may_be_new, pts_body, cov_body, cov_init, self._true_cam = _frame_points(
+        cloud, self._may_be_new, pts_body, cov_body, cov_init, self._true_cam = frame_points(
             self.rig, self.T_body_left, fl, fr, sm, p, images, self.oracles, truth)
         desc = fl.descriptors[cloud.left]
         clock.lap("triangulate")
@@ -442,7 +298,7 @@ class StereoSLAM:
             rec["status"] = "too_few_matches"
         else:
             true_z = self._true_cam[mm.local, 2] if p.weight_depth == "true" else None
-            d_use = _weight_depth(p.weight_depth, depth[mm.local], true_z, self.X[mm.ids], self.T @ self.T_body_left,
+            d_use = weight_depth(p.weight_depth, depth[mm.local], true_z, self.X[mm.ids], self.T @ self.T_body_left,
                                   p.min_depth_m)
             src = pts_body[mm.local]
             if "pose_points" in self.oracles:
@@ -469,7 +325,7 @@ class StereoSLAM:
         (:func:`~slamlab.stereo.refine_pose_stereo`), whose disparity residuals feed the keypoint-noise estimate
         (``pixel_std_estimate``)."""
         p = self.params
-        ids, loc = _refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
+        ids, loc = refine_matches(mm.ids[est.inliers], mm.local[est.inliers], self.n_seen, p)
         pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
         X = self.X[ids]
         T = refine_pose_stereo(est.T, X, pts_left, self.rig, self.T_body_left, iters=p.refine_iters,
@@ -540,7 +396,7 @@ class StereoSLAM:
         for name, rows in (("X", pts_body @ R.T + t), ("P", R @ cov_body @ R.T), ("first_seen", np.full(len(ids), self.frame)),
                            ("n_seen", np.ones(len(ids), dtype=np.int64)), ("alive", np.ones(len(ids), dtype=bool)),
                            ("desc", desc)):
-            setattr(self, name, _append_rows(self._buffers, name, getattr(self, name), rows))
+            setattr(self, name, append_rows(self._buffers, name, getattr(self, name), rows))
         self.store.add(desc, ids)
 
     def _finish(self, rec, clock, pts_body, inl_mask):
@@ -587,53 +443,6 @@ class StereoSLAM:
         return self
 
     # -- results -------------------------------------------------------------------------------------
-    @property
-    def trajectory(self) -> np.ndarray:
-        """(N, 4, 4) estimated body poses in the map frame, one per processed frame."""
-        return np.array(self.poses) if self.poses else np.empty((0, 4, 4))
-
-    @property
-    def planar_trajectory(self) -> np.ndarray:
-        """(N, 3) ``(x_m, y_m, yaw_rad)`` with the yaw unwrapped."""
-        if not self.poses:
-            return np.empty((0, 3))
-        p = np.array([planar_from_se3(T) for T in self.poses])
-        p[:, 2] = np.unwrap(p[:, 2])
-        return p
-
-    def counts(self) -> dict:
-        """Per-frame counts as arrays: points, matches, inliers, landmarks.
-
-        Returns
-        -------
-        dict
-            Count name -> numpy.ndarray over the frames.
-        """
-        keys = [k for k in self.records[0] if k not in ("status", "trail")] if self.records else []
-        return {k: np.array([r[k] for r in self.records]) for k in keys}
-
-    def stage_times(self, cpu: bool = False) -> dict:
-        """Per-frame time of each stage in seconds, as arrays: wall clock, or with ``cpu`` the process's
-        CPU time (all its threads: detection runs the two images in two threads).
-
-        Parameters
-        ----------
-        cpu : bool, default False
-            CPU time of the process instead of wall clock.
-
-        Returns
-        -------
-        dict
-            Stage name -> per-frame times [s].
-        """
-        times = self.cpu_times if cpu else self.times
-        return {s: np.array([t[s] for t in times]) for s in STAGES}
-
-    @property
-    def degenerate_frames(self) -> np.ndarray:
-        """Indices of frames that kept the last pose (too few points / matches, RANSAC failure, ill-conditioned pose)."""
-        return np.array([r["frame"] for r in self.records if r["status"] not in ("ok", "init")], dtype=np.int64)
-
     def landmark_map(self, base_only: bool = True) -> np.ndarray:
         """(K, 3) landmark positions in the map frame (000's 2D map: the first two columns).
 

@@ -16,7 +16,8 @@ from .experiments import (
     run_table1,
     time_localise,
 )
-from .log_experiments import LogLocalisationResult, run_log_localisation
+from .log_experiments import run_log_localisation
+from .log_results import LogLocalisationResult
 from .log_suite import LogSuiteResult, more_confident, run_log_suite
 from .map_check import MAP_CHECK_LAYOUTS, endpoint_agreement, map_check
 from .source_table import ours_vs_source

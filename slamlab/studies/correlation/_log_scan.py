@@ -4,15 +4,15 @@ For one test scan of a CARMEN log: its leave-out grids (the log's grid without t
 localisation in every mode (1 scan, or 2-5 joined by odometry), optionally the votes of the single scans before
 it, and the truth check (is a failure a score failure or a search failure?): the search's own score at its
 estimate and near the logged pose, the score's terms there, and where the truth's marks on unexplored cells come
-from. :mod:`slamlab.studies.correlation.log_experiments` builds the points, runs this task on
-:func:`slamlab.sweep.sweep` and tabulates the columns.
+from. :mod:`slamlab.studies.correlation.log_experiments` builds the points and runs this task on
+:func:`slamlab.sweep.sweep`; :mod:`slamlab.studies.correlation.log_results` tabulates the columns.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import check_choice, check_int
+from ..._validate import check_choice, check_int, check_positive
 from ...correlation.algorithm import heading_error, localise_samples
 from ...correlation.samples import ScanSamples, joined_samples
 from ...correlation.scoring import pose_marks, pose_scores
@@ -48,6 +48,14 @@ def check_leave(leave_out, exclude, kmax: int) -> tuple[str, int]:
     if lo == "window" and ex < kmax - 1:
         raise ValueError(f"`exclude` must be >= {kmax - 1} so the joined scans are not in the map; got {ex}")
     return lo, ex
+
+
+def check_unit(x, name: str) -> float:
+    """A number in [0, 1], named ``name`` in the error."""
+    x = check_positive(x, name, allow_zero=True)
+    if x > 1:
+        raise ValueError(f"`{name}` must lie in [0, 1]; got {x}")
+    return x
 
 
 def log_points(idx, modes, scans_c, Pc, noise, leave_out: str = "window", exclude: int = 2,
