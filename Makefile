@@ -13,13 +13,14 @@ PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 
 .PHONY: venv data lab test reproducible notebooks report student autograde docs lint bench lock clean distclean
 
-## venv: create .venv if missing and install slamlab[test] from constraints.txt (again only when those change)
+## venv: create .venv if missing and install slamlab[test] from constraints.txt and the instructor's grading package
+## (grading/: the labs' references and accepted ranges, not part of the library; again only when those change)
 venv: $(STAMP)
 
-$(STAMP): pyproject.toml constraints.txt
+$(STAMP): pyproject.toml constraints.txt grading/pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --upgrade pip
-	$(BIN)/python -m pip install -c constraints.txt -e '.[test]'
+	$(BIN)/python -m pip install -c constraints.txt -e '.[test]' -e ./grading
 	touch $(STAMP)
 
 ## data: fetch every registered real data set that no data folder holds into the cache, verified (optional:
@@ -64,8 +65,10 @@ student: venv
 	$(BIN)/python tools/labs.py student
 
 ## autograde: grade SUBMISSIONS=<folder of <student>/<NN_topic_lab>.ipynb>; writes build/course/grades.csv
+## (JOBS=2: two groups of students graded at once)
+JOBS ?= 1
 autograde: venv
-	$(BIN)/python tools/labs.py autograde $(SUBMISSIONS)
+	$(BIN)/python tools/labs.py autograde $(SUBMISSIONS) --jobs $(JOBS)
 
 ## docs: the course site in build/site/ (open build/site/index.html): chapters with their stored outputs, the student
 ## labs and instructor guide, the API reference; offline, Sphinx warnings are errors (tools/build_site.py)

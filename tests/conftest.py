@@ -23,6 +23,9 @@ REQUIRE_ENV = "SLAMLAB_REQUIRE_REALDATA"
 
 # No progress bars on the tests' stderr, nor in the kernels nbval starts (they inherit this environment).
 os.environ["SLAMLAB_PROGRESS"] = "0"
+# The labs' exploration attempts are counted in each kernel only (no lab_attempts.json in the repository, and a
+# fresh kernel counts from 1, as the stored outputs do); tests of the file set their own path.
+os.environ["SLAMLAB_LAB_ATTEMPTS"] = "memory"
 
 
 def _require_realdata() -> bool:

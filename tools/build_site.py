@@ -331,7 +331,39 @@ def instructor_page(labs: list[Path], chapters: dict[str, str]) -> str:
     intro = (SITE_SRC / "instructor.md").read_text(encoding="utf-8")
     table = ("| lab | title | chapter | minutes | points | time plan (from the lab) |\n"
              "|---|---|---|---|---|---|\n" + "\n".join(rows) + "\n")
-    return intro.replace("<!-- LAB TABLE -->", table)
+    rubrics = []
+    for lab in labs:
+        nb = _read_nb(lab)
+        rubrics.append(f"### {{doc}}`{lab.name[:2]} <{lab.stem}>`: {_md_escape(_title(nb, lab.stem))}\n")
+        for part, points, text in lab_rubrics(nb):
+            rubrics.append(f"- **{part}** ({points:g} points). {text}")
+        rubrics.append("")
+    return intro.replace("<!-- LAB TABLE -->", table).replace("<!-- RUBRICS -->", "\n".join(rubrics))
+
+
+#: The first paragraph of a hand-graded answer cell: "**Rubric (N points).** 1 point: ...; ..."
+_RUBRIC = re.compile(r"^\*\*Rubric \((\d+(?:\.\d+)?) points?\)\.\*\*\s*(.*?)(?:\n\s*\n|$)", re.DOTALL)
+
+
+def lab_rubrics(nb: dict) -> list[tuple[str, float, str]]:
+    """The rubric of every hand-graded answer of a lab: (question, points, the rubric's text) in order.
+
+    A hand-graded cell is a markdown cell with nbgrader's ``solution`` and ``grade``; its first paragraph is the
+    rubric (``**Rubric (N points).** ...``), the rest the model answer, which the site does not publish.
+    """
+    out = []
+    for c in nb["cells"]:
+        meta = c.get("metadata", {}).get("nbgrader", {})
+        if c["cell_type"] != "markdown" or not (meta.get("solution") and meta.get("grade")):
+            continue
+        source = "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
+        m = _RUBRIC.match(source.strip())
+        if m is None:
+            raise ValueError(f"{meta.get('grade_id')}: a hand-graded answer starts with **Rubric (N points).**")
+        part = meta["grade_id"].split("_")[1]
+        label = "open investigation" if part == "inv" else part.upper()
+        out.append((label, float(meta.get("points", 0)), " ".join(m.group(2).split())))
+    return out
 
 
 def _rst_escape(text: str) -> str:

@@ -153,7 +153,7 @@ def execute(path: Path, env: dict[str, str]):
     km = _kernel_manager()
     client = NotebookClient(nb, km=km, timeout=CELL_TIMEOUT_S, allow_errors=True, record_timing=False,
                             store_widget_state=True, resources={"metadata": {"path": str(NOTEBOOK_DIR)}})
-    full_env = {**os.environ, "MPLBACKEND": "Agg", "SLAMLAB_PROGRESS": "0", **env}
+    full_env = {**os.environ, "MPLBACKEND": "Agg", "SLAMLAB_PROGRESS": "0", "SLAMLAB_LAB_ATTEMPTS": "memory", **env}
     try:
         client.execute(env=full_env)
     finally:

@@ -7,9 +7,11 @@ Usage::
     python tools/labs.py autograde SUBMISSIONS [--course build/course]   # make autograde SUBMISSIONS=...
 
 ``student`` copies ``notebooks/labs/*_lab.ipynb`` (nbgrader's source format: solutions between
-``### BEGIN SOLUTION`` / ``### END SOLUTION``, graded cells with ids and points) into an nbgrader
-course folder as the assignment ``labs``, runs ``nbgrader generate_assignment`` and copies the
-student versions to ``--out``. ``autograde`` takes a folder holding one sub-folder per student
+``### BEGIN SOLUTION`` / ``### END SOLUTION``, graded cells with ids and points, the grading between
+``### BEGIN HIDDEN TESTS`` / ``### END HIDDEN TESTS``) into an nbgrader course folder as the assignment
+``labs``, runs ``nbgrader generate_assignment`` (which takes the solutions and hidden tests out) and copies
+the student versions to ``--out``. Autograding needs the instructor's grading package (``grading/``,
+``slamlab_grading``) importable: ``make venv`` installs it. ``autograde`` takes a folder holding one sub-folder per student
 (``SUBMISSIONS/<student_id>/<NN_topic_lab>.ipynb``), runs ``nbgrader autograde`` and writes
 ``grades.csv`` (``nbgrader export``: one total per student) and ``grades_by_task.csv`` (the points of every
 autograded cell: ``student_id, notebook, grade_id, score, max_score``) into the course folder, printing
@@ -66,13 +68,44 @@ def make_student(out: Path, course: Path) -> list[Path]:
     return written
 
 
-def autograde(submissions: Path, course: Path) -> Path:
-    """Autograde ``submissions/<student>/*.ipynb``; return the path of the grades CSV."""
+def autograde(submissions: Path, course: Path, jobs: int = 1) -> Path:
+    """Autograde ``submissions/<student>/*.ipynb``; return the path of the grades CSV.
+
+    With ``jobs`` > 1 the students are split into that many groups, each graded by its own nbgrader in a copy
+    of the course folder (its own gradebook) at the same time; the groups' CSVs are joined into the course's.
+    """
     if not (course / "source" / ASSIGNMENT).is_dir():
         make_student(course / "student", course)  # the gradebook needs the assignment first
     students = sorted(p for p in submissions.iterdir() if p.is_dir())
     if not students:
         raise SystemExit(f"no student folders in {submissions}")
+    groups = [students[k::jobs] for k in range(max(1, min(jobs, len(students))))]
+    if len(groups) == 1:
+        _autograde_group(students, course)
+        return course / "grades.csv"
+    import concurrent.futures
+
+    courses = []
+    for k in range(len(groups)):
+        part = course / f"part{k}"
+        if part.exists():
+            shutil.rmtree(part)
+        shutil.copytree(course, part, ignore=shutil.ignore_patterns("part*", "submitted", "autograded"))
+        courses.append(part)
+    with concurrent.futures.ThreadPoolExecutor(len(groups)) as pool:
+        list(pool.map(_autograde_group, groups, courses))
+    for name in ("grades.csv", "grades_by_task.csv"):
+        lines = [(c / name).read_text().splitlines() for c in courses]
+        (course / name).write_text("\n".join([lines[0][0]] + [r for part in lines for r in part[1:]]) + "\n")
+    for c in courses:  # the autograded notebooks where a single run puts them
+        for sub in ("submitted", "autograded"):
+            if (c / sub).is_dir():
+                shutil.copytree(c / sub, course / sub, dirs_exist_ok=True)
+    return course / "grades.csv"
+
+
+def _autograde_group(students: list[Path], course: Path) -> None:
+    """``nbgrader autograde`` of ``students`` in ``course``, then its ``grades.csv`` and ``grades_by_task.csv``."""
     for student in students:
         dst = course / "submitted" / student.name / ASSIGNMENT
         if dst.exists():
@@ -83,7 +116,6 @@ def autograde(submissions: Path, course: Path) -> Path:
     _nbgrader(course, "autograde", ASSIGNMENT, "--force")
     _nbgrader(course, "export", "--to=grades.csv")
     export_by_task(course)
-    return course / "grades.csv"
 
 
 def export_by_task(course: Path) -> Path:
@@ -125,6 +157,7 @@ def main(argv: list[str] | None = None) -> int:
     ag = sub.add_parser("autograde", help="grade a folder of submissions")
     ag.add_argument("submissions", type=Path)
     ag.add_argument("--course", type=Path, default=ROOT / "build" / "course")
+    ag.add_argument("--jobs", type=int, default=1, help="grade the students in this many groups at once")
     args = parser.parse_args(argv)
     course = args.course.resolve()
     course.mkdir(parents=True, exist_ok=True)
@@ -132,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
         for path in make_student(args.out.resolve(), course):
             print(path)
     else:
-        print(autograde(args.submissions.resolve(), course))
+        print(autograde(args.submissions.resolve(), course, jobs=args.jobs))
     return 0
 
 

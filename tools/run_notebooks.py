@@ -180,6 +180,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     os.environ["MPLBACKEND"] = "Agg"
     os.environ["SLAMLAB_PROGRESS"] = "0"  # no progress bars in the stored outputs (nbval's reference)
+    os.environ["SLAMLAB_LAB_ATTEMPTS"] = "memory"  # the labs count attempts per kernel: no file, counts from 1
     failed = []
     for path in paths:
         if args.check:

@@ -123,7 +123,15 @@ def _stop(proc) -> None:
 
 @pytest.fixture(scope="module")
 def lab_server(tmp_path_factory):
+    """`make lab` with options for a test: no browser, free port, token, autosave off; yields the base URL
+    (see :func:`start_lab_server`)."""
+    yield from start_lab_server(tmp_path_factory)
+
+
+def start_lab_server(tmp_path_factory, kernel_startup: str = ""):
     """`make lab` with options for a test: no browser, free port, token, autosave off; yields the base URL.
+
+    ``kernel_startup`` is more code for the kernels' IPython startup file (run before the first cell).
 
     Safe under pytest-xdist (each worker starts its own server): the venv is brought up to date under a
     lock, folders come from the worker's own temporary directory, and the server does not move to another
@@ -147,7 +155,8 @@ def lab_server(tmp_path_factory):
     startup = ipython_dir / "profile_default" / "startup"
     startup.mkdir(parents=True)
     (startup / "00-slamlab-prelude.py").write_text(
-        reproducible.PRELUDE + "\nimport os as _os; _os.environ['SLAMLAB_PRELUDE_RAN'] = '1'; del _os\n")
+        reproducible.PRELUDE + "\nimport os as _os; _os.environ['SLAMLAB_PRELUDE_RAN'] = '1'; del _os\n"
+        + kernel_startup)
     env = {**os.environ, "MPLBACKEND": "module://matplotlib_inline.backend_inline", "SLAMLAB_PROGRESS": "0",
            "IPYTHONDIR": str(ipython_dir), **reproducible.variant_env(VARIANT)}
     log_path = tmp_path_factory.mktemp("lab-log") / "server.log"

@@ -1,4 +1,5 @@
-"""An installed copy (a wheel, not a checkout) has the registry and the project-made files it reads (issue 41)."""
+"""An installed copy (a wheel, not a checkout) has the registry and the project-made files it reads (issue 41), and
+the labs' feedback files but not the instructor's grading (issue 43)."""
 
 from __future__ import annotations
 
@@ -20,6 +21,8 @@ room = d.find_data("test_room_200.txt")
 assert str(room).startswith({target!r}) and room.is_file(), room
 assert sim.test_room_200().shape == (200, 200)
 assert d.project_data_dir() == d.bundled_data_dir()  # no longer raises outside a checkout
+from slamlab import lab                               # the labs' feedback files ship (issue 43)
+assert len(lab.task_ids()) > 50 and lab.task_ids("08.")
 print(len(d.registry().files), d.cache_dir())
 """
 
@@ -34,6 +37,11 @@ def test_installed_wheel_reads_its_own_files(tmp_path):
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", str(src), "-w", str(wheels)],
                    check=True, capture_output=True)
     (wheel,) = wheels.glob("slamlab-*.whl")
+    import zipfile
+
+    names = zipfile.ZipFile(wheel).namelist()
+    assert any(n.startswith("slamlab/lab/feedback/") and n.endswith(".json") for n in names)
+    assert not any("grading" in n for n in names), "the instructor's grading is not part of the wheel"
     target = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(target), str(wheel)],
                    check=True, capture_output=True)

@@ -13,7 +13,7 @@ import functools
 
 import pytest
 
-from slamlab.lab import core
+from slamlab_grading import core
 
 _CACHED: dict[str, core.ExplorationTask] = {}
 

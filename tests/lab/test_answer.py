@@ -1,10 +1,11 @@
-"""sl.lab.answer with accepted ranges and typical wrong answers (issue 26, goals 2 and 6), on made-up tasks."""
+"""The grading of an exploration (slamlab_grading.answer): accepted ranges and typical wrong answers (issue 26,
+goals 2 and 6; issue 43), on made-up tasks."""
 
 from __future__ import annotations
 
 import pytest
 
-from slamlab.lab import core
+from slamlab_grading import core
 
 
 @pytest.fixture
@@ -25,7 +26,6 @@ def tasks(monkeypatch):
         hint="think about Y.", more="vary one parameter at a time.")
     for t in (old, new):
         monkeypatch.setitem(core._REGISTRY, t.task_id, t)
-    monkeypatch.setattr(core, "_ATTEMPTS", {})
     monkeypatch.delenv("NBGRADER_EXECUTION", raising=False)
     return calls
 
@@ -48,12 +48,12 @@ def test_accepted_range_is_closed_and_does_not_run_the_library(tasks):
     assert core.task("t.new").accepted_range() == (9.0, 11.0)
 
 
-def test_typical_wrong_answer_gets_its_misconception_and_more_on_the_second_attempt(tasks):
+def test_typical_wrong_answer_gets_its_misconception_and_more_after_more_than_one_attempt(tasks):
     first = core.answer("t.new", 8.0, quiet=True)
     assert first.status == "failed"
     assert "last value that fails" in first.message
     assert "first value that succeeds" not in first.message
-    second = core.answer("t.new", 8.0, quiet=True)
+    second = core.answer("t.new", 8.0, quiet=True, tried=2)
     assert "last value that fails" in second.message
     assert "first value that succeeds" in second.message
     unit = core.answer("t.new", 1030.0, quiet=True)  # within the wrong answer's own 5 %
@@ -63,9 +63,7 @@ def test_typical_wrong_answer_gets_its_misconception_and_more_on_the_second_atte
 def test_other_wrong_value_gets_the_general_hint_then_more(tasks):
     first = core.answer("t.new", 50.0, quiet=True)
     assert first.message.endswith("Hint: think about Y.")
-    assert core.answer("t.new", 50.0, quiet=True).message.endswith("think about Y. vary one parameter at a time.")
-    assert core.answer("t.new", 10.0, quiet=True).passed  # a pass resets the count
-    assert core.answer("t.new", 50.0, quiet=True).message.endswith("Hint: think about Y.")
+    assert core.answer("t.new", 50.0, quiet=True, tried=3).message.endswith("think about Y. vary one parameter at a time.")
 
 
 def test_hint_never_contains_the_answer(tasks):
@@ -94,3 +92,24 @@ def test_autograder_raises_on_a_wrong_answer(tasks, monkeypatch):
     monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
     with pytest.raises(AssertionError, match="last value that fails"):
         core.answer("t.new", 8.0, quiet=True)
+
+
+def test_grading_takes_the_students_recorded_answer_and_counts_the_attempts(tasks, tmp_path, monkeypatch, capsys):
+    from slamlab import lab
+
+    monkeypatch.setenv("SLAMLAB_LAB_ATTEMPTS", str(tmp_path / "attempts.json"))
+    monkeypatch.setattr(lab.core, "_task", lambda tid, kind: {"kind": "number", "question": "New form",
+                                                               "unit": "a length", "bounds": [0.0, 1e9],
+                                                               "integer": False})
+    lab.answer("t.new", 50.0, quiet=True)
+    recorded = lab.answer("t.new", 8.0, quiet=True)
+    assert recorded.status == "recorded"
+    assert recorded.value == 8.0
+    res = core.grade("t.new", recorded)
+    out = capsys.readouterr().out
+    assert "2 answer(s) recorded" in out
+    assert res.status == "failed"
+    assert "first value that succeeds" in res.message
+    assert core.grade("t.new", lab.answer("t.new", 10.0, quiet=True)).passed
+    not_a_number = lab.answer("t.new", "ten", quiet=True)
+    assert core.grade("t.new", not_a_number, quiet=True).status == "failed"

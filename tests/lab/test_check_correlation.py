@@ -1,4 +1,6 @@
-"""Lab 06 tasks: solutions written from 004 §7 pass, typical mistakes fail at the expected case."""
+"""Lab 06: solutions written from 004 §7 pass, typical mistakes fail at the expected case on the feedback cases (seed 0)
+and the grading's, the library's own functions are refused, and the explorations' answers hold for independent
+localisers while every named misconception is rejected on 30 seeds."""
 
 from __future__ import annotations
 
@@ -7,7 +9,11 @@ import pytest
 from scipy.signal import correlate2d
 
 import slamlab as sl
-from slamlab import lab
+import slamlab_grading as lab
+from slamlab_grading import core
+from slamlab_grading import tasks_correlation as tc
+
+RNGS = (0, core.GRADING_RNG)  # the feedback file's cases and the grading's
 
 # --- independent solutions (what a student should write) --------------------------------------------
 
@@ -68,6 +74,14 @@ def test_correct_solutions_pass(task_id, fn):
     assert res.passed, res.message
 
 
+def _fails(task_id, fn, where=""):
+    """``fn`` fails on both the feedback and the grading cases, at the case labelled ``where`` (if given)."""
+    for rng in RNGS:
+        res = lab.check(task_id, fn, rng=rng, quiet=True)
+        assert res.status in ("failed", "error"), (rng, res.message)
+        assert where in res.message, (rng, res.message)
+
+
 def test_scan_points_mistakes():
     def all_beams(bearings_rad, ranges, valid, pose):  # forgets the valid mask
         return scan_points(bearings_rad, ranges, np.ones_like(valid), pose)
@@ -75,8 +89,8 @@ def test_scan_points_mistakes():
     def transposed_rotation(bearings_rad, ranges, valid, pose):  # R(θ)^T instead of R(θ)
         return scan_points(bearings_rad, ranges, valid, (pose[0], pose[1], -pose[2]))
 
-    assert "(random, 5 beams) is wrong: expected shape" in lab.check("06.scan_points", all_beams, quiet=True).message
-    assert "case 1 of 5 (random, 5 beams)" in lab.check("06.scan_points", transposed_rotation, quiet=True).message
+    _fails("06.scan_points", all_beams, "is wrong: expected shape")  # at the latest the scan without a valid beam
+    _fails("06.scan_points", transposed_rotation, "case 1 of 5 (random, 5 beams)")
 
 
 def test_stamp_mistakes():
@@ -89,9 +103,17 @@ def test_stamp_mistakes():
     def no_heading(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n):  # forgets the heading
         return _stamp(bearings_rad, ranges, valid, 0.0, l_max, a_c, a_p, a_n)
 
-    assert lab.check("06.stamp", per_beam, quiet=True).status == "failed"  # beams cross near the robot already
-    assert "case 1 of 5" in lab.check("06.stamp", end_only, quiet=True).message
-    assert "case 1 of 5" in lab.check("06.stamp", no_heading, quiet=True).message
+    _fails("06.stamp", per_beam)  # beams cross near the robot already; the last case is built for it
+    _fails("06.stamp", end_only, "case 1 of 5")
+    _fails("06.stamp", no_heading, "case 1 of 5")
+
+
+def test_per_beam_stamp_fails_on_the_edge_case_alone():
+    def per_beam(**kw):
+        return _stamp(**kw, per_beam=True)
+
+    case = next(c for c in tc._stamp_cases(np.random.default_rng(0)) if c.label.startswith("a long beam"))
+    assert not np.array_equal(per_beam(**case.kwargs), tc._stamp_reference(**case.kwargs))
 
 
 def test_score_mistakes():
@@ -106,8 +128,31 @@ def test_score_mistakes():
         a0 = T.shape[0] - o
         return np.pad(correlate2d(M_values, T, mode="full"), ((0, 1), (0, 1)))[a0:a0 + H, a0:a0 + W]
 
-    assert "(robot at the map corner (0, 0)" in lab.check("06.score_at", wraps, quiet=True).message
-    assert "case 1 of 4" in lab.check("06.score_map", off_by_one, quiet=True).message
+    _fails("06.score_at", wraps, "(robot at the map corner (0, 0)")
+    _fails("06.score_map", off_by_one, "case 1 of 4")
+
+
+def test_the_librarys_own_functions_are_refused():
+    def points(bearings_rad, ranges, valid, pose):
+        return sl.scans.scan_to_points(bearings_rad, ranges, pose, valid)
+
+    def stamp_lib(bearings_rad, ranges, valid, heading_rad, l_max, a_c, a_p, a_n):
+        T, _ = sl.correlation.scan_stamps(sl.scans.Scan(bearings_rad, ranges, valid), [heading_rad], l_max=l_max,
+                                          a_c=a_c, a_p=a_p, a_n=a_n)
+        return T[0].astype(float)
+
+    def at(M_values, T, o, row, col):
+        return float(sl.correlation.score_maps(M_values, T[None], o, method="direct")[0, row, col])
+
+    def whole(M_values, T, o):
+        return sl.correlation.score_maps(M_values, T[None], o, method="direct")[0]
+
+    for task_id, fn in (("06.scan_points", points), ("06.stamp", stamp_lib), ("06.score_at", at),
+                        ("06.score_map", whole)):
+        for rng in RNGS:
+            res = lab.check(task_id, fn, rng=rng, quiet=True)
+            assert res.status == "failed"
+            assert "called the library's" in res.message, res.message
 
 
 def _brute_force_best(M, scan, headings_deg, *, step=1.0, hit=(0.5,)):
@@ -144,79 +189,125 @@ def _first_failing(best):
     return None
 
 
-def test_heading_step_exploration_independent():
-    """The first failing Δα from two brute-force localisers (no slamlab.correlation code) is the accepted one."""
-    from slamlab.lab.tasks_correlation import EXPLORE_POSE, brute_force_first_failing_step
+def sl_rooms():
+    return sl.sim.test_room_200(), sl.sim.measurement_room_200()
 
-    M, W = sl_rooms()
+
+def _scan(seed):
     rf = sl.sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.3, quantum_cells=0.1)
-    scan = rf.scan(W, np.array(EXPLORE_POSE), rng=2010)
-    first = _first_failing(_brute_force_best(M, scan, range(360), step=0.5, hit=(0.01, 0.5)))  # 004 §7's template
+    return rf.scan(sl_rooms()[1], np.array(tc.EXPLORE_POSE), rng=seed)
+
+
+def test_heading_step_exploration_independent():
+    """The first failing Δα from a second brute-force localiser (no slamlab.correlation code) is the accepted one;
+    a coarser template's answer, radians and the heading miss get their hints; no answer is told where it sits."""
+    M = sl_rooms()[0]
+    scan = _scan(2010)
+    first = _first_failing(_brute_force_best(M, scan, range(360), step=0.5, hit=(0.01, 0.5)))  # Task 2's template
     coarse = _first_failing(_brute_force_best(M, scan, range(360), step=1.0, hit=(0.5,)))
     # the reason: the chosen heading is the multiple of Δα nearest 37°; every step that misses it by at most 3°
-    # succeeds with either template; the chapter's template survives a 4° miss (11°) and fails at 5° (14°),
+    # succeeds with either template; Task 2's template survives a 4° miss (11°) and fails at 5° (14°),
     # a coarser one (free marks every cell, one obstacle mark) already at the 4° miss
     miss = [min(37 % d, d - 37 % d) for d in range(1, 31)]
     assert (first, coarse) == (14, 11)
     assert max(miss[:coarse - 1]) <= 3
     assert (miss[coarse - 1], miss[first - 1]) == (4, 5)
-    assert first == brute_force_first_failing_step()
+    assert first == tc.brute_force_first_failing_step() == lab.task("06.explore.heading_step").accepted_range()[0]
     assert lab.answer("06.explore.heading_step", first, quiet=True).passed
-    for wrong, hint in ((first - 1, "still succeeds"), (np.radians(first), "unit"), (5, "how far the best")):
+    for wrong, hint in ((coarse, "check the template"), (np.radians(first), "unit"), (5, "how far the best")):
         res = lab.answer("06.explore.heading_step", wrong, quiet=True)
         assert res.status == "failed"
         assert hint in res.message
+    t = lab.task("06.explore.heading_step")
+    for near in (first - 1, first + 1):  # one grid step either side: the general hint, which places nothing
+        res = lab.answer("06.explore.heading_step", near, quiet=True)
+        assert res.status == "failed"
+        assert res.message.endswith(f"Hint: {t.hint}")
+    assert (t.integer, t.bounds) == (True, (1.0, 360.0))
 
 
-def sl_rooms():
-    return sl.sim.test_room_200(), sl.sim.measurement_room_200()
+@pytest.mark.slow
+def test_heading_step_is_the_same_for_every_allowed_seed_and_the_coarse_template_never_passes():
+    """Every seed the question allows (2010-2039) gives the accepted step; the misconceptions' values on each of
+    them (another template, radians, the heading miss) lie outside the range."""
+    lo, hi = lab.task("06.explore.heading_step").accepted_range()
+    for seed in tc.HEADING_SEEDS:
+        first = tc.brute_force_first_failing_step(seed)
+        assert lo <= first <= hi, seed
+        for wrong in (tc.brute_force_first_failing_step(seed, True), np.radians(first), tc._heading_miss_deg(first)):
+            assert not lo <= wrong <= hi, (seed, wrong)
 
 
 @pytest.mark.slow
 def test_exploration_answers():
-    from slamlab.lab.tasks_correlation import EXPLORE_POSE, brute_force_first_failing_step
-
-    M, W = sl_rooms()
-    rf = sl.sim.Rangefinder(n_beams=360, max_range_cells=100.0, range_std_cells=0.3, quantum_cells=0.1)
-    scan = rf.scan(W, np.array(EXPLORE_POSE), rng=2010)
+    M, _ = sl_rooms()
+    scan = _scan(2010)
     first = None
     for d in range(1, 31):
         loc = sl.correlation.localise(M, scan, delta_alpha_rad=np.radians(d))
         if np.hypot(loc.col - 60, loc.row - 40) > 2:
             first = d
             break
-    assert first == brute_force_first_failing_step()  # the library agrees with the brute-force localiser
+    assert first == tc.brute_force_first_failing_step()  # the library agrees with the brute-force localiser
     assert lab.answer("06.explore.heading_step", first, quiet=True).passed
-    assert lab.answer("06.explore.heading_step", first - 1, quiet=True).status == "failed"
 
 
+def _library_run(seed, clutter=120):
+    return sl.studies.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=clutter,
+                                                  delta_alpha_rad=np.radians(2.0), rng=seed, progress=False)
 
+
+@pytest.mark.slow
 def test_failures_exploration_range():
-    """The accepted range is the spread over seeds of a brute-force localiser's failures (no slamlab.correlation
-    code); the library fails at the same poses of the first seed (the same scene, an agreeing localiser), its run
-    for the question's seed (held out of the range) lands inside, and any seed's wrong answers stay outside."""
-    from slamlab.lab.tasks_correlation import FAILURE_SEEDS, brute_force_failures
-
-    runs = brute_force_failures()
-    assert [len(f) for f in runs] == [12] * len(FAILURE_SEEDS)
-    counts = [sum(f) for f in runs]
-    lo, hi = min(counts), max(counts)
-    assert 0 < lo < hi < 12  # the seed matters: one seed's count is not the answer
-    assert lab.task("06.explore.failures").accepted_range() == (lo, hi)
-
-    def library(seed):
-        return sl.studies.correlation.run_monte_carlo(12, range_std_cells=2.0, extra_clutter=120,
-                                              delta_alpha_rad=np.radians(2.0), rng=seed, progress=False).failed
-
-    assert library(FAILURE_SEEDS[0]).astype(int).tolist() == list(runs[0])
-    held_out = int(library(2010).sum())
-    assert 2010 not in FAILURE_SEEDS
-    assert lo <= held_out <= hi
-    for n in range(lo, hi + 1):
-        assert lab.answer("06.explore.failures", n, quiet=True).passed
-    for wrong, hint in ((lo - 1, "fails when"), (hi + 1, "fails when"),
-                        *((12 - n, "successes") for n in range(lo, hi + 1)),
-                        *((n / 12, "fraction") for n in range(lo, hi + 1))):
+    """The accepted range is the brute-force localiser's count (no slamlab.correlation code) ± 1; the library fails
+    the same poses, and counting from its per-pose errors with the question's rule gives the same number."""
+    runs = [tc.brute_force_failures(s) for s in tc.FAILURE_SEEDS]
+    assert [len(f) for f in runs] == [12] * 3
+    n = sum(sum(f) for f in runs)
+    assert lab.task("06.explore.failures").accepted_range() == (n - 1, n + 1)
+    by_errors = 0
+    for seed, bf in zip(tc.FAILURE_SEEDS, runs, strict=True):
+        res = _library_run(seed)
+        assert res.failed.astype(int).tolist() == list(bf)
+        heading_deg = np.degrees(np.abs(res.err_heading_rad))
+        by_errors += int(np.sum((res.err_pos_cells > 2.0) | (heading_deg > 5.0)))
+    assert by_errors == n
+    for v in (n - 1, n, n + 1):
+        assert lab.answer("06.explore.failures", v, quiet=True).passed
+    for wrong, hint in ((36 - n, "successes"), (n / 36, "fraction"), (sum(runs[0]), "one run"),
+                        (tc.brute_force_total(extra_clutter=0), "clutter"), (n + 3, "fails when")):
         res = lab.answer("06.explore.failures", wrong, quiet=True)
         assert res.status == "failed"
         assert hint in res.message
+    t = lab.task("06.explore.failures")
+    assert (t.integer, t.bounds) == (True, (0.0, 36.0))
+
+
+#: Failed poses of one run of Exploration 2 by the brute-force localiser, seeds 2010-2041, without and with the
+#: question's 120 clutter discs (``brute_force_failures(seed, 0)`` and ``brute_force_failures(seed)``, summed:
+#: 64 runs, about two minutes; computed 2026-12-07). The test spot-checks three seeds of each live.
+NO_CLUTTER_2010_2041 = (1, 1, 1, 2, 0, 2, 1, 2, 4, 0, 0, 1, 1, 0, 1, 2, 0, 1, 2, 1, 0, 0, 2, 2, 1, 1, 1, 2, 1, 2, 2, 3)
+WITH_CLUTTER_2010_2041 = (4, 5, 2, 2, 4, 3, 2, 4, 5, 4, 5, 3, 5, 3, 2, 4, 3, 4, 6, 4, 3, 4, 5, 4, 7, 2, 1, 5, 3, 2, 5,
+                          4)
+
+
+@pytest.mark.parametrize("seed", [2013, 2027, 2041])
+def test_the_failure_tables_are_the_brute_force_count(seed):
+    k = seed - 2010
+    assert sum(tc.brute_force_failures(seed, 0)) == NO_CLUTTER_2010_2041[k]
+    assert sum(tc.brute_force_failures(seed)) == WITH_CLUTTER_2010_2041[k]
+
+
+def test_failures_misconceptions_are_rejected_on_30_settings():
+    """Each misconception's value over 30 settings lies outside the range: the clutter forgotten for any three
+    consecutive seeds of 2010-2041, one run alone for any seed of 2010-2039, and the successes and the fraction
+    of any three consecutive seeds (the brute-force counts of the tables above)."""
+    lo, hi = lab.task("06.explore.failures").accepted_range()
+    no_clutter, with_clutter = NO_CLUTTER_2010_2041, WITH_CLUTTER_2010_2041
+    assert sum(with_clutter[:3]) == (lo + hi) / 2  # the question's seeds 2010-2012
+    windows = [sum(no_clutter[i:i + 3]) for i in range(30)]
+    assert all(not lo <= v <= hi for v in windows), windows
+    assert all(not lo <= v <= hi for v in with_clutter[:30]), with_clutter  # one run alone
+    pooled = [sum(with_clutter[i:i + 3]) for i in range(30)]
+    for wrong in ([36 - n for n in pooled], [n / 36 for n in pooled]):  # successes, a fraction
+        assert all(not lo <= v <= hi for v in wrong), wrong

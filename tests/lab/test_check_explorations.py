@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from slamlab.lab import core
-from slamlab.lab import tasks_filters as tf
-from slamlab.lab import tasks_stereo as tst
-from slamlab.lab import tasks_stores as tso
+from slamlab_grading import core
+from slamlab_grading import tasks_filters as tf
+from slamlab_grading import tasks_stereo as tst
+from slamlab_grading import tasks_stores as tso
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 LABS_01_07 = sorted((ROOT / "notebooks" / "labs").glob("0[1-7]_*_lab.ipynb"))
@@ -30,7 +30,7 @@ WITH_RANGE = sorted(k for k, t in EXPLORATIONS.items() if t.accepted is not None
 
 @pytest.fixture(autouse=True)
 def _fresh_attempts(monkeypatch):
-    monkeypatch.setattr(core, "_ATTEMPTS", {})
+    # attempts: the student side records them (slamlab.lab.attempts)
     monkeypatch.delenv("NBGRADER_EXECUTION", raising=False)
 
 
@@ -190,7 +190,7 @@ def test_depth_error_range_holds_for_triangulation_and_the_first_order_formula()
     assert lo <= exact <= hi
     assert t.expected() == pytest.approx(exact, rel=1e-6)  # the library's triangulation is the exact value
     # and by hand, from the projected pixels (the rig is rectified: same rows, u shifts by f B / Z)
-    from slamlab.lab.experiments import stereo_rig
+    from slamlab_grading.experiments import stereo_rig
 
     rig = stereo_rig()
     uvl, uvr = rig.project(np.array([[0.0, 0.0, 8.0]]))
@@ -223,7 +223,7 @@ def test_fast_threshold_range_is_opencvs_answer_and_opencv_counts_as_the_library
     import cv2
 
     from slamlab.features import fast_detect, load_oxford_image
-    from slamlab.lab import tasks_features as tfe
+    from slamlab_grading import tasks_features as tfe
 
     t = core.task("02.explore.fast_threshold")
     lo, hi = t.accepted_range()
@@ -298,3 +298,68 @@ def test_labs_08_10_explorations_are_questions_with_an_investigation_rubric_and_
     assert len(texts) == 2
     assert all("?" in "".join(c["source"]) for c in texts)
     test_lab_has_an_open_investigation_with_a_rubric_and_a_time_plan(lab)
+
+
+# --- the scan (issue 43, item 2): no exploration's text names a public function that computes its answer -----
+
+ALL_LABS = sorted((ROOT / "notebooks" / "labs").glob("*_lab.ipynb"))
+
+
+def _exploration_text(lab: Path, part: str) -> str:
+    """The markdown of exploration ``part`` ("e1") of ``lab``: every markdown cell whose grade id has ``_eK_``."""
+    nb = json.loads(lab.read_text(encoding="utf-8"))
+    return "\n".join("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "markdown"
+                     and f"_{part}_" in c["metadata"].get("nbgrader", {}).get("grade_id", ""))
+
+
+def named_answers(lab: Path, part: str, answered_by) -> list[str]:
+    """The names of ``answered_by`` that the exploration's text spells: the dotted name (``slamlab.`` or ``sl.``
+    or none) or its last component as a word."""
+    text = _exploration_text(lab, part)
+    found = []
+    for name in answered_by:
+        last = name.rsplit(".", 1)[-1]
+        if re.search(rf"(?<![\w.]){re.escape(last)}\b", text) or name.split("slamlab.", 1)[-1] in text:
+            found.append(name)
+    return found
+
+
+def test_the_name_scan_finds_a_named_function(tmp_path):
+    nb = {"cells": [{"cell_type": "markdown", "metadata": {"nbgrader": {"grade_id": "lab99_e1_text"}},
+                     "source": ["**How many?** `run_sim_slam` runs the experiment."]},
+                    {"cell_type": "markdown", "metadata": {"nbgrader": {"grade_id": "lab99_e2_text"}},
+                     "source": ["**How many?** Use the `sl.hough` package's building blocks."]}]}
+    p = tmp_path / "99_x_lab.ipynb"
+    p.write_text(json.dumps(nb))
+    names = ("slamlab.studies.hough.run_sim_slam",)
+    assert named_answers(p, "e1", names) == list(names)
+    assert named_answers(p, "e2", names) == []
+
+
+@pytest.mark.parametrize("lab", ALL_LABS, ids=[p.name for p in ALL_LABS])
+def test_no_exploration_names_the_function_that_answers_it(lab):
+    import importlib
+
+    assert ready_made_calls([lab]) == []
+    tasks = {k: t for k, t in core.all_tasks().items() if k.startswith(lab.name[:2] + ".")}
+    nb = json.loads(lab.read_text(encoding="utf-8"))
+    for c in nb["cells"]:
+        gid = c["metadata"].get("nbgrader", {}).get("grade_id", "")
+        if not (gid.endswith("_check") and "_e" in gid):
+            continue
+        tid = re.search(r'sl\.lab\.answer\("([^"]+)"', "".join(c["source"])).group(1)
+        t = tasks[tid]  # answered_by may be empty: no public function computes the answer
+        for name in t.answered_by:  # each a real public name of slamlab
+            mod, _, attr = name.rpartition(".")
+            while mod and attr:
+                try:
+                    obj = importlib.import_module(mod)
+                    break
+                except ModuleNotFoundError:
+                    mod, _, head = mod.rpartition(".")
+                    attr = f"{head}.{attr}"
+            for a in attr.split("."):
+                obj = getattr(obj, a)
+            assert callable(obj), name
+        part = gid.split("_")[1]
+        assert named_answers(lab, part, t.answered_by) == [], f"{lab.name} {part} names {t.answered_by}"

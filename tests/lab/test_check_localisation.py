@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from slamlab import lab
+import slamlab_grading as lab
 
 # --- independent solutions (what a student should write) --------------------------------------------
 
@@ -71,11 +71,30 @@ def augmented(w_avg, w_slow, w_fast, alpha_slow, alpha_fast, *, guard=True):
         return np.array([s, f, max(0.0, 1.0 - f / s)])
 
 
+TASKS = ("08.low_variance", "08.motion_sample", "08.likelihood_field", "08.augmented")
+
+
+def _fails_both(task_id, fn):
+    """The check of ``fn`` on the student's feedback cases (seed 0: the grading's check and the student's own
+    ``sl.lab.check`` on the shipped feedback file) and on the grading cases: none passes."""
+    from slamlab.lab import check as student_check
+
+    results = [lab.check(task_id, fn, rng=rng, quiet=True) for rng in (0, lab.core.GRADING_RNG)]
+    results.append(student_check(task_id, fn, quiet=True))
+    assert not any(r.passed for r in results), [r.message for r in results]
+    return results
+
+
 @pytest.mark.parametrize(("task_id", "fn"), [("08.low_variance", low_variance), ("08.motion_sample", motion_sample),
                                              ("08.likelihood_field", likelihood_field),
                                              ("08.augmented", augmented)])
 def test_correct_solutions_pass(task_id, fn):
-    res = lab.check(task_id, fn, quiet=True)
+    from slamlab.lab import check as student_check
+
+    for rng in (0, lab.core.GRADING_RNG):
+        res = lab.check(task_id, fn, rng=rng, quiet=True)
+        assert res.passed, res.message
+    res = student_check(task_id, fn, quiet=True)  # the feedback file the student's kernel has
     assert res.passed, res.message
 
 
@@ -96,13 +115,50 @@ def test_mistakes_fail():
         p = 0.0 if w_slow == 0 else max(0.0, 1 - w_fast / w_slow)
         return np.array([w_slow + alpha_slow * (w_avg - w_slow), w_fast + alpha_fast * (w_avg - w_fast), p])
 
-    assert lab.check("08.low_variance", multinomial, quiet=True).status == "failed"
-    assert "case 1 of" in lab.check("08.motion_sample", no_squares, quiet=True).message
-    assert "(a beam at z_max is skipped)" in lab.check("08.likelihood_field", no_skip, quiet=True).message
-    assert "off the map" in lab.check("08.likelihood_field", clamp_outside, quiet=True).message
-    assert lab.check("08.augmented", averages_only_after, quiet=True).status == "failed"
-    res = lab.check("08.augmented", lambda **kw: augmented(**kw, guard=False), quiet=True)
-    assert res.status in ("failed", "error")
+    _fails_both("08.low_variance", multinomial)
+    assert all("case 1 of" in r.message for r in _fails_both("08.motion_sample", no_squares))
+    assert all("(a beam at z_max is skipped)" in r.message for r in _fails_both("08.likelihood_field", no_skip))
+    assert all("off the map" in r.message for r in _fails_both("08.likelihood_field", clamp_outside))
+    _fails_both("08.augmented", averages_only_after)
+    for rng in (0, lab.core.GRADING_RNG):
+        res = lab.check("08.augmented", lambda **kw: augmented(**kw, guard=False), rng=rng, quiet=True)
+        assert res.status in ("failed", "error")
+
+
+def _library_wrappers():
+    import slamlab as sl
+
+    def motion(poses, odom_prev, odom_now, alpha, noise):
+        from slamlab.localisation.models import motion_from_noise
+
+        deltas = tuple(float(d) for d in sl.localisation.odometry_deltas(odom_prev, odom_now))
+        return motion_from_noise(np.asarray(poses, float), deltas, np.asarray(alpha, float), np.asarray(noise, float))
+
+    return {"08.low_variance": lambda weights, n, r: sl.localisation.low_variance_resample(weights, n, offset=r),
+            "08.motion_sample": motion}
+
+
+@pytest.mark.parametrize("task_id", ["08.low_variance", "08.motion_sample", "08.likelihood_field"])
+def test_the_library_itself_is_refused(task_id):
+    """The library's own function, wrapped to the task's signature, and the task's reference do not pass."""
+    fns = [lab.task(task_id).reference] + ([_library_wrappers()[task_id]] if task_id in _library_wrappers() else [])
+    for fn in fns:
+        for res in _fails_both(task_id, fn):
+            assert "called the library's" in res.message, res.message
+
+
+def test_augmented_reference_is_written_out_and_a_library_call_is_refused():
+    """Task 4's reference calls no library code (the library has no one-step update); any slamlab call is refused."""
+    import slamlab as sl
+
+    assert lab.check("08.augmented", lab.task("08.augmented").reference, quiet=True).passed
+
+    def via_library(**kw):
+        sl.localisation.check_alpha((0.1, 0.1, 0.1, 0.1))
+        return augmented(**kw)
+
+    for res in _fails_both("08.augmented", via_library):
+        assert "called the library's" in res.message
 
 
 # --- explorations: accepted ranges against independent computations ------------------------------------------
@@ -118,7 +174,7 @@ def _distinct_fraction_exact(M):
 
 @pytest.mark.parametrize("M", [2, 3, 4, 5, 6])
 def test_survivor_formula_and_sd_by_enumerating_every_draw(M):
-    from slamlab.lab import tasks_localisation as tl
+    from slamlab_grading import tasks_localisation as tl
 
     mean, sd = _distinct_fraction_exact(M)
     assert tl.survivor_fraction(M) == pytest.approx(mean, rel=1e-12)
@@ -159,7 +215,7 @@ def _first_injecting_length(alpha_slow, alpha_fast, drop, *, start_at_first=Fals
 @pytest.mark.parametrize(("a_s", "a_f", "drop"), [(0.001, 0.1, 0.5), (0.05, 0.5, 0.5), (0.001, 0.1, 0.0),
                                                   (0.01, 0.2, 0.8)])
 def test_warm_up_closed_form_equals_a_step_by_step_loop(a_s, a_f, drop):
-    from slamlab.lab import tasks_localisation as tl
+    from slamlab_grading import tasks_localisation as tl
 
     assert tl.warm_up_steps(a_s, a_f, drop) == _first_injecting_length(a_s, a_f, drop)
 
@@ -191,7 +247,7 @@ def test_exploration_answers_of_the_instructor_method():
 
 
 def test_exploration_helpers_reject_bad_input():
-    from slamlab.lab import tasks_localisation as tl
+    from slamlab_grading import tasks_localisation as tl
 
     with pytest.raises(ValueError, match="`M`"):
         tl.survivor_fraction(0)
@@ -201,3 +257,45 @@ def test_exploration_helpers_reject_bad_input():
         tl.warm_up_steps(0.2, 0.1)
     with pytest.raises(ValueError, match="`drop`"):
         tl.warm_up_steps(0.001, 0.1, 1.0)
+
+
+# --- misconceptions rejected over 30 seeds or settings --------------------------------------------------------
+
+
+def test_survivor_misconceptions_rejected_on_30_seeds():
+    """The share lost (one minus a single run's surviving fraction, numpy's sampler, seeds 0-29) and the
+    low-variance sampler's fraction (30 offsets) stay outside the accepted range, each with its hint."""
+    t = lab.task("08.explore.survivors")
+    lo, hi = t.accepted_range()
+    M = 1000
+    for seed in range(30):
+        rng = np.random.default_rng(seed)
+        survived = np.unique(rng.choice(M, M)).size / M
+        assert lo <= survived <= hi
+        lost = 1.0 - survived
+        assert not lo <= lost <= hi
+        assert "never drawn" in lab.answer("08.explore.survivors", lost, quiet=True).message
+        lv = np.unique(low_variance(np.full(M, 1.0), M, float(rng.uniform(0, 1 / M)))).size / M
+        assert not lo <= lv <= hi
+        assert "low-variance" in lab.answer("08.explore.survivors", lv, quiet=True).message
+
+
+SETTINGS = [(a_s, a_f, drop) for a_s in (0.001, 0.002, 0.005, 0.01, 0.02) for a_f in (0.05, 0.1, 0.2)
+            for drop in (0.25, 0.5)]
+
+
+@pytest.mark.parametrize(("a_s", "a_f", "drop"), SETTINGS)
+def test_warm_up_misconceptions_rejected_on_30_settings(a_s, a_f, drop):
+    """For 30 settings of (α_slow, α_fast, drop): the first injecting length by the test's loop, T, and [T, T + 1]
+    (the question's range for its setting) never holds 1/α_slow (the time constant) or 1 (amcl's start)."""
+    assert len(SETTINGS) == 30
+    T = _first_injecting_length(a_s, a_f, drop)
+    for wrong in (1.0 / a_s, 1.0):
+        assert not T <= wrong <= T + 1
+
+
+def test_warm_up_misconceptions_at_the_question_setting_get_their_hint():
+    for wrong, hint in ((1000, "time constant"), (1, "amcl")):
+        res = lab.answer("08.explore.warm_up", wrong, quiet=True)
+        assert res.status == "failed"
+        assert hint in res.message

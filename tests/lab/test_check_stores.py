@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from slamlab import lab
+import slamlab_grading as lab
+from slamlab_grading import core
 
 # --- independent solutions (what a student should write) --------------------------------------------
 
@@ -79,6 +80,18 @@ def test_correct_solutions_pass(task_id, fn):
     assert res.passed, res.message
 
 
+#: The feedback file's cases (seed 0) and the grading's: a named mistake must fail on both, at an edge case.
+SEEDS = (0, core.GRADING_RNG)
+
+
+def _fails_at(task_id, fn, label):
+    """``fn`` fails ``task_id`` at the case whose label starts with ``label`` ("" for any case) on every seed."""
+    for rng in SEEDS:
+        res = lab.check(task_id, fn, rng=rng, quiet=True)
+        assert res.status == "failed", (rng, res.message)
+        assert f"({label}" in res.message, (rng, res.message)
+
+
 def test_tree_sizes_mistakes():
     def merge_when_full(n1, q, batches):  # ">= MAX_SIZE" instead of "> MAX_SIZE"
         return tree_sizes(n1, q, batches, strict=False)
@@ -86,9 +99,15 @@ def test_tree_sizes_mistakes():
     def no_empty_trees(n1, q, batches):  # forgets to append trees until the last can hold the total
         return tree_sizes(n1, q, batches, grow=False)
 
-    assert lab.check("04.tree_sizes", merge_when_full, quiet=True).status == "failed"
-    assert merge_when_full(5, 2.0, [5]) != tree_sizes(5, 2.0, [5])  # and on the edge case itself
-    assert "case 1 of 7" in lab.check("04.tree_sizes", no_empty_trees, quiet=True).message
+    # the random cases may catch them first; the edge cases catch them whatever the seed
+    for rng in SEEDS:
+        assert lab.check("04.tree_sizes", merge_when_full, rng=rng, quiet=True).status == "failed"
+        assert lab.check("04.tree_sizes", no_empty_trees, rng=rng, quiet=True).status == "failed"
+    assert merge_when_full(5, 2.0, [5]) != tree_sizes(5, 2.0, [5])  # the edge case "a batch of exactly MAX_SIZE"
+    assert no_empty_trees(5, 2.0, [4, 4, 4]) != tree_sizes(5, 2.0, [4, 4, 4])  # "the total outgrows the last tree"
+    edge = [c for c in core.task("04.tree_sizes").cases(np.random.default_rng(1)) if not c.label.startswith("random")]
+    for mistake in (merge_when_full, no_empty_trees):
+        assert any(mistake(**c.kwargs) != tree_sizes(**c.kwargs) for c in edge), mistake.__name__
 
 
 def test_base_rule_mistakes():
@@ -100,8 +119,15 @@ def test_base_rule_mistakes():
         late_base = [i for i in b if i == 0 and len(history) == 13]  # the edge case's id 0 is promoted at age 7
         return np.setdiff1d(b, late_base), np.union1d(d, late_base).astype(int)
 
-    assert lab.check("04.base_rule", one_frame_short, quiet=True).status == "failed"
-    assert "(window edge" in lab.check("04.base_rule", drop_before_promote, quiet=True).message
+    for rng in SEEDS:
+        assert lab.check("04.base_rule", one_frame_short, rng=rng, quiet=True).status == "failed"
+    _fails_at("04.base_rule", drop_before_promote, "window edge")
+    edge = next(c for c in core.task("04.base_rule").cases(np.random.default_rng(1)) if c.label.startswith("window"))
+    for a, b in zip(one_frame_short(**edge.kwargs), base_rule(**edge.kwargs), strict=True):
+        if not np.array_equal(a, b):
+            break
+    else:
+        raise AssertionError("the window-edge case does not catch one_frame_short")
 
 
 def test_iter_time_mistakes():
@@ -111,8 +137,8 @@ def test_iter_time_mistakes():
     def natural_log(n1, q, n, s, m, C):
         return iter_time(n1, q, n, s, m, C) * math.log(2)
 
-    assert "case 1 of 5" in lab.check("04.iter_time", adjusted, quiet=True).message
-    assert "case 1 of 5" in lab.check("04.iter_time", natural_log, quiet=True).message
+    _fails_at("04.iter_time", adjusted, "000's optimum")
+    _fails_at("04.iter_time", natural_log, "000's optimum")
 
 
 def test_merge_knn_mistakes():
@@ -129,9 +155,45 @@ def test_merge_knn_mistakes():
         o = np.lexsort((-I, D), axis=1)[:, :k]
         return merge_knn([np.take_along_axis(D, o, 1)], [np.take_along_axis(I, o, 1)], k)
 
-    assert "case 1 of 6" in lab.check("04.merge_knn", first_tree_only, quiet=True).message
-    assert "(one tree of one point" in lab.check("04.merge_knn", no_padding, quiet=True).message
-    assert "(a tie" in lab.check("04.merge_knn", unstable, quiet=True).message
+    for rng in SEEDS:
+        assert lab.check("04.merge_knn", first_tree_only, rng=rng, quiet=True).status == "failed"
+    _fails_at("04.merge_knn", no_padding, "one tree of one point")
+    _fails_at("04.merge_knn", unstable, "a tie")
+    edge = next(c for c in core.task("04.merge_knn").cases(np.random.default_rng(1)) if c.label.startswith("a tie"))
+    assert not np.array_equal(first_tree_only(**edge.kwargs)[1], merge_knn(**edge.kwargs)[1])  # whatever the seed
+
+
+def _library_calls():
+    """The library's own functions wrapped to each task's signature (what the forbid check must catch)."""
+    from slamlab.kdtree import cost_model, knn, stores
+
+    def base_rule_with_the_store(history, base_seen_times, max_non_base_time):
+        book, known, base, dropped = stores.SightingBook(base_seen_times, max_non_base_time), set(), [], []
+        for frame in history:
+            frame = np.asarray(frame, dtype=np.int64)
+            book.observe(frame[[int(i) in known for i in frame]] if frame.size else frame)
+            book.add(frame[[int(i) not in known for i in frame]] if frame.size else frame)
+            known.update(int(i) for i in frame)
+            p, d = book.step()
+            base += p.tolist()
+            dropped += d.tolist()
+        return np.sort(np.array(base, dtype=int)), np.sort(np.array(dropped, dtype=int))
+
+    return {"04.tree_sizes": lambda n1, q, batches: list(stores.multi_tree_sizes(n1, q, batches)[-1]),
+            "04.base_rule": base_rule_with_the_store,
+            "04.iter_time": lambda n1, q, n, s, m, C: cost_model.iter_time(n1, q, n=n, s=s, m=m, C=C,
+                                                                           reading="literal"),
+            "04.merge_knn": lambda dists, ids, k: knn.merge_knn(dists, ids, k)}
+
+
+@pytest.mark.parametrize("task_id", ["04.tree_sizes", "04.base_rule", "04.iter_time", "04.merge_knn"])
+def test_the_librarys_own_function_is_refused(task_id):
+    import slamlab as sl
+
+    fn = _library_calls()[task_id]
+    for res in (lab.check(task_id, fn, quiet=True), sl.lab.check(task_id, fn, quiet=True)):  # grading, feedback
+        assert res.status == "failed", res.message
+        assert "called the library's slamlab.kdtree." in res.message, res.message
 
 
 def test_exploration_answers():
@@ -164,3 +226,53 @@ def _rebuilt(n1, q, batches):
             i += 1
         total += sum(sizes[j] for j in changed)
     return total
+
+
+# --- explorations: every reasonable grid passes, each misconception is rejected on 30 settings -------------------
+
+
+def _grids():
+    """30 grids over 000's plot ranges: n1 steps 5-100, q steps 0.005-0.1 (the question fixes no grid)."""
+    return [(dn, dq) for dn in (5.0, 10.0, 20.0, 25.0, 50.0, 100.0) for dq in (0.005, 0.01, 0.02, 0.05, 0.1)]
+
+
+def test_literal_n1_every_grid_passes_and_each_misconception_is_rejected_on_30_grids():
+    from slamlab_grading import tasks_stores as tso
+
+    lo, hi = core.task("04.explore.literal_n1").accepted_range()
+    for dn, dq in _grids():
+        N1, Q = np.arange(500.0, 20000.0 + 1e-9, dn), np.arange(1.5, 10.0 + 1e-9, dq)
+        literal = tso.literal_iter_time(N1[:, None], Q[None, :])
+        i, j = np.unravel_index(np.argmin(literal), literal.shape)
+        assert lo <= N1[i] <= hi, (dn, dq, N1[i])
+        assert lab.answer("04.explore.literal_n1", float(N1[i]), quiet=True).passed
+        # the changed search term C s T_search: the literal cost plus C (s - 1) searchKd (log2 as in the Appendix)
+        n1, q = N1[:, None], Q[None, :]
+        p = np.log(50000 / n1) / np.log(q) + 1
+        search = p * np.log2(n1) + 9.0 * p * (p - 1) / 2 * np.log2(q)
+        F = literal + 9.0 * 499 * search
+        ia, _ = np.unravel_index(np.argmin(F), F.shape)
+        for wrong in (3500.0, float(N1[ia]), float(Q[j])):  # 000's reading, the changed search term, q
+            assert not lo <= wrong <= hi, (dn, dq, wrong)
+            assert lab.answer("04.explore.literal_n1", wrong, quiet=True).status == "failed"
+
+
+def _workloads():
+    rng = np.random.default_rng(43)
+    out = [(1000, 3.0, (500,) * 40)]
+    while len(out) < 30:
+        n1, q = int(rng.integers(20, 2000)), float(rng.choice([1.5, 2.0, 2.5, 3.0, 4.0, 5.5]))
+        out.append((n1, q, tuple(int(b) for b in rng.integers(1, 2 * n1, int(rng.integers(10, 60))))))
+    return out
+
+
+def test_points_rebuilt_misconceptions_differ_from_the_count_on_30_workloads():
+    from slamlab_grading import tasks_stores as tso
+
+    for n1, q, batches in _workloads():
+        right = _rebuilt(n1, q, batches)
+        assert right == tso.rebuilt_count(n1, q, batches)  # two independent counts
+        stored, one_tree = sum(batches), int(np.sum(np.cumsum(batches)))
+        for wrong in (stored, one_tree, tso.rebuilt_count(n1, q, batches, merges_only=True),
+                      tso.rebuilt_count(n1, q, batches, count_emptied=True)):
+            assert wrong != right, (n1, q, batches)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import importlib.util
 import shutil
+import sys
 from pathlib import Path
 
 import nbformat
@@ -64,116 +65,87 @@ def course(tmp_path_factory):
     return root, students
 
 
-# --- four generated submissions per lab --------------------------------------------------------------------
-# correct: the instructor solution, each exploration answered with the instructor's number (read from the stored
-#          output of its check cell: a student may answer from any experiment, and the test need not rerun it);
-# wrong:   a plausible wrong implementation of task 1, the last task raising (no other task calls it; an
-#          exception must cost that task only), a typical wrong number for one exploration, the other
-#          explorations not done; the other tasks right. (Wrong and raising were two submissions until issue 25:
-#          one submission runs the lab once less, ~5 s of CI per lab, and tests the same cells.)
-# empty:   the student version untouched.
-#: Task 1 of each lab made wrong the way a student might: (text in the solution, its wrong replacement).
-WRONG_TASK = {
-    "01": ("F @ P @ F.T + Q", "F @ P @ F.T"),  # the process noise forgotten
-    "02": ("II[1:, 1:] =", "II[:-1, :-1] ="),  # the zero row and column at the wrong end
-    "03": ("D = np.sqrt(", "D = ("),  # squared distances
-    "04": ("while sizes[i] > max_size(i):", "while sizes[i] >= max_size(i):"),  # a full tree merged
-    "05": ("return (p1 + p2) / 2,", "return p1,"),  # the point on the first ray, not the midpoint
-    "06": ("x + c * px - s * py, y + s * px + c * py", "x + c * px + s * py, y - s * px + c * py"),  # R transposed
-    "07": ("theta = -np.pi / 2 + delta_theta_rad", "theta = delta_theta_rad"),  # theta from 0 instead of -pi/2
-    "08": ('side="right"', 'side="left"'),  # the off-by-one at ties
-    "09": ("C2 = b / (a + b) / rho_range", "C2 = b / (a + b)"),  # the uniform density forgotten
-    "10": ("np.linalg.inv(odometry[-1]) @ odometry", "np.linalg.inv(odometry[0]) @ odometry"),  # the first line
-}
-#: The exploration answered wrong in the "wrong" submission: one whose check is quick.
-WRONG_EXPLORATION = {"01": "e2", "02": "e1", "03": "e2", "04": "e2", "05": "e2", "06": "e1", "07": "e1",
-                     "08": "e2", "09": "e2", "10": "e2"}
-SUBMISSIONS = ("correct", "wrong", "empty")
+# --- what students hand in: tests/lab/submissions/labNN.py, and the untouched student version -------------------
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from submissions import build, lost_cells, of_lab
+
+#: The student ids of the autograde run: a lab's submissions by kind ("mistake_*" numbered in the lab's order).
+KINDS = ("independent", "other_seed", "mistake1", "mistake2", "mistake3", "empty")
 
 
-def _replace_solution(source: str, body: str) -> str:
-    """``source`` with the lines between ``### BEGIN SOLUTION`` and ``### END SOLUTION`` replaced by ``body``."""
-    begin, end = source.index("### BEGIN SOLUTION"), source.index("### END SOLUTION")
-    indent = source[source.rindex("\n", 0, begin) + 1:begin]
-    return source[:begin] + "### BEGIN SOLUTION\n" + indent + body + "\n" + indent + source[end:]
+def _by_student(lab: Path) -> dict:
+    """Student id -> the lab's :class:`~submissions.Submission` (None: the untouched student version)."""
+    subs = of_lab(lab.name[:2])
+    out = {s.kind: s for s in subs if not s.kind.startswith("mistake_")}
+    for k, s in enumerate([s for s in subs if s.kind.startswith("mistake_")], start=1):
+        out[f"mistake{k}"] = s
+    out["empty"] = None
+    return out
 
 
-def _stored_answer(nb, ex: str) -> float:
-    """The number the instructor version's exploration ``ex`` passed with (its check cell's stored output)."""
+@pytest.mark.parametrize("lab", LABS, ids=[p.name for p in LABS])
+def test_every_lab_has_a_submission_of_each_kind(lab):
+    """Issue 43: correct by another method, correct with another seed or setting, two named mistakes (and empty)."""
+    subs = of_lab(lab.name[:2])
+    kinds = [s.kind for s in subs]
+    assert "independent" in kinds, lab.name
+    assert "other_seed" in kinds, lab.name
+    assert sum(k.startswith("mistake_") for k in kinds) >= 2, lab.name
+    assert len([k for k in _by_student(lab) if k.startswith("mistake")]) <= 3, "KINDS has three mistake ids"
+    parts = {c.metadata["nbgrader"]["grade_id"].split("_")[1] for c, m in _nbgrader_cells(nbformat.read(lab, as_version=4))
+             if m["grade"] and c.cell_type == "code"}
+    independent = next(s for s in subs if s.kind == "independent")
+    assert set(independent.bodies) == parts, f"{lab.name}: the independent submission must redo every task"
+    for s in subs:
+        assert set(s.lost) <= parts, (lab.name, s.kind)
+        assert bool(s.lost) == s.kind.startswith("mistake_"), (lab.name, s.kind)
+
+
+@pytest.mark.parametrize("lab", LABS, ids=[p.name for p in LABS])
+def test_check_cells_give_feedback_and_hide_the_grading(lab):
+    """Every check cell: the student's feedback (sl.lab.check / sl.lab.answer) visible, the grading of the same task
+    in nbgrader's hidden tests."""
     import re
 
-    cell = next(c for c in nb.cells if c.metadata.get("nbgrader", {}).get("grade_id", "").endswith(f"_{ex}_check"))
-    text = "".join(o.get("text", "") for o in cell.outputs)
-    return float(re.search(r"— (\S+): passed\.", text).group(1))
-
-
-def _last_task(nb) -> str:
-    """The last implementation task of a lab ("t4"): the one the wrong submission makes raise (no later task calls it)."""
-    parts = [c.metadata["nbgrader"]["grade_id"].split("_")[1] for c in nb.cells
-             if c.metadata.get("nbgrader", {}).get("grade_id", "").endswith("_check")]
-    return max(p for p in parts if p.startswith("t"))
-
-
-def make_submission(lab: Path, kind: str):
-    """The notebook a student of kind ``kind`` ("correct" or "wrong") hands in for ``lab``."""
-    from slamlab import lab as sl_lab
-
-    nb = nbformat.read(lab, as_version=4)
-    num = lab.name[:2]
-    assert _last_task(nb) != "t1", f"{lab.name}: the wrong submission needs task 1 and the last task apart"
-    for c in nb.cells:
-        gid = c.metadata.get("nbgrader", {}).get("grade_id", "")
-        if not gid.endswith("_solution") or c.cell_type != "code":
-            continue
-        part = gid.split("_")[1]  # t1, t2, ..., e1, e2
-        if part.startswith("e"):
-            if kind == "correct":
-                c.source = _replace_solution(c.source, f"return {_stored_answer(nb, part)!r}")
-            elif kind == "wrong" and part == WRONG_EXPLORATION[num]:
-                check = next(d for d in nb.cells if d.metadata.get("nbgrader", {}).get("grade_id") == f"lab{num}_{part}_check")
-                task_id = check.source.split('"')[1]
-                c.source = _replace_solution(c.source, f"return {float(sl_lab.task(task_id).wrong[0].value())!r}")
-            else:
-                c.source = _replace_solution(c.source, "raise NotImplementedError()")
-        elif kind == "wrong" and part == "t1":
-            old, new = WRONG_TASK[num]
-            assert c.source.count(old) == 1, f"{lab.name}: {old!r} in\n{c.source}"
-            c.source = c.source.replace(old, new)
-        elif kind == "wrong" and part == _last_task(nb):
-            c.source = _replace_solution(c.source, 'raise IndexError("index 3 is out of bounds")')
-    return nb
-
-
-def expected_points(lab: Path, kind: str) -> dict[str, float]:
-    """Points per autograded cell of ``lab`` for a submission of kind ``kind``, from the notebook's metadata."""
-    out = {}
     for c, m in _nbgrader_cells(nbformat.read(lab, as_version=4)):
         if not (m["grade"] and c.cell_type == "code"):
             continue
-        part = m["grade_id"].split("_")[1]
-        lost = (kind == "empty"
-                or (kind == "wrong" and (part in ("t1", _last_task(nbformat.read(lab, as_version=4)))
-                                         or part.startswith("e"))))
-        out[m["grade_id"]] = 0.0 if lost else float(m["points"])
-    return out
+        visible, hidden = c.source.split("### BEGIN HIDDEN TESTS")
+        tid = re.search(r'sl\.lab\.(?:check|answer)\("([^"]+)"', visible).group(1)
+        assert "slamlab_grading" not in visible, c.source
+        assert f'slamlab_grading.grade("{tid}", ' in hidden, c.source
+        assert hidden.rstrip().endswith("### END HIDDEN TESTS"), c.source
 
 
 @pytest.fixture(scope="module")
 def autograded(course, tmp_path_factory):
-    """One ``nbgrader autograde`` of four submissions of every lab (see ``make_submission``).
+    """One ``nbgrader autograde`` of every lab's submissions (tests/lab/submissions) and its empty student version.
 
     The tests below read it: the scores, and the empty student versions as nbgrader ran them (each lab's
     student version is executed once, here, rather than once more by nbclient for the student test).
     """
     root, students = course
     subs = tmp_path_factory.mktemp("submissions")
-    for kind in SUBMISSIONS:
-        (subs / kind).mkdir()
     for lab, student in zip(LABS, students, strict=True):
-        shutil.copy2(student, subs / "empty" / student.name)
-        for kind in ("correct", "wrong"):
-            nbformat.write(make_submission(lab, kind), subs / kind / lab.name)
-    return labs_tool.autograde(subs, root)
+        for kind, sub in _by_student(lab).items():
+            (subs / kind).mkdir(exist_ok=True)
+            if sub is None:
+                shutil.copy2(student, subs / kind / student.name)
+            else:
+                nbformat.write(build(lab, sub), subs / kind / lab.name)
+    return labs_tool.autograde(subs, root, jobs=2)  # two groups of students at once (CI has a 20-minute goal)
+
+
+def expected_points(lab: Path, student: str) -> dict[str, float]:
+    """Points per autograded cell of ``lab`` for the submission of ``student``, from the notebook's metadata."""
+    sub = _by_student(lab).get(student)
+    lost = lost_cells(lab, sub) if sub is not None else set()
+    out = {}
+    for c, m in _nbgrader_cells(nbformat.read(lab, as_version=4)):
+        if m["grade"] and c.cell_type == "code":
+            part = m["grade_id"].split("_")[1]
+            out[m["grade_id"]] = 0.0 if sub is None or part in lost else float(m["points"])
+    return out
 
 
 @pytest.mark.slow
@@ -185,7 +157,10 @@ def test_student_versions_run_and_say_not_done_yet(course, autograded):
     root, students = course
     assert [p.name for p in students] == [p.name for p in LABS]
     for path in students:
-        assert "### BEGIN SOLUTION" not in path.read_text(encoding="utf-8"), path.name
+        text = path.read_text(encoding="utf-8")
+        assert "### BEGIN SOLUTION" not in text, path.name
+        assert "slamlab_grading" not in text, path.name  # nbgrader took the hidden tests out
+        assert "HIDDEN TESTS" not in text, path.name
         nb = nbformat.read(root / "autograded" / "empty" / labs_tool.ASSIGNMENT / path.name, as_version=4)
         assert len([c for c in nb.cells if c.cell_type == "code"]) == len(
             [c for c in nbformat.read(path, as_version=4).cells if c.cell_type == "code"]), path.name
@@ -195,7 +170,7 @@ def test_student_versions_run_and_say_not_done_yet(course, autograded):
             assert c.execution_count is not None, f"{path.name}: not executed:\n{c.source}"
             assert "### BEGIN SOLUTION" not in c.source
             errors = [o for o in c.outputs if o.output_type == "error"]
-            if "sl.lab.check(" in c.source or "sl.lab.answer(" in c.source:
+            if "sl.lab.check(" in c.source or "sl.lab.answer(" in c.source:  # nbgrader put the hidden tests back
                 text = "".join(o.get("text", "") for o in c.outputs)
                 assert "not done yet" in text, f"{path.name}: {c.source} printed {text!r}"
                 assert all(o.ename == "AssertionError" and "not done yet" in o.evalue for o in errors), \
@@ -206,31 +181,62 @@ def test_student_versions_run_and_say_not_done_yet(course, autograded):
 
 @pytest.mark.slow
 def test_autograde_gives_each_submission_its_points_per_task(autograded):
-    """Every autograded cell of every submission scores what the notebooks' metadata says it should."""
+    """Every autograded cell of every submission scores what its submission says: full points for the correct ones
+    (another method, another seed), zero where a named mistake sits, zero for the empty student version."""
     with (autograded.parent / "grades_by_task.csv").open() as fh:
         got = {(r["student_id"], r["notebook"], r["grade_id"]): float(r["score"]) for r in csv.DictReader(fh)}
-    expected = {(kind, lab.stem, gid): pts for kind in SUBMISSIONS for lab in LABS
-                for gid, pts in expected_points(lab, kind).items()}
+    expected = {(kind, lab.stem, gid): pts for kind in KINDS for lab in LABS
+                for gid, pts in expected_points(lab, kind).items() if kind in _by_student(lab)}
     wrong = {k: (v, got.get(k)) for k, v in expected.items() if got.get(k) != v}
     assert not wrong, f"(submission, lab, cell): (expected, scored): {wrong}"
-    assert set(got) == set(expected)
+    assert set(got) >= set(expected)
     with autograded.open() as fh:
         totals = {r["student_id"]: float(r["raw_score"]) for r in csv.DictReader(fh)}
-    for kind in SUBMISSIONS:  # nbgrader's own grades.csv: the total of the autograded points (prose is by hand)
-        assert totals[kind] == sum(v for (k, _, _), v in expected.items() if k == kind), kind
+    for kind, total in totals.items():  # nbgrader's own grades.csv: the total of the autograded points (prose by hand)
+        assert total == sum(v for (k, _, _), v in expected.items() if k == kind), kind
     assert totals["empty"] == 0.0
-    assert totals["correct"] == sum(m["points"] for lab in LABS for c, m in _nbgrader_cells(
-        nbformat.read(lab, as_version=4)) if m["grade"] and c.cell_type == "code")
+    full = sum(m["points"] for lab in LABS for c, m in _nbgrader_cells(nbformat.read(lab, as_version=4))
+               if m["grade"] and c.cell_type == "code")
+    assert totals["independent"] == totals["other_seed"] == full
 
 
 @pytest.mark.parametrize("lab", LABS, ids=[p.name for p in LABS])
 def test_lab_checks_every_task_of_its_chapter_once(lab):
     import re
 
-    from slamlab import lab as sl_lab
+    import slamlab_grading as sl_lab
 
     nb = nbformat.read(lab, as_version=4)
     used = re.findall(r'sl\.lab\.(?:check|answer)\("([^"]+)"', "\n".join(c.source for c in nb.cells
                                                                        if c.cell_type == "code"))
     prefix = lab.name[:2] + "."
     assert sorted(used) == list(sl_lab.tasks_of(prefix)), f"{lab.name} checks {used}"
+
+
+_site_spec = importlib.util.spec_from_file_location("build_site_tool", ROOT / "tools" / "build_site.py")
+build_site = importlib.util.module_from_spec(_site_spec)
+_site_spec.loader.exec_module(build_site)
+
+
+@pytest.mark.parametrize("lab", LABS, ids=[p.name for p in LABS])
+def test_every_hand_graded_answer_has_a_rubric_whose_points_add_up(lab):
+    """Issue 43, item 5: a rubric with points for every hand-graded question (the site's instructor guide lists
+    them): ``**Rubric (N points).**`` with N the cell's points, and the breakdown's points ("1 point: ...") sum
+    to N."""
+    import json
+    import re
+
+    nb = json.loads(lab.read_text(encoding="utf-8"))
+    rubrics = build_site.lab_rubrics(nb)
+    hand = [c for c in nb["cells"] if c["cell_type"] == "markdown"
+            and c["metadata"].get("nbgrader", {}).get("solution") and c["metadata"]["nbgrader"].get("grade")]
+    assert len(rubrics) == len(hand) >= 3, lab.name  # the questions (two or three) and the open investigation
+    for (label, points, text), c in zip(rubrics, hand, strict=True):
+        src = "".join(c["source"])
+        head = re.match(r"\*\*Rubric \((\d+(?:\.\d+)?) points?\)\.\*\*", src)
+        assert float(head.group(1)) == points == float(c["metadata"]["nbgrader"]["points"]), (lab.name, label)
+        parts = [float(x) for x in re.findall(r"(\d+(?:\.\d+)?) points?\b(?! in all)", text)]
+        assert parts, f"{lab.name} {label}: no point breakdown in {text!r}"
+        assert sum(parts) == points, f"{lab.name} {label}: the breakdown {parts} does not add up to {points:g}"
+        if label.startswith("Q"):  # an open investigation may have a rubric alone
+            assert len(src.strip()) > len(text) + 40, f"{lab.name} {label}: the model answer follows the rubric"

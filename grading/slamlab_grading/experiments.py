@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..sim import (
+from slamlab.sim import (
     Rangefinder,
     StereoArena,
     StereoSim,
