@@ -23,6 +23,7 @@ never passes silently.
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 from collections.abc import Sequence
 from typing import Any, TypeVar
 
@@ -31,6 +32,11 @@ from ._table import format_table
 __all__ = ["Params", "param", "refuse_set_fields"]
 
 P = TypeVar("P", bound="Params")
+
+#: The widest line of :meth:`Params.table` (the output area of JupyterLab at its default width).
+TABLE_WIDTH = 110
+#: The widest value :meth:`Params.table` prints in its column (a longer one goes to a note).
+_VALUE_ROOM = 32
 
 
 def param(default: Any, source: str, **kwargs: Any) -> Any:
@@ -112,11 +118,45 @@ class Params:
         default = type(self)()
         return {k: getattr(self, k) for k in self.field_names() if getattr(self, k) != getattr(default, k)}
 
-    def table(self) -> str:
-        """Every field, its value and its source, as a text table."""
+    def table(self, width: int = TABLE_WIDTH) -> str:
+        """Every field, its value and its source, as a text table no line of which is wider than ``width``.
+
+        A source (or a value) too long for its column is cut at a clause boundary and marked ``[n]``; the whole
+        text is note ``[n]`` under the table, wrapped at ``width``.
+
+        Parameters
+        ----------
+        width : int
+            The widest line (default :data:`TABLE_WIDTH`, JupyterLab's output area).
+
+        Returns
+        -------
+        str
+        """
         src = self.sources()
-        rows = [[k, _fmt(getattr(self, k)), src[k]] for k in self.field_names()]
-        return format_table(["parameter", "value", "source"], rows, title=type(self).__name__)
+        names = self.field_names()
+        values = [_fmt(getattr(self, k)) for k in names]
+        notes: list[str] = []
+
+        def fit(text: str, room: int, what: str) -> str:
+            if len(text) <= room:
+                return text
+            tag = f"[{len(notes) + 1}]"
+            notes.append(f"{tag} {what}: {text}")
+            head = _head(text, room - len(tag) - 1)
+            return f"{head} {tag}" if head else tag
+
+        name_w = max(len("parameter"), *map(len, names))
+        value_room = max(len("value"), min(max(map(len, values)), _VALUE_ROOM))
+        rows = [[k, fit(v, value_room, f"{k} value") if len(v) > value_room else v] for k, v in zip(names, values, strict=True)]
+        value_w = max(len("value"), *(len(r[1]) for r in rows))
+        room = max(len("source"), width - name_w - value_w - 4)
+        rows = [[k, v, fit(src[k], room, k)] for k, v in rows]
+        out = format_table(["parameter", "value", "source"], rows, title=type(self).__name__)
+        if notes:
+            out += "\n" + "\n".join(textwrap.fill(n, width, subsequent_indent="    ", break_on_hyphens=False)
+                                     for n in notes)
+        return out
 
 
 def refuse_set_fields(params: Params, names: Sequence[str], how: str, *, default: Params | None = None) -> None:
@@ -168,7 +208,26 @@ def refuse_set_fields(params: Params, names: Sequence[str], how: str, *, default
                          f"{'it' if len(clash) == 1 else 'them'} to {values} (leave the default {defaults})")
 
 
+def _head(text: str, room: int) -> str:
+    """The longest start of ``text`` that ends at a clause boundary outside brackets and fits in ``room``."""
+    best, depth = "", 0
+    for i, ch in enumerate(text):
+        if ch in "([":
+            if depth == 0 and i <= room and text[i - 1:i] == " ":
+                best = text[:i - 1]
+            depth += 1
+        elif ch in ")]":
+            depth = max(0, depth - 1)
+        elif depth == 0 and ch in ";:," and i <= room:
+            best = text[:i]
+        if i > room:
+            break
+    return best.rstrip()
+
+
 def _fmt(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
+    if isinstance(value, tuple) and value and all(isinstance(x, (int, float)) for x in value):
+        return f"({', '.join(_fmt(x) for x in value)}{',' if len(value) == 1 else ''})"
     return repr(value) if isinstance(value, str) else str(value)

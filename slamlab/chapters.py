@@ -101,33 +101,41 @@ def get_chapter(number: int) -> Chapter:
     raise ValueError(f"`number` must be one of {[c.number for c in CHAPTERS]}; got {number!r}")
 
 
-def chapter_table() -> str:
-    """The chapter map as a fixed-width text table (printed in ``00_overview``).
-
-    Examples
-    --------
-    >>> print(chapter_table().splitlines()[0])
-    NN  chapter                                    notebook                             subpackage                         source                      status
-    """
-    head = ("NN", "chapter", "notebook", "subpackage", "source", "status")
-    rows = [
-        (f"{c.number:02d}", c.title, c.notebook, ", ".join(c.subpackages), c.sources, c.status)
-        for c in CHAPTERS
-    ]
-    rows += [("--", *topic) for topic in SHARED_TOPICS]
+def _fixed_width(head: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str]:
     widths = [max(len(r[i]) for r in [head, *rows]) for i in range(len(head))]
 
     def fmt(r):
         return "  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)).rstrip()
 
-    lines = [fmt(head), "  ".join("-" * w for w in widths)]
-    lines += [fmt(r) for r in rows]
+    return [fmt(head), "  ".join("-" * w for w in widths), *(fmt(r) for r in rows)]
+
+
+def chapter_table() -> str:
+    """The chapter map as two fixed-width text tables (printed in ``00_overview``).
+
+    The first gives each chapter's title, sources and status; the second, under it after a
+    blank line, its notebook and the slamlab subpackages holding its code. Split in two, every
+    line fits JupyterLab's output area (110 characters).
+
+    Examples
+    --------
+    >>> print(chapter_table().splitlines()[0])
+    NN  chapter                                    source                      status
+    >>> max(len(line) for line in chapter_table().splitlines()) <= 110
+    True
+    """
+    what = [(f"{c.number:02d}", c.title, c.sources, c.status) for c in CHAPTERS]
+    what += [("--", title, sources, status) for title, _, _, sources, status in SHARED_TOPICS]
+    where = [(f"{c.number:02d}", c.notebook, ", ".join(c.subpackages)) for c in CHAPTERS]
+    where += [("--", used, package) for _, used, package, _, _ in SHARED_TOPICS]
+    lines = _fixed_width(("NN", "chapter", "source", "status"), what)
+    lines += ["", *_fixed_width(("NN", "notebook", "subpackage"), where)]
     return "\n".join(lines)
 
 
 #: What notebook 00 takes from 000 §1, §1.1 and what it does with it: (item, 000, here).
 OVERVIEW_VS_SOURCE: tuple[tuple[str, str, str], ...] = (
-    ("definition of SLAM (§1)", "given, with requirements on the pose and the map", "summarised in English"),
+    ("definition of SLAM (§1)", "given, with requirements on pose and map", "summarised in English"),
     ("five subtasks (§1)", "listed in this order", "same order; numbered in the figure"),
     ("standard scheme (§1.1, Fig. 2)", "a figure (its image is not in our text)", "redrawn from §1.1's description"),
 )

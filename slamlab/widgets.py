@@ -3,12 +3,15 @@
 Every chapter's ``<topic>/widgets.py`` builds its sliders with :func:`slider` (no
 update while dragging), labels its controls with :data:`STYLE` (wide descriptions) and
 runs each update through :func:`show_run` (the run, then its table, then its figure,
-or one readable message instead of a traceback).
+or one readable message instead of a traceback), and returns :func:`interactive`, whose
+text form (what a notebook stores beside the widget) is one short line.
 """
 
 from __future__ import annotations
 
-__all__ = ["STYLE", "show_run", "slider"]
+import functools
+
+__all__ = ["STYLE", "interactive", "show_run", "slider"]
 
 #: Label style shared by every control: wide descriptions are not cut off.
 STYLE = {"description_width": "initial"}
@@ -42,6 +45,64 @@ def slider(cls, value, lo, hi, step, desc: str, **kw):
     """
     return cls(value=value, min=lo, max=hi, step=step, description=desc, continuous_update=False, style=STYLE, **kw)
 
+
+@functools.cache
+def _interactive_class():
+    import ipywidgets
+
+    class Interactive(ipywidgets.interactive):
+        """``ipywidgets.interactive`` whose text form names the explore function and counts its controls."""
+
+        def __repr__(self) -> str:
+            parts = getattr(self.f, "__qualname__", "widget").split(".<locals>.")
+            name = parts[-2] if len(parts) > 1 else parts[0]  # the function that built the widget
+            n = len(self.kwargs_widgets)
+            text = f"{name}: {n} control{'' if n == 1 else 's'}"
+            return f"{text} (ipywidgets)" if len(text) <= 47 else text[:60]
+
+    return Interactive
+
+
+def interactive(show, options=None, /, **controls):
+    """``ipywidgets.interactive(show, options, **controls)`` with a one-line text form.
+
+    ipywidgets' own text form spells out the first controls and their settings and
+    cuts it at 110 characters, so a notebook stores a line too wide for JupyterLab's
+    output area. This one names the ``explore_*`` function and counts the controls,
+    in at most 60 characters. Everything else is ``ipywidgets.interactive``.
+
+    Parameters
+    ----------
+    show : callable
+        The update function; it receives the controls' values by keyword.
+    options : dict, optional
+        ipywidgets' options of the interaction, e.g. ``{"manual": True, "manual_name": "run"}`` for a run
+        button instead of an update on every change.
+    **controls
+        The controls (widgets or ipywidgets abbreviations), one per argument of ``show``.
+
+    Returns
+    -------
+    ipywidgets.interactive
+        The widget (an instance of a subclass that only changes ``repr``).
+
+    Examples
+    --------
+    >>> import ipywidgets as widgets
+    >>> def explore_noise(**defaults):
+    ...     def show(noise, n):
+    ...         pass
+    ...     return interactive(show, noise=slider(widgets.FloatSlider, 0.5, 0.0, 1.0, 0.1, "noise"),
+    ...                        n=slider(widgets.IntSlider, 3, 1, 9, 1, "n"))
+    >>> import contextlib, io
+    >>> with contextlib.redirect_stdout(io.StringIO()):  # the first update clears the (terminal) output
+    ...     w = explore_noise()
+    >>> isinstance(w, widgets.interactive), repr(w)
+    (True, 'explore_noise: 2 controls (ipywidgets)')
+    >>> w._repr_mimebundle_()["text/plain"]
+    'explore_noise: 2 controls (ipywidgets)'
+    """
+    return _interactive_class()(show, {} if options is None else dict(options), **controls)
 
 
 def show_run(run, draw=None, *, table=None, errors=(ValueError, TypeError)):

@@ -26,6 +26,12 @@ os.environ["SLAMLAB_PROGRESS"] = "0"
 # The labs' exploration attempts are counted in each kernel only (no lab_attempts.json in the repository, and a
 # fresh kernel counts from 1, as the stored outputs do); tests of the file set their own path.
 os.environ["SLAMLAB_LAB_ATTEMPTS"] = "memory"
+# The grading's accepted ranges are cached for this session (one folder per test worker; the kernels that nbval and
+# nbgrader start inherit it), not in the user's home.
+if "SLAMLAB_GRADING_CACHE" not in os.environ:
+    import tempfile
+
+    os.environ["SLAMLAB_GRADING_CACHE"] = tempfile.mkdtemp(prefix="slamlab-grading-cache-")
 
 
 def _require_realdata() -> bool:

@@ -76,18 +76,27 @@ def test_chapter_str():
 
 def test_chapter_table_is_fixed_width():
     table = chapters.chapter_table()
-    lines = table.splitlines()
-    assert len(lines) == 2 + len(chapters.CHAPTERS) + len(chapters.SHARED_TOPICS)
-    assert lines[0].split() == ["NN", "chapter", "notebook", "subpackage", "source", "status"]
-    assert set(lines[1]) == {"-", " "}
-    # every column starts at the same offset in every row
-    starts = [m.start() for m in re.finditer(r"(?<=  )\S", lines[0])]
-    for line in lines[2:]:
-        for start in starts:
-            assert line[start - 1] == " "
-            assert line[start] != " "
+    n = len(chapters.CHAPTERS) + len(chapters.SHARED_TOPICS)
+    what, where = table.split("\n\n")  # two tables: title, sources, status; then notebook and subpackages
+    for block, head in ((what, ["NN", "chapter", "source", "status"]), (where, ["NN", "notebook", "subpackage"])):
+        lines = block.splitlines()
+        assert len(lines) == 2 + n
+        assert lines[0].split() == head
+        assert set(lines[1]) == {"-", " "}
+        # every column starts at the same offset in every row
+        starts = [m.start() for m in re.finditer(r"(?<=  )\S", lines[0])]
+        for line in lines[2:]:
+            for start in starts:
+                assert line[start - 1] == " "
+                assert line[start] != " "
     for c in chapters.CHAPTERS:
-        row = next(line for line in lines if line.startswith(f"{c.number:02d}  "))
-        assert c.notebook in row
+        row = next(line for line in what.splitlines() if line.startswith(f"{c.number:02d}  "))
+        assert c.title in row
         assert row.endswith(c.status)
-    assert "slamlab.evaluation" in table
+        row = next(line for line in where.splitlines() if line.startswith(f"{c.number:02d}  "))
+        assert c.notebook in row
+        assert row.endswith(", ".join(c.subpackages))
+    assert "slamlab.evaluation" in where
+    # every line fits JupyterLab's output area
+    assert max(len(line) for line in table.splitlines()) <= 110
+    assert max(len(line) for line in chapters.overview_vs_source().splitlines()) <= 110

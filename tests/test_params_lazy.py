@@ -80,3 +80,40 @@ def test_lazy_exports_import_on_first_use(monkeypatch):
     assert "nothing" in pkg.__dir__()
     with pytest.raises(AttributeError, match="has no attribute 'missing'"):
         pkg.__getattr__("missing")
+
+
+@dataclass(frozen=True)
+class _Long(Params):
+    a_long_field_name: float = param(0.5, "ours: " + "a long explanation of the value " * 8)
+    short: int = param(3, "004 §5")
+    pair: tuple = param((2.0, 0.17453292519943295), "ours (the pair)")
+
+
+def test_table_fits_the_output_area_with_long_sources_in_notes():
+    t = _Long().table()
+    lines = t.splitlines()
+    assert max(map(len, lines)) <= 110
+    assert lines[3].endswith("ours [1]")  # the source's first clause, marked
+    assert lines[4].endswith("004 §5")  # a short source stays in its column
+    assert "(2, 0.174533)" in lines[5]  # tuples of numbers at the precision of single numbers
+    notes = " ".join(line.strip() for line in lines[6:])
+    assert notes == "[1] a_long_field_name: " + _Long.sources()["a_long_field_name"].strip()
+    assert max(map(len, _Long().table(width=60).splitlines())) <= 60
+
+
+def test_every_params_table_of_the_library_fits_110_characters():
+    import importlib
+
+    for m in ("correlation.settings", "hough.slam", "kdtree.store_params", "localisation.markov",
+              "localisation.mcl_params", "mono.params", "planes.filter", "sim.planes_room", "stereo.params"):
+        importlib.import_module(f"slamlab.{m}")
+
+    def subclasses(cls):
+        for s in cls.__subclasses__():
+            yield s
+            yield from subclasses(s)
+
+    found = [c for c in subclasses(Params) if c.__module__.startswith("slamlab.")]
+    assert len(found) >= 10
+    for c in found:
+        assert max(map(len, c().table().splitlines())) <= 110, c.__name__

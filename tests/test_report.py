@@ -51,7 +51,7 @@ def test_report_runs_notebook_01_with_fewer_runs(tmp_path):
     assert len(injected) == 1
     text = _outputs(nb)
     assert "CV target, 5 runs x 50 steps" in text  # the stored notebook says 50 runs
-    assert "linearised KF diverged in" in text
+    assert "diverged: linearised KF" in text
     assert "of 3 runs" in text
 
 

@@ -61,3 +61,31 @@ def test_errors_in_table_or_draw_propagate(capsys):
     with pytest.raises(ValueError, match="a bug in the plot"):
         show_run(lambda: _Result(), bad_draw)
     assert "Cannot run" not in capsys.readouterr().out
+
+
+def test_interactive_text_form_is_one_short_line(capsys):
+    """What a notebook stores beside the widget: the explore function's name and its control count, never
+    ipywidgets' own form (the first controls spelled out, cut at 110 characters plus an ellipsis)."""
+    import ipywidgets as widgets
+
+    from slamlab.widgets import interactive, slider
+
+    def explore_something_with_a_long_name():
+        def show(noise_std, detector):
+            pass
+
+        return interactive(show, noise_std=slider(widgets.FloatSlider, 0.5, 0.0, 20.0, 0.5, "image noise σ [grey]" * 5),
+                           detector=widgets.Dropdown(options=["SURF (ours)", "SIFT (OpenCV)"], description="detector"))
+
+    w = explore_something_with_a_long_name()
+    capsys.readouterr()
+    assert isinstance(w, widgets.interactive)
+    text = w._repr_mimebundle_()["text/plain"]
+    assert text == "explore_something_with_a_long_name: 2 controls (ipywidgets)"
+    assert len(text) <= 60
+    assert "\n" not in text
+    # ipywidgets' options pass through: a run button instead of an update on every change
+    manual = interactive(lambda n: None, {"manual": True, "manual_name": "run"}, n=slider(widgets.IntSlider, 1, 1, 3, 1, "n"))
+    assert manual.manual_button.description == "run"
+    # named after the function that built it (here the test); a long name drops the "(ipywidgets)"
+    assert repr(manual) == "test_interactive_text_form_is_one_short_line: 1 control"

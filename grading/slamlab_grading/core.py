@@ -16,9 +16,15 @@ check only prints and returns its :class:`CheckResult`.
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import hashlib
+import json
 import math
+import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -194,9 +200,10 @@ class ExplorationTask:
     answered_by: tuple[str, ...] = ()
 
     def accepted_range(self) -> tuple[float, float]:
-        """The closed range of values that pass."""
+        """The closed range of values that pass (a task of the grading package's own: cached on disk, see
+        :func:`cached_range`)."""
         if self.accepted is not None:
-            lo, hi = (float(v) for v in self.accepted())
+            lo, hi = cached_range(self.task_id, self.accepted)
             if not lo <= hi:
                 raise ValueError(f"{self.task_id}: `accepted` must return (lo, hi) with lo <= hi; got ({lo}, {hi})")
             return lo, hi
@@ -222,6 +229,61 @@ class ExplorationTask:
             if abs(x - v) <= w.atol + w.rtol * abs(v):
                 return w
         return None
+
+
+#: Where :func:`cached_range` keeps the accepted ranges (default ``~/.cache/slamlab_grading``).
+CACHE_ENV = "SLAMLAB_GRADING_CACHE"
+
+
+@functools.cache
+def code_hash() -> str:
+    """The sha256 of every Python file of slamlab and of this package: a cached range is valid for this code only."""
+    import slamlab
+
+    h = hashlib.sha256()
+    for root in (Path(slamlab.__file__).parent, Path(__file__).parent):
+        for f in sorted(root.rglob("*.py")):
+            h.update(str(f.relative_to(root.parent)).encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def cached_range(task_id: str, accepted: Callable[[], tuple[float, float]]) -> tuple[float, float]:
+    """``accepted()``, kept on disk for the same code (:func:`code_hash`): an autograde of 200 students computes
+    each exploration's independent range once, not once per notebook.
+
+    Only a task defined in this package is cached (a test's made-up task is not); the folder is
+    ``$SLAMLAB_GRADING_CACHE`` or ``~/.cache/slamlab_grading``, one small JSON file per task and code, written
+    atomically (two autograders may share it).
+
+    Parameters
+    ----------
+    task_id : str
+        The task.
+    accepted : callable
+        ``accepted() -> (lo, hi)``.
+
+    Returns
+    -------
+    tuple of float
+        ``(lo, hi)``.
+    """
+    if not getattr(accepted, "__module__", "").startswith(__package__ + "."):
+        return tuple(float(v) for v in accepted())
+    folder = Path(os.environ.get(CACHE_ENV) or Path.home() / ".cache" / "slamlab_grading")
+    path = folder / f"{task_id}.{code_hash()}.json"
+    try:
+        lo, hi = json.loads(path.read_text(encoding="utf-8"))
+        return float(lo), float(hi)
+    except (OSError, ValueError, TypeError):
+        pass
+    lo, hi = (float(v) for v in accepted())
+    with contextlib.suppress(OSError):  # a read-only home: computed every time
+        folder.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps([lo, hi]), encoding="utf-8")
+        os.replace(tmp, path)
+    return lo, hi
 
 
 def register(t: Task | ExplorationTask) -> Task | ExplorationTask:

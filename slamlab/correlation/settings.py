@@ -164,7 +164,7 @@ class LocaliseParams(Params):
     """
 
     delta_alpha_rad: float = param(float(np.radians(1.0)), "004 §7: Δα = 1°")
-    a_c: float = param(-1.0, "004 §7: a_c < 0 < a_p, a_n = 0; sharpest peak at a_p = -a_c")
+    a_c: float = param(-1.0, "004 §7: sign opposite to a_p (ours: a_c < 0); sharpest at a_p = -a_c")
     a_p: float = param(1.0, "004 §7")
     a_n: float = param(0.0, "004 §7: conditions (1)-(3) give a_n = 0")
     delta_l_cells: float = param(0.0, "004 §7: ±Δl, value not given (0 marks one cell)")
@@ -177,8 +177,8 @@ class LocaliseParams(Params):
     ambiguity: bool = param(True, "ours: also find the best rival pose (re-scores the headings near the peak)")
     rival_radius_cells: float = param(5.0, "ours: a rival is farther than this from the peak (1 m at 0.2 m)")
     rival_heading_rad: float = param(float(np.radians(30.0)), "ours: ... or its heading is more than 30° off")
-    wall_balance: bool = param(False, "ours (issue 25): a_p × count(wall-direction bin)^(-1/2), mean 1, cap 4")
-    free_mark_weight: float = param(1.0, "ours (issue 25): the stamp's free marks are a_c × this (1: 004's stamp)")
+    wall_balance: bool = param(False, "ours, an experiment chosen on the real logs: a_p × count(wall bin)^(-1/2)")
+    free_mark_weight: float = param(1.0, "ours, an experiment chosen on the real logs: free marks a_c × this (1: 004)")
 
     def __post_init__(self) -> None:
         with contextlib.suppress(TypeError):  # accept numpy dtypes (np.float32) too; check() names a bad one

@@ -54,7 +54,14 @@ class Lines:
     def __str__(self) -> str:
         parts = [f"({r:.2f}, {math.degrees(t):.1f}°, {int(n)})" for r, t, n in
                  zip(self.rho, self.theta_rad, self.votes, strict=True)]
-        return f"{len(self)} lines (rho, θ, votes): " + ", ".join(parts)
+        out, line = [], f"{len(self)} lines (rho, θ, votes):"
+        for k, part in enumerate(parts):  # a few lines per text line: the text fits a notebook's output area
+            piece = f" {part}" + ("," if k < len(parts) - 1 else "")
+            if len(line) + len(piece) > 96:
+                out.append(line)
+                line = " "
+            line += piece
+        return "\n".join([*out, line])
 
 
 def canonical_lines(rho, theta_rad) -> tuple[np.ndarray, np.ndarray]:

@@ -365,9 +365,8 @@ class CostModelResult:
     def __str__(self) -> str:
         _, n1l, ql, _, _ = self.literal
         _, n1, q, _, _ = self.optimum
-        return (f"multi kd-tree optimum for n = {self.n:.0f}, s = {self.s:.0f}, m = {self.m:.0f}, C = {self.C:.2f}: "
-                f"Appendix as printed n1 = {n1l:.0f}, q = {ql:.2f}; with C s T_search n1 = {n1:.0f}, q = {q:.2f} "
-                f"(000: n1 ≈ 3500, q = 5.5)")
+        return (f"optimum for n = {self.n:.0f}, s = {self.s:.0f}, m = {self.m:.0f}, C = {self.C:.2f}: "
+                f"n1 = {n1:.0f}, q = {q:.2f} (as printed: n1 = {n1l:.0f}, q = {ql:.2f})")
 
     def table(self) -> str:
         """The optimum ``n1``, ``q`` of each reading beside 000's, and the 1 % region.

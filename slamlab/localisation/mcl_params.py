@@ -65,21 +65,24 @@ class MCLParams(ModelParams):
         The pose a step reports (:data:`ESTIMATES`).
     """
 
-    alpha: tuple = param((0.2, 0.008, 0.2, 0.02), "ours: 4 × the Markov grid's, in cells (the ablation); PR Tables "
-                                                  "5.5-5.6 α1…α4 (ROS: 0.2 each, in metres)")
-    sigma_hit: float = param(4.0, "ours, cells (the ablation); PR Table 6.3 (ROS: 0.2 m)")
+    alpha: tuple = param((0.2, 0.008, 0.2, 0.02), "ours: 4 × the Markov grid's α, in cells, chosen with sigma_hit, "
+                                                  "jitter and gamma as one change (Ch. 08 §4); PR Tables 5.5-5.6 "
+                                                  "α1…α4 (ROS: 0.2 each, in metres)")
+    sigma_hit: float = param(4.0, "ours, cells, chosen with alpha, jitter and gamma as one change (Ch. 08 §4: taken "
+                                  "back alone to 2 cells, it does no better on 50 runs); PR Table 6.3 (ROS: 0.2 m)")
     max_dist: float = param(12.0, "ours, cells: 3 σ_hit, cap of the distance table (ROS: 2 m)")
-    gamma: float = param(0.5, "ours (the ablation): weights p(z | x)^gamma, a tempered likelihood (1 = PR's "
-                              "product of the beams as if independent)")
+    gamma: float = param(0.5, "ours: weights p(z | x)^gamma, a tempered likelihood (1 = PR's product of the beams "
+                              "as if independent)")
     n_particles: int = param(2000, "ours (003: not given; ROS AMCL 100…5000, Nav2 500…2000)")
     score: str = param("geometric_mean", "ours: the score ω that eq 2.8 averages (SCORES; 003: 'a probability "
-                                         "between 0 and 1'); 'likelihood' = PR Table 8.3. Weights: p(z | x)^gamma")
+                                         "between 0 and 1'); 'likelihood' = PR Table 8.3. The weights are "
+                                         "p(z | x)^gamma whatever the score")
     alpha_slow: float = param(0.001, "003 eq 2.9 (value not given); ROS AMCL docs suggest 0.001")
     alpha_fast: float = param(0.1, "003 eq 2.10 (value not given); ROS AMCL docs suggest 0.1")
-    averages: str = param("debiased", "'003': w_slow, w_fast start at 0 ('initially 0'); 'debiased' (ours): from "
-                                      "0, divided by 1 − (1 − α)^t; 'amcl': at the first w_avg, and again after "
-                                      "every injection (ROS 1 amcl pf.c, Beluga); 'first' (ours): at the first "
-                                      "w_avg, never restarted")
+    averages: str = param("debiased", "ours: 'debiased', from 0 as 003 says, divided by 1 − (1 − α)^t; '003': "
+                                      "w_slow, w_fast start at 0 ('initially 0'); 'amcl': at the first w_avg, and "
+                                      "again after every injection (ROS 1 amcl pf.c, Beluga); 'first' (ours): at "
+                                      "the first w_avg, never restarted")
     resample_threshold: float = param(0.5, "ours: resample when N_eff < threshold·M (ROS 1 amcl's selective "
                                            "resampling: 0.5); 1 = every step (003, PR Table 8.2)")
     beam_skip: bool = param(False, "ours: Nav2/ROS 1 likelihood_field_prob's beam skipping, once converged")
@@ -87,8 +90,8 @@ class MCLParams(ModelParams):
     beam_skip_threshold: float = param(0.3, "ROS/Nav2 beam_skip_threshold: keep a beam when > this share of "
                                             "the particles put its end point near an obstacle")
     beam_skip_error_threshold: float = param(0.9, "ROS/Nav2: if this share of the beams is skipped, use all")
-    jitter: tuple = param((0.6, 0.04), "ours (the ablation): σ of a Gaussian jitter (cells, rad) added to every "
-                                       "particle at every step, moving or not (cf. the roughening of Gordon et al. "
+    jitter: tuple = param((0.6, 0.04), "ours: σ of a Gaussian jitter (cells, rad) added to every particle at "
+                                       "every step, moving or not (cf. the roughening of Gordon et al. "
                                        "1993, after resampling); (0, 0) = none")
     update_min_d: float = param(0.0, "cells; ROS amcl update_min_d (0.2 m; Nav2 0.25 m): update only after "
                                      "moving this far (0 = every step, 003)")
@@ -102,7 +105,7 @@ class MCLParams(ModelParams):
     n_min: int = param(100, "ours: KLD lower bound (ROS 1: 100, Nav2: 500)")
     localised_pos_std: float = param(2.0, "ours: 'localised' when the position σ < this (cells)")
     localised_heading_std_rad: float = param(float(np.radians(5)), "ours: … and the heading σ < this")
-    estimate: str = param("mean", "'mean': the weighted mean of the whole set (003: the set is the estimate); "
+    estimate: str = param("mean", "ours: 'mean', the weighted mean of the whole set (003: the set is the estimate); "
                                   "'best_cluster': the mean of the heaviest cluster of kld_bin bins, the pose "
                                   "ROS 1 amcl publishes")
 

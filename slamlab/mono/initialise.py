@@ -280,7 +280,7 @@ class Initialiser:
             pose = relative_pose_homography(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
         elif self.method == "essential":
             pose = relative_pose_essential(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
-        else:  # "auto" (ours): 003's homography when a dominant plane explains the matches, else the 5-point
+        else:  # "auto" (ours): the homography when a dominant plane explains the matches, else the 5-point
             pose_h = relative_pose_homography(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
             pose_e = relative_pose_essential(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
             n_h = int(np.count_nonzero(pose_h.inliers)) if pose_h.ok else 0

@@ -25,8 +25,8 @@ class MonoParams(Params):
     init_min_tracked : float
         ours: restart when fewer than this share of corners is still tracked
     init_method : str
-        ours: 003 §4.3.1's homography when a dominant plane explains the matches, else the 5-point
-        method it also names ('homography', 'essential')
+        ours: the homography when a dominant plane explains the matches, else the 5-point algorithm
+        (003 §4.3.1 names both; 'homography', 'essential')
     init_plane_share : float
         ours ('auto'): the homography when its RANSAC inliers are at least this share of the 5-point
         method's
@@ -116,8 +116,8 @@ class MonoParams(Params):
     min_corners: int = param(50, "003 §4.3.1: at least 50 FAST points")
     init_disparity_px: float = param(15.0, "003 §5.1.1: 10-20 px ('initial displacement')")
     init_min_tracked: float = param(0.5, "ours: restart when fewer than this share of corners is still tracked")
-    init_method: str = param("auto", "ours: 003 §4.3.1's homography when a dominant plane explains the matches, "
-                                     "else the 5-point method it also names ('homography', 'essential')")
+    init_method: str = param("auto", "ours: the homography when a dominant plane explains the matches, else the "
+                                     "5-point algorithm (003 §4.3.1 names both; 'homography', 'essential')")
     init_plane_share: float = param(0.9, "ours ('auto'): the homography when its RANSAC inliers are at least this "
                                          "share of the 5-point method's")
     init_ransac_px: float = param(2.0, "ours")

@@ -1,6 +1,6 @@
 """Plane-based 3-D particle-filter SLAM from a yawing line scanner (002; Ch. 10).
 
-Its own package, not ``slamlab.localisation`` (where CONVENTIONS first placed 002): it is a
+Its own package, not part of ``slamlab.localisation``: it is a
 3-D system with its own types — frames of 40 000 points, planes ``Π = {n, p, T, A}`` with
 cell grids, particles in SE(3), a plane database — and shares nothing with the 2-D
 grid localisation of Ch. 8 except the idea of a particle filter. The chapter's flights,

@@ -1,6 +1,6 @@
 """The plane transform and its Levenberg-Marquardt solution per particle (002 Fig. 1, eq. system; reconstructed).
 
-002's system is garbled in the text; SPEC reconstructs it. A plane ``ᵐn·x = ᵐp`` of the
+002's system is garbled in the text; we reconstruct it (ours). A plane ``ᵐn·x = ᵐp`` of the
 map seen from the body pose ``x_m = ᵐ_bR x_b + ᵐt_b`` is, in the body frame,
 
     ᵇn_i = (ᵐ_bR)ᵀ ᵐn_i,        ᵇp_i = ᵐp_i − ᵐn_i · ᵐt_b                  (002, reconstructed)

@@ -61,7 +61,7 @@ def test_truth_check_on_csail_scans(real_data):
                     ("conf_obs", "truth_n_obs_on_free")):
         np.testing.assert_array_equal(sum(d[f"{what}_{w}"] for w in ("1", "2", "none")).to_numpy(), d[n].to_numpy())
     assert set(TRUTH_COLUMNS) <= set(d.columns)
-    assert "free on free" in r.terms_table()
+    assert "free/free" in r.terms_table()
     assert "truth - est." in r.terms_table()
     with pytest.raises(TypeError, match="`truth_check` must be a bool"):
         CS.run_log_localisation(log, (100,), truth_check="yes")

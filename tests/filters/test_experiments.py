@@ -38,6 +38,7 @@ def test_unicycle_linearised_kf_loses_track_and_others_do_not():
     assert max(med["EKF"], med["UKF-aug"], med["UKF-add"]) < 0.5
     assert res.failures.sum() == 0
     assert len(res.table().splitlines()) == 2 + len(res.filters)
+    assert max(len(line) for line in res.table().splitlines()) <= 110  # fits JupyterLab's output area
 
 
 def test_sigma_alpha_study_loses_digits_as_alpha_shrinks():
@@ -119,7 +120,10 @@ def test_ours_vs_source_verdicts_follow_the_results():
     assert bad_row.rstrip().endswith("no")
     # the landmark filter's error after n sightings is one sighting's / sqrt(n) (running mean): verdict yes
     lm_row = next(line for line in table.splitlines() if "landmark KF" in line)
-    assert lm_row.rstrip().endswith("yes (000 gives no numbers)")
+    assert lm_row.rstrip().endswith("yes")
+    assert "landmark KF: 000 gives no numbers" in table  # the verdict's note, under the table
+    # every line fits JupyterLab's output area
+    assert max(len(line) for line in table.splitlines()) <= 110
     with pytest.raises(TypeError, match="`joseph` must be a JosephResult; got CVTargetResult"):
         E.ours_vs_source(cv, cv, uni, wide, st, lm)
 

@@ -113,3 +113,23 @@ def test_grading_takes_the_students_recorded_answer_and_counts_the_attempts(task
     assert core.grade("t.new", lab.answer("t.new", 10.0, quiet=True)).passed
     not_a_number = lab.answer("t.new", "ten", quiet=True)
     assert core.grade("t.new", not_a_number, quiet=True).status == "failed"
+
+
+def test_a_packaged_range_is_computed_once_and_a_made_up_one_every_time(tmp_path, monkeypatch):
+    monkeypatch.setenv("SLAMLAB_GRADING_CACHE", str(tmp_path))
+    calls = []
+
+    def packaged():
+        calls.append(1)
+        return (1.0, 2.0)
+
+    packaged.__module__ = "slamlab_grading.tasks_made_up"
+    assert core.cached_range("99.explore.x", packaged) == (1.0, 2.0)
+    assert core.cached_range("99.explore.x", packaged) == (1.0, 2.0)
+    assert len(calls) == 1
+    (cached,) = tmp_path.glob("99.explore.x.*.json")
+    assert core.code_hash() in cached.name
+    made_up = lambda: (calls.append(1), (3.0, 4.0))[1]
+    assert core.cached_range("99.explore.y", made_up) == (3.0, 4.0)
+    assert core.cached_range("99.explore.y", made_up) == (3.0, 4.0)
+    assert len(calls) == 3

@@ -107,8 +107,8 @@ class LogLocalisationResult:
         return within_tolerance(self.err_pos_m, self.err_heading_rad, self.cell_m)
 
     def flagged(self, min_votes: int = 2) -> np.ndarray:
-        """``(modes, n)``: answers fewer than ``min_votes`` of the three single-scan voters agree with (ours, issue
-        25; needs ``votes=True``).
+        """``(modes, n)``: answers fewer than ``min_votes`` of the three single-scan voters agree with (ours; needs
+        ``votes=True``).
 
         Parameters
         ----------
@@ -206,15 +206,16 @@ class LogLocalisationResult:
                  f"{r.score_est:.0f}", f"{r.score_truth:.0f}", f"{r.score_truth - r.score_est:+.0f}",
                  f"{r.score_est_fine:.0f}", f"{r.score_truth_fine:.0f}", f"{r.walls_truth:.2f}", f"{r.walls_est:.2f}", r.kind]
                 for r in d.itertuples()]
-        return format_table(["scan", "mode", "err [m]", "err [°]", "score est.", "truth (grid)", "truth - est.",
-                             "est. fine", "truth fine", "walls at truth", "walls at est.", "kind"], rows,
-                            title=(f"{self.name}: failures, the search's score at its estimate and the best within "
-                                   f"{FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the logged pose (grid; fine = every "
-                                   "0.5 cell and 0.5°); walls = end points on obstacle cells of the leave-out grid"))
+        title = "\n".join([
+            f"{self.name}: failures; scores at the estimate (est.) and at the best grid pose within {FAIL_CELLS:g} cells",
+            f"and {FAIL_DEG:g}° of the logged pose (truth), their difference (diff = truth - est.), and the same off the",
+            "grid (fine: every 0.5 cell and 0.5°); walls = fraction of end points on obstacle cells of the leave-out grid"])
+        return format_table(["scan", "mode", "err [m]", "err [°]", "est.", "truth", "diff", "est. fine",
+                             "truth fine", "walls truth", "walls est.", "kind"], rows, title=title)
 
     def terms_table(self, scans=None) -> str:
         """The score's four terms (:func:`~slamlab.studies.correlation.score_terms`) and marks on unexplored cells at
-        the estimate and at the best grid pose near the truth, and their difference (ours, issue 25;
+        the estimate and at the best grid pose near the truth, and their difference (ours;
         ``truth_check=True``; columns ``est_…`` / ``truth_…`` of :meth:`truth_check`); for the truth also where its
         marks on unexplored cells and its obstacle marks on map free cells come from (``unex_…``, ``conf_obs_…``:
         ``1`` / ``2`` = a left-out scan that many steps away saw / hit the cell, ``none`` = no other scan).
@@ -227,6 +228,8 @@ class LogLocalisationResult:
         Returns
         -------
         str
+            A legend, then per case a table (rows: the estimate, the truth, truth - est.; columns: the score, its
+            four terms and the counts of marks) and the origin of the truth's marks in notes under it.
         """
         d = self.truth_check()
         cases = []
@@ -237,7 +240,18 @@ class LogLocalisationResult:
             med = _median_success(dk)
             if scans is None and med is not None:
                 cases.append((med, "median success"))
-        rows = []
+        head = ["pose", "score", "obs/obs", "obs/free", "free/free", "free/obs", "obs/unex.", "free/unex.",
+                "obs. marks"]
+        blocks = ["\n".join([
+            (f"{self.name}: the score's terms (a_c = {self.params.a_c:g}, a_p = {self.params.a_p:g}) at the estimate and "
+            f"at the best"),
+            (f"grid pose within {FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the logged pose (truth); score = the four "
+            "signed terms mark/map:"),
+            ("obs/obs = the stamp's obstacle marks on map obstacles, obs/free = on map free cells, free/free and "
+            "free/obs"),
+            (f"the same for its free marks; unex. = marks on unexplored cells of the leave-out grid "
+            f"({self.leave_out_text} left out),"),
+            "which count 0; obs. marks = all the stamp's obstacle marks"])]
         for r, case in cases:
             vals = {}
             for who in ("est", "truth"):
@@ -246,36 +260,32 @@ class LogLocalisationResult:
                 n_obs = r[f"{who}_n_obs_on_obs"] + r[f"{who}_n_obs_on_free"] + r[f"{who}_n_obs_unexplored"]
                 vals[who].append(n_obs)
             score = {"est": r["score_est"], "truth": r["score_truth"]}
-            head = [int(r["scan"]), self.mode_name(int(r["joined"])), case, f"{r['err_m']:.1f} m {r['err_deg']:.0f}°"]
-            origin = "; ".join(" / ".join(str(int(r[f"{what}_{w}"])) for w in ("1", "2", "none"))
-                               for what in ("unex_obs", "unex_free", "conf_obs"))
-            for who, label in (("est", "estimate"), ("truth", "truth (best near)")):
-                rows.append([*head, label, f"{score[who]:.0f}", *(f"{x:+.0f}" for x in vals[who][:4]),
-                             *(f"{x:.0f}" for x in vals[who][4:]), origin if who == "truth" else ""])
+            rows = [[label, f"{score[who]:.0f}", *(f"{x:+.0f}" for x in vals[who][:4]),
+                     *(f"{x:.0f}" for x in vals[who][4:])]
+                    for who, label in (("est", "estimate"), ("truth", "truth"))]
             diff = [vals["truth"][i] - vals["est"][i] for i in range(7)]
-            rows.append([*head, "truth - est.", f"{score['truth'] - score['est']:+.0f}", *(f"{x:+.0f}" for x in diff),
-                         ""])
-        return format_table(["scan", "mode", "case", "error", "pose", "score", "obs. on obs.", "obs. on free",
-                             "free on free", "free on obs.", "obs. marks unexpl.", "free marks unexpl.", "obs. marks",
-                             "origin ±1 / ±2 / none: unexpl. obs.; unexpl. free; obs. on free"], rows,
-                            title=(f"{self.name}: the score's terms (a_c = {self.params.a_c:g}, "
-                                   f"a_p = {self.params.a_p:g}; score = the four signed terms) at the estimate and at "
-                                   f"the best grid pose within {FAIL_CELLS:g} cells and {FAIL_DEG:g}° of the "
-                                   "logged pose; unexpl. = on unexplored cells of the leave-out grid "
-                                   f"({self.leave_out_text} left out), which count 0; origin: the truth's obstacle and "
-                                   "free marks on unexplored cells that a left-out scan 1 or 2 steps away saw (the "
-                                   "leave-out removed them) or no other scan saw, and its obstacle marks on map free "
-                                   "cells that such a scan hit"))
+            rows.append(["truth - est.", f"{score['truth'] - score['est']:+.0f}", *(f"{x:+.0f}" for x in diff)])
+            origin = {what: " / ".join(str(int(r[f"{what}_{w}"])) for w in ("1", "2", "none"))
+                      for what in ("unex_obs", "unex_free", "conf_obs")}
+            notes = "\n".join([
+                "origin of the truth's marks (a left-out scan 1 step away saw the cell / 2 steps away / no other scan):",
+                (f"  obstacle marks on unexplored cells {origin['unex_obs']}; free marks on unexplored cells "
+                f"{origin['unex_free']};"),
+                f"  obstacle marks on map free cells (a scan that many steps away hit the cell) {origin['conf_obs']}"])
+            blocks.append(format_table(head, rows, title=(f"scan {int(r['scan'])}, {self.mode_name(int(r['joined']))}: "
+                                                          f"{case}, {r['err_m']:.1f} m and {r['err_deg']:.0f}° off"))
+                          + "\n" + notes)
+        return "\n".join(blocks)
 
     def __str__(self) -> str:
         ok = self.success
-        rates = ", ".join(f"{self.mode_name(k)} {ok[m].sum()}/{ok.shape[1]}" for m, k in enumerate(self.joined))
-        return (f"{self.name}: scans localised within {FAIL_CELLS * self.cell_m:.1f} m and {FAIL_DEG:g}° "
-                f"from no prior: {rates}")
+        rates = ", ".join(f"{ok[m].sum()}/{ok.shape[1]} ({k} scan{'s' if k > 1 else ''})"
+                          for m, k in enumerate(self.joined))
+        return f"{self.name}: localised (within {FAIL_CELLS * self.cell_m:.1f} m and {FAIL_DEG:g}°, no prior): {rates}"
 
     def _title(self) -> str:
         return (f"{self.name} (CARMEN, logged laser poses): grid {self.grid.shape[0]}x{self.grid.shape[1]} cells of "
-                f"{self.cell_m:g} m from the other scans ({self.leave_out_text} left out), ranges < "
+                f"{self.cell_m:g} m\nfrom the other scans ({self.leave_out_text} left out), ranges < "
                 f"{self.max_range_m:g} m, Δα = {np.degrees(self.params.delta_alpha_rad):g}°, no prior")
 
     def table(self) -> str:
@@ -289,9 +299,8 @@ class LogLocalisationResult:
         one = len(self.joined) == 1
         head = ["scan", "x [m]", "y [m]", "θ [°]"]
         for k in self.joined:
-            tag = "" if one else f" ({k})"
-            head += (["x est", "y est", "θ est"] if one else []) + [f"err [m]{tag}", f"err [°]{tag}", f"amb.{tag}",
-                                                                    f"ok{tag}"]
+            head += ["x est", "y est", "θ est", "err [m]", "err [°]", "amb.", "ok"] if one else \
+                [f"m ({k})", f"° ({k})", f"A ({k})", "ok"]
         rows = []
         for j, (i, t) in enumerate(zip(self.scan_indices, self.true_poses_m, strict=True)):
             row = [int(i), f"{t[0]:.2f}", f"{t[1]:.2f}", f"{np.degrees(wrap_angle(t[2])):.1f}"]
@@ -302,7 +311,8 @@ class LogLocalisationResult:
                 row += [f"{self.err_pos_m[m, j]:.2f}", f"{np.degrees(self.err_heading_rad[m, j]):.1f}",
                         f"{self.ambiguity[m, j]:.3f}", "yes" if self.success[m, j] else "NO"]
             rows.append(row)
-        modes = "" if one else "; modes " + ", ".join(f"({k}) {self.mode_name(k)}" for k in self.joined)
+        modes = "" if one else ("\nper mode (k): position error [m], heading error [°], ambiguity A, success;\nmodes "
+                                + ", ".join(f"({k}) {self.mode_name(k)}" for k in self.joined))
         return format_table(head, rows, title=self._title() + modes)
 
     def summary_table(self) -> str:
@@ -319,7 +329,7 @@ class LogLocalisationResult:
                 for m, k in enumerate(self.joined)]
         sx, sa = self.odom_std
         title = (f"{self.name}: {ok.shape[1]} scans ({_describe(self.scan_indices)}), success = within "
-                 f"{FAIL_CELLS * self.cell_m:.1f} m ({FAIL_CELLS:g} cells) and {FAIL_DEG:g}° of the logged pose; "
+                 f"{FAIL_CELLS * self.cell_m:.1f} m ({FAIL_CELLS:g} cells)\nand {FAIL_DEG:g}° of the logged pose; "
                  f"odometry noise σ = {sx:g} m, {np.degrees(sa):g}° per step")
         return format_table(["mode", "localised", "rate", "median err [m]", "median err [°]"], rows, title=title)
 
@@ -357,7 +367,7 @@ class LogLocalisationResult:
                 rows.append([self.mode_name(k), label, *(str(c) for c in counts), flag])
         title = (f"Ambiguity = (rival - base) / (best - base), rival = best score of a pose > "
                  f"{self.params.rival_radius_cells * self.cell_m:g} m or > {np.degrees(self.params.rival_heading_rad):g}° "
-                 "away, base = median of the headings' best scores; scans per bin")
+                 "away,\nbase = median of the headings' best scores; scans per bin")
         return format_table(head, rows, title=title)
 
 

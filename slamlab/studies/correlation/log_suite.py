@@ -78,7 +78,7 @@ class LogSuiteResult:
                     + [c for m in range(tot.shape[0]) for c in (f"{tot[m].sum()}/{tot.shape[1]}",
                                                                  f"{tot[m].mean():.1%}", "")])
         title = (f"Every {self.every}th scan of each log from no prior; success = within {FAIL_CELLS:g} cells "
-                 f"({FAIL_CELLS * r0.cell_m:.1f} m) and {FAIL_DEG:g}° of the logged pose; cells {r0.cell_m:g} m, "
+                 f"({FAIL_CELLS * r0.cell_m:.1f} m) and {FAIL_DEG:g}° of the logged pose;\ncells {r0.cell_m:g} m, "
                  f"ranges < {r0.max_range_m:g} m, {r0.leave_out_text} left out of each grid")
         return format_table(head, rows, title=title)
 
@@ -98,7 +98,7 @@ class LogSuiteResult:
         t = check_positive(threshold, "threshold", allow_zero=True)
         if t > 1:
             raise ValueError(f"`threshold` must lie in [0, 1]; got {t}")
-        return self._flag_table([r.ambiguity for r in self.results], lambda a: a >= t, f">= {t:g}", "amb.",
+        return self._flag_table([r.ambiguity for r in self.results], lambda a: a >= t, f">= {t:g}", "ambiguity",
                                 f"Ambiguity as a failure flag, threshold {t:g}")
 
     def margin_table(self, threshold: float = 1.2) -> str:
@@ -139,7 +139,7 @@ class LogSuiteResult:
             r.flagged(min_votes)  # checks min_votes, and that the votes were run
         return self._flag_table([r.votes for r in self.results], lambda a: a < min_votes, f"< {min_votes} votes",
                                 "votes", f"Votes as a failure flag: scans i, i-1, i-2 localised alone and carried to "
-                                f"scan i by odometry; flagged when fewer than {min_votes} agree (2 cells, 5°)")
+                                f"scan i by odometry;\nflagged when fewer than {min_votes} agree (2 cells, 5°)")
 
     def confident_table(self, modes=(1, 3)) -> str:
         """Per log, then pooled: the scans localised by each of two modes, and by the more confident of their two
@@ -186,7 +186,8 @@ class LogSuiteResult:
             rows.append(row("all", self.results[0].mode_name(k), np.concatenate([a[m] for a in values]),
                             np.concatenate([r.success[m] for r in self.results])))
         return format_table(["log", "mode", f"failures flagged ({rule})", "successes flagged",
-                             f"median {short} (failures)", f"median {short} (successes)"], rows, title=title)
+                             "median (failures)", "median (successes)"], rows,
+                            title=f"{title}; medians of the {short}")
 
     def failure_table(self) -> str:
         """Per log and mode: the failures by kind of :meth:`~slamlab.studies.correlation.LogLocalisationResult.truth_check`

@@ -1,6 +1,6 @@
 """Ch. 5's closing table (004 §7): the source's figures beside ours, from the notebook's runs.
 
-Split from :mod:`slamlab.studies.correlation.log_experiments` (issue 25) unchanged.
+Split from :mod:`slamlab.studies.correlation.log_experiments` unchanged.
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = 
         ["Table 1: max position error [cells]", f"{max(s_ex.max(), s_ey.max()):.0f}",
          f"{max(t.err_x_cells.max(), t.err_y_cells.max()):.0f}"],
         ["Table 1: max heading error [rad]", f"{s_ea.max():.4f}", f"{t.err_heading_rad.max():.4f}"],
-        ["Table 1: range noise σ [cells]", "not given", f"{t.range_std_cells:g}"],
+        ["Table 1: range noise σ [cells]", "normal, σ not given", f"{t.range_std_cells:g}"],
     ]
     if monte_carlo is not None:
         mc = monte_carlo
@@ -75,10 +75,13 @@ def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = 
             rows.append([f"{lb}: heading margin / half-max area [cells]",
                          "sharpest at a_p = -a_c" if k == 0 else "more robust to clutter",
                          f"{np.median(c.heading_margin[k]):.3f} / {np.median(c.half_max_area[k]):.0f}"])
-            rows.append([f"{lb}: failures in the crowded room", "not measured", f"{c.failure_rate[k]:.0%}"])
+            n = c.err_pos_cells.shape[1]
+            rows.append([f"{lb}: failures in the crowded room", "not measured",
+                         f"{c.failure_rate[k]:.0%} ({round(c.failure_rate[k] * n)}/{n})"])
     if log is not None:
         for m, k in enumerate(log.joined):
-            rows.append([(f"real log {log.name}, {log.mode_name(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
+            rows.append([(f"real log, {log.mode_name(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
                           f"and {FAIL_DEG:g}°"), "none (simulation only)",
                          f"{int(log.success[m].sum())}/{log.success.shape[1]}"])
-    return format_table(["quantity", "004", "ours"], rows, title="Ours vs the source (004 §7)")
+    title = "Ours vs the source (004 §7)" + ("" if log is None else f"; real log: {log.name}")
+    return format_table(["quantity", "004", "ours"], rows, title=title)

@@ -49,9 +49,11 @@ class Table1Result:
     time_s: float = field(default=0.0, compare=False)
 
     def __str__(self) -> str:
-        return (f"Table 1, {self.true_poses.shape[0]} poses: max heading error {self.err_heading_rad.max():.4f} rad, "
-                f"max |dX| {self.err_x_cells.max():.0f}, max |dY| {self.err_y_cells.max():.0f} cells "
-                f"(004: 0.0098 rad, 0, 1)")
+        s_ea, s_ex, s_ey = source_table1_errors()
+        return (f"Table 1, {self.true_poses.shape[0]} poses: max errors {self.err_heading_rad.max():.4f} rad "
+                f"({np.degrees(self.err_heading_rad.max()):.2f}°), |dX| {self.err_x_cells.max():.0f}, |dY| "
+                f"{self.err_y_cells.max():.0f} cells; 004: {s_ea.max():.4f} rad ({np.degrees(s_ea.max()):.2f}°), "
+                f"{s_ex.max():.0f}, {s_ey.max():.0f}")
 
     def table(self) -> str:
         """Our Table 1 (rows per pose, then our and 004's maximum errors).
@@ -213,9 +215,9 @@ class ConstantsResult:
         rows = []
         for k, lb in enumerate(self.labels):
             rows.append([lb, f"{np.median(self.half_max_area[k]):.0f}", f"{np.median(self.heading_margin[k]):.3f}",
-                         f"{np.mean(self.err_pos_cells[k] <= 1.5):.0%}", f"{self.failure_rate[k]:.0%}"])
+                         f"{np.mean(self.err_pos_cells[k] <= 1.5):.0%}", _rate_of(self.failure_rate[k], self.err_pos_cells.shape[1])])
         title = (f"{self.err_pos_cells.shape[1]} poses, clutter of 004 Fig. 3b + {self.extra_clutter} extra discs; "
-                 "medians; a sharper peak has a smaller half-max area and a larger heading margin")
+                 "medians;\na sharper peak has a smaller half-max area and a larger heading margin")
         return format_table(["constants", "half-max area", "heading margin", "pos. err <= 1.5", "failures"],
                             rows, title=title)
 
@@ -268,3 +270,8 @@ class CorridorResult:
                  f"(cells, deg); noise-free scans, Δα = {np.degrees(self.single.headings_rad[1] - self.single.headings_rad[0]):g}°")
         return format_table(["mode", "x est", "y est", "θ est", "pos. err", "θ err", "score", "rival", "ambiguity"],
                             rows, title=title)
+
+
+def _rate_of(rate: float, n: int) -> str:
+    """A rate over ``n`` cases with its count: ``"33% (2/6)"``."""
+    return f"{rate:.0%} ({round(rate * n)}/{n})"

@@ -13,7 +13,7 @@ from ...scans import log_grid
 from ...sim.grid import add_clutter, measurement_room_200, test_room_200
 from ...sim.rangefinder import Rangefinder
 from ...widgets import STYLE as _STYLE
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .carmen_logs import as_carmen_log as _carmen_log
 from .experiments import random_clutter
@@ -65,7 +65,7 @@ def explore_localisation(**defaults):
 
         show_run(run, lambda out: localisation_figure(*out), table=table)
 
-    return widgets.interactive(
+    return interactive(
         show,
         x=_slider(widgets.IntSlider, d["x"], 3, 196, 1, "x [cells]"),
         y=_slider(widgets.IntSlider, d["y"], 3, 196, 1, "y [cells]"),
@@ -124,7 +124,7 @@ def explore_log_scan(path=None, **defaults):
 
         show_run(run, lambda out: localisation_figure(*out[2]), table=table)
 
-    return widgets.interactive(
+    return interactive(
         show,
         scan=_slider(widgets.IntSlider, min(d["scan"], log.n_scans - 1), 0, log.n_scans - 1, 1, "scan"),
         a_c=_slider(widgets.FloatSlider, d["a_c"], -2.0, 2.0, 0.25, "a_c (free)"),

@@ -56,8 +56,9 @@ class DetectorSummaryResult:
     times_s: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __str__(self) -> str:
-        return f"{self.image_name} {self.shape[1]}x{self.shape[0]}: " + ", ".join(
-            f"{n} {c}" for n, c in zip(self.names, self.counts, strict=True))
+        lo, hi = int(np.argmin(self.counts)), int(np.argmax(self.counts))
+        return (f"{self.image_name} {self.shape[1]}x{self.shape[0]}: {len(self.names)} detectors, from "
+                f"{self.counts[lo]} keypoints ({self.names[lo]}) to {self.counts[hi]} ({self.names[hi]})")
 
     def table(self) -> str:
         """Keypoint count and descriptor size per detector (stable; what nbval compares).
@@ -77,10 +78,12 @@ class DetectorSummaryResult:
         Returns
         -------
         str
-            Milliseconds per detector.
+            Milliseconds per detector and, when SIFT is among them, the time over SIFT's.
         """
-        rows = [[n, f"{1000 * self.times_s[n]:.0f}"] for n in self.names]
-        return format_table(["detector", "time [ms]"], rows)
+        sift = next((self.times_s[n] for n in self.names if n.startswith("SIFT")), None)
+        rows = [[n, f"{1000 * self.times_s[n]:.0f}"] + ([f"{self.times_s[n] / sift:.2f}"] if sift else [])
+                for n in self.names]
+        return format_table(["detector", "time [ms]"] + (["/ SIFT"] if sift else []), rows)
 
 
 _SUMMARY = {

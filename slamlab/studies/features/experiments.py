@@ -138,8 +138,8 @@ class PairEvaluationResult:
 
     def __str__(self) -> str:
         means = ", ".join(f"{d} {np.nanmean(self.rep[:, :, k]):.2f}" for k, d in enumerate(self.detectors))
-        return (f"{len(self.sequences)} sequences x {len(self.steps)} pairs, {self.n_points} strongest points, "
-                f"tol {self.tol_px:g} px: mean repeatability {means}")
+        return (f"{len(self.sequences)} sequences x {len(self.steps)} pairs, {self.n_points} points, "
+                f"{self.tol_px:g} px: mean repeatability {means}")
 
     def _pivot(self, arr, fmt):
         rows = []

@@ -440,28 +440,31 @@ def matching_vs_source(curve: LeavesCurveResult, trade: RatioTradeoffResult, knn
     Returns
     -------
     str
-        A table: quantity, 000's statement, our figure.
+        A table (quantity, 000's statement, our figure) and notes on its rows under it.
     """
-    rows = []
+    rows, notes = [], []
     at200 = np.flatnonzero(curve.budgets == 200)
     if at200.size:
-        rows.append([f"BBF, 200 leaves: NN recall ({curve.n_stored} stored)", "'in most cases the nearest'",
+        rows.append([f"BBF 200 leaves: NN recall, {curve.n_stored} stored", "'in most cases the nearest'",
                      f"{curve.recall_bbf[at200[0]]:.3f}"])
     m_bbf = [i for i, m in enumerate(knn.methods) if m.startswith("BBF")]
     m_brute = [i for i, m in enumerate(knn.methods) if m == "brute"]
     if m_bbf and m_brute:
         for s, size in enumerate(knn.sizes):
             b, e = m_bbf[0], m_brute[0]
-            rows.append([f"BBF vs exact at {size} stored: recall / precision after ratio 0.8", "a close point if not",
+            rows.append([f"BBF at {size} stored: recall / precision", "a close point if not",
                          f"{knn.recall[s, b]:.3f} / {knn.precision[s, b]:.3f} (exact {knn.precision[s, e]:.3f})"])
-    rows.append([f"exact 64-d search: points evaluated per query ({curve.n_stored} stored)",
-                 "kd-trees lose efficiency in high dimension", f"{curve.exact_evals:.0f}"])
+        notes.append(f"BBF: {knn.methods[m_bbf[0]]}; precision of the matches after the ratio rule 0.8; "
+                     "exact: brute force")
+    rows.append(["exact 64-d search: points per query", "kd-trees lose out in high dimension",
+                 f"{curve.exact_evals:.0f} of {curve.n_stored}"])
     m, p, r, md = trade.source_row
-    rows.append([f"000's rule d2 >= 2 d1, d1 <= {md:g} ({trade.pair}): matches, precision, recall", "accepted as correct",
-                 f"{m}, {p:.3f}, {r:.3f}"])
+    rows.append([f"000's rule, {trade.pair}: matches, P, R", "accepted as correct", f"{m}, {p:.3f}, {r:.3f}"])
+    notes.append(f"000's rule: d2 >= 2 d1 and d1 <= {md:g}; P, R: precision, recall")
     i8 = np.flatnonzero(np.isclose(trade.ratios, 0.8))
     if i8.size:
         k = i8[0]
-        rows.append(["ratio 0.8 (Lowe's usual): matches, precision, recall", "—",
+        rows.append(["ratio 0.8 (Lowe's usual): matches, P, R", "—",
                      f"{trade.n_matches[k]}, {trade.precision[k]:.3f}, {trade.recall[k]:.3f}"])
-    return format_table(["quantity", "000", "ours"], rows, title="Matching: 000 beside ours (times: timing tables)")
+    table = format_table(["quantity", "000", "ours"], rows, title="Matching: 000 beside ours (times: timing tables)")
+    return "\n".join([table, *notes])

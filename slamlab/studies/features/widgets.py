@@ -10,7 +10,7 @@ from ...features.evaluation import OXFORD_SEQUENCES, correct_matches, load_oxfor
 from ...features.matching import Matches, accept_ratio, knn2
 from ...features.plot import plot_keypoint_pair, plot_matches
 from ...widgets import STYLE as _STYLE
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 
 __all__ = ["explore_detectors", "explore_matching"]
 
@@ -79,7 +79,7 @@ def explore_detectors(**defaults):
 
         show_run(run, plot if draw else None, table=table, errors=_ERRORS)
 
-    return widgets.interactive(
+    return interactive(
         show,
         detector=widgets.Dropdown(options=list(_DETECTOR_KNOBS), value=d["detector"], description="detector"),
         threshold_fraction=widgets.FloatSlider(value=d["threshold"], min=0.0, max=1.0, step=0.05,
@@ -143,7 +143,7 @@ def explore_matching(**defaults):
 
         show_run(run, (lambda out: plot_matches(*out[2])) if draw else None, table=table, errors=_ERRORS)
 
-    return widgets.interactive(
+    return interactive(
         show,
         ratio=widgets.FloatSlider(value=d["ratio"], min=0.3, max=1.0, step=0.05, description="ratio d1/d2 <",
                                   continuous_update=False, style=_STYLE),

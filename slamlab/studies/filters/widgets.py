@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ipywidgets as widgets
 
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .experiments import run_cv_target, run_unicycle_comparison
 from .plot import cv_figure, unicycle_figure
@@ -42,7 +42,7 @@ def explore_unicycle(**defaults):
             omega_std_degps=omega_std_degps, init_heading_std_deg=init_heading_std_deg, alpha=alpha, beta=beta,
             kappa=kappa, stabilising_noise=stabilising_noise, rng=d["rng"]), unicycle_figure)
 
-    return widgets.interactive(
+    return interactive(
         show,
         n_runs=_slider(widgets.IntSlider, d["n_runs"], 1, 50, 1, "Monte Carlo runs"),
         range_std_m=_slider(widgets.FloatSlider, d["range_std_m"], 0.01, 2.0, 0.01, "range σ [m]"),
@@ -78,7 +78,7 @@ def explore_cv_target(**defaults):
         show_run(lambda: run_cv_target(d["n_runs"], d["n_steps"], accel_std=accel_std, pos_std_m=pos_std_m,
                                            rng=d["rng"]), cv_figure)
 
-    return widgets.interactive(
+    return interactive(
         show,
         accel_std=_slider(widgets.FloatSlider, d["accel_std"], 0.0, 2.0, 0.05, "acceleration σ [m/s²]"),
         pos_std_m=_slider(widgets.FloatSlider, d["pos_std_m"], 0.05, 5.0, 0.05, "position σ [m]"),

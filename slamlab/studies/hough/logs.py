@@ -111,7 +111,7 @@ class RealLogResult:
         return 1.0 - self.sharpness("slam") / self.sharpness("odometry")
 
     def __str__(self) -> str:
-        return (f"{self.name}: {self.odometry.shape[0]} scans, {self.path_length_m:.1f} m of odometry path; "
+        return (f"{self.name}: {self.odometry.shape[0]} scans, {self.path_length_m:.1f} m of odometry;\n"
                 f"{_steps(int(self.slam.lost.sum()))} fell back on odometry, {int(self.slam.partial.sum())} in part")
 
     def table(self) -> str:
@@ -177,7 +177,7 @@ def real_log_cause_table(results) -> str:
     rows.append(["sharper than odometry: 1 - Hough SLAM / odometry"]
                 + [f"{r.sharper_than_odometry():.1%}" for r in results])
     return format_table(["steps (of each log)"] + [r.name.split(" log ")[1].split(" ")[0] for r in results],
-                        rows, title="Hough SLAM on the real logs, one set of defaults: how each step's pose was found")
+                        rows, title="Hough SLAM on real logs: how each step's pose was found")
 
 
 #: Real-log settings (ours), one set for every log and format: rho resolution and thresholds in metres

@@ -11,7 +11,7 @@ from ...hough.plot import accumulator_figure
 from ...hough.slam import detect_lines
 from ...hough.transform import hough_polar
 from ...widgets import STYLE as _STYLE
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .experiments import SHARED_LOGS, run_real_log, run_sim_slam
 from .plot import real_log_figure, sim_figure
@@ -63,7 +63,7 @@ def explore_accumulator(**defaults):
 
         show_run(run, lambda out: accumulator_figure(*out), table=table)
 
-    return widgets.interactive(
+    return interactive(
         show,
         pose_index=_slider(widgets.IntSlider, d["pose_index"], 0, path.shape[0] - 1, 1, "scan (pose n)"),
         range_std_cells=_slider(widgets.FloatSlider, d["range_std_cells"], 0.0, 1.0, 0.05, "range σ [cells]"),
@@ -97,7 +97,7 @@ def explore_hough_slam(**defaults):
             delta_theta_rad=math.radians(delta_theta_deg), delta_rho=delta_rho, H_min=int(H_min), method=method,
             refine=refine), sim_figure)
 
-    return widgets.interactive(
+    return interactive(
         show,
         n_poses=_slider(widgets.IntSlider, d["n_poses"], 21, 241, 10, "poses along the path"),
         range_std_cells=_slider(widgets.FloatSlider, d["range_std_cells"], 0.0, 1.0, 0.05, "range σ [cells]"),
@@ -136,7 +136,7 @@ def explore_real_log(**defaults):
 
         show_run(run, real_log_figure, errors=(ValueError, TypeError, FileNotFoundError))  # the logs are files
 
-    return widgets.interactive(
+    return interactive(
         show,
         name=widgets.Dropdown(options=[("MbICP SICK log", "mbicp"), ("Mines URG-04LX log", "urg04lx")],
                               value=d["name"], description="log", style=_STYLE),

@@ -124,8 +124,8 @@ class StoreComparisonResult:
                                   for s in self.stores)])
         rows.append(["recall@1 vs exact", *(f"{self.recall[s]:.3f}" for s in self.stores)])
         name = f"000 {self.scenario.replace('table', 'Table ')}" if self.scenario in ("table1", "table2") else self.scenario
-        title = (f"{name} workload: {self.n_iterations} iterations, "
-                 f"{self.stored_end} points at the end, ~{self.queries_per_iteration:.0f} queries per iteration; "
+        title = (f"{name} workload: {self.n_iterations} iterations, {self.stored_end} points at the end\n"
+                 f"~{self.queries_per_iteration:.0f} queries per iteration; "
                  f"multi kd-tree n1 = {self.n1}, q = {self.q:g}; BBF checks = {self.checks}")
         return format_table(heads, rows, title=title)
 
@@ -336,8 +336,8 @@ def ours_vs_source(cost, dimension: DimensionStudyResult, table1: StoreCompariso
         ["C = C1/C2 from 000's one-tree timings", "≈ 9", f"{calibrate_C(526, 0.079, 678, 0.750, 44828):.2f}"],
     ]
     if exact64:
-        rows.append(["exact search in 64-d: leaves visited", "O(log n) per search",
-                     "; ".join(f"{d}: {lv:.0f} %" for d, _, lv, _, _ in exact64)])
+        rows.append(["exact search in 64-d: % leaves visited", "O(log n) per search",
+                     ", ".join(f"{lv:.0f} ({d.split()[0]})" for d, _, lv, _, _ in exact64)])
     for name, res, n_000 in (("Table 1", table1, "~13000"), ("Table 2", table2, "65000")):
         rows.append([f"{name}: points stored at the end", n_000, f"{res.stored_end} ({res.n_iterations} iterations)"])
         rows.append([f"{name}: recall@1 kd-tree / multi", "— (not measured)",
@@ -345,6 +345,6 @@ def ours_vs_source(cost, dimension: DimensionStudyResult, table1: StoreCompariso
     rows.append(["multi: mean points rebuilt per iteration", "~3000-point tree update",
                  f"{table2.ops['multi']['rebuilt_mean']:.0f} (Table 2), {table1.ops['multi']['rebuilt_mean']:.0f} (Table 1)"])
     if real is not None:
-        rows.append(["real stereo stream: recall@1 kd-tree / multi", "—",
+        rows.append(["recorded stream: recall@1 kd-tree / multi", "—",
                      f"{real.recall['rebuild']:.3f} / {real.recall['multi']:.3f} ({real.stored_end} points)"])
     return format_table(["quantity", "000", "ours"], rows, title="Landmark stores: 000 beside ours (times: timed tables)")

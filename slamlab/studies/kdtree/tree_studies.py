@@ -76,9 +76,8 @@ class CFitResult:
     q: float
 
     def __str__(self) -> str:
-        return (f"C = {self.C:.1f} on this machine (BBF search of {self.s} queries {1e3 * self.t_search_s:.0f} ms, "
-                f"rebuild of {self.n} points {1e3 * self.t_build_s:.0f} ms); optimum n1 = {self.n1:.0f}, "
-                f"q = {self.q:.2f} (000: C = 8.98, n1 ≈ 3500, q = 5.5)")
+        return (f"C = {self.C:.1f} ({self.s} BBF searches {1e3 * self.t_search_s:.0f} ms, {self.n} points rebuilt "
+                f"{1e3 * self.t_build_s:.0f} ms); optimum n1 = {self.n1:.0f}, q = {self.q:.2f}; 000: C = 8.98")
 
 
 def fit_C(*, n: int = 44828, s: int = 526, m: int = 678, checks: int = 200, leaf_size: int = 8, rng=2010,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import ipywidgets as widgets
 
 from ...kdtree.cost_model import iter_time, run_cost_model
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .experiments import run_store_comparison
 from .store_plot import plot_cost_contour, plot_iteration_times
@@ -50,7 +50,7 @@ def explore_cost_model(**defaults):
 
         show_run(run, draw, table=table)
 
-    return widgets.interactive(
+    return interactive(
         show,
         n1=_slider(widgets.IntSlider, d["n1"], 500, 20000, 100, "n1"),
         q=_slider(widgets.FloatSlider, d["q"], 1.5, 10.0, 0.1, "q"),
@@ -87,7 +87,7 @@ def explore_stores(**defaults):
             n_new=int(m), p_track=0.0, n_old=n_old, n_clutter=int(s) - n_old, rng=d["rng"]),
             plot_iteration_times, table=lambda res: f"{res.table()}\n{res.timed_table()}")
 
-    return widgets.interactive(
+    return interactive(
         show,
         n1=_slider(widgets.IntSlider, d["n1"], 100, 20000, 100, "n1"),
         q=_slider(widgets.FloatSlider, d["q"], 1.5, 10.0, 0.1, "q"),

@@ -239,8 +239,8 @@ class Workload:
 
     def __str__(self) -> str:
         q = np.mean([it.queries.shape[0] for it in self.iterations])
-        return (f"workload {self.scenario.name}: {len(self)} iterations, {q:.0f} queries and "
-                f"{self.scenario.n_new} new points per iteration, {int(self.stored[-1])} stored at the end")
+        return (f"workload {self.scenario.name}: {len(self)} iterations × ({q:.0f} queries, "
+                f"{self.scenario.n_new} new points), {int(self.stored[-1])} stored at the end")
 
 
 def make_workload(name_or_scenario="table2", *, rng=None, **changes) -> Workload:

@@ -10,22 +10,78 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._table import format_table
 from ..._validate import check_choice, check_int
 from ...localisation.mcl import MCLParams
-from ._tables import fmt, params_line
+from ._tables import fmt, params_line, table
 from .experiments import FAIL_DEG, FAIL_POS_CELLS, run_filter, simulate_run
 
-__all__ = ["KIDNAP_VARIANTS", "KidnapResult", "run_kidnapped"]
+__all__ = ["KIDNAP_VARIANTS", "RESAMPLING_COLUMNS", "KidnapResult", "resampling_stats", "resampling_table",
+           "run_kidnapped"]
+
+#: The per-run resampling figures of :func:`resampling_stats` (each a share of the run's steps, or a median).
+RESAMPLING_COLUMNS = ("resampled", "neff_low", "neff_frac", "injecting")
+
+
+def resampling_stats(records, params: MCLParams) -> dict:
+    """How often one run resampled, and why: the shares of its steps that resampled, that had
+    ``N_eff < resample_threshold·M`` before resampling, that injected particles, and the median ``N_eff/M``.
+
+    Parameters
+    ----------
+    records : sequence of StepRecord
+        The run's step records (the ``records`` of a :class:`slamlab.localisation.MCL`).
+    params : MCLParams
+        The run's settings (its ``resample_threshold``).
+
+    Returns
+    -------
+    dict
+        ``resampled``, ``neff_low``, ``injecting`` (shares of the steps) and ``neff_frac`` (median N_eff/M).
+    """
+    frac = np.array([r.n_eff / max(1, r.n_particles) for r in records])
+    return {"resampled": float(np.mean([r.resampled for r in records])),
+            "neff_low": float(np.mean(frac < params.resample_threshold)),
+            "neff_frac": float(np.median(frac)),
+            "injecting": float(np.mean([r.n_injected > 0 for r in records]))}
+
+
+def resampling_table(summary, labels, base: MCLParams, title: str) -> str:
+    """The resampling figures of a study, one row per variant (``summary``: one row per label with the means over
+    the runs of :data:`RESAMPLING_COLUMNS`).
+
+    Parameters
+    ----------
+    summary : pandas.DataFrame
+        Indexed by the labels, with the columns of :data:`RESAMPLING_COLUMNS`.
+    labels : sequence of str
+        The variants, in table order.
+    base : MCLParams
+        The settings every variant changes (for the notes).
+    title : str
+        The table's title.
+
+    Returns
+    -------
+    str
+    """
+    rows = [[lab, *(fmt(summary.loc[lab, c]) for c in RESAMPLING_COLUMNS)] for lab in labels]
+    return table(["variant", "steps resampled", "N_eff < thr·M", "median N_eff/M", "steps injecting"], rows,
+                 title=title,
+                 notes=[("steps resampled: share of the steps at which the set was resampled; N_eff < thr·M: share "
+                        "of the steps whose effective sample size N_eff = 1/Σw², before resampling, was below the "
+                        f"variant's resample_threshold (defaults {base.resample_threshold:g}) times the count M; "
+                        "median N_eff/M: over the steps of a run; steps injecting: share of the steps at which "
+                        "particles were injected (injection happens inside a resampling, never causes one); all "
+                        "averaged over the runs")])
 
 
 # --- the kidnapped robot --------------------------------------------------------------------------------------
 
 #: Kidnap variants (label, overrides of the defaults): how w_slow/w_fast start decides whether injection fires.
 KIDNAP_VARIANTS = (
-    ("averages from 0 (003)", {"averages": "003"}),
-    ("from the first w_avg, restart after injecting (amcl)", {"averages": "amcl"}),
-    ("from the first w_avg, no restart (ours)", {"averages": "first"}),
+    ("from 0 (003)", {"averages": "003"}),
+    ("first w_avg, restarted (amcl)", {"averages": "amcl"}),
+    ("first w_avg, no restart (ours)", {"averages": "first"}),
     ("from 0, bias-corrected (defaults)", {}),
 )
 
@@ -40,7 +96,7 @@ def _kidnap_task(rng, params: MCLParams, n_steps: int, kidnap_step: int, variant
             "recovery_steps": -1 if k is None else k - kidnap_step,
             "injected_before": float(inj[1:kidnap_step].mean()) / params.n_particles,
             "injected_after": float(inj[kidnap_step:].mean()) / params.n_particles,
-            "err_before": float(np.median(r.err_pos[1:kidnap_step]))}
+            "err_before": float(np.median(r.err_pos[1:kidnap_step])), **resampling_stats(r.records, params)}
 
 
 @dataclass(frozen=True)
@@ -96,13 +152,24 @@ class KidnapResult:
         return out
 
     def table(self) -> str:
-        return format_table(["variant", "tracked before", "recovered", "median steps to recover",
-                             "% injected per step before", "% after", "median err before [cells]"], self.rows(),
-                            title=f"Kidnapped robot{' among unmapped clutter' if self.world != 'map' else ''}: "
-                                  f"{self.n_particles} particles, the same {self.n_runs} runs per "
-                                  f"variant, kidnapped at step {self.kidnap_step} of {self.n_steps}; recovered: "
-                                  f"within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}° from some step to the end\n"
-                                  f"defaults: {params_line(self.base)}")
+        return table(["variant", "tracked", "recovered", "steps", "% inj. before", "% inj. after", "err before"],
+                     self.rows(),
+                     title=f"Kidnapped robot{' among unmapped clutter' if self.world != 'map' else ''}: "
+                           f"{self.n_particles} particles, the same {self.n_runs} runs per variant, kidnapped at "
+                           f"step {self.kidnap_step} of {self.n_steps}\ndefaults: {params_line(self.base)}",
+                     notes=[(f"tracked: share of runs within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}° at the step "
+                            "before the kidnap; recovered: share within them from some step after it to the end; "
+                            "steps: median steps to recover; % inj. before / after: particles injected per step, "
+                            "in % of the count, before / after the kidnap; err before: median position error "
+                            "before the kidnap [cells]")])
+
+    def resampling_table(self) -> str:
+        """Per variant, how often the set was resampled and why: N_eff against the threshold, and injection."""
+        summary = self.table_df.groupby("variant")[list(RESAMPLING_COLUMNS)].mean()
+        return resampling_table(summary, self.labels, self.base,
+                                f"Resampling in the kidnap runs{' among unmapped clutter' if self.world != 'map' else ''}"
+                                f" ({self.n_particles} particles, {self.n_runs} runs of {self.n_steps} steps per "
+                                f"variant)")
 
     def __str__(self) -> str:
         return f"Kidnapped robot, {self.n_runs} runs per variant"

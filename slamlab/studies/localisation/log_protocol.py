@@ -17,13 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._table import format_table
 from ..._validate import check_int
 from ...geometry import wrap_angle
 from ...geometry.odometry import simulate_odometry
 from ...localisation.mcl import MCL, MCLParams
 from ...localisation.particles import FAIL_DEG, FAIL_POS_CELLS
-from ._tables import fmt
+from ._tables import fmt, table
 from .logs import CARMEN_LOGS, REAL_DEG, REAL_POS_M, carmen_path, log_map, log_params
 
 __all__ = ["LogProtocolResult", "run_log_protocol"]
@@ -88,6 +87,13 @@ def _protocol_task(log: str, run: int, n_particles: int, n_runs: int, n_scans: i
         row["track_success"] = float(te[-1] < FAIL_POS_CELLS * cell_m and th[-1] < FAIL_DEG)
         row["track_within_tracking_bound"] = float(te[-1] < REAL_POS_M and th[-1] < REAL_DEG)
     return row
+
+
+def _short(name: str) -> str:
+    """A log's name for a table: its file name without ``.log`` / ``.gz``."""
+    for ext in (".gz", ".log"):
+        name = name.removesuffix(ext)
+    return name
 
 
 def _sweep_task(rng, **kw):
@@ -187,7 +193,7 @@ class LogProtocolResult:
 
     def table(self) -> str:
         s = self.summary()
-        rows = [[name, int(n), f"{r.success:.2f}", f"{r.within_tracking_bound:.2f}", fmt(r.track_success),
+        rows = [[_short(name), int(n), f"{r.success:.2f}", f"{r.within_tracking_bound:.2f}", fmt(r.track_success),
                  fmt(r.track_within), fmt(r.median_converged_step, 0), fmt(r.median_err_after_m, 3)]
                 for (name, n), r in s.iterrows()]
         top = self.table_df["n_particles"].max()
@@ -199,17 +205,20 @@ class LogProtocolResult:
         p = self.params
         track = (f"; tracking: {self.track_particles} particles from the corrected start pose, same odometry"
                  if self.track_particles else "")
-        return format_table(
-            ["log", "particles", "success", f"within {REAL_POS_M:g} m/{REAL_DEG:g}°", "tracking success",
-             f"tracking within {REAL_POS_M:g} m/{REAL_DEG:g}°", "median step converged", "median err after [m]"], rows,
+        return table(
+            ["log", "particles", "success", f"within {REAL_POS_M:g} m/{REAL_DEG:g}°", "track success",
+             "track within", "conv. step", "err after [m]"], rows,
             title=f"Global localisation on real logs: {self.n_runs} stretches of {self.n_scans} scans per log, spread "
-                  f"over the log, one seeded run each; success: within {FAIL_POS_CELLS:g} cells "
-                  f"({FAIL_POS_CELLS * self.cell_m:g} m) and {FAIL_DEG:g}° of the corrected pose at the last scan (the "
-                  f"simulated study's criterion); converged: success from that step to the end{track}\n"
+                  f"over the log, one seeded run each{track}\n"
                   f"settings: {self.cell_m:g} m cells, odometry noise 10 % + 1°/step, σ_hit "
                   f"{p.sigma_hit * self.cell_m:g} m, (z_hit, z_rand) = ({p.z_hit:g}, {p.z_rand:g}), α2 "
                   f"{p.alpha[1] / self.cell_m**2:g} rad²/m², (α_slow, α_fast) = ({p.alpha_slow:g}, "
-                  f"{p.alpha_fast:g}), averages {p.averages}")
+                  f"{p.alpha_fast:g}), averages {p.averages}",
+            notes=[(f"success: share of runs within {FAIL_POS_CELLS:g} cells ({FAIL_POS_CELLS * self.cell_m:g} m) and "
+                   f"{FAIL_DEG:g}° of the corrected pose at the last scan (the simulated study's criterion); within "
+                   f"{REAL_POS_M:g} m/{REAL_DEG:g}°: the tracking bound there; track success / within: the same two "
+                   f"for tracking from the corrected start pose; conv. step: median step from which a run stays a "
+                   f"success; err after: median position error after that step")])
 
     def __str__(self) -> str:
         return f"Real-log protocol: success {self.success():.2f} ({self.n_runs} runs per log)"

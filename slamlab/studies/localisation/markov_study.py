@@ -12,10 +12,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._table import format_table
 from ..._validate import check_int, check_positive
 from ...geometry import wrap_angle
 from ...localisation.markov import MarkovGrid, MarkovParams
+from ._tables import table
 from .experiments import FAIL_DEG, FAIL_POS_CELLS, simulate_run
 
 __all__ = ["MARKOV_PRIORS", "MARKOV_STUDY_PARAMS", "MarkovStudyResult", "run_markov_kidnap", "run_markov_prior"]
@@ -58,7 +58,8 @@ def _markov_task(rng, kind: str, offset: float, n_steps: int, kidnap_step: int |
     for k in range(run.n_steps):
         prev, now = (run.odom_poses[k - 1], run.odom_poses[k]) if k else (None, None)
         est[k] = g.step(prev, now, run.scans[k])
-    return {"ok": _ok_bits(est, run.true_poses), "final_err": float(_errors(est[-1:], run.true_poses[-1:])[0][0])}
+    return {"ok": _ok_bits(est, run.true_poses), "final_err": float(_errors(est[-1:], run.true_poses[-1:])[0][0]),
+            "err_cells": " ".join(f"{e:.2f}" for e in _errors(est, run.true_poses)[0])}
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,8 @@ class MarkovStudyResult:
     Parameters
     ----------
     table_df : pandas.DataFrame
-        One row per (variant, run) of :func:`slamlab.sweep.sweep`.
+        One row per (variant, run) of :func:`slamlab.sweep.sweep`: ``ok`` (one "1" or "0" per step: within the
+        bounds), ``final_err`` (cells) and ``err_cells`` (the position error of every step, cells, as text).
     labels : tuple of str
         The variants, in table order.
     n_runs, n_steps : int
@@ -127,10 +129,12 @@ class MarkovStudyResult:
         for lab in self.labels:
             g = self.table_df[self.table_df["variant"] == lab]
             rows.append([lab, *(f"{self.success(lab, k):.2f}" for k in ks), f"{g['final_err'].median():.2f}"])
-        return format_table(["variant", *(f"success @{k}" for k in ks), "median final err [cells]"], rows,
-                            title=f"{self.title}: Markov grid {self.resolution}-cell cells × {self.n_headings} "
-                                  f"headings, the same {self.n_runs} runs per variant, {self.n_steps} steps; success: "
-                                  f"within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}°")
+        return table(["variant", *(f"success @{k}" if i == 0 else f"@{k}" for i, k in enumerate(ks)),
+                      "final err [cells]"], rows,
+                     title=f"{self.title}: belief cells of {self.resolution} map cells, {self.n_headings} "
+                           f"headings, the same {self.n_runs} runs per variant, {self.n_steps} steps",
+                     notes=[(f"success @k: share of runs within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}° at step "
+                            "k; final err: median position error at the last step")])
 
     def __str__(self) -> str:
         return f"{self.title}, {self.n_runs} runs per variant"

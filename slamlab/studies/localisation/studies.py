@@ -19,14 +19,22 @@ import numpy as np
 from ..._table import format_table
 from ..._validate import check_choice, check_int
 from ...localisation.mcl import MCLParams
-from ._tables import fmt, params_line
+from ._tables import fmt, params_line, table
 from .experiments import FAIL_DEG, FAIL_POS_CELLS, run_filter, simulate_run
-from .kidnap import KIDNAP_VARIANTS, KidnapResult, run_kidnapped
+from .kidnap import (
+    KIDNAP_VARIANTS,
+    RESAMPLING_COLUMNS,
+    KidnapResult,
+    resampling_stats,
+    resampling_table,
+    run_kidnapped,
+)
 
 __all__ = [
     "ABLATION",
     "ABLATION_MORE",
     "CHAPTER_BEFORE",
+    "PLAIN_SETUP",
     "SCORE_VARIANTS",
     "AblationResult",
     "GlobalResult",
@@ -38,23 +46,26 @@ __all__ = [
     "run_score_comparison",
 ]
 
-#: The chapter's global-localisation set-up before issue 27 (what gave 0.10 / 0.30 / 0.52): PR's product weights
-#: (gamma = 1), the geometric-mean score in eq 2.8, 003's averages from 0 (so no injection with α_slow = 0.001),
-#: σ_hit 2 cells, the old motion noise, no jitter; the old study judged at step 20.
+#: A plain set-up of global localisation, the ablation's first row: PR's product weights (gamma = 1), the
+#: geometric-mean score in eq 2.8, 003's averages from 0 (so no injection with α_slow = 0.001), σ_hit 2 cells, the
+#: Markov grid's motion noise (a quarter of the defaults'), no jitter.
 CHAPTER_BEFORE = {"score": "geometric_mean", "averages": "003", "sigma_hit": 2.0, "max_dist": 8.0,
                   "alpha": (0.05, 0.002, 0.05, 0.005), "gamma": 1.0, "jitter": (0.0, 0.0)}
+
+#: The same plain set-up under the name the chapter uses.
+PLAIN_SETUP = CHAPTER_BEFORE
 
 #: The ablation: (label, overrides of the defaults). The first block starts from :data:`CHAPTER_BEFORE` and
 #: changes one factor; the second starts from the defaults and takes one factor back.
 ABLATION = (
-    ("before (first set-up)", CHAPTER_BEFORE),
-    ("before + σ_hit 4, motion ×4, jitter, p^0.5", {**CHAPTER_BEFORE, "sigma_hit": 4.0, "max_dist": 12.0,
+    ("plain set-up", CHAPTER_BEFORE),
+    ("plain + σ_hit 4, motion ×4, jitter, p^0.5", {**CHAPTER_BEFORE, "sigma_hit": 4.0, "max_dist": 12.0,
                                                    "alpha": (0.2, 0.008, 0.2, 0.02), "jitter": (0.6, 0.04),
                                                    "gamma": 0.5}),
-    ("before + injection (debiased averages)", {**CHAPTER_BEFORE, "averages": "debiased"}),
+    ("plain + injection (debiased averages)", {**CHAPTER_BEFORE, "averages": "debiased"}),
     ("defaults", {}),
     ("defaults, σ_hit 2 cells", {"sigma_hit": 2.0, "max_dist": 8.0}),
-    ("defaults, old motion noise", {"alpha": (0.05, 0.002, 0.05, 0.005)}),
+    ("defaults, motion noise / 4", {"alpha": (0.05, 0.002, 0.05, 0.005)}),
     ("defaults, no jitter", {"jitter": (0.0, 0.0)}),
     ("defaults, weights p^1", {"gamma": 1.0}),
     ("defaults, no injection", {"alpha_slow": 0.0, "alpha_fast": 0.0}),
@@ -68,11 +79,12 @@ ABLATION_MORE = (
     ("defaults, amcl update thresholds", {"update_min_d": 2.0, "update_min_a": float(np.pi / 6)}),
 )
 
-#: The observation scores compared (label, overrides): eq 2.8 averages ω; the weights are p(z | x) in every case.
+#: The observation scores compared (label, overrides): eq 2.8 averages ω; the weights are p(z | x)^gamma (the
+#: defaults' gamma = 0.5) in every case.
 SCORE_VARIANTS = (
-    ("ω = p(z | x) (PR Table 8.3; amcl likelihood_field_prob)", {"score": "likelihood"}),
-    ("ω = per-beam geometric mean (ours; defaults)", {"score": "geometric_mean"}),
-    ("ω = 1 + Σ p³ (ROS 1 amcl likelihood_field, Beluga)", {"score": "amcl_cubes"}),
+    ("ω = p(z | x) (PR Table 8.3)", {"score": "likelihood"}),
+    ("ω = geometric mean (ours; defaults)", {"score": "geometric_mean"}),
+    ("ω = 1 + Σ p³ (ROS 1 amcl, Beluga)", {"score": "amcl_cubes"}),
 )
 
 
@@ -92,7 +104,7 @@ def _global_task(rng, params: MCLParams, n_steps: int, variant: str = "", world:
     p = params if n_particles is None else params.replace(n_particles=n_particles)
     r = run_filter(run, params=p, rng=rng)
     return {"ok": _bits(r.ok), "conv": _bits(x.converged for x in r.records), "on_turn": _on_turn(run),
-            "resampled": float(np.mean([x.resampled for x in r.records])), "time_per_step_s": r.time_s / run.n_steps}
+            **resampling_stats(r.records, p), "time_per_step_s": r.time_s / run.n_steps}
 
 
 def _per_step(df, col: str) -> np.ndarray:
@@ -121,7 +133,7 @@ def _group_stats(g, steps) -> dict:
             "success_turn_start": float(ok[turn, -1].mean()) if turn.any() else float("nan"),
             "n_turn_start": int(turn.sum()),
             "success_leg_start": float(ok[~turn, -1].mean()) if (~turn).any() else float("nan"),
-            "resampled": float(g["resampled"].mean()),
+            **{k: float(g[k].mean()) for k in RESAMPLING_COLUMNS},
             "time_per_step_s": float(g["time_per_step_s"].median())}
 
 
@@ -199,13 +211,15 @@ class GlobalResult:
             steps.append(self.n_steps)
         rows = [[int(n), *(fmt(r[f"success@{k}"]) for k in steps), fmt(r.amcl_converged),
                  fmt(r.converged_wrong), fmt(r.median_step, 0)] for n, r in s.iterrows()]
-        return format_table(["particles", *(f"success @{k}" for k in steps), "amcl converged @end",
-                             "converged but wrong", "median step localised"], rows,
-                            title=f"Global localisation from no prior, {self.n_runs} runs per count (the same runs), "
-                                  f"{self.n_steps} steps; success @k: within {FAIL_POS_CELLS:g} cells and "
-                                  f"{FAIL_DEG:g}° at step k; amcl: every particle within "
-                                  f"{self.params.converged_dist:g} cells of the mean\n"
-                                  f"settings: {params_line(self.params)}")
+        return table(["particles", *(f"success @{k}" if i == 0 else f"@{k}" for i, k in enumerate(steps)),
+                      "amcl converged", "converged, wrong", "step localised"], rows,
+                     title=f"Global localisation from no prior, {self.n_runs} runs per count (the same runs), "
+                           f"{self.n_steps} steps\nsettings: {params_line(self.params)}",
+                     notes=[(f"success @k: share of runs within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}° of the "
+                            f"truth at step k; amcl converged: AMCL's test at step {self.n_steps} (every particle "
+                            f"within {self.params.converged_dist:g} cells of the mean); converged, wrong: converged "
+                            f"and not within the bounds; step localised: median step from which a run stays within "
+                            f"the bounds")])
 
     def step_table(self, every: int = 5) -> str:
         """Success against the step, one column per particle count.
@@ -324,7 +338,7 @@ class AblationResult:
 
     @property
     def mid_step(self) -> int:
-        """The earlier step of the table: 20 (issue 12's run length), or half the run when it is shorter."""
+        """The earlier step of the table: 20, or half the run when it is shorter."""
         return 20 if self.n_steps > 20 else max(1, self.n_steps // 2)
 
     def summary(self):
@@ -340,14 +354,22 @@ class AblationResult:
         s = self.summary()
         rows = [[lab, fmt(r[f"success@{self.mid_step}"]), fmt(r[f"success@{self.n_steps}"]), fmt(r.amcl_converged),
                  fmt(r.converged_wrong), f"{fmt(r.success_turn_start)} ({int(r.n_turn_start)})",
-                 fmt(r.success_leg_start), fmt(r.resampled)] for lab, r in s.iterrows()]
-        return format_table(["variant", f"success @{self.mid_step}", f"success @{self.n_steps}", "amcl converged",
-                             "converged but wrong", "success, turn start (runs)", "success, leg start",
-                             "steps resampled"], rows,
-                            title=f"Global localisation{' among unmapped clutter' if self.world != 'map' else ''}: "
-                                  f"{self.n_particles} particles, the same "
-                                  f"{self.n_runs} runs for every variant, {self.n_steps} steps; columns after "
-                                  f"the second at step {self.n_steps}\ndefaults: {params_line(self.base)}")
+                 fmt(r.success_leg_start)] for lab, r in s.iterrows()]
+        return table(["variant", f"success @{self.mid_step}", f"@{self.n_steps}", "amcl conv.", "conv., wrong",
+                      "turn start", "leg start"], rows,
+                     title=f"Global localisation{' among unmapped clutter' if self.world != 'map' else ''}: "
+                           f"{self.n_particles} particles, the same {self.n_runs} runs for every variant, "
+                           f"{self.n_steps} steps\ndefaults: {params_line(self.base)}",
+                     notes=[(f"success @k: share of runs within {FAIL_POS_CELLS:g} cells and {FAIL_DEG:g}° at step k; "
+                            f"the other columns at step {self.n_steps}: amcl conv.: AMCL's convergence test passed; "
+                            f"conv., wrong: passed and not within the bounds; turn start (runs) / leg start: success "
+                            f"of the runs that start in one of the path's turns on the spot / on a straight leg")])
+
+    def resampling_table(self) -> str:
+        """Per variant, how often the set was resampled and why: N_eff against the threshold, and injection."""
+        return resampling_table(self.summary(), self.labels, self.base,
+                                f"Resampling in the global runs ({self.n_particles} particles, {self.n_runs} runs "
+                                f"of {self.n_steps} steps per variant)")
 
     def __str__(self) -> str:
         return f"Ablation of global localisation, {len(self.labels)} variants × {self.n_runs} runs"
@@ -427,12 +449,17 @@ class ScoreComparison:
         k = {r[0]: r for r in self.kidnap.rows()}
         rows = [[lab, fmt(g.loc[lab, f"success@{self.global_.n_steps}"]), fmt(g.loc[lab, "amcl_converged"]),
                  k[lab][2], k[lab][3], k[lab][4], k[lab][1]] for lab in self.global_.labels]
-        return format_table(["score ω that eq 2.8 averages", f"global success @{self.global_.n_steps}",
-                             "amcl converged", "kidnap recovered", "steps to recover", "% injected/step tracking",
-                             "tracked before"], rows,
-                            title=f"The observation score: global localisation ({self.global_.n_particles} particles, "
-                                  f"{self.global_.n_runs} runs) and kidnap ({self.kidnap.n_particles} particles, "
-                                  f"{self.kidnap.n_runs} runs); other settings the defaults")
+        return table(["score ω that eq 2.8 averages", f"global @{self.global_.n_steps}", "amcl conv.",
+                      "recovered", "steps", "% injected", "tracked"], rows,
+                     title=f"The observation score: global localisation ({self.global_.n_particles} particles, "
+                           f"{self.global_.n_runs} runs) and kidnap ({self.kidnap.n_particles} particles, "
+                           f"{self.kidnap.n_runs} runs); weights p(z | x)^{self.global_.base.gamma:g} in every row, "
+                           f"other settings the defaults",
+                     notes=[(f"global @{self.global_.n_steps}: share of the global runs within {FAIL_POS_CELLS:g} "
+                            f"cells and {FAIL_DEG:g}° at step {self.global_.n_steps}; amcl conv.: AMCL's convergence "
+                            f"test passed there; recovered, steps: share of the kidnap runs that recover, median "
+                            f"steps to recover; % injected: particles injected per step while tracking (before the "
+                            f"kidnap); tracked: share within the bounds before the kidnap")])
 
     def __str__(self) -> str:
         return f"Observation scores compared: {len(self.global_.labels)} scores"

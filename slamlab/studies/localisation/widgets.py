@@ -8,7 +8,7 @@ import ipywidgets as widgets
 import numpy as np
 
 from ...localisation.plot import plot_belief
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .experiments import demo_run
 from .logs import CARMEN_LOGS, run_log_mcl
@@ -52,7 +52,7 @@ def explore_mcl(**defaults):
 
         show_run(run, lambda out: mcl_figure(*out), table=table)
 
-    return widgets.interactive(
+    return interactive(
         show,
         n_particles=_slider(widgets.IntSlider, d["n_particles"], 100, 10000, 100, "particles"),
         alpha_slow=_slider(widgets.FloatSlider, d["alpha_slow"], 0.0, 0.2, 0.001, "α_slow", readout_format=".3f"),
@@ -86,7 +86,7 @@ def explore_recorded_run(run, result):
               f"w_slow {rec.w_slow:.3f}, w_fast {rec.w_fast:.3f}; injected {rec.n_injected}")
         recorded_step_figure(run, result, step)
 
-    return widgets.interactive(show, step=widgets.IntSlider(value=0, min=0, max=run.n_steps - 1, step=1,
+    return interactive(show, step=widgets.IntSlider(value=0, min=0, max=run.n_steps - 1, step=1,
                                                             description="step", continuous_update=False))
 
 
@@ -114,7 +114,7 @@ def explore_log(**defaults):
         show_run(lambda: _log_run(log, int(n_scans), int(start), int(n_global)), plot_log_run, table=str,
                      errors=(ValueError, TypeError, FileNotFoundError))  # the logs are data files
 
-    return widgets.interactive(
+    return interactive(
         show,
         log=widgets.Dropdown(options=list(CARMEN_LOGS), value=d["log"], description="log"),
         start=_slider(widgets.IntSlider, d["start"], 0, 150, 10, "first scan"),
@@ -170,7 +170,7 @@ def explore_markov(**defaults):
 
         show_run(run, lambda out: plot_belief(out[0], true_pose=out[2]), table=table)
 
-    return widgets.interactive(
+    return interactive(
         show,
         resolution=_slider(widgets.IntSlider, d["resolution"], 2, 10, 1, "cell size [map cells]"),
         n_headings=_slider(widgets.IntSlider, d["n_headings"], 8, 72, 4, "headings"),

@@ -224,10 +224,11 @@ class ConvergenceTests:
             rows.append([f"{100 * r:.0f}"] + [f"{100 * self.conv_L[i, k]:.0f} / {100 * self.conv_svo[i, k]:.0f}" for k in at]
                         + ["-" if hL[i] is None else str(hL[i]), "-" if hS[i] is None else str(hS[i]),
                            f"{100 * self.err_L[i]:.1f}", f"{100 * self.err_svo[i]:.1f}"])
-        return format_table(["outliers, %", *(f"converged after {k}, % (L / SVO)" for k in at),
-                             "half by L", "half by SVO", "range error at L, %", "range error at SVO, %"], rows,
-                            title=f"003's L < {self.L_max:g} beside SVO's sigma < range/200 "
-                                  f"(camera moving sideways {self.step_m:g} m per frame)")
+        return format_table(["outliers, %", *(f"after {k}" for k in at),
+                             "half: L", "half: SVO", "range err. L, %", "range err. SVO, %"], rows,
+                            title=(f"003's L < {self.L_max:g} beside SVO's sigma < range/200 (camera moving sideways "
+                                   f"{self.step_m:g} m per frame)\nafter k: % of the seeds converged after k "
+                                   "observations (L / SVO); half: observations until half pass"))
 
 
 def run_convergence_tests(outlier_rates=(0.0, 0.2, 0.4), *, n_obs: int = 30, n_seeds: int = 400,

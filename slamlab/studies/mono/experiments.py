@@ -22,6 +22,7 @@ from .convergence import ConvergenceStudy, run_depth_filter_convergence
 from .runs import MonoRunResult, run_mono, trajectory_errors
 
 __all__ = [
+    "CASE_ORDER",
     "FAILURE_CASES",
     "FAILURE_CONSTRUCTIONS",
     "FAILURE_SETTINGS",
@@ -29,6 +30,7 @@ __all__ = [
     "SWEPT_FIELDS",
     "ConvergenceStudy",
     "MonoRunResult",
+    "case_seed",
     "failure_case_frames",
     "failure_table",
     "mono_sim",
@@ -43,7 +45,7 @@ __all__ = [
 ]
 
 #: image sizes per run size (width, height); "full" is the 768×576 of 000's robot's stereo cameras (000 §3: 40° view),
-#: which Ch. 4 renders (003 used a Kinect camera and the ICL-NUIM scenes; it states no image size)
+#: which Ch. 5 renders (003 used a camera it calls "Kinetic" and the ICL-NUIM scenes; it states no image size)
 SIZES = {"tiny": (192, 144), "small": (320, 240), "full": (768, 576)}
 
 SEQUENCES = ("strafe", "arc")
@@ -52,15 +54,46 @@ FAILURE_CASES = ("little_texture", "fast_motion", "pure_rotation", "distant_poin
 #: how each case is made (ours), printed with the table
 FAILURE_CONSTRUCTIONS = {
     "normal": "strafe, 2 cm per frame",
-    "little_texture": "strafe, blur 2.5 px, contrast 12 %",
+    "little_texture": "blur 2.5 px, contrast 12 %",
     "fast_motion": "strafe, 15 cm per frame",
     "pure_rotation": "2 deg per frame in place",
     "distant_points": "strafe in a 60 x 60 m arena",
-    "kidnap": "carried 2 m and 0.6 rad at mid-run",
+    "kidnap": "2 m, 0.6 rad jump at mid-run",
     "bad_initial_map": "initialised after 2 px",
 }
 #: the settings a failure case makes itself (ours): :class:`MonoParams` overrides of its run
 FAILURE_SETTINGS = {"bad_initial_map": {"init_disparity_px": 2.0, "init_min_parallax_deg": 0.0}}
+#: every case in the order of its random stream: stream i of ``SeedSequence(rng)`` renders case i, whichever
+#: cases a study runs, so that one case gives the same frames in every table and widget of the chapter
+CASE_ORDER = ("normal", *FAILURE_CASES)
+
+
+def case_seed(rng, case: str) -> np.random.SeedSequence:
+    """The random stream that renders ``case`` (ours): child ``CASE_ORDER.index(case)`` of ``rng``'s SeedSequence.
+
+    The failure table, the ablation, the parameter sweep and the widgets all render a case from it, so the
+    same ``rng`` gives the same frames of a case wherever it is run.
+
+    Parameters
+    ----------
+    rng : int, SeedSequence, Generator or None
+        The study's seed.
+    case : str
+        ``"normal"`` or one of :data:`FAILURE_CASES`.
+
+    Returns
+    -------
+    numpy.random.SeedSequence
+
+    Examples
+    --------
+    >>> case_seed(0, "fast_motion").spawn_key
+    (2,)
+    """
+    from ...sweep import fresh_seed_sequence
+
+    check_choice(case, "case", CASE_ORDER)
+    return fresh_seed_sequence(rng).spawn(len(CASE_ORDER))[CASE_ORDER.index(case)]
 
 
 def sequence_poses(name: str, n_frames: int = 60, *, step_m: float = 0.02) -> np.ndarray:
@@ -304,7 +337,7 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
     progress : bool, callable or None
         Progress display.
     rng : Generator, int or None
-        Randomness; each case gets its own spawned stream (default 0).
+        Randomness; each case renders from its own stream, :func:`case_seed` (default 0).
     **overrides
         Fields of :class:`MonoParams` to change.
 
@@ -313,21 +346,22 @@ def run_failure_cases(cases=("normal", *FAILURE_CASES), *, size: str = "tiny", n
     dict
         Case → :class:`MonoRunResult`.
     """
-    from ...sweep import fresh_seed_sequence
-
     p = MonoParams.resolve(params, **overrides)
     for case in cases:
+        check_choice(case, "case", CASE_ORDER)
         refuse_set_fields(p, list(FAILURE_SETTINGS.get(case, {})), f"the failure case {case!r} sets it")
     out = {}
-    seeds = fresh_seed_sequence(rng).spawn(len(cases))  # an int seed: SeedSequence(seed)'s children as before
-    for case, ss in zip(progress_bar(cases, desc="failure cases", progress=progress), seeds, strict=True):
-        imgs, Ts, K, ov = failure_case_frames(case, size, n_frames, rng=np.random.default_rng(ss))
+    for case in progress_bar(cases, desc="failure cases", progress=progress):
+        imgs, Ts, K, ov = failure_case_frames(case, size, n_frames, rng=np.random.default_rng(case_seed(rng, case)))
         out[case] = run_mono(imgs, Ts, K, name=case, params=p, progress=False, **ov)
     return out
 
 
 def failure_table(results: dict) -> str:
     """003 §5.5.1's table layout: the correctly tracked share with its mark (X < 30 %, * 30-70 %) and the ATE.
+
+    Columns: the case, its construction, the claimed and the correct share, the mark, the ATE after Sim(3) over
+    all frames, the frames the tracker reported lost and the kinds of initialisation failure met.
 
     Parameters
     ----------
@@ -346,9 +380,10 @@ def failure_table(results: dict) -> str:
                      f"{r.counts.get('lost', 0)}",
                      f"{sum(k.startswith('init_') and k not in ('init_done', 'init_tracking', 'init_first_frame') for k in r.counts)}"])
     tol = next(iter(results.values())).score.tol_frac if results else 0.05
-    return format_table(["case (003 §5.3)", "construction (ours)", "claimed, %", "correct, %", "mark", "ATE Sim(3) all frames, m",
-                         "lost frames", "init failure kinds"], rows,
-                        title=f"Failure cases, rendered (correct: error <= {100 * tol:.0f} % of the path after Sim(3))")
+    return format_table(["case", "construction (ours)", "claimed, %", "correct, %", "mark", "ATE, m", "lost frames",
+                         "init fails"], rows,
+                        title=(f"003 §5.3's failure cases, rendered (correct: error <= {100 * tol:.0f} % of the path; "
+                               "ATE: Sim(3), all frames)"))
 
 
 # -- the parameters 003 tuned (003 §5.1.1) on slamlab.sweep ---------------------------------------
@@ -356,19 +391,26 @@ def failure_table(results: dict) -> str:
 SWEPT_FIELDS = ("init_disparity_px", "max_keyframes", "kf_max_lost_ratio", "max_matches", "kf_min_frames")
 
 
-def _sweep_run(init_disparity_px, max_keyframes, kf_max_lost_ratio, max_matches, rng, size="tiny", n_frames=30,
-               params=None):
-    imgs, Ts, K, _ = failure_case_frames("normal", size, n_frames, rng=rng)
+def _sweep_run(init_disparity_px, max_keyframes, kf_max_lost_ratio, max_matches, frames_seed, size="tiny",
+               n_frames=30, params=None):
+    imgs, Ts, K, _ = failure_case_frames("normal", size, n_frames, rng=np.random.default_rng(frames_seed))
     r = run_mono(imgs, Ts, K, name="sweep", params=params, progress=False, init_disparity_px=init_disparity_px,
                  max_keyframes=max_keyframes, kf_max_lost_ratio=kf_max_lost_ratio, max_matches=max_matches,
                  kf_min_frames=10)
-    return {"tracked_pct": round(100 * r.fraction_tracked), "ate_mm": round(1000 * r.ate_m),
-            "keyframes": r.n_keyframes, "tracking_ms": round(1000 * sum(r.stage_time_s[k] for k in ("align", "match", "refine")), 1)}
+    first_map = r.status.index("initialised") if "initialised" in r.status else -1
+    return {"claimed_pct": round(100 * r.fraction_claimed), "correct_pct": round(100 * r.fraction_tracked),
+            "first_map": first_map, "ate_mm": round(1000 * r.ate_m), "keyframes": r.n_keyframes,
+            "tracking_ms": round(1000 * sum(r.stage_time_s[k] for k in ("align", "match", "refine")), 1)}
 
 
 def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_frames: int = 30,
                         params: MonoParams | None = None, rng=0, progress=None, **overrides):
     """003 §5.1.1's four tuning parameters on the rendered strafe, via :func:`slamlab.sweep.sweep`.
+
+    Every row tracks the same frames (the ``"normal"`` case rendered from :func:`case_seed`), so the rows differ
+    by their settings only. Columns: ``claimed_pct`` the frames the tracker claims, ``correct_pct`` the correctly
+    tracked ones (claimed and within 5 % of the path after Sim(3)), ``first_map`` the frame at which the
+    first map was made (-1: never), ``ate_mm`` the ATE over all frames, ``keyframes`` and ``tracking_ms``.
 
     Parameters
     ----------
@@ -385,7 +427,7 @@ def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_fra
         The settings the grid changes (default: the defaults). The sweep sets :data:`SWEPT_FIELDS` itself
         (``kf_min_frames`` is 10 in these runs): ``params`` and ``overrides`` may not set them.
     rng : int, SeedSequence or Generator
-        Where every run's stream is spawned from.
+        The seed of the rendered frames (one rendering for every row).
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
     **overrides
@@ -406,5 +448,6 @@ def run_parameter_sweep(grid=None, *, n_jobs: int = 1, size: str = "tiny", n_fra
     if grid is None:
         grid = [base, {**base, "init_disparity_px": 5.0}, {**base, "init_disparity_px": 30.0},
                 {**base, "max_keyframes": 3}, {**base, "kf_max_lost_ratio": 0.1}, {**base, "max_matches": 30}]
-    return sweep(_sweep_run, grid, rng=root_seed_sequence(rng, "rng"), n_jobs=n_jobs, progress=progress,
-                 fixed={"size": size, "n_frames": n_frames, "params": p})
+    frames_seed = case_seed(root_seed_sequence(rng, "rng"), "normal")
+    return sweep(_sweep_run, grid, rng_arg=None, n_jobs=n_jobs, progress=progress,
+                 fixed={"size": size, "n_frames": n_frames, "params": p, "frames_seed": frames_seed})

@@ -66,9 +66,9 @@ def pinhole_table(X_cam=(0.5, -0.2, 4.0), cameras=None) -> str:
         hfov = np.degrees(2 * np.arctan(w / (2 * K[0, 0])))
         rows.append([name, f"{w}x{h}", f"{K[0, 0]:.1f}", f"{K[1, 1]:.1f}", f"{K[0, 2]:.1f}", f"{K[1, 2]:.1f}",
                      f"{hfov:.1f}", f"({u:.1f}, {v_:.1f})"])
-    return format_table(["camera", "image", "fx, px", "fy, px", "u0, px", "v0, px", "h. field of view, deg",
-                         f"pixel of X = ({X[0]:g}, {X[1]:g}, {X[2]:g}) m"], rows,
-                        title="Pinhole model (003 §2.1): K and the projection u = fx X/Z + u0, v = fy Y/Z + v0")
+    return format_table(["camera", "image", "fx, px", "fy, px", "u0, px", "v0, px", "h. view, deg", "pixel of X, px"],
+                        rows, title=("Pinhole model (003 §2.1): u = fx X/Z + u0, v = fy Y/Z + v0; "
+                                     f"X = ({X[0]:g}, {X[1]:g}, {X[2]:g}) m"))
 
 
 # -- 003 §4.1.2, eq. 6.4 ------------------------------------------------------------------------------

@@ -81,7 +81,7 @@ def run_kitti_mono(folder=None, *, n_frames: int | None = None, params: MonoPara
 KITTI_ABLATIONS = {
     "defaults": {},
     "no re-initialisation after a loss": {"reinit_when_lost": False},
-    "003's homography initialisation": {"init_method": "homography"},
+    "homography initialisation always": {"init_method": "homography"},
     "SVO's constant-position prior": {"motion_model": "constant_position"},
     "unwarped seed patches": {"warp_patches": False},
 }

@@ -28,6 +28,7 @@ from .experiments import (
     PITCH_DOWN_RAD,
     ConvergenceStudy,
     MonoRunResult,
+    case_seed,
     failure_case_frames,
     mono_sim,
     render_sequence,
@@ -59,7 +60,7 @@ ABLATIONS = {
     "no outlier rejection (RdE off)": {"outlier_rejection": False},
     "no refinement (alignment only)": {"refine": False},
     "SVO's constant-position prior": {"motion_model": "constant_position"},
-    "003's homography initialisation": {"init_method": "homography"},
+    "homography initialisation always": {"init_method": "homography"},
     "5-point initialisation always": {"init_method": "essential"},
 }
 
@@ -84,7 +85,8 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
         The settings every configuration changes (default: the defaults); not the fields a configuration
         or a case sets itself (``ValueError`` naming them).
     rng : int, SeedSequence or Generator
-        One stream per case is spawned from it (the renders).
+        The renders' seed: a case renders from :func:`~slamlab.studies.mono.experiments.case_seed`, the same
+        frames as in :func:`~slamlab.studies.mono.experiments.run_failure_cases` with the same ``rng``.
     progress : bool, callable or None
         See :mod:`slamlab._progress`.
     **overrides
@@ -96,7 +98,6 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
         ``{(config, case): MonoRunResult}``.
     """
     from ..._progress import progress_bar
-    from ...sweep import fresh_seed_sequence
 
     configs = ABLATIONS if configs is None else dict(configs)
     p = MonoParams.resolve(params, **overrides)  # a bad `params` or override fails here, naming the fields
@@ -104,17 +105,18 @@ def run_ablation(configs=None, *, cases=("fast_motion",), size: str = "tiny", n_
         p.replace(**o)  # and a bad configuration
     varied = {k for o in (*configs.values(), *(FAILURE_SETTINGS.get(c, {}) for c in cases)) for k in o}
     refuse_set_fields(p, sorted(varied), "the configurations or cases of run_ablation set it")
-    seeds = fresh_seed_sequence(rng).spawn(len(cases))  # an int seed: SeedSequence(seed)'s children as before
     out = {}
-    for case, ss in zip(cases, seeds, strict=True):
-        imgs, Ts, K, ov = failure_case_frames(case, size, n_frames, rng=np.random.default_rng(ss))
+    for case in cases:
+        imgs, Ts, K, ov = failure_case_frames(case, size, n_frames, rng=np.random.default_rng(case_seed(rng, case)))
         for label, o in progress_bar(list(configs.items()), desc=case, progress=progress):
             out[(label, case)] = run_mono(imgs, Ts, K, name=f"{case}, {label}", params=p, progress=False, **{**ov, **o})
     return out
 
 
 def ablation_table(results: dict, *, title: str = "003 §5.4's switches and the motion prior on our pipeline (rendered)") -> str:
-    """One row per (configuration, case): claimed and correct shares, ATE over all and claimed frames.
+    """One row per (configuration, case): claimed and correct shares, ATE over all and claimed frames, losses.
+
+    When every row has one case, the case is named in the title instead of a column.
 
     Parameters
     ----------
@@ -128,12 +130,15 @@ def ablation_table(results: dict, *, title: str = "003 §5.4's switches and the 
     str
     """
     rows = []
+    cases = list(dict.fromkeys(case for _, case in results))
+    one = len(cases) == 1
     for (label, case), r in results.items():
         f3 = lambda x: f"{x:.3f}" if np.isfinite(x) else "-"
-        rows.append([label, case, f"{100 * r.fraction_claimed:.0f}", f"{100 * r.fraction_tracked:.0f}", f3(r.ate_m),
-                     f3(r.ate_claimed_m), f"{r.counts.get('lost', 0)}"])
-    return format_table(["configuration", "case", "claimed, %", "correct, %", "ATE all frames, m", "ATE claimed, m",
-                         "lost"], rows, title=title)
+        rows.append([label, *(() if one else (case,)), f"{100 * r.fraction_claimed:.0f}",
+                     f"{100 * r.fraction_tracked:.0f}", f3(r.ate_m), f3(r.ate_claimed_m), f"{r.counts.get('lost', 0)}"])
+    return format_table(["configuration", *(() if one else ("case",)), "claimed, %", "correct, %", "ATE all, m",
+                         "ATE claimed, m", "lost frames"], rows,
+                        title=f"{title}: {cases[0]}" if one else title)
 
 
 def source_findings_table(ablation: dict, failures: dict) -> str:
@@ -183,11 +188,23 @@ def source_findings_table(ablation: dict, failures: dict) -> str:
          "not implemented (patches only)"],
         ["accuracy", "§5.4: 'not more than a couple of cm' with some configurations",
          f"ATE {cm(d0)} ({cases[0]}, rendered)" if d0 is not None else "-"],
-        ["robustness", ("§5.5.1: six experiments; SVO lost in 3 of 6, PTAM finished 1, ORB-SLAM most accurate, SDVL "
-                        "in between"), f"our failure cases: X in {n_x} of {len(fails)}, * in {n_star}"],
+        ["robustness", ("§5.5.1: six experiments, each system's best of 3 runs; SVO lost in 3 of 6, PTAM finished "
+                        "1, ORB-SLAM most accurate, SDVL in between (its sequences, not our constructed cases: the "
+                        "counts do not compare)"),
+         f"our failure cases: X in {n_x} of {len(fails)}, * in {n_star}"],
+        ["tracking time", ("§5.5.2: SVO fastest (a few ms), ORB-SLAM slowest, LSD-SLAM between them; SDVL between "
+                           "SVO and LSD-SLAM"), "not measured here (benchmarks/bench_mono.py)"],
     ]
-    return format_table(["question", "003 found", "our pipeline (ATE all frames, correct share)"], rows,
-                        title="003 §5.4-5.5 beside our runs")
+    table = format_table(["question", "our pipeline (ATE all frames, correct share)"], [[q, o] for q, _, o in rows],
+                         title="003 §5.4-5.5 beside our runs (003's words below the table)")
+    return table + "\n" + _notes("003 found:", [f"{q}: {w}" for q, w, _ in rows])
+
+
+def _notes(head: str, items, width: int = 110) -> str:
+    """``head`` then each item as a wrapped line under a table, no line wider than ``width``."""
+    import textwrap
+
+    return "\n".join([head, *(textwrap.fill(t, width, initial_indent="  ", subsequent_indent="    ") for t in items)])
 
 
 # -- homography vs essential matrix (003 §4.3.1) -------------------------------------------------
@@ -275,40 +292,47 @@ def ours_vs_source(failures: dict, sequence: MonoRunResult, kitti: MonoRunResult
     n_fail_ok = sum(r.verdict == "ok" for k, r in failures.items() if k != "normal")
     n_cases = sum(k != "normal" for k in failures)
     rows = [
-        ["camera", "Kinect (monocular, §5.1.2); ICL-NUIM OR3 (§5.2)", "rendered 40° camera (000's rig); KITTI 06 left"],
+        ["camera", "'Kinetic' [a]; ICL-NUIM OR3 (§5.2)", "rendered 40° (000's rig); KITTI 06 left"],
         ["FAST points to start", ">= 50 (usually > 300)", f">= {p.min_corners}"],
-        ["initial displacement", "10-20 px", f"{p.init_disparity_px:.0f} px"],
-        ["initialisation", "homography + RANSAC (5-point named)", p.init_method + " (homography available)"],
-        ["search band", "rho +- 2 sigma; 1e-10 if rho - 2 sigma <= 0", f"rho +- {p.n_sigma:.0f} sigma; 1e-10"],
+        ["initial displacement", "10-20 px (§5.1.1)", f"{p.init_disparity_px:.0f} px"],
+        ["initialisation", "5-point named, homography shown [b]", f"{p.init_method}: homography or 5-point"],
+        ["search band", "rho +- 2 sigma; 1e-10 if <= 0", f"rho +- {p.n_sigma:.0f} sigma; 1e-10"],
         ["convergence", "L < 0.1", f"L < {p.L_max} (or SVO sigma < range/200)"],
-        ["keyframe rule", ">= 30 frames and >= 10 % lost, or > 30 %",
-         f">= {p.kf_min_frames} and >= {100 * p.kf_lost_ratio:.0f} %, or > {100 * p.kf_max_lost_ratio:.0f} %"],
+        ["keyframe rule", ">= 30 frames, >= 10 % lost, or > 30 %",
+         f">= {p.kf_min_frames}, >= {100 * p.kf_lost_ratio:.0f} %, or > {100 * p.kf_max_lost_ratio:.0f} %"],
         ["alignment patch", "4x4, pyramid, coarse to fine",
          f"{p.align_patch_px}x{p.align_patch_px}, levels {p.align_max_level}..{p.align_min_level}"],
         ["motion prior", "constant velocity", p.motion_model.replace("_", " ")],
-        ["accuracy", "'not more than a couple of cm' (§5.4, some configurations)",
-         f"ATE {100 * sequence.ate_m:.1f} cm, all frames ({sequence.name}, rendered)"],
-        ["failure cases tracked > 70 %", "6 named (§5.3), no numbers", f"{n_fail_ok} of {n_cases}"],
+        ["accuracy", "'a couple of cm' [c]", f"ATE {100 * sequence.ate_m:.1f} cm, all frames, {sequence.name.split(' (')[0]}"],
+        ["failure cases ok (> 70 %)", "6 named (§5.3), no numbers", f"{n_fail_ok} of {n_cases} (our constructions)"],
     ]
     if convergence is not None:
         def half(i):
             k = np.flatnonzero(convergence.converged[i] >= 0.5)
             return f"{k[0]}" if k.size else "> " + str(convergence.converged.shape[1] - 1)
 
-        rows.append(["seeds converged (half, SVO test)", "'with enough parallax' (Fig. 4.5, no numbers)",
-                     "; ".join(f"{100 * r:.0f} % outliers: {half(i)} obs."
-                               for i, r in enumerate(convergence.outlier_rates))])
+        rows.append(["seeds converged (half)", "'enough parallax' (Fig. 4.5)",
+                     " / ".join(half(i) for i in range(len(convergence.outlier_rates))) + " obs. (SVO test) [d]"])
     if kitti is not None:
-        rows.append(["real data", "ICL-NUIM OR3 (§5.2), six experiments (§5.5.1); tables lost",
-                     (f"KITTI 06, {len(kitti.tracked)} frames: correct {100 * kitti.fraction_tracked:.0f} %, "
-                     f"ATE {kitti.ate_m:.2f} m (all frames)")])
-    return format_table(["item", "003", "ours"], rows, title="Ours vs the source (003)")
+        rows.append(["real data", "ICL-NUIM OR3 (§5.2) [e]",
+                     (f"KITTI 06, {len(kitti.tracked)} fr.: {100 * kitti.fraction_tracked:.0f} % correct, "
+                      f"ATE {kitti.ate_m:.2f} m")])
+    notes = [("[a] 003 §5.1.2: the images came from a monocular camera it calls 'Kinetic', run under ROS; we "
+              "read it as a Kinect (our reading: it may name ROS Kinetic, the ROS release)."),
+             ("[b] 003 §4.3.1: 'the initial map is computed with the 5-point algorithm', then a RANSAC homography "
+              "'assuming a dominant plane'; our 'auto' picks one of the two (ours)."),
+             "[c] 003 §5.4: 'not more than a couple of centimetres', with some configurations.",
+             "[e] 003 §5.5.1: six experiments against PTAM, SVO, LSD-SLAM and ORB-SLAM; its tables are lost."]
+    if convergence is not None:
+        notes.insert(3, "[d] observations until half of the seeds pass SVO's test at "
+                     + " / ".join(f"{100 * r:.0f}" for r in convergence.outlier_rates) + " % outliers.")
+    return format_table(["item", "003", "ours"], rows, title="Ours vs the source (003)") + "\n" + _notes("Notes:", notes)
 
 
 # -- mono vs stereo on the same frames ----------------------------------------------------------
 def run_mono_vs_stereo(sequence: str = "strafe", *, n_frames: int = 40, size: str = "small",
                        params: MonoParams | None = None, rng=0, snapshot_frames=(), **overrides):
-    """The monocular pipeline on the left images and Ch. 4's stereo pipeline on the pairs, same poses.
+    """The monocular pipeline on the left images and Ch. 5's stereo pipeline on the pairs, same poses.
 
     Parameters
     ----------
@@ -369,7 +393,7 @@ def run_mono_vs_stereo(sequence: str = "strafe", *, n_frames: int = 40, size: st
 
 @dataclass(frozen=True)
 class MonoVsStereo:
-    """The monocular run and Ch. 4's stereo pipeline on the same rendered poses.
+    """The monocular run and Ch. 5's stereo pipeline on the same rendered poses.
 
     Attributes
     ----------
@@ -390,7 +414,7 @@ class MonoVsStereo:
         m = self.mono
         rows = [["monocular (left camera)", f"{100 * m.fraction_tracked:.0f}", "-", f"{m.ate_m:.3f}", f"{m.rpe_m:.3f}"],  # all frames
                 # 2 decimals: the stereo pipeline's last digit changes with the number of BLAS threads
-                ["stereo pipeline of Ch. 4", "100", f"{self.stereo_ate_se3_m:.2f}", f"{self.stereo_ate_sim3_m:.2f}",
+                ["stereo pipeline of Ch. 5", "100", f"{self.stereo_ate_se3_m:.2f}", f"{self.stereo_ate_sim3_m:.2f}",
                  f"{self.stereo_rpe_m:.2f}"]]
         return format_table(["pipeline", "correctly tracked, %", "ATE SE(3), m", "ATE Sim(3), m", "RPE (Sim(3) scale), m"], rows,
                             title=f"{m.name.split(' ')[0]}, {len(m.tracked)} frames, same poses")

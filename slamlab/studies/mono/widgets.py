@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import ipywidgets as widgets
 
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .experiments import (
     FAILURE_CASES,
@@ -60,7 +60,7 @@ def explore_mono(**defaults):
 
         show_run(run, _draw_run, table=str)
 
-    return widgets.interactive(
+    return interactive(
         show,
         init_disparity_px=_slider(widgets.FloatSlider, d["init_disparity_px"], 2.0, 40.0, 1.0, "init disp. [px]"),
         kf_min_frames=_slider(widgets.IntSlider, d["kf_min_frames"], 1, 40, 1, "KF min frames"),
@@ -90,7 +90,7 @@ def explore_failure_cases(**defaults):
                                                progress=False, motion_model=motion_model)[case],
                      _draw_run, table=str)
 
-    return widgets.interactive(
+    return interactive(
         show,
         case=widgets.Dropdown(options=("normal", *FAILURE_CASES), value=d["case"], description="case"),
         motion_model=widgets.ToggleButtons(options=("constant_velocity", "constant_position"), value=d["motion_model"],
@@ -122,7 +122,7 @@ def explore_motion_prior(**defaults):
 
         show_run(run, _draw_run, table=str)
 
-    return widgets.interactive(
+    return interactive(
         show,
         sequence=widgets.Dropdown(options=("strafe", "arc"), value=d["sequence"], description="sequence"),
         motion_model=widgets.ToggleButtons(options=("constant_velocity", "constant_position"), value=d["motion_model"],
@@ -150,7 +150,7 @@ def explore_depth_filter(**defaults):
         show_run(lambda: run_depth_filter_convergence((outlier_rate,), n_obs=int(n_obs), tau=tau, rng=d["rng"]),
                      plot_convergence, table=lambda c: c.table(at=tuple(sorted({0, 5, 10, 20, int(n_obs)}))))
 
-    return widgets.interactive(
+    return interactive(
         show,
         outlier_rate=_slider(widgets.FloatSlider, d["outlier_rate"], 0.0, 0.9, 0.05, "outliers"),
         tau=widgets.FloatLogSlider(value=d["tau"], base=10, min=-3, max=-1, step=0.25, description="τ_ρ [1/m]",

@@ -30,11 +30,11 @@ __all__ = [
 
 #: (label, max_planes, min_normal_rank) of :func:`run_pairs_ablation`
 PAIR_VARIANTS = (
-    ("all planes, >= 2 normal directions (ours, default)", 10, 2),
+    ("all planes, >= 2 directions (ours, default)", 10, 2),
     ("all planes, one pair is enough (002)", 10, 1),
     ("2 largest planes, >= 2 directions", 2, 2),
     ("2 largest planes, one pair is enough", 2, 1),
-    ("largest plane only: one pair (002's minimum)", 1, 1),
+    ("largest plane only, one pair (002's minimum)", 1, 1),
 )
 
 #: The settings of the pairs and incidence ablations' flights when no ``params`` is given: 200 particles.
@@ -111,9 +111,10 @@ class FlightComparison:
         _, rms_o = r0.rms()
         rows.append(["odometry alone", "-", f"{r0.ate_odo_m:.3f}", f"{rms_o[0]:.3f}", f"{rms_o[1]:.3f}",
                      f"{rms_o[2]:.3f}", f"{rms_o[3]:.2f}", f"{rms_o[4]:.2f}", f"{rms_o[5]:.2f}"])
-        tab = format_table(["run", "frames used / kept", "ATE [m]", "x [m]", "y [m]", "z [m]", "roll [deg]",
-                            "pitch [deg]", "yaw [deg]"], rows,
-                           title=f"{self.title} ({r0.n_frames} frames, {r0.params.n_particles} particles; RMS errors)")
+        tab = format_table(["run", "used / kept", "ATE [m]", "x", "y", "z", "roll", "pitch", "yaw"], rows,
+                           title=(f"{self.title} ({r0.n_frames} frames, {r0.params.n_particles} particles)\nRMS "
+                                  "errors: x, y, z [m], roll, pitch, yaw [deg]\nused / kept: frames that corrected "
+                                  "the particles / kept the prediction"))
         return tab + (f"\n{self.note}" if self.note else "")
 
 
@@ -181,17 +182,17 @@ def run_frame_source_ablation(flight=None, *, duration_s: float = 8.0, params: P
     """
     p = PlaneSLAMParams.resolve(params, **overrides)
     fl = flight_or_simulate(flight, duration_s, rng)
-    cases = (("002: frames and prediction from the odometry", "odometry", "odometry"),
-             ("frames from the true poses, prediction from the odometry", "truth", "odometry"),
-             ("frames from the odometry, prediction from the true poses", "odometry", "truth"),
-             ("both from the true poses", "truth", "truth"))
+    cases = (("002: frames, prediction: odometry", "odometry", "odometry"),
+             ("frames: true poses, prediction: odometry", "truth", "odometry"),
+             ("frames: odometry, prediction: true poses", "odometry", "truth"),
+             ("frames, prediction: true poses", "truth", "truth"))
     res = tuple(run_flight(flight=fl, rng=rng, params=p, frame_poses=a, increment_poses=b, progress=False)
                 for _, a, b in cases)
     e = in_frame_rotation_error_deg(fl)
     tilt = [map_normal_error_deg(r, fl.room) for r in res]
-    note = ("odometry's rotation error inside a frame (each line against the frame's last line), RMS about x / y / "
-            f"z: {e[0]:.2f} / {e[1]:.2f} / {e[2]:.2f} deg\nmap planes' normals against the room's, median angle "
-            "[deg], row by row: " + " / ".join(f"{t:.2f}" for t in tilt))
+    note = ("odometry's rotation error inside a frame (each line against the frame's last line),\n"
+            f"  RMS about x / y / z: {e[0]:.2f} / {e[1]:.2f} / {e[2]:.2f} deg\nmap planes' normals against the "
+            "room's, median angle [deg], row by row: " + " / ".join(f"{t:.2f}" for t in tilt))
     return FlightComparison("Where the error comes from", tuple(c[0] for c in cases), res, note)
 
 
@@ -228,10 +229,11 @@ class IncidenceResult:
             rms, _ = fl.rms()
             rows.append([lab, f"{f4.error_with_m:.3f}", f"{f4.peak:.2f}", f"{fl.ate_m:.3f}", f"{rms[0]:.3f}",
                          f"{rms[1]:.3f}", f"{rms[5]:.2f}"])
-        return format_table(["incidence correction", "Fig. 4 error [m]", "Fig. 4 peak / uniform", "flight ATE [m]",
+        return format_table(["incidence correction", "Fig. 4 error [m]", "Fig. 4 peak", "flight ATE [m]",
                              "x RMS [m]", "y RMS [m]", "yaw RMS [deg]"], rows,
-                            title=f"Incidence correction on / off (Fig. 4: one cycle; flight: "
-                                  f"{self.flights[0].n_frames} frames, {self.flights[0].params.n_particles} particles)")
+                            title=(f"Incidence correction on / off (Fig. 4: one cycle; flight: "
+                                   f"{self.flights[0].n_frames} frames, {self.flights[0].params.n_particles} "
+                                   "particles)\nFig. 4 peak: the largest weight / the uniform weight"))
 
 
 def run_incidence_ablation(flight=None, *, duration_s: float = 20.0, fig4_particles: int = 400,

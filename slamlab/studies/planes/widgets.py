@@ -5,7 +5,7 @@ from __future__ import annotations
 import ipywidgets as widgets
 
 from ...widgets import STYLE as _STYLE
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .experiments import run_flight
 from .figures import run_intensity_figure
@@ -39,7 +39,7 @@ def explore_flight(**defaults):
                                         intensity_weights=bool(intensity_weights), rng=d["rng"]),
                      plot_flight_errors, table=lambda res: f"{res}\n{res.table()}")
 
-    return widgets.interactive(
+    return interactive(
         show,
         n_particles=_slider(widgets.IntSlider, d["n_particles"], 10, 400, 10, "particles"),
         V_xyz_m2=_slider(widgets.FloatSlider, d["V_xyz_m2"], 0.0, 0.01, 1e-4, "V xyz [m²] (variance)",
@@ -74,7 +74,7 @@ def explore_intensity_figure(**defaults):
                                                   incidence_correction=bool(incidence_correction), rng=d["rng"]),
                      plot_intensity_figure, table=lambda r: f"{r.table()}\n{r.profile_table()}")
 
-    return widgets.interactive(
+    return interactive(
         show,
         offset_m=_slider(widgets.FloatSlider, d["offset_m"], 0.0, 1.5, 0.1, "offset along the walls [m]"),
         V_xyz_m2=_slider(widgets.FloatSlider, d["V_xyz_m2"], 0.0, 1.0, 0.01, "V xyz [m²] (variance)"),

@@ -448,7 +448,7 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
     rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
     run_experiment("closed loop", "small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
     n = len(rec.iterations)
-    return rec.workload(f"stereo closed loop, {n} frames ({detector.upper()}, recorded)",
+    return rec.workload(f"stereo loop ({detector.upper()}, {n} frames)",
                         base_seen_times=p.base_seen_times, max_non_base_time=p.max_non_base_time)
 
 

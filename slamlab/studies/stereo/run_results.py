@@ -71,7 +71,7 @@ class StereoRunResult:
         return (
             f"{self.name}: {self.n_frames} frames, {self.detector}/{self.policy}, max position error "
             f"{self.pos_err_m.max():.2f} m, max heading error {np.rad2deg(np.abs(self.yaw_err_rad).max()):.1f} deg, "
-            f"{len(self.degenerate)} degenerate frames"
+            f"{len(self.degenerate)} degenerate"
         )
 
     # -- figures of 000 §3.7 -------------------------------------------------------------------------
@@ -219,6 +219,9 @@ class DriftStudy:
             rows.append([f"{1e3 * d:.1f}", f"{1e3 * d * np.sqrt(r.n_frames):.1f}", f"{r.pos_err_m.max():.2f}",
                          f"{np.rad2deg(np.abs(r.yaw_err_rad).max()):.1f}", f"{np.median(c['n_stereo']):.0f}",
                          f"{np.min(c['n_stereo']):.0f}", f"{np.median(c['n_inliers'][1:]):.0f}", f"{len(r.degenerate)}"])  # fmt: skip
-        head = ["drift, mrad/frame", "~drift at end, mrad", "max pos. err, m", "max heading err, deg",
-                "stereo matches (median)", "(min)", "inliers (median)", "degenerate"]  # fmt: skip
-        return format_table(head, rows, title=f"calibration drift of the right camera: {self.experiment} ({self.runs[0].detector})")
+        head = ["σ, mrad/frame", "~at end, mrad", "max pos., m", "max yaw, deg", "stereo median", "min",
+                "inliers median", "degenerate"]  # fmt: skip
+        return (format_table(head, rows, title=f"calibration drift of the right camera: {self.experiment} "
+                                               f"({self.runs[0].detector})")
+                + "\nσ: random-walk step per axis and frame; at end: σ √frames; max: over the frames"
+                  "\nstereo matches and RANSAC inliers: per frame")

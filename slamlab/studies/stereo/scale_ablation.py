@@ -20,6 +20,7 @@ from ..._table import format_table
 from ..._validate import as_finite_array, as_rng, check_int, check_positive
 from ...stereo.params import StereoParams
 from ...stereo.slam import StereoSLAM
+from ._text import fit_table
 from .kitti_experiments import KITTI_PARAMS
 
 __all__ = ["ABLATION_BASE", "CONDITION_SETTINGS", "PROPOSED_FIX", "PROPOSED_FIX_OFF", "SCALE_ABLATION", "ConditionAblation", "ScaleAblation", "run_condition_ablation",
@@ -32,7 +33,7 @@ _FIX = {"pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_firs
 #: covariance in the landmark filter (``update_cov_depth``); 'true' and ``_oracle``: the simulator's truth
 #: (see :func:`run_scale_ablation`)
 SCALE_ABLATION = {
-    "KITTI_PARAMS of stop 36 (both at the landmark's depth)": {},
+    "both at the landmark's depth (KITTI_PARAMS without PROPOSED_FIX)": {},
     "no keypoint noise": {"pixel_std_obs": 0.0},
     "both at the measured depth": {"weight_depth": "measured", "update_cov_depth": "measured"},
     "pose weight at the measured depth only": {"weight_depth": "measured"},
@@ -61,14 +62,14 @@ SCALE_ABLATION = {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "_oracle": ("init_position",)},
     "refined pose + 1.5 x the cut + second sighting replaces the first": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True},
-    "... + refinement on landmarks seen twice (PROPOSED_FIX: KITTI_PARAMS of stop 37)": {
+    "... + refinement on landmarks seen twice (PROPOSED_FIX)": {
         "pose_refine": "reprojection", "reobserve_depth_factor": 1.5, "drop_first_sighting": True,
         "refine_min_seen": 2},
     # the noise model (stop 38): the filter's pixel_std (0.5 px) against the scene's keypoint noise
     "PROPOSED_FIX + pixel_std 1 px (the 1 px scene's noise: an oracle there)": {**_FIX, "pixel_std": 1.0},
     "PROPOSED_FIX + no innovation gate in the landmark filter": {**_FIX, "update_gate": None},
     "PROPOSED_FIX + Huber threshold 4 px": {**_FIX, "refine_huber_px": 4.0},
-    "PROPOSED_FIX + pixel_std estimated online (today's KITTI_PARAMS)": {**_FIX, "pixel_std_estimate": True},
+    "PROPOSED_FIX + pixel_std estimated online (KITTI_PARAMS)": {**_FIX, "pixel_std_estimate": True},
 }
 
 #: the options stop 37 proposes against the displacement underestimate (issue 25): the pose refined on the
@@ -89,8 +90,8 @@ ABLATION_BASE = KITTI_PARAMS.replace(**PROPOSED_FIX_OFF)
 #: stop 37 (with PROPOSED_FIX) and today's (with the noise estimated online, stop 38)
 CONDITION_SETTINGS = {
     "old defaults (measured depth)": {"weight_depth": "measured", "update_cov_depth": "measured"},
-    "KITTI_PARAMS of stop 36": {},
-    "KITTI_PARAMS of stop 37 (+ PROPOSED_FIX)": PROPOSED_FIX,
+    "KITTI_PARAMS without PROPOSED_FIX": {},
+    "KITTI_PARAMS without the noise estimate": PROPOSED_FIX,
     "KITTI_PARAMS (+ pixel_std estimated online)": {**PROPOSED_FIX, "pixel_std_estimate": True},
 }
 
@@ -166,8 +167,8 @@ class ScaleAblation:
             for i, row in enumerate(rows):
                 row.insert(2, f"{self.end_ratio[i].mean():.3f}")
         n_seeds, n_steps = self.step_ratios.shape[1:]
-        return format_table(head,
-                            rows, title=(f"scale ablation: {n_seeds} seeds x {n_steps + 1} frames, {self.path_length_m:.1f} m, "
+        return fit_table(head,
+                         rows, title=(f"scale ablation: {n_seeds} seeds x {n_steps + 1} frames, {self.path_length_m:.1f} m, "
                                          f"keypoint noise {self.pixel_std_obs:g} px (simulated)"))
 
 

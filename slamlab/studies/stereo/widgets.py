@@ -7,7 +7,7 @@ from IPython.display import display
 
 from ...stereo.params import STEREO_DETECTORS, RenderParams
 from ...widgets import STYLE as _STYLE
-from ...widgets import show_run
+from ...widgets import interactive, show_run
 from .experiments import experiment_poses, run_experiment
 from .plot import run_figure
 
@@ -50,7 +50,7 @@ def explore_stereo_slam(**defaults):
             run_figure, table=lambda res: f"{res.table()}\n{res.timing_table()}",
         )  # fmt: skip
 
-    return widgets.interactive(
+    return interactive(
         show,
         {"manual": True, "manual_name": "run"},
         experiment=widgets.Dropdown(options=["turn in place", "closed loop"], value=d["experiment"], description="experiment"),
