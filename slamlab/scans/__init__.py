@@ -17,7 +17,7 @@ from .grid import (
     make_grid,
     world_to_cell,
 )
-from .logmap import leave_out_grid, log_counts, log_grid
+from .logmap import leave_out_grid, log_counts, log_grid, map_coverage
 from .occupancy import RULES, OccupancyGrid, free_space_samples, likelihood_field, occupancy_grid
 from .raycast import cast_rays
 from .scan import UNITS, Scan, scan_to_points
@@ -41,6 +41,7 @@ __all__ = [
     "log_counts",
     "log_grid",
     "make_grid",
+    "map_coverage",
     "occupancy_grid",
     "scan_to_points",
     "world_to_cell",

@@ -8,6 +8,9 @@ API summary
   the frame, the scans and poses in cells and the hit/pass counts of all scans (one grid).
 - :func:`leave_out_grid` ``(counts, scans_cells, poses_cells, leave_out) -> grid``: the cell codes of
   the counts minus those of some scans (counts add over scans: no recount of the rest).
+- :func:`map_coverage` ``(grid, scan_cells, pose_cells, radius_cells=1) -> float``: the share of a scan's end
+  points, placed at a given pose, within ``radius_cells`` of an obstacle cell of a grid (ours): how much of the
+  scan a leave-out map knows, from the logged pose and the map alone.
 
 A *log* is any object with ``poses`` (``(n, 3)`` metric poses), ``n_scans`` and
 ``scans(indices=None)`` returning metric :class:`~slamlab.scans.Scan` objects, as
@@ -20,11 +23,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import check_positive
-from .grid import GridFrame
+from .._validate import check_int
+from .grid import OBSTACLE, GridFrame, check_grid
 from .occupancy import OccupancyGrid, label_counts, occupancy_grid
 from .scan import Scan
 
-__all__ = ["leave_out_grid", "log_counts", "log_grid"]
+__all__ = ["leave_out_grid", "log_counts", "log_grid", "map_coverage"]
 
 
 def _check_log(log) -> None:
@@ -134,3 +138,60 @@ def log_grid(log, *, cell_m: float = 0.2, max_range_m: float = 10.0, leave_out=(
     """
     frame, scans_c, Pc, full = log_counts(log, cell_m=cell_m, max_range_m=max_range_m)
     return leave_out_grid(full, scans_c, Pc, leave_out), frame, scans_c, Pc
+
+
+def map_coverage(grid, scan_cells: Scan, pose_cells, radius_cells: int = 1) -> float:
+    """Share of a scan's end points within ``radius_cells`` of an obstacle cell of ``grid`` at ``pose_cells`` (ours).
+
+    How much of the scan the map knows, judged from a pose and the map alone (never from a localiser's answer):
+    each end point lies in the cell :func:`~slamlab.scans.occupancy_grid` votes its hit in, and counts as covered
+    when an obstacle cell lies within ``radius_cells`` of that cell in rows and columns (a square of
+    ``2·radius_cells + 1`` cells). With the logged pose and a map that leaves the scan out, a low share means the
+    scan sees walls that no other scan drew.
+
+    Parameters
+    ----------
+    grid : numpy.ndarray of int8, shape (H, W)
+        Cell codes (:data:`~slamlab.scans.FREE`, :data:`~slamlab.scans.OBSTACLE`, :data:`~slamlab.scans.UNEXPLORED`).
+    scan_cells : Scan
+        The scan in cell units (its returns are the end points).
+    pose_cells : array_like, shape (3,)
+        The scan's pose ``(x = col, y = row, heading_rad)`` [cells, rad].
+    radius_cells : int, default 1
+        Chebyshev radius of the neighbourhood searched for an obstacle cell [cells], at least 0.
+
+    Returns
+    -------
+    float
+        In [0, 1]; 0 for a scan without returns. End points outside the grid are not covered.
+
+    Examples
+    --------
+    >>> g = np.zeros((1, 5), dtype=np.int8); g[0, 3] = OBSTACLE
+    >>> s = Scan([0.0, 0.0], [2.0, 4.0], [True, True])
+    >>> map_coverage(g, s, [0, 0, 0.0]), map_coverage(g, s, [0, 0, 0.0], radius_cells=0)
+    (1.0, 0.0)
+    """
+    g = check_grid(grid)
+    if not isinstance(scan_cells, Scan):
+        raise TypeError(f"`scan_cells` must be a Scan in cell units; got {type(scan_cells).__name__}")
+    q = np.asarray(pose_cells, dtype=float)
+    if q.shape != (3,) or not np.all(np.isfinite(q)):
+        raise ValueError(f"`pose_cells` must be a finite (x, y, heading_rad) pose; got {pose_cells!r}")
+    r = check_int(radius_cells, "radius_cells", minimum=0)
+    n = int(scan_cells.valid.sum())
+    if n == 0:
+        return 0.0
+    th = q[2] + scan_cells.bearings_rad[scan_cells.valid]
+    rng = scan_cells.ranges[scan_cells.valid] + 0.01  # the hit cell, as occupancy_grid votes it
+    col = np.floor(q[0] + rng * np.cos(th) + 0.5).astype(np.int64)
+    row = np.floor(q[1] + rng * np.sin(th) + 0.5).astype(np.int64)
+    H, W = g.shape
+    d = np.arange(-r, r + 1)
+    rows = row[:, None, None] + d[None, :, None]  # (n, 2r+1, 1)
+    cols = col[:, None, None] + d[None, None, :]  # (n, 1, 2r+1)
+    rows, cols = np.broadcast_arrays(rows, cols)
+    inside = (rows >= 0) & (rows < H) & (cols >= 0) & (cols < W)
+    wall = np.zeros(rows.shape, dtype=bool)
+    wall[inside] = g[rows[inside], cols[inside]] == OBSTACLE
+    return float(wall.any(axis=(1, 2)).sum() / n)

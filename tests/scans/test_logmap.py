@@ -92,3 +92,37 @@ def test_bad_input_names_the_argument(room_log):
         SC.leave_out_grid(counts, scans_c, Pc, [3, 25])
     with pytest.raises(TypeError, match="`counts` must be an OccupancyGrid"):
         SC.leave_out_grid(counts.grid, scans_c, Pc, [3])
+
+
+def test_map_coverage_counts_end_points_near_walls():
+    # a wall along column 10 (rows 0..20); a scan at (0, 10) looking along +x with beams hitting the wall, one beam
+    # short of it by 2 cells, one beam that is a miss: coverage counts returns only, within the Chebyshev radius
+    g = np.zeros((21, 21), dtype=np.int8)
+    g[:, 10] = SC.OBSTACLE
+    s = SC.Scan([0.0, 0.0, 0.3, 0.0], [10.0, 8.0, 10.0 / np.cos(0.3), 5.0], [True, True, True, False])
+    pose = np.array([0.0, 10.0, 0.0])
+    # hits: (col 10, row 10) on the wall; (col 8) two cells short; (col 10, row 10 + 3.09) on the wall
+    assert SC.map_coverage(g, s, pose) == pytest.approx(2 / 3)
+    assert SC.map_coverage(g, s, pose, radius_cells=2) == 1.0
+    # shifted one cell back from the wall: the hits still covered at radius 1 (the short beam now 3 cells off),
+    # none at radius 0
+    assert SC.map_coverage(g, s, pose - [1.0, 0.0, 0.0], radius_cells=0) == 0.0
+    assert SC.map_coverage(g, s, pose - [1.0, 0.0, 0.0], radius_cells=1) == pytest.approx(2 / 3)
+    # end points outside the grid are not covered; a scan without returns covers nothing
+    assert SC.map_coverage(g, s, [0.0, 10.0, np.pi], radius_cells=1) == 0.0
+    assert SC.map_coverage(g, SC.Scan([0.0], [3.0], [False]), pose) == 0.0
+
+
+def test_map_coverage_bad_input():
+    g = np.zeros((5, 5), dtype=np.int8)
+    s = SC.Scan([0.0], [1.0], [True])
+    with pytest.raises(TypeError, match="`scan_cells` must be a Scan"):
+        SC.map_coverage(g, np.ones(3), [0, 0, 0])
+    with pytest.raises(ValueError, match="`pose_cells` must be a finite"):
+        SC.map_coverage(g, s, [0, 0])
+    with pytest.raises(ValueError, match="`pose_cells` must be a finite"):
+        SC.map_coverage(g, s, [0, np.nan, 0])
+    with pytest.raises(ValueError, match="`radius_cells`"):
+        SC.map_coverage(g, s, [0, 0, 0], radius_cells=-1)
+    with pytest.raises(ValueError, match="`grid` must hold only"):
+        SC.map_coverage(np.full((5, 5), 7), s, [0, 0, 0])
