@@ -261,11 +261,13 @@ def extract_planes(points, *, tolerance_m: float = 0.03, iterations: int = 100, 
             ab = Z @ np.linalg.eigh(Z.T @ Z)[1][:, 1:]              # in-plane principal coordinates
             width = np.diff(np.percentile(ab, [10, 90], axis=0), axis=0).min()
             if width < min_width_m:
+                rejected.append(remaining[mask])           # on no plane: back into the leftover at the end
                 remaining = remaining[~mask]
-                rejected.append(remaining.size)
                 continue
         planes.append((n, p, remaining[mask]))
         remaining = remaining[~mask]
     leftover = np.zeros(X.shape[0], dtype=bool)
     leftover[remaining] = True
+    for idx in rejected:
+        leftover[idx] = True
     return planes, leftover

@@ -1,4 +1,5 @@
-"""Ch. 10's studies, plane-based 3-D SLAM (002): the flight, Figs. 2 and 4, the ablations, tables, plots, widgets."""
+"""Ch. 10's studies, plane-based 3-D SLAM (002): the flight, Figs. 2, 3 and 4, the map's storage against the raw
+clouds, the ablations, tables, plots, widgets."""
 
 from ..._lazy import lazy_exports
 from .ablations import (
@@ -37,9 +38,11 @@ from .figures import (
     run_intensity_study,
     run_pairs_figure,
 )
+from .intensity_image import IntensityImage, scan_intensity_image
+from .storage import StorageResult, flight_storage, map_storage
 
-_PLOT = ("plot_flight_errors", "plot_intensity_figure", "plot_pairs_figure", "plot_plane_map", "plot_room",
-         "scanner_geometry_figure")
+_PLOT = ("plot_flight_errors", "plot_intensity_figure", "plot_intensity_image", "plot_pairs_figure", "plot_plane_map",
+         "plot_room", "scanner_geometry_figure")
 _WIDGETS = ("explore_flight", "explore_intensity_figure")
 # plots (pyplot) and widgets (ipywidgets) load on first use: `import slamlab.studies.planes` stays light
 __getattr__, __dir__ = lazy_exports(__name__, {**dict.fromkeys(_PLOT, ".plot"), **dict.fromkeys(_WIDGETS, ".widgets")})
@@ -53,15 +56,19 @@ __all__ = [
     "FlightComparison",
     "FlightResult",
     "IncidenceResult",
+    "IntensityImage",
     "IntensityResult",
     "IntensitySpread",
     "IntensityStudy",
     "PairsResult",
+    "StorageResult",
     "euler_errors",
     "flight_frames",
     "flight_head",
+    "flight_storage",
     "in_frame_rotation_error_deg",
     "map_normal_error_deg",
+    "map_storage",
     "ours_vs_source",
     "plot_room",
     "run_flight",
@@ -72,6 +79,7 @@ __all__ = [
     "run_intensity_study",
     "run_pairs_ablation",
     "run_pairs_figure",
+    "scan_intensity_image",
     "scanner_geometry_figure",
     "setup_table",
     "three_plane_room",

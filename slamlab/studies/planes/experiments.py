@@ -305,7 +305,7 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
         raise ValueError(f"the flight has {len(flight)} lines: fewer than two frames of `frame_lines` = {frame_lines}")
     frames = flight_frames(flight, frame_lines, frame_poses=frame_poses, increment_poses=increment_poses)
     slam = PlaneSLAM(flight.poses[frame_lines - 1], params=p, rng=np.random.default_rng(seeds[1]))
-    est, true, odo, times, stage, cpu, nplanes, npoints = [], [], [], [], [], [], [], []
+    est, true, odo, times, stage, cpu, nplanes, npoints, noff = [], [], [], [], [], [], [], [], []
     for k, fr, U, T in progress_bar(frames, total=n_frames, desc="flight", progress=progress):
         c0 = time.process_time()
         rep = slam.step(fr, U)
@@ -317,6 +317,7 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
         stage.append([rep.times_s[s] for s in STAGES])
         nplanes.append(rep.n_planes)
         npoints.append(rep.n_points)
+        noff.append(rep.n_points - sum(pl.n_points for pl in slam.last_planes))   # points on no plane
     est, true, odo, ts = np.array(est), np.array(true), np.array(odo), np.array(times)
     tr_true = Trajectory.from_poses(true, ts)
     tr_est = Trajectory.from_poses(est, ts)
@@ -328,7 +329,8 @@ def run_flight(duration_s: float | None = None, *, size: str = "small", frame_li
                         ate(tr_true, tr_odo).rmse if n_frames >= 3 else float("nan"),
                         rpe(tr_true, tr_est).rmse, rpe(tr_true, tr_est, relation="rotation_deg").rmse,
                         n_frames, slam.n_kept_prediction, float(np.mean(nplanes)), float(np.mean(npoints)), slam.map,
-                        p, np.array(stage), np.array(cpu))
+                        p, np.array(stage), np.array(cpu), frame_points=np.array(npoints, dtype=np.int64),
+                        frame_off_plane=np.array(noff, dtype=np.int64))
 
 
 def setup_table(flight: Flight, frame_lines: int = 40) -> str:

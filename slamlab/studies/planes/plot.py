@@ -1,5 +1,5 @@
-"""Plots of Ch. 10's study results (002): Fig. 2 (one, two, three plane pairs), Fig. 4 (intensity weights), Fig. 8
-(a flight's errors), Fig. 9 (a flight's plane map and paths)."""
+"""Plots of Ch. 10's study results (002): Fig. 2 (one, two, three plane pairs), Fig. 3 (the intensity image),
+Fig. 4 (intensity weights), Fig. 8 (a flight's errors), Fig. 9 (a flight's plane map and paths)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from ...planes.plot import axes_3d, thin_points
 from ...plotting import new_axes
 from ...sim.planes_room import PlaneScanner, scanner_beam_directions
 
-__all__ = ["plot_flight_errors", "plot_intensity_figure", "plot_pairs_figure", "plot_plane_map", "plot_room",
-           "scanner_geometry_figure"]
+__all__ = ["plot_flight_errors", "plot_intensity_figure", "plot_intensity_image", "plot_pairs_figure",
+           "plot_plane_map", "plot_room", "scanner_geometry_figure"]
 
 
 def plot_pairs_figure(result):
@@ -65,6 +65,40 @@ def plot_intensity_figure(result, *, ax=None):
     ax.axvline(np.mean(result.predicted[:, 0]), color="0.4", ls="--", label="odometry (prediction mean)")
     ax.legend(loc="upper left", fontsize=8)
     return ax
+
+
+def plot_intensity_image(result):
+    """002 Fig. 3: left, the intensities of the scan lines as an image (rows: lines, columns: beams); right, in
+    place of 002's photo, the room model's reflectance panels seen along the same beams (ours).
+
+    Pixels are drawn with the angles they span (a line's yaw step by a beam's step), so the room keeps its shape.
+
+    Parameters
+    ----------
+    result : IntensityImage
+        From :func:`~slamlab.studies.planes.scan_intensity_image`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 5.2), sharey=True)
+    b, ln = result.beams, result.lines
+    extent = (b[0] - 0.5, b[-1] + 0.5, ln[-1] + 0.5, ln[0] - 0.5)
+    aspect = result.deg_per_line / result.step_deg if np.isfinite(result.deg_per_line) else "auto"
+    im = a1.imshow(result.image, cmap="gray", extent=extent, aspect=aspect, interpolation="nearest")
+    fig.colorbar(im, ax=a1, shrink=0.8, label="intensity")
+    a1.set_title("002 Fig. 3 left: intensities of the scan lines\n(simulated scanner)")
+    a1.set_ylabel(f"scan line ({result.deg_per_line:.3g}° of yaw each)")
+    im = a2.imshow(result.render, cmap="gray", extent=extent, aspect=aspect, interpolation="nearest",
+                   vmin=0.0, vmax=1.0)
+    fig.colorbar(im, ax=a2, shrink=0.8, label="reflectance ρ")
+    a2.set_title("ours, in place of 002's photo: the room model's\npanels seen from one point along the same beams")
+    for ax in (a1, a2):
+        ax.grid(False)
+        ax.set_xlabel(f"beam index ({result.beam_deg[0]:.0f}°..{result.beam_deg[-1]:.0f}° from up; 90°: forward)")
+    fig.tight_layout()
+    return fig
 
 
 def plot_flight_errors(result):

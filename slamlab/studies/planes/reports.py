@@ -61,6 +61,10 @@ class FlightResult:
         Wall seconds per stage per frame.
     cpu_times_s : (F,) float
         CPU seconds per cycle.
+    frame_points : (F,) int
+        Points per frame.
+    frame_off_plane : (F,) int
+        Points of each frame on none of its planes (002: they must be kept too).
     """
 
     times_s: np.ndarray
@@ -83,6 +87,8 @@ class FlightResult:
     params: PlaneSLAMParams = field(repr=False)
     stage_times_s: np.ndarray = field(repr=False)
     cpu_times_s: np.ndarray = field(repr=False)
+    frame_points: np.ndarray = field(repr=False)
+    frame_off_plane: np.ndarray = field(repr=False)
 
     def __str__(self) -> str:
         return (f"Flight: {self.n_frames} frames, ATE {self.ate_m:.3f} m (odometry {self.ate_odo_m:.3f} m), "
@@ -191,11 +197,15 @@ def timing_table(times: dict, *, load: str | None = None) -> str:
     return tab + f"\ngoal {GOAL_S:.2f} s per cycle (half of 002's {SOURCE_TIMES_S['total']:.3f} s): wall time {verdict} it"
 
 
-def ours_vs_source(flight: FlightResult, pairs, fig4, *, one_pair=None, incidence=None) -> str:
+def ours_vs_source(flight: FlightResult, pairs, fig4, *, one_pair=None, incidence=None, fig3=None,
+                   storage=None) -> str:
     """"Ours vs the source" for Ch. 10: what 002 reports beside what we measured (timings: see timing_table);
     ``pairs`` a :class:`~slamlab.studies.planes.PairsResult`, ``fig4`` an
-    :class:`~slamlab.studies.planes.IntensityResult`; optional ``one_pair`` (:func:`~slamlab.studies.planes.run_pairs_ablation`'s result) and ``incidence``
-    (:func:`~slamlab.studies.planes.run_incidence_ablation`'s) add their rows.
+    :class:`~slamlab.studies.planes.IntensityResult`; optional ``one_pair``
+    (:func:`~slamlab.studies.planes.run_pairs_ablation`'s result), ``incidence``
+    (:func:`~slamlab.studies.planes.run_incidence_ablation`'s), ``fig3``
+    (:func:`~slamlab.studies.planes.scan_intensity_image`'s) and ``storage``
+    (:func:`~slamlab.studies.planes.flight_storage`'s) add their rows.
 
     Parameters
     ----------
@@ -209,6 +219,10 @@ def ours_vs_source(flight: FlightResult, pairs, fig4, *, one_pair=None, incidenc
         :func:`~slamlab.studies.planes.run_pairs_ablation`'s result.
     incidence : IncidenceResult, optional
         :func:`~slamlab.studies.planes.run_incidence_ablation`'s result.
+    fig3 : IntensityImage, optional
+        :func:`~slamlab.studies.planes.scan_intensity_image`'s result.
+    storage : StorageResult, optional
+        :func:`~slamlab.studies.planes.flight_storage`'s result.
 
     Returns
     -------
@@ -221,6 +235,11 @@ def ours_vs_source(flight: FlightResult, pairs, fig4, *, one_pair=None, incidenc
         ["particles", "400", str(flight.params.n_particles)],
         ["points per frame", "> 40000", f"{flight.mean_points:.0f} (mean)"],
         ["locus for 1 / 2 / 3 pairs", "plane / line / point", f"{dims[0]}-D / {dims[1]}-D / {dims[2]}-D"],
+    ]
+    if fig3 is not None:
+        rows.append(["Fig. 3: intensity image", "beside a photo of the room",
+                     f"beside the model (correlation {fig3.correlation():.2f})"])
+    rows += [
         ["Fig. 4: planes in the frame", "3, two of them parallel",
          f"{fig4.n_planes}, {fig4.normal_rank} normal directions"],
         ["Fig. 4: the weights' maximum", "well expressed", f"{fig4.peak:.2f} x the uniform weight"],
@@ -245,5 +264,12 @@ def ours_vs_source(flight: FlightResult, pairs, fig4, *, one_pair=None, incidenc
                      f"flight ATE {on.ate_m:.3f} / {off.ate_m:.3f} m (on / off) [b]"])
         notes.append(f"[b] Fig. 4 error {incidence.fig4[0].error_with_m:.3f} m with the correction, "
                      f"{incidence.fig4[1].error_with_m:.3f} m without")
+    if storage is not None:
+        rows.append(["map against the raw clouds", "'substantially' smaller, no figure",
+                     f"{storage.ratio():.1f} x smaller [c]"])
+        notes.append(f"[c] {storage.n_frames} frames: raw {storage.raw_bytes() / 1e6:.3f} MB against planes "
+                     f"{storage.plane_bytes() / 1e6:.3f} MB + points on no plane "
+                     f"{storage.off_plane_bytes() / 1e6:.3f} MB\n    ({storage.bytes_per_value}-byte values); "
+                     f"with our voxel store instead of those points: {storage.ratio(voxels=True):.1f} x")
     tab = format_table(["quantity", "002", "ours"], rows, title="Ch. 10: ours vs the source (002)")
     return "\n".join([tab, *notes])
