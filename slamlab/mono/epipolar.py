@@ -22,7 +22,8 @@ from ..geometry.triangulation import triangulate_midpoint
 from .align import bilinear
 from .depth_filter import depth_interval
 
-__all__ = ["EpipolarMatch", "affine_warp", "epipolar_segments", "extract_patches", "search_epipolar", "warped_patches", "zncc"]
+__all__ = ["EpipolarCandidates", "EpipolarMatch", "affine_warp", "epipolar_candidates", "epipolar_segments",
+           "extract_patches", "search_epipolar", "warped_patches", "zncc"]
 
 _FAR_DEPTH = 1e6  # depths beyond this are drawn at their vanishing point
 
@@ -128,6 +129,126 @@ def epipolar_segments(K, T_cur_ref, f, mu, sigma, n_sigma: float = 2.0):
     Xa = np.where(ok[:, None], Xa, [0.0, 0.0, 1.0])
     Xb = np.where(ok[:, None], Xb, [0.0, 0.0, 1.0])
     return project_points(K, Xa), project_points(K, Xb), ok
+
+
+def _segment_frames(A, B):
+    """Per segment ``A → B`` (S, 2): the unit normal and direction in float32 with their offsets, and the length.
+
+    Returns ``(n_u, n_v, off_n, e_u, e_v, off_e, L)``: a pixel ``(u, v)`` lies ``|u n_u + v n_v − off_n|`` from
+    the line and ``u e_u + v e_v − off_e`` along it from ``A``.
+    """
+    A = np.asarray(A, dtype=np.float64)
+    d = np.asarray(B, dtype=np.float64) - A
+    L = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
+    e = d / L[:, None]  # unit direction; normal (-e_v, e_u)
+    nrm = np.column_stack([-e[:, 1], e[:, 0]])
+    n32, e32 = nrm.astype(np.float32), e.astype(np.float32)
+    return (n32[:, 0], n32[:, 1], np.sum(A * nrm, axis=1).astype(np.float32),
+            e32[:, 0], e32[:, 1], np.sum(A * e, axis=1).astype(np.float32), L)
+
+
+def _in_band(cu, cv, n_u, n_v, off_n, e_u, e_v, off_e, L, tol_px):
+    """True where the pixel ``(cu, cv)`` (float32) is within ``tol_px`` of the segment (:func:`_segment_frames`).
+
+    Element-wise float32 products that broadcast (a (C, 1) column against (S,) rows, or pairs of equal
+    length): each pair gives the same bits whichever form is used, and no BLAS product decides, by its
+    machine-dependent rounding, which corner is within ``tol_px``.
+    """
+    dist = np.abs(cu * n_u + cv * n_v - off_n)
+    along = cu * e_u + cv * e_v - off_e
+    return (dist <= tol_px) & (along >= -tol_px) & (along <= L + tol_px)
+
+
+@dataclass(frozen=True)
+class EpipolarCandidates:
+    """The FAST corners each seed's search looks at (:func:`epipolar_candidates`, 003 §4.2).
+
+    Attributes
+    ----------
+    seed_idx, corner_idx : ndarray of int, shape (P,)
+        The candidate pairs: seed index and index into ``corners_uv`` of each corner within ``tol_px`` of that
+        seed's segment, by seed then by corner row.
+    n_rows : ndarray of int, shape (N,)
+        Corners in the rows the segment spans (found by binary search in the row-sorted corners).
+    n_box : ndarray of int, shape (N,)
+        Those also in the columns the segment spans: 003's subset, the corners whose position is checked.
+    n_band : ndarray of int, shape (N,)
+        Those within ``tol_px`` of the segment: the candidates that are scored.
+    """
+
+    seed_idx: np.ndarray
+    corner_idx: np.ndarray
+    n_rows: np.ndarray
+    n_box: np.ndarray
+    n_band: np.ndarray
+
+
+def epipolar_candidates(corners_uv, a, b, ok=None, *, tol_px: float = 2.0) -> EpipolarCandidates:
+    """FAST corners within ``tol_px`` of each epipolar segment, found from the corners' row order (003 §4.2).
+
+    003 §4.2: the search looks only at the FAST corners, and "since the points obtained by FAST are sorted
+    by rows and columns, not every detected point needs checking, a subset is enough": only those that
+    share rows and columns with the epipolar line (its Fig. 6.6b, orange). Here the corners are sorted by
+    row once; each segment's rows (``± tol_px·√2``, ours: so that the subset holds the whole band) are found by
+    binary search, then its columns filter them (the subset, ``n_box``), and only those are tested against
+    the band (``n_band``). The band test is :func:`search_epipolar`'s, so the pairs are exactly the
+    candidates it scores. Vectorised over seeds (no Python loop).
+
+    Parameters
+    ----------
+    corners_uv : array_like, shape (C, 2)
+        Corners of the current image [px].
+    a, b : array_like, shape (N, 2)
+        End points of the seeds' segments [px] (:func:`epipolar_segments`).
+    ok : array_like of bool, shape (N,), optional
+        Segments to search (default all); a segment not ok has no candidates.
+    tol_px : float
+        Largest distance of a candidate from its segment [px] (default 2).
+
+    Returns
+    -------
+    EpipolarCandidates
+        The candidate pairs and, per seed, the corners in its rows, in its rows and columns, and in its band.
+
+    Examples
+    --------
+    >>> c = epipolar_candidates([[10, 10], [20, 11], [20, 40], [90, 10]], [[0, 10]], [[50, 10]])
+    >>> c.n_rows.tolist(), c.n_box.tolist(), c.n_band.tolist(), c.corner_idx.tolist()
+    ([3], [2], [2], [0, 1])
+    """
+    from .._validate import as_finite_array, check_positive
+
+    corners = as_finite_array(corners_uv, "corners_uv", ndim=2)
+    if corners.shape[1] != 2:
+        raise ValueError(f"`corners_uv` must have shape (C, 2); got {corners.shape}")
+    a = as_finite_array(a, "a", ndim=2)
+    b = as_finite_array(b, "b", ndim=2)
+    if a.shape[1] != 2 or a.shape != b.shape:
+        raise ValueError(f"`a` and `b` must have one shape (N, 2); got {a.shape} and {b.shape}")
+    n = a.shape[0]
+    ok = np.ones(n, bool) if ok is None else np.asarray(ok, dtype=bool).reshape(-1)
+    if ok.shape != (n,):
+        raise ValueError(f"`ok` must have shape ({n},), one flag per segment; got {ok.shape}")
+    tol_px = check_positive(tol_px, "tol_px")
+    pad = tol_px * np.sqrt(2.0)  # a band corner lies at most tol·√2 beyond the segment's end, in u and in v
+    order = np.argsort(corners[:, 1], kind="stable")
+    v_sorted = corners[order, 1]
+    lo = np.searchsorted(v_sorted, np.minimum(a[:, 1], b[:, 1]) - pad, side="left")
+    hi = np.searchsorted(v_sorted, np.maximum(a[:, 1], b[:, 1]) + pad, side="right")
+    n_rows = np.where(ok, hi - lo, 0)
+    # the row ranges, concatenated: pair k of seed s is sorted corner lo[s] + (k - start of s's block)
+    seed = np.repeat(np.arange(n), n_rows)
+    start = np.cumsum(n_rows) - n_rows
+    corner = order[np.arange(seed.size) - start[seed] + lo[seed]]
+    u = corners[corner, 0]
+    in_cols = (u >= np.minimum(a[seed, 0], b[seed, 0]) - pad) & (u <= np.maximum(a[seed, 0], b[seed, 0]) + pad)
+    seed, corner = seed[in_cols], corner[in_cols]
+    n_box = np.bincount(seed, minlength=n)
+    nu, nv, offn, eu, ev, offe, L = _segment_frames(a, b)
+    cu, cv = (corners[corner, k].astype(np.float32) for k in (0, 1))
+    band = _in_band(cu, cv, nu[seed], nv[seed], offn[seed], eu[seed], ev[seed], offe[seed], L[seed], tol_px)
+    seed, corner = seed[band], corner[band]
+    return EpipolarCandidates(seed, corner, n_rows, n_box, np.bincount(seed, minlength=n))
 
 
 @dataclass(frozen=True)
@@ -315,21 +436,12 @@ def search_epipolar(K, T_cur_ref, f, mu, sigma, ref_patches, img_cur, corners_uv
     ref_n = _normalise(ref_patches)
     for s0 in range(0, n, chunk):
         sl = slice(s0, min(n, s0 + chunk))
-        A, B = a[sl], b[sl]
-        d = B - A
-        L = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
-        e = d / L[:, None]  # unit direction; normal (-e_v, e_u)
-        nrm = np.column_stack([-e[:, 1], e[:, 0]])
-        # distance to the line and position along the segment for every (corner, seed): element-wise
-        # (C, S) products, not a BLAS matrix product, whose rounding (and so which corner is within
-        # tol_px) would depend on the machine
+        seg = _segment_frames(a[sl], b[sl])
+        # every (corner, seed) pair as a (C, S) array: element-wise, not a BLAS matrix product (_in_band)
         cu, cv = (corners[:, k:k + 1].astype(np.float32) for k in (0, 1))
-        n32, e32 = nrm.astype(np.float32), e.astype(np.float32)
-        dist = np.abs(cu * n32[:, 0] + cv * n32[:, 1] - np.sum(A * nrm, axis=1).astype(np.float32))  # (C, S)
-        along = cu * e32[:, 0] + cv * e32[:, 1] - np.sum(A * e, axis=1).astype(np.float32)
-        near = (dist <= tol_px) & (along >= -tol_px) & (along <= L + tol_px) & ok[sl]
+        near = _in_band(cu, cv, *seg, tol_px) & ok[sl]
         ci, si = np.nonzero(near)
-        ncand[sl] = np.bincount(si, minlength=L.size)
+        ncand[sl] = np.bincount(si, minlength=seg[-1].size)
         if ci.size == 0:
             continue
         sc = np.einsum("ij,ij->i", ref_n[s0 + si], cur_n[ci])  # ZNCC of each candidate pair

@@ -7,6 +7,7 @@ from .convergence import (
     run_convergence_tests,
     run_depth_filter_convergence,
 )
+from .epipolar_subset import EpipolarSubset, run_epipolar_subset
 from .experiments import (
     failure_table,
     run_failure_cases,
@@ -14,8 +15,10 @@ from .experiments import (
     run_parameter_sweep,
     sequence_poses,
 )
+from .findings import StillStart, practice_findings_table, run_still_start
 from .formulas import chapter_cameras, inverse_depth_point_table, pinhole_table, tau_table
 from .kitti import epipolar_demo, load_kitti, run_kitti_ablation, run_kitti_mono
+from .repeats import RepeatedRuns, run_repeats
 from .runs import MonoRunResult, run_mono
 from .studies import (
     MonoVsStereo,
@@ -26,12 +29,16 @@ from .studies import (
     run_mono_vs_stereo,
     source_findings_table,
 )
+from .timing import source_timing_table, stage_timing_table
 
 __all__ = [
     "ConvergenceStudy",
     "ConvergenceTests",
+    "EpipolarSubset",
     "MonoRunResult",
     "MonoVsStereo",
+    "RepeatedRuns",
+    "StillStart",
     "ablation_table",
     "chapter_cameras",
     "compare_init_methods",
@@ -48,9 +55,11 @@ __all__ = [
     "plot_convergence",
     "plot_map_top",
     "plot_pinhole",
+    "practice_findings_table",
     "run_ablation",
     "run_convergence_tests",
     "run_depth_filter_convergence",
+    "run_epipolar_subset",
     "run_failure_cases",
     "run_kitti_ablation",
     "run_kitti_mono",
@@ -58,8 +67,12 @@ __all__ = [
     "run_mono_sequence",
     "run_mono_vs_stereo",
     "run_parameter_sweep",
+    "run_repeats",
+    "run_still_start",
     "sequence_poses",
     "source_findings_table",
+    "source_timing_table",
+    "stage_timing_table",
     "tau_table",
 ]
 
