@@ -8,11 +8,12 @@ definition on a small case; every pair must give the identical peak.
     python benchmarks/bench_correlation.py            # timings
     python benchmarks/bench_correlation.py --monte-carlo   # + the 200-pose Monte Carlo of the notebook
     python benchmarks/bench_correlation.py --intel         # + every 25th Intel scan: 1 scan vs 2, 3 joined
-    python benchmarks/bench_correlation.py --logs          # + every 25th scan of each shared CARMEN log, per-log table
+    python benchmarks/bench_correlation.py --logs --set 'joined=(1, 3)'   # + the goal protocol: every 10th scan of
+                                                   # each shared CARMEN log, coverage, the goal, the logged poses
     python benchmarks/bench_correlation.py --logs --every 100 --only intel,seattle   # smaller / fewer logs
     python benchmarks/bench_correlation.py --logs --map-check   # + is each log's beam layout read right? (issue 25)
     python benchmarks/bench_correlation.py --logs --failures    # + each failure: score failure or search failure?
-    python benchmarks/bench_correlation.py --logs --set 'joined=(1, 3)' --leave-out used   # each mode's own scans left out
+    python benchmarks/bench_correlation.py --logs --set 'joined=(1, 3)' --leave-out used   # each mode's own scans out
     python benchmarks/bench_correlation.py --logs --failures --terms   # + the score's terms at estimate and truth
     python benchmarks/bench_correlation.py --refine-cost        # + CPU time of refine=10 (issue 25)
 """
@@ -114,7 +115,7 @@ def main():
                     help="also localise every 25th scan of the Intel log, one scan vs 2 and 3 joined by odometry")
     ap.add_argument("--logs", action="store_true",
                     help="also localise every --every-th scan of each shared CARMEN log (run_log_suite's defaults)")
-    ap.add_argument("--every", type=int, default=25, help="scan step of the --logs run (default 25)")
+    ap.add_argument("--every", type=int, default=10, help="scan step of the --logs run (default 10, the goal's)")
     ap.add_argument("--exclude", type=int, default=None,
                     help="scans left out on either side of each --logs scan (default: run_log_localisation's, 2)")
     ap.add_argument("--max-range", type=float, default=None, help="range limit [m] of the --logs run (default 10)")
@@ -264,7 +265,8 @@ def compare_logs(every: int, only: str | None, n_jobs: int, settings: dict, extr
 
 def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: bool = False,
          failures: bool = False, terms: bool = False) -> None:
-    """Issue 25: every ``every``-th scan of each shared CARMEN log, modes 1/2/3, with the real-log defaults."""
+    """Every ``every``-th scan of each shared CARMEN log with the real-log defaults: the per-log table, the scans
+    not covered, the goal (with modes 1 and 3), the logged poses' check, then the failure flags."""
     from slamlab.studies.correlation.log_suite import SHARED_CARMEN_LOGS
 
     paths = [p for p in SHARED_CARMEN_LOGS if only is None or p.split("/")[1].split("-")[0] in only.split(",")]
@@ -281,6 +283,10 @@ def logs(every: int, only: str | None, n_jobs: int, settings: dict, map_check: b
                                      **settings, **({"truth_check": True} if failures else {}))
     print(f"took {time.perf_counter() - t0:.1f} s wall ({n_jobs} job(s)); load average now {os.getloadavg()[0]:.1f}")
     print(r.table())
+    print(r.coverage_table())
+    if 1 in r.results[0].joined and 3 in r.results[0].joined:
+        print(r.goal_table())
+    print(r.truth_table())
     if failures:
         print(r.failure_table())
         for res in r.results:

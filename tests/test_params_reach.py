@@ -192,6 +192,10 @@ CALLS: dict[str, tuple[typing.Callable, bool]] = {
     "correlation.experiments.run_constants_study": (
         lambda S, p: S.correlation.run_constants_study(2, n_beams=90, choices=((0.0, 1.0, 0.0),), params=p), False),
     "correlation.experiments.run_corridor_tie": (lambda S, p: S.correlation.run_corridor_tie(params=p), False),
+    "correlation.aperture.run_aperture_study": (
+        lambda S, p: S.correlation.run_aperture_study((0.0, 10.0), 1, n_beams=90, params=p), False),
+    "correlation.stamp_trim.run_stamp_trim_study": (
+        lambda S, p: S.correlation.run_stamp_trim_study((1.0, 0.5), 1, n_beams=90, params=p), False),
     "correlation.log_experiments.run_log_localisation": (
         lambda S, p: S.correlation.run_log_localisation(scan_indices=(50,), params=p), True),
     "correlation.log_suite.run_log_suite": (
@@ -255,6 +259,10 @@ CALLS: dict[str, tuple[typing.Callable, bool]] = {
         lambda S, p: S.mono.run_ablation({"as given": {}}, cases=("normal",), n_frames=6, params=p), False),
     "mono.studies.run_mono_vs_stereo": (
         lambda S, p: S.mono.run_mono_vs_stereo(n_frames=6, size="tiny", params=p), False),
+    "mono.epipolar_subset.run_epipolar_subset": (
+        lambda S, p: S.mono.run_epipolar_subset((0, 2), params=p), False),
+    "mono.findings.run_still_start": (lambda S, p: S.mono.run_still_start(2, n_frames=6, params=p), False),
+    "mono.repeats.run_repeats": (lambda S, p: S.mono.run_repeats(("normal",), n_runs=2, n_frames=6, params=p), False),
     # planes (notebook 10)
     "planes.ablations.run_pairs_ablation": (
         lambda S, p: S.planes.run_pairs_ablation(duration_s=3.0, variants=(("all", 10, 2),), params=p), False),

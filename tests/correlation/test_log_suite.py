@@ -33,7 +33,8 @@ def test_log_suite_tables_and_bad_threshold(real_data):
     assert r.rates().shape == (1, 1)
     assert r.results[0].scan_indices.tolist() == [500]
     assert "Every 500th scan of each log" in r.table()
-    assert "intel      1     1/1" in r.table()
+    assert r.table().splitlines()[4].split()[:4] == ["intel", "1", "0", "1/1"]  # 1 scan, covered, localised
+    assert "not covered: fewer than 50%" in r.table()
     assert "failures flagged (>= 0.8)" in r.ambiguity_table(0.8)
     assert r.ambiguity_table().splitlines()[-1].split()[:2] == ["all", "1"]
     assert "intel 1/1" in str(r)
@@ -48,55 +49,33 @@ def test_log_suite_tables_and_bad_threshold(real_data):
 
 
 @pytest.mark.realdata
-def test_intel_meets_the_issue_25_goals_at_every_25th_scan(real_data):
-    """Issue 25's goal on the Intel log at the goal's size (every 25th scan, 36 scans) with the real-log defaults.
+def test_coverage_and_the_goal_counted_by_hand(real_data):
+    # a real 3-scan run of one log, then coverage and errors set by hand so the counts are known
+    import dataclasses
 
-    csail and fhw meet the goal too (docs/benchmarks.md) but cost 60-85 s each; orebro and seattle do not yet.
-    """
-    log = read_carmen(real_data / "carmen-radish-corrected" / "intel-corrected.log.gz")
-    r = CS.run_log_suite([log], 25, joined=(1, 3))
-    ok = r.results[0].success
-    assert ok.shape == (2, 36)
-    # the goal: >= 75 % from a single scan, >= 90 % with 3 joined scans
-    assert ok[0].mean() >= 0.75
-    assert ok[1].mean() >= 0.90
-
-
-def _goal_rates(real_data, name: str, every: int):
-    """Single-scan and 3-scan success rates of every ``every``-th scan of a shared log with the real-log defaults.
-
-    ``ambiguity=False``: the rival search only scores the estimate's rivals, it never moves the estimate (the
-    peak search runs before it), so the success counts are the defaults' at about 3/4 of the time.
-    """
-    log = read_carmen(real_data / "carmen-radish-corrected" / f"{name}-corrected.log.gz")
-    ok = CS.run_log_suite([log], every, joined=(1, 3), ambiguity=False).results[0].success
-    return ok.mean(axis=1)
-
-
-#: (log, every n-th scan): csail at the goal's set; fhw on a cheaper subset, every 50th scan (9 scans, half of the
-#: goal's every 25th; the whole set costs about 30 s); orebro and seattle miss the goal, strict xfails that fail
-#: loudly the day it is met
-_GOAL_LOGS = [
-    pytest.param("csail", 25, id="csail-every-25th"),
-    pytest.param("fhw", 50, id="fhw-every-50th"),
-    pytest.param("orebro", 25, id="orebro-every-25th", marks=pytest.mark.xfail(
-        strict=True, reason="issue 25: orebro misses the goal (4/9 single, 7/9 with 3 scans; orebro 50 and 200 are "
-                            "score failures: the map they see was drawn only by scans the ±2 leave-out removes, "
-                            "docs/benchmarks.md): passes the day it is met")),
-    pytest.param("seattle", 25, id="seattle-every-25th", marks=pytest.mark.xfail(
-        strict=True, reason="issue 25: seattle misses the 3-scan goal (7/9 with 3 scans; seattle 75 is a score "
-                            "failure in every term, with either leave-out, docs/benchmarks.md): passes the day it is met")),
-]
-
-
-@pytest.mark.realdata
-@pytest.mark.parametrize(("name", "every"), _GOAL_LOGS)
-def test_log_meets_the_issue_25_goals(real_data, name, every):
-    """Issue 25's goal on each shared log but intel (above). Bounds from the goal: >= 75 % single, >= 90 % with 3
-    joined scans."""
-    single, three = _goal_rates(real_data, name, every)
-    assert single >= 0.75
-    assert three >= 0.90
+    log = read_carmen(real_data / "carmen-radish-corrected" / "seattle-corrected.log.gz")
+    r = CS.run_log_localisation(log, (60, 120, 180), joined=(1, 3), delta_alpha_rad=np.radians(10.0), progress=False)
+    assert r.coverage.shape == (3,) and np.all((r.coverage >= 0) & (r.coverage <= 1))
+    assert r.pose_check["scan"].tolist() == [60, 120, 180]
+    # scan 60 not covered (0.4 < 0.5); mode 1 right on 120 only, mode 3 right on 60, 120, 180
+    err = np.array([[0.1, 0.1, 5.0], [0.1, 0.1, 0.1]])
+    r = dataclasses.replace(r, coverage=np.array([0.4, 0.9, 0.5]), err_pos_m=err, err_heading_rad=np.zeros((2, 3)))
+    assert r.covered.tolist() == [False, True, True]
+    s = CS.LogSuiteResult((r,), 60)
+    np.testing.assert_allclose(s.rates(), [[0.5, 1.0]])     # over scans 120 and 180 only
+    row = s.table().splitlines()[4].split()
+    assert row[:6] == ["seattle", "3", "1", "1/2", "50.0%", "0.100"]
+    g = s.meets_goal()
+    assert g["pooled"] == (0.5, 1.0) and g["lowest"] == (0.5, 1.0) and not g["met"]
+    assert CS.LogSuiteResult((r,), 60).meets_goal(single=0.5, joined=0.9, per_log=0.5)["met"]
+    goal = s.goal_table().splitlines()
+    assert goal[3].split()[-3:] == ["no", "2/3", "(66.7%)"]   # mode 1 over all 3 scans: 60 and 120 right
+    cov = s.coverage_table().splitlines()
+    assert cov[-1].split() == ["seattle", "60", "0.40", "yes", "yes"]
+    with pytest.raises(ValueError, match=r"`single` must lie in \[0, 1\]"):
+        s.meets_goal(single=1.5)
+    with pytest.raises(ValueError, match=r"`min_coverage` must lie in \[0, 1\]"):
+        CS.run_log_localisation(log, (60,), min_coverage=2.0)
 
 
 @pytest.mark.realdata

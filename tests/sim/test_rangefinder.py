@@ -112,3 +112,26 @@ def test_bad_input():
         R.simulate_scans(g, [[1, 1, 0]], rangefinder=3)
     with pytest.raises(TypeError, match="`rng` must be a numpy Generator"):
         R.Rangefinder().scan(g, [1, 1, 0], rng="seed")
+
+
+def test_aperture_returns_the_nearest_echo_in_the_cone():
+    # a wall at column 20 straight ahead (17.5 cells from x = 2: the ray enters the cell's face at 19.5) and a post
+    # at (row 7, col 12) off the axis: seen from (2, 10) its nearest face is 9.5 cells ahead and about 2.5 to 3.5
+    # cells to the side, 14.7°-19.6° off the beam: a 20° cone misses it (its centre ray is the nearest echo of the
+    # wall), a 45° cone returns it
+    g = np.zeros((21, 21), dtype=np.int8)
+    g[:, 20] = 1
+    g[7, 12] = 1
+    kw = {"n_beams": 1, "fov_rad": 0.1, "max_range_cells": 30, "quantum_cells": 0.0}
+    assert R.Rangefinder(**kw).scan(g, [2.0, 10.0, 0.0]).ranges[0] == pytest.approx(17.5)
+    assert R.Rangefinder(**kw, aperture_rad=np.radians(20), aperture_rays=21).scan(g, [2.0, 10.0, 0.0]).ranges[0] \
+        == pytest.approx(17.5)
+    wide = R.Rangefinder(**kw, aperture_rad=np.radians(45), aperture_rays=46).scan(g, [2.0, 10.0, 0.0])
+    # the nearest ray to hit the post travels at least 9.5 cells (its face x = 11.5) and at most ~10.1
+    assert 9.5 <= wide.ranges[0] <= np.hypot(9.5, 3.5) and wide.valid[0]
+    with pytest.raises(ValueError, match="`aperture_rad` must be below π"):
+        R.Rangefinder(aperture_rad=4.0)
+    with pytest.raises(ValueError, match="`aperture_rad`"):
+        R.Rangefinder(aperture_rad=-0.1)
+    with pytest.raises(ValueError, match="`aperture_rays`"):
+        R.Rangefinder(aperture_rays=1)

@@ -18,10 +18,10 @@ from ...correlation.samples import ScanSamples, joined_samples
 from ...correlation.scoring import pose_marks, pose_scores
 from ...geometry.se2 import se2_compose, se2_inverse, se2_relative
 from ...scans import grid_to_values
-from ...scans.logmap import leave_out_grid
+from ...scans.logmap import leave_out_grid, map_coverage
 from ...scans.occupancy import label_counts, occupancy_grid
 from .map_check import endpoints_on_walls
-from .studies import FAIL_CELLS, FAIL_DEG, within_tolerance
+from .studies import COVERAGE_RADIUS_CELLS, FAIL_CELLS, FAIL_DEG, within_tolerance
 from .terms import COUNT_NAMES, TERM_NAMES, mark_terms
 
 #: ``leave_out`` of :func:`~slamlab.studies.correlation.run_log_localisation`: which scans a test scan's grid lacks.
@@ -122,7 +122,8 @@ def localise_log_scan(*, index: int, leave, scans, rel, full, scans_c, Pc, p, he
                       refine_heading_rad: float = float(np.radians(3.0)), score_norm: str = "none",
                       min_explored_fraction: float = 0.8) -> dict:
     """One sweep task: the leave-out grids of scan ``index`` (``leave``: per mode the scans left out,
-    :func:`leave_sets`) and its localisation in every mode (deterministic); with ``truth_check`` also
+    :func:`leave_sets`), the scan's coverage by the largest mode's grid at the logged pose (``coverage``,
+    :func:`~slamlab.scans.map_coverage`) and its localisation in every mode (deterministic); with ``truth_check`` also
     :func:`truth_check_row`'s columns per mode; with a ``"votes"`` leave-out set also each mode's votes
     (:func:`count_votes`)."""
     grids = mode_grids(leave, full, scans_c, Pc, hit_ratio)
@@ -140,7 +141,8 @@ def localise_log_scan(*, index: int, leave, scans, rel, full, scans_c, Pc, p, he
                                score_norm=score_norm, min_explored_fraction=min_explored_fraction)
         return loc, samples
 
-    row, poses = {}, {}
+    row = {"coverage": map_coverage(grids[max(joined)], scans_c[index], Pc[index], COVERAGE_RADIUS_CELLS)}
+    poses = {}
     for k in joined:
         grid = grids[k]
         loc, samples = search(grid, scans[:k], rel[:k])

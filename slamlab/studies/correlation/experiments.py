@@ -81,14 +81,33 @@ def _localise_one(*, scan, choice: int, grid, settings, margins: bool = False, p
     return row
 
 
-def _localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 1, progress: bool | None = None):
-    """Localise every scan with every setting on :func:`slamlab.sweep.sweep`: one task per (setting, scan).
+def localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 1, progress: bool | None = None):
+    """Localise every scan with every setting on :func:`slamlab.sweep.sweep`: one task per (setting, scan) (ours).
 
     The scans were drawn by the caller (the random part stays in the parent, in its order); a
     localisation draws nothing (``rng_arg=None``), so the table is the same for any ``n_jobs``.
-    The rival search is switched off (``ambiguity=False``): these runs report no ambiguity. Returns the table
-    (columns ``choice``, ``pose_index``, ``x``, ``y``, ``heading_rad`` and with ``margins`` ``half_max_area``,
-    ``heading_margin``), setting-major.
+    The rival search is switched off (``ambiguity=False``): these runs report no ambiguity.
+
+    Parameters
+    ----------
+    M : numpy.ndarray of int, shape (H, W)
+        The stored map (cell codes).
+    scans : sequence of Scan
+        The scans, in cell units.
+    settings : sequence of LocaliseParams
+        The settings each scan is localised with.
+    margins : bool, default False
+        Also the half-maximum area and the heading margin of each localisation.
+    n_jobs : int, default 1
+        Sweep workers (same table for any).
+    progress : bool, optional
+        Progress bar (default: in a notebook only).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``choice``, ``pose_index``, ``x``, ``y``, ``heading_rad`` and with ``margins`` ``half_max_area``,
+        ``heading_margin``; setting-major.
     """
     from ...sweep import sweep
 
@@ -199,7 +218,7 @@ def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int 
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
-    est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
+    est = _estimates(localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
     ea, ex, ey = absolute_errors(poses, est)
     return Table1Result(poses, est, ea, ex, ey, float(range_std_cells), int(n_beams), p, time.perf_counter() - t0)
 
@@ -256,7 +275,7 @@ def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, 
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
-    est = _estimates(_localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
+    est = _estimates(localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
     ea, ex, ey = absolute_errors(poses, est)
     ep = np.hypot(ex, ey)
     failed = ~within_tolerance(ep, ea)
@@ -332,7 +351,7 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     scans = [rf.scan(W, p, rng) for p in poses]
     k = len(consts)
     t0 = time.perf_counter()
-    table = _localise_scans(M, scans, settings, margins=True, n_jobs=n_jobs, progress=progress)
+    table = localise_scans(M, scans, settings, margins=True, n_jobs=n_jobs, progress=progress)
     est = _estimates(table).reshape(k, n, 3)
     pm = table["half_max_area"].to_numpy(dtype=float).reshape(k, n)
     hm = table["heading_margin"].to_numpy(dtype=float).reshape(k, n)

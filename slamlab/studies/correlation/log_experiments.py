@@ -20,6 +20,8 @@ from ...scans.logmap import log_counts
 from ._log_scan import TRUTH_COLUMNS, VOTE_SCANS, check_leave, check_unit, localise_log_scan, log_points
 from .carmen_logs import as_carmen_log
 from .log_results import LogLocalisationResult
+from .map_check import logged_pose_check
+from .studies import MIN_COVERAGE
 
 __all__ = [
     "ODOM_STD",
@@ -39,7 +41,8 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
                          n_jobs: int = 1, progress: bool | None = None, truth_check: bool = False,
                          refine: int = 0, refine_heading_rad: float = float(np.radians(3.0)),
                          score_norm: str = "none", min_explored_fraction: float = 0.8, leave_out: str = "window",
-                         votes: bool = False, **overrides) -> LogLocalisationResult:
+                         votes: bool = False, min_coverage: float = MIN_COVERAGE,
+                         **overrides) -> LogLocalisationResult:
     """Localise scans of a CARMEN log on grids built from the log's own poses (real data; 004 §7 + ours).
 
     Each test scan is localised on the grid (``cell_m`` cells, 004's three values) of every
@@ -53,7 +56,9 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     The corrected logs carry no raw odometry, so each step between consecutive scans is the
     logged relative pose plus Gaussian noise ``odom_std = (σ_xy [m], σ_θ [rad])``, drawn from ``rng`` once per
     step of the log, so a scan's joined odometry does not depend on which other scans are localised.
-    Every result carries the ambiguity of :class:`~slamlab.correlation.Localisation`.
+    Every result carries the ambiguity of :class:`~slamlab.correlation.Localisation`, each scan's coverage by its
+    leave-out grid (``min_coverage``) and whether its logged pose agrees with its neighbours' scans
+    (:func:`~slamlab.studies.correlation.logged_pose_check`, ``result.pose_check``).
 
     Parameters
     ----------
@@ -118,6 +123,12 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
         fewer than 2 is :meth:`~slamlab.studies.correlation.LogLocalisationResult.flagged`). The modes' answers are
         unchanged; about twice the single-scan work.
 
+    min_coverage : float, default MIN_COVERAGE (0.5)
+        A scan is *covered* when at least this share of its end points lies within one cell of an obstacle cell of
+        its leave-out grid at the logged pose (ours; the reasons at
+        :data:`~slamlab.studies.correlation.studies.MIN_COVERAGE`). Every scan is localised; ``result.covered``
+        marks which ones count towards the goal, and the tables print the others as "not covered". In [0, 1].
+
     Returns
     -------
     LogLocalisationResult
@@ -134,6 +145,7 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     kmax = max(modes)
     lo, ex = check_leave(leave_out, exclude, kmax)
     hr = check_unit(hit_ratio, "hit_ratio")
+    mc = check_unit(min_coverage, "min_coverage")
     for name, flag in (("truth_check", truth_check), ("votes", votes)):
         if not isinstance(flag, (bool, np.bool_)):
             raise TypeError(f"`{name}` must be a bool; got {type(flag).__name__}")
@@ -182,4 +194,4 @@ def run_log_localisation(path=None, scan_indices=(50, 150, 250, 350, 450, 550, 6
     return LogLocalisationResult(log.name, idx, true_m, est_m, err_p, err_a, amb, cell, rmax,
                                  ex if lo == "window" else None, full.grid, frame, modes,
                                  (float(sd[0]), float(sd[1])), example, p, time.perf_counter() - t0, margin, truth, lo,
-                                 vote)
+                                 vote, table["coverage"].to_numpy(dtype=float), mc, logged_pose_check(log, idx))

@@ -18,7 +18,7 @@ from ...correlation.algorithm import LocaliseParams
 from ...geometry import wrap_angle
 from ...scans import GridFrame
 from ._log_scan import TRUTH_COLUMNS, VOTE_SCANS, check_unit
-from .studies import FAIL_CELLS, FAIL_DEG, within_tolerance
+from .studies import COVERAGE_RADIUS_CELLS, FAIL_CELLS, FAIL_DEG, MIN_COVERAGE, within_tolerance
 from .terms import TERM_NAMES
 
 __all__ = ["LogLocalisationResult"]
@@ -77,6 +77,16 @@ class LogLocalisationResult:
     votes : numpy.ndarray of int, shape (modes, n), optional
         Per answer, how many of the single-scan localisations of scans i, i-1, i-2 agree with it
         (``run_log_localisation(votes=True)``; None: not run); :meth:`flagged` marks those with fewer than 2.
+    coverage : numpy.ndarray, shape (n,), optional
+        Per scan, the share of its end points within :data:`~slamlab.studies.correlation.studies.COVERAGE_RADIUS_CELLS`
+        of an obstacle cell of its leave-out grid at the logged pose (:func:`~slamlab.scans.map_coverage`; ours);
+        :attr:`covered` applies :attr:`min_coverage`.
+    min_coverage : float
+        The share at or above which a scan is covered (default
+        :data:`~slamlab.studies.correlation.studies.MIN_COVERAGE`).
+    pose_check : pandas.DataFrame, optional
+        Per scan, is its logged pose consistent with its neighbours' scans?
+        (:func:`~slamlab.studies.correlation.logged_pose_check`: ``move_m``, ``turn_deg``, ``doubtful``, …).
     """
 
     name: str  # the log's file name
@@ -100,6 +110,16 @@ class LogLocalisationResult:
     truth: dict | None = field(default=None, repr=False, compare=False)  # truth_check=True: _TRUTH_COLUMNS
     leave_out: str = "window"  # "window": ±exclude scans; "used": each mode's own scans
     votes: np.ndarray | None = field(default=None, repr=False)  # (modes, n) votes=True: agreeing single scans
+    coverage: np.ndarray | None = field(default=None, repr=False)  # (n,) end points near the leave-out map's walls
+    min_coverage: float = MIN_COVERAGE
+    pose_check: object = field(default=None, repr=False, compare=False)  # pandas.DataFrame of logged_pose_check
+
+    @property
+    def covered(self) -> np.ndarray:
+        """``(n,)``: scans whose :attr:`coverage` is at least :attr:`min_coverage` (all, when not recorded)."""
+        if self.coverage is None:
+            return np.ones(self.scan_indices.size, dtype=bool)
+        return self.coverage >= self.min_coverage
 
     @property
     def success(self) -> np.ndarray:
@@ -202,15 +222,16 @@ class LogLocalisationResult:
         """
         d = self.truth_check()
         d = d[~d["ok"]]
-        rows = [[int(r.scan), self.mode_name(int(r.joined)), f"{r.err_m:.2f}", f"{r.err_deg:.1f}",
+        rows = [[int(r.scan), int(r.joined), f"{r.err_m:.2f}", f"{r.err_deg:.1f}",
                  f"{r.score_est:.0f}", f"{r.score_truth:.0f}", f"{r.score_truth - r.score_est:+.0f}",
                  f"{r.score_est_fine:.0f}", f"{r.score_truth_fine:.0f}", f"{r.walls_truth:.2f}", f"{r.walls_est:.2f}", r.kind]
                 for r in d.itertuples()]
         title = "\n".join([
             f"{self.name}: failures; scores at the estimate (est.) and at the best grid pose within {FAIL_CELLS:g} cells",
             f"and {FAIL_DEG:g}° of the logged pose (truth), their difference (diff = truth - est.), and the same off the",
-            "grid (fine: every 0.5 cell and 0.5°); walls = fraction of end points on obstacle cells of the leave-out grid"])
-        return format_table(["scan", "mode", "err [m]", "err [°]", "est.", "truth", "diff", "est. fine",
+            "grid (fine: every 0.5 cell and 0.5°); walls = fraction of end points on obstacle cells of the leave-out grid;",
+            "scans: 1 alone, or joined by odometry"])
+        return format_table(["scan", "scans", "err [m]", "err [°]", "est.", "truth", "diff", "est. fine",
                              "truth fine", "walls truth", "walls est.", "kind"], rows, title=title)
 
     def terms_table(self, scans=None) -> str:

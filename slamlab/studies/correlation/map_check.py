@@ -7,6 +7,9 @@ ahead of the robot's centre, range scale) blurs the log's map: the end points of
 the walls that the *other* scans drew. :func:`endpoint_agreement` measures that fraction for one layout;
 :func:`map_check` tabulates it for several layouts on several logs, so the right layout of a log is the one
 where its fraction is highest.
+
+The logged poses themselves are a SLAM solution: :func:`logged_pose_check` aligns a scan to its neighbours' scans
+(ICP) and reports how far that moves its logged pose, to tell a localisation failure from a doubtful truth.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from ...scans import OBSTACLE, UNEXPLORED, Scan
 from ...scans.logmap import leave_out_grid, log_counts
 from .carmen_logs import SHARED_CARMEN_LOGS, as_carmen_log, short_log_name
 
-__all__ = ["MAP_CHECK_LAYOUTS", "endpoint_agreement", "endpoints_on_walls", "map_check"]
+__all__ = ["MAP_CHECK_LAYOUTS", "endpoint_agreement", "endpoints_on_walls", "logged_pose_check", "map_check"]
 
 #: The layouts :func:`map_check` compares: label → :func:`endpoint_agreement` keywords (CARMEN's first).
 MAP_CHECK_LAYOUTS = (
@@ -211,3 +214,76 @@ def map_check(paths=None, layouts=MAP_CHECK_LAYOUTS, **settings) -> str:
     return format_table(["layout"] + [short_log_name(log.name) for log in logs], rows,
                         title="Scan end points on obstacle cells of the other scans' grid (all / on seen cells); "
                               "* = the log's best layout")
+
+
+def logged_pose_check(log, scan_indices, *, neighbours=(-1, 1), max_range_m: float = 10.0,
+                      max_pair_m: float = 0.5, doubt_m: float = 0.2, doubt_deg: float = 2.5):
+    """Is a logged pose consistent with its neighbours' scans? A local scan-to-scan alignment (ours).
+
+    The logged poses of the corrected logs are a SLAM solution, not a measured truth. For each scan ``i``, its
+    returns (ranges < ``max_range_m``) are aligned by point-to-point ICP (:func:`slamlab.hough.icp`, pairs farther
+    than ``max_pair_m`` rejected) to the returns of scans ``i + d`` (``d`` in ``neighbours``) placed at their logged
+    poses, starting from scan ``i``'s logged pose. The alignment's move from the logged pose is what the
+    neighbours say about it: when it exceeds ``doubt_m`` or ``doubt_deg`` (default half the success tolerance, 2
+    cells of 0.2 m and 5°), the logged pose is a *doubtful truth*: a correct localisation could be scored a failure
+    against it.
+
+    Parameters
+    ----------
+    log : CarmenLog
+        The log.
+    scan_indices : sequence of int
+        The scans to check.
+    neighbours : sequence of int, default (-1, 1)
+        Offsets of the scans aligned to (non-zero); those outside the log are skipped (at the log's first and last
+        scans), and at least one must be in it.
+    max_range_m : float, default 10
+        Returns at or beyond it are not used [m].
+    max_pair_m : float, default 0.5
+        ICP's pair distance limit [m].
+    doubt_m, doubt_deg : float
+        The move [m] and turn [deg] beyond which the logged pose is doubtful.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per scan: ``scan``, ``move_m``, ``turn_deg`` (the alignment's correction of the logged pose),
+        ``rmse_m`` and ``pairs`` (ICP's residual and paired points), ``converged``, ``doubtful``.
+    """
+    import pandas as pd
+
+    from ...hough.icp import icp
+
+    if not all(hasattr(log, a) for a in ("poses", "n_scans", "scan")):
+        raise TypeError(f"`log` must be a CarmenLog; got {type(log).__name__}")
+    idx = np.asarray(scan_indices)
+    if idx.ndim != 1 or idx.size == 0 or not np.issubdtype(idx.dtype, np.integer):
+        raise ValueError(f"`scan_indices` must be a non-empty list of ints; got {scan_indices!r}")
+    offs = np.asarray(neighbours)
+    if offs.ndim != 1 or offs.size == 0 or not np.issubdtype(offs.dtype, np.integer) or np.any(offs == 0):
+        raise ValueError(f"`neighbours` must be a non-empty list of non-zero int offsets; got {neighbours!r}")
+    if idx.min() < 0 or idx.max() >= log.n_scans:
+        raise ValueError(f"`scan_indices` must lie in [0, {log.n_scans - 1}]; got {idx.min()}..{idx.max()}")
+    if log.n_scans < 2:
+        raise ValueError(f"`log` must hold at least 2 scans to align one to another; got {log.n_scans}")
+    rmax = check_positive(max_range_m, "max_range_m")
+    pair = check_positive(max_pair_m, "max_pair_m")
+    dm, dd = check_positive(doubt_m, "doubt_m"), check_positive(doubt_deg, "doubt_deg")
+
+    def returns(i, pose):
+        s = log.scan(int(i))
+        keep = s.valid & (s.ranges < rmax)
+        return s.points(pose)[keep[s.valid]]
+
+    rows = []
+    for i in idx:
+        near = [int(i + d) for d in offs if 0 <= i + d < log.n_scans]
+        if not near:
+            raise ValueError(f"scan {i} has no neighbour {tuple(offs.tolist())} in the log (0..{log.n_scans - 1})")
+        target = np.vstack([returns(j, log.poses[j]) for j in near])
+        res = icp(returns(i, np.zeros(3)), target, init=log.poses[i], max_dist=pair)
+        d = res.pose - log.poses[i]
+        move, turn = float(np.hypot(d[0], d[1])), float(np.degrees(abs(np.arctan2(np.sin(d[2]), np.cos(d[2])))))
+        rows.append({"scan": int(i), "move_m": move, "turn_deg": turn, "rmse_m": res.rmse, "pairs": res.n_inliers,
+                     "converged": bool(res.converged), "doubtful": bool(move > dm or turn > dd)})
+    return pd.DataFrame(rows)
