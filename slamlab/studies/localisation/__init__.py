@@ -13,13 +13,19 @@ from .experiments import (
     run_markov_vs_mcl,
     simulate_run,
 )
-from .log_protocol import LogProtocolResult, run_log_protocol
-from .logs import (
+from .log_maps import (
     CARMEN_LOGS,
-    LogMCLResult,
+    TUNED_LOGS,
     carmen_path,
-    global_log_settings,
     log_map,
+    read_log_counts,
+    stretch_coverage,
+    stretch_map,
+)
+from .log_protocol import LogProtocolResult, maps_table, run_log_protocol
+from .logs import (
+    LogMCLResult,
+    global_log_settings,
     log_params,
     log_settings,
     logs_table,
@@ -65,6 +71,7 @@ __all__ = [
     "MARKOV_STUDY_PARAMS",
     "PLAIN_SETUP",
     "SCORE_VARIANTS",
+    "TUNED_LOGS",
     "AblationResult",
     "FilterRun",
     "GlobalResult",
@@ -84,7 +91,9 @@ __all__ = [
     "log_params",
     "log_settings",
     "logs_table",
+    "maps_table",
     "ours_vs_source",
+    "read_log_counts",
     "run_correlation_side_by_side",
     "run_filter",
     "run_global_ablation",
@@ -97,5 +106,7 @@ __all__ = [
     "run_markov_vs_mcl",
     "run_score_comparison",
     "simulate_run",
+    "stretch_coverage",
+    "stretch_map",
 ]
 __all__ += list(_PLOT + _WIDGETS)  # loaded on first use

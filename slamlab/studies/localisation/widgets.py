@@ -11,7 +11,8 @@ from ...localisation.plot import plot_belief
 from ...widgets import interactive, show_run
 from ...widgets import slider as _slider
 from .experiments import demo_run
-from .logs import CARMEN_LOGS, run_log_mcl
+from .log_maps import CARMEN_LOGS
+from .logs import run_log_mcl
 from .plot import mcl_figure, plot_log_run, recorded_step_figure
 
 __all__ = ["explore_log", "explore_markov", "explore_mcl", "explore_recorded_run"]
