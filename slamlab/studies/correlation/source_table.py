@@ -19,6 +19,8 @@ from .experiments import (
     Table1Result,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
+from .aperture import ApertureResult
+from .stamp_trim import StampTrimResult
 from .studies import source_table1_errors
 
 if TYPE_CHECKING:
@@ -28,7 +30,8 @@ __all__ = ["ours_vs_source"]
 
 
 def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = None,
-                   constants: ConstantsResult | None = None, log: LogLocalisationResult | None = None) -> str:
+                   constants: ConstantsResult | None = None, log: LogLocalisationResult | None = None,
+                   aperture: ApertureResult | None = None, trim: StampTrimResult | None = None) -> str:
     """The notebook's closing table: 004's figures (§7, Table 1) beside ours, from the runs' results.
 
     Parameters
@@ -41,6 +44,10 @@ def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = 
         From :func:`run_constants_study`.
     log : LogLocalisationResult, optional
         From :func:`run_log_localisation`.
+    aperture : ApertureResult, optional
+        From :func:`~slamlab.studies.correlation.run_aperture_study`: a row per aperture.
+    trim : StampTrimResult, optional
+        From :func:`~slamlab.studies.correlation.run_stamp_trim_study`: a row per trimmed quantile.
 
     Returns
     -------
@@ -78,6 +85,19 @@ def ours_vs_source(table1: Table1Result, monte_carlo: MonteCarloResult | None = 
             n = c.err_pos_cells.shape[1]
             rows.append([f"{lb}: failures in the crowded room", "not measured",
                          f"{c.failure_rate[k]:.0%} ({round(c.failure_rate[k] * n)}/{n})"])
+    if aperture is not None:
+        for j, a in enumerate(aperture.apertures_deg):
+            ok = aperture.success[j]
+            claim = "a laser's beam works" if a == 0 else ("ultrasonic >10°: inaccurate" if j == 1 else "")
+            rows.append([f"beam aperture {a:g}°: poses localised", claim, f"{ok.sum()}/{ok.size}"])
+    if trim is not None:
+        side = np.median(trim.stamp_side, axis=1)
+        for j, q in enumerate(trim.quantiles):
+            if q == 1:
+                continue
+            ok = trim.success[j]
+            rows.append([f"T_n trimmed to {q:g} of the returns: cells / poses", "trim if l_max >> mean l",
+                         f"{(side[j] / side[0]) ** 2:.2f} / {ok.sum()}/{ok.size}"])
     if log is not None:
         for m, k in enumerate(log.joined):
             rows.append([(f"real log, {log.mode_name(k)}: scans within {FAIL_CELLS * log.cell_m:.1f} m "
