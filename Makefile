@@ -11,7 +11,7 @@ PYTEST_ARGS := tests slamlab notebooks --doctest-modules \
 	--nbval --nbval-current-env --nbval-sanitize-with notebooks/nbval_sanitize.cfg \
 	-p no:cacheprovider -n 2 --dist loadfile --durations=30
 
-.PHONY: venv data lab test reproducible notebooks report student autograde docs lint bench lock clean distclean
+.PHONY: venv data lab test test-latest reproducible notebooks report student autograde docs lint bench lock clean distclean
 
 ## venv: create .venv if missing and install slamlab[test] from constraints.txt and the instructor's grading package
 ## (grading/: the labs' references and accepted ranges, not part of the library; again only when those change)
@@ -45,6 +45,13 @@ lab: venv
 ## test: the whole suite in one pytest run: unit tests, doctests, every notebook under nbval
 test: venv
 	MPLBACKEND=Agg $(BIN)/python -m pytest $(PYTEST_ARGS)
+
+## test-latest: dependency drift (not part of make test; run it before make lock): a temporary venv with the newest
+## versions pyproject.toml allows (no constraints.txt), nbval over every notebook and lab there; prints each differing
+## cell and the packages whose versions differ from the lock (tools/test_latest.py). LATEST_ARGS="--only 02 --jobs 2"
+LATEST_ARGS ?=
+test-latest:
+	$(PYTHON) tools/test_latest.py $(LATEST_ARGS)
 
 ## reproducible: re-run every notebook and lab under another BLAS kernel, 1 thread, OpenCV 1 thread, no AVX-512,
 ## with OpenCV's and numpy's global RNGs moved first; compare every output with the stored one (VARIANT=alt|nosimd)

@@ -155,8 +155,32 @@ def fast_cv(image, *, threshold: int = 20, nonmax: bool = True) -> Features:
     return features_from_keypoints(det.detect(img, None), None, "FAST-cv")
 
 
+#: Every other MSER setting, fixed at the defaults of OpenCV 5.0.0.93 (the lock's ``opencv-python-headless``,
+#: read from ``cv2.MSER_create()``'s getters): ``MSER_create``'s keywords, and ``pass2Only`` (set by its setter).
+#: Set explicitly so that a default changed by a later OpenCV cannot change our regions unseen.
+_MSER_FIXED = {"max_variation": 0.25, "min_diversity": 0.2, "max_evolution": 200, "area_threshold": 1.01,
+               "min_margin": 0.003, "edge_blur_size": 5}
+_MSER_PASS2_ONLY = False
+
+
+def _mser_detector(delta: int, min_area: int, max_area: int):
+    """``cv2.MSER`` with every parameter set: ours, and ``_MSER_FIXED`` (OpenCV 5.0.0.93's defaults)."""
+    import cv2
+
+    det = cv2.MSER_create(delta=check_int(delta, "delta", minimum=1),
+                          min_area=check_int(min_area, "min_area", minimum=1),
+                          max_area=check_int(max_area, "max_area", minimum=1), **_MSER_FIXED)
+    det.setPass2Only(_MSER_PASS2_ONLY)
+    return det
+
+
 def mser_cv(image, *, delta: int = 5, min_area: int = 60, max_area: int = 14400) -> Features:
     """OpenCV MSER regions as keypoints: centroid, σ = sqrt(area / π), no descriptor.
+
+    Every MSER parameter is passed explicitly: ``delta``, ``min_area`` and ``max_area`` below,
+    the others fixed at OpenCV 5.0.0.93's defaults (``max_variation`` 0.25, ``min_diversity`` 0.2,
+    ``max_evolution`` 200, ``area_threshold`` 1.01, ``min_margin`` 0.003, ``edge_blur_size`` 5,
+    ``pass2Only`` off; ours: the choice to pin them).
 
     Parameters
     ----------
@@ -171,14 +195,19 @@ def mser_cv(image, *, delta: int = 5, min_area: int = 60, max_area: int = 14400)
     -------
     Features
         One keypoint per region, ``response`` = area in pixels.
-    """
-    import cv2
 
+    Notes
+    -----
+    The regions depend on the OpenCV version, not only on these parameters (measured by us):
+    ``opencv-python-headless`` 5.1.0.95 reports the same defaults but no longer applies
+    ``min_diversity`` to grey images (its documentation describes the parameter as "for color
+    image"). On Oxford graf/img1 resized to 768×576 (notebook 02, section 4) it finds 1798
+    regions, exactly the regions 5.0.0.93 finds with ``min_diversity=0``, where 5.0.0.93 (the
+    lock, ``constraints.txt``) finds 137. No parameter restores the pruning under 5.1.0.95;
+    the lock keeps 5.0.0.93.
+    """
     img = to_gray_uint8(image)
-    det = cv2.MSER_create(delta=check_int(delta, "delta", minimum=1),
-                          min_area=check_int(min_area, "min_area", minimum=1),
-                          max_area=check_int(max_area, "max_area", minimum=1))
-    regions, _ = det.detectRegions(img)
+    regions, _ = _mser_detector(delta, min_area, max_area).detectRegions(img)
     k = len(regions)
     if k == 0:
         return Features.empty("MSER")
