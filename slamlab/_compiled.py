@@ -12,6 +12,10 @@ through :func:`kernel` so that all share the same settings:
   every CPU of our kind, whether it has AVX2 or AVX-512. Where a kernel reproduces a BLAS product that
   rounds a multiply-add once, it says so with an explicit ``fma`` (``slamlab.hough._kernels``).
 
+Kernels load one by one: a kernel's machine code is compiled or read from the cache on its own first call,
+so a process pays only for the kernels it calls (numba's import and LLVM, about 105 MiB, come with the first one);
+:func:`loaded_kernels` names them.
+
 ``SLAMLAB_NO_NUMBA=1`` makes :func:`numba_enabled` false: callers then take the numpy path (a way to
 compare the two, and a fallback where numba cannot be installed).
 """
@@ -20,11 +24,13 @@ from __future__ import annotations
 
 import os
 
-__all__ = ["jitable", "kernel", "numba_enabled"]
+__all__ = ["jitable", "kernel", "loaded_kernels", "numba_enabled"]
 
 #: helpers marked by :func:`jitable`, made callable from compiled code when the first kernel compiles
 _JITABLE: list = []
 _REGISTERED: set = set()
+#: qualified names of the kernels compiled or loaded in this process, in order of first call
+_LOADED: list = []
 
 
 def numba_enabled() -> bool:
@@ -72,6 +78,7 @@ def kernel(fn):
                     register_jitable(inline="always")(helper)
                     _REGISTERED.add(id(helper))
             compiled = numba.njit(cache=True, nogil=True)(fn)
+            _LOADED.append(f"{fn.__module__}.{fn.__qualname__}")
         return compiled(*args)
 
     call.__name__ = fn.__name__
@@ -101,3 +108,14 @@ def jitable(fn):
     """
     _JITABLE.append(fn)
     return fn
+
+
+def loaded_kernels() -> tuple[str, ...]:
+    """Kernels this process has called, hence compiled or loaded from numba's cache (``module.name``).
+
+    Returns
+    -------
+    tuple of str
+        In the order of their first call.
+    """
+    return tuple(_LOADED)

@@ -47,8 +47,20 @@ def two_nearest(qi, ti, d):
     return qi[first_min], ti[first_min], d1, d2, second
 
 
-def pair_distances(A, B, ia, ib, block: int = 1 << 16) -> np.ndarray:
-    """Descriptor distance of each pair ``(A[ia], B[ib])``: Hamming for uint8, Euclidean otherwise."""
+#: bytes of one block's gathered descriptors (per side) in :func:`pair_distances` (ours, memory: a block of 2^16
+#: SIFT pairs held 3 x 32 MiB of temporaries; each pair's distance does not depend on the block size)
+PAIR_BLOCK_BYTES = 1 << 22
+
+
+def _block_rows(A) -> int:
+    """Pairs per block of :func:`pair_distances` for descriptors ``A``: ``PAIR_BLOCK_BYTES`` of rows, at most 2^16."""
+    return max(1, min(1 << 16, PAIR_BLOCK_BYTES // max(1, A.shape[1] * A.itemsize)))
+
+
+def pair_distances(A, B, ia, ib, block: int | None = None) -> np.ndarray:
+    """Descriptor distance of each pair ``(A[ia], B[ib])``: Hamming for uint8, Euclidean otherwise; pairs taken
+    ``block`` at a time (None: as many as fill ``PAIR_BLOCK_BYTES``, at most 2^16)."""
+    block = _block_rows(A) if block is None else block
     out = np.empty(ia.size)
     for s0 in range(0, ia.size, block):
         x, y = A[ia[s0:s0 + block]], B[ib[s0:s0 + block]]

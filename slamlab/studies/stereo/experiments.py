@@ -426,8 +426,9 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
     and returns the recorded :class:`~slamlab.studies.kdtree.workloads.Workload` for
     :func:`slamlab.studies.kdtree.experiments.run_store_comparison`. ``detector="sift"`` gives 128-d float
     descriptors (OpenCV); ``"surf"`` the 64-d SURF of the features chapter. The map search is 000's
-    global one for every detector (ORB's window search would leave the store almost no queries).
-    ``progress``: a bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
+    global one for every detector (ORB's window search would leave the store almost no queries). The two
+    images of a pair are detected one after the other (``parallel_detect=False``: the same features; memory,
+    issue 45). ``progress``: a bar over the frames (None: on unless ``$SLAMLAB_PROGRESS=0``).
 
     Parameters
     ----------
@@ -444,7 +445,9 @@ def record_stereo_stream(n_frames: int | None = None, *, detector: str = "sift",
     -------
     Workload
     """
-    p = StereoParams(detector=detector, map_search="global")
+    # the two images detected one after the other (the same features): the recording is not timed, and SIFT's
+    # scale space of one image takes about 100 MiB, held twice when both images are detected at once (ours)
+    p = StereoParams(detector=detector, map_search="global", parallel_detect=False)
     rec = RecordingStore(ExactStore(p.base_seen_times, p.max_non_base_time))
     run_experiment("closed loop", "small", n_frames=n_frames, params=p, store=rec, progress=progress, rng=rng)
     n = len(rec.iterations)
