@@ -65,11 +65,11 @@ def test_parse_params_reads_literals_and_words():
 @pytest.mark.slow
 @pytest.mark.realdata
 def test_report_runs_notebook_06_with_fewer_poses(tmp_path, real_data):
-    params = report.parse_params(["TABLE1_POSES=3", "MC_SIZE=4", "CONSTANTS_POSES=2", "LOG_EVERY=300",
-                                  "LOG_JOINED=(1, 3)"])
+    params = report.parse_params(["TABLE1_POSES=3", "MC_SIZE=4", "CONSTANTS_POSES=2", "SENSOR_POSES=2",
+                                  "LOG_EVERY=300", "LOG_JOINED=(1, 3)"])
     out = report.run_report("06", params, tmp_path)
-    assert out.name == ("06_correlation_localisation-TABLE1_POSES=3-MC_SIZE=4-CONSTANTS_POSES=2-LOG_EVERY=300-"
-                        "LOG_JOINED=(1,3).ipynb")
+    assert out.name == ("06_correlation_localisation-TABLE1_POSES=3-MC_SIZE=4-CONSTANTS_POSES=2-SENSOR_POSES=2-"
+                        "LOG_EVERY=300-LOG_JOINED=(1,3).ipynb")
     text = _outputs(nbformat.read(out, as_version=4))
     assert "every 300th from 300 to 900" in text
     assert "every 100th" not in text
@@ -78,4 +78,5 @@ def test_report_runs_notebook_06_with_fewer_poses(tmp_path, real_data):
     assert "Monte Carlo, 4 poses" in text
     assert "Monte Carlo (4 poses): position exact" in text
     assert "2 poses, clutter of 004 Fig. 3b + 60 extra discs" in text
+    assert "Beam aperture: the same 2 random poses" in text
     assert "Monte Carlo, 12 poses" not in text
