@@ -192,9 +192,9 @@ CALLS: dict[str, tuple[typing.Callable, bool]] = {
     "correlation.experiments.run_constants_study": (
         lambda S, p: S.correlation.run_constants_study(2, n_beams=90, choices=((0.0, 1.0, 0.0),), params=p), False),
     "correlation.experiments.run_corridor_tie": (lambda S, p: S.correlation.run_corridor_tie(params=p), False),
-    "correlation.aperture.run_aperture_study": (
+    "correlation.experiments.run_aperture_study": (
         lambda S, p: S.correlation.run_aperture_study((0.0, 10.0), 1, n_beams=90, params=p), False),
-    "correlation.stamp_trim.run_stamp_trim_study": (
+    "correlation.experiments.run_stamp_trim_study": (
         lambda S, p: S.correlation.run_stamp_trim_study((1.0, 0.5), 1, n_beams=90, params=p), False),
     "correlation.log_experiments.run_log_localisation": (
         lambda S, p: S.correlation.run_log_localisation(scan_indices=(50,), params=p), True),

@@ -22,12 +22,21 @@ import time
 
 import numpy as np
 
-from ..._validate import as_rng, check_choice, check_int, check_positive
-from ...correlation.algorithm import LocaliseParams, heading_error, localise, localise_joined
+from ..._validate import as_finite_array, as_rng, check_choice, check_int, check_positive
+from ...correlation.algorithm import (
+    LocaliseParams,
+    heading_candidates,
+    heading_error,
+    localise,
+    localise_joined,
+    scan_stamps,
+)
 from ...scans.logmap import log_grid  # log_grid re-exported (one place: scans)
 from ...sim.grid import add_clutter, free_cells, measurement_room_200, test_room_200
 from ...sim.paths import random_free_poses
 from ...sim.rangefinder import Rangefinder
+from .aperture import ApertureResult
+from .stamp_trim import StampTrimResult, trim_scan
 from .studies import (
     FAIL_CELLS,
     FAIL_DEG,
@@ -51,9 +60,11 @@ __all__ = [
     "corridor_grid",
     "log_grid",
     "random_clutter",
+    "run_aperture_study",
     "run_constants_study",
     "run_corridor_tie",
     "run_monte_carlo",
+    "run_stamp_trim_study",
     "run_table1",
     "time_localise",
 ]
@@ -402,3 +413,134 @@ def run_corridor_tie(*, max_range_cells: float = 25.0, spacing_cells: float = 30
     scans = [rf.scan(g, q) for q in poses]
     return CorridorResult(poses[0].copy(), poses, localise(g, scans[0], params=p),
                           localise_joined(g, scans, poses, params=p), params=p)
+
+
+def run_aperture_study(apertures_deg=(0.0, 10.0, 30.0), n_poses: int = 6, *, range_std_cells: float = 0.3,
+                       n_beams: int = 360, max_range_cells: float = 100.0, aperture_rays: int = 9,
+                       params: LocaliseParams | None = None, rng=2010, n_jobs: int = 1, progress: bool | None = None,
+                       **overrides) -> ApertureResult:
+    """Localise the same random poses with beams of several apertures (004 §7's sensor requirement; ours).
+
+    Table 1's set-up (:func:`~slamlab.studies.correlation.run_table1`: the measurement room with unmapped clutter,
+    the mapped room, Gaussian range noise, 0.1-cell rounding, the full 360° search) with
+    ``Rangefinder(aperture_rad=…)``: each beam returns the nearest echo among ``aperture_rays`` rays across its
+    cone.
+
+    Parameters
+    ----------
+    apertures_deg : sequence of float, default (0, 10, 30)
+        Full cone angles [deg], each in [0, 180); 0 is a thin ray (a laser). 004: ultrasonic sensors usually over 10°.
+    n_poses : int, default 6
+        Random free poses (the same for every aperture).
+    range_std_cells : float, default 0.3
+        Range noise σ [cells].
+    n_beams : int, default 360
+        Beams over 360°.
+    max_range_cells : float, default 100.0
+        Range limit [cells].
+    aperture_rays : int, default 9
+        Rays per cone (at least 2).
+    params : LocaliseParams, optional
+        Settings of every localisation (default :class:`LocaliseParams`).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator: the poses, then per aperture one child stream for the scans' noise.
+    n_jobs : int, default 1
+        Workers of the localisations (same result for any).
+    progress : bool, optional
+        Progress bar (default: in a notebook only).
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    ApertureResult
+    """
+    p = LocaliseParams.resolve(params, **overrides)
+    ap = as_finite_array(apertures_deg, "apertures_deg")
+    if ap.ndim != 1 or ap.size == 0 or np.any(ap < 0) or np.any(ap >= 180):
+        raise ValueError(f"`apertures_deg` must be a non-empty list of angles in [0, 180) degrees; got {apertures_deg!r}")
+    n = check_int(n_poses, "n_poses", minimum=1)
+    sd = check_positive(range_std_cells, "range_std_cells", allow_zero=True)
+    rng = as_rng(rng)
+    M, W = _worlds(True, 0, rng)
+    poses = random_free_poses(W, n, margin_cells=2, rng=rng)
+    streams = rng.spawn(ap.size)
+    thin = Rangefinder(n_beams=n_beams, max_range_cells=max_range_cells, quantum_cells=0.0)
+    scans, short = [], []
+    for a, stream in zip(ap, streams, strict=True):
+        rf = Rangefinder(n_beams=n_beams, max_range_cells=max_range_cells, range_std_cells=sd,
+                         aperture_rad=float(np.radians(a)), aperture_rays=aperture_rays)
+        exact = Rangefinder(n_beams=n_beams, max_range_cells=max_range_cells, quantum_cells=0.0,
+                            aperture_rad=float(np.radians(a)), aperture_rays=aperture_rays)
+        gaps = []
+        for q in poses:
+            ray, cone = thin.scan(W, q), exact.scan(W, q)
+            both = ray.valid & cone.valid
+            gaps.append(ray.ranges[both] - cone.ranges[both])
+            scans.append(rf.scan(W, q, stream))
+        short.append(float(np.median(np.concatenate(gaps))))
+    t0 = time.perf_counter()
+    table = localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress)
+    est = table[["x", "y", "heading_rad"]].to_numpy(dtype=float)
+    ea, ex, ey = absolute_errors(np.tile(poses, (ap.size, 1)), est)
+    return ApertureResult(ap, poses, np.hypot(ex, ey).reshape(ap.size, n), ea.reshape(ap.size, n), np.array(short),
+                          sd, int(n_beams), p, time.perf_counter() - t0)
+
+
+def _timed_localise(M, scan, p):
+    """One localisation (no rival search) and its CPU time."""
+    t0 = time.process_time()
+    loc = localise(M, scan, params=p)
+    return time.process_time() - t0, loc.pose
+
+
+def run_stamp_trim_study(quantiles=(1.0, 0.75, 0.5), n_poses: int = 6, *, range_std_cells: float = 0.3,
+                         n_beams: int = 360, max_range_cells: float = 100.0, params: LocaliseParams | None = None,
+                         rng=2010, **overrides) -> StampTrimResult:
+    """Localise the same random poses with scans trimmed to quantiles of their ranges (004 §7's advice; ours).
+
+    Table 1's set-up (:func:`~slamlab.studies.correlation.run_table1`: unmapped clutter, Gaussian range noise,
+    0.1-cell rounding, the full 360° search, no rival search); each scan trimmed by :func:`trim_scan`. Runs in this
+    process, one localisation at a time, so that the CPU times compare.
+
+    Parameters
+    ----------
+    quantiles : sequence of float, default (1, 0.75, 0.5)
+        Shares of each scan's returns kept, each in (0, 1]; the first row is the reference of the cell ratio.
+    n_poses : int, default 6
+        Random free poses.
+    range_std_cells, n_beams, max_range_cells
+        The rangefinder, as in :func:`~slamlab.studies.correlation.run_table1`.
+    params : LocaliseParams, optional
+        Settings of every localisation (the rival search off).
+    rng : int or numpy.random.Generator, default 2010
+        Seed or generator of the poses and the scans' noise.
+    **overrides
+        :class:`LocaliseParams` fields to change.
+
+    Returns
+    -------
+    StampTrimResult
+    """
+    p = LocaliseParams.resolve(params, **overrides).replace(ambiguity=False)
+    qs = as_finite_array(quantiles, "quantiles")
+    if qs.ndim != 1 or qs.size == 0 or np.any(qs <= 0) or np.any(qs > 1):
+        raise ValueError(f"`quantiles` must be a non-empty list of shares in (0, 1]; got {quantiles!r}")
+    n = check_int(n_poses, "n_poses", minimum=1)
+    rf = Rangefinder(n_beams=n_beams, max_range_cells=max_range_cells, range_std_cells=range_std_cells)
+    rng = as_rng(rng)
+    M, W = _worlds(True, 0, rng)
+    poses = random_free_poses(W, n, margin_cells=2, rng=rng)
+    scans = [rf.scan(W, q, rng) for q in poses]
+    heads = heading_candidates(p.delta_alpha_rad)
+    est = np.empty((qs.size, n, 3))
+    side = np.empty((qs.size, n), dtype=int)
+    cpu = np.empty((qs.size, n))
+    for j, q in enumerate(qs):
+        for i, s in enumerate(scans):
+            t = trim_scan(s, float(q))
+            side[j, i] = scan_stamps(t, heads[:1], params=p)[0].shape[1]
+            cpu[j, i], est[j, i] = _timed_localise(M, t, p)
+    ea, ex, ey = absolute_errors(np.tile(poses, (qs.size, 1)), est.reshape(-1, 3))
+    return StampTrimResult(qs, poses, np.hypot(ex, ey).reshape(qs.size, n), ea.reshape(qs.size, n), side,
+                           np.median(cpu, axis=1), p)

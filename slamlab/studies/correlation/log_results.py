@@ -18,7 +18,7 @@ from ...correlation.algorithm import LocaliseParams
 from ...geometry import wrap_angle
 from ...scans import GridFrame
 from ._log_scan import TRUTH_COLUMNS, VOTE_SCANS, check_unit
-from .studies import COVERAGE_RADIUS_CELLS, FAIL_CELLS, FAIL_DEG, MIN_COVERAGE, within_tolerance
+from .studies import FAIL_CELLS, FAIL_DEG, MIN_COVERAGE, within_tolerance
 from .terms import TERM_NAMES
 
 __all__ = ["LogLocalisationResult"]

@@ -17,8 +17,8 @@ import numpy as np
 from ..._table import format_table
 from ..._validate import check_int, check_positive
 from ...correlation.settings import LocaliseParams
-from .carmen_logs import SHARED_CARMEN_LOGS, as_carmen_log, short_log_name
 from ._log_scan import check_unit
+from .carmen_logs import SHARED_CARMEN_LOGS, as_carmen_log, short_log_name
 from .log_experiments import LogLocalisationResult, run_log_localisation
 from .studies import COVERAGE_RADIUS_CELLS, FAIL_CELLS, FAIL_DEG
 

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..._table import format_table
+from .aperture import ApertureResult
 from .experiments import (
     FAIL_CELLS,
     FAIL_DEG,
@@ -19,7 +20,6 @@ from .experiments import (
     Table1Result,
     run_table1,  # noqa: F401 (ours_vs_source's example)
 )
-from .aperture import ApertureResult
 from .stamp_trim import StampTrimResult
 from .studies import source_table1_errors
 

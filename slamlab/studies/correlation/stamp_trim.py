@@ -9,21 +9,17 @@ longest kept beam), and localise the same random poses of Table 1's room with ea
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..._table import format_table
-from ..._validate import as_finite_array, as_rng, check_int, check_positive
-from ...correlation.algorithm import LocaliseParams, heading_candidates, localise, scan_stamps
+from ..._validate import check_positive
+from ...correlation.algorithm import LocaliseParams
 from ...scans import Scan
-from ...sim.paths import random_free_poses
-from ...sim.grid import measurement_room_200, test_room_200
-from ...sim.rangefinder import Rangefinder
-from .studies import FAIL_CELLS, FAIL_DEG, absolute_errors, within_tolerance
+from .studies import FAIL_CELLS, FAIL_DEG, within_tolerance
 
-__all__ = ["StampTrimResult", "run_stamp_trim_study", "trim_scan"]
+__all__ = ["StampTrimResult", "trim_scan"]
 
 
 def trim_scan(scan: Scan, quantile: float) -> Scan:
@@ -123,62 +119,3 @@ class StampTrimResult:
         """
         return "; ".join(f"returns kept {q:g}: took {t:.3f} s" for q, t in zip(self.quantiles, self.cpu_s,
                                                                               strict=True))
-
-
-def _timed(M, scan, p):
-    """One localisation (no rival search) and its CPU time."""
-    t0 = time.process_time()
-    loc = localise(M, scan, params=p)
-    return time.process_time() - t0, loc.pose
-
-
-def run_stamp_trim_study(quantiles=(1.0, 0.75, 0.5), n_poses: int = 6, *, range_std_cells: float = 0.3,
-                         n_beams: int = 360, max_range_cells: float = 100.0, params: LocaliseParams | None = None,
-                         rng=2010, **overrides) -> StampTrimResult:
-    """Localise the same random poses with scans trimmed to quantiles of their ranges (004 §7's advice; ours).
-
-    Table 1's set-up (:func:`~slamlab.studies.correlation.run_table1`: unmapped clutter, Gaussian range noise,
-    0.1-cell rounding, the full 360° search, no rival search); each scan trimmed by :func:`trim_scan`. Runs in this
-    process, one localisation at a time, so that the CPU times compare.
-
-    Parameters
-    ----------
-    quantiles : sequence of float, default (1, 0.75, 0.5)
-        Shares of each scan's returns kept, each in (0, 1]; the first row is the reference of the cell ratio.
-    n_poses : int, default 6
-        Random free poses.
-    range_std_cells, n_beams, max_range_cells
-        The rangefinder, as in :func:`~slamlab.studies.correlation.run_table1`.
-    params : LocaliseParams, optional
-        Settings of every localisation (the rival search off).
-    rng : int or numpy.random.Generator, default 2010
-        Seed or generator of the poses and the scans' noise.
-    **overrides
-        :class:`LocaliseParams` fields to change.
-
-    Returns
-    -------
-    StampTrimResult
-    """
-    p = LocaliseParams.resolve(params, **overrides).replace(ambiguity=False)
-    qs = as_finite_array(quantiles, "quantiles")
-    if qs.ndim != 1 or qs.size == 0 or np.any(qs <= 0) or np.any(qs > 1):
-        raise ValueError(f"`quantiles` must be a non-empty list of shares in (0, 1]; got {quantiles!r}")
-    n = check_int(n_poses, "n_poses", minimum=1)
-    rf = Rangefinder(n_beams=n_beams, max_range_cells=max_range_cells, range_std_cells=range_std_cells)
-    rng = as_rng(rng)
-    M, W = test_room_200(), measurement_room_200()
-    poses = random_free_poses(W, n, margin_cells=2, rng=rng)
-    scans = [rf.scan(W, q, rng) for q in poses]
-    heads = heading_candidates(p.delta_alpha_rad)
-    est = np.empty((qs.size, n, 3))
-    side = np.empty((qs.size, n), dtype=int)
-    cpu = np.empty((qs.size, n))
-    for j, q in enumerate(qs):
-        for i, s in enumerate(scans):
-            t = trim_scan(s, float(q))
-            side[j, i] = scan_stamps(t, heads[:1], params=p)[0].shape[1]
-            cpu[j, i], est[j, i] = _timed(M, t, p)
-    ea, ex, ey = absolute_errors(np.tile(poses, (qs.size, 1)), est.reshape(-1, 3))
-    return StampTrimResult(qs, poses, np.hypot(ex, ey).reshape(qs.size, n), ea.reshape(qs.size, n), side,
-                           np.median(cpu, axis=1), p)

@@ -22,6 +22,7 @@ from .experiments import (
     in_frame_rotation_error_deg,
     ours_vs_source,
     run_flight,
+    scan_intensity_image,
     setup_table,
     three_plane_room,
     timing_goal,
@@ -38,7 +39,7 @@ from .figures import (
     run_intensity_study,
     run_pairs_figure,
 )
-from .intensity_image import IntensityImage, scan_intensity_image
+from .intensity_image import IntensityImage
 from .storage import StorageResult, flight_storage, map_storage
 
 _PLOT = ("plot_flight_errors", "plot_intensity_figure", "plot_intensity_image", "plot_pairs_figure", "plot_plane_map",

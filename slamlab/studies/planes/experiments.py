@@ -18,12 +18,20 @@ from scipy.spatial.transform import Rotation
 
 from ..._progress import progress_bar
 from ..._table import format_table
-from ..._validate import as_rng, check_choice, check_int, check_positive
+from ..._validate import as_rng, as_vector, check_choice, check_int, check_positive
 from ...evaluation import Trajectory, ate, rpe
 from ...geometry.so3 import so3_log
 from ...planes.extraction import Frame, build_frame
 from ...planes.filter import STAGES, PlaneSLAM, PlaneSLAMParams
-from ...sim.planes_room import Flight, PlaneRoom, build_corridor, simulate_flight
+from ...sim.planes_room import (
+    Flight,
+    PlaneRoom,
+    build_corridor,
+    cast_rays_planes,
+    scanner_beam_directions,
+    simulate_flight,
+)
+from .intensity_image import IntensityImage
 from .reports import GOAL_S, SOURCE_TIMES_S, FlightResult, ours_vs_source, timing_goal, timing_table
 
 __all__ = [
@@ -371,3 +379,59 @@ def setup_table(flight: Flight, frame_lines: int = 40) -> str:
             ["points per frame (the first frame)", "over 40000", f"{n_frame}"],
             ["room floor area [m^2]", "about 200", f"{area:.0f}"]]
     return format_table(["quantity", "002", "ours"], rows, title="002's sensor and frame beside our simulation")
+
+
+def scan_intensity_image(flight: Flight, *, start_s: float = 4.0, duration_s: float = 2.0,
+                        angles_deg=(45.0, 135.0)) -> IntensityImage:
+    """The intensity image of ``duration_s`` of lines from ``start_s`` and the model seen along the same beams
+    (002 Fig. 3; ours: the rendering in place of the photo).
+
+    Parameters
+    ----------
+    flight : slamlab.sim.Flight
+        The simulated flight.
+    start_s : float
+        Time of the first line, seconds from the flight's start.
+    duration_s : float
+        Length of the run of lines, seconds (at the yaw rate, the horizontal extent of the image).
+    angles_deg : (2,) float
+        Beams kept, as angles from the body's up axis, degrees (90: forward; the scanner covers -135 .. 135).
+
+    Returns
+    -------
+    IntensityImage
+    """
+    if not isinstance(flight, Flight):
+        raise TypeError(f"`flight` must be a Flight; got {type(flight).__name__}")
+    sc = flight.scanner
+    start_s = check_positive(start_s, "start_s", allow_zero=True)
+    duration_s = check_positive(duration_s, "duration_s")
+    first, n = round(start_s * sc.lines_per_s), round(duration_s * sc.lines_per_s)
+    if n < 1 or first + n > len(flight):
+        raise ValueError(f"`start_s` + `duration_s` = {start_s + duration_s} s must lie in the flight "
+                         f"({len(flight)} lines at {sc.lines_per_s:g} lines/s) and hold a line")
+    lo, hi = as_vector(angles_deg, "angles_deg", 2)
+    a = np.linspace(-sc.fov_deg / 2, sc.fov_deg / 2, sc.n_beams)
+    beams = np.flatnonzero((a >= lo - 1e-9) & (a <= hi + 1e-9))
+    if not lo < hi or beams.size == 0:
+        raise ValueError(f"`angles_deg` must be (low, high), low < high, within +-{sc.fov_deg / 2:g}; "
+                         f"got ({lo}, {hi})")
+    lines = np.arange(first, first + n)
+    T = flight.poses[lines]
+    mid = T[n // 2]
+    origin = mid[:3, :3] @ np.asarray(sc.mount_m, dtype=float) + mid[:3, 3]
+    d = np.einsum("nij,bj->nbi", T[:, :3, :3], scanner_beam_directions(sc)[beams]).reshape(-1, 3)
+    r, k, _ = cast_rays_planes(flight.room, origin, d)
+    hit = k >= 0
+    rho = np.full(len(d), np.nan)
+    rho[hit] = flight.room.reflectance(k[hit], origin + r[hit, None] * d[hit])
+    x = T[:, :3, 0]                                                  # body x axis in the map: the yaw
+    yaw = np.unwrap(np.arctan2(x[:, 1], x[:, 0]))
+    step = float(np.rad2deg(np.median(np.abs(np.diff(yaw))))) if n > 1 else float("nan")
+    seen, which = np.unique(k[hit], return_inverse=True)
+    plane = np.full(len(d), -1)
+    plane[hit] = which.ravel()
+    return IntensityImage(flight.intensities[np.ix_(lines, beams)].astype(float), rho.reshape(n, len(beams)),
+                          lines, beams, a[beams], flight.times_s[lines[[0, -1]]], step, float(sc.step_deg), origin,
+                          tuple(flight.room.names[i] for i in seen), plane.reshape(n, len(beams)),
+                          float(sc.intensity_gain))
