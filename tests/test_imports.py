@@ -126,7 +126,7 @@ def test_import_graph_has_no_cycle_at_all():
 #: in reading order, features first). ``sim`` is a peer of the algorithm packages: it makes scans, grids and
 #: images from the layers below, and no algorithm imports it (CONVENTIONS: algorithm modules never import sim).
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("_validate", "_table", "_lazy", "_compiled", "_threads"),
+    ("_validate", "_table", "_lazy", "_compiled", "_threads", "_heap"),
     ("_params", "_progress", "plotting", "chapters"),
     ("data", "sweep", "widgets"),
     ("geometry",),

@@ -175,6 +175,26 @@ def _log_bias(alpha: float, t: int) -> float:
     return float(np.log(-np.expm1(t * np.log1p(-alpha)))) if alpha < 1 else 0.0
 
 
+#: ``|log w_fast − log w_slow|`` below this is a tie (no injection): the two averages are sums of the same terms
+#: in another order, and their last bits depend on the CPU's vector units (numpy's exp/log kernels), while 1e-12 is
+#: far below any difference that eq 2.11 acts on (p_inj < 1e-12: less than one particle in 10^9 steps of 1000)
+LOG_AVERAGE_TIE = 1e-12
+
+
+def _injection_probability(log_slow: float, log_fast: float) -> float:
+    """003 eq 2.11's ``max(0, 1 − w_fast / w_slow)`` from the log averages; a tie within :data:`LOG_AVERAGE_TIE` is 0.
+
+    At the first updates both averages hold the same single term (debiased, they agree to the last bits or not,
+    by CPU), so without the tie rule the injection step ran or not by rounding alone.
+    """
+    if log_slow == -np.inf:
+        return 0.0
+    d = log_fast - log_slow
+    if d >= -LOG_AVERAGE_TIE:
+        return 0.0
+    return float(-np.expm1(d))
+
+
 def _beam_mask(model, X, beams, params) -> np.ndarray:
     """Nav2 / ROS 1 ``likelihood_field_prob`` beam skipping: keep a beam when more than
     ``beam_skip_threshold`` of the particles put its end point within ``beam_skip_distance`` of an
@@ -275,8 +295,7 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     n_up = state.n_updates + 1
     log_w = log_wp + params.gamma * L  # PR Table 8.2 line 5: w = p(z | x) (tempered by gamma)
     w, ok = normalise_log_weights(log_w)
-    p_inj = (max(0.0, 1.0 - float(np.exp(lf_used - ls_used))) if ls_used > -np.inf else 0.0) \
-        if params.injection else 0.0
+    p_inj = _injection_probability(ls_used, lf_used) if params.injection else 0.0
     note = ""
     if not ok:
         if params.injection:
@@ -292,14 +311,15 @@ def _mcl_step(state, odom_prev, odom_now, scan, model, params, rng=None, *, free
     if resample:
         X = _resample(X, w, params, rng)
         M = X.shape[0]
-        if p_inj > 0:
+        if params.injection:
+            # drawn whatever p_inj is, so that the stream's use never depends on how p_inj rounds
             inj = rng.random(M) < p_inj  # 2.11: P_A = M·p_inj in expectation
             n_inj = int(inj.sum())
             if n_inj:
                 xy = free_cell_centres(model.grid) if free_xy is None else free_xy
                 X = X.copy()
                 X[inj] = uniform_free_particles(model.grid, n_inj, rng, centres=xy)
-            if params.averages == "amcl":  # pf.c: "reset averages, to avoid spiraling off into complete randomness"
+            if params.averages == "amcl" and p_inj > 0:  # pf.c: "reset averages, to avoid spiraling off into ..."
                 ls = lf = -np.inf
                 n_up = 0
         w = np.full(M, 1.0 / M)

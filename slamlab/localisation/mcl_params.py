@@ -69,7 +69,7 @@ class MCLParams(ModelParams):
                                                   "jitter and gamma as one change (Ch. 08 §4); PR Tables 5.5-5.6 "
                                                   "α1…α4 (ROS: 0.2 each, in metres)")
     sigma_hit: float = param(4.0, "ours, cells, chosen with alpha, jitter and gamma as one change (Ch. 08 §4: taken "
-                                  "back alone to 2 cells, it does no better on 50 runs); PR Table 6.3 (ROS: 0.2 m)")
+                                  "back alone to 2 cells, it does worse on 50 runs); PR Table 6.3 (ROS: 0.2 m)")
     max_dist: float = param(12.0, "ours, cells: 3 σ_hit, cap of the distance table (ROS: 2 m)")
     gamma: float = param(0.5, "ours: weights p(z | x)^gamma, a tempered likelihood (1 = PR's product of the beams "
                               "as if independent)")

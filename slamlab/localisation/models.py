@@ -10,7 +10,7 @@ API summary
   :func:`slamlab.scans.likelihood_field`; ``log_likelihood(poses, beams)`` over
   particles × beams in one gather.
 - the expected ranges come from :func:`slamlab.scans.cast_rays` (exact grid traversal from many poses at once), and
-  :func:`beam_model_prob` (Table 6.1: z_hit, z_short, z_max, z_rand).
+  :func:`beam_model_prob` (Table 6.1: z_hit, z_short, z_max, z_rand; in :mod:`slamlab.localisation.beam_model`).
 - :func:`scan_beams`: the beams of a :class:`~slamlab.scans.Scan` a filter uses.
 
 003 names the ingredients only (an observation model giving each particle a
@@ -24,11 +24,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import erf
 
 from .._params import Params, param
 from .._validate import check_choice, check_int, check_positive
 from ..scans import OBSTACLE, Scan, check_grid, likelihood_field
+from .beam_model import beam_model_prob  # re-exported: moved there unchanged
 from .motion import (  # noqa: F401 (re-exported: moved there unchanged)
     check_alpha,
     check_particles,
@@ -52,6 +52,9 @@ __all__ = [
     "scan_beams",
 ]
 
+
+#: particles per block of the likelihood-field gather (its float64 work arrays then stay in the cache; ours)
+_CHUNK = 1024
 
 #: The observation scores a filter can weigh with (see :meth:`LikelihoodFieldModel.log_score`).
 SCORES = ("likelihood", "geometric_mean", "amcl_cubes")
@@ -182,6 +185,15 @@ class LikelihoodFieldModel:
     (PR line 3). ``log p(z | x) = Σ_k log q_k`` is precomputed per cell as a table, so a
     weight is one gather per beam.
 
+    The end point's cell (ours): with ``(bx, by)`` the beam's ``Beams.end_xy``, ``col = floor(x + cos θ·bx
+    − sin θ·by + 0.5)`` and ``row = floor(y + sin θ·bx + cos θ·by + 0.5)``, in float64, left to right (as
+    :meth:`end_points`; an end point on a cell edge goes to the upper cell). The batched gather does exactly
+    these operations (numpy rounds each one, it fuses none), so it picks the same cell as a per-particle loop
+    written this way at every particle and beam, cell edges included: its per-beam ``log q`` (float32 table
+    values) are the loop's bit for bit, and :meth:`log_likelihood`, their float64 sum, differs from the loop's
+    sum by the summation order only (at most B ulps of ``Σ|log q_k|``; a beam in another cell would move it by
+    at least one float32 step of a term, ~1e-7 relative to that term).
+
     Parameters
     ----------
     grid : array_like of int, shape (H, W)
@@ -215,7 +227,7 @@ class LikelihoodFieldModel:
         #: log of the largest q (an end point on an obstacle): scores are ≤ 1 relative to it
         self.log_q_max = float(self.log_q(np.array(0.0)))
         #: the log-q table, padded by ``z_max`` cells of "outside" so that an end point of a pose on the
-        #: map needs no bounds test (float32: one gather per beam is the hot loop)
+        #: map needs no bounds test (float32 values: one gather per beam is the hot loop)
         self.pad = int(np.ceil(self.z_max)) + 2
         H, W = g.shape
         T = np.full((H + 2 * self.pad, W + 2 * self.pad), self.log_outside, dtype=np.float32)
@@ -273,24 +285,38 @@ class LikelihoodFieldModel:
             raise TypeError(f"`beams` must be Beams (from scan_beams); got {type(beams).__name__}")
         keep = self.used(beams)
         Hp, Wp = self._padded_shape
-        off = self.pad + 0.5  # floor(x + 0.5) of the cell, shifted into the padded table
-        c = np.cos(P[:, 2]).astype(np.float32)[:, None]
-        s = np.sin(P[:, 2]).astype(np.float32)[:, None]
-        bx = beams.end_xy[keep, 0].astype(np.float32)[None, :]
-        by = beams.end_xy[keep, 1].astype(np.float32)[None, :]
-        x = (P[:, 0] + off).astype(np.float32)[:, None]
-        y = (P[:, 1] + off).astype(np.float32)[:, None]
-        col = np.floor(x + c * bx - s * by)
-        row = np.floor(y + s * bx + c * by)
+        c, s = np.cos(P[:, 2])[:, None], np.sin(P[:, 2])[:, None]  # float64, in the class docstring's order
+        bx, by = beams.end_xy[keep, 0][None, :], beams.end_xy[keep, 1][None, :]
         H, W = self.shape
-        if not (P[:, 0].min() >= -1 and P[:, 0].max() <= W and P[:, 1].min() >= -1 and P[:, 1].max() <= H):
-            # a pose off the map: its end points may leave the padding (inside it, z_max cells each side, they cannot)
-            np.clip(col, 0, Wp - 1, out=col)
-            np.clip(row, 0, Hp - 1, out=row)
-        idx = row.astype(np.int32)
-        idx *= Wp
-        idx += col.astype(np.int32)
-        return table[idx], keep
+        # a pose off the map: its end points may leave the padding (inside it, z_max cells each side, they cannot)
+        off_map = not (P[:, 0].min() >= -1 and P[:, 0].max() <= W and P[:, 1].min() >= -1 and P[:, 1].max() <= H)
+        n, m = len(P), min(len(P), _CHUNK)
+        out = np.empty((n, bx.shape[1]), dtype=table.dtype)
+        col, row, tmp = (np.empty((m, bx.shape[1])) for _ in range(3))  # reused: chunks stay in the cache
+        idx = np.empty((m, bx.shape[1]), dtype=np.intp)
+        for i in range(0, n, m):
+            j = min(i + m, n)
+            cl, rw, tp, ix = col[:j - i], row[:j - i], tmp[:j - i], idx[:j - i]
+            np.multiply(c[i:j], bx, out=cl)  # ((x + c·bx) − s·by) + 0.5
+            cl += P[i:j, :1]
+            cl -= np.multiply(s[i:j], by, out=tp)
+            cl += 0.5
+            np.multiply(s[i:j], bx, out=rw)  # ((y + s·bx) + c·by) + 0.5
+            rw += P[i:j, 1:2]
+            rw += np.multiply(c[i:j], by, out=tp)
+            rw += 0.5
+            np.floor(cl, out=cl)
+            np.floor(rw, out=rw)
+            if off_map:
+                np.clip(cl, -self.pad, Wp - 1 - self.pad, out=cl)
+                np.clip(rw, -self.pad, Hp - 1 - self.pad, out=rw)
+            rw += self.pad  # the index in the padded table, (row + pad)·Wp + col + pad: integers < 2**53, exact
+            rw *= Wp
+            rw += cl
+            rw += self.pad
+            ix[...] = rw
+            np.take(table, ix, out=out[i:j])
+        return out, keep
 
     def used(self, beams: Beams) -> np.ndarray:
         """Mask of the beams that enter the likelihood: ranges below ``z_max`` (PR Table 6.3 line 3).
@@ -439,61 +465,3 @@ class LikelihoodFieldModel:
             n = max(1, self.n_used(beams))
         L = lq.sum(axis=1, dtype=np.float64)
         return L if score == "likelihood" else L / n - self.log_q_max
-
-
-# --- beam model (PR Table 6.1) ------------------------------------------------------------------------
-
-
-def beam_model_prob(z, z_star, *, z_max: float, z_hit: float = 0.8, z_short: float = 0.1,
-                    z_max_w: float = 0.05, z_rand: float = 0.05, sigma_hit: float = 1.0,
-                    lambda_short: float = 0.1) -> np.ndarray:
-    """``p(z_k | x, m)`` of the beam model (PR Table 6.1 and eqs 6.4-6.12), element-wise.
-
-    ``z_hit·p_hit + z_short·p_short + z_max_w·p_max + z_rand·p_rand`` with ``p_hit`` a
-    normal ``N(z; z*, σ_hit²)`` truncated to ``[0, z_max]`` (normaliser from ``erf``),
-    ``p_short = η·λ·exp(−λz)`` on ``[0, z*]`` with ``η = 1/(1 − exp(−λz*))``,
-    ``p_max = 1`` at ``z = z_max`` (a point mass) and ``p_rand = 1/z_max`` on ``[0, z_max)``.
-
-    Parameters
-    ----------
-    z : array_like
-        Measured ranges.
-    z_star : array_like
-        Expected ranges (ray cast), broadcast with ``z``.
-    z_max : float
-        Maximum range.
-    z_hit, z_short, z_max_w, z_rand : float
-        Mixture weights of the hit, short, max-range and random components.
-    sigma_hit : float
-        σ of the hit component.
-    lambda_short : float
-        Rate λ of the short component.
-
-    Returns
-    -------
-    ndarray
-        ``p(z_k | x, m)`` element-wise.
-
-    Examples
-    --------
-    >>> round(float(beam_model_prob(5.0, 5.0, z_max=10.0, z_hit=1, z_short=0, z_max_w=0, z_rand=0)), 6)
-    0.398942
-    """
-    z = np.asarray(z, dtype=float)
-    zs = np.asarray(z_star, dtype=float)
-    zmax = check_positive(z_max, "z_max")
-    for name, val in (("z_hit", z_hit), ("z_short", z_short), ("z_max_w", z_max_w), ("z_rand", z_rand)):
-        check_positive(val, name, allow_zero=True)
-    sig = check_positive(sigma_hit, "sigma_hit")
-    lam = check_positive(lambda_short, "lambda_short")
-    inside = (z >= 0) & (z < zmax)
-    # eq 6.4-6.6: truncated normal
-    eta_hit = 1.0 / (0.5 * (erf((zmax - zs) / (np.sqrt(2) * sig)) - erf((0 - zs) / (np.sqrt(2) * sig))))
-    p_hit = np.where(inside, eta_hit * np.exp(-0.5 * ((z - zs) / sig) ** 2) / (np.sqrt(2 * np.pi) * sig), 0.0)
-    # eq 6.7-6.9: unexpected objects
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        eta_short = np.where(zs > 0, 1.0 / (1.0 - np.exp(-lam * zs)), 0.0)
-    p_short = np.where((z >= 0) & (z <= zs) & (zs > 0), eta_short * lam * np.exp(-lam * z), 0.0)
-    p_max = (z >= zmax).astype(float)  # eq 6.10
-    p_rand = np.where(inside, 1.0 / zmax, 0.0)  # eq 6.11
-    return z_hit * p_hit + z_short * p_short + z_max_w * p_max + z_rand * p_rand

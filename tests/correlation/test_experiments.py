@@ -197,7 +197,7 @@ def test_localisation_table_has_one_row_per_choice_and_pose():
     scans = [S.Rangefinder(n_beams=90, max_range_cells=40.0).scan(S.test_room_200(), [60.0, 40.0, 0.5])] * 2
     settings = (C.LocaliseParams(delta_alpha_rad=np.radians(10.0)),
                 C.LocaliseParams(delta_alpha_rad=np.radians(10.0), a_c=0.0))
-    table = CS.experiments.localise_scans(S.test_room_200(), scans, settings, margins=True, progress=False)
+    table = CS.batch.localise_scans(S.test_room_200(), scans, settings, margins=True, progress=False)
     assert table.columns.tolist() == ["choice", "pose_index", "x", "y", "heading_rad", "half_max_area",
                                       "heading_margin"]
     assert table[["choice", "pose_index"]].to_numpy().tolist() == [[0, 0], [0, 1], [1, 0], [1, 1]]

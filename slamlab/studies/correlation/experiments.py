@@ -36,6 +36,7 @@ from ...sim.grid import add_clutter, free_cells, measurement_room_200, test_room
 from ...sim.paths import random_free_poses
 from ...sim.rangefinder import Rangefinder
 from .aperture import ApertureResult
+from .batch import localise_scans, scan_estimates
 from .stamp_trim import StampTrimResult, trim_scan
 from .studies import (
     FAIL_CELLS,
@@ -81,71 +82,6 @@ def _worlds(clutter: bool, extra_clutter: int, rng):
     if extra_clutter:
         W = add_clutter(W, random_clutter(W, extra_clutter, rng=rng))
     return M, W
-
-
-def _localise_one(*, scan, choice: int, grid, settings, margins: bool = False, pose_index: int = 0) -> dict:
-    """One sweep task: localise one ``scan`` on ``grid`` with ``settings[choice]`` (deterministic)."""
-    loc = localise(grid, scan, params=settings[choice])
-    row = {"x": float(loc.pose[0]), "y": float(loc.pose[1]), "heading_rad": float(loc.pose[2])}
-    if margins:
-        row["half_max_area"], row["heading_margin"] = _margins(loc)
-    return row
-
-
-def localise_scans(M, scans, settings, *, margins: bool = False, n_jobs: int = 1, progress: bool | None = None):
-    """Localise every scan with every setting on :func:`slamlab.sweep.sweep`: one task per (setting, scan) (ours).
-
-    The scans were drawn by the caller (the random part stays in the parent, in its order); a
-    localisation draws nothing (``rng_arg=None``), so the table is the same for any ``n_jobs``.
-    The rival search is switched off (``ambiguity=False``): these runs report no ambiguity.
-
-    Parameters
-    ----------
-    M : numpy.ndarray of int, shape (H, W)
-        The stored map (cell codes).
-    scans : sequence of Scan
-        The scans, in cell units.
-    settings : sequence of LocaliseParams
-        The settings each scan is localised with.
-    margins : bool, default False
-        Also the half-maximum area and the heading margin of each localisation.
-    n_jobs : int, default 1
-        Sweep workers (same table for any).
-    progress : bool, optional
-        Progress bar (default: in a notebook only).
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns ``choice``, ``pose_index``, ``x``, ``y``, ``heading_rad`` and with ``margins`` ``half_max_area``,
-        ``heading_margin``; setting-major.
-    """
-    from ...sweep import sweep
-
-    settings = tuple(q.replace(ambiguity=False) for q in settings)
-    points = [{"choice": j, "pose_index": i, "scan": s} for j in range(len(settings)) for i, s in enumerate(scans)]
-    table = sweep(_localise_one, points, rng_arg=None, n_jobs=n_jobs, progress=progress, on_error="raise",
-                  desc="correlation localisation", fixed={"grid": M, "settings": settings, "margins": margins})
-    return table.drop(columns=["scan", "replicate", "error"])
-
-
-def _estimates(table) -> np.ndarray:
-    """``(n, 3)`` estimated poses (x, y, heading) of a :func:`_localise_scans` table."""
-    return table[["x", "y", "heading_rad"]].to_numpy(dtype=float)
-
-
-def _margins(loc, heading_window=3):
-    """Half-maximum area of the score map [cells] and relative heading margin of one localisation."""
-    dmap = loc.score_map
-    med = float(np.median(dmap))
-    area = float(np.count_nonzero(dmap >= med + 0.5 * (loc.score - med)))
-    b = loc.best_per_heading
-    n = b.size
-    idx = (np.arange(n) - loc.heading_index) % n
-    far = np.minimum(idx, n - idx) >= heading_window
-    bmed = float(np.median(b))
-    head = (loc.score - b[far].max()) / max(loc.score - bmed, 1e-12)
-    return area, head
 
 
 def random_clutter(grid, n: int, *, radius_cells: float = 1.5, margin_cells: int = 3, rng=None) -> list[tuple]:
@@ -229,7 +165,7 @@ def run_table1(n_poses: int = 10, *, range_std_cells: float = 0.3, n_beams: int 
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
-    est = _estimates(localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
+    est = scan_estimates(localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
     ea, ex, ey = absolute_errors(poses, est)
     return Table1Result(poses, est, ea, ex, ey, float(range_std_cells), int(n_beams), p, time.perf_counter() - t0)
 
@@ -286,7 +222,7 @@ def run_monte_carlo(size: str | int = "small", *, range_std_cells: float = 0.3, 
     poses = random_free_poses(W, n, margin_cells=2, rng=rng)
     scans = [rf.scan(W, pose, rng) for pose in poses]  # every draw here, in the order of the sequential loop
     t0 = time.perf_counter()
-    est = _estimates(localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
+    est = scan_estimates(localise_scans(M, scans, (p,), n_jobs=n_jobs, progress=progress))
     ea, ex, ey = absolute_errors(poses, est)
     ep = np.hypot(ex, ey)
     failed = ~within_tolerance(ep, ea)
@@ -363,7 +299,7 @@ def run_constants_study(n_poses: int = 12, *, extra_clutter: int = 60, range_std
     k = len(consts)
     t0 = time.perf_counter()
     table = localise_scans(M, scans, settings, margins=True, n_jobs=n_jobs, progress=progress)
-    est = _estimates(table).reshape(k, n, 3)
+    est = scan_estimates(table).reshape(k, n, 3)
     pm = table["half_max_area"].to_numpy(dtype=float).reshape(k, n)
     hm = table["heading_margin"].to_numpy(dtype=float).reshape(k, n)
     ep = np.hypot(est[..., 0] - poses[:, 0], est[..., 1] - poses[:, 1])

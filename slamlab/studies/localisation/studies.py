@@ -466,9 +466,9 @@ def run_score_comparison(variants=SCORE_VARIANTS, *, n_runs: int = 20, kidnap_pa
     refuse_set_fields(p, ["n_particles"], "`kidnap_particles` and `global_particles`")
     g_particles = check_int(global_particles, "global_particles", minimum=1)
     k_particles = check_int(kidnap_particles, "kidnap_particles", minimum=1)
-    # The kidnap half's stream is the next int seed, not a spawned one: notebook 08 prints this table, and with two
-    # spawned streams one of its numbers (the cubes' steps to recover) differs between numpy with and without its
-    # AVX-512 kernels (10 vs 12, measured): these MCL runs are not bit-reproducible across CPU features.
+    # The kidnap half's stream is the next int seed, not a spawned one (the table notebook 08 prints was first stored
+    # so). The table once differed between numpy with and without its AVX-512 kernels: the injection step drew from
+    # the stream or not as p_inj rounded to 0 or 1e-16 (fixed in slamlab.localisation.mcl, LOG_AVERAGE_TIE).
     if isinstance(rng, numbers.Integral) and not isinstance(rng, bool):
         rng_g, rng_k = rng, rng + 1
     else:
