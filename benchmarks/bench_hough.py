@@ -12,9 +12,9 @@ ours and the reference measured in the same process, and their ratio (reference 
   once the first-call time of the kernels in a new process, compiling and loaded from the cache;
 * the classic transform of 004 (ours, numpy) vs OpenCV on the same image.
 
-With ``--real-logs`` it runs instead the ablation of Hough SLAM on the two shared real logs (issue 25):
-per setting and log, the steps on odometry alone (fell back), the partial steps (parallel lines; heading from
-lines) and the sharpness 1 - (obstacle cells per 100 returns, Hough SLAM map) / (the same, odometry map).
+With ``--real-logs`` it runs instead Hough SLAM on every shared real log (``SHARED_LOGS``) and its ablation
+(``ablate_real_logs``): per change and log, the sharpness 1 - (obstacle cells per 100 returns, Hough SLAM map) /
+(the same, odometry map), against the log's odometry and the re-timed one, and the causes of the steps on odometry alone.
 
 Usage: ``python benchmarks/bench_hough.py [--repeat N] [--real-logs]``.
 """
@@ -98,43 +98,18 @@ def measure(phi, r, d_rho, d_theta, r_max, repeat):
     }
 
 
-#: The ablation of ``--real-logs``: label → overrides of :data:`slamlab.studies.hough.REAL_LOG_PARAMS` (per log
-#: key when a dict of dicts). The first row is the settings without our two additions (per-format max_gap, no
-#: heading step, no second line search at ``H_min_retry``).
-ABLATION = (
-    ("per-format max_gap, no heading step",
-     {"urg04lx": {"heading": False, "H_min_retry": None},
-      "mbicp": {"heading": False, "H_min_retry": None, "max_gap": 0.3}}),
-    ("one set (max_gap 0.2 m), no heading step, no retry", {"heading": False, "H_min_retry": None}),
-    ("one set + heading step, no retry", {"H_min_retry": None}),
-    ("defaults: one set + heading step + H_min retry 10", {}),
-    ("defaults, partial step off", {"partial": False}),
-    ("defaults, max_gap 0.3 m", {"max_gap": 0.3}),
-    ("defaults, H_min 10", {"H_min": 10}),
-    ("defaults, refit band 5 cm", {"band": 0.05}),
-    ("defaults, H_min 10 + band 5 cm", {"H_min": 10, "band": 0.05}),
-    ("defaults, angle_tol 1°", {"angle_tol_rad": math.radians(1.0)}),
-    ("defaults, rho_tol 10 cm", {"rho_tol": 0.1}),
-)
-
-
 def real_log_ablation():
-    """Print the ``--real-logs`` table: each setting of :data:`ABLATION` on both shared logs."""
+    """Print the ``--real-logs`` tables: each shared log's default run, the causes of its steps on odometry alone,
+    and :data:`slamlab.studies.hough.REAL_LOG_ABLATION` (one change at a time, every log)."""
     from slamlab.data import find_data
 
-    paths = {key: find_data(rel) for key, rel in sh.SHARED_LOGS.items()}
-    print(f"{'setting':56s} {'log':8s} {'alone':>7s} {'parallel':>9s} {'heading':>8s} {'cells S/O':>11s} "
-          f"{'sharper':>8s} {'s':>5s}  causes of the steps on odometry alone")
-    for label, over in ABLATION:
-        for key, path in paths.items():
-            kw = over.get(key, {}) if over and isinstance(next(iter(over.values())), dict) else over
-            t0 = time.perf_counter()
-            r = sh.run_real_log(path, progress=False, **kw)
-            c, n = r.slam.cause_counts(), r.odometry.shape[0] - 1
-            print(f"{label:56s} {key:8s} {r.slam.lost[1:].sum() / n:7.1%} {c['partial'] / n:9.1%} "
-                  f"{c['heading'] / n:8.1%} {r.sharpness('slam'):5.2f}/{r.sharpness('odometry'):5.2f} "
-                  f"{r.sharper_than_odometry():8.1%} {time.perf_counter() - t0:5.1f}  "
-                  + ", ".join(f"{k} {v}" for k, v in c.items() if v and k not in ("lines", "partial", "heading")))
+    t0 = time.perf_counter()
+    runs = [sh.run_real_log(find_data(rel), progress=False) for rel in sh.SHARED_LOGS.values()]
+    for r in runs:
+        print(r.table())
+    print(sh.real_log_cause_table(runs))
+    print(sh.ablate_real_logs(runs).table())
+    print(f"{time.perf_counter() - t0:.1f} s")
 
 
 _FIRST_CALL = """

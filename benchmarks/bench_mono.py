@@ -8,7 +8,10 @@
    (tracking + mapping), per-stage times; beside it, a feature-based reference on the same
    frames: ``cv2.calcOpticalFlowPyrLK`` frame to frame + ``cv2.solvePnPRansac`` on the same map.
 
-    python benchmarks/bench_mono.py [--frames 40]
+3. ``--kitti``: the monocular pipeline with its defaults on the shared KITTI 06 (51 frames) and KITTI 01
+   (51 frames) sets: correct share and ATE against the goal (>= 80 %, <= 2 % of the path), frames/s.
+
+    python benchmarks/bench_mono.py [--frames 40] [--kitti]
 """
 
 from __future__ import annotations
@@ -116,15 +119,32 @@ def se3_from(T_wc):
     return se3_inverse(T_wc)
 
 
+def bench_kitti():
+    from slamlab.data import find_data
+    from slamlab.studies.mono.kitti import run_kitti_mono
+    from slamlab.studies.mono.kitti_goal import kitti_goal_table
+
+    runs = {}
+    for label, name in (("KITTI 06", "kitti-odometry-06-stereo-51"), ("KITTI 01", "kitti-odometry-01-stereo")):
+        t = time.perf_counter()
+        runs[label] = run_kitti_mono(find_data(name))
+        dt = time.perf_counter() - t
+        print(f"  {label}: {len(runs[label].claimed)} frames in {dt:.1f} s ({len(runs[label].claimed) / dt:.1f} frames/s)")
+    print(kitti_goal_table(runs))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--frames", type=int, default=40)
+    ap.add_argument("--kitti", action="store_true", help="also the KITTI 06 and 01 goal runs")
     args = ap.parse_args()
     os.environ.setdefault("SLAMLAB_PROGRESS", "0")
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
           f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}")
     bench_filter()
     bench_tracking(args.frames)
+    if args.kitti:
+        bench_kitti()
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

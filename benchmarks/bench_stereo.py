@@ -13,6 +13,7 @@ query vs ``cv2.BFMatcher.knnMatch``.
     python benchmarks/bench_stereo.py --long             # + the ~80 m run of 000 §4.2 (slow)
     python benchmarks/bench_stereo.py --kitti            # + the 20 KITTI frames, issue 17's changes off (before) and on (after)
     python benchmarks/bench_stereo.py --kitti51          # + the 51-frame KITTI 06 set, issue 25's changes off and on
+    python benchmarks/bench_stereo.py --detectors surf,orb --frames 2 --kitti-sets  # + KITTI 06 and 01: table, ablation
     python benchmarks/bench_stereo.py --highway --seeds 8  # + the scale ablation on the simulated highway (51 frames)
     python benchmarks/bench_stereo.py --detectors orb --frames 2 --conditions --seeds 3  # + the highway's scene conditions
 
@@ -66,6 +67,8 @@ def main(argv=None):
     ap.add_argument("--long", action="store_true", help="also run the ~80 m path in the 10x12 m room")
     ap.add_argument("--kitti", action="store_true", help="also run the 20 KITTI frames with issue 17's changes off (before) and on (after)")
     ap.add_argument("--kitti51", action="store_true", help="also run the 51-frame KITTI 06 set, issue 25's changes off and on")
+    ap.add_argument("--kitti-sets", action="store_true",
+                    help="also run KITTI_PARAMS on KITTI 06 (51 frames) and KITTI 01 and the ablation of its last changes")
     ap.add_argument("--highway", action="store_true", help="also run the scale ablation on the simulated highway scene")
     ap.add_argument("--seeds", type=int, default=8, help="scenes per setting of --highway")
     ap.add_argument("--highway-frames", type=int, default=51, help="frames per run of --highway")
@@ -179,6 +182,17 @@ def main(argv=None):
             say("```")
             say(f"  ({det}: {time.perf_counter() - t0:.0f} s for both runs; load average "
                 f"{' '.join(f'{x:.2f}' for x in os.getloadavg())})")
+    if args.kitti_sets:
+        say()
+        t0 = time.perf_counter()
+        dets = tuple(d for d in args.detectors.split(",") if d in ("surf", "orb"))
+        say("```")
+        runs = sl.studies.stereo.kitti_set_runs(sl.studies.stereo.KITTI_ABLATION, detectors=dets, rng=0)
+        say(sl.studies.stereo.kitti_sets_table(runs))
+        say()
+        say(sl.studies.stereo.kitti_ablation_table(runs))
+        say("```")
+        say(f"  ({time.perf_counter() - t0:.0f} s; load average {' '.join(f'{x:.2f}' for x in os.getloadavg())})")
     if args.highway:
         say()
         t0 = time.perf_counter()

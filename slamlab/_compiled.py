@@ -23,6 +23,7 @@ compare the two, and a fallback where numba cannot be installed).
 from __future__ import annotations
 
 import os
+import threading
 
 __all__ = ["jitable", "kernel", "loaded_kernels", "numba_enabled"]
 
@@ -31,6 +32,8 @@ _JITABLE: list = []
 _REGISTERED: set = set()
 #: qualified names of the kernels compiled or loaded in this process, in order of first call
 _LOADED: list = []
+#: one first call at a time: two threads calling a kernel for the first time would both compile or load it
+_FIRST_CALL = threading.Lock()
 
 
 def numba_enabled() -> bool:
@@ -70,15 +73,18 @@ def kernel(fn):
     def call(*args):
         nonlocal compiled
         if compiled is None:
-            import numba
-            from numba.extending import register_jitable
+            with _FIRST_CALL:
+                if compiled is None:
+                    import numba
+                    from numba.extending import register_jitable
 
-            for helper in _JITABLE:  # before the first kernel compiles: the helpers it may call
-                if id(helper) not in _REGISTERED:
-                    register_jitable(inline="always")(helper)
-                    _REGISTERED.add(id(helper))
-            compiled = numba.njit(cache=True, nogil=True)(fn)
-            _LOADED.append(f"{fn.__module__}.{fn.__qualname__}")
+                    for helper in _JITABLE:  # before the first kernel compiles: the helpers it may call
+                        if id(helper) not in _REGISTERED:
+                            register_jitable(inline="always")(helper)
+                            _REGISTERED.add(id(helper))
+                    dispatcher = numba.njit(cache=True, nogil=True)(fn)
+                    compiled = dispatcher
+                    _LOADED.append(f"{fn.__module__}.{fn.__qualname__}")
         return compiled(*args)
 
     call.__name__ = fn.__name__

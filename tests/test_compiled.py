@@ -72,3 +72,47 @@ def test_hamming_words_is_the_bit_count_of_the_xor_in_python_and_inside_the_kern
     t = np.arange(20)[::-1].copy()  # query i's one candidate: target 19 - i
     d1 = ranges_hamming_2nn(Dq, Dt, t, np.arange(20), np.arange(1, 21))[1]
     assert d1.tolist() == ref[np.arange(20), t].astype(float).tolist()
+
+
+def _scaled_sum(x, k):
+    total = 0.0
+    for i in range(x.shape[0]):
+        total += k * x[i]
+    return total
+
+
+def test_first_calls_from_two_threads_make_one_dispatcher(monkeypatch):
+    # two threads calling a kernel for the first time at once: without the first-call lock each made its own
+    # dispatcher (compiled or loaded twice; loaded_kernels() listed it twice)
+    import threading
+
+    import numba
+
+    from slamlab import _compiled
+
+    made = []
+    real_njit = numba.njit
+
+    def counting_njit(*a, **k):
+        made.append(1)
+        return real_njit(*a, **k)
+
+    monkeypatch.setattr(numba, "njit", counting_njit)
+    compiled = kernel(_scaled_sum)
+    x = np.arange(10.0)
+    start = threading.Barrier(4)
+    out = []
+
+    def first_call():
+        start.wait()
+        out.append(compiled(x, 2.0))
+
+    threads = [threading.Thread(target=first_call) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert out == [90.0] * 4
+    assert len(made) == 1
+    name = f"{_scaled_sum.__module__}.{_scaled_sum.__qualname__}"
+    assert _compiled.loaded_kernels().count(name) == 1

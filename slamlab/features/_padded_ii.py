@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._compiled import numba_enabled
 from .._threads import run_tasks
 
 __all__ = ["PaddedIntegralImage", "by_chunks", "haar_from_corners"]
@@ -92,10 +93,15 @@ class PaddedIntegralImage:
             inner = E[pad:pad + H + 1, pad:pad + W + 1]
             inner[0] = 0.0
             inner[:, 0] = 0.0
-            body = inner[1:, 1:]  # columns, then rows, in two halves (independent: same sums)
-            halves = (slice(None, W // 2), slice(W // 2, None)), (slice(None, H // 2), slice(H // 2, None))
-            run_tasks([lambda c=c: np.cumsum(image[:, c], axis=0, out=body[:, c]) for c in halves[0]], workers)
-            run_tasks([lambda r=r: np.cumsum(body[r], axis=1, out=body[r]) for r in halves[1]], workers)
+            body = inner[1:, 1:]
+            if image.dtype == np.float64 and numba_enabled():  # the same sums, row by row (issue 45)
+                from ._surf_kernels import integral_body
+
+                integral_body(image, body)
+            else:  # columns, then rows, in two halves (independent: same sums)
+                halves = (slice(None, W // 2), slice(W // 2, None)), (slice(None, H // 2), slice(H // 2, None))
+                run_tasks([lambda c=c: np.cumsum(image[:, c], axis=0, out=body[:, c]) for c in halves[0]], workers)
+                run_tasks([lambda r=r: np.cumsum(body[r], axis=1, out=body[r]) for r in halves[1]], workers)
             E[pad:pad + H + 1, :pad] = inner[:, :1]  # edge padding, as np.pad(mode="edge")
             E[pad:pad + H + 1, pad + W + 1:] = inner[:, -1:]
             E[:pad] = E[pad]

@@ -35,7 +35,11 @@ step×step sub-grids, the coarser ones on strided views, and each octave after t
 of its four layers from the octave before (same filter side, twice the step); NMS compares the
 points above the threshold with their 26 neighbours; orientation and descriptors gather Haar
 responses for chunks of a few dozen keypoints of one rounded scale at once (temporaries that stay
-in the 1 MiB L2 cache), the orientation's sliding window from sums over angle bins.
+in the 1 MiB L2 cache), the orientation's sliding window from sums over angle bins. Where numba is
+available (issue 45; ``SLAMLAB_NO_NUMBA=1`` takes the numpy path) the response maps, the NMS, the
+orientation's Haar responses and window sums and the 64-d descriptor's sums run in compiled kernels
+(``_surf_kernels``, on chunks of 512 keypoints) that repeat the numpy operations in the same order: the same
+numbers bit for bit, tested.
 """
 
 from __future__ import annotations

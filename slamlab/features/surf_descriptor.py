@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._compiled import numba_enabled
 from .._validate import check_int
 from ._padded_ii import PaddedIntegralImage, by_chunks
 
@@ -44,18 +45,31 @@ def _window_edges(window_rad, step_rad):
     return nW, t, e0, e1, e2
 
 
-def _orientation_chunk(P, uv, s, step_rad, edges, fast):
+def _orientation_chunk(P, uv, s, step_rad, edges, fast, compiled=False):
     """Orientations of the keypoints ``uv`` of rounded scale ``s``, see :func:`surf_orientation`."""
     nW, (t0, t1), e0, e1, e2 = edges
     k = uv.shape[0]
     r0, c0 = np.rint(uv[:, 1]).astype(np.int64)[:, None], np.rint(uv[:, 0]).astype(np.int64)[:, None]
-    if fast:
-        dx, dy = P.haar(P.index(r0, c0) + P.index(_ORI_J * s, _ORI_I * s) - P.index(0, 0), 2 * s)
+    if fast and compiled:  # the same responses and weights, fused per sample (_surf_kernels; issue 45)
+        from ._surf_kernels import haar_samples
+
+        dx, dy = np.empty((k, _ORI_G.size)), np.empty((k, _ORI_G.size))
+        haar_samples(P.flat, P.Wp, P.index(r0, c0) + P.index(_ORI_J * s, _ORI_I * s) - P.index(0, 0), 2 * s,
+                     _ORI_G, dx, dy)
     else:
-        dx, dy = P.haar_clipped(r0 + _ORI_J * s, c0 + _ORI_I * s, 2 * s)
-    dx *= _ORI_G
-    dy *= _ORI_G
+        if fast:
+            dx, dy = P.haar(P.index(r0, c0) + P.index(_ORI_J * s, _ORI_I * s) - P.index(0, 0), 2 * s)
+        else:
+            dx, dy = P.haar_clipped(r0 + _ORI_J * s, c0 + _ORI_I * s, 2 * s)
+        dx *= _ORI_G
+        dy *= _ORI_G
     ang = np.arctan2(dy, dx)
+    if compiled:  # the same bins, sums and choice, one pass per keypoint (_surf_kernels; issue 45)
+        from ._surf_kernels import orientation_best
+
+        best = np.empty((2, k))
+        orientation_best(ang, dx, dy, float(step_rad), nW, float(t0), float(t1), e0, e1, e2, best)
+        return np.arctan2(best[1], best[0]) % (2 * np.pi)
     np.add(ang, 2 * np.pi, out=ang, where=ang < 0)  # = ang % 2π for ang in [-π, π]
     u = np.divide(ang, step_rad, out=ang)
     bins = np.minimum(np.floor(u), nW - 1)
@@ -80,7 +94,7 @@ def _orientation_chunk(P, uv, s, step_rad, edges, fast):
 
 
 def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_rad: float = 0.15,
-                     chunk: int = 128, workers: int = 1, _padded=None) -> np.ndarray:
+                     chunk: int | None = None, workers: int = 1, _padded=None) -> np.ndarray:
     """Dominant orientation from Haar responses in a sliding 60° window (Bay 2008 §4.1).
 
     Returns angles in [0, 2π), image axes (u right, v down). The window sums are differences of
@@ -102,8 +116,9 @@ def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_ra
         Width of the sliding angular window (Bay: π/3).
     step_rad : float
         Step of the window's start angle.
-    chunk : int
-        Keypoints per vectorised chunk.
+    chunk : int, optional
+        Keypoints per vectorised chunk (default 128; 512 with the compiled kernels, whose calls cost more than
+        their temporaries).
     workers : int
         Threads.
     _padded : PaddedIntegralImage, optional
@@ -116,14 +131,15 @@ def surf_orientation(II, uv, scale_px, *, window_rad: float = np.pi / 3, step_ra
     """
     uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     s = np.maximum(np.rint(np.asarray(scale_px, dtype=np.float64)), 1).astype(np.int64)
-    chunk = check_int(chunk, "chunk", minimum=1)
+    compiled = numba_enabled()
+    chunk = check_int((512 if compiled else 128) if chunk is None else chunk, "chunk", minimum=1)
     workers = check_int(workers, "workers", minimum=1)
     P = PaddedIntegralImage(II) if _padded is None else _padded
     edges = _window_edges(float(window_rad), float(step_rad))
     fast = P.fits(uv, 7 * s + 1)  # samples at up to 5s, boxes of half-side 2s
 
     def one(idx, f, si):
-        return _orientation_chunk(P, uv[idx], si, step_rad, edges, f)
+        return _orientation_chunk(P, uv[idx], si, step_rad, edges, f, compiled)
 
     return by_chunks(one, fast, s, chunk, workers, np.zeros(uv.shape[0]))
 
@@ -153,10 +169,17 @@ def _subregion_sums(R):
     return S.reshape(*R.shape[:-1], 16)
 
 
-def _describe_chunk(P, uv, sigma, s, th, extended, fast):
+def _describe_chunk(P, uv, sigma, s, th, extended, fast, compiled=False):
     """Descriptors of the keypoints ``uv`` of rounded scale ``s``, see :func:`surf_describe`."""
     k = uv.shape[0]
     cs, sn = np.cos(th)[:, None], np.sin(th)[:, None]
+    if compiled and fast and not extended:  # the same numbers, fused per keypoint (_surf_kernels; issue 45)
+        from ._surf_kernels import describe_sums
+
+        desc = np.empty((k, 64))
+        describe_sums(P.flat, P.Wp, int(P.index(0, 0)), uv, sigma, cs[:, 0], sn[:, 0], int(s), _D_OFF, _D_G, desc)
+        norm = np.linalg.norm(desc, axis=1, keepdims=True)
+        return desc / np.where(norm > 0, norm, 1.0)
     sg = sigma[:, None]
     # sample positions: the 20×20 grid rotated by θ (u right, v down), rounded to pixels;
     # x = (X·c - Y·s)·σ + u with the products taken on the 20 grid values (the same numbers)
@@ -210,7 +233,7 @@ def _describe_chunk(P, uv, sigma, s, th, extended, fast):
     return desc / np.where(norm > 0, norm, 1.0)
 
 
-def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, chunk: int = 32,
+def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, chunk: int | None = None,
                   workers: int = 1, _padded=None):
     """64-d (or extended 128-d) SURF descriptors, unit length (Bay 2008 §4.2).
 
@@ -233,8 +256,9 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
         Keypoint orientations (0 for U-SURF).
     extended : bool
         128-d descriptor (sums split by the sign of the other response).
-    chunk : int
-        Keypoints per vectorised chunk.
+    chunk : int, optional
+        Keypoints per vectorised chunk (default 32; 512 with the compiled kernels, whose calls cost more than
+        their temporaries).
     workers : int
         Threads.
     _padded : PaddedIntegralImage, optional
@@ -252,12 +276,13 @@ def surf_describe(II, uv, scale_px, orientation_rad, *, extended: bool = False, 
     K = uv.shape[0]
     dim = 128 if extended else 64
     out = np.zeros((K, dim), dtype=np.float32)
-    chunk = check_int(chunk, "chunk", minimum=1)
+    compiled = numba_enabled()
+    chunk = check_int((512 if compiled else 32) if chunk is None else chunk, "chunk", minimum=1)
     workers = check_int(workers, "workers", minimum=1)
     P = PaddedIntegralImage(II) if _padded is None else _padded
     fast = P.fits(uv, np.ceil(13.44 * sigma) + s_int + 1)  # samples within 9.5·√2·σ, boxes of half-side s
 
     def one(idx, f, si):
-        return _describe_chunk(P, uv[idx], sigma[idx], si, th[idx], extended, f)
+        return _describe_chunk(P, uv[idx], sigma[idx], si, th[idx], extended, f, compiled)
 
     return by_chunks(one, fast, s_int, chunk, workers, out)

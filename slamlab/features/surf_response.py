@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._compiled import numba_enabled
 from .._threads import run_tasks
 from .._validate import as_finite_array, as_vector, check_int, check_positive
 from ._padded_ii import PaddedIntegralImage
@@ -224,21 +225,31 @@ def _response_stacks(II, n_octaves, init_step, workers=1, padded=None, phase_oct
     Speed (issue 17): octave ``o > 0`` shares two filter sides with octave ``o - 1`` (15 and 27 with
     9, 15, 21, 27; ...) on a grid twice as coarse, so its intervals 0 and 1 are the previous octave's
     intervals 1 and 3 taken every second row and column (OpenSURF shares these layers too); only 10
-    of the 16 maps are computed, split over ``workers``. The first ``phase_octaves`` octaves run on
-    contiguous phases (:class:`_Phases`); the coarser ones, whose phases would outweigh their maps
-    (16 phases for 2 maps at step 4), on strided views of the padded image. Same values bit for bit.
+    of the 16 maps are computed, split over ``workers``. With compiled kernels (issue 45) each map is one
+    pass over the padded image (``_surf_kernels.hessian_det``: the operations of :func:`hessian_response`
+    per grid point). Without, the first ``phase_octaves`` octaves run on contiguous phases (:class:`_Phases`);
+    the coarser ones, whose phases would outweigh their maps (16 phases for 2 maps at step 4), on strided
+    views of the padded image. Same values bit for bit.
     """
     H, W = II.shape[0] - 1, II.shape[1] - 1
     L = filter_sizes(n_octaves)
     E = PaddedIntegralImage(II) if padded is None else padded
     out, jobs = [], []
+    compiled = numba_enabled()
+    if compiled:
+        _load_kernels(E)
     for o in range(n_octaves):
         step = init_step * 2**o
         nr, nc = -(-H // step), -(-W // step)
         D = np.empty((4, nr, nc))
         new = range(4) if o == 0 else (2, 3)
         reach = (int(L[o][-1]) - 1) // 2 + 1
-        if o < phase_octaves:
+        if compiled and reach + step <= E.pad:  # the same values, one pass per map (_surf_kernels; issue 45)
+            from ._surf_kernels import hessian_det
+
+            jobs += [lambda Li=int(L[o][i]), d=D[i], step=step, nr=nr, nc=nc: hessian_det(
+                     E.flat, E.Wp, int(E.index(0, 0)), step, nr, nc, Li, d) for i in new]
+        elif o < phase_octaves:
             ph = _Phases(E, step, reach, nr, nc)
             jobs += [lambda ph=ph, Li=int(L[o][i]), d=D[i]: _hessian_phases(ph, Li, d) for i in new]
         else:
@@ -252,6 +263,18 @@ def _response_stacks(II, n_octaves, init_step, workers=1, padded=None, phase_oct
         (D0, _), (D, _) = out[o - 1], out[o]
         D[0], D[1] = D0[1, ::2, ::2], D0[3, ::2, ::2]
     return out
+
+
+def _load_kernels(E):
+    """Compile (or load from numba's cache) the response and NMS kernels here, before worker threads call them.
+
+    Two threads making the first call of a kernel at once would each compile or load it (the same code,
+    twice the time); a call on a 1×1 grid and a 3×3×3 stack costs microseconds.
+    """
+    from ._surf_kernels import hessian_det, interior_maxima
+
+    hessian_det(E.flat, E.Wp, int(E.index(0, 0)), 1, 1, 1, 9, np.empty((1, 1)))
+    interior_maxima(np.zeros((3, 3, 3)), 0.0, np.empty(27, dtype=np.int64))
 
 
 # the 26 neighbours of the 3×3×3 box: the 6 faces first (column ones first), then edges, corners
@@ -269,6 +292,14 @@ def _interior_maxima(D, threshold):
     order as ``scipy.ndimage.maximum_filter`` (a point equal to the max is kept).
     """
     _, nr, nc = D.shape
+    if numba_enabled():  # the same points in the same order, one pass (_surf_kernels; issue 45)
+        from ._surf_kernels import interior_maxima
+
+        f = np.empty(D.size, dtype=np.int64)
+        f = f[:interior_maxima(D, float(threshold), f)]
+        i, rc = np.divmod(f, nr * nc)
+        r, c = np.divmod(rc, nc)
+        return i, r, c
     inner = D[1:-1, 1:-1, 1:-1]
     cand = threshold < inner
     cand &= inner >= D[1:-1, 1:-1, :-2]  # the two column neighbours on whole arrays, the rest by gathers

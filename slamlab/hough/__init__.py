@@ -6,6 +6,7 @@ Scans are :class:`slamlab.scans.Scan` objects; maps come from :func:`slamlab.sca
 from .._lazy import lazy_exports
 from .association import LineHistory, associate_lines, association_probability
 from .icp import IcpResult, icp, icp_odometry, rigid_fit_2d
+from .latency import LAGS_SCANS, line_rotation_steps, odometry_lag, retime_poses
 from .lines import (
     Lines,
     align_lines,
@@ -18,7 +19,7 @@ from .lines import (
 )
 from .mapping import map_agreement
 from .pose import PoseChange, pose_from_lines, pose_from_two_lines, select_line_pair
-from .slam import STEP_CAUSES, HoughSlamParams, HoughSlamResult, detect_lines, hough_slam
+from .slam import STEP_CAUSES, HoughSlamParams, HoughSlamResult, detect_lines, hough_slam, scan_lines
 from .transform import (
     HoughAccumulator,
     hough_classic,
@@ -34,6 +35,7 @@ _PLOT = ("accumulator_figure", "plot_accumulator", "plot_built_map", "plot_scan_
 __getattr__, __dir__ = lazy_exports(__name__, dict.fromkeys(_PLOT, ".plot"))
 
 __all__ = [
+    "LAGS_SCANS",
     "STEP_CAUSES",
     "HoughAccumulator",
     "HoughSlamParams",
@@ -55,15 +57,19 @@ __all__ = [
     "icp",
     "icp_odometry",
     "line_difference",
+    "line_rotation_steps",
     "line_scan",
     "lines_about_centre",
     "map_agreement",
     "merge_duplicates",
+    "odometry_lag",
     "pose_from_lines",
     "pose_from_two_lines",
     "rasterise_scan",
     "refine_lines",
+    "retime_poses",
     "rigid_fit_2d",
+    "scan_lines",
     "select_line_pair",
     "theta_axis",
     "transform_lines",

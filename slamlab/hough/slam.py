@@ -34,7 +34,7 @@ from .lines import Lines, find_peaks, merge_duplicates, refine_lines, transform_
 from .pose import pose_from_lines, weighted_median
 from .transform import hough_polar, theta_axis
 
-__all__ = ["STEP_CAUSES", "HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam"]
+__all__ = ["STEP_CAUSES", "HoughSlamParams", "HoughSlamResult", "detect_lines", "hough_slam", "scan_lines"]
 
 #: How each step's pose was obtained (ours): the code stored in :attr:`HoughSlamResult.cause`.
 #: Codes 0 and 1 use the lines; every other code means the step fell back on odometry, for that cause.
@@ -275,6 +275,50 @@ def _detect(bearings_rad, ranges, params: HoughSlamParams) -> Lines:
     return lines
 
 
+def _retry_params(params: HoughSlamParams) -> HoughSlamParams | None:
+    """The settings of the second line search (``H_min_retry`` below ``H_min``), or None."""
+    low = params.H_min_retry is not None and params.H_min_retry < params.H_min  # a retry only below H_min
+    return params.replace(H_min=params.H_min_retry) if low else None
+
+
+def _scan_lines(returns, params: HoughSlamParams, retry: HoughSlamParams | None) -> Lines:
+    lines = _detect(*returns, params)
+    if len(lines) < 2 and retry is not None:  # ours: a sparse scan, searched again at a lower threshold
+        lines = _detect(*returns, retry)
+    return lines
+
+
+def scan_lines(scans: Sequence[Scan], params: HoughSlamParams | None = None, **overrides) -> list[Lines]:
+    """Each scan's lines as :func:`hough_slam` finds them: :func:`detect_lines`, then the ``H_min_retry`` search.
+
+    Pass the result to ``hough_slam(..., lines=)`` to run the loop again without detecting again.
+
+    Parameters
+    ----------
+    scans : sequence of Scan
+        The scans (one unit).
+    params : HoughSlamParams, optional
+        Settings (default :class:`HoughSlamParams`).
+    **overrides
+        Fields of :class:`HoughSlamParams` to change.
+
+    Returns
+    -------
+    list of Lines
+        One per scan, strongest first.
+
+    Examples
+    --------
+    >>> from slamlab.hough import line_scan
+    >>> phi, r = line_scan(10.0, np.radians(45.0), r_max=16.0)
+    >>> [len(x) for x in scan_lines([Scan(phi, r, np.ones(phi.size, bool))] * 2, H_min=20)]
+    [1, 1]
+    """
+    params = HoughSlamParams.resolve(params, **overrides)
+    retry = _retry_params(params)
+    return [_scan_lines(_returns(s, f"scans[{k}]"), params, retry) for k, s in enumerate(scans)]
+
+
 def _relative(history, n1, n2, params):
     ids1, l1 = history.scan(n1)
     ids2, l2 = history.scan(n2)
@@ -356,7 +400,7 @@ def _heading(history, n1, n2, prior, params):
 
 def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
                params: HoughSlamParams | None = None, *, progress: bool | None = None,
-               **overrides) -> HoughSlamResult:
+               lines: Sequence[Lines] | None = None, **overrides) -> HoughSlamResult:
     """Run Hough-transform SLAM over a sequence of scans (004 Fig. 2, Fig. 4).
 
     Parameters
@@ -372,6 +416,9 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     params : HoughSlamParams, optional
     progress : bool, optional
         A bar over the scans (None: on unless ``$SLAMLAB_PROGRESS=0``).
+    lines : sequence of Lines, optional
+        Each scan's lines from :func:`scan_lines` with the same detection settings (the
+        detection is skipped; ours, for re-running the loop).
     **overrides
         Fields of :class:`HoughSlamParams` to change.
 
@@ -400,12 +447,12 @@ def hough_slam(scans: Sequence[Scan], start_pose=(0.0, 0.0, 0.0), odometry=None,
     cause = np.zeros(n, dtype=np.int64)
     history = LineHistory()
     keyframe = 0
-    low = params.H_min_retry is not None and params.H_min_retry < params.H_min  # a retry only below H_min
-    retry = params.replace(H_min=params.H_min_retry) if low else None
+    retry = _retry_params(params)
+    found = None if lines is None else list(lines)
+    if found is not None and (len(found) != n or not all(isinstance(x, Lines) for x in found)):
+        raise ValueError(f"`lines` must hold one Lines per scan ({n}); got {len(found)} items")
     for k in progress_bar(range(n), desc="Hough SLAM", progress=progress):
-        lines = _detect(*returns[k], params)
-        if len(lines) < 2 and retry is not None:  # ours: a sparse scan, searched again at a lower threshold
-            lines = _detect(*returns[k], retry)
+        lines = _scan_lines(returns[k], params, retry) if found is None else found[k]
         n_lines[k] = len(lines)
         if k == 0:
             history.add_scan(lines, np.full(len(lines), -1))

@@ -176,6 +176,10 @@ class Initialiser:
         Triangulation angle a point of the first map needs [deg] (default 0).
     plane_share : float
         ``"auto"``: the homography when its inliers are at least this share of the 5-point's (default 0.9).
+    plane_share_of : str
+        ``"auto"``: the 5-point method's count compared: ``"ransac"`` its RANSAC inliers (default, ours), or
+        ``"front"`` those ``cv2.recoverPose`` keeps (in front, nearer than 50 baselines: on a road, the far
+        points drop out and the road's homography wins with a wrong pose).
     median_depth_m : float
         Median depth the first map is scaled to (default 1).
     lk_win_px : int
@@ -202,6 +206,7 @@ class Initialiser:
     min_parallax_deg: float = 1.0
     min_point_parallax_deg: float = 0.0  # ours: points of the first map need at least this triangulation angle
     plane_share: float = 0.9  # "auto": the homography when its inliers are at least this share of the 5-point's
+    plane_share_of: str = "ransac"  # "auto": the 5-point's RANSAC inliers ("ransac") or those in front ("front")
     median_depth_m: float = 1.0
     lk_win_px: int = 21
     fb_max_px: float = 1.0
@@ -220,6 +225,7 @@ class Initialiser:
         check_probability(self.min_tracked_ratio, "min_tracked_ratio")
         check_choice(self.method, "method", ("homography", "essential", "auto"))
         check_probability(self.plane_share, "plane_share")
+        check_choice(self.plane_share_of, "plane_share_of", ("ransac", "front"))
         check_positive(self.min_parallax_deg, "min_parallax_deg", allow_zero=True)
         check_positive(self.min_point_parallax_deg, "min_point_parallax_deg", allow_zero=True)
 
@@ -284,7 +290,9 @@ class Initialiser:
             pose_h = relative_pose_homography(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
             pose_e = relative_pose_essential(self.ref_uv, self.cur_uv, self.K, ransac_px=self.ransac_px)
             n_h = int(np.count_nonzero(pose_h.inliers)) if pose_h.ok else 0
-            n_e = int(np.count_nonzero(pose_e.inliers)) if pose_e.ok else 0
+            # the 5-point's RANSAC inliers, not only those recoverPose keeps (ours: see `plane_share_of`)
+            n_e = (pose_e.n_ransac if self.plane_share_of == "ransac" else int(np.count_nonzero(pose_e.inliers))) \
+                if pose_e.ok else 0
             pose = pose_h if pose_h.ok and n_h >= self.plane_share * n_e else pose_e
             self.counts["auto_homography" if pose is pose_h else "auto_essential"] = \
                 self.counts.get("auto_homography" if pose is pose_h else "auto_essential", 0) + 1

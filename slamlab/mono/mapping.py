@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.se3 import se3_compose, se3_inverse, transform_points
-from ..geometry.so3 import rotation_angle
+from ..geometry.so3 import rotation_angle, se3_exp, se3_log
 from .align import build_pyramid, project
 from .depth_filter import (
     Seeds,
@@ -124,6 +124,10 @@ class MappingMixin:
                 self._T_show = r["T_pred"][idx]
                 return None
             s = step * (f1 - f0) / max(float(np.sqrt(np.sum(t**2))), 1e-12)
+            s_map = self._map_scale(res, r) if f0 == r["anchor"] and self.p.reinit_scale == "map" else None
+            if s_map is not None:
+                s = s_map
+                self._count("reinit_scaled_by_map")
             t, X0 = t * s, X0 * s
             self._count("reinitialised")
             self._reinit = None
@@ -143,6 +147,11 @@ class MappingMixin:
         self.point_fail = np.concatenate([self.point_fail, np.zeros(len(X0), np.int64)])
         self._T_cw = T1 = orthonormalise(T1)
         self._last_idx = idx
+        if vel is None and self.p.init_velocity:
+            # ours: the first map's motion per frame, (T1 T0⁻¹)^(1/n) over its n frames, is the velocity of the
+            # first tracked frame (a car moving ~1 m per frame leaves the alignment's reach from the last pose)
+            n = max(res.frame1 - res.frame0, 1)
+            vel = orthonormalise(se3_exp(se3_log(se3_compose(T1, se3_inverse(T0))) / n))
         self._T_cw_prev = None if vel is None else se3_compose(se3_inverse(vel), T1)
         self._n_coast = 0
         self._prev_pyr = build_pyramid(image, self.p.align_max_level)
@@ -153,6 +162,24 @@ class MappingMixin:
         self._add_keyframe(image, idx, np.arange(n_old, len(self.points)), res.uv1)
         self._n_at_kf = min(len(X0), self.p.max_matches)
         return len(X0)
+
+    def _map_scale(self, res, r, *, max_px: float = 1.5, min_common: int = 10):
+        """Scale of a new two-view map from the old map (ours): the median ratio of an old point's depth to the
+        new point's at the same pixel (within ``max_px``) of the anchor frame, the last tracked one; ``None``
+        with fewer than ``min_common`` such pairs.
+
+        Brute-force pixel distances, element-wise in float64 (no BLAS: a pair at the threshold is decided the
+        same way on every machine).
+        """
+        uv_old, z_old = r["anchor_uv"], r["anchor_z"]
+        if len(uv_old) < min_common or len(res.uv0) < min_common:
+            return None
+        d2 = np.sum((res.uv0[:, None, :] - uv_old[None, :, :]) ** 2, axis=2)  # (new, old) squared px
+        j = np.argmin(d2, axis=1)
+        ok = (d2[np.arange(len(j)), j] <= max_px**2) & (res.X0[:, 2] > 1e-9) & (z_old[j] > 1e-9)
+        if np.count_nonzero(ok) < min_common:
+            return None
+        return float(np.median(z_old[j[ok]] / res.X0[ok, 2]))
 
     def _add_keyframe(self, image, idx, vis_idx, vis_uv):
         p = self.p

@@ -30,10 +30,14 @@ class MonoParams(Params):
     init_plane_share : float
         ours ('auto'): the homography when its RANSAC inliers are at least this share of the 5-point
         method's
+    init_plane_share_of : str
+        ours ('auto'): the 5-point method's inliers counted: its RANSAC inliers ('ransac') or those
+        cv2.recoverPose keeps in front within 50 baselines ('front')
     init_ransac_px : float
         ours
     init_min_parallax_deg : float
-        ours: median triangulation angle needed
+        ours: median triangulation angle needed (KITTI 01's forward motion: 1 deg kept a re-initialisation
+        waiting)
     init_min_point_parallax_deg : float
         ours: triangulation angle each point of the first map needs
     convergence : str
@@ -97,8 +101,18 @@ class MonoParams(Params):
     reinit_when_lost : bool
         ours: after coasting, a new two-view map placed at the predicted pose, scaled by the velocity
         (constant-velocity prior only)
+    reinit_velocity_frames : int
+        ours: a re-initialisation is checked against, and moves with, the mean one-frame motion of this many
+        last tracked frames (1: the last frame's velocity)
+    reinit_scale : str
+        ours: a re-initialisation's scale: 'map' the median depth ratio of the old map's points to the new
+        map's at the same pixels of the last tracked frame (the steps when fewer than 10 pixels agree),
+        'steps' the median of the last tracked frames' steps
     prefer_seen : bool
         ours: among the map points in view, those matched in the previous frame first
+    init_velocity : bool
+        ours: the first map's two-view motion, per frame, is the constant-velocity prior of the first tracked
+        frame (off: that frame starts at the last pose)
     min_inlier_share : float
         ours: lost when fewer than this share of the matched points are inliers
     max_align_rms : float
@@ -118,10 +132,14 @@ class MonoParams(Params):
     init_min_tracked: float = param(0.5, "ours: restart when fewer than this share of corners is still tracked")
     init_method: str = param("auto", "ours: the homography when a dominant plane explains the matches, else the "
                                      "5-point algorithm (003 §4.3.1 names both; 'homography', 'essential')")
-    init_plane_share: float = param(0.9, "ours ('auto'): the homography when its RANSAC inliers are at least this "
+    init_plane_share: float = param(0.7, "ours ('auto'): the homography when its RANSAC inliers are at least this "
                                          "share of the 5-point method's")
+    init_plane_share_of: str = param("ransac", "ours ('auto'): the 5-point method's inliers counted: its RANSAC "
+                                               "inliers ('ransac') or those cv2.recoverPose keeps in front within "
+                                               "50 baselines ('front')")
     init_ransac_px: float = param(2.0, "ours")
-    init_min_parallax_deg: float = param(1.0, "ours: median triangulation angle needed")
+    init_min_parallax_deg: float = param(0.5, "ours: median triangulation angle needed (KITTI 01's forward motion: "
+                                              "1 deg kept a re-initialisation waiting)")
     init_min_point_parallax_deg: float = param(0.0, "ours: triangulation angle each point of the first map needs")
     # depth filter (003 §4.1.1, §4.2, §4.3.2; SVO)
     convergence: str = param("linearity", "003 §4.3.2: 'linearity' (L < 0.1) or SVO's 'sigma'")
@@ -158,7 +176,16 @@ class MonoParams(Params):
                                   "before a re-initialisation (0: re-initialise at once)")
     reinit_when_lost: bool = param(True, "ours: after coasting, a new two-view map placed at the predicted pose, "
                                          "scaled by the velocity (constant-velocity prior only)")
+    reinit_velocity_frames: int = param(5, "ours: a re-initialisation is checked against, and moves with, the mean "
+                                           "one-frame motion of this many last tracked frames (1: the last frame's "
+                                           "velocity)")
+    reinit_scale: str = param("map", "ours: a re-initialisation's scale: 'map' the median depth ratio of the old "
+                                     "map's points to the new map's at the same pixels of the last tracked frame "
+                                     "(the steps when fewer than 10 pixels agree), 'steps' the median of the last "
+                                     "tracked frames' steps")
     prefer_seen: bool = param(True, "ours: among the map points in view, those matched in the previous frame first")
+    init_velocity: bool = param(True, "ours: the first map's two-view motion, per frame, is the constant-velocity "
+                                      "prior of the first tracked frame (off: that frame starts at the last pose)")
     # failure detection and the switches of 003 §5.1.1 / §5.4 (ours unless stated)
     min_inlier_share: float = param(0.35, "ours: lost when fewer than this share of the matched points are inliers")
     max_align_rms: float = param(40.0, "ours: lost when the alignment's photometric RMS (grey levels) exceeds this")
@@ -174,6 +201,7 @@ class MonoParams(Params):
         check_probability(self.init_min_tracked, "init_min_tracked")
         check_choice(self.init_method, "init_method", ("homography", "essential", "auto"))
         check_probability(self.init_plane_share, "init_plane_share")
+        check_choice(self.init_plane_share_of, "init_plane_share_of", ("ransac", "front"))
         check_positive(self.init_ransac_px, "init_ransac_px")
         check_positive(self.init_min_parallax_deg, "init_min_parallax_deg", allow_zero=True)
         check_positive(self.init_min_point_parallax_deg, "init_min_point_parallax_deg", allow_zero=True)
@@ -207,10 +235,13 @@ class MonoParams(Params):
         check_positive(self.reproj_inlier_deg, "reproj_inlier_deg")
         check_int(self.min_inliers, "min_inliers", minimum=6)
         check_int(self.max_coast, "max_coast", minimum=0)
+        check_int(self.reinit_velocity_frames, "reinit_velocity_frames", minimum=1, maximum=10)
+        check_choice(self.reinit_scale, "reinit_scale", ("map", "steps"))
         check_int(self.refine_iters, "refine_iters", minimum=1)
         if not 0.0 <= check_positive(self.min_inlier_share, "min_inlier_share", allow_zero=True) <= 1.0:
             raise ValueError(f"`min_inlier_share` must be in [0, 1]; got {self.min_inlier_share}")
         check_positive(self.max_align_rms, "max_align_rms")
-        for name in ("outlier_rejection", "refine", "prefer_seen", "warp_patches", "reinit_when_lost"):
+        for name in ("outlier_rejection", "refine", "prefer_seen", "warp_patches", "reinit_when_lost",
+                     "init_velocity"):
             if not isinstance(getattr(self, name), bool):
                 raise TypeError(f"`{name}` must be True or False; got {getattr(self, name)!r}")

@@ -25,6 +25,7 @@ import numpy as np
 
 from .._validate import as_image, as_matrix
 from ..geometry.se3 import se3_compose, se3_inverse, transform_points
+from ..geometry.so3 import se3_exp, se3_log
 from .align import build_pyramid, project, refine_pose, sparse_align
 from .depth_filter import init_seeds
 from .initialise import Initialiser, track_lk
@@ -61,6 +62,7 @@ class MonoSLAM(MappingMixin):
         self.init = self._new_initialiser()
         self._last_idx = -1  # index of the last tracked (or initialised) frame
         self._steps: list[float] = []  # recent per-frame steps (map units) of tracked frames
+        self._twists: list[np.ndarray] = []  # and their one-frame motions (se3_log of the velocity)
         self._reinit = None  # while re-initialising after a loss (ours): velocity, predicted poses, frame offset
         self.initialised = False
         self.keyframes: list[Keyframe] = []
@@ -95,7 +97,8 @@ class MonoSLAM(MappingMixin):
                            min_disparity_px=p.init_disparity_px, min_tracked_ratio=p.init_min_tracked,
                            method=p.init_method, ransac_px=p.init_ransac_px,
                            min_parallax_deg=p.init_min_parallax_deg,
-                           min_point_parallax_deg=p.init_min_point_parallax_deg, plane_share=p.init_plane_share)
+                           min_point_parallax_deg=p.init_min_point_parallax_deg, plane_share=p.init_plane_share,
+                           plane_share_of=p.init_plane_share_of)
 
     def _corners(self, image):
         from ..features.opencv import fast_cv
@@ -343,10 +346,18 @@ class MonoSLAM(MappingMixin):
             # ours: a new two-view map, anchored at the predicted pose with the velocity's scale
             # the step: median of the last tracked frames' steps (one velocity can be off)
             steps = self._steps[-5:] or [float(np.sqrt(np.sum(vel1[:3, 3] ** 2)))]
+            # the velocity the new map is checked against and moves with: the mean one-frame motion of the
+            # last `reinit_velocity_frames` tracked frames (ours: the last one alone can be off by 30°)
+            if self._twists:
+                vel1 = orthonormalise(se3_exp(np.mean(self._twists[-p.reinit_velocity_frames:], axis=0)))
+                T_pred = orthonormalise(se3_compose(vel1, T_prev))
             # the new initialiser starts from the last tracked frame (its pose is known), so that this
             # frame can already complete it
+            # the old map's points in the last tracked frame (the anchor): pixels and depths, for the scale
+            z_old = transform_points(T_prev, self.points[self._prev_vis])[:, 2]
             self._reinit = {"vel": vel1, "T_pred": {self._last_idx: T_prev, idx: T_pred},
-                            "frames": [self._last_idx, idx], "step": float(np.median(steps))}
+                            "frames": [self._last_idx, idx], "step": float(np.median(steps)),
+                            "anchor": self._last_idx, "anchor_uv": self._prev_uv.copy(), "anchor_z": z_old}
             self.init = self._new_initialiser()
             self.init.add_frame(self._prev_img)
             st = self.init.add_frame(image)
@@ -375,8 +386,10 @@ class MonoSLAM(MappingMixin):
         self._n_coast = 0
         self._T_show = None
         if self.records and self.records[-1]["tracked"]:  # a step between two consecutive tracked frames
-            d = se3_compose(T_new, se3_inverse(self._T_cw))[:3, 3]
+            v = se3_compose(T_new, se3_inverse(self._T_cw))
+            d = v[:3, 3]
             self._steps = [*self._steps[-9:], float(np.sqrt(np.sum(d**2)))]
+            self._twists = [*self._twists[-9:], se3_log(v)]
         self._T_cw = orthonormalise(T_new)
         self._last_idx = idx
         self._prev_pyr = pyr

@@ -49,6 +49,10 @@ class TwoViewPose:
         False when the input was degenerate.
     reason : str
         Why it failed (``""`` when ``ok``).
+    n_ransac : int
+        Pairs the RANSAC model explains, before any cheirality or distance test (the homography's: ``inliers``;
+        the essential matrix's: more than ``inliers``, which keeps those ``cv2.recoverPose`` triangulates in
+        front of both views and nearer than 50 baselines).
     """
 
     R: np.ndarray
@@ -58,6 +62,7 @@ class TwoViewPose:
     normal: np.ndarray | None
     ok: bool
     reason: str = ""
+    n_ransac: int = 0
 
 
 def _fail(n, reason):
@@ -262,7 +267,7 @@ def relative_pose_homography(uv0, uv1, K, *, ransac_px: float = 2.0, min_points:
         return _fail(n, "no_parallax")
     R, tn, nn = best
     return TwoViewPose(R, tn, inl, best_key[0], nn, best_key[0] >= min_points,
-                       "" if best_key[0] >= min_points else "cheirality")
+                       "" if best_key[0] >= min_points else "cheirality", int(inl.sum()))
 
 
 def relative_pose_essential(uv0, uv1, K, *, ransac_px: float = 1.0, prob: float = 0.999,
@@ -303,4 +308,4 @@ def relative_pose_essential(uv0, uv1, K, *, ransac_px: float = 1.0, prob: float 
     t = t.ravel()
     if n_front < min_points or not np.all(np.isfinite(t)):
         return _fail(n, "cheirality")
-    return TwoViewPose(R, t / _norm3(t), inl, int(n_front), None, True)
+    return TwoViewPose(R, t / _norm3(t), inl, int(n_front), None, True, "", int(np.count_nonzero(mask)))

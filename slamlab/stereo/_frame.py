@@ -47,22 +47,24 @@ def check_pair(left, right, image_shape):
                          f"the rig's cameras; got {sl[0]}x{sl[1]}")
 
 
-def frame_points(rig, T_body_left, fl, fr, sm, p: StereoParams, images, oracle, truth):
+def frame_points(rig, T_body_left, fl, fr, sm, p: StereoParams, images, oracle, truth, extra_offset_px=0.0):
     """The frame's stereo points (000 §3.3) in the body frame: ``(cloud, may_be_new, pts_body, cov_body, cov_init,
     true_cam)``. ``may_be_new``: the points that may become landmarks (within ``max_depth_m``; beyond it, up to
     ``reobserve_depth_factor`` times deeper, a point may match a landmark but not become one); ``cov_init`` the new
     landmarks' first covariances; ``true_cam`` the points' true left-camera positions (from ``truth``, the ablation
     oracle; None when no setting asks for them). ``images``: the ``(left, right)`` pair whose disparities are
-    refined first (None: not refined); ``oracle`` 'cut': the depth cut on the true depths ``truth``."""
+    refined first (None: not refined); ``oracle`` 'cut': the depth cut on the true depths ``truth``;
+    ``extra_offset_px`` is added to every disparity beside ``disparity_offset_px`` (the online estimate)."""
     if "cut" in oracle and truth is not None:  # the depth cut on the true depth (ablation)
-        cloud = triangulate_local(rig, fl, fr, sm, images=images, params=p, max_depth_m=1e12)
+        cloud = triangulate_local(rig, fl, fr, sm, images=images, params=p, max_depth_m=1e12,
+                                  extra_offset_px=extra_offset_px)
         zt = truth[cloud.left, 2]
         keep = (zt >= p.min_depth_m) & (zt <= p.max_depth_m)
         cloud = type(cloud)(cloud.points[keep], cloud.cov[keep], cloud.left[keep], cloud.gap_m[keep])
         may_be_new = np.ones(len(cloud.points), bool)  # the oracle's cut replaces the one below
     else:
         cloud = triangulate_local(rig, fl, fr, sm, images=images, params=p,
-                                  max_depth_m=p.max_depth_m * p.reobserve_depth_factor)
+                                  max_depth_m=p.max_depth_m * p.reobserve_depth_factor, extra_offset_px=extra_offset_px)
         may_be_new = cloud.points[:, 2] <= p.max_depth_m
     Rb, tb = T_body_left[:3, :3], T_body_left[:3, 3]
     pts_body = cloud.points @ Rb.T + tb

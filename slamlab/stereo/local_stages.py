@@ -12,7 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._compiled import numba_enabled
-from .._validate import as_finite_array, check_int, check_positive
+from .._validate import as_finite_array, check_int, check_positive, check_real
 from ..features.base import Features
 from ..features.matching import best_per_target, ratio_rule
 from ..geometry.camera import StereoRig
@@ -353,7 +353,7 @@ class LocalCloud(NamedTuple):
 
 
 def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: StereoMatches, *, images=None,
-                      params: StereoParams | None = None, **overrides) -> LocalCloud:
+                      extra_offset_px: float = 0.0, params: StereoParams | None = None, **overrides) -> LocalCloud:
     """Midpoint triangulation of the stereo matches, with covariances (000 §3.3).
 
     Keeps points in front of both cameras with depth in ``[min_depth_m, max_depth_m]``.
@@ -376,6 +376,9 @@ def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: 
         From :func:`stereo_match`.
     images : tuple of array_like, optional
         ``(left_image, right_image)`` for the sub-pixel refinement.
+    extra_offset_px : float, default 0.0
+        Added to every disparity beside ``disparity_offset_px`` (the online estimate of
+        :class:`~slamlab.stereo.StereoSLAM`, ``disparity_offset_estimate``) [px].
     params : StereoParams, optional
         Pipeline settings (default :class:`StereoParams`).
     **overrides
@@ -392,26 +395,32 @@ def triangulate_local(rig: StereoRig, left: Features, right: Features, matches: 
     check_features(right, "right")
     if not isinstance(matches, StereoMatches):
         raise TypeError(f"`matches` must be StereoMatches; got {type(matches).__name__}")
+    offset_px = p.disparity_offset_px + check_real(extra_offset_px, "extra_offset_px")
     if images is not None and (not isinstance(images, (tuple, list)) or len(images) != 2):
         raise TypeError("`images` must be a pair (left_image, right_image)")
     if images is None or not (p.refine_disparity and is_rectified(rig)):
-        return _triangulate_local(rig, left, right, matches, p.min_depth_m, p.max_depth_m, p.pixel_std)
+        return _triangulate_local(rig, left, right, matches, p.min_depth_m, p.max_depth_m, p.pixel_std,
+                                  offset_px=offset_px)
     from ..features.base import to_gray_uint8
 
     grey = [to_gray_uint8(im, name, channel_order=p.channel_order) for im, name in zip(images, ("left_image", "right_image"), strict=True)]
     return _triangulate_local(rig, left, right, matches, p.min_depth_m, p.max_depth_m, p.pixel_std,
-                              refine=(*grey, p.subpixel_half_px, p.subpixel_search_px))
+                              refine=(*grey, p.subpixel_half_px, p.subpixel_search_px), offset_px=offset_px)
 
 
-def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixel_std, refine=None) -> LocalCloud:
+def _triangulate_local(rig, left, right, matches, min_depth_m, max_depth_m, pixel_std, refine=None,
+                       offset_px=0.0) -> LocalCloud:
     """:func:`triangulate_local` on checked arguments (the per-frame core); ``refine`` =
-    ``(grey_left, grey_right, half_px, search_px)`` refines the disparities first."""
+    ``(grey_left, grey_right, half_px, search_px)`` refines the disparities first; ``offset_px`` is added to every
+    disparity (the right keypoints move left by it: ``disparity_offset_px``)."""
     if len(matches.left) == 0:
         return LocalCloud(np.empty((0, 3)), np.empty((0, 3, 3)), np.empty(0, np.intp), np.empty(0))
     uvl, uvr, li = left.uv[matches.left], right.uv[matches.right], matches.left
     if refine is not None:
         uvl, uvr, ok = _subpixel_disparity(refine[0], refine[1], uvl, uvr, refine[2], refine[3])
         uvl, uvr, li = uvl[ok], uvr[ok], li[ok]
+    if offset_px:
+        uvr = uvr - np.array([offset_px, 0.0])
     tri = triangulate_stereo(rig, uvl, uvr)
     P = tri.points
     ok = tri.valid & (P[:, 2] >= min_depth_m) & (P[:, 2] <= max_depth_m)

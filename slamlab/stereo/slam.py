@@ -17,6 +17,7 @@ from .._validate import as_matrix, as_rng
 from ..geometry.camera import StereoRig
 from ..kdtree.stores import base_rule
 from ._frame import STAGES, StageClock, append_rows, check_pair, frame_points, refine_matches, weight_depth
+from .disparity_offset import DisparityOffsetTracker
 from .landmark_filter import duplicate_mask, gated_update, in_view, landmark_observations, pixel_update
 from .local_stages import check_features, detect_pair, is_rectified, stereo_match
 from .map_stages import match_in_window, match_to_landmarks, match_to_map
@@ -73,9 +74,14 @@ class StereoSLAM(RunResults):
         self.params = p = StereoParams.resolve(params, **overrides)
         self.store = resolve_store(store, p)
         self._noise = KeypointNoiseTracker(p)  # pixel_std: the nominal, or raised to the online estimate
+        #: the disparity offset estimated online on top of ``disparity_offset_px`` (``disparity_offset_estimate``;
+        #: rectified rigs only; its ``offset_px`` stays 0 otherwise)
+        self.disparity_offset = DisparityOffsetTracker(p)
+        self._offset_used = 0.0
         self.rng = as_rng(rng)
         self._image_shape = (rig.left.height_px, rig.left.width_px)
         self._refine = p.refine_disparity and is_rectified(rig)
+        self._estimate_offset = p.disparity_offset_estimate and is_rectified(rig)
         # the landmark filter in stereo pixels needs a rectified rig with one focal length (else: in x, y, z)
         self._pixel_filter = (p.filter_space == "pixels" and is_rectified(rig)
                               and bool(np.isclose(rig.left.fx, rig.right.fx)))
@@ -151,13 +157,14 @@ class StereoSLAM(RunResults):
     def _process(self, fl, fr, left, right, clock) -> FrameRecord:
         """The stages after detection; ``left``/``right`` images (None: no disparity refinement)."""
         p = self._noise.current(self.params)
+        self._offset_used = self.disparity_offset.offset_px if self._estimate_offset else 0.0
         clock.lap("detect")
         sm = stereo_match(fl, fr, self.rig, params=p)
         clock.lap("stereo")
         images = (left, right) if self._refine and left is not None else None
         truth, self.truth_left_cam_m, self._true_cam = self.truth_left_cam_m, None, None
         cloud, self._may_be_new, pts_body, cov_body, cov_init, self._true_cam = frame_points(
-            self.rig, self.T_body_left, fl, fr, sm, p, images, self.oracles, truth)
+            self.rig, self.T_body_left, fl, fr, sm, p, images, self.oracles, truth, self._offset_used)
         desc = fl.descriptors[cloud.left]
         clock.lap("triangulate")
         rec = FrameRecord(
@@ -249,9 +256,19 @@ class StereoSLAM(RunResults):
         self._add_landmarks(pts_new, (cov_body if cov_init is None else cov_init)[new], desc[new], est.T)
         rec["n_new"] = len(new)
         self._last_ids = np.concatenate([ids, np.arange(first_new, len(self.X))])
+        if self._estimate_offset:
+            self._observe_offset(ids, loc, pts_body, est.T)
         inl_mask = np.zeros(len(pts_body), bool)
         inl_mask[loc] = True
         return inl_mask
+
+    def _observe_offset(self, ids, loc, pts_body, T):
+        """``disparity_offset_estimate``: the inliers' stereo pixels, their disparities corrected by
+        ``disparity_offset_px`` only (this frame's estimate taken off), to the disparity-offset tracker."""
+        pts_left = (pts_body[loc] - self.T_body_left[:3, 3]) @ self.T_body_left[:3, :3]
+        z = self.rig.stereo_pixels(pts_left)
+        uvd = np.c_[z[:, 0], z[:, 1], z[:, 0] - z[:, 2] - self._offset_used]
+        self.disparity_offset.observe(ids, uvd, T @ self.T_body_left, self.rig)
 
     def _locate_window(self, rec, clock, desc, uv, pts_body, cov_body, depth):
         """The window search (``map_search='window'``, our addition): a first pose from the landmarks of the

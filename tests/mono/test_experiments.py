@@ -150,7 +150,7 @@ def test_after_coasting_a_new_map_is_started_at_the_predicted_pose(strafe_frames
     from slamlab.geometry.se3 import se3_compose, se3_inverse
 
     imgs, _, K = strafe_frames
-    slam = MonoSLAM(K, motion_model="constant_velocity", max_coast=0)
+    slam = MonoSLAM(K, motion_model="constant_velocity", max_coast=0, reinit_velocity_frames=1)
     for img in imgs[:10]:
         slam.process(img)
     T1, T2 = (se3_inverse(r["T_wc"]) for r in slam.records[-2:])
@@ -193,3 +193,20 @@ def test_mono_vs_stereo_repeats_from_its_seed():
     assert (a.stereo_rpe_m, a.stereo_ate_sim3_m, a.stereo_ate_se3_m) == (b.stereo_rpe_m, b.stereo_ate_sim3_m,
                                                                          b.stereo_ate_se3_m)
     assert a.stereo_ate_se3_m != c.stereo_ate_se3_m
+
+
+def test_a_new_map_moves_with_the_mean_motion_of_the_last_tracked_frames(strafe_frames):
+    from slamlab.geometry.se3 import se3_compose, se3_inverse
+    from slamlab.geometry.so3 import se3_exp, se3_log
+
+    imgs, _, K = strafe_frames
+    slam = MonoSLAM(K, motion_model="constant_velocity", max_coast=0, reinit_velocity_frames=3)
+    for img in imgs[:10]:
+        slam.process(img)
+    assert all(r["tracked"] for r in slam.records[-4:])
+    T = [se3_inverse(r["T_wc"]) for r in slam.records[-4:]]  # world -> camera of the last 4 tracked frames
+    # the mean twist of the last 3 one-frame motions, written independently of the pipeline
+    xi = np.mean([se3_log(se3_compose(T[k + 1], se3_inverse(T[k]))) for k in range(3)], axis=0)
+    rec = slam.process(np.full_like(imgs[0], 90))
+    assert rec["status"] == "lost"
+    np.testing.assert_allclose(se3_inverse(rec["T_wc"]), se3_compose(se3_exp(xi), T[-1]), atol=1e-9)

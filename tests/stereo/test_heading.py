@@ -61,3 +61,22 @@ def test_heading_frames_lists_the_degenerate_frame(turning):
         heading_frames(runs["last"], truth, min_deg=-1.0)
     with pytest.raises(ValueError, match="degenerate_pose"):
         StereoSLAM(StereoRig.parallel(0.2, 384, 288), degenerate_pose="hold")
+
+
+def test_default_pose_of_a_degenerate_frame_in_a_turn_in_place_follows_the_turn():
+    # a turn in place of 6 deg per frame (the ~80 m run turns 15 deg a frame on a larger image); the third frame
+    # gives no pose (a rotation-std limit of 1 urad). Keeping the last pose would leave it about 6.7 deg behind the truth;
+    # the default repeats the last motion, so the heading error stays within the 5 deg goal of the ~80 m run.
+    rig = StereoRig.parallel(0.2, 384, 288)
+    sim = StereoSim(StereoArena(texture_seed=1), rig, rng=0)
+    yaw = np.deg2rad([0.0, 6.0, 12.0])
+    slam = StereoSLAM(rig, sim.T_body_left, rng=0)
+    assert slam.params.degenerate_pose == "constant_velocity"
+    for i, y in enumerate(yaw):
+        if i == 2:
+            slam.params = slam.params.replace(max_rot_std_rad=1e-6)
+        slam.process(*sim.render_pair([3.0, 4.0, y]))
+    assert slam.degenerate_frames.tolist() == [2]
+    err_deg = np.rad2deg(np.abs(slam.planar_trajectory[:, 2] - yaw))
+    assert err_deg[1] < 2.0  # the located frame
+    assert err_deg[2] <= 5.0  # the degenerate one: 6.7 deg with degenerate_pose="last"

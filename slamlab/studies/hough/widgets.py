@@ -138,7 +138,8 @@ def explore_real_log(**defaults):
 
     return interactive(
         show,
-        name=widgets.Dropdown(options=[("MbICP SICK log", "mbicp"), ("Mines URG-04LX log", "urg04lx")],
+        name=widgets.Dropdown(options=[("MbICP SICK log", "mbicp"), ("Mines URG-04LX log exp2", "urg04lx"),
+                                              ("Mines URG-04LX log exp1", "urg04lx_exp1")],
                               value=d["name"], description="log", style=_STYLE),
         n_scans=_slider(widgets.IntSlider, d["n_scans"], 20, 800, 20, "scans"),
         step=_slider(widgets.IntSlider, d["step"], 1, 5, 1, "use every k-th scan"),

@@ -18,6 +18,7 @@ from .experiments import (
 from .findings import StillStart, practice_findings_table, run_still_start
 from .formulas import chapter_cameras, inverse_depth_point_table, pinhole_table, tau_table
 from .kitti import epipolar_demo, load_kitti, run_kitti_ablation, run_kitti_mono
+from .kitti_goal import KITTI_GOAL_ABLATIONS, goal_ablation_table, kitti_goal_table
 from .repeats import RepeatedRuns, run_repeats
 from .runs import MonoRunResult, run_mono
 from .studies import (
@@ -32,6 +33,7 @@ from .studies import (
 from .timing import source_timing_table, stage_timing_table
 
 __all__ = [
+    "KITTI_GOAL_ABLATIONS",
     "ConvergenceStudy",
     "ConvergenceTests",
     "EpipolarSubset",
@@ -48,7 +50,9 @@ __all__ = [
     "explore_mono",
     "explore_motion_prior",
     "failure_table",
+    "goal_ablation_table",
     "inverse_depth_point_table",
+    "kitti_goal_table",
     "load_kitti",
     "ours_vs_source",
     "pinhole_table",

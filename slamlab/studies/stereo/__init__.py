@@ -19,7 +19,21 @@ from .experiments import (
     run_stereo_slam_variants,
 )
 from .heading import heading_frames
-from .kitti_experiments import KITTI_PARAMS, KittiRunResult, kitti_comparison, ours_vs_source, run_kitti
+from .kitti_experiments import (
+    KITTI_ABLATION,
+    KITTI_GOAL,
+    KITTI_PARAMS,
+    KITTI_SETS,
+    KittiRunResult,
+    kitti_ablation,
+    kitti_ablation_table,
+    kitti_comparison,
+    kitti_set_runs,
+    kitti_sets,
+    kitti_sets_table,
+    ours_vs_source,
+    run_kitti,
+)
 from .scale_ablation import (
     ABLATION_BASE,
     PROPOSED_FIX,
@@ -40,7 +54,10 @@ __all__ = [
     "COMPARISON",
     "DISPARITY_PARAMS",
     "EXPERIMENTS",
+    "KITTI_ABLATION",
+    "KITTI_GOAL",
     "KITTI_PARAMS",
+    "KITTI_SETS",
     "PROPOSED_FIX",
     "PROPOSED_FIX_OFF",
     "SCALE_ABLATION",
@@ -53,7 +70,12 @@ __all__ = [
     "disparity_errors",
     "experiment_poses",
     "heading_frames",
+    "kitti_ablation",
+    "kitti_ablation_table",
     "kitti_comparison",
+    "kitti_set_runs",
+    "kitti_sets",
+    "kitti_sets_table",
     "ours_vs_source",
     "record_stereo_stream",
     "run_comparison",

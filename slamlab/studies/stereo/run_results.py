@@ -121,6 +121,7 @@ class StereoRunResult:
         rows = [
             ["frames (degenerate)", f"{self.n_frames} ({len(self.degenerate)})", ""],
             ["max position error, m", f"{self.pos_err_m.max():.2f}", "<= 0.5 (req.)" if self.name == "closed loop" else "<= 0.15"],
+            ["max heading error, deg", f"{deg(np.abs(self.yaw_err_rad).max()):.1f}", ""],
         ]
         if self.name == "turn in place":
             rows.append(["spread of positions, m", f"{self.position_spread_m:.2f}", "~0.20"])
@@ -173,7 +174,8 @@ def comparison_table(results: dict) -> str:
     if not runs:
         raise ValueError("`results` is empty")
     deg = np.rad2deg
-    rows = [["max position error, m", *(f"{r.pos_err_m.max():.2f}" for r in runs)]]
+    rows = [["max position error, m", *(f"{r.pos_err_m.max():.2f}" for r in runs)],
+            ["max heading error, deg", *(f"{deg(np.abs(r.yaw_err_rad).max()):.1f}" for r in runs)]]
     if runs[0].name == "turn in place":
         rows.append(["spread of positions, m", *(f"{r.position_spread_m:.2f}" for r in runs)])
         rows.append(["heading error at 180 deg, deg", *(f"{deg(abs(r.yaw_err_rad[r.frame_at_turn(np.pi)])):.1f}" for r in runs)])
