@@ -59,3 +59,42 @@ def test_notebook_setup_applies_it():
             "print(len(calls))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "1"
+
+
+_FAULTS = textwrap.dedent("""
+    import resource
+    import numpy as np
+    from slamlab._heap import limit_heap_growth, reuse_large_blocks
+    assert limit_heap_growth()
+    def faults(n=100):
+        f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        for _ in range(n):
+            a = np.ones(2 * 2**20 // 8)
+            del a
+        return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0
+    outside = faults()
+    with reuse_large_blocks():
+        with reuse_large_blocks():  # nested: counted
+            inside = faults()
+        nested_left = faults()
+    after = faults()
+    print(outside, inside, nested_left, after)
+""")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt: Linux only")
+def test_reuse_large_blocks_maps_no_fresh_pages_inside_and_restores_the_limit_after():
+    out = subprocess.run([sys.executable, "-c", _FAULTS], capture_output=True, text=True, check=True)
+    outside, inside, nested_left, after = map(int, out.stdout.split())
+    # a 2 MiB array is 512 pages: under the limit each one is mapped afresh and faults its pages in
+    assert outside > 100 * 400
+    assert inside < 2000 and nested_left < 2000  # reused from the heap
+    assert after > 100 * 400  # the limit is back
+
+
+def test_reuse_large_blocks_does_nothing_without_the_limit():
+    code = ("from slamlab import _heap\n"
+            "with _heap.reuse_large_blocks():\n"
+            "    print(_heap._STATE['depth'])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "0"

@@ -310,6 +310,18 @@ def localise_samples(M_values, samples: ScanSamples, *, prior_heading_rad: float
     >>> loc.col, loc.row, round(float(np.degrees(loc.pose[2])))
     (70, 30, 40)
     """
+    from .._heap import reuse_large_blocks
+
+    with reuse_large_blocks():  # its FFT batches: heap blocks reused, not mapped afresh (slamlab._heap)
+        return _localise_samples(M_values, samples, prior_heading_rad=prior_heading_rad, window_rad=window_rad,
+                                 score_norm=score_norm, min_explored_fraction=min_explored_fraction, refine=refine,
+                                 refine_heading_rad=refine_heading_rad)
+
+
+def _localise_samples(M_values, samples: ScanSamples, *, prior_heading_rad: float | None = None,
+                     window_rad: float | None = None, score_norm: str = "none", min_explored_fraction: float = 0.8,
+                     refine: int = 0, refine_heading_rad: float = float(np.radians(3.0))) -> Localisation:
+    """:func:`localise_samples` without the heap setting."""
     Mv = as_finite_array(M_values, "M_values", ndim=2)
     if Mv.size == 0:
         raise ValueError(f"`M_values` must not be empty; got shape {Mv.shape}")
