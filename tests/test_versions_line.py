@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import json
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -49,11 +51,15 @@ def test_versions_line_reads_the_installed_distributions():
     assert len(line) <= 110
 
 
-def test_notebook_setup_prints_the_line_first(capsys):
-    sl.notebook_setup()
-    assert capsys.readouterr().out == sl.versions_line() + "\n"
-    sl.notebook_setup(show_versions=False)
-    assert capsys.readouterr().out == ""
+def test_notebook_setup_prints_the_line_first():
+    # in a fresh process: notebook_setup changes numpy's print options and the heap of the process it runs in
+    code = ("import slamlab as sl\n"
+            "sl.notebook_setup()\n"
+            "print('--')\n"
+            "sl.notebook_setup(show_versions=False)\n"
+            "print('--')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out == sl.versions_line() + "\n--\n--\n"
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT / "notebooks").as_posix())

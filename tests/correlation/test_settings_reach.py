@@ -7,7 +7,7 @@ import pytest
 
 from slamlab import correlation as C
 from slamlab.studies import correlation as CS
-from slamlab.studies.correlation import _log_scan
+from slamlab.studies.correlation import _log_scan, batch
 from slamlab.studies.correlation import experiments as E
 
 #: A valid value other than the default for every field.
@@ -44,6 +44,7 @@ def recorder(monkeypatch):
         return _fake_localisation()
 
     monkeypatch.setattr(E, "localise", localise)
+    monkeypatch.setattr(batch, "localise", localise)  # localise_scans: the batches of run_table1, run_monte_carlo
     monkeypatch.setattr(E, "localise_joined", localise_joined)
     return seen
 
